@@ -5,6 +5,7 @@ packages=(
   g++ cmake ninja-build pkg-config
   libeigen3-dev libccd-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  nlohmann-json3-dev
   libfcl-dev libqhull-dev
 )
 missing=()

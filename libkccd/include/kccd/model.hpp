@@ -1,0 +1,101 @@
+// The immutable robot model: kinematic tree, bodies, checked pairs. Built once from a file.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "kccd/ssch.hpp"
+
+namespace kccd {
+
+/// Index of the world frame wherever a joint index is expected.
+inline constexpr int kWorld = -1;
+
+enum class JointType : std::uint8_t { Fixed, Revolute, Prismatic, Translation3d, Rotation3d };
+
+/// How a joint's interval is swept: `Exact` accepts only zero-width intervals; `Fast` (chords,
+/// larger radius) and `Accurate` (tangent apexes, no radius growth) cover any interval.
+enum class SweepMode : std::uint8_t { Exact, Fast, Accurate };
+
+/// One joint. Its motion acts in the joint frame given by `origin` (pose in the parent frame at
+/// zero state); its children and bodies move with it.
+struct Joint {
+  std::string name;
+  int parent = kWorld;          ///< index of the parent joint, or kWorld
+  JointType type = JointType::Fixed;
+  Pose origin = Pose::Identity();
+  Vec3 axis = Vec3::UnitZ();    ///< unit axis (revolute / prismatic)
+  SweepMode sweep = SweepMode::Accurate;
+  std::optional<std::array<double, 2>> limits;  ///< position limits (1-DOF joints)
+  double error = 0.0;           ///< translation3d: metres; rotation3d: radians
+  int state_offset = 0;         ///< first index of this joint's values in the state vector
+  int dof = 0;                  ///< number of state values (0, 1 or 3)
+};
+
+/// One rigid body: an SSCH in the frame of a joint (or the world).
+struct Body {
+  std::string name;
+  int frame = kWorld;
+  std::vector<Vec3> points;
+  double radius = 0.0;
+};
+
+/// A checked body pair and the frame both are compared in (least common ancestor).
+struct BodyPair {
+  int a = 0;
+  int b = 0;
+  int lca = kWorld;
+};
+
+/// A model file that cannot be loaded: the message names file, line and field.
+class ModelError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The immutable model. Build it with loadModel() / parseModel() or assemble it and call
+/// finalize(); a Checker then holds every mutable buffer.
+class Model {
+ public:
+  std::string name;
+  double safety_margin = 0.0;
+  int point_budget = 32;        ///< max core points of any swept volume
+  std::vector<Joint> joints;    ///< parents always precede children
+  std::vector<Body> bodies;
+  std::vector<BodyPair> pairs;
+
+  /// Number of state values.
+  int stateSize() const { return state_size_; }
+  /// Names of the state values (`shoulder`, `payload_pose.x`, ...).
+  const std::vector<std::string>& stateNames() const { return state_names_; }
+  /// Index of a joint or body by name, or -1.
+  int jointIndex(const std::string& joint) const;
+  int bodyIndex(const std::string& body) const;
+  /// Least common ancestor of two frames (kWorld when none).
+  int commonAncestor(int frame_a, int frame_b) const;
+  /// Name of a frame index ("world" for kWorld).
+  const std::string& frameName(int frame) const;
+
+  /// Computes state offsets, names and the pair list. `check_all` selects every pair of bodies
+  /// in different frames; `ignore` removes pairs, `include` adds them. Throws ModelError.
+  void finalize(bool check_all, const std::vector<std::array<int, 2>>& ignore,
+                const std::vector<std::array<int, 2>>& include);
+
+ private:
+  int state_size_ = 0;
+  std::vector<std::string> state_names_;
+};
+
+/// Loads a `kccd: 1` YAML model file. Throws ModelError("file:line:col: field: problem").
+Model loadModel(const std::string& path);
+/// Parses YAML text; `source` names it in error messages.
+Model parseModel(const std::string& yaml_text, const std::string& source);
+
+const char* toString(JointType type);
+const char* toString(SweepMode mode);
+
+}  // namespace kccd

@@ -1,0 +1,390 @@
+// Queries over interval boxes: lazily swept volumes shared by all pairs, pairs compared in their
+// least-common-ancestor frame, and an any-time table of lower bounds refined smallest first.
+#include "kccd/checker.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "kccd/distance.hpp"
+#include "sweep.hpp"
+
+namespace kccd {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+using Clock = std::chrono::steady_clock;
+
+}  // namespace
+
+const char* toString(Status status) {
+  switch (status) {
+    case Status::Ok: return "ok";
+    case Status::WrongStateSize: return "wrong_state_size";
+    case Status::NonFiniteState: return "non_finite_state";
+    case Status::LowerAboveUpper: return "lower_above_upper";
+    case Status::ExactNeedsPoint: return "exact_needs_point_interval";
+    case Status::NumericalFailure: return "numerical_failure";
+  }
+  return "?";
+}
+
+const char* toString(QueryType type) {
+  switch (type) {
+    case QueryType::Collision: return "collision";
+    case QueryType::Closest: return "closest";
+    case QueryType::NClosest: return "nclosest";
+    case QueryType::Distances: return "distances";
+  }
+  return "?";
+}
+
+Checker::Checker(const Model& model) : model_(model) {
+  const int nb = static_cast<int>(model.bodies.size());
+  const int np = static_cast<int>(model.pairs.size());
+  const int ns = model.stateSize();
+  const int budget = model.point_budget;
+
+  // Levels per body: level 0 is the body in its own frame, level l+1 the volume swept through
+  // the joint of level l and expressed in that joint's parent frame, up to the world.
+  int max_points = budget;
+  int arena = 0;
+  for (int b = 0; b < nb; ++b) {
+    const Body& body = model.bodies[b];
+    level_begin_.push_back(static_cast<int>(volumes_.size()));
+    int frame = body.frame;
+    int level = 0;
+    while (true) {
+      Volume v;
+      v.offset = arena;
+      v.capacity = level == 0 ? static_cast<int>(body.points.size()) : budget;
+      arena += v.capacity;
+      volumes_.push_back(v);
+      path_.push_back(frame);
+      ++level;
+      if (frame == kWorld) break;
+      frame = model.joints[frame].parent;
+    }
+    levels_.push_back(level);
+    max_points = std::max(max_points, static_cast<int>(body.points.size()));
+  }
+  points_.resize(arena);
+  for (int b = 0; b < nb; ++b) {
+    Volume& v = volumes_[level_begin_[b]];
+    const Body& body = model.bodies[b];
+    std::copy(body.points.begin(), body.points.end(), points_.begin() + v.offset);
+    v.count = v.capacity;
+    v.radius = body.radius;
+    v.bound = detail::boundingSphere(body.points, body.radius);
+  }
+  int expansion = 1;
+  for (const Joint& j : model.joints) expansion = std::max(expansion, detail::sweepExpansion(j));
+  scratch_.resize(static_cast<std::size_t>(expansion) * max_points);
+  scratch_dist_.resize(scratch_.size());
+
+  // Per pair: the level of the LCA frame on each body's path, and how far each state value can
+  // move the pair's core points per unit change (for keeping stored bounds valid).
+  reach_.assign(static_cast<std::size_t>(np) * ns, 0.0);
+  for (int p = 0; p < np; ++p) {
+    const BodyPair& pair = model.pairs[p];
+    for (int side = 0; side < 2; ++side) {
+      const int b = side == 0 ? pair.a : pair.b;
+      const Body& body = model.bodies[b];
+      double extent = 0.0;  // bound on |core point| in the frame of the current level
+      for (const Vec3& q : body.points) extent = std::max(extent, q.norm());
+      int level = 0;
+      for (; path_[level_begin_[b] + level] != pair.lca; ++level) {
+        const Joint& j = model.joints[path_[level_begin_[b] + level]];
+        double* reach = &reach_[static_cast<std::size_t>(p) * ns + j.state_offset];
+        switch (j.type) {
+          case JointType::Fixed: break;
+          case JointType::Revolute: reach[0] += extent; break;
+          case JointType::Prismatic: reach[0] += 1.0; break;
+          case JointType::Translation3d:
+            for (int k = 0; k < 3; ++k) reach[k] += 1.0;
+            break;
+          case JointType::Rotation3d:  // exp is 1-Lipschitz: angle change <= sum of |component changes|
+            for (int k = 0; k < 3; ++k) reach[k] += extent;
+            break;
+        }
+        const bool unbounded_travel = j.type == JointType::Prismatic || j.type == JointType::Translation3d;
+        extent = unbounded_travel ? kInf : extent + j.origin.translation().norm();
+      }
+      pair_level_.push_back(level);
+    }
+  }
+  table_.assign(np, Entry{});
+  box_.assign(static_cast<std::size_t>(np) * 2 * ns, 0.0);
+  order_.resize(np);
+  out_.resize(np);
+  fresh_.assign(np, 0);
+  nbest_.assign(np, 0.0);
+  lower_.assign(ns, 0.0);
+  upper_.assign(ns, 0.0);
+}
+
+void Checker::reset() noexcept {
+  for (Entry& e : table_) e.valid = false;
+}
+
+bool Checker::validate(std::span<const double> lower, std::span<const double> upper) noexcept {
+  const int ns = model_.stateSize();
+  Status& s = result_.status;
+  if (static_cast<int>(lower.size()) != ns || static_cast<int>(upper.size()) != ns) {
+    s = Status::WrongStateSize;
+    return false;
+  }
+  for (int i = 0; i < ns; ++i) {
+    if (!std::isfinite(lower[i]) || !std::isfinite(upper[i])) {
+      s = Status::NonFiniteState;
+      return false;
+    }
+    if (lower[i] > upper[i]) {
+      s = Status::LowerAboveUpper;
+      return false;
+    }
+  }
+  for (const Joint& j : model_.joints) {
+    if (j.sweep != SweepMode::Exact) continue;
+    for (int k = 0; k < j.dof; ++k) {
+      if (lower[j.state_offset + k] != upper[j.state_offset + k]) {
+        s = Status::ExactNeedsPoint;
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+const Checker::Volume* Checker::volume(int body, int level) noexcept {
+  const int idx = level_begin_[body] + level;
+  Volume& v = volumes_[idx];
+  if (level == 0 || v.stamp == cycle_) return &v;
+  const Volume* below = volume(body, level - 1);
+  if (below == nullptr) return nullptr;
+  const Joint& joint = model_.joints[path_[idx - 1]];
+  double radius = below->radius;
+  const std::span<const Vec3> in(points_.data() + below->offset, below->count);
+  int n = detail::sweepJoint(joint, lower_.data() + joint.state_offset, upper_.data() + joint.state_offset, in,
+                             scratch_.data(), radius);
+  if (n < 0) return nullptr;
+  n = detail::reduceToBudget(scratch_.data(), n, v.capacity, scratch_dist_.data(), radius);
+  std::copy(scratch_.begin(), scratch_.begin() + n, points_.begin() + v.offset);
+  v.count = n;
+  v.radius = radius;
+  v.bound = detail::boundingSphere({points_.data() + v.offset, static_cast<std::size_t>(n)}, radius);
+  if (!std::isfinite(v.bound.radius)) return nullptr;
+  v.stamp = cycle_;
+  ++result_.stats.volumes_swept;
+  return &v;
+}
+
+SschView Checker::sweptVolume(int body, int frame) noexcept {
+  if (body < 0 || body >= static_cast<int>(levels_.size())) return {};
+  for (int level = 0; level < levels_[body]; ++level) {
+    if (path_[level_begin_[body] + level] != frame) continue;
+    const Volume* v = volume(body, level);
+    if (v == nullptr) return {};
+    return {{points_.data() + v->offset, static_cast<std::size_t>(v->count)}, v->radius};
+  }
+  return {};
+}
+
+double Checker::refresh(int p, double stop_above) noexcept {
+  const BodyPair& pair = model_.pairs[p];
+  Entry& e = table_[p];
+  const Volume* va = volume(pair.a, pair_level_[2 * p]);
+  const Volume* vb = volume(pair.b, pair_level_[2 * p + 1]);
+  ++result_.stats.pairs_checked;
+  if (va == nullptr || vb == nullptr) {
+    result_.status = Status::NumericalFailure;
+    e.valid = false;
+    e.current = 0.0;
+    return 0.0;
+  }
+  // Bounding spheres first: often enough to prove the pair clear.
+  double bound = std::max(0.0, (va->bound.center - vb->bound.center).norm() - va->bound.radius - vb->bound.radius);
+  bound = std::max(0.0, bound * (1.0 - 1e-12));
+  if (bound < stop_above) {
+    GjkOptions opt;
+    opt.stop_above = stop_above;
+    opt.warm_start = &e.direction;
+    const DistanceResult d = distance({{points_.data() + va->offset, static_cast<std::size_t>(va->count)}, va->radius},
+                                      {{points_.data() + vb->offset, static_cast<std::size_t>(vb->count)}, vb->radius},
+                                      opt);
+    ++result_.stats.gjk_calls;
+    if (d.status == GjkStatus::InvalidInput) {
+      result_.status = Status::NumericalFailure;
+      e.valid = false;
+      e.current = 0.0;
+      return 0.0;
+    }
+    bound = std::max(bound, d.distance);
+    e.direction = d.direction;
+    e.witness_a = d.witness_a;
+    e.witness_b = d.witness_b;
+  }
+  e.valid = true;
+  e.bound = bound;
+  e.current = bound;
+  const int ns = model_.stateSize();
+  std::copy(lower_.begin(), lower_.end(), box_.begin() + static_cast<std::ptrdiff_t>(p) * 2 * ns);
+  std::copy(upper_.begin(), upper_.end(), box_.begin() + static_cast<std::ptrdiff_t>(p) * 2 * ns + ns);
+  return bound;
+}
+
+void Checker::publish(int p, PairDistance& out) const noexcept {
+  const Entry& e = table_[p];
+  out.pair = p;
+  out.distance = e.current;
+  out.fresh = fresh_[p] != 0;
+  out.witness_a = e.witness_a;
+  out.witness_b = e.witness_b;
+}
+
+const QueryResult& Checker::query(std::span<const double> lower, std::span<const double> upper,
+                                  const QueryOptions& options) noexcept {
+  const Clock::time_point start = Clock::now();
+  result_ = QueryResult{};
+  result_.type = options.type;
+  result_.margin = options.margin >= 0.0 ? options.margin : model_.safety_margin;
+  const double margin = result_.margin;
+  if (!validate(lower, upper)) {
+    result_.collision = true;
+    result_.min_distance = 0.0;
+    return result_;
+  }
+  ++cycle_;
+  std::copy(lower.begin(), lower.end(), lower_.begin());
+  std::copy(upper.begin(), upper.end(), upper_.begin());
+  const int np = static_cast<int>(model_.pairs.size());
+  const int ns = model_.stateSize();
+
+  // Carry every stored bound over to this box: unchanged while the box stays inside the stored
+  // one, otherwise lowered by the most the pair's points can have moved (ALGORITHMS.md 5).
+  for (int p = 0; p < np; ++p) {
+    Entry& e = table_[p];
+    if (!e.valid) {
+      e.current = 0.0;
+      continue;
+    }
+    const double* box_lo = &box_[static_cast<std::size_t>(p) * 2 * ns];
+    const double* box_hi = box_lo + ns;
+    const double* reach = &reach_[static_cast<std::size_t>(p) * ns];
+    double moved = 0.0;
+    for (int s = 0; s < ns; ++s) {
+      if (reach[s] == 0.0) continue;
+      const double grow = std::max({0.0, box_lo[s] - lower[s], upper[s] - box_hi[s]});
+      if (grow > 0.0) moved += reach[s] * grow;
+    }
+    e.current = moved == 0.0 ? e.bound : std::max(0.0, (e.bound - moved) * (1.0 - 1e-12));
+    if (!std::isfinite(e.current)) e.current = 0.0;
+  }
+  for (int p = 0; p < np; ++p) order_[p] = p;
+  std::sort(order_.begin(), order_.end(), [this](int x, int y) { return table_[x].current < table_[y].current; });
+
+  const bool timed = options.budget_us > 0.0;
+  const Clock::time_point deadline =
+      start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::micro>(options.budget_us));
+  auto expired = [&]() {
+    if ((options.max_pairs >= 0 && result_.stats.pairs_checked >= options.max_pairs) ||
+        (timed && Clock::now() > deadline)) {
+      result_.stats.budget_exhausted = true;
+      return true;
+    }
+    return false;
+  };
+  std::fill(fresh_.begin(), fresh_.end(), 0);
+  auto run = [&](int p, double stop_above) {
+    refresh(p, stop_above);
+    fresh_[p] = 1;
+  };
+
+  int count = 0;  // pairs reported
+  switch (options.type) {
+    case QueryType::Collision: {
+      int hit = -1;
+      for (int p : order_) {
+        if (table_[p].current > margin) break;  // every remaining bound clears the margin
+        if (expired()) {
+          hit = p;
+          break;
+        }
+        run(p, margin);
+        if (table_[p].current <= margin) {
+          hit = p;
+          break;
+        }
+      }
+      if (hit >= 0) publish(hit, out_[count++]);
+      break;
+    }
+    case QueryType::Closest: {
+      double best = kInf;
+      for (int p : order_) {
+        if (table_[p].current > margin || table_[p].current >= best) break;
+        if (expired()) break;
+        run(p, std::min(best, margin));
+        best = std::min(best, table_[p].current);
+      }
+      break;
+    }
+    case QueryType::NClosest: {
+      const int n = std::clamp(options.n, 1, std::max(np, 1));
+      // best[0..fresh) holds the smallest fresh bounds so far, sorted.
+      int fresh = 0;
+      double* best = nbest_.data();
+      for (int p : order_) {
+        const double nth = fresh >= n ? best[n - 1] : kInf;
+        if (table_[p].current >= nth) break;
+        if (expired()) break;
+        run(p, nth);
+        const double d = table_[p].current;
+        int k = std::min(fresh, n - 1);
+        if (fresh < n || d < best[k]) {
+          while (k > 0 && best[k - 1] > d) {
+            best[k] = best[k - 1];
+            --k;
+          }
+          best[k] = d;
+          fresh = std::min(fresh + 1, n);
+        }
+      }
+      break;
+    }
+    case QueryType::Distances:
+      for (int p : order_) {
+        if (expired()) break;
+        run(p, kInf);
+      }
+      break;
+  }
+
+  // The answer: every bound in the table is valid for this box.
+  double min_distance = kInf;
+  int argmin = -1;
+  for (int p = 0; p < np; ++p) {
+    if (table_[p].current < min_distance) {
+      min_distance = table_[p].current;
+      argmin = p;
+    }
+  }
+  if (options.type == QueryType::Closest && argmin >= 0 && min_distance <= margin) {
+    publish(argmin, out_[count++]);
+  } else if (options.type == QueryType::NClosest) {
+    std::sort(order_.begin(), order_.end(), [this](int x, int y) { return table_[x].current < table_[y].current; });
+    const int n = std::min(std::max(options.n, 1), np);
+    for (int k = 0; k < n; ++k) publish(order_[k], out_[count++]);
+  } else if (options.type == QueryType::Distances) {
+    for (int p = 0; p < np; ++p) publish(p, out_[count++]);
+  }
+  if (result_.status != Status::Ok) min_distance = 0.0;
+  result_.min_distance = min_distance;
+  result_.collision = result_.status != Status::Ok || min_distance <= margin;
+  result_.pairs = std::span<const PairDistance>(out_.data(), static_cast<std::size_t>(count));
+  result_.stats.time_us = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+  return result_;
+}
+
+}  // namespace kccd

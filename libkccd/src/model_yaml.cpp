@@ -1,0 +1,257 @@
+// The `kccd: 1` YAML model format (ARCHITECTURE.md section 3). Every error names the file, the
+// line and column, and the field; loading stops at the first one.
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "kccd/model.hpp"
+
+namespace kccd {
+namespace {
+
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& field, const std::string& what) const {
+    std::ostringstream msg;
+    msg << source_;
+    if (node.IsDefined() && node.Mark().line >= 0)
+      msg << ':' << node.Mark().line + 1 << ':' << node.Mark().column + 1;
+    msg << ": " << field << ": " << what;
+    throw ModelError(msg.str());
+  }
+
+  void onlyKeys(const YAML::Node& map, const std::string& field, std::initializer_list<const char*> keys) const {
+    if (!map.IsMap()) fail(map, field, "expected a mapping");
+    for (const auto& kv : map) {
+      const std::string k = kv.first.Scalar();
+      if (std::none_of(keys.begin(), keys.end(), [&](const char* allowed) { return k == allowed; }))
+        fail(kv.first, field + "." + k, "unknown field");
+    }
+  }
+
+  YAML::Node require(const YAML::Node& map, const char* key, const std::string& field, const YAML::Node& where) const {
+    YAML::Node n = map[key];
+    if (!n.IsDefined() || n.IsNull()) fail(where, field + "." + key, "required field is missing");
+    return n;
+  }
+
+  std::string text(const YAML::Node& n, const std::string& field) const {
+    if (!n.IsScalar()) fail(n, field, "expected a string");
+    if (n.Scalar().empty()) fail(n, field, "must not be empty");
+    return n.Scalar();
+  }
+
+  double number(const YAML::Node& n, const std::string& field) const {
+    if (!n.IsScalar()) fail(n, field, "expected a number");
+    double v = 0.0;
+    try {
+      v = n.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(n, field, "expected a number, got '" + n.Scalar() + "'");
+    }
+    if (!std::isfinite(v)) fail(n, field, "must be finite");
+    return v;
+  }
+
+  Vec3 vec3(const YAML::Node& n, const std::string& field) const {
+    if (!n.IsSequence()) fail(n, field, "expected a list of 3 numbers");
+    if (n.size() != 3) fail(n, field, "expected 3 numbers, got " + std::to_string(n.size()));
+    return {number(n[0], field + "[0]"), number(n[1], field + "[1]"), number(n[2], field + "[2]")};
+  }
+
+ private:
+  std::string source_;
+};
+
+Pose parseOrigin(const Reader& r, const YAML::Node& n, const std::string& field) {
+  r.onlyKeys(n, field, {"xyz", "rpy"});
+  Pose pose = Pose::Identity();
+  if (n["xyz"]) pose.translation() = r.vec3(n["xyz"], field + ".xyz");
+  if (n["rpy"]) {
+    const Vec3 rpy = r.vec3(n["rpy"], field + ".rpy");
+    // URDF convention: fixed-axis roll about x, then pitch about y, then yaw about z.
+    pose.linear() = (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
+                     Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
+                        .toRotationMatrix();
+  }
+  return pose;
+}
+
+JointType parseType(const Reader& r, const YAML::Node& n, const std::string& field) {
+  const std::string t = r.text(n, field);
+  if (t == "fixed") return JointType::Fixed;
+  if (t == "revolute") return JointType::Revolute;
+  if (t == "prismatic") return JointType::Prismatic;
+  if (t == "translation3d") return JointType::Translation3d;
+  if (t == "rotation3d") return JointType::Rotation3d;
+  r.fail(n, field, "unknown joint type '" + t + "' (fixed, revolute, prismatic, translation3d, rotation3d)");
+}
+
+SweepMode parseSweep(const Reader& r, const YAML::Node& n, const std::string& field) {
+  const std::string t = r.text(n, field);
+  if (t == "exact") return SweepMode::Exact;
+  if (t == "fast") return SweepMode::Fast;
+  if (t == "accurate") return SweepMode::Accurate;
+  r.fail(n, field, "unknown sweep mode '" + t + "' (exact, fast, accurate)");
+}
+
+void parseJoints(const Reader& r, const YAML::Node& list, Model& m) {
+  if (!list.IsSequence()) r.fail(list, "joints", "expected a list");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node n = list[i];
+    const std::string f = "joints[" + std::to_string(i) + "]";
+    r.onlyKeys(n, f, {"name", "parent", "type", "origin", "axis", "sweep", "limits", "error"});
+    Joint j;
+    j.name = r.text(r.require(n, "name", f, n), f + ".name");
+    const std::string fn = "joint '" + j.name + "'";
+    if (j.name == "world") r.fail(n["name"], f + ".name", "'world' is reserved");
+    if (m.jointIndex(j.name) >= 0) r.fail(n["name"], f + ".name", "duplicate joint name '" + j.name + "'");
+    const std::string parent = r.text(r.require(n, "parent", fn, n), fn + ".parent");
+    if (parent != "world") {
+      j.parent = m.jointIndex(parent);
+      if (j.parent < 0) r.fail(n["parent"], fn + ".parent", "'" + parent + "' is not a joint defined earlier");
+    }
+    j.type = parseType(r, r.require(n, "type", fn, n), fn + ".type");
+    if (n["origin"]) j.origin = parseOrigin(r, n["origin"], fn + ".origin");
+    const bool one_dof = j.type == JointType::Revolute || j.type == JointType::Prismatic;
+    if (one_dof) {
+      const YAML::Node axis = r.require(n, "axis", fn, n);
+      const Vec3 a = r.vec3(axis, fn + ".axis");
+      if (!(a.norm() > 1e-12)) r.fail(axis, fn + ".axis", "zero axis");
+      j.axis = a.normalized();
+    } else if (n["axis"]) {
+      r.fail(n["axis"], fn + ".axis", std::string("a ") + toString(j.type) + " joint has no axis");
+    }
+    if (n["sweep"]) {
+      j.sweep = parseSweep(r, n["sweep"], fn + ".sweep");
+      if (j.type == JointType::Fixed) r.fail(n["sweep"], fn + ".sweep", "a fixed joint has no sweep mode");
+    }
+    if (n["limits"]) {
+      const YAML::Node l = n["limits"];
+      if (!one_dof) r.fail(l, fn + ".limits", "limits apply to revolute and prismatic joints only");
+      if (!l.IsSequence() || l.size() != 2) r.fail(l, fn + ".limits", "expected [lower, upper]");
+      const double lo = r.number(l[0], fn + ".limits[0]"), hi = r.number(l[1], fn + ".limits[1]");
+      if (lo > hi) r.fail(l, fn + ".limits", "lower limit is above the upper limit");
+      j.limits = std::array<double, 2>{lo, hi};
+    }
+    if (n["error"]) {
+      if (j.type != JointType::Translation3d && j.type != JointType::Rotation3d)
+        r.fail(n["error"], fn + ".error", "an error bound applies to translation3d and rotation3d joints only");
+      j.error = r.number(n["error"], fn + ".error");
+      if (j.error < 0.0) r.fail(n["error"], fn + ".error", "must be >= 0");
+    }
+    m.joints.push_back(std::move(j));
+  }
+}
+
+void parseBodies(const Reader& r, const YAML::Node& list, Model& m) {
+  if (!list.IsSequence()) r.fail(list, "bodies", "expected a list");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node n = list[i];
+    const std::string f = "bodies[" + std::to_string(i) + "]";
+    r.onlyKeys(n, f, {"name", "frame", "points", "radius"});
+    Body b;
+    b.name = r.text(r.require(n, "name", f, n), f + ".name");
+    const std::string fb = "body '" + b.name + "'";
+    if (m.bodyIndex(b.name) >= 0) r.fail(n["name"], f + ".name", "duplicate body name '" + b.name + "'");
+    const std::string frame = r.text(r.require(n, "frame", fb, n), fb + ".frame");
+    if (frame != "world") {
+      b.frame = m.jointIndex(frame);
+      if (b.frame < 0) r.fail(n["frame"], fb + ".frame", "unknown joint '" + frame + "'");
+    }
+    const YAML::Node pts = r.require(n, "points", fb, n);
+    if (!pts.IsSequence()) r.fail(pts, fb + ".points", "expected a list of [x, y, z]");
+    if (pts.size() == 0) r.fail(pts, fb + ".points", "empty point list");
+    for (std::size_t k = 0; k < pts.size(); ++k)
+      b.points.push_back(r.vec3(pts[k], fb + ".points[" + std::to_string(k) + "]"));
+    const YAML::Node rad = r.require(n, "radius", fb, n);
+    b.radius = r.number(rad, fb + ".radius");
+    if (b.radius < 0.0) r.fail(rad, fb + ".radius", "negative radius");
+    m.bodies.push_back(std::move(b));
+  }
+}
+
+std::vector<std::array<int, 2>> parsePairList(const Reader& r, const YAML::Node& list, const Model& m,
+                                              const std::string& field) {
+  std::vector<std::array<int, 2>> out;
+  if (!list.IsSequence()) r.fail(list, field, "expected a list of [body, body]");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node p = list[i];
+    const std::string f = field + "[" + std::to_string(i) + "]";
+    if (!p.IsSequence() || p.size() != 2) r.fail(p, f, "expected [body, body]");
+    std::array<int, 2> ids{};
+    for (int k = 0; k < 2; ++k) {
+      const std::string name = r.text(p[k], f);
+      ids[k] = m.bodyIndex(name);
+      if (ids[k] < 0) r.fail(p[k], f, "unknown body '" + name + "'");
+    }
+    if (ids[0] == ids[1]) r.fail(p, f, "a body paired with itself");
+    out.push_back(ids);
+  }
+  return out;
+}
+
+}  // namespace
+
+Model parseModel(const std::string& yaml_text, const std::string& source) {
+  const Reader r(source);
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::ParserException& e) {
+    throw ModelError(source + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                     ": YAML syntax error: " + e.msg);
+  }
+  if (!root.IsMap()) r.fail(root, "model", "expected a mapping with kccd, joints, bodies");
+  r.onlyKeys(root, "model", {"kccd", "name", "safety_margin", "point_budget", "joints", "bodies", "pairs"});
+  const YAML::Node version = r.require(root, "kccd", "model", root);
+  if (!version.IsScalar() || version.Scalar() != "1")
+    r.fail(version, "kccd", "unsupported format version '" + version.Scalar() + "' (this build reads 1)");
+  Model m;
+  m.name = root["name"] ? r.text(root["name"], "name") : std::string("model");
+  if (root["safety_margin"]) {
+    m.safety_margin = r.number(root["safety_margin"], "safety_margin");
+    if (m.safety_margin < 0.0) r.fail(root["safety_margin"], "safety_margin", "must be >= 0");
+  }
+  if (root["point_budget"]) {
+    const double b = r.number(root["point_budget"], "point_budget");
+    if (b != std::floor(b) || b < 4 || b > 4096) r.fail(root["point_budget"], "point_budget", "must be an integer in 4..4096");
+    m.point_budget = static_cast<int>(b);
+  }
+  if (root["joints"]) parseJoints(r, root["joints"], m);
+  parseBodies(r, r.require(root, "bodies", "model", root), m);
+  if (m.bodies.empty()) r.fail(root["bodies"], "bodies", "a model needs at least one body");
+  bool check_all = true;
+  std::vector<std::array<int, 2>> ignore, include;
+  if (const YAML::Node pairs = root["pairs"]) {
+    r.onlyKeys(pairs, "pairs", {"check", "ignore", "include"});
+    if (pairs["check"]) {
+      const std::string c = r.text(pairs["check"], "pairs.check");
+      if (c != "all" && c != "none") r.fail(pairs["check"], "pairs.check", "expected 'all' or 'none', got '" + c + "'");
+      check_all = c == "all";
+    }
+    if (pairs["ignore"]) ignore = parsePairList(r, pairs["ignore"], m, "pairs.ignore");
+    if (pairs["include"]) include = parsePairList(r, pairs["include"], m, "pairs.include");
+  }
+  try {
+    m.finalize(check_all, ignore, include);
+  } catch (const ModelError& e) {
+    r.fail(root["pairs"], "pairs", e.what());
+  }
+  return m;
+}
+
+Model loadModel(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ModelError(path + ": cannot open the model file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return parseModel(buffer.str(), path);
+}
+
+}  // namespace kccd

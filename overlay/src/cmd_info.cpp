@@ -1,0 +1,76 @@
+// `kccd info MODEL`: joints, state values, bodies, points and checked pairs.
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+#include "cli_util.hpp"
+#include "commands.hpp"
+
+namespace kccd::cli {
+namespace {
+
+struct InfoArgs {
+  std::string model;
+  bool json = false;
+};
+
+int runInfo(const InfoArgs& args) {
+  const Model m = loadOrExplain(args.model);
+  int points = 0;
+  for (const Body& b : m.bodies) points += static_cast<int>(b.points.size());
+  if (args.json) {
+    nlohmann::json j;
+    j["name"] = m.name;
+    j["safety_margin"] = m.safety_margin;
+    j["point_budget"] = m.point_budget;
+    j["state"] = m.stateNames();
+    for (const Joint& jt : m.joints) {
+      nlohmann::json o{{"name", jt.name}, {"type", toString(jt.type)}, {"parent", m.frameName(jt.parent)}, {"dof", jt.dof}};
+      if (jt.type != JointType::Fixed) o["sweep"] = toString(jt.sweep);
+      if (jt.limits) o["limits"] = {(*jt.limits)[0], (*jt.limits)[1]};
+      if (jt.type == JointType::Translation3d || jt.type == JointType::Rotation3d) o["error"] = jt.error;
+      j["joints"].push_back(o);
+    }
+    for (const Body& b : m.bodies)
+      j["bodies"].push_back({{"name", b.name}, {"frame", m.frameName(b.frame)}, {"points", b.points.size()}, {"radius", b.radius}});
+    j["pairs"] = nlohmann::json::array();
+    for (const BodyPair& p : m.pairs)
+      j["pairs"].push_back({{"a", m.bodies[p.a].name}, {"b", m.bodies[p.b].name}, {"frame", m.frameName(p.lca)}});
+    j["totals"] = {{"joints", m.joints.size()}, {"dof", m.stateSize()}, {"bodies", m.bodies.size()}, {"points", points},
+                   {"pairs", m.pairs.size()}};
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << "model " << m.name << ": " << m.joints.size() << " joints, " << m.stateSize() << " state values, "
+            << m.bodies.size() << " bodies, " << points << " points, " << m.pairs.size() << " checked pairs\n"
+            << "safety margin " << m.safety_margin << " m, point budget " << m.point_budget << "\n\njoints:\n";
+  for (const Joint& jt : m.joints) {
+    std::cout << "  " << std::left << std::setw(20) << jt.name << std::setw(14) << toString(jt.type) << "parent "
+              << std::setw(16) << m.frameName(jt.parent);
+    if (jt.type != JointType::Fixed) std::cout << " sweep " << toString(jt.sweep);
+    if (jt.limits) std::cout << "  limits [" << (*jt.limits)[0] << ", " << (*jt.limits)[1] << "]";
+    std::cout << "\n";
+  }
+  std::cout << "\nstate values (order of --lower/--upper/--state):\n";
+  for (std::size_t i = 0; i < m.stateNames().size(); ++i) std::cout << "  " << i << ": " << m.stateNames()[i] << "\n";
+  std::cout << "\nbodies:\n";
+  for (const Body& b : m.bodies)
+    std::cout << "  " << std::left << std::setw(20) << b.name << "frame " << std::setw(16) << m.frameName(b.frame)
+              << b.points.size() << " points, radius " << b.radius << "\n";
+  std::cout << "\nchecked pairs (compared in their common-ancestor frame):\n";
+  for (const BodyPair& p : m.pairs)
+    std::cout << "  " << m.bodies[p.a].name << " - " << m.bodies[p.b].name << "  [" << m.frameName(p.lca) << "]\n";
+  return 0;
+}
+
+}  // namespace
+
+Runner addInfo(CLI::App& app) {
+  auto args = std::make_shared<InfoArgs>();
+  CLI::App* sub = app.add_subcommand("info", "Show a model's joints, state values, bodies and checked pairs");
+  sub->add_option("model", args->model, "Model file (YAML, kccd: 1)")->required();
+  sub->add_flag("--json", args->json, "Machine-readable output");
+  return [args] { return runInfo(*args); };
+}
+
+}  // namespace kccd::cli
