@@ -1,0 +1,126 @@
+// End-to-end: the kccd program as scripts use it (JSON contract, exit codes, one-line errors).
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+struct Outcome {
+  int code = -1;
+  std::string out;  // stdout and stderr
+  std::string err;
+};
+
+Outcome kccd(const std::string& args, bool merge_stderr = false) {
+  const std::string err_file = ::testing::TempDir() + "/kccd_stderr.txt";
+  const std::string cmd = std::string(KCCD_CLI) + " " + args + (merge_stderr ? " 2>&1" : " 2>" + err_file);
+  Outcome r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  while (pipe != nullptr && fgets(buf.data(), buf.size(), pipe) != nullptr) r.out += buf.data();
+  const int status = pipe != nullptr ? pclose(pipe) : -1;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (!merge_stderr) {
+    if (FILE* f = fopen(err_file.c_str(), "r")) {
+      while (fgets(buf.data(), buf.size(), f) != nullptr) r.err += buf.data();
+      fclose(f);
+    }
+  }
+  return r;
+}
+
+const std::string kDemo = std::string(KCCD_DATA_DIR) + "/demo_arm.yaml";
+
+TEST(Cli, InfoListsStateNamesAndPairs) {
+  const Outcome r = kccd("info " + kDemo + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["state"], nlohmann::json({"shoulder_yaw", "shoulder_pitch", "elbow"}));
+  EXPECT_EQ(j["totals"]["bodies"], 6);
+  EXPECT_EQ(j["pairs"].size(), j["totals"]["pairs"].get<std::size_t>());
+  EXPECT_EQ(kccd("info " + kDemo).code, 0);
+}
+
+TEST(Cli, QueryJsonContract) {
+  const Outcome r = kccd("query " + kDemo + " --lower 0.1,0.2,0.3 --upper 0.2,0.4,0.6 --type distances --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["type"], "distances");
+  EXPECT_EQ(j["status"], "ok");
+  ASSERT_TRUE(j["collision"].is_boolean());
+  ASSERT_TRUE(j["min_distance"].is_number());
+  const auto info = nlohmann::json::parse(kccd("info " + kDemo + " --json").out);
+  ASSERT_EQ(j["pairs"].size(), info["pairs"].size());  // every checked pair
+  double min_d = 1e9;
+  for (const auto& p : j["pairs"]) {
+    for (const char* key : {"a", "b", "frame"}) EXPECT_TRUE(p[key].is_string()) << key;
+    EXPECT_GE(p["distance"].get<double>(), 0.0);
+    EXPECT_EQ(p["witness_a"].size(), 3u);
+    EXPECT_EQ(p["witness_b"].size(), 3u);
+    min_d = std::min(min_d, p["distance"].get<double>());
+  }
+  EXPECT_DOUBLE_EQ(j["min_distance"].get<double>(), min_d);
+  EXPECT_EQ(j["collision"].get<bool>(), min_d <= j["margin"].get<double>());
+  for (const char* key : {"time_us", "pairs_checked", "gjk_calls"}) EXPECT_TRUE(j["stats"][key].is_number()) << key;
+}
+
+TEST(Cli, QueryTypesAndState) {
+  for (const char* type : {"collision", "closest", "nclosest --n 3"}) {
+    const Outcome r = kccd("query " + kDemo + " --state 0.1,0.3,0.4 --json --type " + type);
+    ASSERT_EQ(r.code, 0) << type << ": " << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["status"], "ok");
+  }
+  const auto n = nlohmann::json::parse(kccd("query " + kDemo + " --state 0.1,0.3,0.4 --json --type nclosest --n 3").out);
+  EXPECT_EQ(n["pairs"].size(), 3u);
+  EXPECT_LE(n["pairs"][0]["distance"].get<double>(), n["pairs"][1]["distance"].get<double>());
+}
+
+TEST(Cli, BadInputGivesOneLineAndNonZeroExit) {
+  struct Case {
+    std::string args;
+    int code;
+    std::string text;
+  };
+  const std::vector<Case> cases = {
+      {"query /nonexistent/m.yaml --state 0", 2, "/nonexistent/m.yaml: cannot open"},
+      {"query " + kDemo + " --state 0.1,0.2", 2, "--state has 2 values but model 'demo_arm' has 3"},
+      {"query " + kDemo + " --state 0.1,abc,0.3", 2, "--state: value 2 ('abc') is not a number"},
+      {"query " + kDemo + " --lower 0.1,0.2,0.3", 2, "needs --lower and --upper"},
+      {"query " + kDemo + " --state 0,0,0 --type fastest", 2, "unknown query type 'fastest'"},
+      {"query " + kDemo + " --lower 0.3,0,0 --upper 0.1,0,0", 3, "lower_above_upper"},
+      {"query " + kDemo + " --state nan,0,0", 3, "non_finite_state"},
+  };
+  for (const Case& c : cases) {
+    const Outcome r = kccd(c.args);
+    EXPECT_EQ(r.code, c.code) << c.args;
+    EXPECT_NE(r.err.find(c.text), std::string::npos) << c.args << " -> " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << " -> " << r.err;
+  }
+  // A bad model file: the message names file, line and field.
+  const std::string bad = ::testing::TempDir() + "/bad_model.yaml";
+  FILE* f = fopen(bad.c_str(), "w");
+  fputs("kccd: 1\nbodies:\n  - {name: a, frame: world, points: [[0, 0]], radius: 0.1}\n", f);
+  fclose(f);
+  const Outcome r = kccd("info " + bad);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad_model.yaml:3:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("body 'a'.points[0]"), std::string::npos) << r.err;
+}
+
+TEST(Cli, HelpExplainsEverySubcommand) {
+  const Outcome r = kccd("--help", true);
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("query"), std::string::npos);
+  EXPECT_NE(r.out.find("info"), std::string::npos);
+  const Outcome q = kccd("query --help", true);
+  EXPECT_EQ(q.code, 0);
+  for (const char* flag : {"--lower", "--upper", "--state", "--type", "--n", "--margin", "--budget-us", "--json"})
+    EXPECT_NE(q.out.find(flag), std::string::npos) << flag;
+  EXPECT_NE(kccd("").code, 0);  // a subcommand is required
+}
+
+}  // namespace

@@ -1,0 +1,173 @@
+// Model files: what loads, and one clear message (file, line, field) for each kind of mistake.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "kccd/model.hpp"
+
+namespace kccd {
+namespace {
+
+const std::string kGood = R"(kccd: 1
+name: t
+safety_margin: 0.01
+joints:
+  - name: base
+    parent: world
+    type: revolute
+    origin: {xyz: [0, 0, 0.5], rpy: [0, 0, 1.5707963267948966]}
+    axis: [0, 0, 2]
+    sweep: fast
+    limits: [-1, 1]
+  - name: slide
+    parent: base
+    type: prismatic
+    axis: [1, 0, 0]
+  - name: pose
+    parent: world
+    type: translation3d
+    error: 0.01
+  - name: turn
+    parent: pose
+    type: rotation3d
+    error: 0.02
+bodies:
+  - name: floor
+    frame: world
+    points: [[0, 0, 0]]
+    radius: 0.1
+  - name: arm
+    frame: base
+    points: [[0, 0, 0], [1, 0, 0]]
+    radius: 0.05
+  - name: tool
+    frame: slide
+    points: [[0, 0, 0]]
+    radius: 0.02
+  - name: box
+    frame: turn
+    points: [[0, 0, 0], [0.1, 0, 0]]
+    radius: 0.03
+pairs:
+  ignore: [[arm, tool]]
+)";
+
+// Replaces the first occurrence of `from` in the good model.
+std::string edit(const std::string& from, const std::string& to) {
+  std::string s = kGood;
+  const auto at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return s.replace(at, from.size(), to);
+}
+
+std::string loadError(const std::string& text) {
+  try {
+    parseModel(text, "cell.yaml");
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  return "(loaded)";
+}
+
+TEST(Model, LoadsAValidFile) {
+  const Model m = parseModel(kGood, "cell.yaml");
+  EXPECT_EQ(m.name, "t");
+  EXPECT_DOUBLE_EQ(m.safety_margin, 0.01);
+  ASSERT_EQ(m.joints.size(), 4u);
+  EXPECT_EQ(m.stateSize(), 1 + 1 + 3 + 3);
+  const std::vector<std::string> names{"base", "slide", "pose.x", "pose.y", "pose.z", "turn.x", "turn.y", "turn.z"};
+  EXPECT_EQ(m.stateNames(), names);
+  EXPECT_TRUE(m.joints[0].axis.isApprox(Vec3::UnitZ()));  // normalised on load
+  EXPECT_EQ(m.joints[0].sweep, SweepMode::Fast);
+  EXPECT_EQ(m.joints[1].sweep, SweepMode::Accurate);      // the default
+  EXPECT_TRUE((m.joints[0].origin.linear() * Vec3::UnitX()).isApprox(Vec3::UnitY(), 1e-12));  // yaw 90 deg
+  EXPECT_EQ(m.joints[3].state_offset, 5);
+  // Pairs: all pairs in different frames, minus the ignored one.
+  ASSERT_EQ(m.pairs.size(), 5u);
+  for (const BodyPair& p : m.pairs) {
+    EXPECT_FALSE(m.bodies[p.a].name == "arm" && m.bodies[p.b].name == "tool");
+    if (m.bodies[p.a].name == "arm" && m.bodies[p.b].name == "box") {
+      EXPECT_EQ(p.lca, kWorld);
+    }
+  }
+  EXPECT_EQ(m.commonAncestor(m.jointIndex("slide"), m.jointIndex("base")), m.jointIndex("base"));
+}
+
+struct BadCase {
+  const char* what;
+  std::string text;
+  std::vector<std::string> expected;  // substrings of the message
+};
+
+TEST(Model, EveryMistakeGetsOneClearMessage) {
+  const std::vector<BadCase> cases = {
+      {"unknown joint type", edit("type: prismatic", "type: prismatik"),
+       {"cell.yaml:14:", "joint 'slide'.type", "unknown joint type 'prismatik'"}},
+      {"parent not yet defined", edit("parent: base", "parent: later"),
+       {"cell.yaml:13:", "joint 'slide'.parent", "'later' is not a joint defined earlier"}},
+      {"duplicate joint", edit("name: slide", "name: base"), {"cell.yaml:12:", "duplicate joint name 'base'"}},
+      {"duplicate body", edit("name: tool", "name: arm"), {"cell.yaml:", "duplicate body name 'arm'"}},
+      {"wrong vector length", edit("axis: [1, 0, 0]", "axis: [1, 0]"),
+       {"cell.yaml:15:", "joint 'slide'.axis", "expected 3 numbers, got 2"}},
+      {"zero axis", edit("axis: [1, 0, 0]", "axis: [0, 0, 0]"), {"cell.yaml:15:", "zero axis"}},
+      {"negative radius", edit("radius: 0.05", "radius: -0.05"),
+       {"cell.yaml:32:", "body 'arm'.radius", "negative radius"}},
+      {"empty point list", edit("points: [[0, 0, 0], [1, 0, 0]]", "points: []"),
+       {"cell.yaml:31:", "body 'arm'.points", "empty point list"}},
+      {"unknown body in pairs", edit("ignore: [[arm, tool]]", "ignore: [[arm, tol]]"),
+       {"cell.yaml:42:", "pairs.ignore[0]", "unknown body 'tol'"}},
+      {"unknown frame", edit("frame: slide", "frame: slider"), {"body 'tool'.frame", "unknown joint 'slider'"}},
+      {"not a number", edit("radius: 0.1", "radius: big"), {"cell.yaml:28:", "expected a number, got 'big'"}},
+      {"NaN", edit("radius: 0.1", "radius: .nan"), {"cell.yaml:28:", "must be finite"}},
+      {"missing field", edit("    type: revolute\n", ""), {"joint 'base'.type", "required field is missing"}},
+      {"unknown field", edit("sweep: fast", "swep: fast"), {"cell.yaml:10:", "joints[0].swep", "unknown field"}},
+      {"bad sweep mode", edit("sweep: fast", "sweep: quick"), {"unknown sweep mode 'quick'"}},
+      {"limits reversed", edit("limits: [-1, 1]", "limits: [1, -1]"), {"lower limit is above the upper limit"}},
+      {"version", edit("kccd: 1", "kccd: 2"), {"cell.yaml:1:", "unsupported format version '2'"}},
+      {"no version", edit("kccd: 1\n", ""), {"model.kccd", "required field is missing"}},
+      {"negative error", edit("error: 0.01", "error: -0.01"), {"joint 'pose'.error", "must be >= 0"}},
+      {"axis on a 3-DOF joint", edit("    error: 0.02", "    axis: [0, 0, 1]"), {"rotation3d joint has no axis"}},
+      {"YAML syntax", edit("name: t", "name: [t"), {"cell.yaml:", "YAML syntax error"}},
+      {"world as joint name", edit("name: slide", "name: world"), {"'world' is reserved"}},
+      {"pair with itself", edit("ignore: [[arm, tool]]", "ignore: [[arm, arm]]"), {"a body paired with itself"}},
+      {"same-frame include", edit("ignore: [[arm, tool]]", "include: [[floor, floor]]"), {"a body paired with itself"}},
+      {"bad check", edit("ignore: [[arm, tool]]", "check: some"), {"pairs.check", "expected 'all' or 'none'"}},
+  };
+  for (const BadCase& c : cases) {
+    const std::string msg = loadError(c.text);
+    for (const std::string& part : c.expected)
+      EXPECT_NE(msg.find(part), std::string::npos) << c.what << ": '" << part << "' not in: " << msg;
+    EXPECT_EQ(std::count(msg.begin(), msg.end(), '\n'), 0) << c.what << ": one line only";
+  }
+}
+
+TEST(Model, MissingFileNamesThePath) {
+  try {
+    loadModel("/nonexistent/robot.yaml");
+    FAIL() << "loaded a missing file";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/robot.yaml: cannot open"), std::string::npos);
+  }
+}
+
+TEST(Model, SampleScenesHaveTheirDocumentedSize) {
+  struct Expect {
+    const char* file;
+    std::size_t bodies;
+    int dof;
+    int points;
+  };
+  for (const Expect& e : {Expect{"humanoid.yaml", 26, 20, 80}, Expect{"industrial_cell.yaml", 13, 12, 50},
+                          Expect{"demo_arm.yaml", 6, 3, 16}}) {
+    const Model m = loadModel(std::string(KCCD_DATA_DIR) + "/" + e.file);
+    int points = 0;
+    for (const Body& b : m.bodies) points += static_cast<int>(b.points.size());
+    EXPECT_EQ(m.bodies.size(), e.bodies) << e.file;
+    EXPECT_EQ(m.stateSize(), e.dof) << e.file;
+    EXPECT_EQ(points, e.points) << e.file;
+    EXPECT_FALSE(m.pairs.empty()) << e.file;
+  }
+}
+
+}  // namespace
+}  // namespace kccd

@@ -1,0 +1,234 @@
+// Query types agree with each other; bad state input gives an unsafe status; braking intervals.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "kccd/braking.hpp"
+#include "kccd/checker.hpp"
+#include "support/random_model.hpp"
+
+namespace kccd {
+namespace {
+
+QueryOptions options(QueryType type, int n = 1, double margin = -1.0) {
+  QueryOptions o;
+  o.type = type;
+  o.n = n;
+  o.margin = margin;
+  return o;
+}
+
+TEST(Queries, TypesAgreeWithEachOther) {
+  std::mt19937_64 rng(77);
+  int collisions = 0, clear = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const Model m = testing::randomModel(rng, 5, 5);
+    if (m.pairs.empty()) continue;
+    std::vector<double> lower, upper;
+    testing::randomBox(rng, m, lower, upper);
+    const double margin = std::uniform_real_distribution<double>(0.0, 0.3)(rng);
+    // Fresh checkers: every answer is computed for this box alone.
+    Checker all_c(m), col_c(m), clo_c(m), nc_c(m);
+    const QueryResult& all = all_c.query(lower, upper, options(QueryType::Distances, 1, margin));
+    ASSERT_EQ(all.status, Status::Ok);
+    ASSERT_EQ(all.pairs.size(), m.pairs.size());
+    double min_d = std::numeric_limits<double>::infinity();
+    for (const PairDistance& pd : all.pairs) {
+      EXPECT_TRUE(pd.fresh);
+      min_d = std::min(min_d, pd.distance);
+    }
+    EXPECT_DOUBLE_EQ(all.min_distance, min_d);
+    EXPECT_EQ(all.collision, min_d <= margin);
+
+    const QueryResult& col = col_c.query(lower, upper, options(QueryType::Collision, 1, margin));
+    EXPECT_EQ(col.collision, min_d <= margin) << "case " << i;
+    if (col.collision) {
+      ASSERT_EQ(col.pairs.size(), 1u);
+      EXPECT_LE(col.pairs[0].distance, margin);
+      ++collisions;
+    } else {
+      EXPECT_TRUE(col.pairs.empty());
+      ++clear;
+    }
+
+    const QueryResult& clo = clo_c.query(lower, upper, options(QueryType::Closest, 1, margin));
+    EXPECT_EQ(clo.collision, min_d <= margin);
+    if (min_d <= margin) {
+      ASSERT_EQ(clo.pairs.size(), 1u);
+      EXPECT_NEAR(clo.pairs[0].distance, min_d, 1e-12);  // the argmin of all distances
+      EXPECT_NEAR(all.pairs[clo.pairs[0].pair].distance, min_d, 1e-12);
+    } else {
+      EXPECT_TRUE(clo.pairs.empty());
+    }
+
+    const int n = 1 + i % static_cast<int>(m.pairs.size());
+    const QueryResult& nc = nc_c.query(lower, upper, options(QueryType::NClosest, n, margin));
+    ASSERT_EQ(static_cast<int>(nc.pairs.size()), n);
+    std::vector<double> sorted;
+    for (const PairDistance& pd : all.pairs) sorted.push_back(pd.distance);
+    std::sort(sorted.begin(), sorted.end());
+    for (int k = 0; k < n; ++k) {
+      EXPECT_NEAR(nc.pairs[k].distance, sorted[k], 1e-12) << "case " << i << " rank " << k;
+      EXPECT_TRUE(nc.pairs[k].fresh);
+      EXPECT_LE(nc.pairs[k].distance, all.pairs[nc.pairs[k].pair].distance + 1e-12);
+    }
+    EXPECT_LE(col_c.query(lower, upper, options(QueryType::Collision, 1, margin)).stats.gjk_calls,
+              static_cast<int>(m.pairs.size()));
+  }
+  EXPECT_GT(collisions, 100);
+  EXPECT_GT(clear, 100);
+}
+
+TEST(Queries, BudgetsOnlyLoosenBounds) {
+  std::mt19937_64 rng(78);
+  for (int i = 0; i < 1000; ++i) {
+    const Model m = testing::randomModel(rng, 5, 5);
+    if (m.pairs.empty()) continue;
+    std::vector<double> lower, upper;
+    testing::randomBox(rng, m, lower, upper);
+    Checker full(m), limited(m);
+    const QueryResult& f = full.query(lower, upper, options(QueryType::Distances));
+    std::vector<double> exact;
+    for (const PairDistance& pd : f.pairs) exact.push_back(pd.distance);
+    QueryOptions o = options(QueryType::Distances);
+    o.max_pairs = i % static_cast<int>(m.pairs.size());
+    const QueryResult& r = limited.query(lower, upper, o);
+    EXPECT_TRUE(r.stats.budget_exhausted);
+    for (const PairDistance& pd : r.pairs) {
+      EXPECT_LE(pd.distance, exact[pd.pair]);  // never above the full answer
+      if (!pd.fresh) {
+        EXPECT_EQ(pd.distance, 0.0);  // nothing known yet: counts as touching
+      }
+    }
+    EXPECT_TRUE(r.collision);  // unrefreshed pairs are unsafe
+    // A time budget too small to do anything is also conservative.
+    Checker hurried(m);
+    QueryOptions t = options(QueryType::Collision);
+    t.budget_us = 1e-6;
+    EXPECT_TRUE(hurried.query(lower, upper, t).collision);
+  }
+}
+
+TEST(Queries, ReusesBoundsWhenTheBoxShrinks) {
+  std::mt19937_64 rng(79);
+  const Model m = testing::randomModel(rng, 4, 5);
+  std::vector<double> lower, upper;
+  testing::randomBox(rng, m, lower, upper);
+  Checker c(m);
+  c.query(lower, upper, options(QueryType::Distances));
+  // A box inside the last one: every stored bound is still valid and nothing is recomputed.
+  QueryOptions peek = options(QueryType::Distances);
+  peek.max_pairs = 0;
+  const QueryResult& r = c.query(lower, upper, peek);
+  EXPECT_EQ(r.stats.gjk_calls, 0);
+  Checker fresh(m);
+  const QueryResult& f = fresh.query(lower, upper, options(QueryType::Distances));
+  for (std::size_t k = 0; k < r.pairs.size(); ++k) EXPECT_EQ(r.pairs[k].distance, f.pairs[k].distance);
+}
+
+TEST(Queries, BadStateInputIsAnUnsafeStatus) {
+  const Model m = testing::randomModel(*std::make_unique<std::mt19937_64>(5), 3, 3);
+  const int n = m.stateSize();
+  ASSERT_GT(n, 0);
+  Checker c(m);
+  std::vector<double> lo(n, 0.0), hi(n, 0.1);
+  const std::vector<double> shorter(n - 1, 0.0);
+  EXPECT_EQ(c.query(shorter, hi).status, Status::WrongStateSize);
+  auto with = [&](double v) {
+    std::vector<double> x = lo;
+    x[n - 1] = v;
+    return x;
+  };
+  EXPECT_EQ(c.query(with(std::nan("")), hi).status, Status::NonFiniteState);
+  EXPECT_EQ(c.query(with(-std::numeric_limits<double>::infinity()), hi).status, Status::NonFiniteState);
+  EXPECT_EQ(c.query(with(0.2), hi).status, Status::LowerAboveUpper);
+  for (Status s : {c.query(shorter, hi).status}) EXPECT_NE(s, Status::Ok);
+  EXPECT_TRUE(c.query(with(0.2), hi).collision);
+  EXPECT_EQ(c.query(with(0.2), hi).min_distance, 0.0);
+}
+
+TEST(Queries, ExactSweepRejectsWideIntervals) {
+  Model m;
+  Joint j;
+  j.name = "j";
+  j.type = JointType::Revolute;
+  j.sweep = SweepMode::Exact;
+  m.joints.push_back(j);
+  m.bodies.push_back({"a", kWorld, {Vec3(0, 0, 0)}, 0.1});
+  m.bodies.push_back({"b", 0, {Vec3(1, 0, 0)}, 0.1});
+  m.finalize(true, {}, {});
+  Checker c(m);
+  const std::vector<double> lo{0.1}, hi{0.1 + 1e-12};
+  EXPECT_EQ(c.query(lo, hi).status, Status::ExactNeedsPoint);
+  const QueryResult& r = c.query(lo, lo, options(QueryType::Distances));
+  EXPECT_EQ(r.status, Status::Ok);
+  EXPECT_NEAR(r.pairs[0].distance, 0.8, 1e-12);
+}
+
+TEST(Queries, RevoluteSweepBoundIsTightForASpinningPoint) {
+  // A point at radius 1 sweeping 90 degrees towards an obstacle on the arc's far end.
+  Model m;
+  Joint j;
+  j.name = "j";
+  j.type = JointType::Revolute;
+  j.axis = Vec3::UnitZ();
+  m.joints.push_back(j);
+  m.bodies.push_back({"obstacle", kWorld, {Vec3(0, 1.5, 0)}, 0.0});
+  m.bodies.push_back({"tip", 0, {Vec3(1, 0, 0)}, 0.0});
+  m.finalize(true, {}, {});
+  for (SweepMode mode : {SweepMode::Fast, SweepMode::Accurate}) {
+    m.joints[0].sweep = mode;
+    Checker c(m);
+    const std::vector<double> lo{0.0}, hi{1.5707963267948966};
+    const double d = c.query(lo, hi, options(QueryType::Distances)).pairs[0].distance;
+    EXPECT_LE(d, 0.5);  // at q = pi/2 the tip is 0.5 away
+    // Accurate (tangent apexes) is exact here; fast (chords) loses at most the sagitta 1 - cos(pi/4).
+    EXPECT_GT(d, mode == SweepMode::Accurate ? 0.5 - 1e-9 : 0.5 - (1.0 - std::cos(0.7853981633974483)) - 1e-9);
+  }
+}
+
+TEST(Braking, StoppingDistanceAndIntervals) {
+  BrakingParams p;
+  p.latency = 0.01;
+  p.max_acceleration = 2.0;
+  p.deceleration = 4.0;
+  // At 1 rad/s: 0.01 + 0.0001 + (1.02)^2 / 8.
+  EXPECT_NEAR(stoppingDistance(1.0, p), 0.01 + 0.0001 + 1.02 * 1.02 / 8.0, 1e-15);
+  // Standing still, a push during the latency still moves it a little.
+  EXPECT_NEAR(stoppingDistance(0.0, p), 0.0001 + 0.02 * 0.02 / 8.0, 1e-15);
+  // Moving away fast: no travel in this direction.
+  EXPECT_EQ(stoppingDistance(-5.0, p), 0.0);
+  p.position_error = 0.001;
+  p.velocity_error = 0.01;
+  double lo = 0.0, hi = 0.0;
+  brakingInterval(0.5, 1.0, p, lo, hi);
+  EXPECT_NEAR(hi, 0.5 + 0.001 + stoppingDistance(1.01, p), 1e-15);
+  EXPECT_NEAR(lo, 0.5 - 0.001 - stoppingDistance(-0.99, p), 1e-15);
+  EXPECT_LT(lo, 0.5);
+  EXPECT_GT(hi, 0.5 + 0.12);
+
+  Model m;
+  Joint j;
+  j.name = "j";
+  j.type = JointType::Revolute;
+  j.limits = std::array<double, 2>{-1.0, 0.6};
+  m.joints.push_back(j);
+  m.bodies.push_back({"a", kWorld, {Vec3(0, 0, 0)}, 0.1});
+  m.finalize(true, {}, {});
+  std::vector<double> lower(1), upper(1);
+  const std::vector<double> q{0.5}, v{1.0};
+  const std::vector<BrakingParams> params{p};
+  ASSERT_TRUE(brakingIntervals(m, q, v, params, lower, upper));
+  EXPECT_EQ(upper[0], 0.6);  // clamped to the limit
+  EXPECT_NEAR(lower[0], lo, 1e-15);
+  std::vector<BrakingParams> bad{p};
+  bad[0].deceleration = 0.0;
+  EXPECT_FALSE(brakingIntervals(m, q, v, bad, lower, upper));
+  const std::vector<double> nan_q{std::nan("")};
+  EXPECT_FALSE(brakingIntervals(m, nan_q, v, params, lower, upper));
+}
+
+}  // namespace
+}  // namespace kccd
