@@ -77,11 +77,15 @@ Checker::Checker(const Model& model) : model_(model) {
     v.count = v.capacity;
     v.radius = body.radius;
     v.bound = detail::boundingSphere(body.points, body.radius);
+    v.swept_sphere = v.bound;
   }
   int expansion = 1;
   for (const Joint& j : model.joints) expansion = std::max(expansion, detail::sweepExpansion(j));
   scratch_.resize(static_cast<std::size_t>(expansion) * max_points);
   scratch_dist_.resize(scratch_.size());
+  scratch_rho_.resize(max_points);
+  scratch_level_.resize(max_points);
+  scratch_order_.resize(max_points);
 
   // Per pair: the level of the LCA frame on each body's path, and how far each state value can
   // move the pair's core points per unit change (for keeping stored bounds valid).
@@ -166,8 +170,9 @@ const Checker::Volume* Checker::volume(int body, int level) noexcept {
   const Joint& joint = model_.joints[path_[idx - 1]];
   double radius = below->radius;
   const std::span<const Vec3> in(points_.data() + below->offset, below->count);
+  const detail::SweepWork work{scratch_rho_.data(), scratch_level_.data(), scratch_order_.data()};
   int n = detail::sweepJoint(joint, lower_.data() + joint.state_offset, upper_.data() + joint.state_offset, in,
-                             scratch_.data(), radius);
+                             scratch_.data(), radius, v.capacity, work);
   if (n < 0) return nullptr;
   n = detail::reduceToBudget(scratch_.data(), n, v.capacity, scratch_dist_.data(), radius);
   std::copy(scratch_.begin(), scratch_.begin() + n, points_.begin() + v.offset);
@@ -178,6 +183,20 @@ const Checker::Volume* Checker::volume(int body, int level) noexcept {
   v.stamp = cycle_;
   ++result_.stats.volumes_swept;
   return &v;
+}
+
+const Sphere* Checker::sphere(int body, int level) noexcept {
+  const int idx = level_begin_[body] + level;
+  Volume& v = volumes_[idx];
+  if (level == 0 || v.sphere_stamp == cycle_) return &v.swept_sphere;
+  const Sphere* below = sphere(body, level - 1);
+  if (below == nullptr) return nullptr;
+  const Joint& joint = model_.joints[path_[idx - 1]];
+  v.swept_sphere =
+      detail::sweepSphere(joint, lower_.data() + joint.state_offset, upper_.data() + joint.state_offset, *below);
+  if (!v.swept_sphere.center.allFinite() || !std::isfinite(v.swept_sphere.radius)) return nullptr;
+  v.sphere_stamp = cycle_;
+  return &v.swept_sphere;
 }
 
 SschView Checker::sweptVolume(int body, int frame) noexcept {
@@ -194,19 +213,32 @@ SschView Checker::sweptVolume(int body, int frame) noexcept {
 double Checker::refresh(int p, double stop_above) noexcept {
   const BodyPair& pair = model_.pairs[p];
   Entry& e = table_[p];
-  const Volume* va = volume(pair.a, pair_level_[2 * p]);
-  const Volume* vb = volume(pair.b, pair_level_[2 * p + 1]);
+  const int la = pair_level_[2 * p], lb = pair_level_[2 * p + 1];
   ++result_.stats.pairs_checked;
-  if (va == nullptr || vb == nullptr) {
+  auto fail = [&]() {
     result_.status = Status::NumericalFailure;
     e.valid = false;
     e.current = 0.0;
     return 0.0;
-  }
-  // Bounding spheres first: often enough to prove the pair clear.
-  double bound = std::max(0.0, (va->bound.center - vb->bound.center).norm() - va->bound.radius - vb->bound.radius);
-  bound = std::max(0.0, bound * (1.0 - 1e-12));
+  };
+  auto sphereGap = [](const Sphere& x, const Sphere& y) {
+    return std::max(0.0, ((x.center - y.center).norm() - x.radius - y.radius) * (1.0 - 1e-12));
+  };
+  // Cheapest first: spheres swept without sweeping any point often prove the pair clear.
+  const Sphere* sa = sphere(pair.a, la);
+  const Sphere* sb = sphere(pair.b, lb);
+  if (sa == nullptr || sb == nullptr) return fail();
+  double bound = sphereGap(*sa, *sb);
+  e.gjk = false;
   if (bound < stop_above) {
+    const Volume* va = volume(pair.a, la);
+    const Volume* vb = volume(pair.b, lb);
+    if (va == nullptr || vb == nullptr) return fail();
+    bound = std::max(bound, sphereGap(va->bound, vb->bound));
+  }
+  if (bound < stop_above) {
+    const Volume* va = volume(pair.a, la);
+    const Volume* vb = volume(pair.b, lb);
     GjkOptions opt;
     opt.stop_above = stop_above;
     opt.warm_start = &e.direction;
@@ -214,16 +246,12 @@ double Checker::refresh(int p, double stop_above) noexcept {
                                       {{points_.data() + vb->offset, static_cast<std::size_t>(vb->count)}, vb->radius},
                                       opt);
     ++result_.stats.gjk_calls;
-    if (d.status == GjkStatus::InvalidInput) {
-      result_.status = Status::NumericalFailure;
-      e.valid = false;
-      e.current = 0.0;
-      return 0.0;
-    }
+    if (d.status == GjkStatus::InvalidInput) return fail();
     bound = std::max(bound, d.distance);
     e.direction = d.direction;
     e.witness_a = d.witness_a;
     e.witness_b = d.witness_b;
+    e.gjk = true;
   }
   e.valid = true;
   e.bound = bound;
@@ -239,6 +267,7 @@ void Checker::publish(int p, PairDistance& out) const noexcept {
   out.pair = p;
   out.distance = e.current;
   out.fresh = fresh_[p] != 0;
+  out.has_witness = out.fresh && e.gjk;
   out.witness_a = e.witness_a;
   out.witness_b = e.witness_b;
 }

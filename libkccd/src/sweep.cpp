@@ -22,14 +22,30 @@ double maxNorm(std::span<const Vec3> pts) {
   return m;
 }
 
-// Revolute sweep in the joint frame: chords (fast) or chords plus tangent apexes (accurate).
-int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in, Vec3* out, double& radius) {
+// Revolute sweep in the joint frame. Each point's arc is covered at one of three levels:
+//   tangent  - chord ends plus tangent apexes (2*pieces + 1 points), exact cover;
+//   chord    - chord ends (pieces + 1 points), radius grows by the sagitta rho (1 - cos(step / 2));
+//   single   - the arc's middle point (1 point), radius grows by the half-arc chord 2 rho sin(w / 4).
+// The sweep mode sets the best level (accurate: tangent, fast: chord). When the budget cannot hold
+// every point at that level, points far from the axis keep the finer levels first, which keeps the
+// radius growth (the largest error over all points) as small as the budget allows.
+int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in, Vec3* out, double& radius,
+                  int budget, SweepWork work) {
   const Vec3& a = j.axis;
   const double width = std::min(hi - lo, kTwoPi);
   const int pieces = revolutePieces(width);
-  const double step = pieces > 0 ? width / pieces : 0.0;
-  const bool accurate = j.sweep == SweepMode::Accurate;
-  // Angles: piece ends lo + k*step (k = 0..pieces), apexes at piece middles.
+  const int n_in = static_cast<int>(in.size());
+  if (pieces == 0) {  // a single angle: exact
+    const double c = std::cos(lo), s = std::sin(lo);
+    for (int i = 0; i < n_in; ++i) {
+      const Vec3 axial = a.dot(in[i]) * a;
+      const Vec3 radial = in[i] - axial;
+      out[i] = axial + c * radial + s * a.cross(radial);
+    }
+    radius += 16.0 * kEps * maxNorm(in);
+    return n_in;
+  }
+  const double step = width / pieces;
   double c_end[5], s_end[5], c_mid[4], s_mid[4];
   for (int k = 0; k <= pieces; ++k) {
     c_end[k] = std::cos(lo + k * step);
@@ -40,35 +56,66 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
     c_mid[k] = std::cos(lo + (k + 0.5) * step) / half_cos;
     s_mid[k] = std::sin(lo + (k + 0.5) * step) / half_cos;
   }
-  if (pieces == 0) {
-    c_end[0] = std::cos(lo);
-    s_end[0] = std::sin(lo);
+  const double c_centre = std::cos(lo + 0.5 * width), s_centre = std::sin(lo + 0.5 * width);
+  const double sagitta = 1.0 - half_cos;                   // per unit rho
+  const double half_chord = 2.0 * std::sin(0.25 * width);  // per unit rho
+
+  // Levels: 0 single, 1 chord, 2 tangent. Start everyone at the mode's level; if that does not
+  // fit, start at single and refine the points farthest from the axis first.
+  const int top = j.sweep == SweepMode::Accurate ? 2 : 1;
+  const int cost[3] = {1, pieces + 1, 2 * pieces + 1};
+  int* level = work.level;
+  double* rho = work.rho;
+  int* order = work.order;
+  for (int i = 0; i < n_in; ++i) {
+    rho[i] = (in[i] - a.dot(in[i]) * a).norm();
+    level[i] = top;
+    order[i] = i;
+  }
+  if (n_in * cost[top] > budget) {
+    std::sort(order, order + n_in, [rho](int x, int y) { return rho[x] > rho[y]; });
+    int total = 0;
+    for (int i = 0; i < n_in; ++i) level[i] = 0;
+    total = n_in;
+    for (int up = 1; up <= top; ++up) {
+      for (int k = 0; k < n_in; ++k) {
+        const int i = order[k];
+        const int extra = cost[up] - cost[up - 1];
+        if (level[i] != up - 1 || total + extra > budget) break;
+        level[i] = up;
+        total += extra;
+      }
+    }
   }
   double growth = 0.0;
   int n = 0;
-  for (const Vec3& p : in) {
+  for (int i = 0; i < n_in; ++i) {
+    const Vec3& p = in[i];
     const Vec3 axial = a.dot(p) * a;
     const Vec3 radial = p - axial;
     const Vec3 ortho = a.cross(radial);
-    const double rho = radial.norm();
-    if (pieces == 0) {
-      out[n++] = axial + c_end[0] * radial + s_end[0] * ortho;
-      continue;
-    }
-    if (rho <= 1e-12 * (1.0 + p.norm())) {  // on the axis: it stays within 2*rho of itself
+    if (rho[i] <= 1e-12 * (1.0 + p.norm())) {  // on the axis: it stays within 2 rho of itself
       out[n++] = p;
-      growth = std::max(growth, 2.0 * rho);
+      growth = std::max(growth, 2.0 * rho[i]);
       continue;
     }
-    for (int k = 0; k <= pieces; ++k) out[n++] = axial + c_end[k] * radial + s_end[k] * ortho;
-    if (accurate) {
-      for (int k = 0; k < pieces; ++k) out[n++] = axial + c_mid[k] * radial + s_mid[k] * ortho;
-    } else {
-      growth = std::max(growth, rho * (1.0 - half_cos));  // the sagitta of each chord
+    switch (level[i]) {
+      case 0:
+        out[n++] = axial + c_centre * radial + s_centre * ortho;
+        growth = std::max(growth, rho[i] * half_chord);
+        break;
+      case 1:
+        for (int k = 0; k <= pieces; ++k) out[n++] = axial + c_end[k] * radial + s_end[k] * ortho;
+        growth = std::max(growth, rho[i] * sagitta);
+        break;
+      default:
+        for (int k = 0; k <= pieces; ++k) out[n++] = axial + c_end[k] * radial + s_end[k] * ortho;
+        for (int k = 0; k < pieces; ++k) out[n++] = axial + c_mid[k] * radial + s_mid[k] * ortho;
+        break;
     }
   }
   // Rounding in the rotated points is a few ulps of their size.
-  radius += growth + 16.0 * kEps * maxNorm(in);
+  radius += growth * (1.0 + 8.0 * kEps) + 16.0 * kEps * maxNorm(in);
   return n;
 }
 
@@ -91,7 +138,7 @@ int sweepExpansion(const Joint& joint) noexcept {
 }
 
 int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span<const Vec3> in, Vec3* out,
-               double& radius) noexcept {
+               double& radius, int budget, SweepWork work) noexcept {
   int n = 0;
   const double in_norm = maxNorm(in);
   switch (joint.type) {
@@ -99,7 +146,7 @@ int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span
       for (const Vec3& p : in) out[n++] = p;
       break;
     case JointType::Revolute:
-      n = sweepRevolute(joint, lo[0], hi[0], in, out, radius);
+      n = sweepRevolute(joint, lo[0], hi[0], in, out, radius, budget, work);
       break;
     case JointType::Prismatic:
       // Minkowski sum with the segment [lo, hi] along the axis: exact.
@@ -173,6 +220,54 @@ int reduceToBudget(Vec3* pts, int n, int budget, double* dist, double& radius) n
   // Each dropped point lies within sqrt(worst) of a kept one, hence of their hull.
   radius += std::sqrt(worst) * (1.0 + 4.0 * kEps);
   return budget;
+}
+
+Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const Sphere& in) noexcept {
+  Sphere out = in;
+  const Vec3& c = in.center;
+  switch (joint.type) {
+    case JointType::Fixed: break;
+    case JointType::Revolute: {
+      // The centre's arc lies within rho sin(w / 2) of its chord's middle (w < pi), or within
+      // rho of the axis point for wider arcs.
+      const Vec3& a = joint.axis;
+      const Vec3 axial = a.dot(c) * a;
+      const Vec3 radial = c - axial;
+      const double rho = radial.norm();
+      const double width = hi[0] - lo[0];
+      if (width >= 3.141592653589793) {
+        out.center = axial;
+        out.radius += rho;
+      } else {
+        const double mid = lo[0] + 0.5 * width;
+        out.center = axial + std::cos(0.5 * width) * (std::cos(mid) * radial + std::sin(mid) * a.cross(radial));
+        out.radius += rho * std::sin(0.5 * width);
+      }
+      out.radius += 16.0 * kEps * c.norm();
+      break;
+    }
+    case JointType::Prismatic:
+      out.center = c + 0.5 * (lo[0] + hi[0]) * joint.axis;
+      out.radius += 0.5 * (hi[0] - lo[0]) + 8.0 * kEps * (c.norm() + std::abs(lo[0]) + std::abs(hi[0]));
+      break;
+    case JointType::Translation3d: {
+      const Vec3 l(lo[0], lo[1], lo[2]), h(hi[0], hi[1], hi[2]);
+      out.center = c + 0.5 * (l + h);
+      out.radius += 0.5 * (h - l).norm() + joint.error + 8.0 * kEps * (c.norm() + out.center.norm());
+      break;
+    }
+    case JointType::Rotation3d: {
+      const Vec3 l(lo[0], lo[1], lo[2]), h(hi[0], hi[1], hi[2]);
+      out.center = rotationFromVector(0.5 * (l + h)) * c;
+      const double angle = 0.5 * (h - l).norm() + joint.error;
+      const double chord = angle >= 3.141592653589793 ? 2.0 : 2.0 * std::sin(0.5 * angle);
+      out.radius += chord * c.norm() * (1.0 + 4.0 * kEps) + 16.0 * kEps * c.norm();
+      break;
+    }
+  }
+  out.center = joint.origin * out.center;
+  out.radius += 8.0 * kEps * (out.center.norm() + joint.origin.translation().norm());
+  return out;
 }
 
 Sphere boundingSphere(std::span<const Vec3> pts, double radius) noexcept {

@@ -76,7 +76,7 @@ int runQuery(const QueryArgs& args) {
       const BodyPair& p = m.pairs[pd.pair];
       nlohmann::json o{{"a", m.bodies[p.a].name}, {"b", m.bodies[p.b].name}, {"frame", m.frameName(p.lca)},
                        {"distance", pd.distance}, {"fresh", pd.fresh}};
-      if (pd.fresh) {
+      if (pd.has_witness) {
         o["witness_a"] = vec3(pd.witness_a);
         o["witness_b"] = vec3(pd.witness_b);
       }

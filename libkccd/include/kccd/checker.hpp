@@ -42,8 +42,9 @@ struct QueryOptions {
 struct PairDistance {
   int pair = -1;            ///< index into Model::pairs
   double distance = 0.0;
-  bool fresh = false;       ///< computed in this query (witness points valid for this box)
-  Vec3 witness_a = Vec3::Zero();  ///< in the pair's LCA frame
+  bool fresh = false;       ///< recomputed in this query (else carried over from earlier ones)
+  bool has_witness = false; ///< fresh and computed by GJK: witness points are valid
+  Vec3 witness_a = Vec3::Zero();  ///< closest points found, in the pair's LCA frame
   Vec3 witness_b = Vec3::Zero();
 };
 
@@ -95,19 +96,23 @@ class Checker {
     int capacity = 0;
     int count = 0;
     double radius = 0.0;
-    Sphere bound;
+    Sphere bound;          // around the points (valid with stamp)
+    Sphere swept_sphere;   // swept cheaply from the level below (valid with sphere_stamp)
     std::uint64_t stamp = 0;
+    std::uint64_t sphere_stamp = 0;
   };
   struct Entry {           // the any-time table
     bool valid = false;
     double bound = 0.0;    // lower bound for the box stored in box_
     double current = 0.0;  // bound valid for this query's box
+    bool gjk = false;      // the stored bound came from GJK (witness points valid)
     Vec3 direction = Vec3::UnitX();
     Vec3 witness_a = Vec3::Zero(), witness_b = Vec3::Zero();
   };
 
   bool validate(std::span<const double> lower, std::span<const double> upper) noexcept;
   const Volume* volume(int body, int level) noexcept;
+  const Sphere* sphere(int body, int level) noexcept;
   double refresh(int pair, double stop_above) noexcept;
   void publish(int pair, PairDistance& out) const noexcept;
 
@@ -123,6 +128,8 @@ class Checker {
   std::vector<double> box_;                  // per pair: lower[stateSize], upper[stateSize]
   std::vector<Vec3> scratch_;
   std::vector<double> scratch_dist_;
+  std::vector<double> scratch_rho_;
+  std::vector<int> scratch_level_, scratch_order_;
   std::vector<int> order_;
   std::vector<PairDistance> out_;
   std::vector<std::uint8_t> fresh_;          // per pair: recomputed in this query
