@@ -40,7 +40,7 @@ TEST(Cli, InfoListsStateNamesAndPairs) {
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["state"], nlohmann::json({"shoulder_yaw", "shoulder_pitch", "elbow"}));
-  EXPECT_EQ(j["totals"]["bodies"], 6);
+  EXPECT_EQ(j["totals"]["bodies"], 7);
   EXPECT_EQ(j["pairs"].size(), j["totals"]["pairs"].get<std::size_t>());
   EXPECT_EQ(kccd("info " + kDemo).code, 0);
 }
