@@ -198,20 +198,30 @@ inline int supportIndex(std::span<const Vec3> pts, const Vec3& d) {
   return best[pick(best_dot[cd] > best_dot[ab], cd, ab)];
 }
 
-// Largest absolute coordinate, or NaN when a value is not finite (one vectorisable pass over
-// the coordinates, which Vec3 stores contiguously).
-double maxAbsCoordinate(std::span<const Vec3> pts) {
-  static_assert(sizeof(Vec3) == 3 * sizeof(double));
-  const double* x = pts.data()->data();
-  const std::size_t count = 3 * pts.size();
+// One pass over a point set: its largest absolute coordinate (the rounding scale), whether every
+// coordinate is finite, and its centroid (a point of the hull, to start the descent from).
+struct SetSummary {
+  double scale = 0.0;
+  bool finite = true;
+  Vec3 centroid = Vec3::Zero();
+};
+
+SetSummary summarize(std::span<const Vec3> pts) {
+  SetSummary out;
   double m = 0.0;
-  unsigned bad = 0;  // set by NaN (fails every comparison) and by inf (> max)
-  for (std::size_t i = 0; i < count; ++i) {
-    const double a = std::abs(x[i]);
-    bad |= static_cast<unsigned>(!(a <= std::numeric_limits<double>::max()));
-    m = std::max(a, m);
+  double sx = 0.0, sy = 0.0, sz = 0.0;
+  for (const Vec3& p : pts) {
+    sx += p.x();
+    sy += p.y();
+    sz += p.z();
+    m = std::max(m, std::max(std::abs(p.x()), std::max(std::abs(p.y()), std::abs(p.z()))));
   }
-  return bad == 0 ? m : std::numeric_limits<double>::quiet_NaN();
+  out.centroid = Vec3(sx, sy, sz) / static_cast<double>(pts.size());
+  // A NaN or infinite coordinate makes its sum NaN or infinite (so does an overflowing sum, which
+  // is rejected as well); an infinity also shows in the maximum.
+  out.finite = out.centroid.allFinite() && m <= std::numeric_limits<double>::max();
+  out.scale = m;
+  return out;
 }
 
 }  // namespace
@@ -226,9 +236,10 @@ DistanceResult distance(const SschView& a, const SschView& b, const GjkOptions& 
       !std::isfinite(a.radius) || !std::isfinite(b.radius)) {
     return result;  // InvalidInput, distance 0
   }
-  const double scale_a = maxAbsCoordinate(a.points);
-  const double scale_b = maxAbsCoordinate(b.points);
-  if (!std::isfinite(scale_a) || !std::isfinite(scale_b)) return result;
+  const SetSummary sum_a = summarize(a.points);
+  const SetSummary sum_b = summarize(b.points);
+  if (!sum_a.finite || !sum_b.finite) return result;
+  const double scale_a = sum_a.scale, scale_b = sum_b.scale;
 
   // Rounding guard: the dot products behind a bound err by a few ulps of the coordinates.
   const double radii = a.radius + b.radius;
@@ -237,7 +248,8 @@ DistanceResult distance(const SschView& a, const SschView& b, const GjkOptions& 
   const double overlap_vv = overlap_tol * overlap_tol;
   const double tol = std::max(options.relative_tolerance, 0.0);
 
-  Vec3 v = a.points[0] - b.points[0];
+  // Start from the centroids' difference: a point of the Minkowski difference near its middle.
+  Vec3 v = sum_a.centroid - sum_b.centroid;
   if (options.warm_start != nullptr && options.warm_start->allFinite() &&
       options.warm_start->squaredNorm() > 0.0) {
     v = *options.warm_start;
@@ -248,7 +260,7 @@ DistanceResult distance(const SschView& a, const SschView& b, const GjkOptions& 
   GjkStatus status = GjkStatus::IterationLimit;
   int iter = 0;
   if (v.squaredNorm() <= overlap_vv) {
-    status = GjkStatus::Overlap;  // a common point: the very first pair coincides
+    status = GjkStatus::Overlap;  // the centroids (or the warm start) coincide: a common point
     lower = 0.0;
   } else {
     for (; iter < options.max_iterations; ++iter) {
@@ -272,7 +284,7 @@ DistanceResult distance(const SschView& a, const SschView& b, const GjkOptions& 
         status = GjkStatus::Converged;
         break;
       }
-      const Simplex previous = s;
+      const int previous_size = s.size;
       s.w[s.size] = w;
       s.ia[s.size] = ia;
       s.ib[s.size] = ib;
@@ -285,8 +297,7 @@ DistanceResult distance(const SschView& a, const SschView& b, const GjkOptions& 
         ++iter;
         break;
       }
-      if (next_vv >= vv && previous.size > 0) {  // rounding: no descent any more
-        s = previous;
+      if (next_vv >= vv && previous_size > 0) {  // rounding: no descent any more
         status = GjkStatus::NoProgress;
         ++iter;
         break;
@@ -297,8 +308,8 @@ DistanceResult distance(const SschView& a, const SschView& b, const GjkOptions& 
 
   result.iterations = iter;
   result.status = status;
-  Vec3 pa = a.points[0];
-  Vec3 pb = b.points[0];
+  Vec3 pa = sum_a.centroid;
+  Vec3 pb = sum_b.centroid;
   if (s.size > 0) {
     pa.setZero();
     pb.setZero();
