@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <string>
 
+#include <unistd.h>
+
 #include <nlohmann/json.hpp>
 
 namespace {
@@ -16,7 +18,9 @@ struct Outcome {
 };
 
 Outcome kccd(const std::string& args, bool merge_stderr = false) {
-  const std::string err_file = ::testing::TempDir() + "/kccd_stderr.txt";
+  static int calls = 0;  // one stderr file per call and process: ctest runs tests in parallel
+  const std::string err_file =
+      ::testing::TempDir() + "/kccd_stderr_" + std::to_string(getpid()) + "_" + std::to_string(++calls) + ".txt";
   const std::string cmd = std::string(KCCD_CLI) + " " + args + (merge_stderr ? " 2>&1" : " 2>" + err_file);
   Outcome r;
   FILE* pipe = popen(cmd.c_str(), "r");
@@ -29,6 +33,7 @@ Outcome kccd(const std::string& args, bool merge_stderr = false) {
       while (fgets(buf.data(), buf.size(), f) != nullptr) r.err += buf.data();
       fclose(f);
     }
+    std::remove(err_file.c_str());
   }
   return r;
 }

@@ -100,7 +100,7 @@ Checker::Checker(const Model& model) : model_(model) {
       int level = 0;
       for (; path_[level_begin_[b] + level] != pair.lca; ++level) {
         const Joint& j = model.joints[path_[level_begin_[b] + level]];
-        double* reach = &reach_[static_cast<std::size_t>(p) * ns + j.state_offset];
+        double* reach = reach_.data() + static_cast<std::size_t>(p) * ns + j.state_offset;
         switch (j.type) {
           case JointType::Fixed: break;
           case JointType::Revolute: reach[0] += extent; break;
@@ -298,9 +298,9 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
       e.current = 0.0;
       continue;
     }
-    const double* box_lo = &box_[static_cast<std::size_t>(p) * 2 * ns];
+    const double* box_lo = box_.data() + static_cast<std::size_t>(p) * 2 * ns;
     const double* box_hi = box_lo + ns;
-    const double* reach = &reach_[static_cast<std::size_t>(p) * ns];
+    const double* reach = reach_.data() + static_cast<std::size_t>(p) * ns;
     double moved = 0.0;
     for (int s = 0; s < ns; ++s) {
       if (reach[s] == 0.0) continue;
