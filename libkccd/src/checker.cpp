@@ -89,7 +89,7 @@ Checker::Checker(const Model& model) : model_(model) {
 
   // Per pair: the level of the LCA frame on each body's path, and how far each state value can
   // move the pair's core points per unit change (for keeping stored bounds valid).
-  reach_.assign(static_cast<std::size_t>(np) * ns, 0.0);
+  std::vector<double> dense(static_cast<std::size_t>(np) * ns, 0.0);
   for (int p = 0; p < np; ++p) {
     const BodyPair& pair = model.pairs[p];
     for (int side = 0; side < 2; ++side) {
@@ -100,7 +100,7 @@ Checker::Checker(const Model& model) : model_(model) {
       int level = 0;
       for (; path_[level_begin_[b] + level] != pair.lca; ++level) {
         const Joint& j = model.joints[path_[level_begin_[b] + level]];
-        double* reach = reach_.data() + static_cast<std::size_t>(p) * ns + j.state_offset;
+        double* reach = dense.data() + static_cast<std::size_t>(p) * ns + j.state_offset;
         switch (j.type) {
           case JointType::Fixed: break;
           case JointType::Revolute: reach[0] += extent; break;
@@ -118,8 +118,19 @@ Checker::Checker(const Model& model) : model_(model) {
       pair_level_.push_back(level);
     }
   }
+  // Keep only the state values that move the pair (a sparse list per pair).
+  reach_begin_.push_back(0);
+  for (int p = 0; p < np; ++p) {
+    for (int st = 0; st < ns; ++st) {
+      const double r = dense[static_cast<std::size_t>(p) * ns + st];
+      if (r == 0.0) continue;
+      reach_state_.push_back(st);
+      reach_.push_back(r);
+    }
+    reach_begin_.push_back(static_cast<int>(reach_.size()));
+  }
   table_.assign(np, Entry{});
-  box_.assign(static_cast<std::size_t>(np) * 2 * ns, 0.0);
+  box_.assign(2 * reach_.size(), 0.0);
   order_.resize(np);
   out_.resize(np);
   fresh_.assign(np, 0);
@@ -256,9 +267,10 @@ double Checker::refresh(int p, double stop_above) noexcept {
   e.valid = true;
   e.bound = bound;
   e.current = bound;
-  const int ns = model_.stateSize();
-  std::copy(lower_.begin(), lower_.end(), box_.begin() + static_cast<std::ptrdiff_t>(p) * 2 * ns);
-  std::copy(upper_.begin(), upper_.end(), box_.begin() + static_cast<std::ptrdiff_t>(p) * 2 * ns + ns);
+  for (int k = reach_begin_[p]; k < reach_begin_[p + 1]; ++k) {
+    box_[2 * k] = lower_[reach_state_[k]];
+    box_[2 * k + 1] = upper_[reach_state_[k]];
+  }
   return bound;
 }
 
@@ -288,7 +300,6 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   std::copy(lower.begin(), lower.end(), lower_.begin());
   std::copy(upper.begin(), upper.end(), upper_.begin());
   const int np = static_cast<int>(model_.pairs.size());
-  const int ns = model_.stateSize();
 
   // Carry every stored bound over to this box: unchanged while the box stays inside the stored
   // one, otherwise lowered by the most the pair's points can have moved (ALGORITHMS.md 5).
@@ -298,20 +309,24 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
       e.current = 0.0;
       continue;
     }
-    const double* box_lo = box_.data() + static_cast<std::size_t>(p) * 2 * ns;
-    const double* box_hi = box_lo + ns;
-    const double* reach = reach_.data() + static_cast<std::size_t>(p) * ns;
     double moved = 0.0;
-    for (int s = 0; s < ns; ++s) {
-      if (reach[s] == 0.0) continue;
-      const double grow = std::max({0.0, box_lo[s] - lower[s], upper[s] - box_hi[s]});
-      if (grow > 0.0) moved += reach[s] * grow;
+    for (int k = reach_begin_[p]; k < reach_begin_[p + 1]; ++k) {
+      const int st = reach_state_[k];
+      const double grow = std::max({0.0, box_[2 * k] - lower[st], upper[st] - box_[2 * k + 1]});
+      if (grow > 0.0) moved += reach_[k] * grow;
     }
     e.current = moved == 0.0 ? e.bound : std::max(0.0, (e.bound - moved) * (1.0 - 1e-12));
     if (!std::isfinite(e.current)) e.current = 0.0;
   }
+  // Refinement order: smallest bound first. Collision and closest queries only ever refine
+  // pairs within the margin, so only those need sorting.
   for (int p = 0; p < np; ++p) order_[p] = p;
-  std::sort(order_.begin(), order_.end(), [this](int x, int y) { return table_[x].current < table_[y].current; });
+  auto by_bound = [this](int x, int y) { return table_[x].current < table_[y].current; };
+  auto sorted_end = order_.end();
+  if (options.type == QueryType::Collision || options.type == QueryType::Closest) {
+    sorted_end = std::partition(order_.begin(), order_.end(), [&](int x) { return table_[x].current <= margin; });
+  }
+  std::sort(order_.begin(), sorted_end, by_bound);
 
   const bool timed = options.budget_us > 0.0;
   const Clock::time_point deadline =
@@ -334,8 +349,8 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   switch (options.type) {
     case QueryType::Collision: {
       int hit = -1;
-      for (int p : order_) {
-        if (table_[p].current > margin) break;  // every remaining bound clears the margin
+      for (auto it = order_.begin(); it != sorted_end; ++it) {
+        const int p = *it;  // every pair after sorted_end clears the margin already
         if (expired()) {
           hit = p;
           break;
@@ -351,8 +366,9 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
     }
     case QueryType::Closest: {
       double best = kInf;
-      for (int p : order_) {
-        if (table_[p].current > margin || table_[p].current >= best) break;
+      for (auto it = order_.begin(); it != sorted_end; ++it) {
+        const int p = *it;
+        if (table_[p].current >= best) break;
         if (expired()) break;
         run(p, std::min(best, margin));
         best = std::min(best, table_[p].current);
@@ -402,7 +418,7 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   if (options.type == QueryType::Closest && argmin >= 0 && min_distance <= margin) {
     publish(argmin, out_[count++]);
   } else if (options.type == QueryType::NClosest) {
-    std::sort(order_.begin(), order_.end(), [this](int x, int y) { return table_[x].current < table_[y].current; });
+    std::sort(order_.begin(), order_.end(), by_bound);
     const int n = std::min(std::max(options.n, 1), np);
     for (int k = 0; k < n; ++k) publish(order_[k], out_[count++]);
   } else if (options.type == QueryType::Distances) {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "kccd/distance.hpp"
+#include "sweep.hpp"
 
 namespace kccd {
 
@@ -61,19 +62,6 @@ Ssch Ssch::pruned(double tolerance) const {
   return Ssch(std::move(kept), radius_ + growth);
 }
 
-Sphere Ssch::boundingSphere() const {
-  Vec3 lo = points_.front(), hi = points_.front();
-  for (const Vec3& p : points_) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  Sphere s;
-  s.center = 0.5 * (lo + hi);
-  double r = 0.0;
-  for (const Vec3& p : points_) r = std::max(r, (p - s.center).norm());
-  // One ulp-scale guard so rounding in the centre never leaves a point outside.
-  s.radius = r * (1.0 + 4.0 * std::numeric_limits<double>::epsilon()) + radius_;
-  return s;
-}
+Sphere Ssch::boundingSphere() const { return detail::boundingSphere(points_, radius_); }
 
 }  // namespace kccd

@@ -123,9 +123,11 @@ class Checker {
   std::vector<Volume> volumes_;
   std::vector<int> path_;                    // per body and level: the joint swept from that level
   std::vector<int> pair_level_;              // per pair: level of a, level of b
-  std::vector<double> reach_;                // per pair and state value: movement per unit change
+  std::vector<int> reach_begin_;             // per pair: its range in reach_state_ / reach_
+  std::vector<int> reach_state_;             // state values that move the pair
+  std::vector<double> reach_;                // how far they move its core points per unit change
   std::vector<Entry> table_;
-  std::vector<double> box_;                  // per pair: lower[stateSize], upper[stateSize]
+  std::vector<double> box_;                  // per reach entry: the stored bound's lower, upper
   std::vector<Vec3> scratch_;
   std::vector<double> scratch_dist_;
   std::vector<double> scratch_rho_;
@@ -135,7 +137,7 @@ class Checker {
   std::vector<std::uint8_t> fresh_;          // per pair: recomputed in this query
   std::vector<double> nbest_;
   std::vector<double> lower_, upper_;
-  std::uint64_t cycle_ = 0;
+  std::uint64_t cycle_ = 1;                  // volumes stamped with it are current (0: never)
   QueryResult result_;
 };
 
