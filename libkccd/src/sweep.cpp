@@ -35,14 +35,19 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
   const double width = std::min(hi - lo, kTwoPi);
   const int pieces = revolutePieces(width);
   const int n_in = static_cast<int>(in.size());
+  // Points are written straight into the parent frame: with A = R_o axial + t, B = R_o radial and
+  // C = R_o (axis x radial), the point rotated by angle q is A + cos(q) B + sin(q) C.
+  const Eigen::Matrix3d& rot = j.origin.linear();
+  const Vec3& t = j.origin.translation();
+  const double in_norm = maxNorm(in);
   if (pieces == 0) {  // a single angle: exact
     const double c = std::cos(lo), s = std::sin(lo);
     for (int i = 0; i < n_in; ++i) {
       const Vec3 axial = a.dot(in[i]) * a;
       const Vec3 radial = in[i] - axial;
-      out[i] = axial + c * radial + s * a.cross(radial);
+      out[i] = rot * (axial + c * radial + s * a.cross(radial)) + t;
     }
-    radius += 16.0 * kEps * maxNorm(in);
+    radius += 32.0 * kEps * (in_norm + t.norm());
     return n_in;
   }
   const double step = width / pieces;
@@ -93,29 +98,32 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
     const Vec3& p = in[i];
     const Vec3 axial = a.dot(p) * a;
     const Vec3 radial = p - axial;
-    const Vec3 ortho = a.cross(radial);
     if (rho[i] <= 1e-12 * (1.0 + p.norm())) {  // on the axis: it stays within 2 rho of itself
-      out[n++] = p;
+      out[n++] = rot * p + t;
       growth = std::max(growth, 2.0 * rho[i]);
       continue;
     }
+    const Vec3 A = rot * axial + t;
+    const Vec3 B = rot * radial;
+    const Vec3 C = rot * a.cross(radial);
     switch (level[i]) {
       case 0:
-        out[n++] = axial + c_centre * radial + s_centre * ortho;
+        out[n++] = A + c_centre * B + s_centre * C;
         growth = std::max(growth, rho[i] * half_chord);
         break;
       case 1:
-        for (int k = 0; k <= pieces; ++k) out[n++] = axial + c_end[k] * radial + s_end[k] * ortho;
+        for (int k = 0; k <= pieces; ++k) out[n++] = A + c_end[k] * B + s_end[k] * C;
         growth = std::max(growth, rho[i] * sagitta);
         break;
       default:
-        for (int k = 0; k <= pieces; ++k) out[n++] = axial + c_end[k] * radial + s_end[k] * ortho;
-        for (int k = 0; k < pieces; ++k) out[n++] = axial + c_mid[k] * radial + s_mid[k] * ortho;
+        for (int k = 0; k <= pieces; ++k) out[n++] = A + c_end[k] * B + s_end[k] * C;
+        for (int k = 0; k < pieces; ++k) out[n++] = A + c_mid[k] * B + s_mid[k] * C;
         break;
     }
   }
-  // Rounding in the rotated points is a few ulps of their size.
-  radius += growth * (1.0 + 8.0 * kEps) + 16.0 * kEps * maxNorm(in);
+  // Rounding: the outputs (at most |p| / cos(step / 2) + |t| from the origin) err by a few ulps.
+  if (!std::isfinite(growth)) return -1;
+  radius += growth * (1.0 + 8.0 * kEps) + 32.0 * kEps * (in_norm / half_cos + t.norm());
   return n;
 }
 
@@ -146,8 +154,7 @@ int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span
       for (const Vec3& p : in) out[n++] = p;
       break;
     case JointType::Revolute:
-      n = sweepRevolute(joint, lo[0], hi[0], in, out, radius, budget, work);
-      break;
+      return sweepRevolute(joint, lo[0], hi[0], in, out, radius, budget, work);  // already in the parent frame
     case JointType::Prismatic:
       // Minkowski sum with the segment [lo, hi] along the axis: exact.
       for (const Vec3& p : in) out[n++] = p + lo[0] * joint.axis;
