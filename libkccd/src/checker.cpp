@@ -346,6 +346,7 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   };
 
   int count = 0;  // pairs reported
+  const int n_wanted = std::clamp(options.n, 1, std::max(np, 1));  // NClosest
   switch (options.type) {
     case QueryType::Collision: {
       int hit = -1;
@@ -376,7 +377,7 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
       break;
     }
     case QueryType::NClosest: {
-      const int n = std::clamp(options.n, 1, std::max(np, 1));
+      const int n = n_wanted;
       // best[0..fresh) holds the smallest fresh bounds so far, sorted.
       int fresh = 0;
       double* best = nbest_.data();
@@ -419,8 +420,7 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
     publish(argmin, out_[count++]);
   } else if (options.type == QueryType::NClosest) {
     std::sort(order_.begin(), order_.end(), by_bound);
-    const int n = std::min(std::max(options.n, 1), np);
-    for (int k = 0; k < n; ++k) publish(order_[k], out_[count++]);
+    for (int k = 0; k < std::min(n_wanted, np); ++k) publish(order_[k], out_[count++]);
   } else if (options.type == QueryType::Distances) {
     for (int p = 0; p < np; ++p) publish(p, out_[count++]);
   }
