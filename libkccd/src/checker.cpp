@@ -180,20 +180,23 @@ const Checker::Volume* Checker::volume(int body, int level) noexcept {
   if (below == nullptr) return nullptr;
   const Joint& joint = model_.joints[path_[idx - 1]];
   double radius = below->radius;
-  const std::span<const Vec3> in(points_.data() + below->offset, below->count);
   const detail::SweepWork work{scratch_rho_.data(), scratch_level_.data(), scratch_order_.data()};
-  int n = detail::sweepJoint(joint, lower_.data() + joint.state_offset, upper_.data() + joint.state_offset, in,
-                             scratch_.data(), radius, v.capacity, work);
+  int n = detail::sweepJoint(joint, lower_.data() + joint.state_offset, upper_.data() + joint.state_offset,
+                             view(*below).points, scratch_.data(), radius, v.capacity, work);
   if (n < 0) return nullptr;
   n = detail::reduceToBudget(scratch_.data(), n, v.capacity, scratch_dist_.data(), radius);
   std::copy(scratch_.begin(), scratch_.begin() + n, points_.begin() + v.offset);
   v.count = n;
   v.radius = radius;
-  v.bound = detail::boundingSphere({points_.data() + v.offset, static_cast<std::size_t>(n)}, radius);
+  v.bound = detail::boundingSphere(view(v).points, radius);
   if (!std::isfinite(v.bound.radius)) return nullptr;
   v.stamp = cycle_;
   ++result_.stats.volumes_swept;
   return &v;
+}
+
+SschView Checker::view(const Volume& v) const noexcept {
+  return {{points_.data() + v.offset, static_cast<std::size_t>(v.count)}, v.radius};
 }
 
 const Sphere* Checker::sphere(int body, int level) noexcept {
@@ -215,8 +218,7 @@ SschView Checker::sweptVolume(int body, int frame) noexcept {
   for (int level = 0; level < levels_[body]; ++level) {
     if (path_[level_begin_[body] + level] != frame) continue;
     const Volume* v = volume(body, level);
-    if (v == nullptr) return {};
-    return {{points_.data() + v->offset, static_cast<std::size_t>(v->count)}, v->radius};
+    return v == nullptr ? SschView{} : view(*v);
   }
   return {};
 }
@@ -242,27 +244,24 @@ double Checker::refresh(int p, double stop_above) noexcept {
   double bound = sphereGap(*sa, *sb);
   e.gjk = false;
   if (bound < stop_above) {
+    // Then the spheres around the swept points, then GJK on the points themselves.
     const Volume* va = volume(pair.a, la);
     const Volume* vb = volume(pair.b, lb);
     if (va == nullptr || vb == nullptr) return fail();
     bound = std::max(bound, sphereGap(va->bound, vb->bound));
-  }
-  if (bound < stop_above) {
-    const Volume* va = volume(pair.a, la);
-    const Volume* vb = volume(pair.b, lb);
-    GjkOptions opt;
-    opt.stop_above = stop_above;
-    opt.warm_start = &e.direction;
-    const DistanceResult d = distance({{points_.data() + va->offset, static_cast<std::size_t>(va->count)}, va->radius},
-                                      {{points_.data() + vb->offset, static_cast<std::size_t>(vb->count)}, vb->radius},
-                                      opt);
-    ++result_.stats.gjk_calls;
-    if (d.status == GjkStatus::InvalidInput) return fail();
-    bound = std::max(bound, d.distance);
-    e.direction = d.direction;
-    e.witness_a = d.witness_a;
-    e.witness_b = d.witness_b;
-    e.gjk = true;
+    if (bound < stop_above) {
+      GjkOptions opt;
+      opt.stop_above = stop_above;
+      opt.warm_start = &e.direction;
+      const DistanceResult d = distance(view(*va), view(*vb), opt);
+      ++result_.stats.gjk_calls;
+      if (d.status == GjkStatus::InvalidInput) return fail();
+      bound = std::max(bound, d.distance);
+      e.direction = d.direction;
+      e.witness_a = d.witness_a;
+      e.witness_b = d.witness_b;
+      e.gjk = true;
+    }
   }
   e.valid = true;
   e.bound = bound;

@@ -72,16 +72,15 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
   int* level = work.level;
   double* rho = work.rho;
   int* order = work.order;
+  const bool fits = n_in * cost[top] <= budget;
   for (int i = 0; i < n_in; ++i) {
     rho[i] = (in[i] - a.dot(in[i]) * a).norm();
-    level[i] = top;
+    level[i] = fits ? top : 0;
     order[i] = i;
   }
-  if (n_in * cost[top] > budget) {
+  if (!fits) {
     std::sort(order, order + n_in, [rho](int x, int y) { return rho[x] > rho[y]; });
-    int total = 0;
-    for (int i = 0; i < n_in; ++i) level[i] = 0;
-    total = n_in;
+    int total = n_in;
     for (int up = 1; up <= top; ++up) {
       for (int k = 0; k < n_in; ++k) {
         const int i = order[k];
@@ -127,11 +126,30 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
   return n;
 }
 
+// A 3-DOF joint's interval box [lo, hi]: its centre and the radius of the ball around the centre
+// that holds the box, widened by the joint's error bound.
+struct Box3 {
+  Vec3 centre;
+  double reach;
+};
+
+Box3 box3(const Joint& joint, const double* lo, const double* hi) {
+  const Vec3 l(lo[0], lo[1], lo[2]), h(hi[0], hi[1], hi[2]);
+  return {0.5 * (l + h), 0.5 * (h - l).norm() + joint.error};
+}
+
 // Rotation by a rotation vector (Rodrigues).
 Eigen::Matrix3d rotationFromVector(const Vec3& w) {
   const double angle = w.norm();
   if (angle == 0.0) return Eigen::Matrix3d::Identity();
   return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+}
+
+// Every rotation vector in the box lies within |half-diagonal| of its centre, and exp is
+// 1-Lipschitz on SO(3): the rotation differs from the centre's by at most box.reach radians, which
+// moves a point p by at most the returned factor times |p| (2 sin(angle / 2), 2 beyond pi).
+double rotationChord(const Box3& box) {
+  return box.reach >= 3.141592653589793 ? 2.0 : 2.0 * std::sin(0.5 * box.reach);
 }
 
 }  // namespace
@@ -147,14 +165,15 @@ int sweepExpansion(const Joint& joint) noexcept {
 
 int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span<const Vec3> in, Vec3* out,
                double& radius, int budget, SweepWork work) noexcept {
+  if (joint.type == JointType::Revolute)  // writes straight into the parent frame
+    return sweepRevolute(joint, lo[0], hi[0], in, out, radius, budget, work);
   int n = 0;
   const double in_norm = maxNorm(in);
   switch (joint.type) {
     case JointType::Fixed:
+    case JointType::Revolute:
       for (const Vec3& p : in) out[n++] = p;
       break;
-    case JointType::Revolute:
-      return sweepRevolute(joint, lo[0], hi[0], in, out, radius, budget, work);  // already in the parent frame
     case JointType::Prismatic:
       // Minkowski sum with the segment [lo, hi] along the axis: exact.
       for (const Vec3& p : in) out[n++] = p + lo[0] * joint.axis;
@@ -164,22 +183,18 @@ int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span
       break;
     case JointType::Translation3d: {
       // Translate by the box centre; the ball around it covers the box and the error bound.
-      const Vec3 l(lo[0], lo[1], lo[2]), h(hi[0], hi[1], hi[2]);
-      const Vec3 centre = 0.5 * (l + h);
-      for (const Vec3& p : in) out[n++] = p + centre;
-      radius += 0.5 * (h - l).norm() + joint.error + 8.0 * kEps * (in_norm + centre.norm());
+      const Box3 box = box3(joint, lo, hi);
+      for (const Vec3& p : in) out[n++] = p + box.centre;
+      radius += box.reach + 8.0 * kEps * (in_norm + box.centre.norm());
       break;
     }
     case JointType::Rotation3d: {
-      // Rotate by the box centre. Every rotation vector in the box lies within |half-diagonal|
-      // of it, and exp is 1-Lipschitz on SO(3), so the extra angle is at most that plus the
-      // error bound; a point then moves at most 2 sin(angle / 2) |p|.
-      const Vec3 l(lo[0], lo[1], lo[2]), h(hi[0], hi[1], hi[2]);
-      const Eigen::Matrix3d rot = rotationFromVector(0.5 * (l + h));
+      // Rotate by the box centre; every other rotation in the box moves a point by at most
+      // rotationChord() |p|.
+      const Box3 box = box3(joint, lo, hi);
+      const Eigen::Matrix3d rot = rotationFromVector(box.centre);
       for (const Vec3& p : in) out[n++] = rot * p;
-      const double angle = 0.5 * (h - l).norm() + joint.error;
-      const double chord = angle >= 3.141592653589793 ? 2.0 : 2.0 * std::sin(0.5 * angle);
-      radius += chord * in_norm * (1.0 + 4.0 * kEps) + 16.0 * kEps * in_norm;
+      radius += rotationChord(box) * in_norm * (1.0 + 4.0 * kEps) + 16.0 * kEps * in_norm;
       break;
     }
   }
@@ -258,17 +273,15 @@ Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const
       out.radius += 0.5 * (hi[0] - lo[0]) + 8.0 * kEps * (c.norm() + std::abs(lo[0]) + std::abs(hi[0]));
       break;
     case JointType::Translation3d: {
-      const Vec3 l(lo[0], lo[1], lo[2]), h(hi[0], hi[1], hi[2]);
-      out.center = c + 0.5 * (l + h);
-      out.radius += 0.5 * (h - l).norm() + joint.error + 8.0 * kEps * (c.norm() + out.center.norm());
+      const Box3 box = box3(joint, lo, hi);
+      out.center = c + box.centre;
+      out.radius += box.reach + 8.0 * kEps * (c.norm() + out.center.norm());
       break;
     }
     case JointType::Rotation3d: {
-      const Vec3 l(lo[0], lo[1], lo[2]), h(hi[0], hi[1], hi[2]);
-      out.center = rotationFromVector(0.5 * (l + h)) * c;
-      const double angle = 0.5 * (h - l).norm() + joint.error;
-      const double chord = angle >= 3.141592653589793 ? 2.0 : 2.0 * std::sin(0.5 * angle);
-      out.radius += chord * c.norm() * (1.0 + 4.0 * kEps) + 16.0 * kEps * c.norm();
+      const Box3 box = box3(joint, lo, hi);
+      out.center = rotationFromVector(box.centre) * c;
+      out.radius += rotationChord(box) * c.norm() * (1.0 + 4.0 * kEps) + 16.0 * kEps * c.norm();
       break;
     }
   }

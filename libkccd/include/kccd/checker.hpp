@@ -112,6 +112,7 @@ class Checker {
 
   bool validate(std::span<const double> lower, std::span<const double> upper) noexcept;
   const Volume* volume(int body, int level) noexcept;
+  SschView view(const Volume& v) const noexcept;
   const Sphere* sphere(int body, int level) noexcept;
   double refresh(int pair, double stop_above) noexcept;
   void publish(int pair, PairDistance& out) const noexcept;
