@@ -7,6 +7,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev
   libfcl-dev libqhull-dev
+  libcoin-dev inventor-data liburdfdom-dev
+  libosmesa6-dev libgl-dev libopencv-dev
 )
 missing=()
 for p in "${packages[@]}"; do
