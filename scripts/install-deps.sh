@@ -8,7 +8,7 @@ packages=(
   nlohmann-json3-dev
   libfcl-dev libqhull-dev
   libcoin-dev inventor-data liburdfdom-dev
-  libosmesa6-dev libgl-dev libopencv-dev
+  libosmesa6-dev libgl-dev libopencv-dev libtinyxml2-dev
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,6 +1,9 @@
 #include "cli_util.hpp"
 
 #include <cmath>
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <sstream>
 
 namespace kccd::cli {
@@ -38,6 +41,83 @@ Model loadOrExplain(const std::string& path) {
   } catch (const ModelError& e) {
     throw UsageError(e.what());
   }
+}
+
+}  // namespace kccd::cli
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <unistd.h>
+
+namespace kccd::cli {
+namespace {
+double nowSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
+Progress::Progress(std::string what, bool quiet)
+    : what_(std::move(what)), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0), last_time_(nowSeconds()) {}
+
+Progress::~Progress() { finish(); }
+
+void Progress::update(double fraction) {
+  if (quiet_ || finished_) return;
+  fraction = std::clamp(fraction, 0.0, 1.0);
+  const double t = nowSeconds();
+  if (tty_) {
+    if (fraction - last_ < 0.01 && fraction < 1.0) return;
+    const int width = 30, filled = static_cast<int>(fraction * width);
+    std::cerr << "\r" << what_ << " [" << std::string(filled, '#') << std::string(width - filled, ' ') << "] "
+              << static_cast<int>(fraction * 100) << "%" << std::flush;
+    shown_ = true;
+  } else if (t - last_time_ >= 5.0) {
+    std::cerr << what_ << ": " << static_cast<int>(fraction * 100) << "%\n";
+    last_time_ = t;
+  }
+  last_ = fraction;
+}
+
+void Progress::finish() {
+  if (finished_) return;
+  finished_ = true;
+  if (shown_) std::cerr << "\r" << std::string(what_.size() + 40, ' ') << "\r" << std::flush;
+}
+
+void writeFileAtomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".kccd-tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw UsageError(path + ": cannot write (" + std::strerror(errno) + ")");
+    out << text;
+    out.flush();
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw UsageError(path + ": write failed");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw UsageError(path + ": cannot replace the file (" + ec.message() + ")");
+  }
+}
+
+std::string format(double value, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+  return buf;
+}
+
+std::string formatUp(double value, int digits) {
+  std::string s = format(value, digits);
+  double step = std::abs(value) * std::pow(10.0, -digits + 1);
+  for (int i = 0; std::stod(s) < value && i < 64; ++i) s = format(value + step * (i + 1) / 4.0, digits);
+  return s;
 }
 
 }  // namespace kccd::cli

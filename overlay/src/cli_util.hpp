@@ -28,3 +28,34 @@ nlohmann::json vec3(const Vec3& v);
 Model loadOrExplain(const std::string& path);
 
 }  // namespace kccd::cli
+
+namespace kccd::cli {
+
+/// Progress of long work on stderr: a bar on a terminal, a line every few seconds otherwise,
+/// nothing when quiet.
+class Progress {
+ public:
+  Progress(std::string what, bool quiet);
+  ~Progress();
+  /// Reports the fraction done (0 ... 1).
+  void update(double fraction);
+  /// Ends the display (also done by the destructor).
+  void finish();
+
+ private:
+  std::string what_;
+  bool quiet_, tty_, shown_ = false, finished_ = false;
+  double last_ = -1.0;
+  double last_time_ = 0.0;
+};
+
+/// Writes `text` to `path` through a temporary file and a rename: readers never see a partial
+/// file. Throws UsageError naming the path.
+void writeFileAtomically(const std::string& path, const std::string& text);
+
+/// Prints a number with `digits` significant digits, rounded up (for radii that must not shrink).
+std::string formatUp(double value, int digits = 10);
+/// Prints a number with `digits` significant digits (nearest).
+std::string format(double value, int digits = 10);
+
+}  // namespace kccd::cli

@@ -11,5 +11,8 @@ using Runner = std::function<int()>;
 
 Runner addInfo(CLI::App& app);
 Runner addQuery(CLI::App& app);
+Runner addFit(CLI::App& app);
+Runner addPairs(CLI::App& app);
+Runner addImport(CLI::App& app);
 
 }  // namespace kccd::cli

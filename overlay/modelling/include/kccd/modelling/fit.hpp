@@ -1,0 +1,43 @@
+// Fitting a conservative SSCH to a rigid part: few core points, smallest volume, every point of
+// the part inside.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "kccd/modelling/part.hpp"
+
+namespace kccd::modelling {
+
+struct FitOptions {
+  int points = 8;                  ///< number of core points K (1 ... 16)
+  int max_evaluations = 6000;      ///< optimiser budget (volume evaluations)
+  std::uint64_t seed = 1;          ///< for the optimiser's random search directions
+  std::function<void(double)> progress;  ///< called with the fraction done (0 ... 1), optional
+};
+
+/// A fitted SSCH and what it costs: its volume against the part's hull and two simple baselines.
+struct FitResult {
+  std::vector<Vec3> points;
+  double radius = 0.0;
+  double volume = 0.0;           ///< of the SSCH (closed form)
+  double hull_volume = 0.0;      ///< of the part's convex hull
+  double sphere_volume = 0.0;    ///< baseline: smallest enclosing sphere found (K = 1)
+  double capsule_volume = 0.0;   ///< baseline: capsule on the principal axis (K = 2)
+  int hull_vertices = 0;
+  int evaluations = 0;
+};
+
+/// Fits K core points minimising the SSCH volume, then sets the radius exactly (conservative).
+/// Throws std::invalid_argument when K is out of range or the part is empty.
+FitResult fit(const Part& part, const FitOptions& options = {});
+
+/// The smallest radius r such that conv(core) ⊕ ball(r) contains the part (rounding covered).
+double coveringRadius(std::span<const Vec3> core, const Part& part);
+
+/// Volume of conv(points) ⊕ ball(radius) (Steiner's formula).
+double sschVolume(std::span<const Vec3> points, double radius);
+
+}  // namespace kccd::modelling

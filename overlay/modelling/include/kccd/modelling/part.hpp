@@ -1,0 +1,52 @@
+// The geometry of one rigid part, reduced to what a conservative fit needs: points and balls
+// whose convex hull contains every point of the part.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "kccd/ssch.hpp"
+
+namespace kccd::modelling {
+
+/// Points and exact balls whose convex hull contains the part. Curved primitives are covered
+/// from outside (circumscribed polygons), never by an inscribed tessellation.
+struct Part {
+  std::vector<Vec3> points;
+  std::vector<Sphere> balls;
+  int triangles = 0;            ///< mesh triangles read
+  int primitives = 0;           ///< analytic spheres, cylinders and cones covered exactly
+  double coordinate_guard = 0.0;  ///< extra radius for single-precision input (metres)
+
+  bool empty() const { return points.empty() && balls.empty(); }
+  /// Every point and every ball's surface sampled densely (for hulls, reports and tests).
+  std::vector<Vec3> samples(int per_ball = 162) const;
+
+  /// A ball of `radius` around `center` mapped by `transform` (an ellipsoid when it scales
+  /// unevenly: then covered by a circumscribed polyhedron).
+  void addSphere(const Eigen::Affine3d& transform, double radius);
+  /// A cylinder along local y, centred at the origin (Open Inventor / VRML / URDF-after-rotation).
+  void addCylinderY(const Eigen::Affine3d& transform, double radius, double height);
+  /// A cone along local y, base (bottom_radius) at y = -height/2, apex at +height/2.
+  void addConeY(const Eigen::Affine3d& transform, double bottom_radius, double height);
+  /// An axis-aligned box of the given full sizes, centred at the origin.
+  void addBox(const Eigen::Affine3d& transform, const Vec3& size);
+  /// Appends another part's geometry.
+  void append(const Part& other);
+};
+
+/// Which part of a file to read.
+struct ReadOptions {
+  std::string part;    ///< name of a DEF'd node to read alone; empty: the whole file
+  bool merge = false;  ///< accept several top-level parts as one rigid body
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();  ///< applied in the file's frame (URDF mesh scale)
+};
+
+/// Reads an Open Inventor (.iv, ASCII or binary), VRML 1/2 (.wrl) or STL file through Coin3D,
+/// all transforms applied. Throws std::runtime_error with a one-line message naming the file.
+Part readPart(const std::string& path, const ReadOptions& options = {});
+
+/// Vertices of a polyhedron that contains the unit ball (its faces touch the ball from outside).
+const std::vector<Vec3>& circumscribedUnitSphere();
+
+}  // namespace kccd::modelling

@@ -1,0 +1,339 @@
+#include "kccd/modelling/fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+
+#include "kccd/distance.hpp"
+#include "kccd/modelling/convex_hull.hpp"
+
+namespace kccd::modelling {
+namespace {
+
+constexpr int kMaxCorePoints = 16;
+constexpr int kMaxConstraintPoints = 384;
+
+// Distance from x to conv(core): an upper bound (the closest point found lies in the hull).
+double hullDistanceUpper(const Vec3& x, std::span<const Vec3> core) {
+  const DistanceResult d = distance(SschView{std::span<const Vec3>(&x, 1), 0.0}, SschView{core, 0.0});
+  return d.hull_upper;
+}
+
+// What the optimiser must cover: hull vertices (reduced to extreme points) and balls.
+struct Constraints {
+  std::vector<Vec3> points;
+  std::vector<Sphere> balls;
+  double diameter = 0.0;
+  Vec3 center = Vec3::Zero();
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  // principal axes of the part
+};
+
+std::vector<Vec3> fibonacciDirections(int n) {
+  std::vector<Vec3> d;
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / n;
+    const double r = std::sqrt(1.0 - z * z);
+    d.emplace_back(r * std::cos(golden * i), r * std::sin(golden * i), z);
+  }
+  return d;
+}
+
+class Objective {
+ public:
+  explicit Objective(const Constraints& c) : c_(c), last_worst_(0) {}
+
+  double radius(std::span<const Vec3> core) {
+    double r = 0.0;
+    auto consider = [&](const Vec3& x, double grow) {
+      double cheap = std::numeric_limits<double>::infinity();  // distance to the nearest core point
+      for (const Vec3& p : core) cheap = std::min(cheap, (x - p).squaredNorm());
+      if (std::sqrt(cheap) + grow <= r) return false;
+      const DistanceResult d = distance(SschView{std::span<const Vec3>(&x, 1), 0.0}, SschView{core, 0.0}, options_);
+      const double v = d.hull_upper + grow;
+      if (v > r) {
+        r = v;
+        return true;
+      }
+      return false;
+    };
+    if (last_worst_ < c_.points.size()) consider(c_.points[last_worst_], 0.0);
+    for (std::size_t i = 0; i < c_.points.size(); ++i)
+      if (consider(c_.points[i], 0.0)) last_worst_ = i;
+    for (const Sphere& b : c_.balls) consider(b.center, b.radius);
+    return r;
+  }
+
+  double operator()(std::span<const Vec3> core) {
+    ++evaluations;
+    return convexHull(core).sschVolume(radius(core));
+  }
+
+  int evaluations = 0;
+
+ private:
+  const Constraints& c_;
+  std::size_t last_worst_;
+  GjkOptions options_{.max_iterations = 64, .relative_tolerance = 1e-9};
+};
+
+Constraints buildConstraints(const Part& part, int& hull_vertex_count) {
+  Constraints c;
+  c.balls = part.balls;
+  if (!part.points.empty()) {
+    const ConvexHull h = convexHull(part.points);
+    for (int i : h.vertices) c.points.push_back(part.points[i]);
+  }
+  hull_vertex_count = static_cast<int>(c.points.size());
+  if (c.points.size() > static_cast<std::size_t>(kMaxConstraintPoints)) {
+    // Keep the extreme vertex in many directions; the final radius uses every vertex.
+    std::vector<Vec3> kept;
+    std::vector<char> used(c.points.size(), 0);
+    for (const Vec3& d : fibonacciDirections(kMaxConstraintPoints)) {
+      std::size_t best = 0;
+      for (std::size_t i = 1; i < c.points.size(); ++i)
+        if (c.points[i].dot(d) > c.points[best].dot(d)) best = i;
+      if (!used[best]) used[best] = 1, kept.push_back(c.points[best]);
+    }
+    c.points = std::move(kept);
+  }
+  const std::vector<Vec3> all = part.samples(12);
+  Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+  for (const Vec3& v : all) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  c.center = (lo + hi) / 2.0;
+  c.diameter = (hi - lo).norm();
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& v : all) mean += v;
+  mean /= static_cast<double>(all.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Vec3& v : all) cov += (v - mean) * (v - mean).transpose();
+  c.axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
+  return c;
+}
+
+// Farthest-point selection of k seeds among the constraint points (and ball centres).
+std::vector<Vec3> farthestPoints(const std::vector<Vec3>& pool, const Vec3& center, int k) {
+  std::vector<Vec3> out;
+  std::vector<double> d(pool.size(), INFINITY);
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < pool.size(); ++i)
+    if ((pool[i] - center).squaredNorm() > (pool[next] - center).squaredNorm()) next = i;
+  for (int j = 0; j < k && j < static_cast<int>(pool.size()); ++j) {
+    out.push_back(pool[next]);
+    for (std::size_t i = 0; i < pool.size(); ++i) d[i] = std::min(d[i], (pool[i] - pool[next]).squaredNorm());
+    next = static_cast<std::size_t>(std::max_element(d.begin(), d.end()) - d.begin());
+  }
+  while (static_cast<int>(out.size()) < k) out.push_back(out.empty() ? center : out.back());
+  return out;
+}
+
+std::vector<Vec3> kMeans(const std::vector<Vec3>& pool, std::vector<Vec3> seeds) {
+  for (int iter = 0; iter < 12; ++iter) {
+    std::vector<Vec3> sum(seeds.size(), Vec3::Zero());
+    std::vector<int> count(seeds.size(), 0);
+    for (const Vec3& p : pool) {
+      std::size_t best = 0;
+      for (std::size_t j = 1; j < seeds.size(); ++j)
+        if ((p - seeds[j]).squaredNorm() < (p - seeds[best]).squaredNorm()) best = j;
+      sum[best] += p;
+      ++count[best];
+    }
+    for (std::size_t j = 0; j < seeds.size(); ++j)
+      if (count[j] > 0) seeds[j] = sum[j] / count[j];
+  }
+  return seeds;
+}
+
+std::vector<Vec3> scaled(const std::vector<Vec3>& core, const Vec3& center, double s) {
+  std::vector<Vec3> out(core.size());
+  for (std::size_t j = 0; j < core.size(); ++j) out[j] = center + s * (core[j] - center);
+  return out;
+}
+
+// Best uniform shrink of a seed set towards `center` (golden-section search on the factor).
+std::vector<Vec3> bestShrink(const std::vector<Vec3>& core, const Vec3& center, double hi, Objective& f,
+                             double& value) {
+  double a = 0.0, b = hi;
+  const double g = (std::sqrt(5.0) - 1.0) / 2.0;
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  double f1 = f(scaled(core, center, x1)), f2 = f(scaled(core, center, x2));
+  for (int i = 0; i < 24; ++i) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1, x1 = b - g * (b - a), f1 = f(scaled(core, center, x1));
+    } else {
+      a = x1, x1 = x2, f1 = f2, x2 = a + g * (b - a), f2 = f(scaled(core, center, x2));
+    }
+  }
+  const double s = f1 < f2 ? x1 : x2;
+  value = std::min(f1, f2);
+  return scaled(core, center, s);
+}
+
+// Pattern search in randomly rotated frames (a rotating frame avoids the stalls of a fixed
+// compass on the ridges of a max function).
+std::vector<Vec3> patternSearch(std::vector<Vec3> core, double value, const Constraints& c, Objective& f,
+                                const FitOptions& options, std::mt19937_64& rng) {
+  double step = 0.125 * c.diameter;
+  const double min_step = 1e-6 * c.diameter;
+  const int budget = options.max_evaluations;
+  const int start = f.evaluations;
+  std::normal_distribution<double> normal;
+  int failures = 0, sweep = 0;
+  while (step > min_step && f.evaluations - start < budget) {
+    bool improved = false;
+    Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+    // The part's principal frame on every other sweep, a random one in between.
+    const Eigen::Matrix3d frame = sweep++ % 2 == 0 ? c.axes : q.normalized().toRotationMatrix();
+    for (std::size_t j = 0; j < core.size(); ++j) {
+      for (int axis = 0; axis < 3; ++axis) {
+        for (double sign : {1.0, -1.0}) {
+          std::vector<Vec3> trial = core;
+          trial[j] += sign * step * frame.col(axis);
+          double v = f(trial);
+          if (v < value) {
+            core = trial, value = v, improved = true;
+            // Keep going while it pays.
+            for (int k = 0; k < 4; ++k) {
+              trial[j] += sign * step * frame.col(axis);
+              v = f(trial);
+              if (v >= value) break;
+              core = trial, value = v;
+            }
+          }
+        }
+      }
+    }
+    // Collective moves: a single point rarely lowers the radius alone, but the whole set
+    // scaled along one direction, or moved, often does.
+    Vec3 mean = Vec3::Zero();
+    for (const Vec3& p : core) mean += p;
+    mean /= static_cast<double>(core.size());
+    const double rel = step / c.diameter * 2.0;
+    auto collective = [&](const Eigen::Matrix3d& map, const Vec3& shift) {
+      std::vector<Vec3> trial(core.size());
+      for (std::size_t j = 0; j < core.size(); ++j) trial[j] = mean + map * (core[j] - mean) + shift;
+      const double v = f(trial);
+      if (v < value) core = trial, value = v, improved = true;
+    };
+    for (double sign : {-1.0, 1.0}) {
+      collective(Eigen::Matrix3d::Identity() * (1.0 + sign * rel), Vec3::Zero());
+      for (int axis = 0; axis < 3; ++axis) {
+        const Vec3 d = frame.col(axis);
+        collective(Eigen::Matrix3d::Identity() + sign * rel * d * d.transpose(), Vec3::Zero());
+        collective(Eigen::Matrix3d::Identity(), sign * step * d);
+      }
+    }
+    if (improved) {
+      failures = 0;
+    } else if (++failures >= 2) {
+      step *= 0.5;
+      failures = 0;
+    }
+    if (options.progress)
+      options.progress(std::min(1.0, std::max(std::log(c.diameter / 8.0 / step) / std::log(c.diameter / 8.0 / min_step),
+                                              double(f.evaluations - start) / budget)));
+  }
+  return core;
+}
+
+}  // namespace
+
+double sschVolume(std::span<const Vec3> points, double radius) { return convexHull(points).sschVolume(radius); }
+
+double coveringRadius(std::span<const Vec3> core, const Part& part) {
+  double r = 0.0, scale = 0.0;
+  for (const Vec3& p : core) scale = std::max(scale, p.cwiseAbs().maxCoeff());
+  if (!part.points.empty()) {
+    const ConvexHull h = convexHull(part.points);
+    for (int i : h.vertices) {
+      r = std::max(r, hullDistanceUpper(part.points[i], core));
+      scale = std::max(scale, part.points[i].cwiseAbs().maxCoeff());
+    }
+  }
+  for (const Sphere& b : part.balls) {
+    r = std::max(r, hullDistanceUpper(b.center, core) + b.radius);
+    scale = std::max(scale, b.center.cwiseAbs().maxCoeff() + b.radius);
+  }
+  // Rounding of the distance computation (a few ulps of the coordinates) and of the input.
+  return r + 16.0 * std::numeric_limits<double>::epsilon() * scale + part.coordinate_guard;
+}
+
+FitResult fit(const Part& part, const FitOptions& options) {
+  if (options.points < 1 || options.points > kMaxCorePoints)
+    throw std::invalid_argument("the number of core points must be 1 ... " + std::to_string(kMaxCorePoints) +
+                                " (got " + std::to_string(options.points) + ")");
+  if (part.empty()) throw std::invalid_argument("the part has no geometry");
+  FitResult result;
+  const Constraints c = buildConstraints(part, result.hull_vertices);
+  result.hull_volume = convexHull(part.samples()).volume;
+  std::mt19937_64 rng(options.seed);
+
+  std::vector<Vec3> pool = c.points;
+  for (const Sphere& b : c.balls) pool.push_back(b.center);
+
+  auto optimise = [&](int k, const FitOptions& opt) {
+    Objective f(c);
+    std::vector<std::vector<Vec3>> seeds;
+    const std::vector<Vec3> fps = farthestPoints(pool, c.center, k);
+    seeds.push_back(fps);
+    if (k > 1 && static_cast<int>(pool.size()) > k) seeds.push_back(kMeans(pool, fps));
+    std::vector<Vec3> best;
+    double best_value = INFINITY;
+    for (const auto& s : seeds) {
+      Vec3 mean = Vec3::Zero();
+      for (const Vec3& p : s) mean += p;
+      mean /= static_cast<double>(s.size());
+      double v = 0.0;
+      std::vector<Vec3> shrunk = bestShrink(s, mean, 1.5, f, v);
+      if (v < best_value) best = shrunk, best_value = v;
+    }
+    best = patternSearch(best, best_value, c, f, opt, rng);
+    result.evaluations += f.evaluations;
+    return best;
+  };
+
+  result.points = optimise(options.points, options);
+  result.radius = coveringRadius(result.points, part);
+  result.volume = sschVolume(result.points, result.radius);
+
+  // Baselines: the smallest enclosing sphere found, and the capsule on the principal axis.
+  FitOptions quick = options;
+  quick.progress = nullptr;
+  quick.max_evaluations = 600;
+  const std::vector<Vec3> centre = options.points == 1 ? result.points : optimise(1, quick);
+  result.sphere_volume = sschVolume(centre, coveringRadius(centre, part));
+
+  const std::vector<Vec3> samples = part.samples(42);
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& p : samples) mean += p;
+  mean /= static_cast<double>(samples.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Vec3& p : samples) cov += (p - mean) * (p - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pca(cov);
+  result.capsule_volume = INFINITY;
+  for (int k = 0; k < 3; ++k) {  // the best of the three principal axes
+    const Vec3 axis = pca.eigenvectors().col(k);
+    double rad = 0.0;
+    for (const Vec3& p : samples) rad = std::max(rad, ((p - mean) - axis * axis.dot(p - mean)).norm());
+    double a = INFINITY, b = -INFINITY;  // segment [a, b] along the axis covering every sample
+    for (const Vec3& p : samples) {
+      const double t = axis.dot(p - mean);
+      const double d = ((p - mean) - axis * t).norm();
+      const double h = std::sqrt(std::max(0.0, rad * rad - d * d));
+      a = std::min(a, t + h);
+      b = std::max(b, t - h);
+    }
+    if (a > b) a = b = (a + b) / 2.0;
+    const std::vector<Vec3> segment{mean + a * axis, mean + b * axis};
+    result.capsule_volume = std::min(result.capsule_volume, sschVolume(segment, coveringRadius(segment, part)));
+  }
+  if (options.progress) options.progress(1.0);
+  return result;
+}
+
+}  // namespace kccd::modelling

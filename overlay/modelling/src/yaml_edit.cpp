@@ -1,0 +1,248 @@
+#include "kccd/modelling/yaml_edit.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+#include "kccd/model.hpp"
+
+namespace kccd::modelling {
+namespace {
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot read the model file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void writeText(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".kccd-tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw std::runtime_error(path + ": cannot write the model file");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": cannot replace the model file (" + ec.message() + ")");
+  }
+}
+
+YAML::Node load(const std::string& text, const std::string& source) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+}
+
+// End of a flow collection starting at `pos` ('[' or '{'), skipping quotes and comments.
+std::size_t flowEnd(const std::string& t, std::size_t pos) {
+  int depth = 0;
+  for (std::size_t i = pos; i < t.size(); ++i) {
+    const char c = t[i];
+    if (c == '"' || c == '\'') {
+      for (++i; i < t.size() && t[i] != c; ++i)
+        if (c == '"' && t[i] == '\\') ++i;
+    } else if (c == '#' && (i == 0 || std::isspace(static_cast<unsigned char>(t[i - 1])))) {
+      while (i < t.size() && t[i] != '\n') ++i;
+    } else if (c == '[' || c == '{') {
+      ++depth;
+    } else if (c == ']' || c == '}') {
+      if (--depth == 0) return i + 1;
+    }
+  }
+  return t.size();
+}
+
+std::size_t lineStart(const std::string& t, std::size_t pos) {
+  while (pos > 0 && t[pos - 1] != '\n') --pos;
+  return pos;
+}
+
+int indentAt(const std::string& t, std::size_t line_start) {
+  int n = 0;
+  while (line_start + n < t.size() && t[line_start + n] == ' ') ++n;
+  return n;
+}
+
+// End of the text of `value` (which starts at its mark).
+std::size_t valueEnd(const std::string& t, const YAML::Node& value) {
+  const std::size_t start = static_cast<std::size_t>(value.Mark().pos);
+  if (start < t.size() && (t[start] == '[' || t[start] == '{')) return flowEnd(t, start);
+  if (value.IsScalar()) {
+    std::size_t i = start;
+    if (t[i] == '"' || t[i] == '\'') return flowEnd(t, start) == t.size() ? t.size() : [&] {
+      const char q = t[i];
+      for (++i; i < t.size() && t[i] != q; ++i)
+        if (q == '"' && t[i] == '\\') ++i;
+      return i + 1;
+    }();
+    while (i < t.size() && t[i] != '\n' && t[i] != ',' && t[i] != ']' && t[i] != '}' &&
+           !(t[i] == '#' && std::isspace(static_cast<unsigned char>(t[i - 1]))))
+      ++i;
+    while (i > start && std::isspace(static_cast<unsigned char>(t[i - 1]))) --i;
+    return i;
+  }
+  // A block collection: the lines indented more than its first line, or list items at its column.
+  const int column = static_cast<int>(value.Mark().column);
+  std::size_t end = t.find('\n', start);
+  if (end == std::string::npos) return t.size();
+  std::size_t pos = end + 1;
+  while (pos < t.size()) {
+    std::size_t next = t.find('\n', pos);
+    if (next == std::string::npos) next = t.size();
+    const int ind = indentAt(t, pos);
+    const bool blank = pos + ind >= next || t[pos + ind] == '#';
+    if (!blank) {
+      const bool item = ind == column && value.IsSequence() && t[pos + ind] == '-';
+      if (ind <= column && !item) break;
+      end = next;
+    }
+    pos = next + 1;
+  }
+  return end;
+}
+
+struct Found {
+  YAML::Node key, value;
+};
+
+bool findKey(const YAML::Node& map, const std::string& name, Found& out) {
+  if (!map.IsMap()) return false;
+  for (auto it = map.begin(); it != map.end(); ++it)
+    if (it->first.IsScalar() && it->first.Scalar() == name) {
+      out = {it->first, it->second};
+      return true;
+    }
+  return false;
+}
+
+// Replaces the value of `key` (from just after its ':' to the end of the value) with `text`.
+std::string replaceValue(const std::string& t, const Found& f, const std::string& text) {
+  const std::size_t colon = t.find(':', static_cast<std::size_t>(f.key.Mark().pos));
+  const std::size_t end = f.value.IsNull() && f.value.Mark().pos <= f.key.Mark().pos
+                              ? colon + 1
+                              : valueEnd(t, f.value);
+  return t.substr(0, colon + 1) + " " + text + t.substr(end);
+}
+
+std::string quoted(const std::string& name) {
+  for (char c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.' && c != '/')
+      return "\"" + name + "\"";
+  return name;
+}
+
+void check(const std::string& text, const std::string& source) {
+  try {
+    (void)parseModel(text, source + " (edited)");
+  } catch (const ModelError& e) {
+    throw std::runtime_error(std::string("the edited model would not load: ") + e.what());
+  }
+}
+
+}  // namespace
+
+std::string flowPairs(const std::vector<std::array<std::string, 2>>& pairs, int indent) {
+  std::string s = "[", line;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const std::string item = "[" + quoted(pairs[i][0]) + ", " + quoted(pairs[i][1]) + "]";
+    if (i > 0) {
+      s += ",";
+      if (line.size() + item.size() > 90) {
+        s += "\n" + std::string(indent, ' ');
+        line.clear();
+      } else {
+        s += " ";
+      }
+    }
+    s += item;
+    line += item + ", ";
+  }
+  return s + "]";
+}
+
+std::string withBodyGeometry(const std::string& text, const std::string& source, const std::string& body,
+                             const std::string& points_yaml, const std::string& radius_yaml) {
+  const YAML::Node root = load(text, source);
+  const YAML::Node bodies = root["bodies"];
+  if (!bodies || !bodies.IsSequence()) throw std::runtime_error(source + ": no bodies list");
+  for (const YAML::Node& b : bodies) {
+    if (!b.IsMap() || !b["name"] || b["name"].Scalar() != body) continue;
+    // Edit the later of the two values first so the earlier positions stay valid.
+    Found points, radius;
+    if (!findKey(b, "points", points) || !findKey(b, "radius", radius))
+      throw std::runtime_error(source + ":" + std::to_string(b.Mark().line + 1) + ": body " + body +
+                               " has no points/radius to replace");
+    std::string out = text;
+    if (points.key.Mark().pos > radius.key.Mark().pos) {
+      out = replaceValue(out, points, points_yaml);
+      out = replaceValue(out, radius, radius_yaml);
+    } else {
+      out = replaceValue(out, radius, radius_yaml);
+      out = replaceValue(out, points, points_yaml);
+    }
+    check(out, source);
+    return out;
+  }
+  throw std::runtime_error(source + ": no body named '" + body + "'");
+}
+
+std::string withIgnoreList(const std::string& text, const std::string& source,
+                           const std::vector<std::array<std::string, 2>>& pairs) {
+  const YAML::Node root = load(text, source);
+  std::string out;
+  Found section;
+  if (!findKey(root, "pairs", section) || section.value.IsNull()) {
+    out = text;
+    if (!out.empty() && out.back() != '\n') out += "\n";
+    if (findKey(root, "pairs", section)) {  // `pairs:` with nothing under it
+      out = replaceValue(text, section, "\n  ignore: " + flowPairs(pairs, 11));
+    } else {
+      out += "pairs:\n  ignore: " + flowPairs(pairs, 11) + "\n";
+    }
+  } else if (!section.value.IsMap()) {
+    throw std::runtime_error(source + ":" + std::to_string(section.value.Mark().line + 1) + ": pairs is not a map");
+  } else {
+    Found ignore;
+    if (findKey(section.value, "ignore", ignore)) {
+      const int column = static_cast<int>(ignore.key.Mark().column);
+      out = replaceValue(text, ignore, flowPairs(pairs, column + 9));
+    } else {
+      const std::size_t start = static_cast<std::size_t>(section.value.Mark().pos);
+      if (text[start] == '{') {
+        out = text.substr(0, start + 1) + "ignore: " + flowPairs(pairs, 4) + ", " + text.substr(start + 1);
+      } else {
+        const std::size_t line = lineStart(text, start);
+        const int column = static_cast<int>(section.value.Mark().column);
+        out = text.substr(0, line) + std::string(column, ' ') + "ignore: " + flowPairs(pairs, column + 9) + "\n" +
+              text.substr(line);
+      }
+    }
+  }
+  check(out, source);
+  return out;
+}
+
+void setBodyGeometry(const std::string& path, const std::string& body, const std::string& points_yaml,
+                     const std::string& radius_yaml) {
+  writeText(path, withBodyGeometry(readText(path), path, body, points_yaml, radius_yaml));
+}
+
+void setIgnoreList(const std::string& path, const std::vector<std::array<std::string, 2>>& pairs) {
+  writeText(path, withIgnoreList(readText(path), path, pairs));
+}
+
+}  // namespace kccd::modelling
