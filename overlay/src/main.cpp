@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   add(kccd::cli::addInfo);
   add(kccd::cli::addQuery);
   add(kccd::cli::addFit);
+  add(kccd::cli::addPairs);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
