@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   add(kccd::cli::addQuery);
   add(kccd::cli::addFit);
   add(kccd::cli::addPairs);
+  add(kccd::cli::addImport);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

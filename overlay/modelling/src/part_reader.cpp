@@ -134,8 +134,13 @@ void collect(Collector& c, SoNode* node, SoPath* path) {
 
 std::string nodeLabel(SoNode* node, int index) {
   const std::string name = node->getName().getString();
-  return name.empty() ? "#" + std::to_string(index + 1) + " (" + node->getTypeId().getName().getString() + ")"
-                      : name;
+  if (!name.empty()) return name;
+  std::string label = "#";
+  label += std::to_string(index + 1);
+  label += " (";
+  label += node->getTypeId().getName().getString();
+  label += ")";
+  return label;
 }
 
 struct RefGuard {

@@ -1,0 +1,24 @@
+// URDF (and SRDF) to a KCCD model: joints and origins mapped one to one, each link's collision
+// geometry fitted with a conservative SSCH.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <string>
+
+namespace kccd::modelling {
+
+struct ImportOptions {
+  std::string srdf;                             ///< optional SRDF: disable_collisions -> ignore
+  int points = 8;                               ///< core points per fitted link (1 ... 16)
+  double safety_margin = 0.02;                  ///< written into the model
+  std::map<std::string, std::string> packages;  ///< package:// NAME -> directory
+  std::function<void(double)> progress;
+};
+
+/// Converts the URDF file at `path` into `kccd: 1` model text (checked by loading it back).
+/// Throws std::runtime_error with one line naming the file and the element on any problem:
+/// unreadable XML, unsupported joint kinds (floating, planar), unresolved or unreadable meshes.
+std::string importUrdf(const std::string& path, const ImportOptions& options = {});
+
+}  // namespace kccd::modelling
