@@ -276,6 +276,7 @@ FitResult fit(const Part& part, const FitOptions& options) {
   std::vector<Vec3> pool = c.points;
   for (const Sphere& b : c.balls) pool.push_back(b.center);
 
+  std::vector<std::vector<Vec3>> extra_seeds(2);  // whole seeds, used as they are
   auto optimise = [&](int k, const FitOptions& opt) {
     Objective f(c);
     std::vector<std::vector<Vec3>> seeds;
@@ -292,20 +293,21 @@ FitResult fit(const Part& part, const FitOptions& options) {
       std::vector<Vec3> shrunk = bestShrink(s, mean, 1.5, f, v);
       if (v < best_value) best = shrunk, best_value = v;
     }
+    for (const auto& s : extra_seeds)
+      if (static_cast<int>(s.size()) == k) {
+        const double v = f(s);
+        if (v < best_value) best = s, best_value = v;
+      }
     best = patternSearch(best, best_value, c, f, opt, rng);
     result.evaluations += f.evaluations;
     return best;
   };
 
-  result.points = optimise(options.points, options);
-  result.radius = coveringRadius(result.points, part);
-  result.volume = sschVolume(result.points, result.radius);
-
   // Baselines: the smallest enclosing sphere found, and the capsule on the principal axis.
   FitOptions quick = options;
   quick.progress = nullptr;
   quick.max_evaluations = 600;
-  const std::vector<Vec3> centre = options.points == 1 ? result.points : optimise(1, quick);
+  const std::vector<Vec3> centre = optimise(1, quick);
   result.sphere_volume = sschVolume(centre, coveringRadius(centre, part));
 
   const std::vector<Vec3> samples = part.samples(42);
@@ -316,6 +318,7 @@ FitResult fit(const Part& part, const FitOptions& options) {
   for (const Vec3& p : samples) cov += (p - mean) * (p - mean).transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pca(cov);
   result.capsule_volume = INFINITY;
+  std::vector<Vec3> capsule;
   for (int k = 0; k < 3; ++k) {  // the best of the three principal axes
     const Vec3 axis = pca.eigenvectors().col(k);
     double rad = 0.0;
@@ -330,8 +333,18 @@ FitResult fit(const Part& part, const FitOptions& options) {
     }
     if (a > b) a = b = (a + b) / 2.0;
     const std::vector<Vec3> segment{mean + a * axis, mean + b * axis};
-    result.capsule_volume = std::min(result.capsule_volume, sschVolume(segment, coveringRadius(segment, part)));
+    const double v = sschVolume(segment, coveringRadius(segment, part));
+    if (v < result.capsule_volume) result.capsule_volume = v, capsule = segment;
   }
+  // The K points then start from the baselines too, so they never do worse than them.
+  for (int j = 0; j < options.points; ++j) {
+    const double t = options.points == 1 ? 0.5 : double(j) / (options.points - 1);
+    extra_seeds[0].push_back(capsule[0] + t * (capsule[1] - capsule[0]));
+    extra_seeds[1].push_back(centre[0]);
+  }
+  result.points = optimise(options.points, options);
+  result.radius = coveringRadius(result.points, part);
+  result.volume = sschVolume(result.points, result.radius);
   if (options.progress) options.progress(1.0);
   return result;
 }

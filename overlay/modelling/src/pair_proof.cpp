@@ -129,8 +129,9 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
           dims.push_back(s);
           if (std::isnan(ranges[s][0])) unbounded = true;
         }
-    std::fill(lower.begin(), lower.end(), 0.0);
-    std::fill(upper.begin(), upper.end(), 0.0);
+    // Values that do not move the pair sit mid-range (any value would do).
+    for (int s = 0; s < m.stateSize(); ++s)
+      lower[s] = upper[s] = std::isnan(ranges[s][0]) ? 0.0 : (ranges[s][0] + ranges[s][1]) / 2;
     const QueryOptions qopt{.type = QueryType::Distances, .margin = margin};
 
     if (r.adjacent) {

@@ -1,6 +1,13 @@
 // Reading a rigid part with Coin3D: triangles of every shape in world (file) coordinates, and
 // spheres, cylinders and cones covered analytically instead of by Coin's inscribed tessellation.
+#include <cctype>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
 #include <cmath>
+#include <filesystem>
 #include <mutex>
 #include <stdexcept>
 
@@ -143,6 +150,52 @@ std::string nodeLabel(SoNode* node, int index) {
   return label;
 }
 
+// STL, ASCII or binary: a list of triangles (binary when the size matches its triangle count).
+Part readStl(const std::string& path, const Vec3& scale) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open the file");
+  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  Part part;
+  auto add = [&](const Vec3& v) {
+    if (!v.allFinite()) throw std::runtime_error(path + ": non-finite vertex coordinates");
+    part.points.push_back(v.cwiseProduct(scale));
+  };
+  std::uint32_t count = 0;
+  if (data.size() >= 84) std::memcpy(&count, data.data() + 80, 4);
+  if (data.size() >= 84 && data.size() == 84 + 50ull * count) {
+    for (std::uint32_t t = 0; t < count; ++t) {
+      const char* rec = data.data() + 84 + 50ull * t + 12;  // skip the normal
+      for (int k = 0; k < 3; ++k) {
+        float xyz[3];
+        std::memcpy(xyz, rec + 12 * k, 12);
+        add(Vec3(xyz[0], xyz[1], xyz[2]));
+      }
+    }
+    part.triangles = static_cast<int>(count);
+  } else {
+    if (data.compare(0, 5, "solid") != 0)
+      throw std::runtime_error(path + ": not an STL file (neither ASCII 'solid' nor a binary triangle count)");
+    std::istringstream text(data);
+    std::string word;
+    int line_vertices = 0;
+    while (text >> word) {
+      if (word != "vertex") continue;
+      Vec3 v;
+      if (!(text >> v.x() >> v.y() >> v.z()))
+        throw std::runtime_error(path + ": malformed vertex after " + std::to_string(part.points.size()) +
+                                 " vertices");
+      add(v);
+      if (++line_vertices % 3 == 0) ++part.triangles;
+    }
+    if (line_vertices % 3 != 0) throw std::runtime_error(path + ": truncated facet (vertex count not a multiple of 3)");
+  }
+  if (part.triangles == 0) throw std::runtime_error(path + ": no triangles or solid primitives (nothing to fit)");
+  double max_abs = 0.0;
+  for (const Vec3& p : part.points) max_abs = std::max(max_abs, p.cwiseAbs().maxCoeff());
+  part.coordinate_guard = 1e-6 * max_abs;  // single-precision input
+  return part;
+}
+
 struct RefGuard {
   SoNode* node;
   explicit RefGuard(SoNode* n) : node(n) { node->ref(); }
@@ -154,14 +207,24 @@ struct RefGuard {
 Part readPart(const std::string& path, const ReadOptions& options) {
   std::lock_guard<std::mutex> lock(coin_mutex);
   initCoin();
-  Messages messages;
+  static Messages messages;  // Coin keeps the handler's data pointer: it must outlive the call
+  messages.first.clear();
   SoReadError::setHandlerCallback(&Messages::handler, &messages);
   SoDebugError::setHandlerCallback(&Messages::handler, &messages);
 
   SoInput input;
   if (!input.openFile(path.c_str(), TRUE)) throw std::runtime_error(path + ": cannot open the file");
-  SoSeparator* root = SoDB::readAll(&input);
-  input.closeFile();
+  SoSeparator* root = nullptr;
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  if (extension == ".stl") {
+    // Coin's STL reader fails on the second different STL file in a process: read it here.
+    input.closeFile();
+    return readStl(path, options.scale);
+  } else {
+    root = SoDB::readAll(&input);
+    input.closeFile();
+  }
   if (!root)
     throw std::runtime_error(path + ": not a readable Open Inventor, VRML or STL file" +
                              (messages.first.empty() ? std::string() : " (" + messages.first + ")"));
