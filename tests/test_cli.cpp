@@ -3,6 +3,8 @@
 
 #include <array>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include <unistd.h>
@@ -134,3 +136,95 @@ TEST(Cli, HelpExplainsEverySubcommand) {
 }
 
 }  // namespace
+
+namespace {
+
+const std::string kModels = "/usr/share/inventor/data/models/";
+
+std::string scratchCopy(const std::string& from, const std::string& name) {
+  const std::string to = ::testing::TempDir() + "/" + std::to_string(getpid()) + "_" + name;
+  std::ifstream in(from, std::ios::binary);
+  std::ofstream out(to, std::ios::binary);
+  out << in.rdbuf();
+  return to;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TEST(Cli, FitJsonContractAndErrors) {
+  const Outcome r = kccd("fit " + kModels + "simple/cube.iv --points 8 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["points"].size(), 8u);
+  EXPECT_GE(j["radius"].get<double>(), 0.0);
+  EXPECT_NEAR(j["hull_volume"].get<double>(), 8.0, 1e-6);  // Coin's default cube: 2 x 2 x 2
+  EXPECT_NEAR(j["volume"].get<double>(), 8.0, 1e-3);
+  EXPECT_GT(j["baselines"]["sphere_ratio"].get<double>(), 2.0);
+
+  Outcome e = kccd("fit " + kModels + "simple/cube.iv --points 17");
+  EXPECT_EQ(e.code, 2);
+  EXPECT_NE(e.err.find("--points: the number of core points K must be 1 ... 16 (got 17)"), std::string::npos) << e.err;
+  e = kccd("fit " + kModels + "robots/roboHand.iv -q");
+  EXPECT_EQ(e.code, 2);
+  EXPECT_NE(e.err.find("top-level parts"), std::string::npos) << e.err;
+  EXPECT_EQ(e.out, "");  // nothing half-printed
+  e = kccd("fit /nonexistent/part.iv");
+  EXPECT_EQ(e.code, 2);
+  EXPECT_NE(e.err.find("/nonexistent/part.iv: cannot open the file"), std::string::npos) << e.err;
+}
+
+TEST(Cli, FitWritesIntoAModel) {
+  const std::string model = scratchCopy(kDemo, "fit_model.yaml");
+  const Outcome r = kccd("fit " + kModels + "simple/cone.iv --points 4 -q --model " + model + " --body forearm");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string text = slurp(model);
+  EXPECT_NE(text.find("# A small, readable example"), std::string::npos);  // comments kept
+  const Outcome info = kccd("info " + model + " --json");
+  ASSERT_EQ(info.code, 0) << info.err;
+  const auto j = nlohmann::json::parse(info.out);
+  for (const auto& b : j["bodies"])
+    if (b["name"] == "forearm") {
+      EXPECT_EQ(b["points"], 4);
+    }
+  const Outcome bad = kccd("fit " + kModels + "simple/cone.iv -q --model " + model + " --body nobody");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("no body named 'nobody'"), std::string::npos) << bad.err;
+}
+
+TEST(Cli, PairsProvesAndWrites) {
+  const std::string model = scratchCopy(kDemo, "pairs_model.yaml");
+  const Outcome r = kccd("pairs " + model + " --json -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  int never = 0;
+  for (const auto& p : j["pairs"]) never += p["verdict"] == "never";
+  EXPECT_GT(never, 0);
+  const Outcome w = kccd("pairs " + model + " --write -q");
+  ASSERT_EQ(w.code, 0) << w.err;
+  const auto after = nlohmann::json::parse(kccd("info " + model + " --json").out);
+  // Every pair left to check is one the proof could not rule out.
+  EXPECT_EQ(after["pairs"].size(), j["pairs"].size() - j["ignore"].size());
+  EXPECT_EQ(kccd("pairs /nonexistent.yaml").code, 2);
+}
+
+TEST(Cli, ImportWritesALoadableModel) {
+  const std::string dir = std::string(KCCD_TEST_DATA_DIR) + "/urdf";
+  const std::string out = ::testing::TempDir() + "/" + std::to_string(getpid()) + "_imported.yaml";
+  const Outcome r = kccd("import " + dir + "/two_link.urdf --srdf " + dir + "/two_link.srdf --package-path kccd_test=" +
+                         dir + " -k 4 -q -o " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Outcome info = kccd("info " + out + " --json");
+  ASSERT_EQ(info.code, 0) << info.err;
+  EXPECT_EQ(nlohmann::json::parse(info.out)["state"], nlohmann::json({"yaw", "lift", "spin"}));
+  const Outcome e = kccd("import " + dir + "/two_link.urdf -q");
+  EXPECT_EQ(e.code, 2);
+  EXPECT_NE(e.err.find("unknown package 'kccd_test'"), std::string::npos) << e.err;
+  EXPECT_EQ(kccd("import " + dir + "/two_link.urdf --package-path nonsense -q").code, 2);
+}

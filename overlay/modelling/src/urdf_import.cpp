@@ -32,7 +32,11 @@ std::string numUp(double v) {
   return s;
 }
 
-std::string vec(double x, double y, double z) { return "[" + num(x) + ", " + num(y) + ", " + num(z) + "]"; }
+std::string vec(double x, double y, double z) {
+  std::string s = "[";
+  s.append(num(x)).append(", ").append(num(y)).append(", ").append(num(z)).append("]");
+  return s;
+}
 
 Eigen::Affine3d toEigen(const urdf::Pose& p) {
   Eigen::Affine3d t = Eigen::Affine3d::Identity();

@@ -158,11 +158,13 @@ void check(const std::string& text, const std::string& source) {
 std::string flowPairs(const std::vector<std::array<std::string, 2>>& pairs, int indent) {
   std::string s = "[", line;
   for (std::size_t i = 0; i < pairs.size(); ++i) {
-    const std::string item = "[" + quoted(pairs[i][0]) + ", " + quoted(pairs[i][1]) + "]";
+    std::string item = "[";
+    item.append(quoted(pairs[i][0])).append(", ").append(quoted(pairs[i][1])).append("]");
     if (i > 0) {
       s += ",";
       if (line.size() + item.size() > 90) {
-        s += "\n" + std::string(indent, ' ');
+        s += '\n';
+        s.append(static_cast<std::size_t>(indent), ' ');
         line.clear();
       } else {
         s += " ";
