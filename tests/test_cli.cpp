@@ -171,7 +171,9 @@ TEST(Cli, FitJsonContractAndErrors) {
   Outcome e = kccd("fit " + kModels + "simple/cube.iv --points 17");
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(e.err.find("--points: the number of core points K must be 1 ... 16 (got 17)"), std::string::npos) << e.err;
-  e = kccd("fit " + kModels + "robots/roboHand.iv -q");
+  const std::string two = ::testing::TempDir() + "/" + std::to_string(getpid()) + "_two_parts.iv";
+  std::ofstream(two) << "#Inventor V2.1 ascii\nDEF a Separator { Cube {} }\nDEF b Separator { Sphere {} }\n";
+  e = kccd("fit " + two + " -q");
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(e.err.find("top-level parts"), std::string::npos) << e.err;
   EXPECT_EQ(e.out, "");  // nothing half-printed

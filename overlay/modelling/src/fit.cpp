@@ -283,22 +283,49 @@ FitResult fit(const Part& part, const FitOptions& options) {
     const std::vector<Vec3> fps = farthestPoints(pool, c.center, k);
     seeds.push_back(fps);
     if (k > 1 && static_cast<int>(pool.size()) > k) seeds.push_back(kMeans(pool, fps));
-    std::vector<Vec3> best;
-    double best_value = INFINITY;
+    if (k > 1) {
+      // Corners of the principal box, flattened along its thinnest axes when k is small.
+      Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+      for (const Vec3& p : pool) {
+        const Vec3 q = c.axes.transpose() * p;
+        lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+      }
+      const int dims = k >= 8 ? 3 : k >= 4 ? 2 : 1;  // the axes are sorted by increasing spread
+      std::vector<Vec3> corners;
+      for (int i = 0; i < (1 << dims); ++i) {
+        Vec3 q = (lo + hi) / 2;
+        for (int d = 0; d < dims; ++d) q(2 - d) = i & (1 << d) ? hi(2 - d) : lo(2 - d);
+        corners.push_back(c.axes * q);
+      }
+      std::vector<Vec3> seed = farthestPoints(corners, c.axes * ((lo + hi) / 2), std::min<int>(k, corners.size()));
+      while (static_cast<int>(seed.size()) < k) seed.push_back(seed[seed.size() % corners.size()]);
+      seeds.push_back(seed);
+    }
+    // Every seed shrunk to its best scale; the three best are refined, the best result wins.
+    std::vector<std::pair<double, std::vector<Vec3>>> starts;
     for (const auto& s : seeds) {
       Vec3 mean = Vec3::Zero();
       for (const Vec3& p : s) mean += p;
       mean /= static_cast<double>(s.size());
       double v = 0.0;
       std::vector<Vec3> shrunk = bestShrink(s, mean, 1.5, f, v);
-      if (v < best_value) best = shrunk, best_value = v;
+      starts.emplace_back(v, std::move(shrunk));
     }
     for (const auto& s : extra_seeds)
-      if (static_cast<int>(s.size()) == k) {
-        const double v = f(s);
-        if (v < best_value) best = s, best_value = v;
-      }
-    best = patternSearch(best, best_value, c, f, opt, rng);
+      if (static_cast<int>(s.size()) == k) starts.emplace_back(f(s), s);
+    std::sort(starts.begin(), starts.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    const int runs = std::min<int>(3, static_cast<int>(starts.size()));
+    FitOptions share = opt;
+    share.max_evaluations = std::max(1, opt.max_evaluations / runs);
+    std::vector<Vec3> best;
+    double best_value = INFINITY;
+    for (int i = 0; i < runs; ++i) {
+      if (opt.progress)
+        share.progress = [&, i](double x) { opt.progress((i + x) / runs); };
+      std::vector<Vec3> refined = patternSearch(starts[i].second, starts[i].first, c, f, share, rng);
+      const double v = f(refined);
+      if (v < best_value) best = std::move(refined), best_value = v;
+    }
     result.evaluations += f.evaluations;
     return best;
   };

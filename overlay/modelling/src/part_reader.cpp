@@ -221,9 +221,27 @@ Part readPart(const std::string& path, const ReadOptions& options) {
     // Coin's STL reader fails on the second different STL file in a process: read it here.
     input.closeFile();
     return readStl(path, options.scale);
+  }
+  // Node by node: SoDB::readAll would hand back a lone top-level separator itself, hiding
+  // whether the file holds one part or several.
+  root = new SoSeparator;
+  root->ref();
+  bool ok = true;
+  for (;;) {
+    SoNode* node = nullptr;
+    if (!SoDB::read(&input, node)) {
+      ok = false;
+      break;
+    }
+    if (!node) break;  // end of file
+    root->addChild(node);
+  }
+  input.closeFile();
+  if (!ok || (root->getNumChildren() == 0 && !messages.first.empty())) {
+    root->unref();
+    root = nullptr;
   } else {
-    root = SoDB::readAll(&input);
-    input.closeFile();
+    root->unrefNoDelete();
   }
   if (!root)
     throw std::runtime_error(path + ": not a readable Open Inventor, VRML or STL file" +

@@ -1,0 +1,125 @@
+// Fitting speed: seconds per part for K core points, on a generated 10,000-triangle part (in
+// memory and read from a binary STL) and on real Open Inventor models; pairs proofs per model.
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <random>
+
+#include <benchmark/benchmark.h>
+
+#include "kccd/model.hpp"
+#include "kccd/modelling/fit.hpp"
+#include "kccd/modelling/pair_proof.hpp"
+
+namespace km = kccd::modelling;
+using kccd::Vec3;
+
+namespace {
+
+// A bumpy ellipsoid as a 50 x 100 latitude-longitude mesh: 9,800 triangles + 2 caps of 100.
+std::vector<std::array<Vec3, 3>> bumpyTriangles() {
+  const int rows = 50, cols = 100;
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> noise(-0.01, 0.01);
+  std::vector<std::vector<Vec3>> v(rows + 1, std::vector<Vec3>(cols));
+  for (int i = 0; i <= rows; ++i)
+    for (int j = 0; j < cols; ++j) {
+      const double th = std::numbers::pi * i / rows, ph = 2 * std::numbers::pi * j / cols;
+      const double r = 1.0 + 0.1 * std::sin(5 * ph) * std::sin(3 * th) + noise(rng);
+      v[i][j] = Vec3(0.3 * r * std::sin(th) * std::cos(ph), 0.15 * r * std::sin(th) * std::sin(ph), 0.1 * r * std::cos(th));
+    }
+  std::vector<std::array<Vec3, 3>> t;
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) {
+      const int k = (j + 1) % cols;
+      t.push_back({v[i][j], v[i + 1][j], v[i + 1][k]});
+      t.push_back({v[i][j], v[i + 1][k], v[i][k]});
+    }
+  return t;  // 10,000 triangles
+}
+
+km::Part bumpyPart() {
+  km::Part p;
+  for (const auto& t : bumpyTriangles()) p.points.insert(p.points.end(), t.begin(), t.end());
+  p.triangles = static_cast<int>(p.points.size() / 3);
+  return p;
+}
+
+std::string bumpyStl() {
+  const std::string path = (std::filesystem::temp_directory_path() / "kccd_bench_bumpy.stl").string();
+  const auto tris = bumpyTriangles();
+  std::ofstream out(path, std::ios::binary);
+  char header[80] = "kccd benchmark part";
+  out.write(header, 80);
+  const std::uint32_t n = static_cast<std::uint32_t>(tris.size());
+  out.write(reinterpret_cast<const char*>(&n), 4);
+  for (const auto& t : tris) {
+    float rec[12] = {0, 0, 0};
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 3; ++c) rec[3 + 3 * k + c] = static_cast<float>(t[k](c));
+    out.write(reinterpret_cast<const char*>(rec), 48);
+    out.write("\0\0", 2);
+  }
+  return path;
+}
+
+void BM_Fit10kTriangles(benchmark::State& state) {
+  const km::Part part = bumpyPart();
+  km::FitResult r;
+  for (auto _ : state) {
+    r = km::fit(part, {.points = static_cast<int>(state.range(0))});
+    benchmark::DoNotOptimize(r.radius);
+  }
+  state.counters["volume_ratio"] = r.volume / r.hull_volume;
+  state.counters["hull_vertices"] = r.hull_vertices;
+  state.counters["evaluations"] = r.evaluations;
+}
+BENCHMARK(BM_Fit10kTriangles)->Arg(1)->Arg(2)->Arg(4)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
+
+void BM_ReadAndFitStl10k(benchmark::State& state) {
+  const std::string path = bumpyStl();
+  for (auto _ : state) {
+    const km::Part part = km::readPart(path);
+    benchmark::DoNotOptimize(km::fit(part, {.points = 8}).radius);
+  }
+}
+BENCHMARK(BM_ReadAndFitStl10k)->Unit(benchmark::kMillisecond);
+
+void BM_FitInventorModel(benchmark::State& state, const char* file) {
+  const std::string path = std::string("/usr/share/inventor/data/models/") + file;
+  if (!std::filesystem::exists(path)) {
+    state.SkipWithError("inventor-data not installed");
+    return;
+  }
+  const km::Part part = km::readPart(path, {.merge = true});
+  km::FitResult r;
+  for (auto _ : state) r = km::fit(part, {.points = 8});
+  state.counters["triangles"] = part.triangles;
+  state.counters["volume_ratio"] = r.volume / r.hull_volume;
+  state.counters["sphere_ratio"] = r.sphere_volume / r.hull_volume;
+  state.counters["capsule_ratio"] = r.capsule_volume / r.hull_volume;
+}
+BENCHMARK_CAPTURE(BM_FitInventorModel, mug, "household/mug.iv")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FitInventorModel, roboHand, "robots/roboHand.iv")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FitInventorModel, coarseGear, "machines/coarseGear.iv")->Unit(benchmark::kMillisecond);
+
+void BM_ProvePairs(benchmark::State& state, const char* file) {
+  const kccd::Model m = kccd::loadModel(std::string(KCCD_DATA_DIR) + "/" + file);
+  std::vector<km::PairReport> r;
+  for (auto _ : state) r = km::provePairs(m);
+  int never = 0, touching = 0;
+  for (const auto& p : r) never += p.verdict == km::Verdict::Never, touching += p.verdict == km::Verdict::AlwaysTouching;
+  state.counters["pairs"] = static_cast<double>(r.size());
+  state.counters["never"] = never;
+  state.counters["always_touching"] = touching;
+}
+BENCHMARK_CAPTURE(BM_ProvePairs, demo_arm, "demo_arm.yaml")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ProvePairs, industrial_cell, "industrial_cell.yaml")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ProvePairs, humanoid, "humanoid.yaml")->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
