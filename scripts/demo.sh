@@ -19,3 +19,7 @@ lower=-0.05,0.05,0.05,0.05,-0.05,0.0,0.2,-0.9,0.3,1.2,0.0,0.3,0.0,-0.2,-0.9,-0.3
 upper=0.0,0.1,0.1,0.1,0.0,0.05,0.3,-0.8,0.35,1.3,0.1,0.4,0.1,-0.1,-0.8,-0.25,1.3,0.1,0.4,0.1
 step $kccd query data/humanoid.yaml --lower $lower --upper $upper --type nclosest --n 3
 step $kccd query data/humanoid.yaml --lower $lower --upper $upper --type collision --json
+# Modelling: a conservative SSCH for a CAD part (8 core points), and which pairs of the demo arm
+# can never meet anywhere inside the joint limits (proven with the same sweeps).
+step $kccd fit data/parts/gripper.iv --points 8 --name gripper --frame elbow -q
+step $kccd pairs data/demo_arm.yaml -q

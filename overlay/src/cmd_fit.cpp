@@ -18,7 +18,7 @@ struct FitArgs {
   int points = 8;
   std::string part, name, frame = "world", model, body;
   bool merge = false, json = false, quiet = false;
-  int evaluations = 6000;
+  int evaluations = 4000;
 };
 
 // Core points as printed, and the radius recomputed for exactly those points, rounded up.
@@ -134,7 +134,7 @@ Runner addFit(CLI::App& app) {
   sub->add_option("--frame", args->frame, "Frame in the printed snippet")->capture_default_str();
   sub->add_option("--model", args->model, "Write the result into this model file, in place (with --body)");
   sub->add_option("--body", args->body, "Body of --model whose points and radius are replaced");
-  sub->add_option("--evaluations", args->evaluations, "Optimiser budget (volume evaluations)")
+  sub->add_option("--evaluations", args->evaluations, "Optimiser budget per start (volume evaluations; three starts are refined)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   sub->add_flag("--json", args->json, "Machine-readable output");

@@ -46,15 +46,19 @@ std::vector<Vec3> fibonacciDirections(int n) {
 
 class Objective {
  public:
-  explicit Objective(const Constraints& c) : c_(c), last_worst_(0) {}
+  explicit Objective(const Constraints& c)
+      : c_(c), directions_(c.points.size() + c.balls.size(), Vec3::UnitX()), last_worst_(0) {}
 
   double radius(std::span<const Vec3> core) {
     double r = 0.0;
-    auto consider = [&](const Vec3& x, double grow) {
+    auto consider = [&](std::size_t index, const Vec3& x, double grow) {
       double cheap = std::numeric_limits<double>::infinity();  // distance to the nearest core point
       for (const Vec3& p : core) cheap = std::min(cheap, (x - p).squaredNorm());
       if (std::sqrt(cheap) + grow <= r) return false;
-      const DistanceResult d = distance(SschView{std::span<const Vec3>(&x, 1), 0.0}, SschView{core, 0.0}, options_);
+      GjkOptions o = options_;
+      o.warm_start = &directions_[index];  // the last direction: one step moves little
+      const DistanceResult d = distance(SschView{std::span<const Vec3>(&x, 1), 0.0}, SschView{core, 0.0}, o);
+      directions_[index] = d.direction;
       const double v = d.hull_upper + grow;
       if (v > r) {
         r = v;
@@ -62,10 +66,11 @@ class Objective {
       }
       return false;
     };
-    if (last_worst_ < c_.points.size()) consider(c_.points[last_worst_], 0.0);
+    if (last_worst_ < c_.points.size()) consider(last_worst_, c_.points[last_worst_], 0.0);
     for (std::size_t i = 0; i < c_.points.size(); ++i)
-      if (consider(c_.points[i], 0.0)) last_worst_ = i;
-    for (const Sphere& b : c_.balls) consider(b.center, b.radius);
+      if (consider(i, c_.points[i], 0.0)) last_worst_ = i;
+    for (std::size_t i = 0; i < c_.balls.size(); ++i)
+      consider(c_.points.size() + i, c_.balls[i].center, c_.balls[i].radius);
     return r;
   }
 
@@ -78,8 +83,10 @@ class Objective {
 
  private:
   const Constraints& c_;
+  std::vector<Vec3> directions_;
   std::size_t last_worst_;
-  GjkOptions options_{.max_iterations = 64, .relative_tolerance = 1e-9};
+  // The optimiser compares volumes only; the final radius is computed exactly elsewhere.
+  GjkOptions options_{.max_iterations = 64, .relative_tolerance = 1e-7};
 };
 
 Constraints buildConstraints(const Part& part, int& hull_vertex_count) {
@@ -315,8 +322,7 @@ FitResult fit(const Part& part, const FitOptions& options) {
       if (static_cast<int>(s.size()) == k) starts.emplace_back(f(s), s);
     std::sort(starts.begin(), starts.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
     const int runs = std::min<int>(3, static_cast<int>(starts.size()));
-    FitOptions share = opt;
-    share.max_evaluations = std::max(1, opt.max_evaluations / runs);
+    FitOptions share = opt;  // each run gets the whole budget
     std::vector<Vec3> best;
     double best_value = INFINITY;
     for (int i = 0; i < runs; ++i) {

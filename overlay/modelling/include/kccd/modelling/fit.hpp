@@ -13,7 +13,7 @@ namespace kccd::modelling {
 
 struct FitOptions {
   int points = 8;                  ///< number of core points K (1 ... 16)
-  int max_evaluations = 6000;      ///< optimiser budget (volume evaluations)
+  int max_evaluations = 4000;      ///< optimiser budget per start (volume evaluations)
   std::uint64_t seed = 1;          ///< for the optimiser's random search directions
   std::function<void(double)> progress;  ///< called with the fraction done (0 ... 1), optional
 };
