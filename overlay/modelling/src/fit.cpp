@@ -266,6 +266,7 @@ double coveringRadius(std::span<const Vec3> core, const Part& part) {
     r = std::max(r, hullDistanceUpper(b.center, core) + b.radius);
     scale = std::max(scale, b.center.cwiseAbs().maxCoeff() + b.radius);
   }
+  if (!std::isfinite(r) || !std::isfinite(scale)) throw std::invalid_argument("the part has non-finite coordinates");
   // Rounding of the distance computation (a few ulps of the coordinates) and of the input.
   return r + 16.0 * std::numeric_limits<double>::epsilon() * scale + part.coordinate_guard;
 }
