@@ -104,11 +104,17 @@ Part linkPart(const std::string& urdf_path, const urdf::Link& link, const Import
   return part;
 }
 
-std::vector<std::array<std::string, 2>> readSrdf(const std::string& path, const std::set<std::string>& links,
+void loadXml(tinyxml2::XMLDocument& doc, const std::string& path) {
+  if (doc.LoadFile(path.c_str()) == tinyxml2::XML_SUCCESS) return;
+  if (doc.ErrorID() == tinyxml2::XML_ERROR_FILE_NOT_FOUND || doc.ErrorID() == tinyxml2::XML_ERROR_FILE_COULD_NOT_BE_OPENED)
+    throw std::runtime_error(path + ": cannot open the file");
+  throw std::runtime_error(path + ":" + std::to_string(doc.ErrorLineNum()) + ": malformed XML (" +
+                           tinyxml2::XMLDocument::ErrorIDToName(doc.ErrorID()) + ")");
+}
+
+std::vector<std::array<std::string, 2>> readSrdf(const tinyxml2::XMLDocument& doc, const std::string& path,
+                                                 const std::set<std::string>& links,
                                                  const std::set<std::string>& bodies) {
-  tinyxml2::XMLDocument doc;
-  if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS)
-    throw std::runtime_error(path + ":" + std::to_string(doc.ErrorLineNum()) + ": " + doc.ErrorStr());
   const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
   if (!robot) throw std::runtime_error(path + ": not an SRDF file (no <robot> element)");
   std::vector<std::array<std::string, 2>> out;
@@ -132,11 +138,9 @@ std::vector<std::array<std::string, 2>> readSrdf(const std::string& path, const 
 
 std::string importUrdf(const std::string& path, const ImportOptions& options) {
   tinyxml2::XMLDocument doc;  // for XML errors with line numbers
-  if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS) {
-    if (doc.ErrorID() == tinyxml2::XML_ERROR_FILE_NOT_FOUND || doc.ErrorID() == tinyxml2::XML_ERROR_FILE_COULD_NOT_BE_OPENED)
-      throw std::runtime_error(path + ": cannot open the file");
-    throw std::runtime_error(path + ":" + std::to_string(doc.ErrorLineNum()) + ": " + doc.ErrorStr());
-  }
+  loadXml(doc, path);
+  tinyxml2::XMLDocument srdf;  // checked before the (slow) fitting starts
+  if (!options.srdf.empty()) loadXml(srdf, options.srdf);
   const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDFFile(path);
   if (!urdf || !urdf->getRoot()) throw std::runtime_error(path + ": not a valid URDF (urdfdom rejected it)");
 
@@ -215,7 +219,7 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     ++fitted;
   }
   std::vector<std::array<std::string, 2>> ignore;
-  if (!options.srdf.empty()) ignore = readSrdf(options.srdf, link_names, body_names);
+  if (!options.srdf.empty()) ignore = readSrdf(srdf, options.srdf, link_names, body_names);
 
   std::ostringstream out;
   out << "# Imported from " << std::filesystem::path(path).filename().string()
