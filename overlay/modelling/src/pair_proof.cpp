@@ -120,15 +120,26 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
     Checker checker(single);
 
     // The state values that move the two bodies relative to each other.
+    // Each with a lever arm: how far a unit change can move the bodies (an estimate, used only
+    // to choose which interval to split).
     std::vector<int> dims;
+    std::vector<double> lever;
     bool unbounded = false;
-    for (int body : {r.a, r.b})
-      for (int j : jointsBetween(m, m.bodies[body].frame, r.lca))
+    for (int body : {r.a, r.b}) {
+      const Body& bd = m.bodies[body];
+      double reach = bd.radius;
+      for (const Vec3& p : bd.points) reach = std::max(reach, p.norm() + bd.radius);
+      for (int j : jointsBetween(m, bd.frame, r.lca)) {
+        const bool rotational = m.joints[j].type == JointType::Revolute || m.joints[j].type == JointType::Rotation3d;
         for (int k = 0; k < m.joints[j].dof; ++k) {
           const int s = m.joints[j].state_offset + k;
           dims.push_back(s);
+          lever.push_back(rotational ? reach : 1.0);
           if (std::isnan(ranges[s][0])) unbounded = true;
         }
+        reach += m.joints[j].origin.translation().norm();
+      }
+    }
     // Values that do not move the pair sit mid-range (any value would do).
     for (int s = 0; s < m.stateSize(); ++s)
       lower[s] = upper[s] = std::isnan(ranges[s][0]) ? 0.0 : (ranges[s][0] + ranges[s][1]) / 2;
@@ -194,9 +205,9 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
         r.verdict = Verdict::Undecided;
         break;
       }
-      std::size_t widest = 0;
+      std::size_t widest = 0;  // the interval that moves the bodies most
       for (std::size_t d = 1; d < dims.size(); ++d)
-        if (box.hi[d] - box.lo[d] > box.hi[widest] - box.lo[widest]) widest = d;
+        if ((box.hi[d] - box.lo[d]) * lever[d] > (box.hi[widest] - box.lo[widest]) * lever[widest]) widest = d;
       Box other = box;
       const double mid = (box.lo[widest] + box.hi[widest]) / 2;
       box.hi[widest] = mid;
