@@ -56,7 +56,7 @@ double trueDistance(const Model& m, const std::vector<kccd::Pose>& poses, int a,
 TEST(Pairs, ProofsHoldUnderDenseSampling) {
   std::mt19937_64 rng(std::getenv("KCCD_SEED") ? std::stoull(std::getenv("KCCD_SEED")) : 20261121);
   int never = 0, touching = 0, meets = 0, samples = 0;
-  for (int trial = 0; trial < 150; ++trial) {
+  for (int trial = 0; trial < 600; ++trial) {
     Model m = kccd::testing::randomModel(rng, 5, 4);
     randomLimits(m, rng);
     m.safety_margin = std::uniform_real_distribution<double>(0.0, 0.2)(rng);
