@@ -11,5 +11,6 @@ using Runner = std::function<int()>;
 
 Runner addInfo(CLI::App& app);
 Runner addQuery(CLI::App& app);
+Runner addRender(CLI::App& app);
 
 }  // namespace kccd::cli

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   };
   add(kccd::cli::addInfo);
   add(kccd::cli::addQuery);
+  add(kccd::cli::addRender);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

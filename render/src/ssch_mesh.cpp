@@ -1,0 +1,179 @@
+#include "kccd/render/ssch_mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+
+extern "C" {
+#include <libqhull_r/qhull_ra.h>
+}
+
+namespace kccd::render {
+namespace {
+
+SpherePolytope makeSphere(int level) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  for (Vec3& p : v) p.normalize();
+  std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                       {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                       {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                       {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (int l = 0; l < level; ++l) {
+    std::map<std::pair<int, int>, int> mid;
+    auto midpoint = [&](int a, int b) {
+      const auto key = std::minmax(a, b);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      v.push_back((v[a] + v[b]).normalized());
+      mid.emplace(key, static_cast<int>(v.size()) - 1);
+      return static_cast<int>(v.size()) - 1;
+    };
+    std::vector<std::array<int, 3>> next;
+    for (const auto& t3 : f) {
+      const int a = midpoint(t3[0], t3[1]), b = midpoint(t3[1], t3[2]), c = midpoint(t3[2], t3[0]);
+      next.push_back({t3[0], a, c});
+      next.push_back({t3[1], b, a});
+      next.push_back({t3[2], c, b});
+      next.push_back({a, b, c});
+    }
+    f = std::move(next);
+  }
+  SpherePolytope s;
+  double min_plane = 1.0, max_angle = 0.0;
+  for (const auto& t3 : f) {
+    const Vec3 n = (v[t3[1]] - v[t3[0]]).cross(v[t3[2]] - v[t3[0]]).normalized();
+    min_plane = std::min(min_plane, std::abs(n.dot(v[t3[0]])));
+    for (int k = 0; k < 3; ++k) max_angle = std::max(max_angle, std::acos(std::clamp(std::abs(n.dot(v[t3[k]])), -1.0, 1.0)));
+  }
+  s.vertices = std::move(v);
+  // A tiny relative guard so rounding in the scaled vertices never moves a face inside the ball.
+  s.scale = (1.0 / min_plane) * (1.0 + 1e-12);
+  s.cone_tan = std::tan(max_angle) * (1.0 + 1e-9) + 1e-12;
+  return s;
+}
+
+}  // namespace
+
+const SpherePolytope& spherePolytope(int level) {
+  static std::once_flag once;
+  static std::vector<SpherePolytope> levels;
+  std::call_once(once, [] {
+    for (int l = 0; l <= 5; ++l) levels.push_back(makeSphere(l));
+  });
+  return levels.at(static_cast<std::size_t>(std::clamp(level, 0, 5)));
+}
+
+Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level) {
+  if (points.empty()) throw std::invalid_argument("buildSschMesh: no core points");
+  if (!allFinite(points) || !std::isfinite(radius) || radius < 0.0)
+    throw std::invalid_argument("buildSschMesh: non-finite point or bad radius");
+  const SpherePolytope& sphere = spherePolytope(level);
+  double extent = 0.0;
+  for (const Vec3& p : points) extent = std::max(extent, p.cwiseAbs().maxCoeff());
+  // Guard for the float conversion of vertices when drawing (a micrometre at 1 m).
+  const double pad = 1e-6 * (1.0 + extent);
+  const double big_r = (std::max(radius, kMinDrawRadius) + pad) * sphere.scale;
+
+  // Only p_i + R v_j that can be vertices of the Minkowski sum: p_i must be the support point
+  // of the core set for some direction d in the normal cone of v_j (within angle θ of v_j),
+  // which implies v_j·(p_m - p_i) <= tan θ |p_m - p_i| for the support point p_m in v_j.
+  std::vector<coordT> coords;
+  coords.reserve(points.size() * sphere.vertices.size() * 3 / 2);
+  for (const Vec3& v : sphere.vertices) {
+    std::size_t best = 0;
+    double best_dot = -1e300;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const double d = v.dot(points[i]);
+      if (d > best_dot) best_dot = d, best = i;
+    }
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const double gap = best_dot - v.dot(points[i]);
+      if (i != best && gap > sphere.cone_tan * (points[best] - points[i]).norm() + 1e-12 * (1.0 + extent)) continue;
+      const Vec3 q = points[i] + big_r * v;
+      coords.insert(coords.end(), {q.x(), q.y(), q.z()});
+    }
+  }
+  const int n = static_cast<int>(coords.size() / 3);
+
+  Mesh mesh;
+  mesh.level = level;
+  mesh.mesh_radius = big_r;
+  qhT qh_storage;
+  qhT* qh = &qh_storage;
+  FILE* devnull = std::fopen("/dev/null", "w");
+  qh_zero(qh, devnull);
+  char options[] = "qhull Qt";
+  const int code = qh_new_qhull(qh, 3, n, coords.data(), False, options, nullptr, devnull);
+  if (code == 0) {
+    std::vector<int> index(static_cast<std::size_t>(n), -1);
+    auto vertexIndex = [&](vertexT* vx) {
+      const int id = qh_pointid(qh, vx->point);
+      if (index[id] < 0) {
+        index[id] = static_cast<int>(mesh.vertices.size());
+        mesh.vertices.emplace_back(vx->point[0], vx->point[1], vx->point[2]);
+      }
+      return static_cast<std::uint32_t>(index[id]);
+    };
+    facetT* facet;
+    FORALLfacets {
+      std::vector<std::uint32_t> ids;
+      vertexT *vertex, **vertexp;
+      FOREACHvertex_(facet->vertices) ids.push_back(vertexIndex(vertex));
+      const Vec3 normal(facet->normal[0], facet->normal[1], facet->normal[2]);
+      for (std::size_t k = 1; k + 1 < ids.size(); ++k) {
+        std::array<std::uint32_t, 3> t{ids[0], ids[k], ids[k + 1]};
+        const Vec3 n3 =
+            (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+        if (n3.dot(normal) < 0.0) std::swap(t[1], t[2]);
+        mesh.triangles.push_back(t);
+        mesh.normals.push_back(normal);
+      }
+    }
+  }
+  qh_freeqhull(qh, !qh_ALL);
+  int curlong = 0, totlong = 0;
+  qh_memfreeshort(qh, &curlong, &totlong);
+  std::fclose(devnull);
+  if (code != 0 || mesh.triangles.empty())
+    throw std::runtime_error("buildSschMesh: qhull failed (code " + std::to_string(code) + ")");
+
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::array<std::uint32_t, 4>> edges;
+  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const auto key = std::minmax(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3]);
+      auto [it, fresh] = edges.try_emplace(key, std::array<std::uint32_t, 4>{key.first, key.second, t, t});
+      if (!fresh) it->second[3] = t;
+    }
+  mesh.edges.reserve(edges.size());
+  for (const auto& [key, e] : edges) mesh.edges.push_back(e);
+  return mesh;
+}
+
+std::shared_ptr<const Mesh> MeshCache::get(std::span<const Vec3> points, double radius, int level) {
+  std::string key(points.size() * sizeof(Vec3) + sizeof(double) + sizeof(int), '\0');
+  std::memcpy(key.data(), points.data(), points.size() * sizeof(Vec3));
+  std::memcpy(key.data() + points.size() * sizeof(Vec3), &radius, sizeof(double));
+  std::memcpy(key.data() + points.size() * sizeof(Vec3) + sizeof(double), &level, sizeof(int));
+  auto it = entries_.find(key);
+  if (it != entries_.end()) {
+    it->second.used = frame_;
+    ++reused_;
+    return it->second.mesh;
+  }
+  if (entries_.size() >= capacity_) {
+    std::erase_if(entries_, [&](const auto& e) { return e.second.used + 2 < frame_; });
+    if (entries_.size() >= capacity_) entries_.clear();
+  }
+  auto mesh = std::make_shared<const Mesh>(buildSschMesh(points, radius, level));
+  ++built_;
+  entries_.emplace(std::move(key), Entry{mesh, frame_});
+  return mesh;
+}
+
+}  // namespace kccd::render
