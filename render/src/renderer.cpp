@@ -56,13 +56,15 @@ struct Renderer::Gl {
     return rb;
   }
 
-  Gl(int w, int h, int want_samples) : width(w), height(h) {
+  int mask_width = 0, mask_height = 0;
+
+  Gl(int w, int h, int want_samples, int mw, int mh) : width(w), height(h), mask_width(mw), mask_height(mh) {
     GLint max_samples = 0, max_size = 0;
     glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
     glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
-    if (w > max_size || h > max_size)
-      throw GlContextError("GL: image " + std::to_string(w) + "x" + std::to_string(h) + " exceeds the renderbuffer limit " +
-                           std::to_string(max_size));
+    if (std::max({w, h, mw, mh}) > max_size)
+      throw GlContextError("GL: image " + std::to_string(std::max(w, mw)) + "x" + std::to_string(std::max(h, mh)) +
+                           " exceeds the renderbuffer limit " + std::to_string(max_size));
     samples = want_samples > 1 ? std::min(want_samples, static_cast<int>(max_samples)) : 0;
     resolve_colour = renderbuffer(GL_RGBA8, 0, w, h);
     glGenFramebuffers(1, &resolve_fbo);
@@ -76,8 +78,8 @@ struct Renderer::Gl {
       glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ms_colour);
       check(ms_fbo, "multisample colour");
     }
-    mask_colour = renderbuffer(GL_RGBA8, 0, w, h);
-    mask_depth = renderbuffer(GL_DEPTH_COMPONENT24, 0, w, h);
+    mask_colour = renderbuffer(GL_RGBA8, 0, mw, mh);
+    mask_depth = renderbuffer(GL_DEPTH_COMPONENT24, 0, mw, mh);
     glGenFramebuffers(1, &mask_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, mask_fbo);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, mask_colour);
@@ -109,7 +111,11 @@ Renderer::Renderer(const Camera& camera, const RenderOptions& options)
       projection_(camera, options.supersample),
       context_(GlContext::make()),
       world_to_camera_(camera.worldToCamera()) {
-  gl_ = std::make_unique<Gl>(projection_.pinhole().width, projection_.pinhole().height, options.msaa_samples);
+  if (camera.distorted() && options.mask_supersample != options.supersample)
+    mask_projection_ = std::make_unique<Projection>(camera, options.mask_supersample);
+  const Pinhole& mask = maskProjection().pinhole();
+  gl_ = std::make_unique<Gl>(projection_.pinhole().width, projection_.pinhole().height, options.msaa_samples, mask.width,
+                             mask.height);
 }
 
 Renderer::~Renderer() {
@@ -147,7 +153,7 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     }
     centre /= static_cast<double>(cam_points.size());
     p.depth = centre.norm();
-    const double r = std::max(v.radius, kMinDrawRadius);
+    const double r = std::max(v.radius, options_.min_radius);
     zmin -= r;
     int level = options_.max_level;
     if (zmin > options_.near) {
@@ -158,7 +164,7 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
           break;
         }
     }
-    p.mesh = cache_.get(v.points, v.radius, level);
+    p.mesh = cache_.get(v.points, v.radius, level, options_.min_radius);
     const Mesh& m = *p.mesh;
     p.vertices.resize(m.vertices.size() * 3);
     for (std::size_t k = 0; k < m.vertices.size(); ++k) {
@@ -246,9 +252,9 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
 }
 
 cv::Mat Renderer::drawMask(const std::vector<Prepared>& bodies) {
-  const int w = gl_->width, h = gl_->height;
+  const int w = gl_->mask_width, h = gl_->mask_height;
   glBindFramebuffer(GL_FRAMEBUFFER, gl_->mask_fbo);
-  setCamera(projection_, options_.near, options_.far);
+  setCamera(maskProjection(), options_.near, options_.far);
   glClearColor(0, 0, 0, 0);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -295,9 +301,10 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
   }
   if (want_mask) {
     cv::Mat mask = drawMask(bodies);
-    if (projection_.warps()) {
+    const Projection& mp = maskProjection();
+    if (mp.warps()) {
       cv::Mat warped;
-      cv::remap(mask, warped, projection_.mapX(), projection_.mapY(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+      cv::remap(mask, warped, mp.mapX(), mp.mapY(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
                 cv::Scalar::all(0));
       mask = warped;
     }

@@ -69,16 +69,16 @@ const SpherePolytope& spherePolytope(int level) {
   return levels.at(static_cast<std::size_t>(std::clamp(level, 0, 5)));
 }
 
-Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level) {
+Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, double min_radius) {
   if (points.empty()) throw std::invalid_argument("buildSschMesh: no core points");
-  if (!allFinite(points) || !std::isfinite(radius) || radius < 0.0)
+  if (!allFinite(points) || !std::isfinite(radius) || radius < 0.0 || !(min_radius > 0.0))
     throw std::invalid_argument("buildSschMesh: non-finite point or bad radius");
   const SpherePolytope& sphere = spherePolytope(level);
   double extent = 0.0;
   for (const Vec3& p : points) extent = std::max(extent, p.cwiseAbs().maxCoeff());
   // Guard for the float conversion of vertices when drawing (a micrometre at 1 m).
   const double pad = 1e-6 * (1.0 + extent);
-  const double big_r = (std::max(radius, kMinDrawRadius) + pad) * sphere.scale;
+  const double big_r = (std::max(radius, min_radius) + pad) * sphere.scale;
 
   // Only p_i + R v_j that can be vertices of the Minkowski sum: p_i must be the support point
   // of the core set for some direction d in the normal cone of v_j (within angle θ of v_j),
@@ -155,11 +155,13 @@ Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level) {
   return mesh;
 }
 
-std::shared_ptr<const Mesh> MeshCache::get(std::span<const Vec3> points, double radius, int level) {
-  std::string key(points.size() * sizeof(Vec3) + sizeof(double) + sizeof(int), '\0');
+std::shared_ptr<const Mesh> MeshCache::get(std::span<const Vec3> points, double radius, int level,
+                                           double min_radius) {
+  std::string key(points.size() * sizeof(Vec3) + 2 * sizeof(double) + sizeof(int), '\0');
   std::memcpy(key.data(), points.data(), points.size() * sizeof(Vec3));
   std::memcpy(key.data() + points.size() * sizeof(Vec3), &radius, sizeof(double));
   std::memcpy(key.data() + points.size() * sizeof(Vec3) + sizeof(double), &level, sizeof(int));
+  std::memcpy(key.data() + points.size() * sizeof(Vec3) + sizeof(double) + sizeof(int), &min_radius, sizeof(double));
   auto it = entries_.find(key);
   if (it != entries_.end()) {
     it->second.used = frame_;
@@ -170,7 +172,7 @@ std::shared_ptr<const Mesh> MeshCache::get(std::span<const Vec3> points, double 
     std::erase_if(entries_, [&](const auto& e) { return e.second.used + 2 < frame_; });
     if (entries_.size() >= capacity_) entries_.clear();
   }
-  auto mesh = std::make_shared<const Mesh>(buildSschMesh(points, radius, level));
+  auto mesh = std::make_shared<const Mesh>(buildSschMesh(points, radius, level, min_radius));
   ++built_;
   entries_.emplace(std::move(key), Entry{mesh, frame_});
   return mesh;

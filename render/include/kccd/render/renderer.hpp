@@ -42,9 +42,13 @@ struct Style {
 /// Renderer settings fixed at construction.
 struct RenderOptions {
   double supersample = 1.0;    ///< pinhole image scale (1..4); > 1 keeps thin slivers through the warp
+  /// Pinhole scale of the mask pass when the camera distorts: the warp samples the mask at
+  /// the nearest pinhole pixel, so a finer pinhole image keeps the label edges within 1/(2 s) px.
+  double mask_supersample = 2.0;
   int msaa_samples = 4;        ///< colour layer multisampling (0 or 1: off; at most 4 on llvmpipe)
   double tolerance_px = 0.25;  ///< largest outward error of the sphere tessellation, output pixels
   int max_level = 4;           ///< finest sphere tessellation (level 4: 2562 vertices)
+  double min_radius = kMinDrawRadius;  ///< volumes thinner than this are drawn this thick (metres)
   double near = 0.05;          ///< clipping planes, metres along the optical axis
   double far = 100.0;
 };
@@ -76,6 +80,7 @@ class Renderer {
 
   const std::string& rendererString() const;
   const Projection& projection() const { return projection_; }
+  const Projection& maskProjection() const { return mask_projection_ ? *mask_projection_ : projection_; }
   const MeshCache& meshCache() const { return cache_; }
 
  private:
@@ -88,6 +93,7 @@ class Renderer {
 
   RenderOptions options_;
   Projection projection_;
+  std::unique_ptr<Projection> mask_projection_;  // when the mask uses another pinhole scale
   std::unique_ptr<GlContext> context_;
   std::unique_ptr<Gl> gl_;
   MeshCache cache_;

@@ -34,24 +34,25 @@ struct SpherePolytope {
 };
 const SpherePolytope& spherePolytope(int level);
 
-/// Smallest radius a volume is drawn with (metres). Points, segments and flat sets with radius 0
-/// are drawn as if their radius were this, so they stay visible and never look smaller.
+/// Default smallest radius a volume is drawn with (metres). Points, segments and flat sets with
+/// radius 0 are drawn as if their radius were this, so they stay visible and never look smaller.
 inline constexpr double kMinDrawRadius = 1e-3;
 
 /// A mesh containing the SSCH (points, radius): the convex hull (qhull) of circumscribed sphere
-/// polytopes of radius max(radius, kMinDrawRadius) around the core points (only those that can
+/// polytopes of radius max(radius, min_radius) around the core points (only those that can
 /// be hull vertices of the Minkowski sum are passed to qhull). Works for one point, segments
 /// and flat sets. Throws std::invalid_argument for empty or non-finite input.
-Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level);
+Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, double min_radius = kMinDrawRadius);
 
-/// Meshes keyed by the exact volume shape (the bytes of the points, radius and level): a volume
+/// Meshes keyed by the exact volume shape (the bytes of the points, radius, level and minimum radius): a volume
 /// that does not change (a static body, the same state) reuses its mesh; entries unused for a
 /// while are dropped so a moving robot does not grow the cache.
 class MeshCache {
  public:
   explicit MeshCache(std::size_t capacity = 512) : capacity_(capacity) {}
   /// The mesh of the SSCH, built on first use.
-  std::shared_ptr<const Mesh> get(std::span<const Vec3> points, double radius, int level);
+  std::shared_ptr<const Mesh> get(std::span<const Vec3> points, double radius, int level,
+                                  double min_radius = kMinDrawRadius);
   /// Marks the start of a frame (entries unused for a few frames may then be evicted).
   void nextFrame() { ++frame_; }
   std::size_t size() const { return entries_.size(); }
