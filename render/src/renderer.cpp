@@ -4,7 +4,10 @@
 #include <GL/glext.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include <opencv2/imgproc.hpp>
 
@@ -225,14 +228,14 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
     if (p.mesh) order.push_back(&p);
   std::sort(order.begin(), order.end(), [](const Prepared* a, const Prepared* b) { return a->depth > b->depth; });
   for (const Prepared* p : order) {
-    const cv::Scalar c = statusColour(p->status);
-    glColor4d(c[2] / 255.0, c[1] / 255.0, c[0] / 255.0, style.fill_alpha);
+    const cv::Scalar c = statusColour(p->status);  // BGR, drawn as GL's RGB (see the read-back)
+    glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
     drawTriangles(*p->mesh, p->vertices);
   }
   glLineWidth(static_cast<float>(style.outline_width * projection_.supersample()));
   for (const Prepared* p : order) {
     const cv::Scalar c = statusColour(p->status) * 0.7;
-    glColor4d(c[2] / 255.0, c[1] / 255.0, c[0] / 255.0, 1.0);
+    glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
     glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
     glDrawElements(GL_LINES, static_cast<GLsizei>(p->outline.size()), GL_UNSIGNED_INT, p->outline.data());
   }
@@ -246,7 +249,9 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   cv::Mat image(h, w, CV_8UC4);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glFinish();
-  glReadPixels(0, 0, w, h, GL_BGRA, GL_UNSIGNED_BYTE, image.data);
+  // Colours are drawn with blue in GL's red channel, so the plain RGBA read (llvmpipe's fast
+  // path, no swizzle) returns OpenCV's BGRA order.
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, image.data);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return image;
 }
@@ -280,35 +285,64 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
   context_->makeCurrent();
   Frame frame;
   std::vector<Prepared> bodies;
+  static const bool profile = std::getenv("KCCD_RENDER_PROFILE") != nullptr;
+  auto tick = [last = std::chrono::steady_clock::now()](const char* what) mutable {
+    if (!profile) return;
+    glFinish();
+    const auto now = std::chrono::steady_clock::now();
+    std::fprintf(stderr, "%s %.2f ms  ", what, std::chrono::duration<double, std::milli>(now - last).count());
+    last = now;
+  };
   prepare(volumes, bodies, frame);
+  tick("prepare");
   const Camera& cam = projection_.camera();
   if (want_colour) {
     cv::Mat premultiplied = drawColour(bodies, style);
+    tick("colour+readback");
     if (projection_.warps()) {
+      if (fixed_map_a_.empty())  // fixed-point maps: remap's fast path (1/32 px steps)
+        cv::convertMaps(projection_.mapX(), projection_.mapY(), fixed_map_a_, fixed_map_b_, CV_16SC2);
       cv::Mat warped;
-      cv::remap(premultiplied, warped, projection_.mapX(), projection_.mapY(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+      cv::remap(premultiplied, warped, fixed_map_a_, fixed_map_b_, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
                 cv::Scalar::all(0));
       premultiplied = warped;
     }
-    // Straight alpha: colour / alpha.
+    // Straight alpha: colour / alpha, through a table.
+    static const std::vector<uchar> unpremultiply = [] {
+      std::vector<uchar> t(256 * 256);
+      for (int a = 1; a < 256; ++a)
+        for (int c = 0; c < 256; ++c) t[a * 256 + c] = static_cast<uchar>(std::min(255, (c * 255 + a / 2) / a));
+      return t;
+    }();
     frame.bgra = premultiplied;
-    frame.bgra.forEach<cv::Vec4b>([](cv::Vec4b& px, const int*) {
-      const int a = px[3];
-      if (a == 0 || a == 255) return;
-      for (int c = 0; c < 3; ++c) px[c] = static_cast<uchar>(std::min(255, (px[c] * 255 + a / 2) / a));
+    cv::parallel_for_(cv::Range(0, frame.bgra.rows), [&](const cv::Range& rows) {
+      for (int y = rows.start; y < rows.end; ++y) {
+        uchar* px = frame.bgra.ptr<uchar>(y);
+        for (int x = 0; x < frame.bgra.cols; ++x, px += 4) {
+          const uchar* t = &unpremultiply[px[3] * 256];
+          if (px[3] != 255 && px[3] != 0) px[0] = t[px[0]], px[1] = t[px[1]], px[2] = t[px[2]];
+        }
+      }
     });
+    tick("warp+unpremultiply");
     decorate(frame.bgra, volumes, style);
+    tick("decorate");
   }
   if (want_mask) {
     cv::Mat mask = drawMask(bodies);
     const Projection& mp = maskProjection();
     if (mp.warps()) {
+      if (mask_map_.empty()) {  // nearest pinhole pixel per output pixel, as integers
+        cv::Mat unused;
+        cv::convertMaps(mp.mapX(), mp.mapY(), mask_map_, unused, CV_16SC2, true);
+      }
       cv::Mat warped;
-      cv::remap(mask, warped, mp.mapX(), mp.mapY(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+      cv::remap(mask, warped, mask_map_, cv::Mat(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
                 cv::Scalar::all(0));
       mask = warped;
     }
     frame.mask = mask;
+    tick("mask");
     frame.pixels.assign(volumes.size(), 0);
     for (int v = 0; v < cam.height; ++v) {
       const uchar* row = mask.ptr<uchar>(v);
@@ -316,10 +350,11 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
         if (row[u] != 0 && row[u] <= volumes.size()) ++frame.pixels[row[u] - 1];
     }
   }
+  if (profile) std::fprintf(stderr, "\n");
   return frame;
 }
 
-void Renderer::decorate(cv::Mat& bgra, std::span<const Volume> volumes, const Style& style) const {
+void Renderer::decorate(cv::Mat& bgra, std::span<const Volume> volumes, const Style& style) {
   const int font = cv::FONT_HERSHEY_SIMPLEX;
   const double scale = std::clamp(bgra.rows / 900.0, 0.35, 1.0);
   const int thick = std::max(1, static_cast<int>(std::lround(scale * 2)));
@@ -342,6 +377,27 @@ void Renderer::decorate(cv::Mat& bgra, std::span<const Volume> volumes, const St
     }
   }
   if (style.legend) {
+    // Drawn once per image size and copied afterwards.
+    if (legend_.empty() || legend_rows_ != bgra.rows) {
+      legend_rows_ = bgra.rows;
+      legend_ = drawLegend(scale, thick);
+      cv::Mat alpha;
+      cv::extractChannel(legend_, alpha, 3);
+      legend_box_ = cv::boundingRect(alpha);
+    }
+    const cv::Rect box = legend_box_ & cv::Rect(0, 0, bgra.cols, bgra.rows);
+    legend_(box).copyTo(bgra(box));
+  }
+}
+
+cv::Mat Renderer::drawLegend(double scale, int thick) {
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  auto text = [&](cv::Mat& img, const std::string& s, cv::Point at) {
+    cv::putText(img, s, at, font, scale, cv::Scalar(0, 0, 0, 255), thick + 2, cv::LINE_AA);
+    cv::putText(img, s, at, font, scale, cv::Scalar(255, 255, 255, 255), thick, cv::LINE_AA);
+  };
+  cv::Mat bgra;
+  {
     const VolumeStatus all[] = {VolumeStatus::Clear, VolumeStatus::WithinMargin, VolumeStatus::Colliding,
                                 VolumeStatus::NoState};
     const char* names[] = {"clear", "within margin", "colliding", "no state"};
@@ -349,16 +405,17 @@ void Renderer::decorate(cv::Mat& bgra, std::span<const Volume> volumes, const St
     const cv::Size line = cv::getTextSize("within margin", font, scale, thick, &baseline);
     const int pad = std::max(3, line.height / 2), row = line.height + 2 * pad;
     const cv::Rect box(pad, pad, line.width + row + 3 * pad, 4 * row + pad);
-    cv::Mat roi = bgra(box & cv::Rect(0, 0, bgra.cols, bgra.rows));
-    roi.setTo(cv::Scalar(30, 30, 30, 170));
+    bgra = cv::Mat::zeros(box.br().y, box.br().x, CV_8UC4);
+    bgra(box).setTo(cv::Scalar(30, 30, 30, 170));
     for (int i = 0; i < 4; ++i) {
       const int y = box.y + pad + i * row;
       const cv::Scalar c = statusColour(all[i]);
       cv::rectangle(bgra, cv::Rect(box.x + pad, y + pad / 2, row - pad, row - pad), cv::Scalar(c[0], c[1], c[2], 255),
                     cv::FILLED);
-      text(names[i], cv::Point(box.x + row + pad, y + line.height + pad / 2));
+      text(bgra, names[i], cv::Point(box.x + row + pad, y + line.height + pad / 2));
     }
   }
+  return bgra;
 }
 
 }  // namespace kccd::render

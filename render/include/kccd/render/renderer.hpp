@@ -46,7 +46,7 @@ struct RenderOptions {
   /// the nearest pinhole pixel, so a finer pinhole image keeps the label edges within 1/(2 s) px.
   double mask_supersample = 2.0;
   int msaa_samples = 4;        ///< colour layer multisampling (0 or 1: off; at most 4 on llvmpipe)
-  double tolerance_px = 0.25;  ///< largest outward error of the sphere tessellation, output pixels
+  double tolerance_px = 0.5;   ///< largest outward error of the sphere tessellation, output pixels
   int max_level = 4;           ///< finest sphere tessellation (level 4: 2562 vertices)
   double min_radius = kMinDrawRadius;  ///< volumes thinner than this are drawn this thick (metres)
   double near = 0.05;          ///< clipping planes, metres along the optical axis
@@ -89,7 +89,8 @@ class Renderer {
   void prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame);
   cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style);
   cv::Mat drawMask(const std::vector<Prepared>& bodies);
-  void decorate(cv::Mat& bgra, std::span<const Volume> volumes, const Style& style) const;
+  void decorate(cv::Mat& bgra, std::span<const Volume> volumes, const Style& style);
+  static cv::Mat drawLegend(double scale, int thick);
 
   RenderOptions options_;
   Projection projection_;
@@ -98,7 +99,10 @@ class Renderer {
   std::unique_ptr<Gl> gl_;
   MeshCache cache_;
   Pose world_to_camera_;
-  std::vector<float> scratch_;
+  cv::Mat fixed_map_a_, fixed_map_b_, mask_map_;  // remap tables in fixed point
+  cv::Mat legend_;
+  cv::Rect legend_box_;
+  int legend_rows_ = 0;
 };
 
 }  // namespace kccd::render
