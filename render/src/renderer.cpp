@@ -233,12 +233,15 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
     drawTriangles(*p->mesh, p->vertices);
   }
   glLineWidth(static_cast<float>(style.outline_width * projection_.supersample()));
+  glEnable(GL_LINE_SMOOTH);  // coverage in alpha, blended like the fill
+  glHint(GL_LINE_SMOOTH_HINT, GL_NICEST);
   for (const Prepared* p : order) {
     const cv::Scalar c = statusColour(p->status) * 0.7;
     glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
     glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
     glDrawElements(GL_LINES, static_cast<GLsizei>(p->outline.size()), GL_UNSIGNED_INT, p->outline.data());
   }
+  glDisable(GL_LINE_SMOOTH);
   glDisable(GL_BLEND);
   if (gl_->samples > 1) {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->ms_fbo);
