@@ -75,6 +75,9 @@ int runRender(const RenderArgs& args) {
     std::string ext = std::filesystem::path(args.output).extension().string();
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (ext != ".png") throw UsageError("-o " + args.output + ": the output must be a .png file");
+    const std::filesystem::path dir = std::filesystem::path(args.output).parent_path();
+    if (!dir.empty() && !std::filesystem::is_directory(dir))
+      throw UsageError("-o " + args.output + ": directory " + dir.string() + " does not exist");
   }
   std::vector<double> lower, upper;
   if (!args.state.empty()) {

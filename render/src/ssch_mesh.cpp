@@ -46,16 +46,97 @@ SpherePolytope makeSphere(int level) {
   }
   SpherePolytope s;
   double min_plane = 1.0, max_angle = 0.0;
-  for (const auto& t3 : f) {
+  for (auto& t3 : f) {
+    if ((v[t3[1]] - v[t3[0]]).cross(v[t3[2]] - v[t3[0]]).dot(v[t3[0]]) < 0.0) std::swap(t3[1], t3[2]);
+    s.triangles.push_back({static_cast<std::uint32_t>(t3[0]), static_cast<std::uint32_t>(t3[1]),
+                           static_cast<std::uint32_t>(t3[2])});
     const Vec3 n = (v[t3[1]] - v[t3[0]]).cross(v[t3[2]] - v[t3[0]]).normalized();
     min_plane = std::min(min_plane, std::abs(n.dot(v[t3[0]])));
     for (int k = 0; k < 3; ++k) max_angle = std::max(max_angle, std::acos(std::clamp(std::abs(n.dot(v[t3[k]])), -1.0, 1.0)));
+  }
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> owner;  // directed edge -> triangle
+  for (std::uint32_t t = 0; t < s.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) owner[{s.triangles[t][k], s.triangles[t][(k + 1) % 3]}] = t;
+  for (const auto& tri : s.triangles) {
+    std::array<std::uint32_t, 3> nb{};
+    for (int k = 0; k < 3; ++k) nb[k] = owner.at({tri[(k + 1) % 3], tri[k]});
+    s.neighbours.push_back(nb);
   }
   s.vertices = std::move(v);
   // A tiny relative guard so rounding in the scaled vertices never moves a face inside the ball.
   s.scale = (1.0 / min_plane) * (1.0 + 1e-12);
   s.cone_tan = std::tan(max_angle) * (1.0 + 1e-9) + 1e-12;
   return s;
+}
+
+// Fills Mesh::edges from the triangles.
+void buildEdges(Mesh& mesh) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::array<std::uint32_t, 4>> edges;
+  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const auto key = std::minmax(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3]);
+      auto [it, fresh] = edges.try_emplace(key, std::array<std::uint32_t, 4>{key.first, key.second, t, t});
+      if (!fresh) it->second[3] = t;
+    }
+  mesh.edges.clear();
+  mesh.edges.reserve(edges.size());
+  for (const auto& [key, e] : edges) mesh.edges.push_back(e);
+}
+
+// The sphere polytope of radius r around a, swept along the segment to b: faces whose normal
+// points along b - a are moved to b, the others stay at a, and every edge between the two
+// kinds becomes a parallelogram. That is exactly the boundary of hull(S + a, S + b).
+Mesh segmentMesh(const SpherePolytope& sphere, const Vec3& a, const Vec3& b, double r) {
+  const Vec3 d = b - a;
+  const auto nv = static_cast<std::uint32_t>(sphere.vertices.size());
+  std::vector<char> front(sphere.triangles.size());
+  std::vector<Vec3> normals(sphere.triangles.size());
+  for (std::size_t t = 0; t < sphere.triangles.size(); ++t) {
+    const auto& tri = sphere.triangles[t];
+    normals[t] = (sphere.vertices[tri[1]] - sphere.vertices[tri[0]])
+                     .cross(sphere.vertices[tri[2]] - sphere.vertices[tri[0]])
+                     .normalized();
+    front[t] = normals[t].dot(d) > 0.0;
+  }
+  Mesh raw;
+  for (const Vec3& v : sphere.vertices) raw.vertices.push_back(a + r * v);
+  for (const Vec3& v : sphere.vertices) raw.vertices.push_back(b + r * v);
+  for (std::size_t t = 0; t < sphere.triangles.size(); ++t) {
+    const std::uint32_t off = front[t] ? nv : 0;
+    const auto& tri = sphere.triangles[t];
+    raw.triangles.push_back({tri[0] + off, tri[1] + off, tri[2] + off});
+    raw.normals.push_back(normals[t]);
+  }
+  // Silhouette edges of S seen along d: the front triangle holds the edge as u -> w.
+  for (std::size_t t = 0; t < sphere.triangles.size(); ++t) {
+    if (!front[t]) continue;
+    const auto& tri = sphere.triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t u = tri[k], w = tri[(k + 1) % 3];
+      if (front[sphere.neighbours[t][k]]) continue;  // not a silhouette edge
+      const std::array<std::uint32_t, 3> t1{u, w, w + nv}, t2{u, w + nv, u + nv};
+      Vec3 n = (raw.vertices[w] - raw.vertices[u]).cross(d);
+      n = n.norm() > 0.0 ? n.normalized() : normals[t];
+      raw.triangles.push_back(t1);
+      raw.triangles.push_back(t2);
+      raw.normals.push_back(n);
+      raw.normals.push_back(n);
+    }
+  }
+  // Keep only the vertices in use.
+  Mesh mesh;
+  std::vector<std::int64_t> index(raw.vertices.size(), -1);
+  for (auto& tri : raw.triangles)
+    for (auto& i : tri) {
+      if (index[i] < 0) {
+        index[i] = static_cast<std::int64_t>(mesh.vertices.size());
+        mesh.vertices.push_back(raw.vertices[i]);
+      }
+      i = static_cast<std::uint32_t>(index[i]);
+    }
+  mesh.triangles = std::move(raw.triangles);
+  mesh.normals = std::move(raw.normals);
+  return mesh;
 }
 
 }  // namespace
@@ -79,6 +160,15 @@ Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, doubl
   // Guard for the float conversion of vertices when drawing (a micrometre at 1 m).
   const double pad = 1e-6 * (1.0 + extent);
   const double big_r = (std::max(radius, min_radius) + pad) * sphere.scale;
+
+  const bool one_point = std::all_of(points.begin(), points.end(), [&](const Vec3& p) { return p == points[0]; });
+  if (one_point || points.size() == 2) {
+    Mesh mesh = segmentMesh(sphere, points[0], points.back(), big_r);
+    mesh.level = level;
+    mesh.mesh_radius = big_r;
+    buildEdges(mesh);
+    return mesh;
+  }
 
   // Only p_i + R v_j that can be vertices of the Minkowski sum: p_i must be the support point
   // of the core set for some direction d in the normal cone of v_j (within angle θ of v_j),
@@ -143,15 +233,7 @@ Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, doubl
   if (code != 0 || mesh.triangles.empty())
     throw std::runtime_error("buildSschMesh: qhull failed (code " + std::to_string(code) + ")");
 
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::array<std::uint32_t, 4>> edges;
-  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const auto key = std::minmax(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3]);
-      auto [it, fresh] = edges.try_emplace(key, std::array<std::uint32_t, 4>{key.first, key.second, t, t});
-      if (!fresh) it->second[3] = t;
-    }
-  mesh.edges.reserve(edges.size());
-  for (const auto& [key, e] : edges) mesh.edges.push_back(e);
+  buildEdges(mesh);
   return mesh;
 }
 

@@ -29,6 +29,8 @@ struct Mesh {
 /// 1 / (smallest distance from the centre to a face plane), computed from the mesh itself.
 struct SpherePolytope {
   std::vector<Vec3> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;  ///< counter-clockwise seen from outside
+  std::vector<std::array<std::uint32_t, 3>> neighbours; ///< triangle across edge k (vertices k, k + 1)
   double scale = 1.0;
   double cone_tan = 0.0;  ///< tan of the largest angle between a vertex and its faces' normals
 };
@@ -38,10 +40,12 @@ const SpherePolytope& spherePolytope(int level);
 /// radius 0 are drawn as if their radius were this, so they stay visible and never look smaller.
 inline constexpr double kMinDrawRadius = 1e-3;
 
-/// A mesh containing the SSCH (points, radius): the convex hull (qhull) of circumscribed sphere
-/// polytopes of radius max(radius, min_radius) around the core points (only those that can
-/// be hull vertices of the Minkowski sum are passed to qhull). Works for one point, segments
-/// and flat sets. Throws std::invalid_argument for empty or non-finite input.
+/// A mesh containing the SSCH (points, radius): the convex hull of circumscribed sphere
+/// polytopes of radius max(radius, min_radius) around the core points. One point gives the
+/// sphere polytope itself and two points its sweep along the segment (built directly); more
+/// points go through qhull (only points that can be hull vertices of the Minkowski sum are
+/// passed). Works for flat and collinear sets. Throws std::invalid_argument for empty or
+/// non-finite input.
 Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, double min_radius = kMinDrawRadius);
 
 /// Meshes keyed by the exact volume shape (the bytes of the points, radius, level and minimum radius): a volume
