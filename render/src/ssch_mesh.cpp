@@ -65,7 +65,7 @@ SpherePolytope makeSphere(int level) {
   s.vertices = std::move(v);
   // A tiny relative guard so rounding in the scaled vertices never moves a face inside the ball.
   s.scale = (1.0 / min_plane) * (1.0 + 1e-12);
-  s.cone_tan = std::tan(max_angle) * (1.0 + 1e-9) + 1e-12;
+  s.cone_chord = 2.0 * std::sin(max_angle / 2.0) * (1.0 + 1e-9) + 1e-12;
   return s;
 }
 
@@ -170,21 +170,28 @@ Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, doubl
     return mesh;
   }
 
-  // Only p_i + R v_j that can be vertices of the Minkowski sum: p_i must be the support point
-  // of the core set for some direction d in the normal cone of v_j (within angle θ of v_j),
-  // which implies v_j·(p_m - p_i) <= tan θ |p_m - p_i| for the support point p_m in v_j.
+  // Only p_i + R v_j that can be vertices of the Minkowski sum: p_i must then be a support
+  // point of the core set for some direction d in the normal cone of v_j, and |d - v_j| <= c
+  // (cone_chord), so v_j·(p_i - p_k) >= d·(p_i - p_k) - c |p_i - p_k| >= -c |p_i - p_k| for
+  // every core point p_k. Points failing that for some p_k are left out.
+  const std::size_t k = points.size();
+  std::vector<double> dist(k * k), dots(k);
+  for (std::size_t i = 0; i < k; ++i)
+    for (std::size_t j = 0; j < k; ++j) dist[i * k + j] = (points[i] - points[j]).norm();
+  const double slack = 1e-12 * (1.0 + extent);
   std::vector<coordT> coords;
-  coords.reserve(points.size() * sphere.vertices.size() * 3 / 2);
+  coords.reserve(sphere.vertices.size() * 3 * 2);
   for (const Vec3& v : sphere.vertices) {
     std::size_t best = 0;
-    double best_dot = -1e300;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const double d = v.dot(points[i]);
-      if (d > best_dot) best_dot = d, best = i;
+    for (std::size_t i = 0; i < k; ++i) {
+      dots[i] = v.dot(points[i]);
+      if (dots[i] > dots[best]) best = i;
     }
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const double gap = best_dot - v.dot(points[i]);
-      if (i != best && gap > sphere.cone_tan * (points[best] - points[i]).norm() + 1e-12 * (1.0 + extent)) continue;
+    for (std::size_t i = 0; i < k; ++i) {
+      bool keep = dots[i] - dots[best] >= -sphere.cone_chord * dist[i * k + best] - slack;
+      for (std::size_t o = 0; keep && o < k; ++o)
+        keep = dots[i] - dots[o] >= -sphere.cone_chord * dist[i * k + o] - slack;
+      if (!keep) continue;
       const Vec3 q = points[i] + big_r * v;
       coords.insert(coords.end(), {q.x(), q.y(), q.z()});
     }

@@ -32,7 +32,9 @@ struct SpherePolytope {
   std::vector<std::array<std::uint32_t, 3>> triangles;  ///< counter-clockwise seen from outside
   std::vector<std::array<std::uint32_t, 3>> neighbours; ///< triangle across edge k (vertices k, k + 1)
   double scale = 1.0;
-  double cone_tan = 0.0;  ///< tan of the largest angle between a vertex and its faces' normals
+  /// 2 sin(θ / 2) for the largest angle θ between a vertex and its faces' normals: every
+  /// direction in a vertex's normal cone lies within this distance of the vertex direction.
+  double cone_chord = 0.0;
 };
 const SpherePolytope& spherePolytope(int level);
 
