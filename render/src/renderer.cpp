@@ -167,7 +167,10 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
           break;
         }
     }
+    const std::uint64_t before = cache_.built();
     p.mesh = cache_.get(v.points, v.radius, level, options_.min_radius);
+    if (cache_.built() != before) frame.hull_input += p.mesh->hull_input;
+    frame.max_level = std::max(frame.max_level, level);
     const Mesh& m = *p.mesh;
     p.vertices.resize(m.vertices.size() * 3);
     for (std::size_t k = 0; k < m.vertices.size(); ++k) {

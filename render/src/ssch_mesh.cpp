@@ -69,18 +69,24 @@ SpherePolytope makeSphere(int level) {
   return s;
 }
 
-// Fills Mesh::edges from the triangles.
+// Fills Mesh::edges from the triangles (sorted half-edges, paired up).
 void buildEdges(Mesh& mesh) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::array<std::uint32_t, 4>> edges;
+  std::vector<std::array<std::uint32_t, 3>> half;  // low vertex, high vertex, triangle
+  half.reserve(mesh.triangles.size() * 3);
   for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) {
-      const auto key = std::minmax(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3]);
-      auto [it, fresh] = edges.try_emplace(key, std::array<std::uint32_t, 4>{key.first, key.second, t, t});
-      if (!fresh) it->second[3] = t;
+      const auto [lo, hi] = std::minmax(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3]);
+      half.push_back({lo, hi, t});
     }
+  std::sort(half.begin(), half.end());
   mesh.edges.clear();
-  mesh.edges.reserve(edges.size());
-  for (const auto& [key, e] : edges) mesh.edges.push_back(e);
+  mesh.edges.reserve(half.size() / 2);
+  for (std::size_t i = 0; i < half.size();) {
+    std::size_t j = i + 1;
+    while (j < half.size() && half[j][0] == half[i][0] && half[j][1] == half[i][1]) ++j;
+    mesh.edges.push_back({half[i][0], half[i][1], half[i][2], half[j - 1][2]});
+    i = j;
+  }
 }
 
 // The sphere polytope of radius r around a, swept along the segment to b: faces whose normal
@@ -201,6 +207,7 @@ Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, doubl
   Mesh mesh;
   mesh.level = level;
   mesh.mesh_radius = big_r;
+  mesh.hull_input = n;
   qhT qh_storage;
   qhT* qh = &qh_storage;
   FILE* devnull = std::fopen("/dev/null", "w");

@@ -90,7 +90,7 @@ void frame(benchmark::State& state, bool swept, bool moving, bool mask) {
   static const auto static_list = boxes(false), swept_list = boxes(true);
   const auto& list = swept ? swept_list : static_list;
   static std::size_t i = 0;  // continues across runs, so repeated runs do not revisit cached shapes
-  double triangles = 0, built = 0, frames = 0;
+  double triangles = 0, built = 0, frames = 0, hull_input = 0, level = 0;
   for (auto _ : state) {
     const auto& [lo, hi] = list[moving ? i++ % list.size() : 0];
     const QueryResult& q = checker.query(lo, hi, QueryOptions{.type = QueryType::Distances});
@@ -99,11 +99,15 @@ void frame(benchmark::State& state, bool swept, bool moving, bool mask) {
     benchmark::DoNotOptimize(f.bgra.data);
     triangles += f.triangles;
     built += f.meshes_built;
+    hull_input += f.hull_input;
+    level = std::max(level, static_cast<double>(f.max_level));
     ++frames;
   }
   state.counters["triangles"] = triangles / frames;
   state.counters["meshes_built"] = built / frames;
   state.counters["bodies"] = static_cast<double>(m.bodies.size());
+  state.counters["qhull_points"] = hull_input / frames;
+  state.counters["max_level"] = level;
 }
 
 void BM_Static_Fixed(benchmark::State& s) { frame(s, false, false, s.range(0) != 0); }

@@ -50,7 +50,7 @@ struct RenderOptions {
   /// top of the fill edges, already gives anti-aliased silhouettes.
   int msaa_samples = 0;        ///< colour layer multisampling (0 or 1: off; at most 4 on llvmpipe)
   double tolerance_px = 0.5;   ///< largest outward error of the sphere tessellation, output pixels
-  int max_level = 4;           ///< finest sphere tessellation (level 4: 2562 vertices)
+  int max_level = 3;           ///< finest sphere tessellation (level 3: 642 vertices, 0.3 % outward)
   double min_radius = kMinDrawRadius;  ///< volumes thinner than this are drawn this thick (metres)
   double near = 0.05;          ///< clipping planes, metres along the optical axis
   double far = 100.0;
@@ -65,6 +65,8 @@ struct Frame {
   std::vector<int> pixels;
   int meshes_built = 0;   ///< meshes built in this frame (the others came from the cache)
   int triangles = 0;      ///< triangles drawn per pass
+  int hull_input = 0;     ///< points passed to qhull for the meshes built in this frame
+  int max_level = 0;      ///< finest sphere tessellation used
 };
 
 /// Draws volumes with one GL context (made current on the constructing thread; use one

@@ -22,6 +22,7 @@ struct Mesh {
   std::vector<std::array<std::uint32_t, 4>> edges;
   int level = 0;                                    ///< sphere tessellation level used
   double mesh_radius = 0.0;                         ///< radius of the circumscribed sphere polytope
+  int hull_input = 0;                               ///< points passed to qhull (0: built directly)
 };
 
 /// The unit sphere polytope of a tessellation level (icosahedron subdivided `level` times,
