@@ -19,6 +19,12 @@ lower=-0.05,0.05,0.05,0.05,-0.05,0.0,0.2,-0.9,0.3,1.2,0.0,0.3,0.0,-0.2,-0.9,-0.3
 upper=0.0,0.1,0.1,0.1,0.0,0.05,0.3,-0.8,0.35,1.3,0.1,0.4,0.1,-0.1,-0.8,-0.25,1.3,0.1,0.4,0.1
 step $kccd query data/humanoid.yaml --lower $lower --upper $upper --type nclosest --n 3
 step $kccd query data/humanoid.yaml --lower $lower --upper $upper --type collision --json
+# What a fixed camera sees (data/demo_camera.yaml: 1280x720, mild barrel distortion): the static
+# volumes at one state, and the swept volumes of the swing above, coloured by status.
+step $kccd render data/demo_arm.yaml --camera data/demo_camera.yaml --state 0.3,0.4,0.6 --labels -o build-demo/demo_static.png
+step $kccd render data/demo_arm.yaml --camera data/demo_camera.yaml --lower -0.5,0,0 --upper 0.5,0,0 -o build-demo/demo_swept.png
+step $kccd render data/demo_arm.yaml --camera data/demo_camera.yaml --lower -0.5,0,0 --upper 0.5,0,0 --mask -o build-demo/demo_swept_mask.png
+echo "images in build-demo/: demo_static.png, demo_swept.png (RGBA layers), demo_swept_mask.png (labels)"
 # Modelling: a conservative SSCH for a CAD part (8 core points), and which pairs of the demo arm
 # can never meet anywhere inside the joint limits (proven with the same sweeps).
 step $kccd fit data/parts/gripper.iv --points 8 --name gripper --frame elbow -q

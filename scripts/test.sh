@@ -29,5 +29,6 @@ fi
 if [ $sanitize -eq 1 ]; then
   echo "== ASan + UBSan build and tests"
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
     run build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKCCD_SANITIZE=ON -DKCCD_BUILD_BENCHMARKS=OFF
 fi

@@ -14,5 +14,6 @@ Runner addQuery(CLI::App& app);
 Runner addFit(CLI::App& app);
 Runner addPairs(CLI::App& app);
 Runner addImport(CLI::App& app);
+Runner addRender(CLI::App& app);
 
 }  // namespace kccd::cli

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   add(kccd::cli::addFit);
   add(kccd::cli::addPairs);
   add(kccd::cli::addImport);
+  add(kccd::cli::addRender);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,113 @@
+// Drawing SSCH volumes off-screen as the camera sees them: a straight-alpha BGRA layer for
+// compositing and an 8-bit label mask.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "kccd/render/camera.hpp"
+#include "kccd/render/gl_context.hpp"
+#include "kccd/render/ssch_mesh.hpp"
+
+namespace kccd::render {
+
+/// How a volume is coloured: green clear, amber within the margin, red colliding (or an unsafe
+/// query status), grey when no state is known.
+enum class VolumeStatus : std::uint8_t { Clear, WithinMargin, Colliding, NoState };
+const char* toString(VolumeStatus status);
+/// The fill colour of a status as BGR (OpenCV order).
+cv::Scalar statusColour(VolumeStatus status);
+
+/// One volume to draw, in world coordinates (the points are copied by the renderer).
+struct Volume {
+  std::span<const Vec3> points;
+  double radius = 0.0;
+  VolumeStatus status = VolumeStatus::NoState;
+  std::string label;  ///< shown with Style::labels
+};
+
+/// The look of the colour layer.
+struct Style {
+  double fill_alpha = 0.35;    ///< opacity of the fill
+  double outline_width = 2.0;  ///< outline width in output pixels (opaque, anti-aliased: smoothed lines)
+  bool labels = false;         ///< body names at the projected volume centres
+  bool legend = true;          ///< colour legend in the top-left corner
+};
+
+/// Renderer settings fixed at construction.
+struct RenderOptions {
+  double supersample = 1.0;    ///< pinhole image scale (1..4); > 1 keeps thin slivers through the warp
+  /// Pinhole scale of the mask pass when the camera distorts: the warp samples the mask at
+  /// the nearest pinhole pixel, so a finer pinhole image keeps the label edges within 1/(2 s) px.
+  double mask_supersample = 2.0;
+  /// Multisampling of the colour layer (0 or 1: off; at most 4 on llvmpipe). Off by default:
+  /// on llvmpipe 4x MSAA costs ~5x the frame time, and the outline, drawn as smoothed lines on
+  /// top of the fill edges, already gives anti-aliased silhouettes.
+  int msaa_samples = 0;        ///< colour layer multisampling (0 or 1: off; at most 4 on llvmpipe)
+  double tolerance_px = 0.5;   ///< largest outward error of the sphere tessellation, output pixels
+  int max_level = 3;           ///< finest sphere tessellation (level 3: 642 vertices, 0.3 % outward)
+  double min_radius = kMinDrawRadius;  ///< volumes thinner than this are drawn this thick (metres)
+  double near = 0.05;          ///< clipping planes, metres along the optical axis
+  double far = 100.0;
+};
+
+/// What render() produced: the layer (CV_8UC4, BGRA, straight alpha: PNG viewers and
+/// compositing expect it), the mask (CV_8UC1: 0 background, i + 1 for the nearest volume i,
+/// sampled at pixel centres), and per volume the mask pixels it owns.
+struct Frame {
+  cv::Mat bgra;
+  cv::Mat mask;
+  std::vector<int> pixels;
+  int meshes_built = 0;   ///< meshes built in this frame (the others came from the cache)
+  int triangles = 0;      ///< triangles drawn per pass
+  int hull_input = 0;     ///< points passed to qhull for the meshes built in this frame
+  int max_level = 0;      ///< finest sphere tessellation used
+};
+
+/// Draws volumes with one GL context (made current on the constructing thread; use one
+/// Renderer per thread). Meshes are cached by exact volume shape across frames.
+class Renderer {
+ public:
+  /// Creates the GL context and the framebuffers; throws GlContextError or CameraError.
+  explicit Renderer(const Camera& camera, const RenderOptions& options = {});
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  /// Renders the colour layer (when `want_colour`) and the mask (when `want_mask`).
+  Frame render(std::span<const Volume> volumes, const Style& style = {}, bool want_colour = true,
+               bool want_mask = true);
+
+  const std::string& rendererString() const;
+  const Projection& projection() const { return projection_; }
+  const Projection& maskProjection() const { return mask_projection_ ? *mask_projection_ : projection_; }
+  const MeshCache& meshCache() const { return cache_; }
+
+ private:
+  struct Gl;
+  struct Prepared;
+  void prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame);
+  cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style);
+  cv::Mat drawMask(const std::vector<Prepared>& bodies);
+  void decorate(cv::Mat& bgra, std::span<const Volume> volumes, const Style& style);
+  static cv::Mat drawLegend(double scale, int thick);
+
+  RenderOptions options_;
+  Projection projection_;
+  std::unique_ptr<Projection> mask_projection_;  // when the mask uses another pinhole scale
+  std::unique_ptr<GlContext> context_;
+  std::unique_ptr<Gl> gl_;
+  MeshCache cache_;
+  Pose world_to_camera_;
+  cv::Mat fixed_map_a_, fixed_map_b_, mask_map_;  // remap tables in fixed point
+  cv::Mat legend_;
+  cv::Rect legend_box_;
+  int legend_rows_ = 0;
+};
+
+}  // namespace kccd::render

@@ -1,0 +1,79 @@
+// Triangle meshes that contain an SSCH (hull of points ⊕ ball), and a cache of them.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "kccd/ssch.hpp"
+
+namespace kccd::render {
+
+/// A closed convex triangle mesh. Triangles are wound counter-clockwise seen from outside.
+struct Mesh {
+  std::vector<Vec3> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  std::vector<Vec3> normals;                        ///< outward unit normal per triangle
+  /// Every edge once: its two vertices and the two triangles that share it.
+  std::vector<std::array<std::uint32_t, 4>> edges;
+  int level = 0;                                    ///< sphere tessellation level used
+  double mesh_radius = 0.0;                         ///< radius of the circumscribed sphere polytope
+  int hull_input = 0;                               ///< points passed to qhull (0: built directly)
+};
+
+/// The unit sphere polytope of a tessellation level (icosahedron subdivided `level` times,
+/// vertices on the unit sphere) and how much it must be scaled to contain the unit ball:
+/// 1 / (smallest distance from the centre to a face plane), computed from the mesh itself.
+struct SpherePolytope {
+  std::vector<Vec3> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;  ///< counter-clockwise seen from outside
+  std::vector<std::array<std::uint32_t, 3>> neighbours; ///< triangle across edge k (vertices k, k + 1)
+  double scale = 1.0;
+  /// 2 sin(θ / 2) for the largest angle θ between a vertex and its faces' normals: every
+  /// direction in a vertex's normal cone lies within this distance of the vertex direction.
+  double cone_chord = 0.0;
+};
+const SpherePolytope& spherePolytope(int level);
+
+/// Default smallest radius a volume is drawn with (metres). Points, segments and flat sets with
+/// radius 0 are drawn as if their radius were this, so they stay visible and never look smaller.
+inline constexpr double kMinDrawRadius = 1e-3;
+
+/// A mesh containing the SSCH (points, radius): the convex hull of circumscribed sphere
+/// polytopes of radius max(radius, min_radius) around the core points. One point gives the
+/// sphere polytope itself and two points its sweep along the segment (built directly); more
+/// points go through qhull (only points that can be hull vertices of the Minkowski sum are
+/// passed). Works for flat and collinear sets. Throws std::invalid_argument for empty or
+/// non-finite input.
+Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, double min_radius = kMinDrawRadius);
+
+/// Meshes keyed by the exact volume shape (the bytes of the points, radius, level and minimum radius): a volume
+/// that does not change (a static body, the same state) reuses its mesh; entries unused for a
+/// while are dropped so a moving robot does not grow the cache.
+class MeshCache {
+ public:
+  explicit MeshCache(std::size_t capacity = 512) : capacity_(capacity) {}
+  /// The mesh of the SSCH, built on first use.
+  std::shared_ptr<const Mesh> get(std::span<const Vec3> points, double radius, int level,
+                                  double min_radius = kMinDrawRadius);
+  /// Marks the start of a frame (entries unused for a few frames may then be evicted).
+  void nextFrame() { ++frame_; }
+  std::size_t size() const { return entries_.size(); }
+  std::uint64_t built() const { return built_; }
+  std::uint64_t reused() const { return reused_; }
+
+ private:
+  struct Entry {
+    std::shared_ptr<const Mesh> mesh;
+    std::uint64_t used = 0;
+  };
+  std::size_t capacity_;
+  std::uint64_t frame_ = 0, built_ = 0, reused_ = 0;
+  std::unordered_map<std::string, Entry> entries_;
+};
+
+}  // namespace kccd::render

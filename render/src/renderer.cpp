@@ -1,0 +1,427 @@
+#include "kccd/render/renderer.hpp"
+
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include <opencv2/imgproc.hpp>
+
+namespace kccd::render {
+
+const char* toString(VolumeStatus status) {
+  switch (status) {
+    case VolumeStatus::Clear: return "clear";
+    case VolumeStatus::WithinMargin: return "within_margin";
+    case VolumeStatus::Colliding: return "colliding";
+    case VolumeStatus::NoState: return "no_state";
+  }
+  return "?";
+}
+
+cv::Scalar statusColour(VolumeStatus status) {
+  switch (status) {
+    case VolumeStatus::Clear: return {60, 200, 40};
+    case VolumeStatus::WithinMargin: return {0, 180, 255};
+    case VolumeStatus::Colliding: return {40, 40, 230};
+    case VolumeStatus::NoState: return {160, 160, 160};
+  }
+  return {255, 255, 255};
+}
+
+/// The framebuffers: a multisampled colour target resolved into a plain one, and a
+/// single-sampled colour + depth target for the mask.
+struct Renderer::Gl {
+  GLuint ms_fbo = 0, ms_colour = 0;
+  GLuint resolve_fbo = 0, resolve_colour = 0;
+  GLuint mask_fbo = 0, mask_colour = 0, mask_depth = 0;
+  int samples = 0;
+  int width = 0, height = 0;
+
+  static void check(GLuint fbo, const char* what) {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE)
+      throw GlContextError(std::string("GL: ") + what + " framebuffer incomplete (status " + std::to_string(status) + ")");
+  }
+  static GLuint renderbuffer(GLenum format, int samples, int w, int h) {
+    GLuint rb = 0;
+    glGenRenderbuffers(1, &rb);
+    glBindRenderbuffer(GL_RENDERBUFFER, rb);
+    if (samples > 1)
+      glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, w, h);
+    else
+      glRenderbufferStorage(GL_RENDERBUFFER, format, w, h);
+    return rb;
+  }
+
+  int mask_width = 0, mask_height = 0;
+
+  Gl(int w, int h, int want_samples, int mw, int mh) : width(w), height(h), mask_width(mw), mask_height(mh) {
+    GLint max_samples = 0, max_size = 0;
+    glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
+    if (std::max({w, h, mw, mh}) > max_size)
+      throw GlContextError("GL: image " + std::to_string(std::max(w, mw)) + "x" + std::to_string(std::max(h, mh)) +
+                           " exceeds the renderbuffer limit " + std::to_string(max_size));
+    samples = want_samples > 1 ? std::min(want_samples, static_cast<int>(max_samples)) : 0;
+    resolve_colour = renderbuffer(GL_RGBA8, 0, w, h);
+    glGenFramebuffers(1, &resolve_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, resolve_colour);
+    check(resolve_fbo, "colour");
+    if (samples > 1) {
+      ms_colour = renderbuffer(GL_RGBA8, samples, w, h);
+      glGenFramebuffers(1, &ms_fbo);
+      glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ms_colour);
+      check(ms_fbo, "multisample colour");
+    }
+    mask_colour = renderbuffer(GL_RGBA8, 0, mw, mh);
+    mask_depth = renderbuffer(GL_DEPTH_COMPONENT24, 0, mw, mh);
+    glGenFramebuffers(1, &mask_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, mask_fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, mask_colour);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, mask_depth);
+    check(mask_fbo, "mask");
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
+  ~Gl() {
+    const GLuint fbos[] = {ms_fbo, resolve_fbo, mask_fbo};
+    const GLuint rbs[] = {ms_colour, resolve_colour, mask_colour, mask_depth};
+    glDeleteFramebuffers(3, fbos);
+    glDeleteRenderbuffers(4, rbs);
+  }
+};
+
+/// One volume ready to draw: its mesh and the mesh vertices in camera coordinates (float, as
+/// uploaded), the silhouette edges seen from the camera, and its depth for sorting.
+struct Renderer::Prepared {
+  int index = 0;
+  VolumeStatus status = VolumeStatus::NoState;
+  std::shared_ptr<const Mesh> mesh;
+  std::vector<float> vertices;
+  std::vector<std::uint32_t> outline;
+  double depth = 0.0;
+};
+
+Renderer::Renderer(const Camera& camera, const RenderOptions& options)
+    : options_(options),
+      projection_(camera, options.supersample),
+      context_(GlContext::make()),
+      world_to_camera_(camera.worldToCamera()) {
+  if (camera.distorted() && options.mask_supersample != options.supersample)
+    mask_projection_ = std::make_unique<Projection>(camera, options.mask_supersample);
+  const Pinhole& mask = maskProjection().pinhole();
+  gl_ = std::make_unique<Gl>(projection_.pinhole().width, projection_.pinhole().height, options.msaa_samples, mask.width,
+                             mask.height);
+}
+
+Renderer::~Renderer() {
+  context_->makeCurrent();
+  gl_.reset();
+}
+
+const std::string& Renderer::rendererString() const { return context_->renderer(); }
+
+void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame) {
+  cache_.nextFrame();
+  const std::uint64_t built_before = cache_.built();
+  const Camera& cam = projection_.camera();
+  const double focal = std::max(cam.camera_matrix(0, 0), cam.camera_matrix(1, 1));
+  out.resize(volumes.size());
+  std::vector<Vec3> cam_points;
+  for (std::size_t i = 0; i < volumes.size(); ++i) {
+    const Volume& v = volumes[i];
+    Prepared& p = out[i];
+    p.index = static_cast<int>(i);
+    p.status = v.status;
+    p.mesh.reset();
+    p.vertices.clear();
+    p.outline.clear();
+    if (v.points.empty()) continue;
+    // Tessellation fine enough that the circumscribed sphere polytope lies at most
+    // tolerance_px outside the true surface, as seen from the closest point of the volume.
+    cam_points.clear();
+    double zmin = 1e300;
+    Vec3 centre = Vec3::Zero();
+    for (const Vec3& w : v.points) {
+      cam_points.push_back(world_to_camera_ * w);
+      zmin = std::min(zmin, cam_points.back().z());
+      centre += cam_points.back();
+    }
+    centre /= static_cast<double>(cam_points.size());
+    p.depth = centre.norm();
+    const double r = std::max(v.radius, options_.min_radius);
+    zmin -= r;
+    int level = options_.max_level;
+    if (zmin > options_.near) {
+      const double r_px = focal * r / zmin;
+      for (int l = 1; l < options_.max_level; ++l)
+        if ((spherePolytope(l).scale - 1.0) * r_px <= options_.tolerance_px) {
+          level = l;
+          break;
+        }
+    }
+    const std::uint64_t before = cache_.built();
+    p.mesh = cache_.get(v.points, v.radius, level, options_.min_radius);
+    if (cache_.built() != before) frame.hull_input += p.mesh->hull_input;
+    frame.max_level = std::max(frame.max_level, level);
+    const Mesh& m = *p.mesh;
+    p.vertices.resize(m.vertices.size() * 3);
+    for (std::size_t k = 0; k < m.vertices.size(); ++k) {
+      const Vec3 c = world_to_camera_ * m.vertices[k];
+      p.vertices[3 * k] = static_cast<float>(c.x());
+      p.vertices[3 * k + 1] = static_cast<float>(c.y());
+      p.vertices[3 * k + 2] = static_cast<float>(c.z());
+    }
+    // Silhouette edges: one neighbouring triangle faces the camera (at the origin), the other not.
+    std::vector<char> front(m.triangles.size());
+    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+      const Vec3 n = world_to_camera_.linear() * m.normals[t];
+      const Vec3 a = world_to_camera_ * m.vertices[m.triangles[t][0]];
+      front[t] = n.dot(a) < 0.0;
+    }
+    for (const auto& e : m.edges)
+      if (front[e[2]] != front[e[3]]) p.outline.insert(p.outline.end(), {e[0], e[1]});
+    frame.triangles += static_cast<int>(m.triangles.size());
+  }
+  frame.meshes_built = static_cast<int>(cache_.built() - built_before);
+}
+
+namespace {
+
+void setCamera(const Projection& projection, double near, double far) {
+  const std::array<float, 16> m = projection.glMatrix(near, far);
+  glViewport(0, 0, projection.pinhole().width, projection.pinhole().height);
+  glMatrixMode(GL_PROJECTION);
+  glLoadMatrixf(m.data());
+  glMatrixMode(GL_MODELVIEW);
+  glLoadIdentity();
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glFrontFace(GL_CW);  // the projection keeps image rows top-down, which mirrors the winding
+  glEnableClientState(GL_VERTEX_ARRAY);
+}
+
+void drawTriangles(const Mesh& mesh, const std::vector<float>& vertices) {
+  glVertexPointer(3, GL_FLOAT, 0, vertices.data());
+  glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.triangles.size() * 3), GL_UNSIGNED_INT, mesh.triangles.data());
+}
+
+}  // namespace
+
+cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& style) {
+  const int w = gl_->width, h = gl_->height;
+  glBindFramebuffer(GL_FRAMEBUFFER, gl_->samples > 1 ? gl_->ms_fbo : gl_->resolve_fbo);
+  setCamera(projection_, options_.near, options_.far);
+  glClearColor(0, 0, 0, 0);
+  glClear(GL_COLOR_BUFFER_BIT);
+  glDisable(GL_DEPTH_TEST);
+  glEnable(GL_BLEND);
+  // Premultiplied result on a transparent clear; converted to straight alpha after read-back.
+  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  // Back to front; back faces culled, so each convex volume tints a pixel once.
+  std::vector<const Prepared*> order;
+  for (const Prepared& p : bodies)
+    if (p.mesh) order.push_back(&p);
+  std::sort(order.begin(), order.end(), [](const Prepared* a, const Prepared* b) { return a->depth > b->depth; });
+  for (const Prepared* p : order) {
+    const cv::Scalar c = statusColour(p->status);  // BGR, drawn as GL's RGB (see the read-back)
+    glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
+    drawTriangles(*p->mesh, p->vertices);
+  }
+  glLineWidth(static_cast<float>(style.outline_width * projection_.supersample()));
+  glEnable(GL_LINE_SMOOTH);  // coverage in alpha, blended like the fill
+  glHint(GL_LINE_SMOOTH_HINT, GL_NICEST);
+  for (const Prepared* p : order) {
+    const cv::Scalar c = statusColour(p->status) * 0.7;
+    glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
+    glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
+    glDrawElements(GL_LINES, static_cast<GLsizei>(p->outline.size()), GL_UNSIGNED_INT, p->outline.data());
+  }
+  glDisable(GL_LINE_SMOOTH);
+  glDisable(GL_BLEND);
+  if (gl_->samples > 1) {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->ms_fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, gl_->resolve_fbo);
+    glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->resolve_fbo);
+  cv::Mat image(h, w, CV_8UC4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glFinish();
+  // Colours are drawn with blue in GL's red channel, so the plain RGBA read (llvmpipe's fast
+  // path, no swizzle) returns OpenCV's BGRA order.
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, image.data);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  return image;
+}
+
+cv::Mat Renderer::drawMask(const std::vector<Prepared>& bodies) {
+  const int w = gl_->mask_width, h = gl_->mask_height;
+  glBindFramebuffer(GL_FRAMEBUFFER, gl_->mask_fbo);
+  setCamera(maskProjection(), options_.near, options_.far);
+  glClearColor(0, 0, 0, 0);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_BLEND);
+  for (const Prepared& p : bodies) {
+    if (!p.mesh) continue;
+    glColor4ub(static_cast<GLubyte>(p.index + 1), 0, 0, 255);
+    drawTriangles(*p.mesh, p.vertices);
+  }
+  glDisable(GL_DEPTH_TEST);
+  cv::Mat mask(h, w, CV_8UC1);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glFinish();
+  glReadPixels(0, 0, w, h, GL_RED, GL_UNSIGNED_BYTE, mask.data);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  return mask;
+}
+
+Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool want_colour, bool want_mask) {
+  if (volumes.size() > 255) throw std::invalid_argument("Renderer: at most 255 volumes (8-bit mask labels)");
+  context_->makeCurrent();
+  Frame frame;
+  std::vector<Prepared> bodies;
+  static const bool profile = std::getenv("KCCD_RENDER_PROFILE") != nullptr;
+  auto tick = [last = std::chrono::steady_clock::now()](const char* what) mutable {
+    if (!profile) return;
+    glFinish();
+    const auto now = std::chrono::steady_clock::now();
+    std::fprintf(stderr, "%s %.2f ms  ", what, std::chrono::duration<double, std::milli>(now - last).count());
+    last = now;
+  };
+  prepare(volumes, bodies, frame);
+  tick("prepare");
+  const Camera& cam = projection_.camera();
+  if (want_colour) {
+    cv::Mat premultiplied = drawColour(bodies, style);
+    tick("colour+readback");
+    if (projection_.warps()) {
+      if (fixed_map_a_.empty())  // fixed-point maps: remap's fast path (1/32 px steps)
+        cv::convertMaps(projection_.mapX(), projection_.mapY(), fixed_map_a_, fixed_map_b_, CV_16SC2);
+      cv::Mat warped;
+      cv::remap(premultiplied, warped, fixed_map_a_, fixed_map_b_, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                cv::Scalar::all(0));
+      premultiplied = warped;
+    }
+    // Straight alpha: colour / alpha, through a table.
+    static const std::vector<uchar> unpremultiply = [] {
+      std::vector<uchar> t(256 * 256);
+      for (int a = 1; a < 256; ++a)
+        for (int c = 0; c < 256; ++c) t[a * 256 + c] = static_cast<uchar>(std::min(255, (c * 255 + a / 2) / a));
+      return t;
+    }();
+    frame.bgra = premultiplied;
+    cv::parallel_for_(cv::Range(0, frame.bgra.rows), [&](const cv::Range& rows) {
+      for (int y = rows.start; y < rows.end; ++y) {
+        uchar* px = frame.bgra.ptr<uchar>(y);
+        for (int x = 0; x < frame.bgra.cols; ++x, px += 4) {
+          const uchar* t = &unpremultiply[px[3] * 256];
+          if (px[3] != 255 && px[3] != 0) px[0] = t[px[0]], px[1] = t[px[1]], px[2] = t[px[2]];
+        }
+      }
+    });
+    tick("warp+unpremultiply");
+    decorate(frame.bgra, volumes, style);
+    tick("decorate");
+  }
+  if (want_mask) {
+    cv::Mat mask = drawMask(bodies);
+    const Projection& mp = maskProjection();
+    if (mp.warps()) {
+      if (mask_map_.empty()) {  // nearest pinhole pixel per output pixel, as integers
+        cv::Mat unused;
+        cv::convertMaps(mp.mapX(), mp.mapY(), mask_map_, unused, CV_16SC2, true);
+      }
+      cv::Mat warped;
+      cv::remap(mask, warped, mask_map_, cv::Mat(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                cv::Scalar::all(0));
+      mask = warped;
+    }
+    frame.mask = mask;
+    tick("mask");
+    frame.pixels.assign(volumes.size(), 0);
+    for (int v = 0; v < cam.height; ++v) {
+      const uchar* row = mask.ptr<uchar>(v);
+      for (int u = 0; u < cam.width; ++u)
+        if (row[u] != 0 && row[u] <= volumes.size()) ++frame.pixels[row[u] - 1];
+    }
+  }
+  if (profile) std::fprintf(stderr, "\n");
+  return frame;
+}
+
+void Renderer::decorate(cv::Mat& bgra, std::span<const Volume> volumes, const Style& style) {
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  const double scale = std::clamp(bgra.rows / 900.0, 0.35, 1.0);
+  const int thick = std::max(1, static_cast<int>(std::lround(scale * 2)));
+  auto text = [&](const std::string& s, cv::Point at) {
+    cv::putText(bgra, s, at, font, scale, cv::Scalar(0, 0, 0, 255), thick + 2, cv::LINE_AA);
+    cv::putText(bgra, s, at, font, scale, cv::Scalar(255, 255, 255, 255), thick, cv::LINE_AA);
+  };
+  if (style.labels) {
+    for (const Volume& v : volumes) {
+      if (v.points.empty() || v.label.empty()) continue;
+      Vec3 centre = Vec3::Zero();
+      for (const Vec3& p : v.points) centre += p;
+      centre /= static_cast<double>(v.points.size());
+      if ((world_to_camera_ * centre).z() <= options_.near) continue;
+      const Eigen::Vector2d px = projection_.project(centre);
+      if (!std::isfinite(px.x()) || !std::isfinite(px.y())) continue;
+      int baseline = 0;
+      const cv::Size size = cv::getTextSize(v.label, font, scale, thick, &baseline);
+      text(v.label, cv::Point(static_cast<int>(px.x()) - size.width / 2, static_cast<int>(px.y()) + size.height / 2));
+    }
+  }
+  if (style.legend) {
+    // Drawn once per image size and copied afterwards.
+    if (legend_.empty() || legend_rows_ != bgra.rows) {
+      legend_rows_ = bgra.rows;
+      legend_ = drawLegend(scale, thick);
+      cv::Mat alpha;
+      cv::extractChannel(legend_, alpha, 3);
+      legend_box_ = cv::boundingRect(alpha);
+    }
+    const cv::Rect box = legend_box_ & cv::Rect(0, 0, bgra.cols, bgra.rows);
+    legend_(box).copyTo(bgra(box));
+  }
+}
+
+cv::Mat Renderer::drawLegend(double scale, int thick) {
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  auto text = [&](cv::Mat& img, const std::string& s, cv::Point at) {
+    cv::putText(img, s, at, font, scale, cv::Scalar(0, 0, 0, 255), thick + 2, cv::LINE_AA);
+    cv::putText(img, s, at, font, scale, cv::Scalar(255, 255, 255, 255), thick, cv::LINE_AA);
+  };
+  cv::Mat bgra;
+  {
+    const VolumeStatus all[] = {VolumeStatus::Clear, VolumeStatus::WithinMargin, VolumeStatus::Colliding,
+                                VolumeStatus::NoState};
+    const char* names[] = {"clear", "within margin", "colliding", "no state"};
+    int baseline = 0;
+    const cv::Size line = cv::getTextSize("within margin", font, scale, thick, &baseline);
+    const int pad = std::max(3, line.height / 2), row = line.height + 2 * pad;
+    const cv::Rect box(pad, pad, line.width + row + 3 * pad, 4 * row + pad);
+    bgra = cv::Mat::zeros(box.br().y, box.br().x, CV_8UC4);
+    bgra(box).setTo(cv::Scalar(30, 30, 30, 170));
+    for (int i = 0; i < 4; ++i) {
+      const int y = box.y + pad + i * row;
+      const cv::Scalar c = statusColour(all[i]);
+      cv::rectangle(bgra, cv::Rect(box.x + pad, y + pad / 2, row - pad, row - pad), cv::Scalar(c[0], c[1], c[2], 255),
+                    cv::FILLED);
+      text(bgra, names[i], cv::Point(box.x + row + pad, y + line.height + pad / 2));
+    }
+  }
+  return bgra;
+}
+
+}  // namespace kccd::render

@@ -1,0 +1,123 @@
+// Renderer benchmarks: ms per frame at 1280x720 for the humanoid through a camera with mild lens
+// distortion, including the query, mesh building, drawing, read-back, distortion warp and
+// straight-alpha conversion.
+// - Static/fixed:  the same state every frame (every mesh comes from the cache);
+// - Static/moving: a new state every frame (every moving body's mesh is rebuilt);
+// - Swept:         a new braking box every frame (2-20 degrees per joint), swept volumes;
+// each for the colour layer alone and for colour + label mask.
+// Run with --benchmark_repetitions=5 and read the medians.
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <opencv2/calib3d.hpp>
+
+#include "kccd/checker.hpp"
+#include "kccd/render/renderer.hpp"
+#include "kccd/render/scene.hpp"
+
+namespace {
+
+using namespace kccd;
+using namespace kccd::render;
+constexpr double kDeg = 3.141592653589793 / 180.0;
+
+const Model& humanoid() {
+  static const Model m = loadModel(std::string(KCCD_DATA_DIR) + "/humanoid.yaml");
+  return m;
+}
+
+Camera benchCamera() {
+  // 3.2 m in front and to the side of the humanoid, looking at its chest.
+  const Vec3 eye(3.0, -1.2, 1.6), target(0.0, 0.0, 1.1);
+  const Vec3 z = (target - eye).normalized(), x = z.cross(Vec3::UnitZ()).normalized(), y = z.cross(x);
+  cv::Matx33d r;
+  for (int j = 0; j < 3; ++j) r(0, j) = x[j], r(1, j) = y[j], r(2, j) = z[j];
+  Camera c;
+  c.width = 1280;
+  c.height = 720;
+  c.camera_matrix = cv::Matx33d(1000, 0, 641.3, 0, 1000, 358.2, 0, 0, 1);
+  c.distortion = {-0.11, 0.06, 0.0006, -0.0004, -0.01};
+  cv::Rodrigues(r, c.rvec);
+  const Vec3 t = -(Eigen::Matrix3d::Map(r.val).transpose() * eye);
+  c.tvec = cv::Vec3d(t.x(), t.y(), t.z());
+  return c;
+}
+
+// Boxes around random states within the joint limits; width 0 for static frames.
+std::vector<std::pair<std::vector<double>, std::vector<double>>> boxes(bool swept) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Model& m = humanoid();
+  std::vector<std::pair<std::vector<double>, std::vector<double>>> out;
+  for (int i = 0; i < 4096; ++i) {
+    std::vector<double> lo(m.stateSize()), hi(m.stateSize());
+    for (const Joint& j : m.joints)
+      for (int k = 0; k < j.dof; ++k) {
+        const int s = j.state_offset + k;
+        const double a = j.limits ? (*j.limits)[0] : -1.0, b = j.limits ? (*j.limits)[1] : 1.0;
+        const double c = a + (b - a) * (0.25 + 0.5 * u(rng));
+        const double w = swept ? (2.0 + 18.0 * u(rng)) * kDeg : 0.0;
+        lo[s] = c - 0.5 * w;
+        hi[s] = c + 0.5 * w;
+      }
+    out.emplace_back(lo, hi);
+  }
+  return out;
+}
+
+// Knobs for profiling: KCCD_BENCH_MSAA, KCCD_BENCH_SUPERSAMPLE, KCCD_BENCH_TOLERANCE_PX.
+RenderOptions benchOptions() {
+  RenderOptions o;
+  if (const char* v = std::getenv("KCCD_BENCH_MSAA")) o.msaa_samples = std::atoi(v);
+  if (const char* v = std::getenv("KCCD_BENCH_SUPERSAMPLE")) o.supersample = std::atof(v);
+  if (const char* v = std::getenv("KCCD_BENCH_TOLERANCE_PX")) o.tolerance_px = std::atof(v);
+  return o;
+}
+
+Renderer& renderer() {
+  static Renderer r(benchCamera(), benchOptions());
+  return r;
+}
+
+void frame(benchmark::State& state, bool swept, bool moving, bool mask) {
+  const Model& m = humanoid();
+  Renderer& r = renderer();
+  Checker checker(m);
+  static const auto static_list = boxes(false), swept_list = boxes(true);
+  const auto& list = swept ? swept_list : static_list;
+  static std::size_t i = 0;  // continues across runs, so repeated runs do not revisit cached shapes
+  double triangles = 0, built = 0, frames = 0, hull_input = 0, level = 0;
+  for (auto _ : state) {
+    const auto& [lo, hi] = list[moving ? i++ % list.size() : 0];
+    const QueryResult& q = checker.query(lo, hi, QueryOptions{.type = QueryType::Distances});
+    const std::vector<Volume> volumes = sceneVolumes(m, checker, bodyStatus(m, q));
+    const Frame f = r.render(volumes, Style{}, true, mask);
+    benchmark::DoNotOptimize(f.bgra.data);
+    triangles += f.triangles;
+    built += f.meshes_built;
+    hull_input += f.hull_input;
+    level = std::max(level, static_cast<double>(f.max_level));
+    ++frames;
+  }
+  state.counters["triangles"] = triangles / frames;
+  state.counters["meshes_built"] = built / frames;
+  state.counters["bodies"] = static_cast<double>(m.bodies.size());
+  state.counters["qhull_points"] = hull_input / frames;
+  state.counters["max_level"] = level;
+}
+
+void BM_Static_Fixed(benchmark::State& s) { frame(s, false, false, s.range(0) != 0); }
+void BM_Static_Moving(benchmark::State& s) { frame(s, false, true, s.range(0) != 0); }
+void BM_Swept(benchmark::State& s) { frame(s, true, true, s.range(0) != 0); }
+
+BENCHMARK(BM_Static_Fixed)->ArgName("mask")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_Static_Moving)->ArgName("mask")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_Swept)->ArgName("mask")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
+}  // namespace
+
+BENCHMARK_MAIN();

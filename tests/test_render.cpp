@@ -1,0 +1,555 @@
+// The renderer: camera files, projection against cv::projectPoints, meshes that contain the
+// true volume, masks against an independent CPU silhouette, golden images.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "kccd/checker.hpp"
+#include "kccd/render/camera.hpp"
+#include "kccd/render/renderer.hpp"
+#include "kccd/render/scene.hpp"
+#include "kccd/render/ssch_mesh.hpp"
+#include "support/golden.hpp"
+
+namespace {
+
+using namespace kccd;
+using namespace kccd::render;
+
+const std::string kData = KCCD_DATA_DIR;
+
+// A camera at `eye` looking at `target` (z up in the world), OpenCV axes.
+Camera lookAt(const Vec3& eye, const Vec3& target, int w, int h, double f, std::vector<double> dist) {
+  const Vec3 z = (target - eye).normalized();
+  const Vec3 x = z.cross(Vec3::UnitZ()).normalized();
+  const Vec3 y = z.cross(x);
+  Eigen::Matrix3d r;
+  r.row(0) = x;
+  r.row(1) = y;
+  r.row(2) = z;
+  cv::Matx33d rc;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) rc(i, j) = r(i, j);
+  Camera c;
+  c.width = w;
+  c.height = h;
+  c.camera_matrix = cv::Matx33d(f, 0, (w - 1) / 2.0 + 1.3, 0, f * 1.01, (h - 1) / 2.0 - 0.7, 0, 0, 1);
+  c.distortion = std::move(dist);
+  cv::Rodrigues(rc, c.rvec);
+  const Vec3 t = -(r * eye);
+  c.tvec = cv::Vec3d(t.x(), t.y(), t.z());
+  return c;
+}
+
+cv::Point2d cvProject(const Camera& c, const Vec3& p) {
+  std::vector<cv::Point2d> out;
+  cv::projectPoints(std::vector<cv::Point3d>{{p.x(), p.y(), p.z()}}, c.rvec, c.tvec, c.camera_matrix, c.distortion, out);
+  return out[0];
+}
+
+Camera randomCamera(std::mt19937_64& rng, bool distorted, int w = 320, int h = 240) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double dist = 1.5 + 0.4 * u(rng);
+  const Vec3 dir = Vec3(u(rng), u(rng), 0.3 + 0.5 * std::abs(u(rng))).normalized();
+  std::vector<double> d(5, 0.0);
+  if (distorted) d = {0.15 * u(rng) - 0.05, 0.05 * u(rng), 0.002 * u(rng), 0.002 * u(rng), 0.01 * u(rng)};
+  return lookAt(dist * dir, Vec3(0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng)), w, h, 0.9 * w * (1.0 + 0.2 * u(rng)), d);
+}
+
+std::string writeTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Camera files
+
+TEST(RenderCamera, LoadsTheSampleCamera) {
+  const Camera c = loadCamera(kData + "/demo_camera.yaml");
+  EXPECT_EQ(c.width, 1280);
+  EXPECT_EQ(c.height, 720);
+  EXPECT_DOUBLE_EQ(c.camera_matrix(0, 0), 1100.0);
+  ASSERT_EQ(c.distortion.size(), 5u);
+  EXPECT_TRUE(c.distorted());
+  EXPECT_NEAR(c.tvec[2], 2.799277262, 1e-12);
+}
+
+TEST(RenderCamera, RoundTripsThroughSave) {
+  std::mt19937_64 rng(3);
+  const Camera c = randomCamera(rng, true);
+  const std::string path = ::testing::TempDir() + "/kccd_cam_roundtrip.yaml";
+  saveCamera(c, path);
+  const Camera d = loadCamera(path);
+  EXPECT_EQ(d.width, c.width);
+  EXPECT_EQ(d.distortion, c.distortion);
+  EXPECT_EQ(d.rvec, c.rvec);
+  EXPECT_EQ(d.tvec, c.tvec);
+}
+
+std::string cameraText(const std::string& replace_key = "", const std::string& with = "") {
+  std::map<std::string, std::string> fields = {
+      {"image_width", "image_width: 320\n"},
+      {"image_height", "image_height: 240\n"},
+      {"camera_matrix",
+       "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [300., 0., 160., 0., 300., 120., 0., 0., 1.]\n"},
+      {"distortion_coefficients",
+       "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n   data: [-0.1, 0.01, 0., 0., 0.]\n"},
+      {"rvec", "rvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [0., 0., 0.]\n"},
+      {"tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [0., 0., 2.]\n"}};
+  if (!replace_key.empty()) fields[replace_key] = with;
+  std::string text = "%YAML:1.0\n---\n";
+  for (const auto& [k, v] : fields) text += v;
+  return text;
+}
+
+void expectCameraError(const std::string& text, const std::string& field, const std::string& what) {
+  const std::string path = writeTemp("kccd_cam_" + field + ".yaml", text);
+  try {
+    loadCamera(path);
+    ADD_FAILURE() << "accepted a camera with " << what;
+  } catch (const CameraError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find(field), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+}
+
+TEST(RenderCamera, ErrorsNameFileAndField) {
+  EXPECT_NO_THROW(loadCamera(writeTemp("kccd_cam_ok.yaml", cameraText())));
+  expectCameraError(cameraText("tvec", ""), "tvec", "no tvec");
+  expectCameraError(cameraText("image_width", "image_width: -5\n"), "image_width", "a negative width");
+  expectCameraError(cameraText("image_height", "image_height: abc\n"), "image_height", "a text height");
+  expectCameraError(cameraText("camera_matrix",
+                               "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [-300., 0., "
+                               "160., 0., 300., 120., 0., 0., 1.]\n"),
+                    "camera_matrix", "a negative focal length");
+  expectCameraError(cameraText("camera_matrix",
+                               "camera_matrix: !!opencv-matrix\n   rows: 2\n   cols: 2\n   dt: d\n   data: [1., 0., 0., 1.]\n"),
+                    "camera_matrix", "a 2x2 matrix");
+  expectCameraError(cameraText("distortion_coefficients",
+                               "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 3\n   dt: d\n   data: [0.1, "
+                               "0., 0.]\n"),
+                    "distortion_coefficients", "3 coefficients");
+  expectCameraError(cameraText("rvec", "rvec: [1, 2]\n"), "rvec", "a malformed rvec");
+  try {
+    loadCamera("/nonexistent/cam.yaml");
+    ADD_FAILURE();
+  } catch (const CameraError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/cam.yaml"), std::string::npos);
+  }
+  try {
+    loadCamera(writeTemp("kccd_cam_garbage.yaml", "%YAML:1.0\n---\n: : [\n"));
+    ADD_FAILURE();
+  } catch (const CameraError& e) {
+    EXPECT_NE(std::string(e.what()).find("kccd_cam_garbage.yaml"), std::string::npos);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Projection: the GL chain against cv::projectPoints
+
+Vec3 randomVisiblePoint(std::mt19937_64& rng, const Camera& c) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Pose cam_to_world = c.worldToCamera().inverse();
+  const double z = 0.3 + 5.0 * u(rng);
+  const double px = -0.1 * c.width + 1.2 * c.width * u(rng), py = -0.1 * c.height + 1.2 * c.height * u(rng);
+  const Vec3 cam((px - c.camera_matrix(0, 2)) / c.camera_matrix(0, 0) * z,
+                 (py - c.camera_matrix(1, 2)) / c.camera_matrix(1, 1) * z, z);
+  return cam_to_world * cam;
+}
+
+TEST(RenderProjection, PinholeMatchesProjectPoints) {
+  std::mt19937_64 rng(11);
+  double worst = 0.0;
+  for (int cam = 0; cam < 20; ++cam) {
+    const Camera c = randomCamera(rng, false, 1280, 720);
+    for (double s : {1.0, 2.0}) {
+      const Projection p(c, s);
+      EXPECT_EQ(p.warps(), s != 1.0);
+      for (int i = 0; i < 500; ++i) {
+        const Vec3 x = randomVisiblePoint(rng, c);
+        const cv::Point2d ref = cvProject(c, x);
+        const Eigen::Vector2d got = p.project(x);
+        worst = std::max(worst, std::hypot(got.x() - ref.x, got.y() - ref.y));
+      }
+    }
+  }
+  RecordProperty("worst_px", std::to_string(worst));
+  std::cout << "pinhole: worst |GL chain - projectPoints| = " << worst << " px\n";
+  EXPECT_LE(worst, 0.05);
+}
+
+// With distortion the output pixel at projectPoints(X) samples the pinhole image through the
+// warp map (bilinear, as cv::remap does); that sample position must be where GL draws X.
+TEST(RenderProjection, DistortionWarpMatchesProjectPoints) {
+  std::mt19937_64 rng(12);
+  double worst_map = 0.0, worst_project = 0.0;
+  int checked = 0;
+  for (int cam = 0; cam < 6; ++cam) {
+    const Camera c = randomCamera(rng, true, 320, 240);
+    const Projection p(c, cam % 2 == 0 ? 1.0 : 2.0);
+    ASSERT_TRUE(p.warps());
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3 x = randomVisiblePoint(rng, c);
+      const cv::Point2d ref = cvProject(c, x);
+      if (ref.x < 0 || ref.y < 0 || ref.x > c.width - 1 || ref.y > c.height - 1) continue;
+      const int u0 = std::min(static_cast<int>(ref.x), c.width - 2), v0 = std::min(static_cast<int>(ref.y), c.height - 2);
+      const double fu = ref.x - u0, fv = ref.y - v0;
+      auto bilinear = [&](const cv::Mat& m) {
+        return (1 - fu) * (1 - fv) * m.at<float>(v0, u0) + fu * (1 - fv) * m.at<float>(v0, u0 + 1) +
+               (1 - fu) * fv * m.at<float>(v0 + 1, u0) + fu * fv * m.at<float>(v0 + 1, u0 + 1);
+      };
+      const double mx = bilinear(p.mapX()), my = bilinear(p.mapY());
+      if (mx < 0 || my < 0) continue;  // outside the invertible region
+      const Eigen::Vector2d gl = p.pinholePixel(x);
+      // In output pixels: the pinhole image is `supersample` times finer.
+      worst_map = std::max(worst_map, std::hypot(gl.x() - mx, gl.y() - my) / p.supersample());
+      const Eigen::Vector2d proj = p.project(x);
+      worst_project = std::max(worst_project, std::hypot(proj.x() - ref.x, proj.y() - ref.y));
+      ++checked;
+    }
+  }
+  std::cout << "distortion: " << checked << " points, worst warp-map error " << worst_map
+            << " px, worst project() error " << worst_project << " px\n";
+  EXPECT_GT(checked, 5000);
+  EXPECT_LE(worst_map, 0.05);
+  EXPECT_LE(worst_project, 0.05);
+}
+
+// Render-based: a large flat quadrilateral (drawn with a 10 micrometre radius, so its mesh is
+// the quad itself to ~0.003 px) must cover exactly the pixel centres inside its projected
+// outline, except within 0.05 px of the outline.
+TEST(RenderProjection, RasterisedEdgesMatchProjectPoints) {
+  std::mt19937_64 rng(13);
+  RenderOptions opt;
+  opt.min_radius = 1e-5;
+  opt.msaa_samples = 0;
+  int checked = 0, wrong = 0;
+  for (int cam = 0; cam < 4; ++cam) {
+    const Camera c = randomCamera(rng, false, 320, 240);
+    Renderer r(c, opt);
+    std::uniform_real_distribution<double> u(-0.5, 0.5);
+    const std::vector<Vec3> quad = {Vec3(-0.4 + 0.1 * u(rng), -0.3 + 0.1 * u(rng), 0.1 * u(rng)),
+                                    Vec3(0.4 + 0.1 * u(rng), -0.35 + 0.1 * u(rng), 0.1 * u(rng)),
+                                    Vec3(0.35 + 0.1 * u(rng), 0.4 + 0.1 * u(rng), 0.1 * u(rng)),
+                                    Vec3(-0.3 + 0.1 * u(rng), 0.3 + 0.1 * u(rng), 0.1 * u(rng))};
+    // Make it planar: project onto the plane of the first three points.
+    std::vector<Vec3> flat = quad;
+    const Vec3 n = (quad[1] - quad[0]).cross(quad[2] - quad[0]).normalized();
+    flat[3] -= n * n.dot(quad[3] - quad[0]);
+    const Volume v{flat, 0.0, VolumeStatus::Clear, ""};
+    const Frame f = r.render(std::span<const Volume>(&v, 1), Style{}, false, true);
+    std::vector<cv::Point2d> corners;
+    for (const Vec3& p : flat) corners.push_back(cvProject(c, p));
+    std::vector<cv::Point2f> hull;
+    std::vector<cv::Point2f> cf(corners.begin(), corners.end());
+    cv::convexHull(cf, hull);
+    for (int y = 0; y < c.height; ++y)
+      for (int x = 0; x < c.width; ++x) {
+        const double d = cv::pointPolygonTest(hull, cv::Point2f(x, y), true);
+        if (std::abs(d) <= 0.05) continue;
+        ++checked;
+        if ((d > 0) != (f.mask.at<uchar>(y, x) == 1)) ++wrong;
+      }
+  }
+  EXPECT_GT(checked, 200000);
+  EXPECT_EQ(wrong, 0) << "pixel centres more than 0.05 px from a projected edge drawn on the wrong side";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Meshes
+
+struct Shape {
+  std::vector<Vec3> points;
+  double radius;
+  std::string what;
+};
+
+std::vector<Shape> testShapes(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  auto rnd = [&] { return Vec3(u(rng), u(rng), u(rng)); };
+  std::vector<Shape> s = {
+      {{Vec3(0.1, 0.2, 0.3)}, 0.2, "one point"},
+      {{Vec3(0.1, 0.2, 0.3)}, 0.0, "one point, radius 0"},
+      {{Vec3(0, 0, 0), Vec3(0.5, 0.1, 0)}, 0.05, "segment"},
+      {{Vec3(0, 0, 0), Vec3(0.5, 0.1, 0)}, 0.0, "segment, radius 0"},
+      {{Vec3(0, 0, 0), Vec3(0.25, 0.05, 0), Vec3(0.5, 0.1, 0)}, 0.03, "collinear"},
+      {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0), Vec3(0.5, 0.5, 0)}, 0.02, "flat square"},
+      {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)}, 0.0, "flat square, radius 0"},
+      {{Vec3(0, 0, 0), Vec3(0, 0, 0), Vec3(0.3, 0, 0)}, 0.1, "duplicates"},
+      {{Vec3(1000, 2000, -500), Vec3(1000.5, 2000, -500)}, 0.05, "far from the origin"},
+  };
+  for (int i = 0; i < 12; ++i) {
+    Shape sh;
+    const int n = 1 + i % 9;
+    for (int k = 0; k < n; ++k) sh.points.push_back(rnd());
+    sh.radius = i % 4 == 0 ? 0.0 : 0.3 * std::abs(u(rng));
+    sh.what = "random " + std::to_string(n) + " points";
+    s.push_back(sh);
+  }
+  return s;
+}
+
+TEST(RenderMesh, ContainsTheTrueVolume) {
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (const Shape& sh : testShapes(rng))
+    for (int level = 0; level <= 3; ++level) {
+      SCOPED_TRACE(sh.what + ", level " + std::to_string(level));
+      const Mesh m = buildSschMesh(sh.points, sh.radius, level);
+      const double r = std::max(sh.radius, kMinDrawRadius);
+      ASSERT_GE(m.triangles.size(), 4u);
+      // Closed: every edge has two triangles; Euler characteristic 2.
+      for (const auto& e : m.edges) ASSERT_NE(e[2], e[3]);
+      EXPECT_EQ(static_cast<long>(m.vertices.size()) - static_cast<long>(m.edges.size()) +
+                    static_cast<long>(m.triangles.size()),
+                2);
+      // Exact containment: for every face plane, the support of the SSCH in its normal lies inside.
+      for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+        const Vec3& n = m.normals[t];
+        const double offset = n.dot(m.vertices[m.triangles[t][0]]);
+        double support = -1e300;
+        for (const Vec3& p : sh.points) support = std::max(support, n.dot(p));
+        ASSERT_LE(support + r, offset + 1e-9) << "face " << t;
+        // Winding agrees with the outward normal.
+        const auto& tri = m.triangles[t];
+        EXPECT_GE((m.vertices[tri[1]] - m.vertices[tri[0]]).cross(m.vertices[tri[2]] - m.vertices[tri[0]]).dot(n), 0.0);
+      }
+      // Sampled surface points (a core point's support point plus r in a random direction, and
+      // points on segments between core points pushed out by r) lie inside every half-space.
+      for (int k = 0; k < 300; ++k) {
+        const Vec3 dir = Vec3(g(rng), g(rng), g(rng)).normalized();
+        const Vec3& a = sh.points[rng() % sh.points.size()];
+        const Vec3& b = sh.points[rng() % sh.points.size()];
+        const Vec3 x = a + u(rng) * (b - a) + r * dir;
+        for (std::size_t t = 0; t < m.triangles.size(); ++t)
+          ASSERT_LE(m.normals[t].dot(x), m.normals[t].dot(m.vertices[m.triangles[t][0]]) + 1e-9);
+      }
+      // Not much larger than needed: every vertex is within the tessellation's outward error.
+      const double allowed = r * (spherePolytope(level).scale - 1.0) + 1e-5 * (1.0 + 2000.0) * spherePolytope(level).scale;
+      for (const Vec3& v : m.vertices) {
+        double nearest = 1e300;  // distance to the nearest core point bounds the distance to the hull
+        for (const Vec3& p : sh.points) nearest = std::min(nearest, (v - p).norm());
+        EXPECT_LE(nearest - r, allowed + 1e-9);
+      }
+    }
+}
+
+TEST(RenderMesh, TessellationErrorShrinksWithLevel) {
+  EXPECT_GT(spherePolytope(1).scale, spherePolytope(2).scale);
+  EXPECT_GT(spherePolytope(2).scale, spherePolytope(3).scale);
+  EXPECT_LT(spherePolytope(3).scale - 1.0, 0.005);
+  EXPECT_EQ(spherePolytope(2).vertices.size(), 162u);
+}
+
+TEST(RenderMesh, CacheReusesUnchangedShapes) {
+  MeshCache cache;
+  const std::vector<Vec3> a = {Vec3(0, 0, 0), Vec3(1, 0, 0)};
+  std::vector<Vec3> b = a;
+  cache.nextFrame();
+  const auto m1 = cache.get(a, 0.1, 2);
+  const auto m2 = cache.get(b, 0.1, 2);
+  EXPECT_EQ(m1.get(), m2.get());
+  EXPECT_EQ(cache.built(), 1u);
+  b[1].x() = std::nextafter(1.0, 2.0);
+  EXPECT_NE(cache.get(b, 0.1, 2).get(), m1.get());
+  EXPECT_NE(cache.get(a, 0.1000001, 2).get(), m1.get());
+  EXPECT_EQ(cache.built(), 3u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Masks against an independent CPU silhouette
+
+// The silhouette of an SSCH from dense sphere samples projected with cv::projectPoints: balls of
+// the radius centred on a dense set of points of the core hull (vertices, edges, triangles),
+// each ball's rim sampled densely, projected, and its convex outline filled at 5x resolution
+// (pixel (x, y) is the 7x pixel (7x + 3, 7y + 3)), so the fill follows pixel centres to ~0.1 px.
+cv::Mat cpuSilhouette(const Camera& c, const std::vector<Vec3>& pts, double radius) {
+  const int k = 7;
+  cv::Mat big = cv::Mat::zeros(c.height * k, c.width * k, CV_8UC1);
+  std::vector<Vec3> centres = pts;
+  const double step = radius / 6.0;
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    for (std::size_t j = i + 1; j < pts.size(); ++j)
+      for (std::size_t l = j; l < pts.size(); ++l) {
+        // Points of the triangle (i, j, l) (an edge when l == j) at spacing <= step.
+        const double len = std::max((pts[j] - pts[i]).norm(), (pts[l] - pts[i]).norm());
+        const int n = std::max(1, static_cast<int>(std::ceil(len / step)));
+        for (int a = 0; a <= n; ++a)
+          for (int b = 0; a + b <= n; ++b) {
+            const double s = static_cast<double>(a) / n, t = static_cast<double>(b) / n;
+            centres.push_back(pts[i] + s * (pts[j] - pts[i]) + t * (pts[l] - pts[i]));
+          }
+      }
+  std::vector<cv::Point3d> sphere;
+  const int m = 1500;
+  for (int i = 0; i < m; ++i) {  // Fibonacci sphere
+    const double z = 1.0 - (2.0 * i + 1.0) / m, rr = std::sqrt(1.0 - z * z), phi = i * 2.399963229728653;
+    sphere.emplace_back(rr * std::cos(phi), rr * std::sin(phi), z);
+  }
+  std::vector<cv::Point3d> world(sphere.size());
+  std::vector<cv::Point2d> img;
+  for (const Vec3& ce : centres) {
+    for (std::size_t i = 0; i < sphere.size(); ++i)
+      world[i] = cv::Point3d(ce.x(), ce.y(), ce.z()) + radius * sphere[i];
+    cv::projectPoints(world, c.rvec, c.tvec, c.camera_matrix, c.distortion, img);
+    std::vector<cv::Point> fixed;
+    for (const cv::Point2d& p : img)
+      fixed.emplace_back(static_cast<int>(std::lround((p.x * k + (k - 1) / 2.0) * 256)),
+                         static_cast<int>(std::lround((p.y * k + (k - 1) / 2.0) * 256)));
+    std::vector<cv::Point> hull;
+    cv::convexHull(fixed, hull);
+    cv::fillConvexPoly(big, hull, cv::Scalar(1), cv::LINE_8, 8);
+  }
+  cv::Mat out(c.height, c.width, CV_8UC1);
+  for (int y = 0; y < c.height; ++y)
+    for (int x = 0; x < c.width; ++x) out.at<uchar>(y, x) = big.at<uchar>(y * k + k / 2, x * k + k / 2);
+  return out;
+}
+
+TEST(RenderMask, MatchesIndependentCpuSilhouette) {
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  double worst_iou = 1.0, worst_boundary = 0.0;
+  for (int trial = 0; trial < 12; ++trial) {
+    const Camera c = randomCamera(rng, trial % 4 != 3);  // mostly with distortion
+    std::vector<Vec3> pts;
+    const int n = 1 + trial % 4;
+    for (int i = 0; i < n; ++i) pts.push_back(Vec3(0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng)));
+    const double radius = 0.15 + 0.1 * std::abs(u(rng));
+    const cv::Mat cpu = cpuSilhouette(c, pts, radius);
+    Renderer r(c);
+    const Volume v{pts, radius, VolumeStatus::Clear, ""};
+    const Frame f = r.render(std::span<const Volume>(&v, 1), Style{}, false, true);
+    const cv::Mat gl = f.mask > 0, ref = cpu > 0;
+    const double inter = cv::countNonZero(gl & ref), uni = cv::countNonZero(gl | ref);
+    const double iou = inter / uni;
+    worst_iou = std::min(worst_iou, iou);
+    // Containment up to a one-pixel boundary: every CPU pixel is in the mask or next to it.
+    cv::Mat grown;
+    cv::dilate(gl, grown, cv::Mat::ones(3, 3, CV_8U));
+    const int outside = cv::countNonZero(ref & ~grown);
+    const int boundary = cv::countNonZero(ref & ~gl);
+    SCOPED_TRACE("trial " + std::to_string(trial) + ": mask " + std::to_string(cv::countNonZero(gl)) + " px, CPU " +
+                 std::to_string(cv::countNonZero(ref)) + " px, common " + std::to_string(static_cast<int>(inter)));
+    EXPECT_GT(uni, 2000);
+    EXPECT_GE(iou, 0.98);
+    EXPECT_EQ(outside, 0);
+    EXPECT_LE(boundary, 0.02 * cv::countNonZero(ref));
+    worst_boundary = std::max(worst_boundary, static_cast<double>(boundary) / cv::countNonZero(ref));
+  }
+  std::cout << "mask vs CPU silhouette: worst IoU " << worst_iou << ", CPU pixels outside the mask (all within 1 px): at most "
+            << 100.0 * worst_boundary << "% of the silhouette\n";
+}
+
+TEST(RenderMask, NearestBodyWinsAndLabelsAreIndexPlusOne) {
+  const Camera c = lookAt(Vec3(2, 0, 0), Vec3(0, 0, 0), 160, 120, 150, {0, 0, 0, 0, 0});
+  Renderer r(c);
+  const std::vector<Vec3> far = {Vec3(-0.3, 0, 0)}, near = {Vec3(0.3, 0.1, 0)};
+  // The far one first in the list, so drawing order alone would let it win.
+  const Volume v[] = {{far, 0.25, VolumeStatus::Clear, "far"}, {near, 0.15, VolumeStatus::Colliding, "near"}};
+  const Frame f = r.render(v, Style{.legend = false}, true, true);
+  const cv::Point centre_near(static_cast<int>(std::lround(r.projection().project(near[0]).x())),
+                              static_cast<int>(std::lround(r.projection().project(near[0]).y())));
+  EXPECT_EQ(f.mask.at<uchar>(centre_near), 2);
+  EXPECT_EQ(f.mask.at<uchar>(0, 0), 0);
+  EXPECT_GT(f.pixels[0], 0);
+  EXPECT_GT(f.pixels[1], 0);
+  EXPECT_EQ(f.pixels[0] + f.pixels[1], cv::countNonZero(f.mask));
+  // Straight alpha: the fill of the near body alone shows its colour at the fill opacity.
+  const cv::Point far_only(static_cast<int>(std::lround(r.projection().project(far[0]).x())) - 10,
+                           static_cast<int>(std::lround(r.projection().project(far[0]).y())));
+  ASSERT_EQ(f.mask.at<uchar>(far_only), 1);
+  const cv::Vec4b px = f.bgra.at<cv::Vec4b>(far_only);
+  EXPECT_NEAR(px[3], 0.35 * 255, 2);
+  const cv::Scalar green = statusColour(VolumeStatus::Clear);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(px[ch], green[ch], 3) << ch;
+  EXPECT_EQ(f.bgra.at<cv::Vec4b>(c.height - 1, c.width - 1)[3], 0);
+}
+
+TEST(RenderMask, DegenerateVolumesAreVisible) {
+  const Camera c = lookAt(Vec3(1.5, -1.0, 1.0), Vec3(0, 0, 0), 160, 120, 150, {-0.1, 0.01, 0, 0, 0});
+  Renderer r(c);
+  const std::vector<Vec3> square = {Vec3(-0.3, -0.3, 0), Vec3(0.3, -0.3, 0), Vec3(0.3, 0.3, 0), Vec3(-0.3, 0.3, 0)};
+  const std::vector<Vec3> segment = {Vec3(-0.4, 0.4, 0.2), Vec3(0.4, 0.4, 0.2)};
+  const std::vector<Vec3> point = {Vec3(0, 0, 0.5)};
+  const Volume v[] = {{square, 0.0, VolumeStatus::Clear, ""},
+                      {segment, 0.0, VolumeStatus::Clear, ""},
+                      {point, 0.05, VolumeStatus::Clear, ""}};
+  const Frame f = r.render(v, Style{}, true, true);
+  EXPECT_GT(f.pixels[0], 500);  // a flat square seen at an angle
+  EXPECT_GT(f.pixels[2], 20);    // a ball
+  EXPECT_GT(f.pixels[1], 0);    // a radius-0 segment, drawn 1 mm thick
+  EXPECT_GT(cv::countNonZero(f.mask), 500);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Golden images: the demo arm through a 320x180 version of the sample camera.
+
+Camera goldenCamera() {
+  Camera c = loadCamera(kData + "/demo_camera.yaml");
+  const double s = 1.0 / 4.0;
+  c.width = 320;
+  c.height = 180;
+  c.camera_matrix(0, 0) *= s;
+  c.camera_matrix(1, 1) *= s;
+  c.camera_matrix(0, 2) = (c.camera_matrix(0, 2) + 0.5) * s - 0.5;
+  c.camera_matrix(1, 2) = (c.camera_matrix(1, 2) + 0.5) * s - 0.5;
+  return c;
+}
+
+class RenderGolden : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    model_ = new Model(loadModel(kData + "/demo_arm.yaml"));
+    renderer_ = new Renderer(goldenCamera());
+  }
+  static void TearDownTestSuite() {
+    delete renderer_;
+    delete model_;
+  }
+  Frame draw(const std::vector<double>& lower, const std::vector<double>& upper, const Style& style) {
+    Checker checker(*model_);
+    const QueryResult& q = checker.query(lower, upper, QueryOptions{.type = QueryType::Distances});
+    EXPECT_EQ(q.status, Status::Ok);
+    const std::vector<Volume> volumes = sceneVolumes(*model_, checker, bodyStatus(*model_, q));
+    return renderer_->render(volumes, style);
+  }
+  static Model* model_;
+  static Renderer* renderer_;
+};
+Model* RenderGolden::model_ = nullptr;
+Renderer* RenderGolden::renderer_ = nullptr;
+
+const kccd::test::GoldenTolerance kMaskTolerance{0, 0.0025, 4};
+
+TEST_F(RenderGolden, DemoArmStatic) {
+  const Frame f = draw({0.3, 0.4, 0.6}, {0.3, 0.4, 0.6}, Style{.labels = false, .legend = false});
+  EXPECT_TRUE(kccd::test::compareGolden(f.bgra, "demo_static_rgba", renderer_->rendererString()));
+  EXPECT_TRUE(kccd::test::compareGolden(f.mask, "demo_static_mask", renderer_->rendererString(), kMaskTolerance));
+}
+
+TEST_F(RenderGolden, DemoArmSwept) {
+  const Frame f = draw({-0.5, 0.0, 0.0}, {0.5, 0.1, 0.2}, Style{.labels = true, .legend = true});
+  EXPECT_TRUE(kccd::test::compareGolden(f.bgra, "demo_swept_rgba", renderer_->rendererString()));
+  EXPECT_TRUE(kccd::test::compareGolden(f.mask, "demo_swept_mask", renderer_->rendererString(), kMaskTolerance));
+}
+
+TEST(RenderContext, ReportsItsRenderer) {
+  const auto ctx = GlContext::make();
+  EXPECT_FALSE(ctx->renderer().empty());
+  std::cout << "renderer: " << ctx->renderer() << "\n";
+}
+
+}  // namespace
