@@ -546,6 +546,38 @@ TEST_F(RenderGolden, DemoArmSwept) {
   EXPECT_TRUE(kccd::test::compareGolden(f.mask, "demo_swept_mask", renderer_->rendererString(), kMaskTolerance));
 }
 
+// Static frames place each body's own (cached) mesh with its pose: the same pixels as meshes
+// built from the checker's world volumes, and no mesh rebuilt when only the state changes.
+TEST_F(RenderGolden, StaticFramesReuseBodyMeshes) {
+  for (const std::vector<double>& q : {std::vector<double>{0.3, 0.4, 0.6}, std::vector<double>{-0.7, 0.2, 1.1}}) {
+    Checker checker(*model_);
+    const QueryResult& r = checker.query(q, q, QueryOptions{.type = QueryType::Distances});
+    const std::vector<Volume> world = sceneVolumes(*model_, checker, bodyStatus(*model_, r));
+    const std::vector<Volume> posed = staticSceneVolumes(*model_, checker, q, bodyStatus(*model_, r));
+    const Frame a = renderer_->render(world, Style{}, false, true);
+    const Frame b = renderer_->render(posed, Style{}, false, true);
+    // The sphere polytopes are turned with the body, so only edge pixels may differ (both
+    // meshes contain the true volume and lie at most tolerance_px outside it).
+    EXPECT_LE(cv::countNonZero(a.mask != b.mask), 0.01 * cv::countNonZero(a.mask));
+    EXPECT_GT(cv::countNonZero(a.mask), 1000);
+  }
+  // A small motion (same tessellation levels): posed meshes all come from the cache, world
+  // meshes of the moving bodies are rebuilt.
+  auto frame = [&](const std::vector<double>& q, bool posed) {
+    Checker checker(*model_);
+    const QueryResult& r = checker.query(q, q, QueryOptions{.type = QueryType::Distances});
+    const std::vector<Volume> v = posed ? staticSceneVolumes(*model_, checker, q, bodyStatus(*model_, r))
+                                        : sceneVolumes(*model_, checker, bodyStatus(*model_, r));
+    return renderer_->render(v, Style{}, false, true);
+  };
+  frame({0.1, -0.3, 0.9}, true);
+  const int b2 = frame({0.1001, -0.3001, 0.9001}, true).meshes_built;
+  frame({0.1, -0.3, 0.9}, false);
+  const int b4 = frame({0.1001, -0.3001, 0.9001}, false).meshes_built;
+  EXPECT_EQ(b2, 0);
+  EXPECT_GT(b4, 0);
+}
+
 TEST(RenderContext, ReportsItsRenderer) {
   const auto ctx = GlContext::make();
   EXPECT_FALSE(ctx->renderer().empty());

@@ -101,7 +101,9 @@ int runRender(const RenderArgs& args) {
     nearest[m.pairs[pd.pair].b] = std::min(nearest[m.pairs[pd.pair].b], pd.distance);
   }
   const std::vector<render::VolumeStatus> body_status = render::bodyStatus(m, r);
-  std::vector<render::Volume> volumes = render::sceneVolumes(m, checker, body_status);
+  std::vector<render::Volume> volumes = args.state.empty()
+                                           ? render::sceneVolumes(m, checker, body_status)
+                                           : render::staticSceneVolumes(m, checker, lower, body_status);
   for (render::Volume& v : volumes)
     if (!allFinite(v.points) || !std::isfinite(v.radius)) v.points = {};  // unsafe status: nothing to draw
 

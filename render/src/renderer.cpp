@@ -146,11 +146,12 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     if (v.points.empty()) continue;
     // Tessellation fine enough that the circumscribed sphere polytope lies at most
     // tolerance_px outside the true surface, as seen from the closest point of the volume.
+    const Pose to_camera = world_to_camera_ * v.pose;
     cam_points.clear();
     double zmin = 1e300;
     Vec3 centre = Vec3::Zero();
     for (const Vec3& w : v.points) {
-      cam_points.push_back(world_to_camera_ * w);
+      cam_points.push_back(to_camera * w);
       zmin = std::min(zmin, cam_points.back().z());
       centre += cam_points.back();
     }
@@ -174,7 +175,7 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     const Mesh& m = *p.mesh;
     p.vertices.resize(m.vertices.size() * 3);
     for (std::size_t k = 0; k < m.vertices.size(); ++k) {
-      const Vec3 c = world_to_camera_ * m.vertices[k];
+      const Vec3 c = to_camera * m.vertices[k];
       p.vertices[3 * k] = static_cast<float>(c.x());
       p.vertices[3 * k + 1] = static_cast<float>(c.y());
       p.vertices[3 * k + 2] = static_cast<float>(c.z());
@@ -182,8 +183,8 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     // Silhouette edges: one neighbouring triangle faces the camera (at the origin), the other not.
     std::vector<char> front(m.triangles.size());
     for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-      const Vec3 n = world_to_camera_.linear() * m.normals[t];
-      const Vec3 a = world_to_camera_ * m.vertices[m.triangles[t][0]];
+      const Vec3 n = to_camera.linear() * m.normals[t];
+      const Vec3 a = to_camera * m.vertices[m.triangles[t][0]];
       front[t] = n.dot(a) < 0.0;
     }
     for (const auto& e : m.edges)
@@ -373,7 +374,7 @@ void Renderer::decorate(cv::Mat& bgra, std::span<const Volume> volumes, const St
       if (v.points.empty() || v.label.empty()) continue;
       Vec3 centre = Vec3::Zero();
       for (const Vec3& p : v.points) centre += p;
-      centre /= static_cast<double>(v.points.size());
+      centre = v.pose * (centre / static_cast<double>(v.points.size()));
       if ((world_to_camera_ * centre).z() <= options_.near) continue;
       const Eigen::Vector2d px = projection_.project(centre);
       if (!std::isfinite(px.x()) || !std::isfinite(px.y())) continue;

@@ -2,6 +2,8 @@
 
 #include <limits>
 
+#include "kccd/kinematics.hpp"
+
 namespace kccd::render {
 
 std::vector<VolumeStatus> bodyStatus(const Model& model, const QueryResult& result) {
@@ -31,6 +33,25 @@ std::vector<Volume> sceneVolumes(const Model& model, Checker& checker, const std
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
     const SschView v = checker.sweptVolume(static_cast<int>(i), kWorld);
     out.push_back(Volume{v.points, v.radius, status.empty() ? VolumeStatus::NoState : status[i], model.bodies[i].name});
+  }
+  return out;
+}
+
+std::vector<Volume> staticSceneVolumes(const Model& model, Checker& checker, std::span<const double> state,
+                                       const std::vector<VolumeStatus>& status) {
+  std::vector<Volume> out = sceneVolumes(model, checker, status);
+  std::vector<Pose> poses(model.joints.size());
+  if (!framePoses(model, state, poses)) return out;  // the checker's (unsafe) volumes as they are
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const Body& b = model.bodies[i];
+    // Only where the checker's volume is the body moved rigidly: no error bound, the same points,
+    // and a radius grown by no more than rounding (the checker adds a guard of a few ulps; the
+    // drawn radius takes 1 nm more, fixed per body so that its mesh stays cached).
+    const double drawn = b.radius * (1.0 + 1e-9) + 1e-9;
+    if (out[i].points.size() != b.points.size() || hasErrorBound(model, b.frame) || out[i].radius > drawn) continue;
+    out[i].points = b.points;
+    out[i].radius = drawn;
+    out[i].pose = framePose(poses, b.frame);
   }
   return out;
 }

@@ -23,12 +23,14 @@ const char* toString(VolumeStatus status);
 /// The fill colour of a status as BGR (OpenCV order).
 cv::Scalar statusColour(VolumeStatus status);
 
-/// One volume to draw, in world coordinates (the points are copied by the renderer).
+/// One volume to draw: core points in the volume's own frame, placed in the world by `pose`
+/// (the mesh is cached by the points and radius, so a volume that only moves keeps its mesh).
 struct Volume {
   std::span<const Vec3> points;
   double radius = 0.0;
   VolumeStatus status = VolumeStatus::NoState;
   std::string label;  ///< shown with Style::labels
+  Pose pose = Pose::Identity();
 };
 
 /// The look of the colour layer.

@@ -1,6 +1,7 @@
 // From a model and a query to the volumes the renderer draws.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "kccd/checker.hpp"
@@ -17,5 +18,12 @@ std::vector<VolumeStatus> bodyStatus(const Model& model, const QueryResult& resu
 /// order (static volumes when lower == upper, swept volumes otherwise). `status` may be empty:
 /// every body is then grey (no state). The views point into the checker (valid until its next query).
 std::vector<Volume> sceneVolumes(const Model& model, Checker& checker, const std::vector<VolumeStatus>& status);
+
+/// The static volumes at one configuration `state` (the checker's last query must be that point
+/// state). A body moved rigidly keeps its own points (radius + 1 nm, covering the checker's
+/// rounding guard) with its frame's pose, so its mesh stays cached while the robot moves; a body below a joint with an error bound (which grows its volume)
+/// takes the checker's world volume. The point views refer to the model and the checker.
+std::vector<Volume> staticSceneVolumes(const Model& model, Checker& checker, std::span<const double> state,
+                                       const std::vector<VolumeStatus>& status);
 
 }  // namespace kccd::render
