@@ -11,56 +11,37 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/run_program.hpp"
+
 namespace {
 
-struct Outcome {
-  int code = -1;
-  std::string out;  // stdout and stderr
-  std::string err;
-};
+using kccd::testing::Outcome;
 
-Outcome kccd(const std::string& args, bool merge_stderr = false) {
-  static int calls = 0;  // one stderr file per call and process: ctest runs tests in parallel
-  const std::string err_file =
-      ::testing::TempDir() + "/kccd_stderr_" + std::to_string(getpid()) + "_" + std::to_string(++calls) + ".txt";
-  const std::string cmd = std::string(KCCD_CLI) + " " + args + (merge_stderr ? " 2>&1" : " 2>" + err_file);
-  Outcome r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  while (pipe != nullptr && fgets(buf.data(), buf.size(), pipe) != nullptr) r.out += buf.data();
-  const int status = pipe != nullptr ? pclose(pipe) : -1;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  if (!merge_stderr) {
-    if (FILE* f = fopen(err_file.c_str(), "r")) {
-      while (fgets(buf.data(), buf.size(), f) != nullptr) r.err += buf.data();
-      fclose(f);
-    }
-    std::remove(err_file.c_str());
-  }
-  return r;
+Outcome runKccd(const std::string& args, bool merge_stderr = false) {
+  return kccd::testing::runProgram(std::string(KCCD_CLI) + " " + args, merge_stderr);
 }
 
 const std::string kDemo = std::string(KCCD_DATA_DIR) + "/demo_arm.yaml";
 
 TEST(Cli, InfoListsStateNamesAndPairs) {
-  const Outcome r = kccd("info " + kDemo + " --json");
+  const Outcome r = runKccd("info " + kDemo + " --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["state"], nlohmann::json({"shoulder_yaw", "shoulder_pitch", "elbow"}));
   EXPECT_EQ(j["totals"]["bodies"], 7);
   EXPECT_EQ(j["pairs"].size(), j["totals"]["pairs"].get<std::size_t>());
-  EXPECT_EQ(kccd("info " + kDemo).code, 0);
+  EXPECT_EQ(runKccd("info " + kDemo).code, 0);
 }
 
 TEST(Cli, QueryJsonContract) {
-  const Outcome r = kccd("query " + kDemo + " --lower 0.1,0.2,0.3 --upper 0.2,0.4,0.6 --type distances --json");
+  const Outcome r = runKccd("query " + kDemo + " --lower 0.1,0.2,0.3 --upper 0.2,0.4,0.6 --type distances --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["type"], "distances");
   EXPECT_EQ(j["status"], "ok");
   ASSERT_TRUE(j["collision"].is_boolean());
   ASSERT_TRUE(j["min_distance"].is_number());
-  const auto info = nlohmann::json::parse(kccd("info " + kDemo + " --json").out);
+  const auto info = nlohmann::json::parse(runKccd("info " + kDemo + " --json").out);
   ASSERT_EQ(j["pairs"].size(), info["pairs"].size());  // every checked pair
   double min_d = 1e9;
   std::size_t witnesses = 0;
@@ -82,11 +63,11 @@ TEST(Cli, QueryJsonContract) {
 
 TEST(Cli, QueryTypesAndState) {
   for (const char* type : {"collision", "closest", "nclosest --n 3"}) {
-    const Outcome r = kccd("query " + kDemo + " --state 0.1,0.3,0.4 --json --type " + type);
+    const Outcome r = runKccd("query " + kDemo + " --state 0.1,0.3,0.4 --json --type " + type);
     ASSERT_EQ(r.code, 0) << type << ": " << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["status"], "ok");
   }
-  const auto n = nlohmann::json::parse(kccd("query " + kDemo + " --state 0.1,0.3,0.4 --json --type nclosest --n 3").out);
+  const auto n = nlohmann::json::parse(runKccd("query " + kDemo + " --state 0.1,0.3,0.4 --json --type nclosest --n 3").out);
   EXPECT_EQ(n["pairs"].size(), 3u);
   EXPECT_LE(n["pairs"][0]["distance"].get<double>(), n["pairs"][1]["distance"].get<double>());
 }
@@ -107,7 +88,7 @@ TEST(Cli, BadInputGivesOneLineAndNonZeroExit) {
       {"query " + kDemo + " --state nan,0,0", 3, "non_finite_state"},
   };
   for (const Case& c : cases) {
-    const Outcome r = kccd(c.args);
+    const Outcome r = runKccd(c.args);
     EXPECT_EQ(r.code, c.code) << c.args;
     EXPECT_NE(r.err.find(c.text), std::string::npos) << c.args << " -> " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << " -> " << r.err;
@@ -117,22 +98,22 @@ TEST(Cli, BadInputGivesOneLineAndNonZeroExit) {
   FILE* f = fopen(bad.c_str(), "w");
   fputs("kccd: 1\nbodies:\n  - {name: a, frame: world, points: [[0, 0]], radius: 0.1}\n", f);
   fclose(f);
-  const Outcome r = kccd("info " + bad);
+  const Outcome r = runKccd("info " + bad);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("bad_model.yaml:3:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("body 'a'.points[0]"), std::string::npos) << r.err;
 }
 
 TEST(Cli, HelpExplainsEverySubcommand) {
-  const Outcome r = kccd("--help", true);
+  const Outcome r = runKccd("--help", true);
   EXPECT_EQ(r.code, 0);
   EXPECT_NE(r.out.find("query"), std::string::npos);
   EXPECT_NE(r.out.find("info"), std::string::npos);
-  const Outcome q = kccd("query --help", true);
+  const Outcome q = runKccd("query --help", true);
   EXPECT_EQ(q.code, 0);
   for (const char* flag : {"--lower", "--upper", "--state", "--type", "--n", "--margin", "--budget-us", "--json"})
     EXPECT_NE(q.out.find(flag), std::string::npos) << flag;
-  EXPECT_NE(kccd("").code, 0);  // a subcommand is required
+  EXPECT_NE(runKccd("").code, 0);  // a subcommand is required
 }
 
 }  // namespace
@@ -159,7 +140,7 @@ std::string slurp(const std::string& path) {
 }  // namespace
 
 TEST(Cli, FitJsonContractAndErrors) {
-  const Outcome r = kccd("fit " + kModels + "simple/cube.iv --points 8 --json");
+  const Outcome r = runKccd("fit " + kModels + "simple/cube.iv --points 8 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["points"].size(), 8u);
@@ -168,65 +149,65 @@ TEST(Cli, FitJsonContractAndErrors) {
   EXPECT_NEAR(j["volume"].get<double>(), 8.0, 1e-3);
   EXPECT_GT(j["baselines"]["sphere_ratio"].get<double>(), 2.0);
 
-  Outcome e = kccd("fit " + kModels + "simple/cube.iv --points 17");
+  Outcome e = runKccd("fit " + kModels + "simple/cube.iv --points 17");
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(e.err.find("--points: the number of core points K must be 1 ... 16 (got 17)"), std::string::npos) << e.err;
   const std::string two = ::testing::TempDir() + "/" + std::to_string(getpid()) + "_two_parts.iv";
   std::ofstream(two) << "#Inventor V2.1 ascii\nDEF a Separator { Cube {} }\nDEF b Separator { Sphere {} }\n";
-  e = kccd("fit " + two + " -q");
+  e = runKccd("fit " + two + " -q");
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(e.err.find("top-level parts"), std::string::npos) << e.err;
   EXPECT_EQ(e.out, "");  // nothing half-printed
-  e = kccd("fit /nonexistent/part.iv");
+  e = runKccd("fit /nonexistent/part.iv");
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(e.err.find("/nonexistent/part.iv: cannot open the file"), std::string::npos) << e.err;
 }
 
 TEST(Cli, FitWritesIntoAModel) {
   const std::string model = scratchCopy(kDemo, "fit_model.yaml");
-  const Outcome r = kccd("fit " + kModels + "simple/cone.iv --points 4 -q --model " + model + " --body forearm");
+  const Outcome r = runKccd("fit " + kModels + "simple/cone.iv --points 4 -q --model " + model + " --body forearm");
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string text = slurp(model);
   EXPECT_NE(text.find("# A small, readable example"), std::string::npos);  // comments kept
-  const Outcome info = kccd("info " + model + " --json");
+  const Outcome info = runKccd("info " + model + " --json");
   ASSERT_EQ(info.code, 0) << info.err;
   const auto j = nlohmann::json::parse(info.out);
   for (const auto& b : j["bodies"])
     if (b["name"] == "forearm") {
       EXPECT_EQ(b["points"], 4);
     }
-  const Outcome bad = kccd("fit " + kModels + "simple/cone.iv -q --model " + model + " --body nobody");
+  const Outcome bad = runKccd("fit " + kModels + "simple/cone.iv -q --model " + model + " --body nobody");
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("no body named 'nobody'"), std::string::npos) << bad.err;
 }
 
 TEST(Cli, PairsProvesAndWrites) {
   const std::string model = scratchCopy(kDemo, "pairs_model.yaml");
-  const Outcome r = kccd("pairs " + model + " --json -q");
+  const Outcome r = runKccd("pairs " + model + " --json -q");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   int never = 0;
   for (const auto& p : j["pairs"]) never += p["verdict"] == "never";
   EXPECT_GT(never, 0);
-  const Outcome w = kccd("pairs " + model + " --write -q");
+  const Outcome w = runKccd("pairs " + model + " --write -q");
   ASSERT_EQ(w.code, 0) << w.err;
-  const auto after = nlohmann::json::parse(kccd("info " + model + " --json").out);
+  const auto after = nlohmann::json::parse(runKccd("info " + model + " --json").out);
   // Every pair left to check is one the proof could not rule out.
   EXPECT_EQ(after["pairs"].size(), j["pairs"].size() - j["ignore"].size());
-  EXPECT_EQ(kccd("pairs /nonexistent.yaml").code, 2);
+  EXPECT_EQ(runKccd("pairs /nonexistent.yaml").code, 2);
 }
 
 TEST(Cli, ImportWritesALoadableModel) {
   const std::string dir = std::string(KCCD_TEST_DATA_DIR) + "/urdf";
   const std::string out = ::testing::TempDir() + "/" + std::to_string(getpid()) + "_imported.yaml";
-  const Outcome r = kccd("import " + dir + "/two_link.urdf --srdf " + dir + "/two_link.srdf --package-path kccd_test=" +
+  const Outcome r = runKccd("import " + dir + "/two_link.urdf --srdf " + dir + "/two_link.srdf --package-path kccd_test=" +
                          dir + " -k 4 -q -o " + out);
   ASSERT_EQ(r.code, 0) << r.err;
-  const Outcome info = kccd("info " + out + " --json");
+  const Outcome info = runKccd("info " + out + " --json");
   ASSERT_EQ(info.code, 0) << info.err;
   EXPECT_EQ(nlohmann::json::parse(info.out)["state"], nlohmann::json({"yaw", "lift", "spin"}));
-  const Outcome e = kccd("import " + dir + "/two_link.urdf -q");
+  const Outcome e = runKccd("import " + dir + "/two_link.urdf -q");
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(e.err.find("unknown package 'kccd_test'"), std::string::npos) << e.err;
-  EXPECT_EQ(kccd("import " + dir + "/two_link.urdf --package-path nonsense -q").code, 2);
+  EXPECT_EQ(runKccd("import " + dir + "/two_link.urdf --package-path nonsense -q").code, 2);
 }

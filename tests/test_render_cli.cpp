@@ -13,35 +13,15 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "kccd/render/camera.hpp"
+#include "support/run_program.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
+using kccd::testing::Outcome;
 
-Outcome kccd(const std::string& args) {
-  static int calls = 0;
-  const std::string err_file =
-      ::testing::TempDir() + "/kccd_render_stderr_" + std::to_string(getpid()) + "_" + std::to_string(++calls) + ".txt";
-  const std::string cmd = std::string(KCCD_CLI) + " " + args + " 2>" + err_file;
-  Outcome r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  while (pipe != nullptr && fgets(buf.data(), buf.size(), pipe) != nullptr) r.out += buf.data();
-  const int status = pipe != nullptr ? pclose(pipe) : -1;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  if (FILE* f = fopen(err_file.c_str(), "r")) {
-    while (fgets(buf.data(), buf.size(), f) != nullptr) r.err += buf.data();
-    fclose(f);
-  }
-  std::remove(err_file.c_str());
-  return r;
-}
+Outcome runKccd(const std::string& args) { return kccd::testing::runProgram(std::string(KCCD_CLI) + " " + args); }
 
 const std::string kData = KCCD_DATA_DIR;
 const std::string kDemo = kData + "/demo_arm.yaml";
@@ -70,7 +50,7 @@ class RenderCli : public ::testing::Test {
 };
 
 TEST_F(RenderCli, WritesRgbaAndMask) {
-  const Outcome r = kccd(base() + " --state 0.3,0.4,0.6 -o " + out("a.png") + " --labels");
+  const Outcome r = runKccd(base() + " --state 0.3,0.4,0.6 -o " + out("a.png") + " --labels");
   ASSERT_EQ(r.code, 0) << r.err;
   const cv::Mat rgba = cv::imread(out("a.png"), cv::IMREAD_UNCHANGED);
   ASSERT_EQ(rgba.type(), CV_8UC4);
@@ -81,7 +61,7 @@ TEST_F(RenderCli, WritesRgbaAndMask) {
   EXPECT_GT(cv::countNonZero(ch[3]), 1000);
   EXPECT_LT(cv::countNonZero(ch[3]), 320 * 180);
 
-  const Outcome m = kccd(base() + " --state 0.3,0.4,0.6 -o " + out("m.png") + " --mask --json");
+  const Outcome m = runKccd(base() + " --state 0.3,0.4,0.6 -o " + out("m.png") + " --mask --json");
   ASSERT_EQ(m.code, 0) << m.err;
   const cv::Mat mask = cv::imread(out("m.png"), cv::IMREAD_UNCHANGED);
   ASSERT_EQ(mask.type(), CV_8UC1);
@@ -106,8 +86,8 @@ TEST_F(RenderCli, WritesRgbaAndMask) {
 }
 
 TEST_F(RenderCli, SweptVolumesCoverTheStaticOnes) {
-  ASSERT_EQ(kccd(base() + " --state 0,0,0 -o " + out("s.png") + " --mask").code, 0);
-  const Outcome r = kccd(base() + " --lower -0.5,0,0 --upper 0.5,0,0 -o " + out("w.png") + " --mask --json");
+  ASSERT_EQ(runKccd(base() + " --state 0,0,0 -o " + out("s.png") + " --mask").code, 0);
+  const Outcome r = runKccd(base() + " --lower -0.5,0,0 --upper 0.5,0,0 -o " + out("w.png") + " --mask --json");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(r.out)["volumes"], "swept");
   const cv::Mat s = cv::imread(out("s.png"), cv::IMREAD_UNCHANGED), w = cv::imread(out("w.png"), cv::IMREAD_UNCHANGED);
@@ -132,14 +112,14 @@ TEST_F(RenderCli, BadInputExitsTwoWithOneLine) {
       {"render /nonexistent/model.yaml --camera " + camera_ + " --state 0,0,0" + o, "/nonexistent/model.yaml"},
   };
   for (const Case& c : cases) {
-    const Outcome r = kccd(c.args);
+    const Outcome r = runKccd(c.args);
     EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
     EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << "\n" << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   }
   // A camera file with a bad field names the file and the field.
   std::ofstream(out("bad_cam.yaml")) << "%YAML:1.0\n---\nimage_width: 320\nimage_height: 0\n";
-  const Outcome r = kccd("render " + kDemo + " --camera " + out("bad_cam.yaml") + " --state 0,0,0" + o);
+  const Outcome r = runKccd("render " + kDemo + " --camera " + out("bad_cam.yaml") + " --state 0,0,0" + o);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("bad_cam.yaml: image_height"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out("bad.png")));
@@ -155,11 +135,11 @@ TEST_F(RenderCli, UnsafeStatusExitsThreeAndStillWrites) {
                           "  - {name: j, parent: world, type: revolute, axis: [0, 0, 1], sweep: exact}\n"
                           "bodies:\n  - {name: base, frame: world, points: [[0, 0, 0]], radius: 0.1}\n"
                           "  - {name: arm, frame: j, points: [[0.5, 0, 0.3]], radius: 0.05}\n";
-  const Outcome r = kccd("render " + model + " --camera " + camera_ + " --lower 0 --upper 0.1 -o " + out("u.png") + " --json");
+  const Outcome r = runKccd("render " + model + " --camera " + camera_ + " --lower 0 --upper 0.1 -o " + out("u.png") + " --json");
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_NE(r.err.find("unsafe"), std::string::npos);
   EXPECT_TRUE(fs::exists(out("u.png")));
-  EXPECT_EQ(kccd("render " + model + " --camera " + camera_ + " --state 0.1 -o " + out("v.png")).code, 0);
+  EXPECT_EQ(runKccd("render " + model + " --camera " + camera_ + " --state 0.1 -o " + out("v.png")).code, 0);
 }
 
 }  // namespace

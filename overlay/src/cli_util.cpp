@@ -6,6 +6,8 @@
 #include <cstring>
 #include <sstream>
 
+#include "kccd/modelling/fit.hpp"
+
 namespace kccd::cli {
 
 std::vector<double> parseList(const std::string& text, const std::string& option) {
@@ -29,6 +31,45 @@ std::vector<double> parseList(const std::string& text, const std::string& option
   }
   if (!text.empty() && text.back() == ',') throw UsageError(option + ": trailing comma");
   return out;
+}
+
+namespace {
+
+std::vector<double> stateVector(const Model& m, const std::string& text, const std::string& option, bool finite) {
+  std::vector<double> v = parseList(text, option);
+  if (static_cast<int>(v.size()) != m.stateSize()) {
+    std::string names;
+    for (const std::string& n : m.stateNames()) names += (names.empty() ? "" : ", ") + n;
+    throw UsageError(option + " has " + std::to_string(v.size()) + " values but model '" + m.name + "' has " +
+                     std::to_string(m.stateSize()) + " state values (" + names + ")");
+  }
+  for (std::size_t i = 0; finite && i < v.size(); ++i)
+    if (!std::isfinite(v[i]))
+      throw UsageError(option + ": value " + std::to_string(i + 1) + " (" + m.stateNames()[i] + ") is not finite");
+  return v;
+}
+
+}  // namespace
+
+StateBox parseStateBox(const Model& m, const std::string& state, const std::string& lower, const std::string& upper,
+                       const std::string& missing, bool finite) {
+  StateBox box;
+  if (!state.empty()) {
+    if (!lower.empty() || !upper.empty()) throw UsageError("give either --state or --lower/--upper, not both");
+    box.lower = box.upper = stateVector(m, state, "--state", finite);
+    box.point = true;
+    return box;
+  }
+  if (lower.empty() || upper.empty()) throw UsageError(missing);
+  box.lower = stateVector(m, lower, "--lower", finite);
+  box.upper = stateVector(m, upper, "--upper", finite);
+  return box;
+}
+
+void checkCorePoints(int k) {
+  if (k < 1 || k > modelling::kMaxCorePoints)
+    throw UsageError("--points: the number of core points K must be 1 ... " +
+                     std::to_string(modelling::kMaxCorePoints) + " (got " + std::to_string(k) + ")");
 }
 
 nlohmann::json number(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr); }
@@ -113,11 +154,18 @@ std::string format(double value, int digits) {
   return buf;
 }
 
-std::string formatUp(double value, int digits) {
-  std::string s = format(value, digits);
-  double step = std::abs(value) * std::pow(10.0, -digits + 1);
-  for (int i = 0; std::stod(s) < value && i < 64; ++i) s = format(value + step * (i + 1) / 4.0, digits);
-  return s;
+void editFile(const std::string& path, const std::function<std::string(const std::string&)>& edit) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw UsageError(path + ": cannot read the file");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string edited;
+  try {
+    edited = edit(text.str());
+  } catch (const std::runtime_error& e) {
+    throw UsageError(e.what());
+  }
+  writeFileAtomically(path, edited);
 }
 
 }  // namespace kccd::cli

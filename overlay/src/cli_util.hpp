@@ -1,6 +1,7 @@
 // Helpers shared by the kccd subcommands: one-line errors, number lists, JSON conversions.
 #pragma once
 
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -19,6 +20,19 @@ class UsageError : public std::runtime_error {
 
 /// Parses "a,b,c" into numbers; `option` names the flag in error messages.
 std::vector<double> parseList(const std::string& text, const std::string& option);
+
+/// The interval box from `--state` (a single configuration) or `--lower`/`--upper`, each checked
+/// against the model's state size; `missing` is the message when neither is complete. With
+/// `finite`, NaN and infinite values are rejected too (else they reach the query as a status).
+struct StateBox {
+  std::vector<double> lower, upper;
+  bool point = false;  ///< given with --state
+};
+StateBox parseStateBox(const Model& m, const std::string& state, const std::string& lower, const std::string& upper,
+                       const std::string& missing, bool finite);
+
+/// Checks a `--points` value (the number of core points of a fit).
+void checkCorePoints(int k);
 
 /// A non-finite value as JSON null, otherwise the number.
 nlohmann::json number(double value);
@@ -53,8 +67,10 @@ class Progress {
 /// file. Throws UsageError naming the path.
 void writeFileAtomically(const std::string& path, const std::string& text);
 
-/// Prints a number with `digits` significant digits, rounded up (for radii that must not shrink).
-std::string formatUp(double value, int digits = 10);
+/// Replaces the text of the file at `path` by `edit(text)`, atomically; a std::runtime_error from
+/// `edit` or a failed read or write becomes a UsageError naming the file, and the file stays as it was.
+void editFile(const std::string& path, const std::function<std::string(const std::string&)>& edit);
+
 /// Prints a number with `digits` significant digits (nearest).
 std::string format(double value, int digits = 10);
 

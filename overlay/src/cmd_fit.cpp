@@ -21,36 +21,8 @@ struct FitArgs {
   int evaluations = 4000;
 };
 
-// Core points as printed, and the radius recomputed for exactly those points, rounded up.
-struct Printed {
-  std::vector<Vec3> points;
-  std::vector<std::array<std::string, 3>> text;
-  double radius = 0.0;
-  std::string radius_text;
-};
-
-Printed printable(const modelling::FitResult& r, const modelling::Part& part) {
-  Printed p;
-  for (const Vec3& v : r.points) {
-    std::array<std::string, 3> t{format(v.x()), format(v.y()), format(v.z())};
-    p.points.emplace_back(std::stod(t[0]), std::stod(t[1]), std::stod(t[2]));
-    p.text.push_back(t);
-  }
-  p.radius = modelling::coveringRadius(p.points, part);
-  p.radius_text = formatUp(p.radius);
-  return p;
-}
-
-std::string flowPoints(const Printed& p) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < p.text.size(); ++i)
-    s += (i ? ", [" : "[") + p.text[i][0] + ", " + p.text[i][1] + ", " + p.text[i][2] + "]";
-  return s + "]";
-}
-
 int runFit(const FitArgs& args) {
-  if (args.points < 1 || args.points > 16)
-    throw UsageError("--points: the number of core points K must be 1 ... 16 (got " + std::to_string(args.points) + ")");
+  checkCorePoints(args.points);
   if (args.model.empty() != args.body.empty()) throw UsageError("--model and --body go together");
   const auto t0 = std::chrono::steady_clock::now();
   modelling::Part part;
@@ -66,8 +38,9 @@ int runFit(const FitArgs& args) {
                               .max_evaluations = args.evaluations,
                               .progress = [&](double f) { progress.update(f); }});
   }
-  const Printed p = printable(r, part);
-  const double volume = modelling::sschVolume(p.points, p.radius);
+  const std::string points_yaml = modelling::flowPoints(r.points);
+  const std::string radius_yaml = modelling::yamlNumber(r.radius, true);  // never smaller than fitted
+  const double volume = r.volume;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double hull = r.hull_volume;
   auto ratio = [&](double v) { return hull > 0 ? v / hull : std::numeric_limits<double>::infinity(); };
@@ -75,18 +48,15 @@ int runFit(const FitArgs& args) {
       args.name.empty() ? (args.body.empty() ? std::filesystem::path(args.part_file).stem().string() : args.body)
                         : args.name;
 
-  if (!args.model.empty()) {
-    try {
-      modelling::setBodyGeometry(args.model, args.body, flowPoints(p), p.radius_text);
-    } catch (const std::runtime_error& e) {
-      throw UsageError(e.what());
-    }
-  }
+  if (!args.model.empty())
+    editFile(args.model, [&](const std::string& text) {
+      return modelling::withBodyGeometry(text, args.model, args.body, points_yaml, radius_yaml);
+    });
   if (args.json) {
     nlohmann::json j;
     j["points"] = nlohmann::json::array();
-    for (const Vec3& v : p.points) j["points"].push_back(vec3(v));
-    j["radius"] = std::stod(p.radius_text);
+    for (const Vec3& v : r.points) j["points"].push_back(vec3(v));
+    j["radius"] = std::stod(radius_yaml);
     j["volume"] = volume;
     j["hull_volume"] = hull;
     j["volume_ratio"] = number(ratio(volume));
@@ -112,8 +82,8 @@ int runFit(const FitArgs& args) {
   if (!args.model.empty()) out << "# written into " << args.model << ", body " << args.body << "\n";
   out << "- name: " << body_name << "\n"
       << "  frame: " << args.frame << "\n"
-      << "  points: " << flowPoints(p) << "\n"
-      << "  radius: " << p.radius_text << "\n";
+      << "  points: " << points_yaml << "\n"
+      << "  radius: " << radius_yaml << "\n";
   std::cout << out.str();
   return 0;
 }

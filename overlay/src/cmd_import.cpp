@@ -18,8 +18,7 @@ struct ImportArgs {
 };
 
 int runImport(const ImportArgs& args) {
-  if (args.points < 1 || args.points > 16)
-    throw UsageError("--points: the number of core points K must be 1 ... 16 (got " + std::to_string(args.points) + ")");
+  checkCorePoints(args.points);
   modelling::ImportOptions opt;
   opt.srdf = args.srdf;
   opt.points = args.points;

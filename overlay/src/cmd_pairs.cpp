@@ -19,6 +19,10 @@ struct PairsArgs {
   bool write = false, json = false, quiet = false, all = false;
 };
 
+void writeIgnoreList(const std::string& model, const std::vector<std::array<std::string, 2>>& ignore) {
+  editFile(model, [&](const std::string& text) { return modelling::withIgnoreList(text, model, ignore); });
+}
+
 int runPairs(const PairsArgs& args) {
   const Model m = loadOrExplain(args.model);
   std::vector<modelling::PairReport> reports;
@@ -54,7 +58,7 @@ int runPairs(const PairsArgs& args) {
     }
     j["ignore"] = ignore;
     if (args.write) j["written"] = args.model;
-    if (args.write) modelling::setIgnoreList(args.model, ignore);
+    if (args.write) writeIgnoreList(args.model, ignore);
     std::cout << j.dump(2) << "\n";
     return 0;
   }
@@ -84,11 +88,7 @@ int runPairs(const PairsArgs& args) {
             << " undecided, " << counts[4] << " unbounded" << (args.all ? "" : " (pairs that meet: --all lists them)")
             << "\n";
   if (args.write) {
-    try {
-      modelling::setIgnoreList(args.model, ignore);
-    } catch (const std::runtime_error& e) {
-      throw UsageError(e.what());
-    }
+    writeIgnoreList(args.model, ignore);
     std::cout << "wrote " << ignore.size() << " pairs to pairs: ignore in " << args.model << "\n";
   } else {
     std::cout << "suggested:\npairs:\n  ignore: " << modelling::flowPairs(ignore, 11) << "\n";

@@ -28,33 +28,14 @@ QueryType parseType(const std::string& t) {
   throw UsageError("--type: unknown query type '" + t + "' (collision, closest, nclosest, distances)");
 }
 
-std::string stateList(const Model& m) {
-  std::string s;
-  for (const std::string& n : m.stateNames()) s += (s.empty() ? "" : ", ") + n;
-  return s;
-}
-
-std::vector<double> stateVector(const Model& m, const std::string& text, const std::string& option) {
-  std::vector<double> v = parseList(text, option);
-  if (static_cast<int>(v.size()) != m.stateSize())
-    throw UsageError(option + " has " + std::to_string(v.size()) + " values but model '" + m.name + "' has " +
-                     std::to_string(m.stateSize()) + " state values (" + stateList(m) + ")");
-  return v;
-}
-
 int runQuery(const QueryArgs& args) {
   const Model m = loadOrExplain(args.model);
   const QueryType type = parseType(args.type);
-  std::vector<double> lower, upper;
-  if (!args.state.empty()) {
-    if (!args.lower.empty() || !args.upper.empty()) throw UsageError("give either --state or --lower/--upper, not both");
-    lower = upper = stateVector(m, args.state, "--state");
-  } else {
-    if (args.lower.empty() || args.upper.empty())
-      throw UsageError("the interval box needs --lower and --upper (or --state for a single configuration)");
-    lower = stateVector(m, args.lower, "--lower");
-    upper = stateVector(m, args.upper, "--upper");
-  }
+  const StateBox box =
+      parseStateBox(m, args.state, args.lower, args.upper,
+                    "the interval box needs --lower and --upper (or --state for a single configuration)", false);
+  const std::vector<double>& lower = box.lower;
+  const std::vector<double>& upper = box.upper;
   Checker checker(m);
   QueryOptions opt;
   opt.type = type;

@@ -6,8 +6,6 @@
 #include <iostream>
 #include <memory>
 
-#include <unistd.h>
-
 #include <opencv2/imgcodecs.hpp>
 
 #include "cli_util.hpp"
@@ -26,40 +24,18 @@ struct RenderArgs {
   double supersample = 1.0;
 };
 
-std::vector<double> stateVector(const Model& m, const std::string& text, const std::string& option) {
-  std::vector<double> v = parseList(text, option);
-  if (static_cast<int>(v.size()) != m.stateSize()) {
-    std::string names;
-    for (const std::string& n : m.stateNames()) names += (names.empty() ? "" : ", ") + n;
-    throw UsageError(option + " has " + std::to_string(v.size()) + " values but model '" + m.name + "' has " +
-                     std::to_string(m.stateSize()) + " state values (" + names + ")");
-  }
-  for (std::size_t i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v[i]))
-      throw UsageError(option + ": value " + std::to_string(i + 1) + " (" + m.stateNames()[i] + ") is not finite");
-  return v;
-}
-
-// Writes the PNG under a temporary name in the same directory and renames it into place, so
-// a failed run never leaves a partial file.
+// Encodes the PNG in memory and writes it through a temporary file and a rename, so a failed
+// run never leaves a partial file.
 void writePng(const cv::Mat& image, const std::string& path) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  if (!fs::is_directory(dir)) throw UsageError("-o " + path + ": directory " + dir.string() + " does not exist");
-  const fs::path temp = dir / ("." + target.filename().string() + ".tmp" + std::to_string(getpid()) + ".png");
+  std::vector<uchar> png;
   bool ok = false;
   try {
-    ok = cv::imwrite(temp.string(), image);
+    ok = cv::imencode(".png", image, png);
   } catch (const cv::Exception&) {
     ok = false;
   }
-  std::error_code ec;
-  if (ok) fs::rename(temp, target, ec);
-  if (!ok || ec) {
-    fs::remove(temp, ec);
-    throw UsageError("-o " + path + ": cannot write the image");
-  }
+  if (!ok) throw UsageError("-o " + path + ": cannot encode the image");
+  writeFileAtomically(path, std::string(png.begin(), png.end()));
 }
 
 int runRender(const RenderArgs& args) {
@@ -79,31 +55,21 @@ int runRender(const RenderArgs& args) {
     if (!dir.empty() && !std::filesystem::is_directory(dir))
       throw UsageError("-o " + args.output + ": directory " + dir.string() + " does not exist");
   }
-  std::vector<double> lower, upper;
-  if (!args.state.empty()) {
-    if (!args.lower.empty() || !args.upper.empty()) throw UsageError("give either --state or --lower/--upper, not both");
-    lower = upper = stateVector(m, args.state, "--state");
-  } else {
-    if (args.lower.empty() || args.upper.empty())
-      throw UsageError("give the configuration with --state (static volumes) or --lower and --upper (swept volumes)");
-    lower = stateVector(m, args.lower, "--lower");
-    upper = stateVector(m, args.upper, "--upper");
-  }
+  const StateBox box =
+      parseStateBox(m, args.state, args.lower, args.upper,
+                    "give the configuration with --state (static volumes) or --lower and --upper (swept volumes)", true);
+  const std::vector<double>& lower = box.lower;
+  const std::vector<double>& upper = box.upper;
   if (m.bodies.size() > 255) throw UsageError(args.model + ": more than 255 bodies do not fit an 8-bit mask");
 
   Checker checker(m);
   const QueryResult& r = checker.query(lower, upper, QueryOptions{.type = QueryType::Distances});
   const Status status = r.status;
   const double margin = r.margin;
-  std::vector<double> nearest(m.bodies.size(), std::numeric_limits<double>::infinity());
-  for (const PairDistance& pd : r.pairs) {
-    nearest[m.pairs[pd.pair].a] = std::min(nearest[m.pairs[pd.pair].a], pd.distance);
-    nearest[m.pairs[pd.pair].b] = std::min(nearest[m.pairs[pd.pair].b], pd.distance);
-  }
+  const std::vector<double> nearest = render::bodyDistances(m, r);
   const std::vector<render::VolumeStatus> body_status = render::bodyStatus(m, r);
-  std::vector<render::Volume> volumes = args.state.empty()
-                                           ? render::sceneVolumes(m, checker, body_status)
-                                           : render::staticSceneVolumes(m, checker, lower, body_status);
+  std::vector<render::Volume> volumes = box.point ? render::staticSceneVolumes(m, checker, lower, body_status)
+                                                 : render::sceneVolumes(m, checker, body_status);
   for (render::Volume& v : volumes)
     if (!allFinite(v.points) || !std::isfinite(v.radius)) v.points = {};  // unsafe status: nothing to draw
 

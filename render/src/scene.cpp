@@ -6,18 +6,23 @@
 
 namespace kccd::render {
 
-std::vector<VolumeStatus> bodyStatus(const Model& model, const QueryResult& result) {
-  std::vector<VolumeStatus> out(model.bodies.size(), VolumeStatus::Clear);
-  if (result.status != Status::Ok) {
-    out.assign(model.bodies.size(), VolumeStatus::Colliding);
-    return out;
-  }
+std::vector<double> bodyDistances(const Model& model, const QueryResult& result) {
   std::vector<double> nearest(model.bodies.size(), std::numeric_limits<double>::infinity());
   for (const PairDistance& pd : result.pairs) {
     const BodyPair& p = model.pairs[pd.pair];
     nearest[p.a] = std::min(nearest[p.a], pd.distance);
     nearest[p.b] = std::min(nearest[p.b], pd.distance);
   }
+  return nearest;
+}
+
+std::vector<VolumeStatus> bodyStatus(const Model& model, const QueryResult& result) {
+  std::vector<VolumeStatus> out(model.bodies.size(), VolumeStatus::Clear);
+  if (result.status != Status::Ok) {
+    out.assign(model.bodies.size(), VolumeStatus::Colliding);
+    return out;
+  }
+  const std::vector<double> nearest = bodyDistances(model, result);
   for (std::size_t i = 0; i < out.size(); ++i) {
     if (nearest[i] <= 0.0)
       out[i] = VolumeStatus::Colliding;

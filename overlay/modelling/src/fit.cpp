@@ -11,11 +11,11 @@
 
 #include "kccd/distance.hpp"
 #include "kccd/modelling/convex_hull.hpp"
+#include "kccd/modelling/yaml_edit.hpp"
 
 namespace kccd::modelling {
 namespace {
 
-constexpr int kMaxCorePoints = 16;
 constexpr int kMaxConstraintPoints = 384;
 
 // Distance from x to conv(core): an upper bound (the closest point found lies in the hull).
@@ -89,13 +89,59 @@ class Objective {
   GjkOptions options_{.max_iterations = 64, .relative_tolerance = 1e-7};
 };
 
-Constraints buildConstraints(const Part& part, int& hull_vertex_count) {
-  Constraints c;
+// Mean and principal axes (eigenvectors, increasing spread) of a point set.
+struct Principal {
+  Vec3 mean = Vec3::Zero();
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+};
+
+Principal principalAxes(const std::vector<Vec3>& points) {
+  Principal p;
+  for (const Vec3& v : points) p.mean += v;
+  p.mean /= static_cast<double>(points.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Vec3& v : points) cov += (v - p.mean) * (v - p.mean).transpose();
+  p.axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
+  return p;
+}
+
+// What a covering radius is measured against: the hull vertices of the part's points (the
+// hull is computed once per part), its balls and its input rounding guard.
+struct Cover {
+  std::vector<Vec3> vertices;
+  std::vector<Sphere> balls;
+  double guard = 0.0;
+};
+
+Cover makeCover(const Part& part) {
+  Cover c;
+  if (!part.points.empty())
+    for (int i : convexHull(part.points).vertices) c.vertices.push_back(part.points[i]);
   c.balls = part.balls;
-  if (!part.points.empty()) {
-    const ConvexHull h = convexHull(part.points);
-    for (int i : h.vertices) c.points.push_back(part.points[i]);
+  c.guard = part.coordinate_guard;
+  return c;
+}
+
+double coverRadius(std::span<const Vec3> core, const Cover& cover) {
+  double r = 0.0, scale = 0.0;
+  for (const Vec3& p : core) scale = std::max(scale, p.cwiseAbs().maxCoeff());
+  for (const Vec3& v : cover.vertices) {
+    r = std::max(r, hullDistanceUpper(v, core));
+    scale = std::max(scale, v.cwiseAbs().maxCoeff());
   }
+  for (const Sphere& b : cover.balls) {
+    r = std::max(r, hullDistanceUpper(b.center, core) + b.radius);
+    scale = std::max(scale, b.center.cwiseAbs().maxCoeff() + b.radius);
+  }
+  if (!std::isfinite(r) || !std::isfinite(scale)) throw std::invalid_argument("the part has non-finite coordinates");
+  // Rounding of the distance computation (a few ulps of the coordinates) and of the input.
+  return r + 16.0 * std::numeric_limits<double>::epsilon() * scale + cover.guard;
+}
+
+Constraints buildConstraints(const Part& part, const Cover& cover, int& hull_vertex_count) {
+  Constraints c;
+  c.balls = cover.balls;
+  c.points = cover.vertices;
   hull_vertex_count = static_cast<int>(c.points.size());
   if (c.points.size() > static_cast<std::size_t>(kMaxConstraintPoints)) {
     // Keep the extreme vertex in many directions; the final radius uses every vertex.
@@ -114,12 +160,7 @@ Constraints buildConstraints(const Part& part, int& hull_vertex_count) {
   for (const Vec3& v : all) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
   c.center = (lo + hi) / 2.0;
   c.diameter = (hi - lo).norm();
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& v : all) mean += v;
-  mean /= static_cast<double>(all.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Vec3& v : all) cov += (v - mean) * (v - mean).transpose();
-  c.axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
+  c.axes = principalAxes(all).axes;
   return c;
 }
 
@@ -252,24 +293,7 @@ std::vector<Vec3> patternSearch(std::vector<Vec3> core, double value, const Cons
 
 double sschVolume(std::span<const Vec3> points, double radius) { return convexHull(points).sschVolume(radius); }
 
-double coveringRadius(std::span<const Vec3> core, const Part& part) {
-  double r = 0.0, scale = 0.0;
-  for (const Vec3& p : core) scale = std::max(scale, p.cwiseAbs().maxCoeff());
-  if (!part.points.empty()) {
-    const ConvexHull h = convexHull(part.points);
-    for (int i : h.vertices) {
-      r = std::max(r, hullDistanceUpper(part.points[i], core));
-      scale = std::max(scale, part.points[i].cwiseAbs().maxCoeff());
-    }
-  }
-  for (const Sphere& b : part.balls) {
-    r = std::max(r, hullDistanceUpper(b.center, core) + b.radius);
-    scale = std::max(scale, b.center.cwiseAbs().maxCoeff() + b.radius);
-  }
-  if (!std::isfinite(r) || !std::isfinite(scale)) throw std::invalid_argument("the part has non-finite coordinates");
-  // Rounding of the distance computation (a few ulps of the coordinates) and of the input.
-  return r + 16.0 * std::numeric_limits<double>::epsilon() * scale + part.coordinate_guard;
-}
+double coveringRadius(std::span<const Vec3> core, const Part& part) { return coverRadius(core, makeCover(part)); }
 
 FitResult fit(const Part& part, const FitOptions& options) {
   if (options.points < 1 || options.points > kMaxCorePoints)
@@ -277,7 +301,8 @@ FitResult fit(const Part& part, const FitOptions& options) {
                                 " (got " + std::to_string(options.points) + ")");
   if (part.empty()) throw std::invalid_argument("the part has no geometry");
   FitResult result;
-  const Constraints c = buildConstraints(part, result.hull_vertices);
+  const Cover cover = makeCover(part);
+  const Constraints c = buildConstraints(part, cover, result.hull_vertices);
   result.hull_volume = convexHull(part.samples()).volume;
   std::mt19937_64 rng(options.seed);
 
@@ -342,19 +367,15 @@ FitResult fit(const Part& part, const FitOptions& options) {
   quick.progress = nullptr;
   quick.max_evaluations = 600;
   const std::vector<Vec3> centre = optimise(1, quick);
-  result.sphere_volume = sschVolume(centre, coveringRadius(centre, part));
+  result.sphere_volume = sschVolume(centre, coverRadius(centre, cover));
 
   const std::vector<Vec3> samples = part.samples(42);
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& p : samples) mean += p;
-  mean /= static_cast<double>(samples.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Vec3& p : samples) cov += (p - mean) * (p - mean).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pca(cov);
+  const Principal pca = principalAxes(samples);
+  const Vec3& mean = pca.mean;
   result.capsule_volume = INFINITY;
   std::vector<Vec3> capsule;
   for (int k = 0; k < 3; ++k) {  // the best of the three principal axes
-    const Vec3 axis = pca.eigenvectors().col(k);
+    const Vec3 axis = pca.axes.col(k);
     double rad = 0.0;
     for (const Vec3& p : samples) rad = std::max(rad, ((p - mean) - axis * axis.dot(p - mean)).norm());
     double a = INFINITY, b = -INFINITY;  // segment [a, b] along the axis covering every sample
@@ -367,7 +388,7 @@ FitResult fit(const Part& part, const FitOptions& options) {
     }
     if (a > b) a = b = (a + b) / 2.0;
     const std::vector<Vec3> segment{mean + a * axis, mean + b * axis};
-    const double v = sschVolume(segment, coveringRadius(segment, part));
+    const double v = sschVolume(segment, coverRadius(segment, cover));
     if (v < result.capsule_volume) result.capsule_volume = v, capsule = segment;
   }
   // The K points then start from the baselines too, so they never do worse than them.
@@ -377,7 +398,10 @@ FitResult fit(const Part& part, const FitOptions& options) {
     extra_seeds[1].push_back(centre[0]);
   }
   result.points = optimise(options.points, options);
-  result.radius = coveringRadius(result.points, part);
+  // The points as they will be printed (10 significant digits), the radius exactly for those.
+  for (Vec3& p : result.points)
+    for (int i = 0; i < 3; ++i) p(i) = std::stod(yamlNumber(p(i)));
+  result.radius = coverRadius(result.points, cover);
   result.volume = sschVolume(result.points, result.radius);
   if (options.progress) options.progress(1.0);
   return result;

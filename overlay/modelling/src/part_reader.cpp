@@ -73,7 +73,6 @@ Eigen::Affine3d toEigen(const SbMatrix& m) {
 
 struct Collector {
   Part part;
-  double max_abs = 0.0;
 };
 
 void triangle(void* data, SoCallbackAction* action, const SoPrimitiveVertex* v1, const SoPrimitiveVertex* v2,
@@ -156,10 +155,7 @@ Part readStl(const std::string& path, const Vec3& scale) {
   if (!in) throw std::runtime_error(path + ": cannot open the file");
   const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   Part part;
-  auto add = [&](const Vec3& v) {
-    if (!v.allFinite()) throw std::runtime_error(path + ": non-finite vertex coordinates");
-    part.points.push_back(v.cwiseProduct(scale));
-  };
+  auto add = [&](const Vec3& v) { part.points.push_back(v.cwiseProduct(scale)); };
   std::uint32_t count = 0;
   if (data.size() >= 84) std::memcpy(&count, data.data() + 80, 4);
   if (data.size() >= 84 && data.size() == 84 + 50ull * count) {
@@ -189,10 +185,6 @@ Part readStl(const std::string& path, const Vec3& scale) {
     }
     if (line_vertices % 3 != 0) throw std::runtime_error(path + ": truncated facet (vertex count not a multiple of 3)");
   }
-  if (part.triangles == 0) throw std::runtime_error(path + ": no triangles or solid primitives (nothing to fit)");
-  double max_abs = 0.0;
-  for (const Vec3& p : part.points) max_abs = std::max(max_abs, p.cwiseAbs().maxCoeff());
-  part.coordinate_guard = 1e-6 * max_abs;  // single-precision input
   return part;
 }
 
@@ -202,9 +194,8 @@ struct RefGuard {
   ~RefGuard() { node->unref(); }
 };
 
-}  // namespace
-
-Part readPart(const std::string& path, const ReadOptions& options) {
+// Any scene Coin reads (Open Inventor, VRML), with the part selection of `options`.
+Part readScene(const std::string& path, const ReadOptions& options) {
   std::lock_guard<std::mutex> lock(coin_mutex);
   initCoin();
   static Messages messages;  // Coin keeps the handler's data pointer: it must outlive the call
@@ -215,13 +206,6 @@ Part readPart(const std::string& path, const ReadOptions& options) {
   SoInput input;
   if (!input.openFile(path.c_str(), TRUE)) throw std::runtime_error(path + ": cannot open the file");
   SoSeparator* root = nullptr;
-  std::string extension = std::filesystem::path(path).extension().string();
-  for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  if (extension == ".stl") {
-    // Coin's STL reader fails on the second different STL file in a process: read it here.
-    input.closeFile();
-    return readStl(path, options.scale);
-  }
   // Node by node: SoDB::readAll would hand back a lone top-level separator itself, hiding
   // whether the file holds one part or several.
   root = new SoSeparator;
@@ -290,17 +274,27 @@ Part readPart(const std::string& path, const ReadOptions& options) {
     }
     collect(c, top, nullptr);
   }
-  if (c.part.triangles == 0 && c.part.primitives == 0)
+  return std::move(c.part);
+}
+
+}  // namespace
+
+Part readPart(const std::string& path, const ReadOptions& options) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  // Coin's STL reader fails on the second different STL file in a process: STL is read here.
+  Part part = extension == ".stl" ? readStl(path, options.scale) : readScene(path, options);
+  if (part.triangles == 0 && part.primitives == 0)
     throw std::runtime_error(path + (options.part.empty() ? "" : " (part " + options.part + ")") +
                              ": no triangles or solid primitives (nothing to fit)");
   double max_abs = 0.0;
-  for (const Vec3& p : c.part.points) max_abs = std::max(max_abs, p.cwiseAbs().maxCoeff());
-  for (const Sphere& b : c.part.balls) max_abs = std::max(max_abs, b.center.cwiseAbs().maxCoeff() + b.radius);
-  for (const Vec3& p : c.part.points)
+  for (const Vec3& p : part.points) max_abs = std::max(max_abs, p.cwiseAbs().maxCoeff());
+  for (const Sphere& b : part.balls) max_abs = std::max(max_abs, b.center.cwiseAbs().maxCoeff() + b.radius);
+  for (const Vec3& p : part.points)
     if (!p.allFinite()) throw std::runtime_error(path + ": non-finite vertex coordinates");
-  // Coin stores single-precision coordinates and matrices: cover their rounding.
-  c.part.coordinate_guard = 1e-6 * max_abs;
-  return std::move(c.part);
+  // Coin and STL store single-precision coordinates (Coin its matrices too): cover their rounding.
+  part.coordinate_guard = 1e-6 * max_abs;
+  return part;
 }
 
 }  // namespace kccd::modelling

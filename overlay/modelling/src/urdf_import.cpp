@@ -19,18 +19,7 @@
 namespace kccd::modelling {
 namespace {
 
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.10g", v == 0.0 ? 0.0 : v);
-  return buf;
-}
-
-// Rounds up in the last printed digit, so a printed radius never shrinks.
-std::string numUp(double v) {
-  std::string s = num(v);
-  for (int i = 1; std::stod(s) < v && i < 64; ++i) s = num(v + std::abs(v) * 1e-10 * i);
-  return s;
-}
+std::string num(double v) { return yamlNumber(v); }
 
 std::string vec(double x, double y, double z) {
   std::string s = "[";
@@ -201,20 +190,11 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     if (options.progress)
       fo.progress = [&](double f) { options.progress((fitted + f) / std::max(1, with_geometry)); };
     const FitResult fit_result = fit(part, fo);
-    // Print the points, then recompute the radius for the printed values and round it up.
-    std::vector<Vec3> printed;
-    std::string points = "[";
-    for (std::size_t i = 0; i < fit_result.points.size(); ++i) {
-      const Vec3& v = fit_result.points[i];
-      printed.emplace_back(std::stod(num(v.x())), std::stod(num(v.y())), std::stod(num(v.z())));
-      points += (i ? ", " : "") + vec(v.x(), v.y(), v.z());
-    }
-    points += "]";
     bodies << "  - name: " << link->name << "\n"
            << "    frame: " << frame_of.at(link->name) << "\n"
-           << "    points: " << points << "\n"
-           << "    radius: " << numUp(coveringRadius(printed, part)) << "   # volume "
-           << num(fit_result.volume) << " m^3, hull " << num(fit_result.hull_volume) << " m^3\n";
+           << "    points: " << flowPoints(fit_result.points) << "\n"
+           << "    radius: " << yamlNumber(fit_result.radius, true) << "   # volume " << num(fit_result.volume)
+           << " m^3, hull " << num(fit_result.hull_volume) << " m^3\n";
     body_names.insert(link->name);
     ++fitted;
   }

@@ -1,9 +1,7 @@
 #include "kccd/modelling/yaml_edit.hpp"
 
+#include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
@@ -12,32 +10,6 @@
 
 namespace kccd::modelling {
 namespace {
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot read the model file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void writeText(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".kccd-tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw std::runtime_error(path + ": cannot write the model file");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot replace the model file (" + ec.message() + ")");
-  }
-}
 
 YAML::Node load(const std::string& text, const std::string& source) {
   try {
@@ -155,6 +127,27 @@ void check(const std::string& text, const std::string& source) {
 
 }  // namespace
 
+std::string yamlNumber(double value, bool up) {
+  char buf[40];
+  auto print = [&](double v) {
+    std::snprintf(buf, sizeof buf, "%.10g", v == 0.0 ? 0.0 : v);
+    return std::string(buf);
+  };
+  std::string s = print(value);
+  for (int i = 1; up && std::stod(s) < value && i < 64; ++i) s = print(value + std::abs(value) * 1e-10 * i);
+  return s;
+}
+
+std::string flowPoints(std::span<const Vec3> points) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (i) s += ", ";
+    s.append("[").append(yamlNumber(points[i].x())).append(", ").append(yamlNumber(points[i].y()));
+    s.append(", ").append(yamlNumber(points[i].z())).append("]");
+  }
+  return s + "]";
+}
+
 std::string flowPairs(const std::vector<std::array<std::string, 2>>& pairs, int indent) {
   std::string s = "[", line;
   for (std::size_t i = 0; i < pairs.size(); ++i) {
@@ -236,15 +229,6 @@ std::string withIgnoreList(const std::string& text, const std::string& source,
   }
   check(out, source);
   return out;
-}
-
-void setBodyGeometry(const std::string& path, const std::string& body, const std::string& points_yaml,
-                     const std::string& radius_yaml) {
-  writeText(path, withBodyGeometry(readText(path), path, body, points_yaml, radius_yaml));
-}
-
-void setIgnoreList(const std::string& path, const std::vector<std::array<std::string, 2>>& pairs) {
-  writeText(path, withIgnoreList(readText(path), path, pairs));
 }
 
 }  // namespace kccd::modelling

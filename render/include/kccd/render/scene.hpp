@@ -9,6 +9,9 @@
 
 namespace kccd::render {
 
+/// Per body the smallest distance bound among its pairs in a query result (+inf in none).
+std::vector<double> bodyDistances(const Model& model, const QueryResult& result);
+
 /// Per body status from a Distances query result: the smallest bound among the body's pairs,
 /// <= 0 colliding, <= margin within margin, else clear. An unsafe query status (anything but
 /// Ok) makes every body colliding. Bodies in no checked pair are clear.

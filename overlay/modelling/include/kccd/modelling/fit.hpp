@@ -11,6 +11,9 @@
 
 namespace kccd::modelling {
 
+/// The most core points a fit may use.
+inline constexpr int kMaxCorePoints = 16;
+
 struct FitOptions {
   int points = 8;                  ///< number of core points K (1 ... 16)
   int max_evaluations = 4000;      ///< optimiser budget per start (volume evaluations)
@@ -20,7 +23,7 @@ struct FitOptions {
 
 /// A fitted SSCH and what it costs: its volume against the part's hull and two simple baselines.
 struct FitResult {
-  std::vector<Vec3> points;
+  std::vector<Vec3> points;      ///< rounded to 10 significant digits: printing them loses nothing
   double radius = 0.0;
   double volume = 0.0;           ///< of the SSCH (closed form)
   double hull_volume = 0.0;      ///< of the part's convex hull
@@ -30,7 +33,8 @@ struct FitResult {
   int evaluations = 0;
 };
 
-/// Fits K core points minimising the SSCH volume, then sets the radius exactly (conservative).
+/// Fits K core points minimising the SSCH volume, rounds them to 10 significant digits, then sets
+/// the radius exactly for those points (conservative; print it with yamlNumber(r, true)).
 /// Throws std::invalid_argument when K is out of range or the part is empty.
 FitResult fit(const Part& part, const FitOptions& options = {});
 

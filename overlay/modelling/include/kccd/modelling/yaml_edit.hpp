@@ -1,27 +1,30 @@
-// Small in-place edits of model files that keep everything else (comments, order, layout):
-// only the edited values are rewritten, and the result is checked by loading it again.
+// Small edits of model text that keep everything else (comments, order, layout): only the
+// edited values are rewritten, and the result is checked by loading it again. Also the number
+// and list formats the tools write into model files.
 #pragma once
 
 #include <array>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "kccd/ssch.hpp"
+
 namespace kccd::modelling {
 
-/// Replaces the `points` and `radius` of body `body` in the model file at `path` with the given
-/// YAML texts. Throws std::runtime_error (naming the file) when the body is missing or the
-/// edited file would not load; the file is then left untouched.
-void setBodyGeometry(const std::string& path, const std::string& body, const std::string& points_yaml,
-                     const std::string& radius_yaml);
-
-/// Sets `pairs: ignore:` of the model file at `path` to `pairs` (creating the keys if needed).
-void setIgnoreList(const std::string& path, const std::vector<std::array<std::string, 2>>& pairs);
-
-/// The same edits on text (`source` names it in messages); return the edited text.
+/// Replaces the `points` and `radius` of body `body` in model text (`source` names it in
+/// messages) with the given YAML texts and returns the edited text. Throws std::runtime_error
+/// when the body is missing or the edited model would not load.
 std::string withBodyGeometry(const std::string& text, const std::string& source, const std::string& body,
                              const std::string& points_yaml, const std::string& radius_yaml);
+/// Sets `pairs: ignore:` of model text to `pairs` (creating the keys if needed); same errors.
 std::string withIgnoreList(const std::string& text, const std::string& source,
                            const std::vector<std::array<std::string, 2>>& pairs);
+/// A number as written into model files: 10 significant digits, rounded up when `up` (for radii,
+/// which must not shrink).
+std::string yamlNumber(double value, bool up = false);
+/// Points as a YAML flow list [[x, y, z], ...] with yamlNumber digits.
+std::string flowPoints(std::span<const Vec3> points);
 
 /// A YAML flow list of name pairs, wrapped to lines of about 100 characters after `indent`.
 std::string flowPairs(const std::vector<std::array<std::string, 2>>& pairs, int indent);
