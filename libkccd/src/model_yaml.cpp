@@ -3,11 +3,13 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
 
 #include "kccd/model.hpp"
+#include "kccd/yaml_document.hpp"
 
 namespace kccd {
 namespace {
@@ -30,7 +32,7 @@ class Reader {
     for (const auto& kv : map) {
       const std::string k = kv.first.Scalar();
       if (std::none_of(keys.begin(), keys.end(), [&](const char* allowed) { return k == allowed; }))
-        fail(kv.first, field + "." + k, "unknown field");
+        fail(kv.first, field + "." + printable(k, 40), "unknown field");
     }
   }
 
@@ -43,6 +45,8 @@ class Reader {
   std::string text(const YAML::Node& n, const std::string& field) const {
     if (!n.IsScalar()) fail(n, field, "expected a string");
     if (n.Scalar().empty()) fail(n, field, "must not be empty");
+    for (const char c : n.Scalar())
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F) fail(n, field, "contains a control character: '" + printable(n.Scalar()) + "'");
     return n.Scalar();
   }
 
@@ -52,9 +56,24 @@ class Reader {
     try {
       v = n.as<double>();
     } catch (const YAML::Exception&) {
-      fail(n, field, "expected a number, got '" + n.Scalar() + "'");
+      fail(n, field, "expected a number, got '" + printable(n.Scalar()) + "'");
     }
     if (!std::isfinite(v)) fail(n, field, "must be finite");
+    return v;
+  }
+
+  // A length in metres: finite and within kMaxModelLength.
+  double length(const YAML::Node& n, const std::string& field) const {
+    const double v = number(n, field);
+    if (std::abs(v) > kMaxModelLength) fail(n, field, "beyond the largest length a model may give (1e6 m)");
+    return v;
+  }
+
+  Vec3 point(const YAML::Node& n, const std::string& field) const {
+    const Vec3 v = vec3(n, field);
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(v[k]) > kMaxModelLength)
+        fail(n[k], field + "[" + std::to_string(k) + "]", "beyond the largest length a model may give (1e6 m)");
     return v;
   }
 
@@ -71,7 +90,7 @@ class Reader {
 Pose parseOrigin(const Reader& r, const YAML::Node& n, const std::string& field) {
   r.onlyKeys(n, field, {"xyz", "rpy"});
   Pose pose = Pose::Identity();
-  if (n["xyz"]) pose.translation() = r.vec3(n["xyz"], field + ".xyz");
+  if (n["xyz"]) pose.translation() = r.point(n["xyz"], field + ".xyz");
   if (n["rpy"]) {
     const Vec3 rpy = r.vec3(n["rpy"], field + ".rpy");
     // URDF convention: fixed-axis roll about x, then pitch about y, then yaw about z.
@@ -122,8 +141,10 @@ void parseJoints(const Reader& r, const YAML::Node& list, Model& m) {
     if (one_dof) {
       const YAML::Node axis = r.require(n, "axis", fn, n);
       const Vec3 a = r.vec3(axis, fn + ".axis");
-      if (!(a.norm() > 1e-12)) r.fail(axis, fn + ".axis", "zero axis");
-      j.axis = a.normalized();
+      // Scaled by its largest component first, so tiny and huge components normalise alike.
+      const double scale = a.cwiseAbs().maxCoeff();
+      if (!(scale > 0.0)) r.fail(axis, fn + ".axis", "zero axis");
+      j.axis = (a / scale).normalized();
     } else if (n["axis"]) {
       r.fail(n["axis"], fn + ".axis", std::string("a ") + toString(j.type) + " joint has no axis");
     }
@@ -142,7 +163,7 @@ void parseJoints(const Reader& r, const YAML::Node& list, Model& m) {
     if (n["error"]) {
       if (j.type != JointType::Translation3d && j.type != JointType::Rotation3d)
         r.fail(n["error"], fn + ".error", "an error bound applies to translation3d and rotation3d joints only");
-      j.error = r.number(n["error"], fn + ".error");
+      j.error = j.type == JointType::Translation3d ? r.length(n["error"], fn + ".error") : r.number(n["error"], fn + ".error");
       if (j.error < 0.0) r.fail(n["error"], fn + ".error", "must be >= 0");
     }
     m.joints.push_back(std::move(j));
@@ -168,9 +189,9 @@ void parseBodies(const Reader& r, const YAML::Node& list, Model& m) {
     if (!pts.IsSequence()) r.fail(pts, fb + ".points", "expected a list of [x, y, z]");
     if (pts.size() == 0) r.fail(pts, fb + ".points", "empty point list");
     for (std::size_t k = 0; k < pts.size(); ++k)
-      b.points.push_back(r.vec3(pts[k], fb + ".points[" + std::to_string(k) + "]"));
+      b.points.push_back(r.point(pts[k], fb + ".points[" + std::to_string(k) + "]"));
     const YAML::Node rad = r.require(n, "radius", fb, n);
-    b.radius = r.number(rad, fb + ".radius");
+    b.radius = r.length(rad, fb + ".radius");
     if (b.radius < 0.0) r.fail(rad, fb + ".radius", "negative radius");
     m.bodies.push_back(std::move(b));
   }
@@ -200,6 +221,7 @@ std::vector<std::array<int, 2>> parsePairList(const Reader& r, const YAML::Node&
 
 Model parseModel(const std::string& yaml_text, const std::string& source) {
   const Reader r(source);
+  checkYamlDocument(yaml_text, source);  // one document, unique keys, bounded nesting
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -211,11 +233,11 @@ Model parseModel(const std::string& yaml_text, const std::string& source) {
   r.onlyKeys(root, "model", {"kccd", "name", "safety_margin", "point_budget", "joints", "bodies", "pairs"});
   const YAML::Node version = r.require(root, "kccd", "model", root);
   if (!version.IsScalar() || version.Scalar() != "1")
-    r.fail(version, "kccd", "unsupported format version '" + version.Scalar() + "' (this build reads 1)");
+    r.fail(version, "kccd", "unsupported format version '" + printable(version.Scalar()) + "' (this build reads 1)");
   Model m;
   m.name = root["name"] ? r.text(root["name"], "name") : std::string("model");
   if (root["safety_margin"]) {
-    m.safety_margin = r.number(root["safety_margin"], "safety_margin");
+    m.safety_margin = r.length(root["safety_margin"], "safety_margin");
     if (m.safety_margin < 0.0) r.fail(root["safety_margin"], "safety_margin", "must be >= 0");
   }
   if (root["point_budget"]) {
@@ -247,11 +269,19 @@ Model parseModel(const std::string& yaml_text, const std::string& source) {
 }
 
 Model loadModel(const std::string& path) {
-  std::ifstream in(path);
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw ModelError(path + ": cannot open the model file (no such file)");
+  if (!std::filesystem::is_regular_file(status)) throw ModelError(path + ": not a regular file");
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw ModelError(path + ": cannot open the model file");
+  constexpr std::size_t kMaxBytes = YamlLimits{}.max_bytes;
+  if (std::filesystem::file_size(path, ec) > kMaxBytes)
+    throw ModelError(path + ": larger than " + std::to_string(kMaxBytes >> 20) + " MiB");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  return parseModel(buffer.str(), path);
+  const std::string text = buffer.str();
+  return parseModel(text, path);
 }
 
 }  // namespace kccd

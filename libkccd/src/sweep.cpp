@@ -8,12 +8,34 @@ namespace kccd::detail {
 namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
+constexpr double kPi = 3.141592653589793;
 constexpr double kTwoPi = 6.283185307179586;
 
 // Pieces for a revolute interval of width `width` (capped at a full turn).
 int revolutePieces(double width) {
   if (!(width > 0.0)) return 0;
   return std::max(1, static_cast<int>(std::ceil(std::min(width, kTwoPi) / kMaxPieceAngle - 1e-12)));
+}
+
+// A revolute interval [lo, hi] as an arc of small angles: start in [-pi - 1e-14, pi] and width in
+// [0, 2 pi]. The ends may be any finite doubles (files write +-3.4e38 for "unlimited"): evaluating
+// cos(lo + k * step) directly would lose the step where one ulp of lo is radians. sin and cos of
+// any double are accurate to an ulp, so atan2 gives the start to a few ulps of pi; the width
+// hi - lo is exact or within a relative eps. The arc is widened by both errors, so it contains
+// every angle of the interval.
+struct Arc {
+  double start;
+  double width;
+};
+
+Arc revoluteArc(double lo, double hi) {
+  const double width = hi - lo;  // may be +inf for ends near the double range: a full turn
+  if (!(width < kTwoPi)) return {-kPi, kTwoPi};
+  if (width == 0.0) return {lo, 0.0};  // a single angle: evaluated directly, exactly
+  if (std::abs(lo) <= kTwoPi) return {lo, std::min(kTwoPi, width * (1.0 + 2.0 * kEps) + 4.0 * kEps * kTwoPi)};
+  const double start_error = 16.0 * kEps * kTwoPi;
+  const double start = std::atan2(std::sin(lo), std::cos(lo)) - start_error;
+  return {start, std::min(kTwoPi, width * (1.0 + 2.0 * kEps) + 2.0 * start_error)};
 }
 
 double maxNorm(std::span<const Vec3> pts) {
@@ -32,7 +54,9 @@ double maxNorm(std::span<const Vec3> pts) {
 int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in, Vec3* out, double& radius,
                   int budget, SweepWork work) {
   const Vec3& a = j.axis;
-  const double width = std::min(hi - lo, kTwoPi);
+  const Arc arc = revoluteArc(lo, hi);
+  lo = arc.start;
+  const double width = arc.width;
   const int pieces = revolutePieces(width);
   const int n_in = static_cast<int>(in.size());
   // Points are written straight into the parent frame: with A = R_o axial + t, B = R_o radial and
@@ -135,22 +159,29 @@ struct Box3 {
 
 Box3 box3(const Joint& joint, const double* lo, const double* hi) {
   const Vec3 l(lo[0], lo[1], lo[2]), h(hi[0], hi[1], hi[2]);
-  return {0.5 * (l + h), 0.5 * (h - l).norm() + joint.error};
+  return {0.5 * l + 0.5 * h, 0.5 * (h - l).norm() + joint.error};
 }
 
-// Rotation by a rotation vector (Rodrigues).
-Eigen::Matrix3d rotationFromVector(const Vec3& w) {
-  const double angle = w.norm();
-  if (angle == 0.0) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+// A rotation3d box: the rotation of its centre and the most any rotation in the box differs
+// from it. Every rotation vector in the box lies within |half-diagonal| of the centre, and exp is
+// 1-Lipschitz on SO(3). The centre's angle |c| is itself rounded (by a few ulps of |c|, which is
+// radians for |c| near 1e16), so that error joins the reach; a reach of pi or more allows every
+// rotation and the centre's is not needed.
+struct Rotation3 {
+  Eigen::Matrix3d rot;
+  double reach;
+};
+
+Rotation3 rotation3(const Box3& box) {
+  const double angle = box.centre.stableNorm();
+  const double reach = box.reach + 8.0 * kEps * angle;
+  if (!(reach < kPi)) return {Eigen::Matrix3d::Identity(), kPi};
+  if (angle == 0.0) return {Eigen::Matrix3d::Identity(), reach};
+  return {Eigen::AngleAxisd(angle, box.centre / angle).toRotationMatrix(), reach};
 }
 
-// Every rotation vector in the box lies within |half-diagonal| of its centre, and exp is
-// 1-Lipschitz on SO(3): the rotation differs from the centre's by at most box.reach radians, which
-// moves a point p by at most the returned factor times |p| (2 sin(angle / 2), 2 beyond pi).
-double rotationChord(const Box3& box) {
-  return box.reach >= 3.141592653589793 ? 2.0 : 2.0 * std::sin(0.5 * box.reach);
-}
+// A rotation by at most `reach` radians moves a point p by at most the returned factor times |p|.
+double rotationChord(double reach) { return reach >= kPi ? 2.0 : 2.0 * std::sin(0.5 * reach); }
 
 }  // namespace
 
@@ -191,10 +222,9 @@ int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span
     case JointType::Rotation3d: {
       // Rotate by the box centre; every other rotation in the box moves a point by at most
       // rotationChord() |p|.
-      const Box3 box = box3(joint, lo, hi);
-      const Eigen::Matrix3d rot = rotationFromVector(box.centre);
-      for (const Vec3& p : in) out[n++] = rot * p;
-      radius += rotationChord(box) * in_norm * (1.0 + 4.0 * kEps) + 16.0 * kEps * in_norm;
+      const Rotation3 r3 = rotation3(box3(joint, lo, hi));
+      for (const Vec3& p : in) out[n++] = r3.rot * p;
+      radius += rotationChord(r3.reach) * in_norm * (1.0 + 4.0 * kEps) + 16.0 * kEps * in_norm;
       break;
     }
   }
@@ -256,12 +286,13 @@ Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const
       const Vec3 axial = a.dot(c) * a;
       const Vec3 radial = c - axial;
       const double rho = radial.norm();
-      const double width = hi[0] - lo[0];
-      if (width >= 3.141592653589793) {
+      const Arc arc = revoluteArc(lo[0], hi[0]);
+      const double width = arc.width;
+      if (width >= kPi) {
         out.center = axial;
         out.radius += rho;
       } else {
-        const double mid = lo[0] + 0.5 * width;
+        const double mid = arc.start + 0.5 * width;
         out.center = axial + std::cos(0.5 * width) * (std::cos(mid) * radial + std::sin(mid) * a.cross(radial));
         out.radius += rho * std::sin(0.5 * width);
       }
@@ -279,9 +310,9 @@ Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const
       break;
     }
     case JointType::Rotation3d: {
-      const Box3 box = box3(joint, lo, hi);
-      out.center = rotationFromVector(box.centre) * c;
-      out.radius += rotationChord(box) * c.norm() * (1.0 + 4.0 * kEps) + 16.0 * kEps * c.norm();
+      const Rotation3 r3 = rotation3(box3(joint, lo, hi));
+      out.center = r3.rot * c;
+      out.radius += rotationChord(r3.reach) * c.norm() * (1.0 + 4.0 * kEps) + 16.0 * kEps * c.norm();
       break;
     }
   }

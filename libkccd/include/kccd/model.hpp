@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "kccd/input_error.hpp"
 #include "kccd/ssch.hpp"
 
 namespace kccd {
@@ -52,10 +53,14 @@ struct BodyPair {
 };
 
 /// A model file that cannot be loaded: the message names file, line and field.
-class ModelError : public std::runtime_error {
+class ModelError : public InputError {
  public:
-  using std::runtime_error::runtime_error;
+  using InputError::InputError;
 };
+
+/// Largest absolute length a model file may give (points, radii, origins, margins, error bounds):
+/// metres, far beyond any robot cell, and small enough that squares and sums stay exact to ~1e-7 m.
+inline constexpr double kMaxModelLength = 1e6;
 
 /// The immutable model. Build it with loadModel() / parseModel() or assemble it and call
 /// finalize(); a Checker then holds every mutable buffer.
@@ -90,7 +95,8 @@ class Model {
   std::vector<std::string> state_names_;
 };
 
-/// Loads a `kccd: 1` YAML model file. Throws ModelError("file:line:col: field: problem").
+/// Loads a `kccd: 1` YAML model file: exactly one YAML document, no repeated key, lengths within
+/// kMaxModelLength, any finite angle. Throws ModelError("file:line:col: field: problem").
 Model loadModel(const std::string& path);
 /// Parses YAML text; `source` names it in error messages.
 Model parseModel(const std::string& yaml_text, const std::string& source);

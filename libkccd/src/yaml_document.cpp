@@ -1,0 +1,138 @@
+// One YAML document, unique plain keys, bounded nesting: checked on the parser's event stream.
+#include "kccd/yaml_document.hpp"
+
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/exceptions.h>
+#include <yaml-cpp/parser.h>
+
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "kccd/input_error.hpp"
+
+namespace kccd {
+namespace {
+
+class Checker final : public YAML::EventHandler {
+ public:
+  Checker(const std::string& source, const YamlLimits& limits) : source_(source), limits_(limits) {}
+
+  void OnDocumentStart(const YAML::Mark& mark) override {
+    if (++documents_ > 1) fail(mark, "document", "a second YAML document ('---' or '...' followed by more): the file must hold exactly one");
+  }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { leaf(mark, "~", true); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { leaf(mark, "", false); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string& value) override {
+    leaf(mark, value, true);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    open(mark, false);
+  }
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    open(mark, true);
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapEnd() override { close(); }
+
+ private:
+  struct Frame {
+    bool map = false;
+    bool expect_key = true;  // maps: the next node is a key
+    std::size_t index = 0;   // sequences: index of the next item
+    std::string key;         // maps: the key of the value being read
+    std::set<std::string> keys;
+  };
+
+  [[noreturn]] void fail(const YAML::Mark& mark, const std::string& field, const std::string& problem) const {
+    std::ostringstream msg;
+    msg << source_;
+    if (mark.line >= 0) msg << ':' << mark.line + 1 << ':' << mark.column + 1;
+    msg << ": " << (field.empty() ? std::string("document") : field) << ": " << problem;
+    throw InputError(msg.str());
+  }
+
+  std::string path() const {
+    std::string p;
+    for (std::size_t i = 0; i < stack_.size(); ++i) {
+      const Frame& f = stack_[i];
+      if (f.map) {
+        if (f.expect_key) break;  // no key read yet
+        if (!p.empty()) p += '.';
+        p += printable(f.key, 40);
+      } else {
+        p += '[' + std::to_string(f.index) + ']';
+      }
+    }
+    return p;
+  }
+
+  // A node that is a key of the innermost mapping is checked here; returns true when it was one.
+  bool key(const YAML::Mark& mark, const std::string& value, bool plain) {
+    if (stack_.empty() || !stack_.back().map || !stack_.back().expect_key) return false;
+    Frame& f = stack_.back();
+    if (!plain) fail(mark, path(), "a mapping key must be a plain value (no alias, list or mapping)");
+    if (!f.keys.insert(value).second) {
+      f.key = value;
+      f.expect_key = false;
+      fail(mark, path(), "duplicate key '" + printable(value, 40) + "' (YAML keys are unique: which value was meant?)");
+    }
+    f.key = value;
+    f.expect_key = false;
+    return true;
+  }
+
+  // A value (or sequence item) has been read completely.
+  void done() {
+    if (stack_.empty()) return;
+    Frame& f = stack_.back();
+    if (f.map) f.expect_key = true;
+    else ++f.index;
+  }
+
+  void leaf(const YAML::Mark& mark, const std::string& value, bool plain) {
+    if (!key(mark, value, plain)) done();
+  }
+
+  void open(const YAML::Mark& mark, bool map) {
+    key(mark, "", false);  // a list or mapping as a key fails there
+    if (static_cast<int>(stack_.size()) >= limits_.max_depth)
+      fail(mark, path(), "nested deeper than " + std::to_string(limits_.max_depth) + " levels");
+    Frame f;
+    f.map = map;
+    stack_.push_back(std::move(f));
+  }
+
+  void close() {
+    if (!stack_.empty()) stack_.pop_back();
+    done();
+  }
+
+  const std::string& source_;
+  const YamlLimits& limits_;
+  int documents_ = 0;
+  std::vector<Frame> stack_;
+};
+
+}  // namespace
+
+void checkYamlDocument(std::string_view text, const std::string& source, const YamlLimits& limits) {
+  if (text.size() > limits.max_bytes)
+    throw InputError(source + ": file: larger than " + std::to_string(limits.max_bytes >> 20) + " MiB");
+  std::istringstream in{std::string(text)};
+  Checker checker(source, limits);
+  try {
+    YAML::Parser parser(in);
+    while (parser.HandleNextDocument(checker)) {
+    }
+  } catch (const YAML::Exception& e) {
+    std::ostringstream msg;
+    msg << source;
+    if (e.mark.line >= 0) msg << ':' << e.mark.line + 1 << ':' << e.mark.column + 1;
+    msg << ": YAML syntax error: " << printable(e.msg, 120);
+    throw InputError(msg.str());
+  }
+}
+
+}  // namespace kccd
