@@ -10,6 +10,8 @@ packages=(
   libcoin-dev inventor-data liburdfdom-dev
   libosmesa6-dev libgl-dev libopencv-dev libtinyxml2-dev
 )
+# --fuzz: also the compiler and runtime of the libFuzzer targets (scripts/fuzz.sh).
+[ "${1:-}" = "--fuzz" ] && packages+=(clang-14 libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

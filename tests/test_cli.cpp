@@ -1,8 +1,10 @@
 // End-to-end: the kccd program as scripts use it (JSON contract, exit codes, one-line errors).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -163,6 +165,79 @@ TEST(Cli, FitJsonContractAndErrors) {
   EXPECT_NE(e.err.find("/nonexistent/part.iv: cannot open the file"), std::string::npos) << e.err;
 }
 
+// Every option error, whatever the parser finds, is one line starting "kccd: " and exit 2.
+TEST(Cli, OptionErrorsFollowTheOneLineContract) {
+  struct Case {
+    std::string args;
+    std::string text;
+  };
+  const std::vector<Case> cases = {
+      {"query " + kDemo + " --state 0,0,0 --n 0", "--n: expected a whole number from 1 to 1000000, got '0'"},
+      {"query " + kDemo + " --state 0,0,0 --n abc", "--n: expected a whole number"},
+      {"query " + kDemo + " --state 0,0,0 --bogus", "unknown option or extra argument: --bogus"},
+      {"query", "model is required"},
+      {"frobnicate", "unknown subcommand 'frobnicate'"},
+      {"query " + kDemo + " --state=", "--state: needs a value"},
+      {"query " + kDemo + " --state 0,0,0 --margin nan", "--margin: must be a finite number, got 'nan'"},
+      {"query " + kDemo + " --state 0,0,0 --budget-us nan", "--budget-us: must be a finite number"},
+      {"query " + kDemo + " --state 0,0,0 --budget-us 9.2e15", "--budget-us: must be in [0, 1e+12]"},
+      {"query " + kDemo + " --state 0,0,0 --margin -1", "--margin: must be in [0, 1e+06]"},
+      {"pairs " + kDemo + " --max-boxes 0", "--max-boxes: expected a whole number"},
+      {"query " + kDemo + " --state \"$(printf '0,\\033[31m,0')\"", "\\x1b[31m"},
+  };
+  for (const Case& c : cases) {
+    const Outcome r = runKccd(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << " -> " << r.err;
+    EXPECT_EQ(r.err.rfind("kccd: ", 0), 0u) << c.args << " -> " << r.err;
+    EXPECT_NE(r.err.find(c.text), std::string::npos) << c.args << " -> " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << " -> " << r.err;
+    EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << c.args << ": raw escape byte echoed";
+    EXPECT_LT(r.err.size(), 300u) << c.args << " -> " << r.err;  // no 309-digit numbers
+  }
+  for (const char* ok : {"--help", "--version", "query --help"}) EXPECT_EQ(runKccd(ok).code, 0) << ok;
+}
+
+// Huge but finite inputs the loader accepts never turn a colliding box into "clear".
+TEST(Cli, HugeAnglesAndAxesStaySafe) {
+  const std::string model = ::testing::TempDir() + "/huge_angles.yaml";
+  for (const char* axis : {"[0, 0, 1]", "[1e200, 1e200, 0]"}) {
+    {
+      std::ofstream f(model);
+      f << "kccd: 1\nsafety_margin: 0.02\njoints: [{name: r, parent: world, type: revolute, axis: " << axis
+        << ", limits: [-2e16, 2e16]}]\nbodies:\n  - {name: b, frame: world, points: [[1, 0, 0]], radius: 0.1}\n"
+        << "  - {name: c, frame: r, points: [[0, 1.1, 0]], radius: 0.1}\n";
+    }
+    for (const char* box : {"--lower=-1e17 --upper=1e17", "--lower=1e17 --upper=1.00000000001e17",
+                            "--lower=-3.4e38 --upper=3.4e38"}) {
+      const Outcome r = runKccd("query " + model + " " + box + " --json");
+      ASSERT_EQ(r.code, 0) << r.err;
+      EXPECT_TRUE(nlohmann::json::parse(r.out)["collision"].get<bool>()) << axis << " " << box << ": " << r.out;
+    }
+    const Outcome p = runKccd("pairs " + model + " --json -q");
+    ASSERT_EQ(p.code, 0) << p.err;
+    const auto proofs = nlohmann::json::parse(p.out);
+    for (const auto& pair : proofs["pairs"]) EXPECT_NE(pair["verdict"], "never") << p.out;
+  }
+}
+
+// A model with only fixed joints (no state values) is queried with no values at all.
+TEST(Cli, ModelWithoutStateValuesCanBeQueried) {
+  const std::string model = ::testing::TempDir() + "/fixed_only.yaml";
+  {
+    std::ofstream f(model);
+    f << "kccd: 1\njoints: [{name: f, parent: world, type: fixed, origin: {xyz: [1, 0, 0]}}]\nbodies:\n"
+         "  - {name: a, frame: world, points: [[0, 0, 0]], radius: 0.1}\n"
+         "  - {name: b, frame: f, points: [[0, 0, 0]], radius: 0.1}\n";
+  }
+  for (const char* args : {""}) {
+    const Outcome r = runKccd("query " + model + args + " --type closest --json");
+    ASSERT_EQ(r.code, 0) << args << ": " << r.err;
+    EXPECT_NEAR(nlohmann::json::parse(r.out)["min_distance"].get<double>(), 0.8, 1e-9);
+  }
+  EXPECT_EQ(runKccd("query " + model + " --state 1").code, 2);
+  EXPECT_EQ(runKccd("query " + model + " --state=").code, 2);  // CLI11 wants a value after '='; omit --state
+}
+
 TEST(Cli, FitWritesIntoAModel) {
   const std::string model = scratchCopy(kDemo, "fit_model.yaml");
   const Outcome r = runKccd("fit " + kModels + "simple/cone.iv --points 4 -q --model " + model + " --body forearm");
@@ -179,6 +254,38 @@ TEST(Cli, FitWritesIntoAModel) {
   const Outcome bad = runKccd("fit " + kModels + "simple/cone.iv -q --model " + model + " --body nobody");
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("no body named 'nobody'"), std::string::npos) << bad.err;
+}
+
+// Edits of one model by concurrent runs all land (a lock serialises them); a symbolic link stays
+// a link, the file keeps its mode, and no temporary file is left behind.
+TEST(Cli, ConcurrentEditsOfOneModelAreNotLost) {
+  const std::string dir = ::testing::TempDir() + "/concurrent_edit";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string real = dir + "/real.yaml", link = dir + "/link.yaml";
+  std::filesystem::copy_file(kDemo, real);
+  std::filesystem::permissions(real, std::filesystem::perms(0640));
+  std::filesystem::create_symlink("real.yaml", link);
+  const std::vector<std::string> bodies = {"upper_arm", "forearm", "post", "table", "gripper"};
+  std::string script;
+  for (const std::string& b : bodies)
+    script += std::string(KCCD_CLI) + " fit " + kModels + "simple/cone.iv --points 3 --evaluations 300 -q --model " +
+              link + " --body " + b + " >/dev/null & ";
+  script += "wait";
+  ASSERT_EQ(kccd::testing::runProgram(script).code, 0);
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+  EXPECT_EQ(std::filesystem::status(real).permissions() & std::filesystem::perms::all, std::filesystem::perms(0640));
+  const Outcome info = runKccd("info " + real + " --json");
+  ASSERT_EQ(info.code, 0) << info.err;
+  int edited = 0;
+  const auto j = nlohmann::json::parse(info.out);
+  for (const auto& b : j["bodies"])
+    if (std::find(bodies.begin(), bodies.end(), b["name"].get<std::string>()) != bodies.end())
+      edited += b["points"] == 3;
+  EXPECT_EQ(edited, static_cast<int>(bodies.size())) << info.out;  // every edit landed
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++files;
+  EXPECT_EQ(files, 2);
 }
 
 TEST(Cli, PairsProvesAndWrites) {

@@ -1,6 +1,8 @@
 // Model files: what loads, and one clear message (file, line, field) for each kind of mistake.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <string>
 
 #include "kccd/model.hpp"
@@ -132,6 +134,22 @@ TEST(Model, EveryMistakeGetsOneClearMessage) {
       {"pair with itself", edit("ignore: [[arm, tool]]", "ignore: [[arm, arm]]"), {"a body paired with itself"}},
       {"same-frame include", edit("ignore: [[arm, tool]]", "include: [[floor, floor]]"), {"a body paired with itself"}},
       {"bad check", edit("ignore: [[arm, tool]]", "check: some"), {"pairs.check", "expected 'all' or 'none'"}},
+      // The model used must be the model written: YAML's rules, not the first value that fits.
+      {"duplicate key", edit("    radius: 0.1\n", "    radius: 0.1\n    radius: 0.9\n"),
+       {"cell.yaml:29:", "bodies[0].radius", "duplicate key 'radius'"}},
+      {"duplicate key, flow style", edit("{xyz: [0, 0, 0.5],", "{xyz: [0, 0, 0.5], xyz: [1, 1, 1],"),
+       {"cell.yaml:8:32", "joints[0].origin.xyz", "duplicate key 'xyz'"}},
+      {"duplicate version", edit("kccd: 1\n", "kccd: 1\nkccd: 2\n"), {"cell.yaml:2:1", "duplicate key 'kccd'"}},
+      {"second bodies block", kGood + "bodies: []\n", {"cell.yaml:", "duplicate key 'bodies'"}},
+      {"second document", kGood + "---\nkccd: 1\n", {"cell.yaml:", "a second YAML document"}},
+      {"text after the end marker", kGood + "...\nradius: 3\n", {"cell.yaml:", "a second YAML document"}},
+      {"deep nesting", edit("points: [[0, 0, 0]]", "points: " + std::string(100, '[') + std::string(100, ']')),
+       {"cell.yaml:", "nested deeper than 64 levels"}},
+      {"a list as a key", edit("name: t\n", "? [a, b]\n: t\n"), {"cell.yaml:2:", "a mapping key must be a plain value"}},
+      {"length beyond the bound", edit("radius: 0.1", "radius: 2e6"), {"body 'floor'.radius", "largest length"}},
+      {"coordinate beyond the bound", edit("points: [[0, 0, 0], [1, 0, 0]]", "points: [[0, 0, 0], [1e7, 0, 0]]"),
+       {"body 'arm'.points[1][0]", "largest length"}},
+      {"control byte in a name", edit("name: tool", "name: \"to\\x1bol\""), {"control character", "to\\x1bol"}},
   };
   for (const BadCase& c : cases) {
     const std::string msg = loadError(c.text);
@@ -139,6 +157,26 @@ TEST(Model, EveryMistakeGetsOneClearMessage) {
       EXPECT_NE(msg.find(part), std::string::npos) << c.what << ": '" << part << "' not in: " << msg;
     EXPECT_EQ(std::count(msg.begin(), msg.end(), '\n'), 0) << c.what << ": one line only";
   }
+}
+
+TEST(Model, AxesOfAnyScaleNormalise) {
+  for (const char* axis : {"[0, 0, 1e-150]", "[0, 0, 1e200]", "[1e-300, 0, 3e-300]", "[1.5e308, 0, 1.5e308]"}) {
+    const Model m = parseModel(edit("axis: [0, 0, 2]", std::string("axis: ") + axis), "cell.yaml");
+    EXPECT_NEAR(m.joints[0].axis.norm(), 1.0, 1e-15) << axis;
+  }
+  EXPECT_NEAR(parseModel(edit("axis: [0, 0, 2]", "axis: [1e200, 1e200, 0]"), "c").joints[0].axis.x(), std::sqrt(0.5), 1e-15);
+  // Angles of any finite size are angles: limits as exporters write "unlimited".
+  EXPECT_NO_THROW(parseModel(edit("limits: [-1, 1]", "limits: [-3.4e38, 3.4e38]"), "cell.yaml"));
+}
+
+TEST(Model, NotARegularFileIsRefused) {
+  try {
+    loadModel("/dev/zero");  // would never end
+    FAIL() << "loaded /dev/zero";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/zero: not a regular file"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(loadModel(::testing::TempDir()), ModelError);
 }
 
 TEST(Model, MissingFileNamesThePath) {

@@ -327,9 +327,11 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   }
   std::sort(order_.begin(), sorted_end, by_bound);
 
-  const bool timed = options.budget_us > 0.0;
+  // Budgets beyond kMaxBudgetUs (and NaN) mean unlimited: converting them to clock ticks would overflow.
+  const bool timed = options.budget_us > 0.0 && options.budget_us <= kMaxBudgetUs;
   const Clock::time_point deadline =
-      start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::micro>(options.budget_us));
+      start + (timed ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::micro>(options.budget_us))
+                     : Clock::duration::zero());
   auto expired = [&]() {
     if ((options.max_pairs >= 0 && result_.stats.pairs_checked >= options.max_pairs) ||
         (timed && Clock::now() > deadline)) {

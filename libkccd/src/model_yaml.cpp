@@ -221,7 +221,11 @@ std::vector<std::array<int, 2>> parsePairList(const Reader& r, const YAML::Node&
 
 Model parseModel(const std::string& yaml_text, const std::string& source) {
   const Reader r(source);
-  checkYamlDocument(yaml_text, source);  // one document, unique keys, bounded nesting
+  try {
+    checkYamlDocument(yaml_text, source);  // one document, unique keys, bounded nesting
+  } catch (const InputError& e) {
+    throw ModelError(e.what());
+  }
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -268,7 +272,7 @@ Model parseModel(const std::string& yaml_text, const std::string& source) {
   return m;
 }
 
-Model loadModel(const std::string& path) {
+std::string readModelText(const std::string& path) {
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(status)) throw ModelError(path + ": cannot open the model file (no such file)");
@@ -280,8 +284,9 @@ Model loadModel(const std::string& path) {
     throw ModelError(path + ": larger than " + std::to_string(kMaxBytes >> 20) + " MiB");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  const std::string text = buffer.str();
-  return parseModel(text, path);
+  return buffer.str();
 }
+
+Model loadModel(const std::string& path) { return parseModel(readModelText(path), path); }
 
 }  // namespace kccd

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "kccd/model.hpp"
@@ -17,6 +18,15 @@ class UsageError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+/// `text` as one printable line (control bytes escaped, line breaks as spaces), for messages.
+std::string oneLine(const std::string& text);
+
+/// A command-line parser message made readable: one line, huge bounds (DBL_MAX) written short.
+std::string optionMessage(const std::string& text);
+
+/// An option validator: a finite number in [lo, hi] (NaN and infinities are refused).
+CLI::Validator finiteIn(double lo, double hi);
 
 /// Parses "a,b,c" into numbers; `option` names the flag in error messages.
 std::vector<double> parseList(const std::string& text, const std::string& option);
@@ -38,8 +48,9 @@ void checkCorePoints(int k);
 nlohmann::json number(double value);
 nlohmann::json vec3(const Vec3& v);
 
-/// Loads a model, turning every failure into one line on stderr (throws UsageError).
-Model loadOrExplain(const std::string& path);
+/// Loads a model, turning every failure into one line on stderr (throws UsageError); with `text`,
+/// also returns the file's text as it was read.
+Model loadOrExplain(const std::string& path, std::string* text = nullptr);
 
 }  // namespace kccd::cli
 
@@ -63,13 +74,18 @@ class Progress {
   double last_time_ = 0.0;
 };
 
-/// Writes `text` to `path` through a temporary file and a rename: readers never see a partial
-/// file. Throws UsageError naming the path.
+/// Writes `text` to `path` through a new uniquely named file in the same folder and a rename:
+/// readers never see a partial file. A symbolic link stays a link (its target is replaced) and an
+/// existing file keeps its mode. Throws UsageError naming the path.
 void writeFileAtomically(const std::string& path, const std::string& text);
 
-/// Replaces the text of the file at `path` by `edit(text)`, atomically; a std::runtime_error from
-/// `edit` or a failed read or write becomes a UsageError naming the file, and the file stays as it was.
-void editFile(const std::string& path, const std::function<std::string(const std::string&)>& edit);
+/// Replaces the text of the file at `path` by `edit(text)`, atomically, holding an exclusive lock
+/// (flock) on the file from the read to the rename, so concurrent edits of one file apply one after
+/// the other and none is lost. With `expected`, the edit is refused when the file no longer holds
+/// that text. A std::runtime_error from `edit` or a failed read or write becomes a UsageError
+/// naming the file, and the file stays as it was.
+void editFile(const std::string& path, const std::function<std::string(const std::string&)>& edit,
+              const std::string* expected = nullptr);
 
 /// Prints a number with `digits` significant digits (nearest).
 std::string format(double value, int digits = 10);

@@ -106,7 +106,7 @@ Runner addFit(CLI::App& app) {
   sub->add_option("--body", args->body, "Body of --model whose points and radius are replaced");
   sub->add_option("--evaluations", args->evaluations, "Optimiser budget per start (volume evaluations; three starts are refined)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 10000000));
   sub->add_flag("--json", args->json, "Machine-readable output");
   sub->add_flag("--quiet,-q", args->quiet, "No progress display");
   sub->footer(

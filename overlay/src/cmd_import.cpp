@@ -61,7 +61,7 @@ Runner addImport(CLI::App& app) {
   sub->add_option("--points,-k", args->points, "Core points per link (1 ... 16)")->capture_default_str();
   sub->add_option("--margin", args->margin, "safety_margin written into the model (metres)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteIn(0.0, kMaxModelLength));
   sub->add_option("--package-path", args->packages, "Resolves package://NAME/... meshes: NAME=DIR (repeatable)");
   sub->add_option("-o,--output", args->output, "Model file to write (default: standard output)");
   sub->add_flag("--quiet,-q", args->quiet, "No progress display");

@@ -19,12 +19,16 @@ struct PairsArgs {
   bool write = false, json = false, quiet = false, all = false;
 };
 
-void writeIgnoreList(const std::string& model, const std::vector<std::array<std::string, 2>>& ignore) {
-  editFile(model, [&](const std::string& text) { return modelling::withIgnoreList(text, model, ignore); });
+// The proofs hold for the model as it was read: the list is written only into that same text.
+void writeIgnoreList(const std::string& model, const std::string& proven_text,
+                     const std::vector<std::array<std::string, 2>>& ignore) {
+  editFile(model, [&](const std::string& text) { return modelling::withIgnoreList(text, model, ignore); },
+           &proven_text);
 }
 
 int runPairs(const PairsArgs& args) {
-  const Model m = loadOrExplain(args.model);
+  std::string model_text;
+  const Model m = loadOrExplain(args.model, &model_text);
   std::vector<modelling::PairReport> reports;
   {
     Progress progress("proving pairs", args.quiet || args.json);
@@ -58,7 +62,7 @@ int runPairs(const PairsArgs& args) {
     }
     j["ignore"] = ignore;
     if (args.write) j["written"] = args.model;
-    if (args.write) writeIgnoreList(args.model, ignore);
+    if (args.write) writeIgnoreList(args.model, model_text, ignore);
     std::cout << j.dump(2) << "\n";
     return 0;
   }
@@ -88,7 +92,7 @@ int runPairs(const PairsArgs& args) {
             << " undecided, " << counts[4] << " unbounded" << (args.all ? "" : " (pairs that meet: --all lists them)")
             << "\n";
   if (args.write) {
-    writeIgnoreList(args.model, ignore);
+    writeIgnoreList(args.model, model_text, ignore);
     std::cout << "wrote " << ignore.size() << " pairs to pairs: ignore in " << args.model << "\n";
   } else {
     std::cout << "suggested:\npairs:\n  ignore: " << modelling::flowPairs(ignore, 11) << "\n";
@@ -106,10 +110,10 @@ Runner addPairs(CLI::App& app) {
       "engine's conservative sweeps, split until proven), and finds adjacent pairs that always touch");
   sub->add_option("model", args->model, "Model file (YAML, kccd: 1)")->required();
   sub->add_option("--margin", args->margin, "Safety margin in metres (default: the model's)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteIn(0.0, kMaxModelLength));
   sub->add_option("--max-boxes", args->max_boxes, "Box budget per pair before giving up (undecided)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 100000000));
   sub->add_flag("--write", args->write,
                 "Write the ignore list (proven + always touching + already ignored) into the model, in place");
   sub->add_flag("--all", args->all, "Also list the pairs that meet");

@@ -100,11 +100,11 @@ Runner addQuery(CLI::App& app) {
   sub->add_option("--state", args->state, "A single configuration (zero-width interval)");
   sub->add_option("--type", args->type, "collision | closest | distances | nclosest (cheapest first)")
       ->capture_default_str();
-  sub->add_option("--n", args->n, "Number of pairs for --type nclosest")->capture_default_str()->check(CLI::PositiveNumber);
+  sub->add_option("--n", args->n, "Number of pairs for --type nclosest")->capture_default_str()->check(CLI::Range(1, 1000000));
   sub->add_option("--margin", args->margin, "Safety margin in metres (default: the model's)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteIn(0.0, kMaxModelLength));
   sub->add_option("--budget-us", args->budget_us, "Time budget in microseconds (default: unlimited)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteIn(0.0, kMaxBudgetUs));
   sub->add_flag("--json", args->json, "Machine-readable output");
   sub->footer("Exit status: 0 answered (collision or not), 2 bad input, 3 unsafe query status.");
   return [args] { return runQuery(*args); };

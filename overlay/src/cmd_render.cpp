@@ -144,7 +144,7 @@ Runner addRender(CLI::App& app) {
   sub->add_flag("--no-legend", args->no_legend, "No colour legend");
   sub->add_option("--supersample", args->supersample, "Render the pinhole image this many times larger (1..4)")
       ->capture_default_str()
-      ->check(CLI::Range(1.0, 4.0));
+      ->check(finiteIn(1.0, 4.0));
   sub->add_flag("--json", args->json, "Machine-readable summary");
   sub->footer("Colours: green clear, amber within the safety margin, red colliding.\n"
               "Exit status: 0 written, 2 bad input, 3 unsafe query status (image still written).");

@@ -22,19 +22,38 @@ int main(int argc, char** argv) {
   add(kccd::cli::addPairs);
   add(kccd::cli::addImport);
   add(kccd::cli::addRender);
+  if (argc > 1 && argv[1][0] != '-') {  // CLI11 would only say that a subcommand is required
+    std::string names;
+    bool known = false;
+    for (const auto& [sub, run] : commands) {
+      known = known || sub->get_name() == argv[1];
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      std::cerr << "kccd: unknown subcommand '" << kccd::printable(argv[1], 40) << "' (" << names << ")\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::Success& e) {  // --help, --version: printed, exit 0
     return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    const std::string help = argc > 1 && argv[1][0] != '-' ? std::string("kccd ") + argv[1] + " --help" : "kccd --help";
+    std::cerr << "kccd: " << kccd::cli::optionMessage(e.what()) << " (see " << help << ")\n";
+    return 2;
   }
   try {
     for (auto& [sub, run] : commands)
       if (sub->parsed()) return run();
   } catch (const kccd::cli::UsageError& e) {
-    std::cerr << "kccd: " << e.what() << "\n";
+    std::cerr << "kccd: " << kccd::cli::oneLine(e.what()) << "\n";
+    return 2;
+  } catch (const kccd::InputError& e) {
+    std::cerr << "kccd: " << kccd::cli::oneLine(e.what()) << "\n";
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "kccd: error: " << e.what() << "\n";
+    std::cerr << "kccd: internal error: " << kccd::cli::oneLine(e.what()) << "\n";
     return 1;
   }
   return 0;

@@ -13,19 +13,23 @@ using LVec = Eigen::Matrix<long double, 3, 1>;
 using LMat = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
 using LVecX = Eigen::Matrix<long double, Eigen::Dynamic, 1>;
 
-// Affine minimiser of |sum alpha_i q_i| with sum alpha_i = 1 (KKT system, full-pivot LU).
+// Affine minimiser of |sum alpha_i q_i| with sum alpha_i = 1: with D = [q_1 - q_0, ...] the
+// least-squares solution of D mu = -q_0 (column-pivoting QR, which does not square the condition
+// number the way the normal equations would: thin corrals far from the origin stay accurate).
 LVecX affineMinimizer(const std::vector<LVec>& s) {
   const int n = static_cast<int>(s.size());
-  LMat k = LMat::Zero(n + 1, n + 1);
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) k(i, j) = s[i].dot(s[j]);
-    k(i, n) = 1.0L;
-    k(n, i) = 1.0L;
+  LVecX alpha(n);
+  if (n == 1) {
+    alpha(0) = 1.0L;
+    return alpha;
   }
-  LVecX rhs = LVecX::Zero(n + 1);
-  rhs(n) = 1.0L;
-  const LVecX sol = k.fullPivLu().solve(rhs);
-  return sol.head(n);
+  LMat d(3, n - 1);
+  for (int i = 1; i < n; ++i) d.col(i - 1) = s[i] - s[0];
+  const LVecX rhs = -s[0];
+  const LVecX mu = d.colPivHouseholderQr().solve(rhs);
+  alpha(0) = 1.0L - mu.sum();
+  alpha.tail(n - 1) = mu;
+  return alpha;
 }
 
 // Wolfe (1976): minimum-norm point of conv(q).

@@ -30,11 +30,15 @@ enum class QueryType : std::uint8_t {
 };
 const char* toString(QueryType type);
 
+/// The largest time budget a query honours (about 11.6 days, in microseconds); larger is unlimited.
+inline constexpr double kMaxBudgetUs = 1e12;
+
+/// What a query asks and how long it may take.
 struct QueryOptions {
   QueryType type = QueryType::Collision;
   int n = 1;               ///< for NClosest
-  double margin = -1.0;    ///< distances <= margin count as collision; < 0: the model's margin
-  double budget_us = 0.0;  ///< time budget in microseconds; <= 0: unlimited
+  double margin = -1.0;    ///< distances <= margin count as collision; < 0 or NaN: the model's margin
+  double budget_us = 0.0;  ///< time budget in microseconds; <= 0, NaN or > kMaxBudgetUs: unlimited
   int max_pairs = -1;      ///< work budget: recompute at most this many pairs; < 0: unlimited
 };
 

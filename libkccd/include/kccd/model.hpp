@@ -98,6 +98,8 @@ class Model {
 /// Loads a `kccd: 1` YAML model file: exactly one YAML document, no repeated key, lengths within
 /// kMaxModelLength, any finite angle. Throws ModelError("file:line:col: field: problem").
 Model loadModel(const std::string& path);
+/// The text of a model file (a regular file of at most 64 MiB). Throws ModelError.
+std::string readModelText(const std::string& path);
 /// Parses YAML text; `source` names it in error messages.
 Model parseModel(const std::string& yaml_text, const std::string& source);
 

@@ -76,7 +76,9 @@ std::vector<std::array<double, 2>> jointRanges(const Model& m) {
     for (int k = 0; k < j.dof; ++k) {
       auto& out = r[j.state_offset + k];
       switch (j.type) {
-        case JointType::Revolute: out = j.limits ? *j.limits : std::array<double, 2>{-kPi, kPi}; break;
+        case JointType::Revolute:  // limits a turn or more apart (files write +-3.4e38) allow every angle
+          out = j.limits && (*j.limits)[1] - (*j.limits)[0] < 2 * kPi ? *j.limits : std::array<double, 2>{-kPi, kPi};
+          break;
         case JointType::Prismatic: out = j.limits ? *j.limits : std::array<double, 2>{nan, nan}; break;
         case JointType::Rotation3d: out = {-kPi, kPi}; break;
         default: out = {nan, nan}; break;
@@ -142,7 +144,7 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
     }
     // Values that do not move the pair sit mid-range (any value would do).
     for (int s = 0; s < m.stateSize(); ++s)
-      lower[s] = upper[s] = std::isnan(ranges[s][0]) ? 0.0 : (ranges[s][0] + ranges[s][1]) / 2;
+      lower[s] = upper[s] = std::isnan(ranges[s][0]) ? 0.0 : 0.5 * ranges[s][0] + 0.5 * ranges[s][1];
     const QueryOptions qopt{.type = QueryType::Distances, .margin = margin};
 
     if (r.adjacent) {
@@ -189,7 +191,7 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
         continue;
       }
       // Not proven here: is the centre a real encounter?
-      for (std::size_t d = 0; d < dims.size(); ++d) lower[dims[d]] = upper[dims[d]] = (box.lo[d] + box.hi[d]) / 2;
+      for (std::size_t d = 0; d < dims.size(); ++d) lower[dims[d]] = upper[dims[d]] = 0.5 * box.lo[d] + 0.5 * box.hi[d];
       const QueryResult& c = checker.query(lower, upper, qopt);
       ++r.boxes;
       if (c.status == Status::Ok) {
@@ -209,7 +211,7 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
       for (std::size_t d = 1; d < dims.size(); ++d)
         if ((box.hi[d] - box.lo[d]) * lever[d] > (box.hi[widest] - box.lo[widest]) * lever[widest]) widest = d;
       Box other = box;
-      const double mid = (box.lo[widest] + box.hi[widest]) / 2;
+      const double mid = 0.5 * box.lo[widest] + 0.5 * box.hi[widest];
       box.hi[widest] = mid;
       other.lo[widest] = mid;
       stack.push_back(std::move(other));

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (clang-14, ASan + UBSan) and runs each for a while on a fresh copy
+# of its seed corpus (tests/fuzz/corpus/NAME plus sample files from data/). Any crash, sanitizer
+# report, leak, time-out or memory blow-up fails the run and leaves the input in build-fuzz/artifacts/.
+#   scripts/fuzz.sh [--seconds N] [TARGET...]     (default: 15 s each, every target)
+# Environment: KCCD_JOBS (default 2).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=15
+targets=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --seconds) seconds=$2; shift 2 ;;
+    --seconds=*) seconds=${1#*=}; shift ;;
+    -*) echo "fuzz.sh: unknown option $1" >&2; exit 2 ;;
+    *) targets+=("$1"); shift ;;
+  esac
+done
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_model fuzz_camera fuzz_part fuzz_urdf)
+bash scripts/install-deps.sh --fuzz
+CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DKCCD_BUILD_FUZZERS=ON -DKCCD_BUILD_TESTS=OFF -DKCCD_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build build-fuzz -j "${KCCD_JOBS:-2}" --target "${targets[@]}"
+
+seeds() {  # extra seed files from data/ per target
+  case "$1" in
+    fuzz_model) ls data/*.yaml | grep -v camera ;;
+    fuzz_camera) ls data/*camera*.yaml ;;
+    fuzz_part) ls data/parts/* ;;
+    fuzz_urdf) ls tests/data/urdf/*.urdf ;;
+  esac
+}
+mkdir -p build-fuzz/artifacts
+status=0
+for t in "${targets[@]}"; do
+  corpus=build-fuzz/corpus/$t
+  rm -rf "$corpus" && mkdir -p "$corpus"
+  [ -d "tests/fuzz/corpus/${t#fuzz_}" ] && cp -r "tests/fuzz/corpus/${t#fuzz_}/." "$corpus/"
+  for f in $(seeds "$t"); do cp "$f" "$corpus/"; done
+  echo "== $t: ${seconds} s from $(ls "$corpus" | wc -l) seeds"
+  # An out-of-memory stop under ASan can leave libFuzzer stuck: the outer timeout kills it.
+  if ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 \
+     LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
+     timeout -s KILL $((seconds + 120)) "build-fuzz/tests/fuzz/$t" -max_total_time="$seconds" -timeout=10 \
+       -rss_limit_mb=2048 -malloc_limit_mb=1024 -max_len=65536 -print_final_stats=1 \
+       -artifact_prefix="build-fuzz/artifacts/$t-" "$corpus" > "build-fuzz/$t.log" 2>&1; then
+    grep -E "stat::number_of_executed_units|stat::new_units_added" "build-fuzz/$t.log" | tr '\n' ' '; echo
+  else
+    echo "fuzz.sh: $t FAILED (log: build-fuzz/$t.log, inputs: build-fuzz/artifacts/)"; tail -40 "build-fuzz/$t.log"
+    status=1
+  fi
+done
+exit $status
