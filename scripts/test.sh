@@ -1,18 +1,20 @@
 #!/usr/bin/env bash
 # Builds KCCD and runs the whole test suite: a Release build, then the same tests under
-# AddressSanitizer + UndefinedBehaviorSanitizer. Options:
+# AddressSanitizer + UndefinedBehaviorSanitizer, then every libFuzzer target briefly. Options:
 #   --no-sanitize   skip the sanitizer build
 #   --sanitize-only run only the sanitizer build
+#   --no-fuzz       skip the fuzz targets (scripts/fuzz.sh)
 # Environment: KCCD_JOBS (default 2), KCCD_SOAK=N for a long property-test soak.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 jobs=${KCCD_JOBS:-2}
-release=1 sanitize=1
+release=1 sanitize=1 fuzz=1
 for arg in "$@"; do
   case "$arg" in
     --no-sanitize) sanitize=0 ;;
     --sanitize-only) release=0 ;;
+    --no-fuzz) fuzz=0 ;;
     *) echo "test.sh: unknown option $arg" >&2; exit 2 ;;
   esac
 done
@@ -31,4 +33,8 @@ if [ $sanitize -eq 1 ]; then
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
     run build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKCCD_SANITIZE=ON -DKCCD_BUILD_BENCHMARKS=OFF
+fi
+if [ $fuzz -eq 1 ]; then
+  echo "== libFuzzer targets (${KCCD_FUZZ_SECONDS:-15} s each)"
+  bash scripts/fuzz.sh --seconds "${KCCD_FUZZ_SECONDS:-15}"
 fi
