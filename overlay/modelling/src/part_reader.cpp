@@ -619,9 +619,20 @@ Part readScene(const std::string& data, const std::string& path, const ReadOptio
     } else {
       // Count the top-level parts that hold geometry: several of them is more than one body.
       std::vector<std::string> parts;
+      // Each through a path from the root: top-level nodes to its left set the state it uses
+      // (a Coordinate3 before an IndexedFaceSet).
       for (int i = 0; i < root->getNumChildren(); ++i) {
         Collector probe;
-        run(probe, root->getChild(i), nullptr);
+        SoPath* to_child = new SoPath(root);
+        to_child->ref();
+        to_child->append(i);
+        try {
+          run(probe, nullptr, to_child);
+        } catch (...) {
+          to_child->unref();
+          throw;
+        }
+        to_child->unref();
         if (!probe.part.empty()) parts.push_back(nodeLabel(root->getChild(i), i));
       }
       if (parts.size() > 1 && !options.merge) {
