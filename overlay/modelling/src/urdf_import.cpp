@@ -1,13 +1,17 @@
 #include "kccd/modelling/urdf_import.hpp"
 
+#include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <deque>
 #include <filesystem>
 #include <set>
 #include <sstream>
+#include <mutex>
 #include <numbers>
 #include <stdexcept>
 
+#include <console_bridge/console.h>
 #include <tinyxml2.h>
 #include <urdf_parser/urdf_parser.h>
 
@@ -93,12 +97,167 @@ Part linkPart(const std::string& urdf_path, const urdf::Link& link, const Import
   return part;
 }
 
-void loadXml(tinyxml2::XMLDocument& doc, const std::string& path) {
-  if (doc.LoadFile(path.c_str()) == tinyxml2::XML_SUCCESS) return;
-  if (doc.ErrorID() == tinyxml2::XML_ERROR_FILE_NOT_FOUND || doc.ErrorID() == tinyxml2::XML_ERROR_FILE_COULD_NOT_BE_OPENED)
-    throw std::runtime_error(path + ": cannot open the file");
+void loadXml(tinyxml2::XMLDocument& doc, const std::string& text, const std::string& path) {
+  if (doc.Parse(text.data(), text.size()) == tinyxml2::XML_SUCCESS) return;
   throw std::runtime_error(path + ":" + std::to_string(doc.ErrorLineNum()) + ": malformed XML (" +
                            tinyxml2::XMLDocument::ErrorIDToName(doc.ErrorID()) + ")");
+}
+
+// urdfdom reports through console_bridge, several lines on the console per problem: they are
+// kept here instead, the first error for the one-line message.
+class CaptureLog : public console_bridge::OutputHandler {
+ public:
+  std::string first;
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR && first.empty()) first = printable(text);
+  }
+};
+
+struct UrdfParse {
+  urdf::ModelInterfaceSharedPtr model;
+  std::string error;
+};
+
+UrdfParse parseWithUrdfdom(const std::string& text) {
+  static std::mutex mutex;  // console_bridge's handler is process-wide
+  std::lock_guard<std::mutex> lock(mutex);
+  CaptureLog capture;
+  const console_bridge::LogLevel level = console_bridge::getLogLevel();
+  console_bridge::useOutputHandler(&capture);
+  console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_WARN);
+  UrdfParse result;
+  try {
+    result.model = urdf::parseURDF(text);
+  } catch (...) {
+    console_bridge::restorePreviousOutputHandler();
+    console_bridge::setLogLevel(level);
+    throw;
+  }
+  console_bridge::restorePreviousOutputHandler();
+  console_bridge::setLogLevel(level);
+  result.error = capture.first;
+  return result;
+}
+
+// Where a problem is: "file:line: link 'name': collision N: ".
+struct Place {
+  const std::string& path;
+  std::string what;
+  std::runtime_error error(const tinyxml2::XMLElement* e, const std::string& problem) const {
+    return std::runtime_error(path + ":" + std::to_string(e->GetLineNum()) + ": " + what + problem);
+  }
+};
+
+// The numbers of an attribute, as urdfdom reads them but refusing what it would bend: exactly
+// `count` finite numbers. Missing: `fallback` (empty: required).
+std::vector<double> numbers(const Place& at, const tinyxml2::XMLElement* e, const char* attribute, std::size_t count,
+                            const std::vector<double>& fallback = {}) {
+  const std::string name = std::string(e->Name()) + " " + attribute;
+  const char* text = e->Attribute(attribute);
+  if (!text) {
+    if (fallback.empty()) throw at.error(e, name + ": missing");
+    return fallback;
+  }
+  std::vector<double> out;
+  const std::string s = text;
+  std::size_t i = 0;
+  while (true) {
+    while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
+    if (i == s.size()) break;
+    std::size_t j = i;
+    while (j < s.size() && !std::isspace(static_cast<unsigned char>(s[j]))) ++j;
+    const std::string word = s.substr(i, j - i);
+    double v = 0;
+    const char* begin = word.data() + (word[0] == '+' ? 1 : 0);
+    const auto [end, ec] = std::from_chars(begin, word.data() + word.size(), v);
+    if (ec == std::errc::result_out_of_range || (ec == std::errc() && end == word.data() + word.size() && !std::isfinite(v)))
+      throw at.error(e, name + ": '" + printable(word) + "' is not a finite number");
+    if (ec != std::errc() || end != word.data() + word.size())
+      throw at.error(e, name + ": '" + printable(word) + "' is not a number");
+    out.push_back(v);
+    i = j;
+  }
+  if (out.size() != count)
+    throw at.error(e, name + ": " + std::to_string(out.size()) + " numbers, expected " + std::to_string(count));
+  return out;
+}
+
+void checkOrigin(const Place& at, const tinyxml2::XMLElement* parent) {
+  if (const tinyxml2::XMLElement* o = parent->FirstChildElement("origin")) {
+    numbers(at, o, "xyz", 3, {0, 0, 0});
+    numbers(at, o, "rpy", 3, {0, 0, 0});
+  }
+}
+
+void nonNegative(const Place& at, const tinyxml2::XMLElement* e, const char* attribute, const std::vector<double>& v) {
+  for (const double x : v)
+    if (x < 0)
+      throw at.error(e, std::string(e->Name()) + " " + attribute + ": " + num(x) + " is negative");
+}
+
+// Every <collision> of every link checked as the fit reads it; returns the number per link.
+std::map<std::string, int> checkCollisions(const tinyxml2::XMLDocument& doc, const std::string& path) {
+  std::map<std::string, int> counts;
+  const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
+  if (!robot) return counts;  // urdfdom names the problem
+  for (const tinyxml2::XMLElement* link = robot->FirstChildElement("link"); link;
+       link = link->NextSiblingElement("link")) {
+    const char* name = link->Attribute("name");
+    const std::string link_name = name ? name : "";
+    int index = 0;
+    for (const tinyxml2::XMLElement* c = link->FirstChildElement("collision"); c;
+         c = c->NextSiblingElement("collision")) {
+      const Place at{path, "link '" + printable(link_name) + "': collision " + std::to_string(++index) + ": "};
+      checkOrigin(at, c);
+      const tinyxml2::XMLElement* geometry = c->FirstChildElement("geometry");
+      if (!geometry) throw at.error(c, "no <geometry>");
+      const tinyxml2::XMLElement* shape = geometry->FirstChildElement();
+      if (!shape) throw at.error(geometry, "<geometry> holds no shape");
+      if (shape->NextSiblingElement())
+        throw at.error(shape->NextSiblingElement(), "<geometry> holds more than one shape");
+      const std::string type = shape->Name();
+      if (type == "box") {
+        nonNegative(at, shape, "size", numbers(at, shape, "size", 3));
+      } else if (type == "sphere") {
+        nonNegative(at, shape, "radius", numbers(at, shape, "radius", 1));
+      } else if (type == "cylinder") {
+        nonNegative(at, shape, "radius", numbers(at, shape, "radius", 1));
+        nonNegative(at, shape, "length", numbers(at, shape, "length", 1));
+      } else if (type == "mesh") {
+        const char* file = shape->Attribute("filename");
+        if (!file || !*file) throw at.error(shape, "mesh filename: missing");
+        for (const double x : numbers(at, shape, "scale", 3, {1, 1, 1}))
+          if (x == 0) throw at.error(shape, "mesh scale: a factor of 0 flattens the mesh");
+      } else {
+        throw at.error(shape, "<" + printable(type) + ">: not a URDF shape (box, cylinder, sphere, mesh)");
+      }
+    }
+    counts[link_name] += index;
+  }
+  for (const tinyxml2::XMLElement* joint = robot->FirstChildElement("joint"); joint;
+       joint = joint->NextSiblingElement("joint")) {
+    const char* name = joint->Attribute("name");
+    const Place at{path, "joint '" + printable(name ? name : "") + "': "};
+    checkOrigin(at, joint);
+    if (const tinyxml2::XMLElement* axis = joint->FirstChildElement("axis")) numbers(at, axis, "xyz", 3, {1, 0, 0});
+    if (const tinyxml2::XMLElement* limit = joint->FirstChildElement("limit")) {
+      numbers(at, limit, "lower", 1, {0});
+      numbers(at, limit, "upper", 1, {0});
+    }
+  }
+  return counts;
+}
+
+// The line of the first <collision> of link `name` (for messages about what urdfdom kept).
+int collisionLine(const tinyxml2::XMLDocument& doc, const std::string& name) {
+  const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
+  for (const tinyxml2::XMLElement* link = robot ? robot->FirstChildElement("link") : nullptr; link;
+       link = link->NextSiblingElement("link"))
+    if (const char* n = link->Attribute("name"); n && name == n) {
+      const tinyxml2::XMLElement* c = link->FirstChildElement("collision");
+      return (c ? c : link)->GetLineNum();
+    }
+  return 0;
 }
 
 std::vector<std::array<std::string, 2>> readSrdf(const tinyxml2::XMLDocument& doc, const std::string& path,
@@ -126,12 +285,29 @@ std::vector<std::array<std::string, 2>> readSrdf(const tinyxml2::XMLDocument& do
 }  // namespace
 
 std::string importUrdf(const std::string& path, const ImportOptions& options) {
+  // One read of the file: the XML checks and urdfdom see the same text. tinyxml2 bounds the
+  // element nesting before urdfdom's parser (which recurses without a bound) sees it.
+  const std::string urdf_text = readInputFile(path);
   tinyxml2::XMLDocument doc;  // for XML errors with line numbers
-  loadXml(doc, path);
+  loadXml(doc, urdf_text, path);
+  const std::map<std::string, int> collisions = checkCollisions(doc, path);
   tinyxml2::XMLDocument srdf;  // checked before the (slow) fitting starts
-  if (!options.srdf.empty()) loadXml(srdf, options.srdf);
-  const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDFFile(path);
-  if (!urdf || !urdf->getRoot()) throw std::runtime_error(path + ": not a valid URDF (urdfdom rejected it)");
+  if (!options.srdf.empty()) loadXml(srdf, readInputFile(options.srdf), options.srdf);
+  const UrdfParse parsed = parseWithUrdfdom(urdf_text);
+  const urdf::ModelInterfaceSharedPtr& urdf = parsed.model;
+  if (!urdf || !urdf->getRoot())
+    throw std::runtime_error(path + ": not a valid URDF (" +
+                             (parsed.error.empty() ? std::string("urdfdom rejected it") : "urdfdom: " + parsed.error) + ")");
+  // urdfdom drops every collision of a link when one of them does not parse: whatever slipped
+  // through the checks above must not become a link without geometry.
+  for (const auto& [name, count] : collisions) {
+    const urdf::LinkConstSharedPtr link = urdf->getLink(name);
+    const std::size_t kept = link ? link->collision_array.size() : 0;
+    if (kept != static_cast<std::size_t>(count))
+      throw std::runtime_error(path + ":" + std::to_string(collisionLine(doc, name)) + ": link '" + printable(name) +
+                               "': " + std::to_string(count) + " <collision> elements but urdfdom read " +
+                               std::to_string(kept) + (parsed.error.empty() ? "" : " (" + parsed.error + ")"));
+  }
 
   std::ostringstream joints, bodies;
   std::set<std::string> link_names, body_names;

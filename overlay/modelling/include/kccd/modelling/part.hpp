@@ -2,7 +2,9 @@
 // whose convex hull contains every point of the part.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "kccd/ssch.hpp"
@@ -44,7 +46,25 @@ struct ReadOptions {
 
 /// Reads an Open Inventor (.iv, ASCII or binary), VRML 1/2 (.wrl) or STL file through Coin3D,
 /// all transforms applied. Throws std::runtime_error with a one-line message naming the file.
+///
+/// Refused with that error rather than read: anything but a regular file of at most
+/// kMaxInputBytes (binary Open Inventor: kMaxBinaryInventorBytes); ASCII scenes nested deeper than
+/// kMaxNesting braces or brackets; includes (Open Inventor File, VRML Inline and EXTERNPROTO,
+/// VRML 1 WWWInline: the part must be one self-contained file); coordinate indices or vertex
+/// counts outside their coordinates; negative or non-finite sizes of spheres, cylinders, cones
+/// and boxes; non-finite transforms or vertices; zero or non-finite `options.scale`.
 Part readPart(const std::string& path, const ReadOptions& options = {});
+
+inline constexpr std::uintmax_t kMaxInputBytes = 256ull << 20;           ///< any part or URDF file
+inline constexpr std::uintmax_t kMaxBinaryInventorBytes = 4ull << 20;    ///< see readPart
+inline constexpr int kMaxNesting = 256;                                  ///< braces and brackets, or groups
+
+/// The whole content of an input file: regular files only (no directories, devices or FIFOs),
+/// at most `max_bytes`. Throws std::runtime_error naming the file.
+std::string readInputFile(const std::string& path, std::uintmax_t max_bytes = kMaxInputBytes);
+
+/// `text` fit for a one-line message: control bytes and DEL written as \xNN.
+std::string printable(std::string_view text);
 
 /// Vertices of a polyhedron that contains the unit ball (its faces touch the ball from outside).
 const std::vector<Vec3>& circumscribedUnitSphere();

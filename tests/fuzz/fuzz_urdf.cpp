@@ -1,0 +1,47 @@
+// libFuzzer target: kccd::modelling::importUrdf on arbitrary bytes. A model or the importer's
+// one-line std::runtime_error is fine; a crash, any other exception or a multi-line message is a
+// finding.
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include <unistd.h>
+
+#include "kccd/modelling/urdf_import.hpp"
+
+namespace {
+
+const std::filesystem::path& workDir() {
+  static const std::filesystem::path dir = [] {
+    std::filesystem::path d = std::filesystem::temp_directory_path() / ("kccd_fuzz_urdf_" + std::to_string(getpid()));
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string path = (workDir() / "input.urdf").string();
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  }
+  try {
+    // One core point: the fit stays quick; meshes are looked up next to the input (none there).
+    (void)kccd::modelling::importUrdf(path, {.points = 1});
+  } catch (const std::runtime_error& e) {
+    const std::string message = e.what();
+    if (message.find('\n') != std::string::npos) {
+      std::fprintf(stderr, "multi-line message: %s\n", message.c_str());
+      std::abort();
+    }
+  }
+  return 0;
+}
