@@ -94,22 +94,19 @@ void checkCameraText(const std::string& text, const std::string& path) {
   }
 }
 
-// OpenCV's parse error text "name(line): problem" as "path:line: yaml: problem".
+// OpenCV's parse error text "name(line): problem" as "path:line: yaml: problem" (OpenCV 4.6
+// puts that text in the exception's function name and its own function name in the message).
 [[noreturn]] void failParse(const std::string& path, const cv::Exception& e) {
-  std::string err = e.err;
-  std::size_t line = 0;
-  const std::size_t close = err.find("): ");
-  const std::size_t open = close == std::string::npos ? std::string::npos : err.rfind('(', close);
-  if (open != std::string::npos) {
-    const std::string digits = err.substr(open + 1, close - open - 1);
-    if (!digits.empty() && digits.size() < 9 && std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-      line = std::stoul(digits);
-      err = err.substr(close + 3);
-    }
+  for (const std::string& text : {e.func, e.err}) {
+    const std::size_t close = text.find("): ");
+    const std::size_t open = close == std::string::npos ? std::string::npos : text.rfind('(', close);
+    if (open == std::string::npos) continue;
+    const std::string digits = text.substr(open + 1, close - open - 1);
+    if (digits.empty() || digits.size() > 8 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      continue;
+    failAt(path, std::stoul(digits), "yaml", "OpenCV cannot read it: " + printable(text.substr(close + 3), 100));
   }
-  const std::string problem = "OpenCV cannot read it: " + printable(err, 100);
-  if (line > 0) failAt(path, line, "yaml", problem);
-  fail(path, "yaml", problem);
+  fail(path, "yaml", "OpenCV cannot read it: " + printable(e.err, 100));
 }
 
 // A key given twice in a mapping, as OpenCV parsed it (the YAML pre-check names the line; this
@@ -287,6 +284,8 @@ Camera loadCamera(const std::string& path) {
       fail(path, "yaml", "OpenCV cannot read it");
   } catch (const cv::Exception& e) {
     failParse(path, e);
+  } catch (const std::exception& e) {  // OpenCV 4.6 lets std::length_error out of some malformed keys
+    fail(path, "yaml", "OpenCV cannot read it (" + printable(e.what(), 60) + ")");
   }
   Camera c;
   try {
@@ -305,6 +304,10 @@ Camera loadCamera(const std::string& path) {
     c.tvec = readVec3(fs, path, "tvec");
   } catch (const cv::Exception& e) {
     failParse(path, e);
+  } catch (const CameraError&) {
+    throw;
+  } catch (const std::exception& e) {
+    fail(path, "yaml", "OpenCV cannot read it (" + printable(e.what(), 60) + ")");
   }
   c.validate(path);
   return c;
