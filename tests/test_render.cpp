@@ -6,8 +6,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <random>
+
+#include <sys/stat.h>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -152,6 +155,155 @@ TEST(RenderCamera, ErrorsNameFileAndField) {
     ADD_FAILURE();
   } catch (const CameraError& e) {
     EXPECT_NE(std::string(e.what()).find("kccd_cam_garbage.yaml"), std::string::npos);
+  }
+}
+
+// The message of the CameraError loading `text` throws (empty when it loads).
+std::string loadError(const std::string& name, const std::string& text) {
+  const std::string path = writeTemp(name, text);
+  try {
+    loadCamera(path);
+  } catch (const CameraError& e) {
+    const kccd::InputError& base = e;  // the one error type for unusable input
+    return base.what();
+  }
+  return "";
+}
+
+void expectOneLine(const std::string& msg, const std::string& path, const std::string& expect) {
+  EXPECT_NE(msg.find(path), std::string::npos) << msg;
+  EXPECT_NE(msg.find(expect), std::string::npos) << msg;
+  EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  EXPECT_EQ(msg.find("OpenCV("), std::string::npos) << msg;  // no OpenCV internals
+}
+
+TEST(RenderCamera, RejectsDuplicateKeysAndTrailingDocuments) {
+  const std::string ok = cameraText();
+  const std::string dir = ::testing::TempDir() + "/";
+  // Block style: the second image_width (line 9 of the sorted layout) is named with its line.
+  std::string dup = ok;
+  dup.insert(dup.find("image_height"), "image_width: 640\n");
+  std::string msg = loadError("kccd_cam_dup.yaml", dup);
+  expectOneLine(msg, dir + "kccd_cam_dup.yaml:", "image_width: duplicate key");
+  // The second of the two (the layout is sorted: the original one comes after image_height).
+  const int line = static_cast<int>(std::count(dup.begin(), dup.begin() + static_cast<long>(dup.rfind("image_width:")), '\n')) + 1;
+  EXPECT_NE(msg.find(".yaml:" + std::to_string(line) + ":"), std::string::npos) << msg;
+  // Flow style, inside a matrix.
+  std::string flow = cameraText("rvec", "rvec: !!opencv-matrix {rows: 3, cols: 1, dt: d, rows: 1, data: [0., 0., 0.]}\n");
+  expectOneLine(loadError("kccd_cam_flowdup.yaml", flow), "kccd_cam_flowdup.yaml:", "rvec.rows: duplicate key");
+  // Anything after the document: '---' or '...' followed by more.
+  expectOneLine(loadError("kccd_cam_doc2.yaml", ok + "---\nimage_width: 640\n"), "kccd_cam_doc2.yaml:", "second YAML document");
+  expectOneLine(loadError("kccd_cam_doc3.yaml", ok + "...\nimage_width: 640\n"), "kccd_cam_doc3.yaml:", "second YAML document");
+  EXPECT_EQ(loadError("kccd_cam_end.yaml", ok + "...\n"), "");  // an explicit end alone is fine
+}
+
+TEST(RenderCamera, ParseErrorsAreOneLineWithThePlace) {
+  const std::string ok = cameraText();
+  const struct {
+    std::string name, text, expect;
+  } cases[] = {
+      {"kccd_cam_empty.yaml", "", "empty"},
+      {"kccd_cam_blank.yaml", "\n  \n", "empty"},
+      {"kccd_cam_truncated.yaml", ok.substr(0, ok.find("data: [300., 0.,") + 16), ".yaml:"},
+      {"kccd_cam_noheader.yaml", ok.substr(ok.find('\n') + 1), ".yaml:1: header"},
+      {"kccd_cam_json.yaml", "{\"image_width\": 320}", ".yaml:1: header"},
+      {"kccd_cam_list.yaml", "%YAML:1.0\n---\n- 1\n- 2\n", "top level must be a mapping"},
+      {"kccd_cam_scalar.yaml", "%YAML:1.0\n---\n42\n", ".yaml:"},
+      {"kccd_cam_binary.yaml", std::string("%YAML:1.0\n\0\x01\x02\xff", 14), ".yaml:2: file: control byte \\x00"},
+      {"kccd_cam_quoted.yaml", "%YAML:1.0\n---\n\"image_width\": 320\n", "yaml: OpenCV cannot read it"},
+      {"kccd_cam_matrix_huge.yaml",
+       cameraText("rvec", "rvec: !!opencv-matrix\n   rows: 3000000\n   cols: 3000000\n   dt: d\n   data: [0., 0., 0.]\n"),
+       "rvec: 3000000x3000000 is not a camera matrix size"},
+      {"kccd_cam_matrix_count.yaml",
+       cameraText("tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [0., 0.]\n"), "tvec: data has 2 values"},
+      {"kccd_cam_matrix_text.yaml",
+       cameraText("tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [0., a, 0.]\n"), "tvec: data holds"},
+      {"kccd_cam_matrix_dt.yaml",
+       cameraText("tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: 3d\n   data: [0., 0., 0.]\n"), ".yaml:"},
+      {"kccd_cam_matrix_dt2.yaml",
+       cameraText("tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: x\n   data: [0., 0., 0.]\n"), "tvec: dt 'x'"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string msg = loadError(c.name, c.text);
+    ASSERT_FALSE(msg.empty());
+    expectOneLine(msg, c.name, c.expect);
+  }
+}
+
+TEST(RenderCamera, FilesThatAreNotRegularAreRejectedWithoutReading) {
+  const std::string dir = ::testing::TempDir() + "/kccd_cam_dir.yaml";
+  std::filesystem::create_directories(dir);
+  const std::string fifo = ::testing::TempDir() + "/kccd_cam_fifo.yaml";
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& path : {dir, fifo, std::string("/dev/zero")}) {
+    try {
+      loadCamera(path);  // would block (FIFO) or never end (/dev/zero) if it were read
+      ADD_FAILURE() << path;
+    } catch (const CameraError& e) {
+      expectOneLine(e.what(), path, "not a regular file");
+    }
+  }
+  std::filesystem::remove(fifo);
+  // Size is bounded: a camera file is a few hundred bytes.
+  std::string big = cameraText() + "# " + std::string(2 << 20, 'x') + "\n";
+  expectOneLine(loadError("kccd_cam_big.yaml", big), "kccd_cam_big.yaml", "file: larger than");
+}
+
+TEST(RenderCamera, BoundsWhatTheRendererCanDraw) {
+  auto matrix = [](const std::string& key, int rows, int cols, const std::string& data) {
+    return key + ": !!opencv-matrix\n   rows: " + std::to_string(rows) + "\n   cols: " + std::to_string(cols) +
+           "\n   dt: d\n   data: [" + data + "]\n";
+  };
+  auto k = [&](const std::string& data) { return matrix("camera_matrix", 3, 3, data); };
+  auto d = [&](const std::string& data) { return matrix("distortion_coefficients", 1, 5, data); };
+  const struct {
+    std::string key, with, field, expect;
+  } cases[] = {
+      {"image_width", "image_width: 16384\n", "image_width", "not in 1..8192"},
+      {"camera_matrix", k("1e300, 0., 160., 0., 300., 120., 0., 0., 1."), "camera_matrix", "must be in 1..1e+06 px"},
+      {"camera_matrix", k("1e-3, 0., 160., 0., 1e-3, 120., 0., 0., 1."), "camera_matrix", "must be in 1..1e+06 px"},
+      {"camera_matrix", k("300., 0., 1e9, 0., 300., 120., 0., 0., 1."), "camera_matrix", "principal point"},
+      {"camera_matrix", k("300., 0., 160., 0., 300., -1e9, 0., 0., 1."), "camera_matrix", "principal point"},
+      {"distortion_coefficients", d("1e6, 0., 0., 0., 0."), "distortion_coefficients", "coefficient 0 = 1e+06 is out of range"},
+      {"distortion_coefficients", d("-2.5, 0., 0., 0., 0."), "distortion_coefficients", "cannot be inverted at image pixel"},
+      {"distortion_coefficients", matrix("distortion_coefficients", 1, 14, "0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 2., 0."),
+       "distortion_coefficients", "tilt"},
+      {"rvec", matrix("rvec", 3, 1, "1e3, 0., 0."), "rvec", "longer than 100"},
+      {"tvec", matrix("tvec", 3, 1, "0., 0., 1e300"), "tvec", "farther than"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.with);
+    const std::string msg = loadError("kccd_cam_bound_" + c.field + ".yaml", cameraText(c.key, c.with));
+    ASSERT_FALSE(msg.empty());
+    expectOneLine(msg, "kccd_cam_bound_" + c.field + ".yaml: " + c.field + ": ", c.expect);
+  }
+  // Too many pixels, and a lens whose undistorted image would exceed 8192 pixels a side.
+  std::string many = cameraText("image_width", "image_width: 8192\n");
+  many.replace(many.find("image_height: 240"), 17, "image_height: 8192");
+  expectOneLine(loadError("kccd_cam_many.yaml", many), "kccd_cam_many.yaml: image_width: ", "more than 16777216 pixels");
+  std::string wide = cameraText("image_width", "image_width: 8192\n");
+  wide.replace(wide.find("image_height: 240"), 17, "image_height: 2048");
+  wide.replace(wide.find(k("300., 0., 160., 0., 300., 120., 0., 0., 1.")), k("300., 0., 160., 0., 300., 120., 0., 0., 1.").size(),
+               k("7000., 0., 4095.5, 0., 7000., 1023.5, 0., 0., 1."));
+  wide.replace(wide.find(d("-0.1, 0.01, 0., 0., 0.")), d("-0.1, 0.01, 0., 0., 0.").size(), d("-0.11, 0.06, 0.0006, -0.0004, -0.01"));
+  expectOneLine(loadError("kccd_cam_wide.yaml", wide), "kccd_cam_wide.yaml: distortion_coefficients: ",
+                "more than 8192 a side");
+}
+
+TEST(RenderCamera, TinyImagesRender) {
+  for (const auto& [w, h] : {std::pair{8, 3}, std::pair{3, 8}, std::pair{1, 1}}) {
+    Camera c = lookAt(Vec3(2, 0, 0), Vec3(0, 0, 0), w, h, 3.0 * w, {-0.1, 0.01, 0, 0, 0});
+    c.camera_matrix(0, 2) = (w - 1) / 2.0;
+    c.camera_matrix(1, 2) = (h - 1) / 2.0;
+    Renderer r(c);
+    const std::vector<Vec3> ball = {Vec3(0, 0, 0)};
+    const Volume v[] = {{ball, 1.5, VolumeStatus::Clear, "ball"}};  // wider than the view
+    const Frame f = r.render(v, Style{.labels = true, .legend = true});
+    EXPECT_EQ(f.bgra.cols, w);
+    EXPECT_EQ(f.bgra.rows, h);
+    EXPECT_EQ(f.pixels[0], w * h) << w << "x" << h;
   }
 }
 
@@ -492,6 +644,46 @@ TEST(RenderMask, DegenerateVolumesAreVisible) {
   EXPECT_GT(f.pixels[2], 20);    // a ball
   EXPECT_GT(f.pixels[1], 0);    // a radius-0 segment, drawn 1 mm thick
   EXPECT_GT(cv::countNonZero(f.mask), 500);
+}
+
+TEST(RenderMask, VolumesThatCannotBeDrawnAreReported) {
+  // Camera at x = 2 looking along -x: camera z = -world x, camera x = world -y (right).
+  const Camera c = lookAt(Vec3(2, 0, 0), Vec3(0, 0, 0), 160, 120, 150, {0, 0, 0, 0, 0});
+  Renderer r(c);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<Vec3> behind = {Vec3(5, 0, 0)}, far = {Vec3(-2e7, 0, 0)}, bad = {Vec3(nan, 0, 0)},
+                          distant = {Vec3(-500, 0, 0)}, off_axis = {Vec3(1.9999, -1e5, 0)};
+  const Volume v[] = {{behind, 0.5, VolumeStatus::Clear, "behind"},  {far, 1e3, VolumeStatus::Clear, "far"},
+                      {bad, 0.1, VolumeStatus::Clear, "bad"},        {distant, 30, VolumeStatus::Clear, "distant"},
+                      {off_axis, 0.01, VolumeStatus::Clear, "off axis"}};
+  const Frame f = r.render(v, Style{.labels = true}, true, true);
+  EXPECT_EQ(f.visibility[0], Visibility::BehindCamera);
+  EXPECT_EQ(f.visibility[1], Visibility::BeyondFar);
+  EXPECT_EQ(f.visibility[2], Visibility::NotFinite);
+  EXPECT_EQ(f.visibility[3], Visibility::Drawn);
+  EXPECT_EQ(f.visibility[4], Visibility::Drawn);  // its label (centre at ~1e11 px) is skipped
+  EXPECT_EQ(f.pixels[0] + f.pixels[1] + f.pixels[2], 0);
+  EXPECT_GT(f.pixels[3], 50);  // 500 m away, beyond the default far plane (100 m): still drawn
+  EXPECT_GT(f.far, 500.0);
+  // 1 cm from the camera (closer than the default near plane, 5 cm): a ball of 2 cm radius
+  // seen from 1 cm covers the whole view, not clipped away by the near plane.
+  const std::vector<Vec3> close = {Vec3(1.97, 0, 0)};
+  const Volume u[] = {{close, 0.02, VolumeStatus::Clear, "close"}};
+  const Frame e = r.render(u, Style{}, true, true);
+  EXPECT_EQ(e.visibility[0], Visibility::Drawn);
+  EXPECT_LT(e.near, 0.01);
+  EXPECT_EQ(e.pixels[0], c.width * c.height);
+  EXPECT_STREQ(toString(Visibility::BeyondFar), "beyond far plane");
+
+  // A volume containing the camera fills the view in the mask and tints the colour layer.
+  const std::vector<Vec3> room = {Vec3(0, 0, 0)}, ball = {Vec3(0, 0, 0)};
+  const Volume w[] = {{ball, 0.3, VolumeStatus::Clear, "ball"}, {room, 5.0, VolumeStatus::Colliding, "room"}};
+  const Frame g = r.render(w, Style{.legend = false}, true, true);
+  EXPECT_EQ(g.visibility[1], Visibility::FillsView);
+  EXPECT_EQ(g.pixels[1], c.width * c.height);
+  EXPECT_EQ(cv::countNonZero(g.mask == 2), c.width * c.height);
+  EXPECT_NEAR(g.bgra.at<cv::Vec4b>(0, 0)[3], 0.35 * 255, 2);
+  EXPECT_GT(g.bgra.at<cv::Vec4b>(c.height / 2, c.width / 2)[3], g.bgra.at<cv::Vec4b>(0, 0)[3]);  // the ball shows through
 }
 
 // ---------------------------------------------------------------------------------------------

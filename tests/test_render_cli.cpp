@@ -5,8 +5,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <string>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
@@ -126,6 +129,82 @@ TEST_F(RenderCli, BadInputExitsTwoWithOneLine) {
   // No partial or temporary files are left behind.
   for (const auto& e : fs::directory_iterator(dir_))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
+TEST_F(RenderCli, CameraFileErrorsExitTwoWithOneLine) {
+  const std::string o = " --state 0,0,0 -o " + out("bad.png");
+  std::ifstream in(camera_);
+  const std::string ok((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string dup = ok;
+  dup.insert(dup.find("image_height"), "image_width: 640\n");
+  std::string height = ok;
+  height.replace(height.find("image_height: 180"), 17, "image_height: 20000");
+  fs::create_directories(out("dir.yaml"));
+  ASSERT_EQ(::mkfifo(out("fifo.yaml").c_str(), 0600), 0);
+  const struct {
+    std::string name, text, expect;
+  } cases[] = {
+      {"dup.yaml", dup, ":4:1: image_width: duplicate key"},
+      {"trail.yaml", ok + "---\nimage_width: 640\n",
+       ":" + std::to_string(std::count(ok.begin(), ok.end(), '\n') + 1) + ":1: document: a second YAML document"},
+      {"empty.yaml", "", ": file: empty"},
+      {"noheader.yaml", ok.substr(ok.find('\n') + 1), ":1: header"},
+      {"list.yaml", "%YAML:1.0\n---\n- 1\n", ": document: the top level must be a mapping"},
+      {"binary.yaml", std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10), ":1: file: control byte"},
+      {"truncated.yaml", ok.substr(0, ok.find("data:") + 12), ":"},
+      {"height.yaml", height, ": image_height: 20000 is not in 1..8192"},
+      {"dir.yaml", "", ": file: not a regular file"},
+      {"fifo.yaml", "", ": file: not a regular file"},
+  };
+  for (const auto& c : cases) {
+    if (c.name != "dir.yaml" && c.name != "fifo.yaml") std::ofstream(out(c.name), std::ios::binary) << c.text;
+    const Outcome r = runKccd("render " + kDemo + " --camera " + out(c.name) + o);
+    EXPECT_EQ(r.code, 2) << c.name << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("kccd: " + out(c.name) + c.expect, 0), 0u)
+        << c.name << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << "\n" << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out("bad.png")));
+}
+
+TEST_F(RenderCli, VolumesThatCannotBeDrawnAreReported) {
+  const std::string model = out("slide.yaml");
+  std::ofstream(model) << "kccd: 1\nname: slide\nsafety_margin: 0.01\njoints:\n"
+                          "  - {name: s, parent: world, type: prismatic, axis: [1, 0, 0]}\n"
+                          "bodies:\n  - {name: base, frame: world, points: [[0, 0, 0]], radius: 0.1}\n"
+                          "  - {name: carriage, frame: s, points: [[0, 0, 0.5], [0.1, 0, 0.5]], radius: 0.05}\n"
+                          "  - {name: room, frame: s, points: [[0, 0, 0]], radius: 50}\n";
+  auto notDrawn = [](const nlohmann::json& j) {
+    std::map<std::string, std::string> m;
+    for (const auto& e : j["not_drawn"]) m[e["body"]] = e["reason"];
+    return m;
+  };
+  // Far along the prismatic joint: behind the camera (static) or reaching beyond the far plane (swept).
+  Outcome r = runKccd("render " + model + " --camera " + camera_ + " --state 1e100 -o " + out("a.png") + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(notDrawn(j)["carriage"], "behind the camera");
+  EXPECT_EQ(notDrawn(j)["room"], "behind the camera");
+  r = runKccd("render " + model + " --camera " + camera_ + " --lower 100 --upper 1e100 -o " + out("b.png") + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(notDrawn(j)["carriage"], "beyond far plane");
+  // The text output says so too, and with --labels nothing overflows.
+  r = runKccd("render " + model + " --camera " + camera_ + " --state 1e100 --labels -o " + out("c.png"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("carriage: clear, 0 px (not drawn: behind the camera)"), std::string::npos) << r.out;
+  // At the origin the 50 m room contains the camera: it fills the view.
+  r = runKccd("render " + model + " --camera " + camera_ + " --state 0 --mask -o " + out("d.png") + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["fills_view"], nlohmann::json::array({"room"}));
+  EXPECT_EQ(j["bodies"][2]["pixels"], 320 * 180);
+  // Overflow to infinity: an unsafe status (3) with one line naming it, never exit 1.
+  r = runKccd("render " + model + " --camera " + camera_ + " --state 1e308 -o " + out("e.png") + " --json");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find("unsafe"), std::string::npos) << r.err;
+  r = runKccd("render " + model + " --camera " + camera_ + " --lower 0 --upper 1e300 -o " + out("f.png"));
+  EXPECT_EQ(r.code, 3) << r.err;
 }
 
 TEST_F(RenderCli, UnsafeStatusExitsThreeAndStillWrites) {

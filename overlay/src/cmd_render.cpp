@@ -70,8 +70,6 @@ int runRender(const RenderArgs& args) {
   const std::vector<render::VolumeStatus> body_status = render::bodyStatus(m, r);
   std::vector<render::Volume> volumes = box.point ? render::staticSceneVolumes(m, checker, lower, body_status)
                                                  : render::sceneVolumes(m, checker, body_status);
-  for (render::Volume& v : volumes)
-    if (!allFinite(v.points) || !std::isfinite(v.radius)) v.points = {};  // unsafe status: nothing to draw
 
   render::RenderOptions options;
   options.supersample = args.supersample;
@@ -79,7 +77,10 @@ int runRender(const RenderArgs& args) {
   try {
     renderer = std::make_unique<render::Renderer>(camera, options);
   } catch (const render::CameraError& e) {
-    throw UsageError(args.camera + ": " + e.what());
+    // Messages of the projection name the camera as "camera: field: problem".
+    std::string msg = e.what();
+    if (msg.rfind("camera: ", 0) == 0) msg = msg.substr(8);
+    throw UsageError(args.camera + ": " + msg);
   }
   render::Style style;
   style.labels = args.labels;
@@ -92,6 +93,16 @@ int runRender(const RenderArgs& args) {
   const double total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const double frame_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
   const bool swept = lower != upper;
+  // Volumes that are not drawn as meshes are always reported (JSON and text).
+  bool not_finite = false;
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) not_finite |= frame.visibility[i] == render::Visibility::NotFinite;
+  auto drawnNote = [&](std::size_t i) -> std::string {
+    switch (frame.visibility[i]) {
+      case render::Visibility::Drawn: return "";
+      case render::Visibility::FillsView: return " (contains the camera: fills the view)";
+      default: return std::string(" (not drawn: ") + render::toString(frame.visibility[i]) + ")";
+    }
+  };
   if (args.json) {
     nlohmann::json j;
     j["output"] = args.output;
@@ -104,6 +115,14 @@ int runRender(const RenderArgs& args) {
     j["status"] = toString(status);
     j["margin"] = margin;
     j["bodies"] = nlohmann::json::array();
+    j["not_drawn"] = nlohmann::json::array();
+    j["fills_view"] = nlohmann::json::array();
+    for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+      const render::Visibility v = frame.visibility[i];
+      if (v == render::Visibility::FillsView) j["fills_view"].push_back(m.bodies[i].name);
+      else if (v != render::Visibility::Drawn)
+        j["not_drawn"].push_back({{"body", m.bodies[i].name}, {"reason", render::toString(v)}});
+    }
     for (std::size_t i = 0; i < m.bodies.size(); ++i)
       j["bodies"].push_back({{"name", m.bodies[i].name}, {"label", i + 1}, {"status", render::toString(body_status[i])},
                              {"min_distance", number(nearest[i])}, {"pixels", frame.pixels[i]}});
@@ -116,10 +135,18 @@ int runRender(const RenderArgs& args) {
               << "renderer " << renderer->rendererString() << "\n";
     for (std::size_t i = 0; i < m.bodies.size(); ++i)
       std::cout << "  " << i + 1 << " " << m.bodies[i].name << ": " << render::toString(body_status[i]) << ", "
-                << frame.pixels[i] << " px\n";
+                << frame.pixels[i] << " px" << drawnNote(i) << "\n";
   }
   if (status != Status::Ok) {
     std::cerr << "kccd: query status " << toString(status) << " (unsafe)\n";
+    return 3;
+  }
+  if (not_finite) {
+    for (std::size_t i = 0; i < m.bodies.size(); ++i)
+      if (frame.visibility[i] == render::Visibility::NotFinite) {
+        std::cerr << "kccd: body " << m.bodies[i].name << ": volume not finite (overflow): not drawn (unsafe)\n";
+        break;
+      }
     return 3;
   }
   return 0;
@@ -147,7 +174,9 @@ Runner addRender(CLI::App& app) {
       ->check(finiteIn(1.0, 4.0));
   sub->add_flag("--json", args->json, "Machine-readable summary");
   sub->footer("Colours: green clear, amber within the safety margin, red colliding.\n"
-              "Exit status: 0 written, 2 bad input, 3 unsafe query status (image still written).");
+              "Volumes containing the camera fill the view; volumes behind the camera, farther than 1e6 m\n"
+              "or not finite are not drawn and are listed (text: 'not drawn: reason'; JSON: not_drawn).\n"
+              "Exit status: 0 written, 2 bad input, 3 unsafe query status or a non-finite volume (image still written).");
   return [args] { return runRender(*args); };
 }
 

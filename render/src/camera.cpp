@@ -1,31 +1,151 @@
 #include "kccd/render/camera.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
-#include <filesystem>
+#include <cstring>
+#include <sstream>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+
+#include "kccd/yaml_document.hpp"
 
 namespace kccd::render {
 namespace {
 
 constexpr int kDistortionSizes[] = {4, 5, 8, 12, 14};
+constexpr int kMaxMatrixSide = 16;  // rows, cols of a matrix in a camera file
 
 [[noreturn]] void fail(const std::string& source, const std::string& field, const std::string& problem) {
   throw CameraError(source + ": " + field + ": " + problem);
 }
 
+[[noreturn]] void failAt(const std::string& source, std::size_t line, const std::string& field,
+                         const std::string& problem) {
+  throw CameraError(source + ":" + std::to_string(line) + ": " + field + ": " + problem);
+}
+
+// The whole file, read without blocking on anything that is not a regular file (a FIFO, a
+// device, a directory) and bounded in size.
+std::string readCameraFile(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) {
+    const int err = errno;
+    fail(path, "file", std::string("cannot open the camera file (") + (err == ENOENT ? "no such file" : std::strerror(err)) + ")");
+  }
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) fail(path, "file", std::string("cannot read the camera file (") + std::strerror(errno) + ")");
+  if (!S_ISREG(st.st_mode)) fail(path, "file", "not a regular file");
+  if (st.st_size > static_cast<off_t>(kMaxCameraFileBytes))
+    fail(path, "file", "larger than " + std::to_string(kMaxCameraFileBytes >> 10) + " KiB (a camera file is a few hundred bytes)");
+  std::string text;
+  char buffer[8192];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail(path, "file", std::string("cannot read the camera file (") + std::strerror(errno) + ")");
+    }
+    if (n == 0) break;
+    text.append(buffer, static_cast<std::size_t>(n));
+    if (text.size() > kMaxCameraFileBytes)
+      fail(path, "file", "larger than " + std::to_string(kMaxCameraFileBytes >> 10) + " KiB (a camera file is a few hundred bytes)");
+  }
+  return text;
+}
+
+// Structure before OpenCV parses anything: text only, OpenCV's `%YAML:1.x` header, then one YAML
+// document with unique plain keys (the `%YAML:1.0` line is not standard YAML: it is blanked for
+// the check, keeping the line numbers).
+void checkCameraText(const std::string& text, const std::string& path) {
+  std::size_t line = 1;
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '\n') ++line;
+    else if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7f)
+      failAt(path, line, "file", "control byte " + printable(std::string_view(&ch, 1)) + " (not a text file)");
+  }
+  std::size_t start = 0;
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) start = 3;  // UTF-8 byte order mark
+  const std::size_t eol = std::min(text.find('\n', start), text.size());
+  std::string first = text.substr(start, eol - start);
+  while (!first.empty() && (first.back() == '\r' || first.back() == ' ' || first.back() == '\t')) first.pop_back();
+  const bool header = first.size() > 8 && (first.compare(0, 8, "%YAML:1.") == 0 || first.compare(0, 8, "%YAML 1.") == 0) &&
+                      std::all_of(first.begin() + 8, first.end(), [](char c) { return c >= '0' && c <= '9'; });
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos) fail(path, "file", "empty (an OpenCV YAML camera file starts with %YAML:1.0)");
+  if (!header)
+    failAt(path, 1, "header", "the first line must be %YAML:1.0 (an OpenCV FileStorage YAML camera file), not '" +
+                                  printable(first, 40) + "'");
+  std::string yaml = text;
+  std::fill(yaml.begin() + static_cast<std::ptrdiff_t>(start), yaml.begin() + static_cast<std::ptrdiff_t>(eol), ' ');
+  try {
+    checkYamlDocument(yaml, path);
+  } catch (const InputError& e) {
+    throw CameraError(e.what());
+  }
+}
+
+// OpenCV's parse error text "name(line): problem" as "path:line: yaml: problem" (OpenCV 4.6
+// puts that text in the exception's function name and its own function name in the message).
+[[noreturn]] void failParse(const std::string& path, const cv::Exception& e) {
+  for (const std::string& text : {e.func, e.err}) {
+    const std::size_t close = text.find("): ");
+    const std::size_t open = close == std::string::npos ? std::string::npos : text.rfind('(', close);
+    if (open == std::string::npos) continue;
+    const std::string digits = text.substr(open + 1, close - open - 1);
+    if (digits.empty() || digits.size() > 8 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      continue;
+    failAt(path, std::stoul(digits), "yaml", "OpenCV cannot read it: " + printable(text.substr(close + 3), 100));
+  }
+  fail(path, "yaml", "OpenCV cannot read it: " + printable(e.err, 100));
+}
+
+// A key given twice in a mapping, as OpenCV parsed it (the YAML pre-check names the line; this
+// guards against the two parsers reading keys differently).
+void checkUniqueKeys(const cv::FileNode& map, const std::string& path, const std::string& prefix) {
+  std::vector<std::string> keys;
+  for (cv::FileNodeIterator it = map.begin(); it != map.end(); ++it) keys.push_back((*it).name());
+  std::sort(keys.begin(), keys.end());
+  const auto dup = std::adjacent_find(keys.begin(), keys.end());
+  if (dup != keys.end()) fail(path, prefix + printable(*dup, 40), "duplicate key");
+}
+
 cv::Mat readMatrix(const cv::FileStorage& fs, const std::string& source, const char* field) {
   const cv::FileNode node = fs[field];
   if (node.empty()) fail(source, field, "missing");
+  const std::string layout = "not an OpenCV matrix (!!opencv-matrix with rows, cols, dt, data)";
+  if (!node.isMap()) fail(source, field, layout);
+  checkUniqueKeys(node, source, std::string(field) + ".");
+  // Sizes first: OpenCV allocates rows x cols before it compares them with the data.
+  const cv::FileNode rows = node["rows"], cols = node["cols"], dt = node["dt"], data = node["data"];
+  if (!rows.isInt() || !cols.isInt() || !dt.isString() || !data.isSeq()) fail(source, field, layout);
+  const int r = static_cast<int>(rows), c = static_cast<int>(cols);
+  if (r < 1 || r > kMaxMatrixSide || c < 1 || c > kMaxMatrixSide)
+    fail(source, field, std::to_string(r) + "x" + std::to_string(c) + " is not a camera matrix size (rows and cols in 1.." +
+                            std::to_string(kMaxMatrixSide) + ")");
+  const std::string type = static_cast<std::string>(dt);
+  if (type.size() != 1 || std::string("ucwsifd").find(type[0]) == std::string::npos)
+    fail(source, field, "dt '" + printable(type, 20) + "' is not one of u, c, w, s, i, f, d");
+  if (data.size() != static_cast<std::size_t>(r) * static_cast<std::size_t>(c))
+    fail(source, field, "data has " + std::to_string(data.size()) + " values, rows x cols is " + std::to_string(r * c));
+  for (cv::FileNodeIterator it = data.begin(); it != data.end(); ++it)
+    if (!(*it).isInt() && !(*it).isReal()) fail(source, field, "data holds a value that is not a number");
   cv::Mat m;
   try {
     node >> m;
   } catch (const cv::Exception&) {
     m.release();
   }
-  if (m.empty() || m.channels() != 1) fail(source, field, "not an OpenCV matrix (!!opencv-matrix with rows, cols, dt, data)");
+  if (m.empty() || m.channels() != 1) fail(source, field, layout);
   m.convertTo(m, CV_64F);
   return m;
 }
@@ -35,7 +155,7 @@ int readSize(const cv::FileStorage& fs, const std::string& source, const char* f
   if (node.empty()) fail(source, field, "missing");
   if (!node.isInt()) fail(source, field, "not an integer");
   const int v = static_cast<int>(node);
-  if (v <= 0 || v > 16384) fail(source, field, std::to_string(v) + " is not in 1..16384");
+  if (v <= 0 || v > kMaxImageSide) fail(source, field, std::to_string(v) + " is not in 1.." + std::to_string(kMaxImageSide));
   return v;
 }
 
@@ -43,6 +163,39 @@ cv::Vec3d readVec3(const cv::FileStorage& fs, const std::string& source, const c
   const cv::Mat m = readMatrix(fs, source, field);
   if (m.total() != 3) fail(source, field, "needs 3 values, has " + std::to_string(m.total()));
   return {m.at<double>(0), m.at<double>(1), m.at<double>(2)};
+}
+
+std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// Normalised coordinates of the pixel centres `pixels` (n x 1, CV_64FC2) through the inverse of
+// the distortion model, and which of them the inversion really solved (checked by distorting
+// again) within one image width / height of extra field on each side.
+void undistortChecked(const Camera& camera, const cv::Mat& pixels, cv::Mat& normal, std::vector<unsigned char>& valid) {
+  const int n = pixels.rows;
+  const double fx = camera.camera_matrix(0, 0), fy = camera.camera_matrix(1, 1);
+  const double cx = camera.camera_matrix(0, 2), cy = camera.camera_matrix(1, 2);
+  cv::undistortPoints(pixels, normal, camera.camera_matrix, camera.distortion, cv::noArray(), cv::noArray(),
+                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-10));
+  cv::Mat xyz(n, 1, CV_64FC3), back;
+  for (int i = 0; i < n; ++i) {
+    const cv::Vec2d p = normal.at<cv::Vec2d>(i);
+    xyz.at<cv::Vec3d>(i) = cv::Vec3d(p[0], p[1], 1.0);
+  }
+  cv::projectPoints(xyz, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.camera_matrix, camera.distortion, back);
+  // At most one image width / height of extra field on each side.
+  const double x_lo = -(cx + 0.5) / fx - camera.width / fx, x_hi = (camera.width - cx - 0.5) / fx + camera.width / fx;
+  const double y_lo = -(cy + 0.5) / fy - camera.height / fy, y_hi = (camera.height - cy - 0.5) / fy + camera.height / fy;
+  valid.assign(n, 0);
+  for (int i = 0; i < n; ++i) {
+    const cv::Vec2d p = normal.at<cv::Vec2d>(i), b = back.at<cv::Vec2d>(i), u = pixels.at<cv::Vec2d>(i);
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || std::hypot(b[0] - u[0], b[1] - u[1]) > 1e-3) continue;
+    if (p[0] < x_lo || p[0] > x_hi || p[1] < y_lo || p[1] > y_hi) continue;
+    valid[i] = 1;
+  }
 }
 
 }  // namespace
@@ -63,8 +216,12 @@ Pose Camera::worldToCamera() const {
 }
 
 void Camera::validate(const std::string& source) const {
-  if (width <= 0 || width > 16384) fail(source, "image_width", "not in 1..16384");
-  if (height <= 0 || height > 16384) fail(source, "image_height", "not in 1..16384");
+  const std::string sides = "not in 1.." + std::to_string(kMaxImageSide);
+  if (width <= 0 || width > kMaxImageSide) fail(source, "image_width", sides);
+  if (height <= 0 || height > kMaxImageSide) fail(source, "image_height", sides);
+  if (static_cast<long>(width) * height > kMaxImagePixels)
+    fail(source, "image_width", std::to_string(width) + "x" + std::to_string(height) + " has more than " +
+                                    std::to_string(kMaxImagePixels) + " pixels");
   const cv::Matx33d& k = camera_matrix;
   for (int i = 0; i < 9; ++i)
     if (!std::isfinite(k.val[i])) fail(source, "camera_matrix", "non-finite value");
@@ -72,36 +229,86 @@ void Camera::validate(const std::string& source) const {
   if (k(0, 1) != 0.0) fail(source, "camera_matrix", "skew (row 0, column 1) must be 0");
   if (k(1, 0) != 0.0 || k(2, 0) != 0.0 || k(2, 1) != 0.0 || k(2, 2) != 1.0)
     fail(source, "camera_matrix", "must have the form [fx 0 cx; 0 fy cy; 0 0 1]");
+  if (k(0, 0) < 1.0 || k(0, 0) > kMaxFocal || k(1, 1) < 1.0 || k(1, 1) > kMaxFocal)
+    fail(source, "camera_matrix", "focal lengths fx " + num(k(0, 0)) + ", fy " + num(k(1, 1)) + " must be in 1.." + num(kMaxFocal) + " px");
+  if (k(0, 2) < -width || k(0, 2) > 2.0 * width || k(1, 2) < -height || k(1, 2) > 2.0 * height)
+    fail(source, "camera_matrix", "principal point (" + num(k(0, 2)) + ", " + num(k(1, 2)) +
+                                      ") must lie within one image size of the image (cx in -width..2 width, cy in -height..2 height)");
   if (!std::count(std::begin(kDistortionSizes), std::end(kDistortionSizes), static_cast<int>(distortion.size())))
     fail(source, "distortion_coefficients", "needs 4, 5, 8, 12 or 14 values, has " + std::to_string(distortion.size()));
-  for (double d : distortion)
-    if (!std::isfinite(d)) fail(source, "distortion_coefficients", "non-finite value");
+  for (std::size_t i = 0; i < distortion.size(); ++i) {
+    if (!std::isfinite(distortion[i])) fail(source, "distortion_coefficients", "non-finite value");
+    const double bound = i >= 12 ? 1.0 : kMaxDistortion;  // tilt angles tx, ty in radians
+    if (std::abs(distortion[i]) > bound)
+      fail(source, "distortion_coefficients", "coefficient " + std::to_string(i) + " = " + num(distortion[i]) + " is out of range (|k|, |p|, |s| <= " +
+                                                  num(kMaxDistortion) + ", tilt |tx|, |ty| <= 1 rad)");
+  }
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(rvec[i])) fail(source, "rvec", "non-finite value");
     if (!std::isfinite(tvec[i])) fail(source, "tvec", "non-finite value");
   }
+  if (cv::norm(rvec) > 100.0) fail(source, "rvec", "longer than 100 (its length is the rotation angle in radians)");
+  if (cv::norm(tvec) > kMaxTranslation) fail(source, "tvec", "farther than " + num(kMaxTranslation) + " m");
+  if (!distorted()) return;
+  // The renderer inverts the distortion model at every pixel and draws a pinhole image widened
+  // to cover the distorted frame: the border decides both (cheap: 2 (w + h) pixels).
+  std::vector<cv::Vec2d> border;
+  for (int u = 0; u < width; ++u) border.emplace_back(u, 0), border.emplace_back(u, height - 1);
+  for (int v = 0; v < height; ++v) border.emplace_back(0, v), border.emplace_back(width - 1, v);
+  cv::Mat pixels(static_cast<int>(border.size()), 1, CV_64FC2, border.data()), normal;
+  std::vector<unsigned char> valid;
+  undistortChecked(*this, pixels, normal, valid);
+  double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
+  for (std::size_t i = 0; i < border.size(); ++i) {
+    if (!valid[i])
+      fail(source, "distortion_coefficients",
+           "the lens model cannot be inverted at image pixel (" + num(border[i][0]) + ", " + num(border[i][1]) +
+               ") within one image size of extra field: distortion too strong for this image");
+    const cv::Vec2d p = normal.at<cv::Vec2d>(static_cast<int>(i));
+    xmin = std::min(xmin, p[0]), xmax = std::max(xmax, p[0]);
+    ymin = std::min(ymin, p[1]), ymax = std::max(ymax, p[1]);
+  }
+  const double w = (xmax - xmin) * k(0, 0) + 5, h = (ymax - ymin) * k(1, 1) + 5;
+  if (w > kMaxPinholeSide || h > kMaxPinholeSide)
+    fail(source, "distortion_coefficients",
+         "the undistorted image covering this lens would need " + num(std::ceil(w)) + "x" + num(std::ceil(h)) +
+             " pixels, more than " + std::to_string(kMaxPinholeSide) + " a side");
 }
 
 Camera loadCamera(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw CameraError(path + ": cannot open camera file (no such file)");
+  const std::string text = readCameraFile(path);
+  checkCameraText(text, path);
   cv::FileStorage fs;
   try {
-    if (!fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML))
-      throw CameraError(path + ": cannot open camera file");
+    if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML))
+      fail(path, "yaml", "OpenCV cannot read it");
   } catch (const cv::Exception& e) {
-    throw CameraError(path + ": not a readable OpenCV YAML file (" + e.msg + ")");
+    failParse(path, e);
+  } catch (const std::exception& e) {  // OpenCV 4.6 lets std::length_error out of some malformed keys
+    fail(path, "yaml", "OpenCV cannot read it (" + printable(e.what(), 60) + ")");
   }
   Camera c;
-  c.width = readSize(fs, path, "image_width");
-  c.height = readSize(fs, path, "image_height");
-  const cv::Mat k = readMatrix(fs, path, "camera_matrix");
-  if (k.rows != 3 || k.cols != 3) fail(path, "camera_matrix", "must be 3x3");
-  c.camera_matrix = cv::Matx33d(k);
-  const cv::Mat d = readMatrix(fs, path, "distortion_coefficients");
-  if (d.rows != 1 && d.cols != 1) fail(path, "distortion_coefficients", "must be a row or a column");
-  c.distortion.assign(d.begin<double>(), d.end<double>());
-  c.rvec = readVec3(fs, path, "rvec");
-  c.tvec = readVec3(fs, path, "tvec");
+  try {
+    const cv::FileNode root = fs.root();
+    if (!root.isMap()) fail(path, "document", "the top level must be a mapping of camera fields (image_width: ...)");
+    checkUniqueKeys(root, path, "");
+    c.width = readSize(fs, path, "image_width");
+    c.height = readSize(fs, path, "image_height");
+    const cv::Mat k = readMatrix(fs, path, "camera_matrix");
+    if (k.rows != 3 || k.cols != 3) fail(path, "camera_matrix", "must be 3x3");
+    c.camera_matrix = cv::Matx33d(k);
+    const cv::Mat d = readMatrix(fs, path, "distortion_coefficients");
+    if (d.rows != 1 && d.cols != 1) fail(path, "distortion_coefficients", "must be a row or a column");
+    c.distortion.assign(d.begin<double>(), d.end<double>());
+    c.rvec = readVec3(fs, path, "rvec");
+    c.tvec = readVec3(fs, path, "tvec");
+  } catch (const cv::Exception& e) {
+    failParse(path, e);
+  } catch (const CameraError&) {
+    throw;
+  } catch (const std::exception& e) {
+    fail(path, "yaml", "OpenCV cannot read it (" + printable(e.what(), 60) + ")");
+  }
   c.validate(path);
   return c;
 }
@@ -116,9 +323,10 @@ void saveCamera(const Camera& camera, const std::string& path) {
 }
 
 Projection::Projection(const Camera& camera, double supersample)
-    : camera_(camera), supersample_(supersample), world_to_camera_(camera.worldToCamera()) {
+    : camera_(camera), supersample_(supersample) {
   camera_.validate("camera");
-  if (!(supersample >= 1.0 && supersample <= 4.0)) throw CameraError("supersample must be in 1..4");
+  world_to_camera_ = camera.worldToCamera();
+  if (!(supersample >= 1.0 && supersample <= 4.0)) throw CameraError("camera: supersample: must be in 1..4");
   const double s = supersample;
   const double fx = camera.camera_matrix(0, 0), fy = camera.camera_matrix(1, 1);
   const double cx = camera.camera_matrix(0, 2), cy = camera.camera_matrix(1, 2);
@@ -143,34 +351,29 @@ Projection::Projection(const Camera& camera, double supersample)
     return;
   }
   // Normalised coordinates of every output pixel centre (the inverse of the distortion model).
+  // In blocks of rows: the temporaries of the inversion stay small for large images.
   const int n = camera.width * camera.height;
-  cv::Mat pixels(n, 1, CV_64FC2), normal;
-  for (int v = 0, i = 0; v < camera.height; ++v)
-    for (int u = 0; u < camera.width; ++u, ++i) pixels.at<cv::Vec2d>(i) = cv::Vec2d(u, v);
-  cv::undistortPoints(pixels, normal, camera.camera_matrix, camera.distortion, cv::noArray(), cv::noArray(),
-                          cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-10));
-  // Keep only the pixels the inversion really solved (checked by distorting again).
-  cv::Mat xyz(n, 1, CV_64FC3), back;
-  for (int i = 0; i < n; ++i) {
-    const cv::Vec2d p = normal.at<cv::Vec2d>(i);
-    xyz.at<cv::Vec3d>(i) = cv::Vec3d(p[0], p[1], 1.0);
-  }
-  cv::projectPoints(xyz, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.camera_matrix, camera.distortion, back);
-  // At most one image width / height of extra field on each side.
-  const double x_lo = -(cx + 0.5) / fx - camera.width / fx, x_hi = (camera.width - cx - 0.5) / fx + camera.width / fx;
-  const double y_lo = -(cy + 0.5) / fy - camera.height / fy, y_hi = (camera.height - cy - 0.5) / fy + camera.height / fy;
+  cv::Mat normal(n, 1, CV_64FC2);
   std::vector<unsigned char> valid(n, 0);
+  const int block_rows = std::max(1, (1 << 16) / camera.width);
+  for (int v0 = 0; v0 < camera.height; v0 += block_rows) {
+    const int rows = std::min(block_rows, camera.height - v0), m = rows * camera.width, first = v0 * camera.width;
+    cv::Mat pixels(m, 1, CV_64FC2), block_normal;
+    for (int v = v0, i = 0; v < v0 + rows; ++v)
+      for (int u = 0; u < camera.width; ++u, ++i) pixels.at<cv::Vec2d>(i) = cv::Vec2d(u, v);
+    std::vector<unsigned char> block_valid;
+    undistortChecked(camera, pixels, block_normal, block_valid);
+    block_normal.copyTo(normal.rowRange(first, first + m));
+    std::copy(block_valid.begin(), block_valid.end(), valid.begin() + first);
+  }
   double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
-  for (int v = 0, i = 0; v < camera.height; ++v)
-    for (int u = 0; u < camera.width; ++u, ++i) {
-      const cv::Vec2d p = normal.at<cv::Vec2d>(i), b = back.at<cv::Vec2d>(i);
-      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || std::hypot(b[0] - u, b[1] - v) > 1e-3) continue;
-      if (p[0] < x_lo || p[0] > x_hi || p[1] < y_lo || p[1] > y_hi) continue;
-      valid[i] = 1;
+  for (int i = 0; i < n; ++i)
+    if (valid[i]) {
+      const cv::Vec2d p = normal.at<cv::Vec2d>(i);
       xmin = std::min(xmin, p[0]), xmax = std::max(xmax, p[0]);
       ymin = std::min(ymin, p[1]), ymax = std::max(ymax, p[1]);
     }
-  if (xmin > xmax) throw CameraError("camera: the distortion model cannot be inverted anywhere in the image");
+  if (xmin > xmax) throw CameraError("camera: distortion_coefficients: the lens model cannot be inverted anywhere in the image");
   const double pad = 2.0;
   pinhole_.cx = -xmin * pinhole_.fx + pad;
   pinhole_.cy = -ymin * pinhole_.fy + pad;

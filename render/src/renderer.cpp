@@ -1,5 +1,7 @@
 #include "kccd/render/renderer.hpp"
 
+#include "kccd/distance.hpp"
+
 #include <GL/gl.h>
 #include <GL/glext.h>
 
@@ -8,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
 
 #include <opencv2/imgproc.hpp>
 
@@ -19,6 +22,19 @@ const char* toString(VolumeStatus status) {
     case VolumeStatus::WithinMargin: return "within_margin";
     case VolumeStatus::Colliding: return "colliding";
     case VolumeStatus::NoState: return "no_state";
+  }
+  return "?";
+}
+
+const char* toString(Visibility visibility) {
+  switch (visibility) {
+    case Visibility::Drawn: return "drawn";
+    case Visibility::FillsView: return "contains the camera";
+    case Visibility::Empty: return "no volume";
+    case Visibility::NotFinite: return "not finite";
+    case Visibility::BehindCamera: return "behind the camera";
+    case Visibility::BeyondFar: return "beyond far plane";
+    case Visibility::NoMesh: return "no mesh";
   }
   return "?";
 }
@@ -107,6 +123,9 @@ struct Renderer::Prepared {
   std::vector<float> vertices;
   std::vector<std::uint32_t> outline;
   double depth = 0.0;
+  bool fills = false;     // contains the camera: drawn as a full-view fill, no mesh
+  double clearance = 0.0;  // distance from the camera to the mesh (lower bound), when drawn
+  double reach = 0.0;      // distance from the camera to the farthest point of the mesh
 };
 
 Renderer::Renderer(const Camera& camera, const RenderOptions& options)
@@ -114,8 +133,22 @@ Renderer::Renderer(const Camera& camera, const RenderOptions& options)
       projection_(camera, options.supersample),
       context_(GlContext::make()),
       world_to_camera_(camera.worldToCamera()) {
-  if (camera.distorted() && options.mask_supersample != options.supersample)
-    mask_projection_ = std::make_unique<Projection>(camera, options.mask_supersample);
+  GLint max_renderbuffer = 0, viewport[2] = {0, 0};
+  glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
+  glGetIntegerv(GL_MAX_VIEWPORT_DIMS, viewport);
+  const int max_w = std::min<int>(max_renderbuffer, viewport[0]), max_h = std::min<int>(max_renderbuffer, viewport[1]);
+  auto fits = [&](const Projection& p) { return p.pinhole().width <= max_w && p.pinhole().height <= max_h; };
+  if (!fits(projection_)) {
+    std::ostringstream msg;
+    msg << "camera: image_width: the " << camera.width << "x" << camera.height << " image is drawn as a "
+        << projection_.pinhole().width << "x" << projection_.pinhole().height << " pinhole image (supersample "
+        << options.supersample << "), more than this GL allows (" << max_w << "x" << max_h << "): use a smaller supersample";
+    throw CameraError(msg.str());
+  }
+  if (camera.distorted() && options.mask_supersample != options.supersample) {
+    auto mask = std::make_unique<Projection>(camera, options.mask_supersample);
+    if (fits(*mask)) mask_projection_ = std::move(mask);  // else the mask keeps the colour pass's scale
+  }
   const Pinhole& mask = maskProjection().pinhole();
   gl_ = std::make_unique<Gl>(projection_.pinhole().width, projection_.pinhole().height, options.msaa_samples, mask.width,
                              mask.height);
@@ -134,7 +167,9 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
   const Camera& cam = projection_.camera();
   const double focal = std::max(cam.camera_matrix(0, 0), cam.camera_matrix(1, 1));
   out.resize(volumes.size());
+  frame.visibility.assign(volumes.size(), Visibility::Empty);
   std::vector<Vec3> cam_points;
+  const Vec3 origin = Vec3::Zero();
   for (std::size_t i = 0; i < volumes.size(); ++i) {
     const Volume& v = volumes[i];
     Prepared& p = out[i];
@@ -143,21 +178,39 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     p.mesh.reset();
     p.vertices.clear();
     p.outline.clear();
+    p.fills = false;
+    Visibility& visibility = frame.visibility[i];
     if (v.points.empty()) continue;
     // Tessellation fine enough that the circumscribed sphere polytope lies at most
     // tolerance_px outside the true surface, as seen from the closest point of the volume.
     const Pose to_camera = world_to_camera_ * v.pose;
     cam_points.clear();
-    double zmin = 1e300;
+    double zmin = 1e300, zmax = -1e300;
     Vec3 centre = Vec3::Zero();
     for (const Vec3& w : v.points) {
       cam_points.push_back(to_camera * w);
       zmin = std::min(zmin, cam_points.back().z());
+      zmax = std::max(zmax, cam_points.back().z());
       centre += cam_points.back();
     }
     centre /= static_cast<double>(cam_points.size());
-    p.depth = centre.norm();
     const double r = std::max(v.radius, options_.min_radius);
+    double spread = 0.0;
+    for (const Vec3& c : cam_points) spread = std::max(spread, (c - centre).norm());
+    if (!allFinite(cam_points) || !std::isfinite(v.radius) || !std::isfinite(spread + r) || !std::isfinite(centre.norm())) {
+      visibility = Visibility::NotFinite;
+      continue;
+    }
+    p.depth = centre.norm();
+    if (zmax + r <= 0.0) {
+      visibility = Visibility::BehindCamera;
+      continue;
+    }
+    p.reach = p.depth + spread + r;
+    if (p.reach * 1.01 > kMaxDrawDistance) {
+      visibility = Visibility::BeyondFar;
+      continue;
+    }
     zmin -= r;
     int level = options_.max_level;
     if (zmin > options_.near) {
@@ -168,8 +221,23 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
           break;
         }
     }
+    // How near the mesh comes to the camera: the volume's distance less the tessellation's
+    // outward error. A volume (nearly) containing the camera covers the whole view.
+    const DistanceResult d = distance(SschView{cam_points, r}, SschView{std::span<const Vec3>(&origin, 1), 0.0});
+    p.clearance = d.status == GjkStatus::InvalidInput ? 0.0 : d.distance - (spherePolytope(level).scale - 1.0) * r;
+    if (p.clearance <= 1e-4) {
+      p.fills = true;
+      visibility = Visibility::FillsView;
+      continue;
+    }
     const std::uint64_t before = cache_.built();
-    p.mesh = cache_.get(v.points, v.radius, level, options_.min_radius);
+    try {
+      p.mesh = cache_.get(v.points, v.radius, level, options_.min_radius);
+    } catch (const std::exception&) {  // qhull on extreme coordinates
+      visibility = Visibility::NoMesh;
+      continue;
+    }
+    visibility = Visibility::Drawn;
     if (cache_.built() != before) frame.hull_input += p.mesh->hull_input;
     frame.max_level = std::max(frame.max_level, level);
     const Mesh& m = *p.mesh;
@@ -192,6 +260,20 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     frame.triangles += static_cast<int>(m.triangles.size());
   }
   frame.meshes_built = static_cast<int>(cache_.built() - built_before);
+  // Clipping planes that clip no drawn mesh: the near plane closer than the nearest mesh
+  // anywhere in the view frustum, the far plane beyond the farthest one.
+  frame.near = options_.near;
+  frame.far = options_.far;
+  for (const Projection* pr : {static_cast<const Projection*>(&projection_), &maskProjection()}) {
+    const Pinhole& ph = pr->pinhole();
+    const double tx = std::max(ph.cx + 0.5, ph.width - ph.cx - 0.5) / ph.fx;
+    const double ty = std::max(ph.cy + 0.5, ph.height - ph.cy - 0.5) / ph.fy;
+    const double corner = std::sqrt(1.0 + tx * tx + ty * ty);  // frustum corner at unit depth
+    for (const Prepared& p : out)
+      if (p.mesh) frame.near = std::min(frame.near, 0.5 * p.clearance / corner);
+  }
+  for (const Prepared& p : out)
+    if (p.mesh) frame.far = std::max(frame.far, 1.01 * p.reach);
 }
 
 namespace {
@@ -209,6 +291,22 @@ void setCamera(const Projection& projection, double near, double far) {
   glEnableClientState(GL_VERTEX_ARRAY);
 }
 
+// Draws a quad over the whole viewport (the camera matrices are restored afterwards).
+void fillViewport() {
+  glMatrixMode(GL_PROJECTION);
+  glPushMatrix();
+  glLoadIdentity();
+  glMatrixMode(GL_MODELVIEW);
+  glDisable(GL_CULL_FACE);
+  const float quad[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+  glVertexPointer(3, GL_FLOAT, 0, quad);
+  glDrawArrays(GL_TRIANGLE_FAN, 0, 4);
+  glEnable(GL_CULL_FACE);
+  glMatrixMode(GL_PROJECTION);
+  glPopMatrix();
+  glMatrixMode(GL_MODELVIEW);
+}
+
 void drawTriangles(const Mesh& mesh, const std::vector<float>& vertices) {
   glVertexPointer(3, GL_FLOAT, 0, vertices.data());
   glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.triangles.size() * 3), GL_UNSIGNED_INT, mesh.triangles.data());
@@ -216,10 +314,10 @@ void drawTriangles(const Mesh& mesh, const std::vector<float>& vertices) {
 
 }  // namespace
 
-cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& style) {
+cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& style, double near, double far) {
   const int w = gl_->width, h = gl_->height;
   glBindFramebuffer(GL_FRAMEBUFFER, gl_->samples > 1 ? gl_->ms_fbo : gl_->resolve_fbo);
-  setCamera(projection_, options_.near, options_.far);
+  setCamera(projection_, near, far);
   glClearColor(0, 0, 0, 0);
   glClear(GL_COLOR_BUFFER_BIT);
   glDisable(GL_DEPTH_TEST);
@@ -246,6 +344,13 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
     glDrawElements(GL_LINES, static_cast<GLsizei>(p->outline.size()), GL_UNSIGNED_INT, p->outline.data());
   }
   glDisable(GL_LINE_SMOOTH);
+  // Volumes containing the camera tint the whole view, in front of everything else.
+  for (const Prepared& p : bodies)
+    if (p.fills) {
+      const cv::Scalar c = statusColour(p.status);
+      glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
+      fillViewport();
+    }
   glDisable(GL_BLEND);
   if (gl_->samples > 1) {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->ms_fbo);
@@ -263,18 +368,20 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   return image;
 }
 
-cv::Mat Renderer::drawMask(const std::vector<Prepared>& bodies) {
+cv::Mat Renderer::drawMask(const std::vector<Prepared>& bodies, double near, double far) {
   const int w = gl_->mask_width, h = gl_->mask_height;
   glBindFramebuffer(GL_FRAMEBUFFER, gl_->mask_fbo);
-  setCamera(maskProjection(), options_.near, options_.far);
-  glClearColor(0, 0, 0, 0);
+  setCamera(maskProjection(), near, far);
+  // A volume containing the camera is the nearest everywhere.
+  const auto fill = std::find_if(bodies.begin(), bodies.end(), [](const Prepared& p) { return p.fills; });
+  glClearColor(fill == bodies.end() ? 0.0f : static_cast<float>(fill->index + 1) / 255.0f, 0, 0, 0);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_BLEND);
   for (const Prepared& p : bodies) {
-    if (!p.mesh) continue;
+    if (!p.mesh || fill != bodies.end()) continue;
     glColor4ub(static_cast<GLubyte>(p.index + 1), 0, 0, 255);
     drawTriangles(*p.mesh, p.vertices);
   }
@@ -304,7 +411,7 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
   tick("prepare");
   const Camera& cam = projection_.camera();
   if (want_colour) {
-    cv::Mat premultiplied = drawColour(bodies, style);
+    cv::Mat premultiplied = drawColour(bodies, style, frame.near, frame.far);
     tick("colour+readback");
     if (projection_.warps()) {
       if (fixed_map_a_.empty())  // fixed-point maps: remap's fast path (1/32 px steps)
@@ -332,11 +439,11 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
       }
     });
     tick("warp+unpremultiply");
-    decorate(frame.bgra, volumes, style);
+    decorate(frame.bgra, volumes, frame.visibility, style);
     tick("decorate");
   }
   if (want_mask) {
-    cv::Mat mask = drawMask(bodies);
+    cv::Mat mask = drawMask(bodies, frame.near, frame.far);
     const Projection& mp = maskProjection();
     if (mp.warps()) {
       if (mask_map_.empty()) {  // nearest pinhole pixel per output pixel, as integers
@@ -361,7 +468,8 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
   return frame;
 }
 
-void Renderer::decorate(cv::Mat& bgra, std::span<const Volume> volumes, const Style& style) {
+void Renderer::decorate(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility,
+                        const Style& style) {
   const int font = cv::FONT_HERSHEY_SIMPLEX;
   const double scale = std::clamp(bgra.rows / 900.0, 0.35, 1.0);
   const int thick = std::max(1, static_cast<int>(std::lround(scale * 2)));
@@ -370,14 +478,16 @@ void Renderer::decorate(cv::Mat& bgra, std::span<const Volume> volumes, const St
     cv::putText(bgra, s, at, font, scale, cv::Scalar(255, 255, 255, 255), thick, cv::LINE_AA);
   };
   if (style.labels) {
-    for (const Volume& v : volumes) {
-      if (v.points.empty() || v.label.empty()) continue;
+    for (std::size_t i = 0; i < volumes.size(); ++i) {
+      const Volume& v = volumes[i];
+      if (visibility[i] != Visibility::Drawn || v.label.empty()) continue;
       Vec3 centre = Vec3::Zero();
       for (const Vec3& p : v.points) centre += p;
       centre = v.pose * (centre / static_cast<double>(v.points.size()));
       if ((world_to_camera_ * centre).z() <= options_.near) continue;
       const Eigen::Vector2d px = projection_.project(centre);
-      if (!std::isfinite(px.x()) || !std::isfinite(px.y())) continue;
+      // Centres far outside the image have no visible label (and would overflow int).
+      if (!(px.x() > -bgra.cols && px.x() < 2.0 * bgra.cols && px.y() > -bgra.rows && px.y() < 2.0 * bgra.rows)) continue;
       int baseline = 0;
       const cv::Size size = cv::getTextSize(v.label, font, scale, thick, &baseline);
       text(v.label, cv::Point(static_cast<int>(px.x()) - size.width / 2, static_cast<int>(px.y()) + size.height / 2));
@@ -393,7 +503,7 @@ void Renderer::decorate(cv::Mat& bgra, std::span<const Volume> volumes, const St
       legend_box_ = cv::boundingRect(alpha);
     }
     const cv::Rect box = legend_box_ & cv::Rect(0, 0, bgra.cols, bgra.rows);
-    legend_(box).copyTo(bgra(box));
+    if (!box.empty()) legend_(box).copyTo(bgra(box));  // an image a few pixels high shows none of it
   }
 }
 

@@ -10,15 +10,25 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include "kccd/input_error.hpp"
 #include "kccd/ssch.hpp"
 
 namespace kccd::render {
 
 /// A camera file that cannot be used: the message names the file and the field.
-class CameraError : public std::runtime_error {
+class CameraError : public InputError {
  public:
-  using std::runtime_error::runtime_error;
+  using InputError::InputError;
 };
+
+/// Bounds of the cameras the renderer accepts (checked by Camera::validate).
+inline constexpr int kMaxImageSide = 8192;                ///< image_width, image_height
+inline constexpr long kMaxImagePixels = 1L << 24;         ///< width * height (4096 x 4096)
+inline constexpr int kMaxPinholeSide = 8192;              ///< the widened pinhole image at supersample 1
+inline constexpr double kMaxFocal = 1e6;                  ///< fx, fy in 1 .. kMaxFocal pixels
+inline constexpr double kMaxDistortion = 1e4;             ///< |k_i|, |p_i|, |s_i|; tilt |tx|, |ty| <= 1 rad
+inline constexpr double kMaxTranslation = 1e6;            ///< |tvec| in metres
+inline constexpr std::size_t kMaxCameraFileBytes = 1 << 20;
 
 /// A calibrated camera in OpenCV's conventions (pixel centres at integer coordinates).
 struct Camera {
@@ -33,12 +43,17 @@ struct Camera {
   bool distorted() const;
   /// The world -> camera transform (x right, y down, z forward).
   Pose worldToCamera() const;
-  /// Checks sizes, finiteness and ranges; throws CameraError("<source>: <field>: <problem>").
+  /// Checks sizes, finiteness and ranges, and that the distortion model can be inverted on the
+  /// whole image border with a widened pinhole image of at most kMaxPinholeSide pixels a side;
+  /// throws CameraError("<source>: <field>: <problem>").
   void validate(const std::string& source) const;
 };
 
 /// Reads an OpenCV FileStorage camera file (image_width, image_height, camera_matrix,
-/// distortion_coefficients, rvec, tvec) and validates it. Throws CameraError.
+/// distortion_coefficients, rvec, tvec) and validates it. The file must be a regular text file
+/// of at most kMaxCameraFileBytes starting with `%YAML:1.x`, holding one YAML document whose
+/// top level is a mapping without repeated keys. Throws CameraError (an InputError), never
+/// anything else for any file content.
 Camera loadCamera(const std::string& path);
 /// Writes a camera file in the same layout (used by tests and tools).
 void saveCamera(const Camera& camera, const std::string& path);

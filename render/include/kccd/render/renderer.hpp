@@ -23,6 +23,24 @@ const char* toString(VolumeStatus status);
 /// The fill colour of a status as BGR (OpenCV order).
 cv::Scalar statusColour(VolumeStatus status);
 
+/// How a volume ended up in a frame. Only Drawn and FillsView volumes appear in the images.
+enum class Visibility : std::uint8_t {
+  Drawn,         ///< drawn as its mesh (possibly outside the image: see Frame::pixels)
+  FillsView,     ///< contains the camera (or comes within 0.1 mm of it): fills the whole view
+  Empty,         ///< no core points
+  NotFinite,     ///< a NaN or infinite coordinate or radius (overflow): not drawn
+  BehindCamera,  ///< entirely behind the camera: not drawn
+  BeyondFar,     ///< reaches farther than kMaxDrawDistance from the camera: not drawn
+  NoMesh,        ///< its mesh could not be built: not drawn
+};
+/// "drawn", "contains the camera", "no volume", "not finite", "behind the camera",
+/// "beyond far plane", "no mesh".
+const char* toString(Visibility visibility);
+
+/// Volumes reaching farther than this from the camera (metres) are not drawn (float vertices
+/// and the depth range stop being meaningful); nearer ones move the far plane out as needed.
+inline constexpr double kMaxDrawDistance = 1e6;
+
 /// One volume to draw: core points in the volume's own frame, placed in the world by `pose`
 /// (the mesh is cached by the points and radius, so a volume that only moves keeps its mesh).
 struct Volume {
@@ -54,7 +72,10 @@ struct RenderOptions {
   double tolerance_px = 0.5;   ///< largest outward error of the sphere tessellation, output pixels
   int max_level = 3;           ///< finest sphere tessellation (level 3: 642 vertices, 0.3 % outward)
   double min_radius = kMinDrawRadius;  ///< volumes thinner than this are drawn this thick (metres)
-  double near = 0.05;          ///< clipping planes, metres along the optical axis
+  /// Clipping planes, metres along the optical axis. Per frame, the near plane moves closer
+  /// when a volume comes nearer to the camera than this, and the far plane moves out to the
+  /// farthest volume (up to kMaxDrawDistance), so no drawn volume is clipped by them.
+  double near = 0.05;
   double far = 100.0;
 };
 
@@ -65,6 +86,8 @@ struct Frame {
   cv::Mat bgra;
   cv::Mat mask;
   std::vector<int> pixels;
+  std::vector<Visibility> visibility;  ///< per volume
+  double near = 0.0, far = 0.0;       ///< the clipping planes used
   int meshes_built = 0;   ///< meshes built in this frame (the others came from the cache)
   int triangles = 0;      ///< triangles drawn per pass
   int hull_input = 0;     ///< points passed to qhull for the meshes built in this frame
@@ -75,7 +98,9 @@ struct Frame {
 /// Renderer per thread). Meshes are cached by exact volume shape across frames.
 class Renderer {
  public:
-  /// Creates the GL context and the framebuffers; throws GlContextError or CameraError.
+  /// Creates the GL context and the framebuffers; throws GlContextError or CameraError (also
+  /// when the pinhole image exceeds this GL's renderbuffer or viewport limit; the mask pass then
+  /// falls back to the colour pass's scale before giving up).
   explicit Renderer(const Camera& camera, const RenderOptions& options = {});
   ~Renderer();
   Renderer(const Renderer&) = delete;
@@ -94,9 +119,10 @@ class Renderer {
   struct Gl;
   struct Prepared;
   void prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame);
-  cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style);
-  cv::Mat drawMask(const std::vector<Prepared>& bodies);
-  void decorate(cv::Mat& bgra, std::span<const Volume> volumes, const Style& style);
+  cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style, double near, double far);
+  cv::Mat drawMask(const std::vector<Prepared>& bodies, double near, double far);
+  void decorate(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility,
+                const Style& style);
   static cv::Mat drawLegend(double scale, int thick);
 
   RenderOptions options_;
