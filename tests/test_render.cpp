@@ -209,6 +209,9 @@ TEST(RenderCamera, ParseErrorsAreOneLineWithThePlace) {
       {"kccd_cam_json.yaml", "{\"image_width\": 320}", ".yaml:1: header"},
       {"kccd_cam_list.yaml", "%YAML:1.0\n---\n- 1\n- 2\n", "top level must be a mapping"},
       {"kccd_cam_scalar.yaml", "%YAML:1.0\n---\n42\n", ".yaml:"},
+      // OpenCV's parser loops forever on this (a marker followed by text; found by fuzzing).
+      {"kccd_cam_marker.yaml", "%YAML:1.0\n---xML:Y\n--x\n-", ".yaml:2: document: '---' must stand alone"},
+      {"kccd_cam_marker2.yaml", cameraText() + "...x\n", "document: '...' must stand alone"},
       {"kccd_cam_binary.yaml", std::string("%YAML:1.0\n\0\x01\x02\xff", 14), ".yaml:2: file: control byte \\x00"},
       {"kccd_cam_quoted.yaml", "%YAML:1.0\n---\n\"image_width\": 320\n", "yaml: OpenCV cannot read it"},
       {"kccd_cam_matrix_huge.yaml",

@@ -74,6 +74,19 @@ void checkCameraText(const std::string& text, const std::string& path) {
     else if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7f)
       failAt(path, line, "file", "control byte " + printable(std::string_view(&ch, 1)) + " (not a text file)");
   }
+  // "---" or "..." at the start of a line with more text right after it is content to YAML but a
+  // document marker to OpenCV (whose parser can then loop forever): neither reading is wanted.
+  line = 1;
+  for (std::size_t at = 0; at < text.size(); at = text.find('\n', at) + 1, ++line) {
+    if (text.compare(at, 3, "---") != 0 && text.compare(at, 3, "...") != 0) {
+      if (text.find('\n', at) == std::string::npos) break;
+      continue;
+    }
+    const char next = at + 3 < text.size() ? text[at + 3] : '\n';
+    if (next != '\n' && next != '\r' && next != ' ' && next != '\t')
+      failAt(path, line, "document", "'" + text.substr(at, 3) + "' must stand alone at the start of a line (a document marker)");
+    if (text.find('\n', at) == std::string::npos) break;
+  }
   std::size_t start = 0;
   if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) start = 3;  // UTF-8 byte order mark
   const std::size_t eol = std::min(text.find('\n', start), text.size());
