@@ -12,29 +12,14 @@
 
 #include <unistd.h>
 
+#include "input_file.hpp"
 #include "kccd/modelling/part.hpp"
-
-namespace {
-
-const std::filesystem::path& workDir() {
-  static const std::filesystem::path dir = [] {
-    std::filesystem::path d = std::filesystem::temp_directory_path() / ("kccd_fuzz_part_" + std::to_string(getpid()));
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
-
-}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
   static const char* const extensions[] = {".iv", ".wrl", ".stl"};
-  const std::string path = (workDir() / (std::string("input") + extensions[data[0] % 3])).string();
-  {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
-  }
+  const std::string path =
+      kccd::fuzz::writeInput("fuzz_part", std::string("input") + extensions[data[0] % 3], data + 1, size - 1);
   try {
     (void)kccd::modelling::readPart(path, {.merge = (data[0] & 4) != 0});
   } catch (const std::runtime_error& e) {

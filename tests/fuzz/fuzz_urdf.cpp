@@ -12,27 +12,11 @@
 
 #include <unistd.h>
 
+#include "input_file.hpp"
 #include "kccd/modelling/urdf_import.hpp"
 
-namespace {
-
-const std::filesystem::path& workDir() {
-  static const std::filesystem::path dir = [] {
-    std::filesystem::path d = std::filesystem::temp_directory_path() / ("kccd_fuzz_urdf_" + std::to_string(getpid()));
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
-
-}  // namespace
-
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::string path = (workDir() / "input.urdf").string();
-  {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
-  }
+  const std::string path = kccd::fuzz::writeInput("fuzz_urdf", "input.urdf", data, size);
   try {
     // One core point: the fit stays quick; meshes are looked up next to the input (none there).
     (void)kccd::modelling::importUrdf(path, {.points = 1});
