@@ -147,6 +147,13 @@ TEST(PartInputs, CoordinateIndicesOutsideTheirCoordinatesAreRefused) {
       {kIv + coords + "FaceSet { numVertices [3, 3] }\n", "FaceSet: numVertices: 6 vertices"},
       {kIv + coords + "TriangleStripSet { startIndex 2 numVertices [3] }\n", "TriangleStripSet: numVertices"},
       {kIv + coords + "QuadMesh { verticesPerRow 3 verticesPerColumn 3 }\n", "QuadMesh: verticesPerColumn x verticesPerRow"},
+      // Faces and strips of fewer than 3 vertices: Coin reads past its arrays (SIGSEGV) or
+      // allocates without end (found by fuzz_part).
+      {kIv + coords + "FaceSet { numVertices [2] }\n", "FaceSet: numVertices[0]: 2 vertices, at least 3 needed"},
+      {kIv + coords + "FaceSet { numVertices [3, 0] }\n", "FaceSet: numVertices[1]: 0 vertices"},
+      {kIv + coords + "FaceSet { numVertices [3, -1] }\n", "numVertices[1]: -1 (the rest) leaves 1 vertices"},
+      {kIv + coords + "TriangleStripSet { numVertices [2] }\n", "TriangleStripSet: numVertices[0]: 2 vertices"},
+      {kIv + coords + "LineSet { numVertices [1] }\n", "LineSet: numVertices[0]: 1 vertices, at least 2"},
       {"#VRML V2.0 utf8\nShape { geometry IndexedFaceSet { coord Coordinate { point [0 0 0, 1 0 0, 0 1 0] }"
        " coordIndex [0 1 5 -1] } }\n",
        "VRMLIndexedFaceSet: coordIndex[2]: 5"},

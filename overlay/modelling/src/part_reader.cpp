@@ -197,15 +197,24 @@ std::string checkIndices(const char* field, const SoMFInt32& indices, int count)
   return {};
 }
 
-// start + the vertices counts (-1: all the rest) within `count` coordinates.
-std::string checkCounts(const SoMFInt32& counts, int start, int count) {
+// start + the vertices counts (-1: all the rest) within `count` coordinates, each count at least
+// `least` (Coin reads out of bounds or allocates without end on a face or strip of fewer than 3).
+std::string checkCounts(const SoMFInt32& counts, int start, int count, int least = 0) {
   if (start < 0 || start > count)
     return "startIndex: " + std::to_string(start) + " is outside the " + std::to_string(count) + " coordinates";
   long long used = start;
   for (int i = 0; i < counts.getNum(); ++i) {
     const int32_t n = counts[i];
-    if (n == -1 && i + 1 == counts.getNum()) break;
+    if (n == -1 && i + 1 == counts.getNum()) {
+      if (count - used < least)
+        return "numVertices[" + std::to_string(i) + "]: -1 (the rest) leaves " + std::to_string(count - used) +
+               " vertices, fewer than " + std::to_string(least);
+      break;
+    }
     if (n < 0) return "numVertices[" + std::to_string(i) + "]: " + std::to_string(n) + " is negative";
+    if (n < least)
+      return "numVertices[" + std::to_string(i) + "]: " + std::to_string(n) + " vertices, at least " +
+             std::to_string(least) + " needed";
     used += n;
     if (used > count)
       return "numVertices: " + std::to_string(used - start) + " vertices from index " + std::to_string(start) +
@@ -297,7 +306,8 @@ SoCallbackAction::Response shape(void* data, SoCallbackAction* action, const SoN
                                   : node->isOfType(SoLineSet::getClassTypeId())
                                         ? static_cast<const SoLineSet*>(node)->numVertices
                                         : static_cast<const SoTriangleStripSet*>(node)->numVertices;
-    first({checkCounts(counts, s->startIndex.getValue(), inventorCoordinates(action, s))});
+    const int least = node->isOfType(SoLineSet::getClassTypeId()) ? 2 : 3;
+    first({checkCounts(counts, s->startIndex.getValue(), inventorCoordinates(action, s), least)});
   } else if (node->isOfType(SoPointSet::getClassTypeId())) {
     const auto* s = static_cast<const SoPointSet*>(node);
     SoMFInt32 counts;
