@@ -2,16 +2,20 @@
 # Builds the libFuzzer targets (clang-14, ASan + UBSan) and runs each for a while on a fresh copy
 # of its seed corpus (tests/fuzz/corpus/NAME plus sample files from data/). Any crash, sanitizer
 # report, leak, time-out or memory blow-up fails the run and leaves the input in build-fuzz/artifacts/.
-#   scripts/fuzz.sh [--seconds N] [TARGET...]     (default: 15 s each, every target)
+#   scripts/fuzz.sh [--seconds N] [TARGET...]   explore: N seconds each (default 15), a new seed each run
+#   scripts/fuzz.sh --ci [TARGET...]            CI: a fixed seed and a fixed number of inputs per
+#                                               target (about 15 s each here), so a run is repeatable
 # Environment: KCCD_JOBS (default 2).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=15
+ci=0
 targets=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds=$2; shift 2 ;;
     --seconds=*) seconds=${1#*=}; shift ;;
+    --ci) ci=1; seconds=120; shift ;;
     -*) echo "fuzz.sh: unknown option $1" >&2; exit 2 ;;
     *) targets+=("$1"); shift ;;
   esac
@@ -21,6 +25,15 @@ bash scripts/install-deps.sh --fuzz
 CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DKCCD_BUILD_FUZZERS=ON -DKCCD_BUILD_TESTS=OFF -DKCCD_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build build-fuzz -j "${KCCD_JOBS:-2}" --target "${targets[@]}"
+
+ci_runs() {  # inputs per target in --ci mode (about 15 s each on this project's machines)
+  case "$1" in
+    fuzz_model) echo 30000 ;;
+    fuzz_camera) echo 200000 ;;
+    fuzz_part) echo 30000 ;;
+    fuzz_urdf) echo 4000 ;;
+  esac
+}
 
 seeds() {  # extra seed files from data/ per target
   case "$1" in
@@ -41,11 +54,17 @@ for t in "${targets[@]}"; do
   # urdfdom keep per-process caches the leak checker would report on every input (the ASan test
   # suite checks our own code on those paths, with tests/lsan.supp).
   leaks=0; [ "$t" = fuzz_model ] && leaks=1
-  echo "== $t: ${seconds} s from $(ls "$corpus" | wc -l) seeds"
+  limits=(-max_total_time="$seconds")
+  if [ $ci -eq 1 ]; then
+    limits+=(-seed=1 -runs="$(ci_runs "$t")")
+    echo "== $t: $(ci_runs "$t") inputs (seed 1) from $(ls "$corpus" | wc -l) seeds"
+  else
+    echo "== $t: ${seconds} s from $(ls "$corpus" | wc -l) seeds"
+  fi
   # An out-of-memory stop under ASan can leave libFuzzer stuck: the outer timeout kills it.
   if ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 \
      LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
-     timeout -s KILL $((seconds + 120)) "build-fuzz/tests/fuzz/$t" -max_total_time="$seconds" -timeout=10 \
+     timeout -s KILL $((seconds + 120)) "build-fuzz/tests/fuzz/$t" "${limits[@]}" -timeout=10 \
        -rss_limit_mb=2048 -malloc_limit_mb=1024 -max_len=65536 -print_final_stats=1 -detect_leaks=$leaks \
        -artifact_prefix="build-fuzz/artifacts/$t-" "$corpus" > "build-fuzz/$t.log" 2>&1; then
     grep -E "stat::number_of_executed_units|stat::new_units_added" "build-fuzz/$t.log" | tr '\n' ' '; echo

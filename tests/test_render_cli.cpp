@@ -15,7 +15,8 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "kccd/render/camera.hpp"
+#include "kccd/calib/camera.hpp"
+#include "kccd/render/projection.hpp"
 #include "support/run_program.hpp"
 
 namespace {
@@ -35,7 +36,7 @@ class RenderCli : public ::testing::Test {
     dir_ = fs::path(::testing::TempDir()) / ("kccd_render_cli_" + std::to_string(getpid()));
     fs::create_directories(dir_);
     // A small version of the sample camera keeps the runs short (the distortion map is per pixel).
-    kccd::render::Camera c = kccd::render::loadCamera(kData + "/demo_camera.yaml");
+    kccd::calib::Camera c = kccd::calib::loadCamera(kData + "/demo_camera.yaml");
     c.width = 320;
     c.height = 180;
     c.camera_matrix(0, 0) /= 4;
@@ -43,7 +44,7 @@ class RenderCli : public ::testing::Test {
     c.camera_matrix(0, 2) = (c.camera_matrix(0, 2) + 0.5) / 4 - 0.5;
     c.camera_matrix(1, 2) = (c.camera_matrix(1, 2) + 0.5) / 4 - 0.5;
     camera_ = (dir_ / "camera.yaml").string();
-    kccd::render::saveCamera(c, camera_);
+    kccd::calib::saveCamera(c, camera_);
   }
   void TearDown() override { fs::remove_all(dir_); }
   std::string out(const std::string& name) const { return (dir_ / name).string(); }

@@ -41,10 +41,10 @@ void writePng(const cv::Mat& image, const std::string& path) {
 int runRender(const RenderArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
   const Model m = loadOrExplain(args.model);
-  render::Camera camera;
+  calib::Camera camera;
   try {
-    camera = render::loadCamera(args.camera);
-  } catch (const render::CameraError& e) {
+    camera = calib::loadCamera(args.camera);
+  } catch (const calib::CameraError& e) {
     throw UsageError(e.what());
   }
   {
@@ -76,7 +76,7 @@ int runRender(const RenderArgs& args) {
   std::unique_ptr<render::Renderer> renderer;
   try {
     renderer = std::make_unique<render::Renderer>(camera, options);
-  } catch (const render::CameraError& e) {
+  } catch (const calib::CameraError& e) {
     // Messages of the projection name the camera as "camera: field: problem".
     std::string msg = e.what();
     if (msg.rfind("camera: ", 0) == 0) msg = msg.substr(8);

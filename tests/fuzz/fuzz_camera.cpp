@@ -1,5 +1,5 @@
 // libFuzzer target: camera files. Any input must load or be rejected with kccd::InputError
-// (render::CameraError); any other exception, a crash, a hang or a sanitizer report is a finding.
+// (calib::CameraError); any other exception, a crash, a hang or a sanitizer report is a finding.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -10,12 +10,12 @@
 
 #include "input_file.hpp"
 #include "kccd/input_error.hpp"
-#include "kccd/render/camera.hpp"
+#include "kccd/calib/camera.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = kccd::fuzz::writeInput("fuzz_camera", "camera.yaml", data, size);
   try {
-    const kccd::render::Camera camera = kccd::render::loadCamera(path);
+    const kccd::render::Camera camera = kccd::calib::loadCamera(path);
     camera.validate(path);  // a loaded camera is a valid one
   } catch (const kccd::InputError&) {
   }

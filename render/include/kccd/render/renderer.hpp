@@ -10,7 +10,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "kccd/render/camera.hpp"
+#include "kccd/render/projection.hpp"
 #include "kccd/render/gl_context.hpp"
 #include "kccd/render/ssch_mesh.hpp"
 

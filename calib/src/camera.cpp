@@ -1,4 +1,4 @@
-#include "kccd/render/camera.hpp"
+#include "kccd/calib/camera.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <sstream>
 
 #include <opencv2/calib3d.hpp>
@@ -15,7 +16,7 @@
 
 #include "kccd/yaml_document.hpp"
 
-namespace kccd::render {
+namespace kccd::calib {
 namespace {
 
 constexpr int kDistortionSizes[] = {4, 5, 8, 12, 14};
@@ -172,6 +173,16 @@ int readSize(const cv::FileStorage& fs, const std::string& source, const char* f
   return v;
 }
 
+// An optional quality figure: absent, or a finite number >= 0.
+std::optional<double> readQuality(const cv::FileStorage& fs, const std::string& source, const char* field) {
+  const cv::FileNode node = fs[field];
+  if (node.empty()) return std::nullopt;
+  if (!node.isInt() && !node.isReal()) fail(source, field, "not a number");
+  const double v = static_cast<double>(node);
+  if (!std::isfinite(v) || v < 0.0) fail(source, field, "must be a finite number >= 0");
+  return v;
+}
+
 cv::Vec3d readVec3(const cv::FileStorage& fs, const std::string& source, const char* field) {
   const cv::Mat m = readMatrix(fs, source, field);
   if (m.total() != 3) fail(source, field, "needs 3 values, has " + std::to_string(m.total()));
@@ -184,10 +195,12 @@ std::string num(double v) {
   return s.str();
 }
 
+}  // namespace
+
 // Normalised coordinates of the pixel centres `pixels` (n x 1, CV_64FC2) through the inverse of
 // the distortion model, and which of them the inversion really solved (checked by distorting
 // again) within one image width / height of extra field on each side.
-void undistortChecked(const Camera& camera, const cv::Mat& pixels, cv::Mat& normal, std::vector<unsigned char>& valid) {
+void undistortPixels(const Camera& camera, const cv::Mat& pixels, cv::Mat& normal, std::vector<unsigned char>& valid) {
   const int n = pixels.rows;
   const double fx = camera.camera_matrix(0, 0), fy = camera.camera_matrix(1, 1);
   const double cx = camera.camera_matrix(0, 2), cy = camera.camera_matrix(1, 2);
@@ -211,7 +224,6 @@ void undistortChecked(const Camera& camera, const cv::Mat& pixels, cv::Mat& norm
   }
 }
 
-}  // namespace
 
 bool Camera::distorted() const {
   return std::any_of(distortion.begin(), distortion.end(), [](double d) { return d != 0.0; });
@@ -270,7 +282,7 @@ void Camera::validate(const std::string& source) const {
   for (int v = 0; v < height; ++v) border.emplace_back(0, v), border.emplace_back(width - 1, v);
   cv::Mat pixels(static_cast<int>(border.size()), 1, CV_64FC2, border.data()), normal;
   std::vector<unsigned char> valid;
-  undistortChecked(*this, pixels, normal, valid);
+  undistortPixels(*this, pixels, normal, valid);
   double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
   for (std::size_t i = 0; i < border.size(); ++i) {
     if (!valid[i])
@@ -315,6 +327,9 @@ Camera loadCamera(const std::string& path) {
     c.distortion.assign(d.begin<double>(), d.end<double>());
     c.rvec = readVec3(fs, path, "rvec");
     c.tvec = readVec3(fs, path, "tvec");
+    c.reprojection_rms_px = readQuality(fs, path, "reprojection_rms_px");
+    c.rotation_sigma_deg = readQuality(fs, path, "rotation_sigma_deg");
+    c.position_sigma_m = readQuality(fs, path, "position_sigma_m");
   } catch (const cv::Exception& e) {
     failParse(path, e);
   } catch (const CameraError&) {
@@ -333,106 +348,9 @@ void saveCamera(const Camera& camera, const std::string& path) {
   fs << "camera_matrix" << cv::Mat(camera.camera_matrix);
   fs << "distortion_coefficients" << cv::Mat(camera.distortion).reshape(1, 1);
   fs << "rvec" << cv::Mat(camera.rvec) << "tvec" << cv::Mat(camera.tvec);
+  if (camera.reprojection_rms_px) fs << "reprojection_rms_px" << *camera.reprojection_rms_px;
+  if (camera.rotation_sigma_deg) fs << "rotation_sigma_deg" << *camera.rotation_sigma_deg;
+  if (camera.position_sigma_m) fs << "position_sigma_m" << *camera.position_sigma_m;
 }
 
-Projection::Projection(const Camera& camera, double supersample)
-    : camera_(camera), supersample_(supersample) {
-  camera_.validate("camera");
-  world_to_camera_ = camera.worldToCamera();
-  if (!(supersample >= 1.0 && supersample <= 4.0)) throw CameraError("camera: supersample: must be in 1..4");
-  const double s = supersample;
-  const double fx = camera.camera_matrix(0, 0), fy = camera.camera_matrix(1, 1);
-  const double cx = camera.camera_matrix(0, 2), cy = camera.camera_matrix(1, 2);
-  pinhole_.fx = s * fx;
-  pinhole_.fy = s * fy;
-  if (!camera.distorted()) {
-    // Same frame, scaled: output pixel u covers pinhole pixels around s (u + 0.5) - 0.5.
-    pinhole_.cx = s * (cx + 0.5) - 0.5;
-    pinhole_.cy = s * (cy + 0.5) - 0.5;
-    pinhole_.width = static_cast<int>(std::lround(s * camera.width));
-    pinhole_.height = static_cast<int>(std::lround(s * camera.height));
-    warps_ = s != 1.0;
-    if (warps_) {
-      map_x_.create(camera.height, camera.width, CV_32F);
-      map_y_.create(camera.height, camera.width, CV_32F);
-      for (int v = 0; v < camera.height; ++v)
-        for (int u = 0; u < camera.width; ++u) {
-          map_x_.at<float>(v, u) = static_cast<float>(s * (u + 0.5) - 0.5);
-          map_y_.at<float>(v, u) = static_cast<float>(s * (v + 0.5) - 0.5);
-        }
-    }
-    return;
-  }
-  // Normalised coordinates of every output pixel centre (the inverse of the distortion model).
-  // In blocks of rows: the temporaries of the inversion stay small for large images.
-  const int n = camera.width * camera.height;
-  cv::Mat normal(n, 1, CV_64FC2);
-  std::vector<unsigned char> valid(n, 0);
-  const int block_rows = std::max(1, (1 << 16) / camera.width);
-  for (int v0 = 0; v0 < camera.height; v0 += block_rows) {
-    const int rows = std::min(block_rows, camera.height - v0), m = rows * camera.width, first = v0 * camera.width;
-    cv::Mat pixels(m, 1, CV_64FC2), block_normal;
-    for (int v = v0, i = 0; v < v0 + rows; ++v)
-      for (int u = 0; u < camera.width; ++u, ++i) pixels.at<cv::Vec2d>(i) = cv::Vec2d(u, v);
-    std::vector<unsigned char> block_valid;
-    undistortChecked(camera, pixels, block_normal, block_valid);
-    block_normal.copyTo(normal.rowRange(first, first + m));
-    std::copy(block_valid.begin(), block_valid.end(), valid.begin() + first);
-  }
-  double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
-  for (int i = 0; i < n; ++i)
-    if (valid[i]) {
-      const cv::Vec2d p = normal.at<cv::Vec2d>(i);
-      xmin = std::min(xmin, p[0]), xmax = std::max(xmax, p[0]);
-      ymin = std::min(ymin, p[1]), ymax = std::max(ymax, p[1]);
-    }
-  if (xmin > xmax) throw CameraError("camera: distortion_coefficients: the lens model cannot be inverted anywhere in the image");
-  const double pad = 2.0;
-  pinhole_.cx = -xmin * pinhole_.fx + pad;
-  pinhole_.cy = -ymin * pinhole_.fy + pad;
-  pinhole_.width = static_cast<int>(std::ceil((xmax - xmin) * pinhole_.fx + 2 * pad)) + 1;
-  pinhole_.height = static_cast<int>(std::ceil((ymax - ymin) * pinhole_.fy + 2 * pad)) + 1;
-  warps_ = true;
-  map_x_.create(camera.height, camera.width, CV_32F);
-  map_y_.create(camera.height, camera.width, CV_32F);
-  for (int v = 0, i = 0; v < camera.height; ++v)
-    for (int u = 0; u < camera.width; ++u, ++i) {
-      const cv::Vec2d p = normal.at<cv::Vec2d>(i);
-      map_x_.at<float>(v, u) = valid[i] ? static_cast<float>(p[0] * pinhole_.fx + pinhole_.cx) : -1e6f;
-      map_y_.at<float>(v, u) = valid[i] ? static_cast<float>(p[1] * pinhole_.fy + pinhole_.cy) : -1e6f;
-    }
-}
-
-std::array<float, 16> Projection::glMatrix(double near, double far) const {
-  const Pinhole& p = pinhole_;
-  std::array<float, 16> m{};
-  m[0] = static_cast<float>(2.0 * p.fx / p.width);
-  m[5] = static_cast<float>(2.0 * p.fy / p.height);
-  m[8] = static_cast<float>(2.0 * (p.cx + 0.5) / p.width - 1.0);
-  m[9] = static_cast<float>(2.0 * (p.cy + 0.5) / p.height - 1.0);
-  m[10] = static_cast<float>((far + near) / (far - near));
-  m[11] = 1.0f;
-  m[14] = static_cast<float>(-2.0 * far * near / (far - near));
-  return m;
-}
-
-Eigen::Vector2d Projection::pinholePixel(const Vec3& world, double near, double far) const {
-  const Vec3 c = world_to_camera_ * world;
-  const double x = static_cast<float>(c.x()), y = static_cast<float>(c.y()), z = static_cast<float>(c.z());
-  const std::array<float, 16> m = glMatrix(near, far);
-  const double xc = m[0] * x + m[8] * z, yc = m[5] * y + m[9] * z, wc = m[11] * z;
-  const double xw = (xc / wc + 1.0) * 0.5 * pinhole_.width, yw = (yc / wc + 1.0) * 0.5 * pinhole_.height;
-  return {xw - 0.5, yw - 0.5};
-}
-
-Eigen::Vector2d Projection::project(const Vec3& world) const {
-  const Eigen::Vector2d p = pinholePixel(world);
-  if (!camera_.distorted()) return (p.array() + 0.5) / supersample_ - 0.5;
-  const cv::Vec3d normal((p.x() - pinhole_.cx) / pinhole_.fx, (p.y() - pinhole_.cy) / pinhole_.fy, 1.0);
-  std::vector<cv::Point2d> out;
-  cv::projectPoints(std::vector<cv::Vec3d>{normal}, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera_.camera_matrix,
-                    camera_.distortion, out);
-  return {out[0].x, out[0].y};
-}
-
-}  // namespace kccd::render
+}  // namespace kccd::calib
