@@ -5,7 +5,9 @@
 #include <memory>
 #include <sstream>
 
-#include "cli_util.hpp"
+#include "cli_args.hpp"
+#include "cli_files.hpp"
+#include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/modelling/fit.hpp"
 #include "kccd/modelling/yaml_edit.hpp"
@@ -21,16 +23,12 @@ struct FitArgs {
   int evaluations = 4000;
 };
 
-int runFit(const FitArgs& args) {
+Exit runFit(const FitArgs& args) {
   checkCorePoints(args.points);
   if (args.model.empty() != args.body.empty()) throw UsageError("--model and --body go together");
   const auto t0 = std::chrono::steady_clock::now();
   modelling::Part part;
-  try {
-    part = modelling::readPart(args.part_file, {.part = args.part, .merge = args.merge});
-  } catch (const std::runtime_error& e) {
-    throw UsageError(e.what());
-  }
+  part = modelling::readPart(args.part_file, {.part = args.part, .merge = args.merge});
   modelling::FitResult r;
   {
     Progress progress("fitting " + std::filesystem::path(args.part_file).filename().string(), args.quiet || args.json);
@@ -70,7 +68,7 @@ int runFit(const FitArgs& args) {
     j["time_s"] = seconds;
     if (!args.model.empty()) j["written"] = {{"model", args.model}, {"body", args.body}};
     std::cout << j.dump(2) << "\n";
-    return 0;
+    return Exit::Ok;
   }
   std::ostringstream out;
   out << "# kccd fit " << args.part_file << ": " << part.triangles << " triangles, " << part.primitives
@@ -85,7 +83,7 @@ int runFit(const FitArgs& args) {
       << "  points: " << points_yaml << "\n"
       << "  radius: " << radius_yaml << "\n";
   std::cout << out.str();
-  return 0;
+  return Exit::Ok;
 }
 
 }  // namespace

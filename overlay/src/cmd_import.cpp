@@ -2,7 +2,9 @@
 #include <iostream>
 #include <memory>
 
-#include "cli_util.hpp"
+#include "cli_args.hpp"
+#include "cli_files.hpp"
+#include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/modelling/urdf_import.hpp"
 
@@ -17,7 +19,7 @@ struct ImportArgs {
   bool quiet = false;
 };
 
-int runImport(const ImportArgs& args) {
+Exit runImport(const ImportArgs& args) {
   checkCorePoints(args.points);
   modelling::ImportOptions opt;
   opt.srdf = args.srdf;
@@ -33,11 +35,7 @@ int runImport(const ImportArgs& args) {
   {
     Progress progress("fitting links", args.quiet);
     opt.progress = [&](double f) { progress.update(f); };
-    try {
-      text = modelling::importUrdf(args.urdf, opt);
-    } catch (const std::runtime_error& e) {
-      throw UsageError(e.what());
-    }
+    text = modelling::importUrdf(args.urdf, opt);
   }
   if (args.output.empty() || args.output == "-") {
     std::cout << text;
@@ -45,7 +43,7 @@ int runImport(const ImportArgs& args) {
     writeFileAtomically(args.output, text);
     if (!args.quiet) std::cerr << "wrote " << args.output << "\n";
   }
-  return 0;
+  return Exit::Ok;
 }
 
 }  // namespace

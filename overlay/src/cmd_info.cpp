@@ -3,7 +3,9 @@
 #include <iostream>
 #include <memory>
 
-#include "cli_util.hpp"
+#include "cli_args.hpp"
+#include "cli_files.hpp"
+#include "cli_output.hpp"
 #include "commands.hpp"
 
 namespace kccd::cli {
@@ -14,7 +16,7 @@ struct InfoArgs {
   bool json = false;
 };
 
-int runInfo(const InfoArgs& args) {
+Exit runInfo(const InfoArgs& args) {
   const Model m = loadOrExplain(args.model);
   int points = 0;
   for (const Body& b : m.bodies) points += static_cast<int>(b.points.size());
@@ -39,7 +41,7 @@ int runInfo(const InfoArgs& args) {
     j["totals"] = {{"joints", m.joints.size()}, {"dof", m.stateSize()}, {"bodies", m.bodies.size()}, {"points", points},
                    {"pairs", m.pairs.size()}};
     std::cout << j.dump(2) << "\n";
-    return 0;
+    return Exit::Ok;
   }
   std::cout << "model " << m.name << ": " << m.joints.size() << " joints, " << m.stateSize() << " state values, "
             << m.bodies.size() << " bodies, " << points << " points, " << m.pairs.size() << " checked pairs\n"
@@ -60,7 +62,7 @@ int runInfo(const InfoArgs& args) {
   std::cout << "\nchecked pairs (compared in their common-ancestor frame):\n";
   for (const BodyPair& p : m.pairs)
     std::cout << "  " << m.bodies[p.a].name << " - " << m.bodies[p.b].name << "  [" << m.frameName(p.lca) << "]\n";
-  return 0;
+  return Exit::Ok;
 }
 
 }  // namespace

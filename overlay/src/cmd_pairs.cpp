@@ -4,7 +4,9 @@
 #include <iostream>
 #include <memory>
 
-#include "cli_util.hpp"
+#include "cli_args.hpp"
+#include "cli_files.hpp"
+#include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/modelling/pair_proof.hpp"
 #include "kccd/modelling/yaml_edit.hpp"
@@ -26,7 +28,7 @@ void writeIgnoreList(const std::string& model, const std::string& proven_text,
            &proven_text);
 }
 
-int runPairs(const PairsArgs& args) {
+Exit runPairs(const PairsArgs& args) {
   std::string model_text;
   const Model m = loadOrExplain(args.model, &model_text);
   std::vector<modelling::PairReport> reports;
@@ -64,7 +66,7 @@ int runPairs(const PairsArgs& args) {
     if (args.write) j["written"] = args.model;
     if (args.write) writeIgnoreList(args.model, model_text, ignore);
     std::cout << j.dump(2) << "\n";
-    return 0;
+    return Exit::Ok;
   }
   int counts[5] = {0, 0, 0, 0, 0};
   for (const auto& r : reports) ++counts[static_cast<int>(r.verdict)];
@@ -97,7 +99,7 @@ int runPairs(const PairsArgs& args) {
   } else {
     std::cout << "suggested:\npairs:\n  ignore: " << modelling::flowPairs(ignore, 11) << "\n";
   }
-  return 0;
+  return Exit::Ok;
 }
 
 }  // namespace

@@ -3,7 +3,9 @@
 #include <iostream>
 #include <memory>
 
-#include "cli_util.hpp"
+#include "cli_args.hpp"
+#include "cli_files.hpp"
+#include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/checker.hpp"
 
@@ -28,7 +30,7 @@ QueryType parseType(const std::string& t) {
   throw UsageError("--type: unknown query type '" + t + "' (collision, closest, nclosest, distances)");
 }
 
-int runQuery(const QueryArgs& args) {
+Exit runQuery(const QueryArgs& args) {
   const Model m = loadOrExplain(args.model);
   const QueryType type = parseType(args.type);
   const StateBox box =
@@ -82,9 +84,9 @@ int runQuery(const QueryArgs& args) {
   }
   if (r.status != Status::Ok) {
     std::cerr << "kccd: query status " << toString(r.status) << " (unsafe)\n";
-    return 3;
+    return Exit::Unsafe;
   }
-  return 0;
+  return Exit::Ok;
 }
 
 }  // namespace

@@ -8,7 +8,9 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "cli_util.hpp"
+#include "cli_args.hpp"
+#include "cli_files.hpp"
+#include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/checker.hpp"
 #include "kccd/render/renderer.hpp"
@@ -38,15 +40,10 @@ void writePng(const cv::Mat& image, const std::string& path) {
   writeFileAtomically(path, std::string(png.begin(), png.end()));
 }
 
-int runRender(const RenderArgs& args) {
+Exit runRender(const RenderArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
   const Model m = loadOrExplain(args.model);
-  calib::Camera camera;
-  try {
-    camera = calib::loadCamera(args.camera);
-  } catch (const calib::CameraError& e) {
-    throw UsageError(e.what());
-  }
+  const calib::Camera camera = calib::loadCamera(args.camera);
   {
     std::string ext = std::filesystem::path(args.output).extension().string();
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -139,7 +136,7 @@ int runRender(const RenderArgs& args) {
   }
   if (status != Status::Ok) {
     std::cerr << "kccd: query status " << toString(status) << " (unsafe)\n";
-    return 3;
+    return Exit::Unsafe;
   }
   if (not_finite) {
     for (std::size_t i = 0; i < m.bodies.size(); ++i)
@@ -147,9 +144,9 @@ int runRender(const RenderArgs& args) {
         std::cerr << "kccd: body " << m.bodies[i].name << ": volume not finite (overflow): not drawn (unsafe)\n";
         break;
       }
-    return 3;
+    return Exit::Unsafe;
   }
-  return 0;
+  return Exit::Ok;
 }
 
 }  // namespace

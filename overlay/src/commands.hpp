@@ -7,7 +7,17 @@
 
 namespace kccd::cli {
 
-using Runner = std::function<int()>;
+/// The exit status of every subcommand (ARCHITECTURE.md section 5): turned into a number only in
+/// main, which also maps the exceptions (an InputError or UsageError is BadInput).
+enum class Exit : int {
+  Ok = 0,           ///< done (also --help and --version)
+  Internal = 1,     ///< a bug: an exception that is not about the input
+  BadInput = 2,     ///< bad input or option: one line naming the file and place
+  Unsafe = 3,       ///< an unsafe query status (query, render, overlay)
+  NotSolvable = 4,  ///< calibration could not solve (degenerate, too few inliers)
+};
+
+using Runner = std::function<Exit()>;
 
 Runner addInfo(CLI::App& app);
 Runner addQuery(CLI::App& app);

@@ -1,8 +1,22 @@
 // kccd: conservative continuous collision detection for robots, from the command line.
 #include <iostream>
 
-#include "cli_util.hpp"
+#include "cli_args.hpp"
+#include "cli_files.hpp"
+#include "cli_output.hpp"
 #include "commands.hpp"
+
+namespace {
+
+using kccd::cli::Exit;
+
+// Says why on one line and gives the exit status.
+int fail(Exit status, const std::string& message) {
+  std::cerr << "kccd: " << message << "\n";
+  return static_cast<int>(status);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -29,10 +43,7 @@ int main(int argc, char** argv) {
       known = known || sub->get_name() == argv[1];
       names += (names.empty() ? "" : ", ") + sub->get_name();
     }
-    if (!known) {
-      std::cerr << "kccd: unknown subcommand '" << kccd::printable(argv[1], 40) << "' (" << names << ")\n";
-      return 2;
-    }
+    if (!known) return fail(Exit::BadInput, "unknown subcommand '" + kccd::printable(argv[1], 40) + "' (" + names + ")");
   }
   try {
     app.parse(argc, argv);
@@ -40,21 +51,15 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     const std::string help = argc > 1 && argv[1][0] != '-' ? std::string("kccd ") + argv[1] + " --help" : "kccd --help";
-    std::cerr << "kccd: " << kccd::cli::optionMessage(e.what()) << " (see " << help << ")\n";
-    return 2;
+    return fail(Exit::BadInput, kccd::cli::optionMessage(e.what()) + " (see " + help + ")");
   }
   try {
     for (auto& [sub, run] : commands)
-      if (sub->parsed()) return run();
-  } catch (const kccd::cli::UsageError& e) {
-    std::cerr << "kccd: " << kccd::cli::oneLine(e.what()) << "\n";
-    return 2;
-  } catch (const kccd::InputError& e) {
-    std::cerr << "kccd: " << kccd::cli::oneLine(e.what()) << "\n";
-    return 2;
+      if (sub->parsed()) return static_cast<int>(run());
+  } catch (const kccd::InputError& e) {  // every reader's error and every option error (UsageError)
+    return fail(Exit::BadInput, kccd::cli::oneLine(e.what()));
   } catch (const std::exception& e) {
-    std::cerr << "kccd: internal error: " << kccd::cli::oneLine(e.what()) << "\n";
-    return 1;
+    return fail(Exit::Internal, "internal error: " + kccd::cli::oneLine(e.what()));
   }
-  return 0;
+  return static_cast<int>(Exit::Ok);
 }

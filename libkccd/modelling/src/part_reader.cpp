@@ -135,7 +135,7 @@ void onLargeStack(F&& f) {
       },
       &job);
   pthread_attr_destroy(&attr);
-  if (created != 0) throw std::runtime_error("cannot start a reader thread (" + std::string(std::strerror(created)) + ")");
+  if (created != 0) throw PartError("cannot start a reader thread (" + std::string(std::strerror(created)) + ")");
   pthread_join(thread, nullptr);
   if (job.error) std::rethrow_exception(job.error);
 }
@@ -415,7 +415,7 @@ Part readStl(const std::string& data, const std::string& path, const Vec3& scale
     part.triangles = static_cast<int>(count);
   } else {
     if (data.compare(0, 5, "solid") != 0)
-      throw std::runtime_error(path + ": not an STL file (neither ASCII 'solid' nor a binary triangle count)");
+      throw PartError(path + ": not an STL file (neither ASCII 'solid' nor a binary triangle count)");
     std::istringstream text(data);
     std::string word;
     int line_vertices = 0;
@@ -423,12 +423,12 @@ Part readStl(const std::string& data, const std::string& path, const Vec3& scale
       if (word != "vertex") continue;
       Vec3 v;
       if (!(text >> v.x() >> v.y() >> v.z()))
-        throw std::runtime_error(path + ": malformed vertex after " + std::to_string(part.points.size()) +
+        throw PartError(path + ": malformed vertex after " + std::to_string(part.points.size()) +
                                  " vertices");
       add(v);
       if (++line_vertices % 3 == 0) ++part.triangles;
     }
-    if (line_vertices % 3 != 0) throw std::runtime_error(path + ": truncated facet (vertex count not a multiple of 3)");
+    if (line_vertices % 3 != 0) throw PartError(path + ": truncated facet (vertex count not a multiple of 3)");
   }
   return part;
 }
@@ -445,7 +445,7 @@ void scanText(const std::string& data, const std::string& path) {
     if (previous != "DEF" && previous != "USE" && previous != "PROTO")
       for (const char* include : includes)
         if (token == include)
-          throw std::runtime_error(path + ":" + std::to_string(line) + ": " + token +
+          throw PartError(path + ":" + std::to_string(line) + ": " + token +
                                    ": includes are not supported (put the included geometry into this file)");
     previous = std::move(token);
     token.clear();
@@ -462,18 +462,18 @@ void scanText(const std::string& data, const std::string& path) {
         if (data[i] == '\\') ++i;
         if (i < data.size() && data[i] == '\n') ++line;
       }
-      if (i >= data.size()) throw std::runtime_error(path + ":" + std::to_string(start) + ": unterminated string");
+      if (i >= data.size()) throw PartError(path + ":" + std::to_string(start) + ": unterminated string");
       previous.assign(1, '"');
     } else if (ch == '{' || ch == '[') {
       endToken();
       if (++depth > kMaxNesting)
-        throw std::runtime_error(path + ":" + std::to_string(line) + ": nested deeper than " +
+        throw PartError(path + ":" + std::to_string(line) + ": nested deeper than " +
                                  std::to_string(kMaxNesting) + " levels");
       previous.assign(1, ch);
     } else if (ch == '}' || ch == ']') {
       endToken();
       if (--depth < 0)
-        throw std::runtime_error(path + ":" + std::to_string(line) + ": '" + ch + "' closes nothing");
+        throw PartError(path + ":" + std::to_string(line) + ": '" + ch + "' closes nothing");
       previous.assign(1, ch);
     } else if (std::isspace(static_cast<unsigned char>(ch)) || ch == ',') {
       endToken();
@@ -498,7 +498,7 @@ void checkNesting(SoNode* root, const std::string& path) {
     const auto [node, depth] = stack.back();
     stack.pop_back();
     if (depth > kMaxNesting)
-      throw std::runtime_error(path + ": nested deeper than " + std::to_string(kMaxNesting) + " levels");
+      throw PartError(path + ": nested deeper than " + std::to_string(kMaxNesting) + " levels");
     if (!node->isOfType(SoGroup::getClassTypeId())) continue;
     auto* group = static_cast<SoGroup*>(node);
     for (int i = 0; i < group->getNumChildren(); ++i) stack.emplace_back(group->getChild(i), depth + 1);
@@ -523,7 +523,7 @@ void checkIncludes(SoNode* root, const std::string& path) {
       target = static_cast<const SoVRMLInline*>(node)->url[0].getString();
     else if (node->isOfType(SoWWWInline::getClassTypeId()))
       target = static_cast<const SoWWWInline*>(node)->name.getValue().getString();
-    throw std::runtime_error(path + ": " + nodeName(node) + " '" + printable(target) +
+    throw PartError(path + ": " + nodeName(node) + " '" + printable(target) +
                              "': includes are not supported (put the included geometry into this file)");
   }
 }
@@ -532,10 +532,10 @@ void checkIncludes(SoNode* root, const std::string& path) {
 Part readScene(const std::string& data, const std::string& path, const ReadOptions& options) {
   const std::string header = data.substr(0, data.find('\n'));
   if (header.rfind("#Inventor", 0) != 0 && header.rfind("#VRML", 0) != 0)
-    throw std::runtime_error(path + ": not a readable Open Inventor, VRML or STL file (no #Inventor or #VRML header)");
+    throw PartError(path + ": not a readable Open Inventor, VRML or STL file (no #Inventor or #VRML header)");
   const bool binary = header.find("binary") != std::string::npos;
   if (binary && data.size() > kMaxBinaryInventorBytes)
-    throw std::runtime_error(path + ": binary Open Inventor files are read up to " +
+    throw PartError(path + ": binary Open Inventor files are read up to " +
                              std::to_string(kMaxBinaryInventorBytes >> 20) + " MiB (this one has " +
                              std::to_string(data.size()) + " bytes): convert it to ASCII");
   if (!binary) scanText(data, path);
@@ -543,7 +543,7 @@ Part readScene(const std::string& data, const std::string& path, const ReadOptio
   // (following cycles, devices and missing files) before any check of the scene.
   for (const std::string_view file : {std::string_view("\0\0\0\4File", 8), std::string_view("\0\0\0\6SoFile", 10)})
     if (binary && data.find(file) != std::string::npos)
-      throw std::runtime_error(path + ": File node at byte " + std::to_string(data.find(file)) +
+      throw PartError(path + ": File node at byte " + std::to_string(data.find(file)) +
                                ": includes are not supported (put the included geometry into this file)");
 
   std::lock_guard<std::mutex> lock(coin_mutex);
@@ -577,12 +577,12 @@ Part readScene(const std::string& data, const std::string& path, const ReadOptio
     // refuses the file, whose model would differ from its text.
     if (!read_errors.first.empty()) {
       root->unref();
-      throw std::runtime_error(path + (read_errors.line > 0 ? ":" + std::to_string(read_errors.line) : "") + ": " +
+      throw PartError(path + (read_errors.line > 0 ? ":" + std::to_string(read_errors.line) : "") + ": " +
                                read_errors.first);
     }
     if (!ok || (root->getNumChildren() == 0 && !other_errors.first.empty())) {
       root->unref();
-      throw std::runtime_error(path + ": not a readable Open Inventor, VRML or STL file" +
+      throw PartError(path + ": not a readable Open Inventor, VRML or STL file" +
                                (other_errors.first.empty() ? std::string() : " (" + other_errors.first + ")"));
     }
     root->unrefNoDelete();
@@ -605,7 +605,7 @@ Part readScene(const std::string& data, const std::string& path, const ReadOptio
     Collector c;
     auto run = [&](Collector& into, SoNode* node, SoPath* p) {
       collect(into, node, p);
-      if (!into.error.empty()) throw std::runtime_error(path + ": " + into.error);
+      if (!into.error.empty()) throw PartError(path + ": " + into.error);
     };
     if (!options.part.empty()) {
       SoSearchAction search;
@@ -615,7 +615,7 @@ Part readScene(const std::string& data, const std::string& path, const ReadOptio
       search.apply(top);
       SoPath* found = search.getPath();
       if (!found)
-        throw std::runtime_error(path + ": no node named '" + printable(options.part) + "' (DEF " +
+        throw PartError(path + ": no node named '" + printable(options.part) + "' (DEF " +
                                  printable(options.part) + ")");
       SoPath* copy = found->copy();
       copy->ref();
@@ -649,7 +649,7 @@ Part readScene(const std::string& data, const std::string& path, const ReadOptio
         std::string list;
         for (std::size_t i = 0; i < parts.size() && i < 8; ++i) list += (i ? ", " : "") + parts[i];
         if (parts.size() > 8) list += ", ...";
-        throw std::runtime_error(path + ": holds " + std::to_string(parts.size()) + " top-level parts (" + list +
+        throw PartError(path + ": holds " + std::to_string(parts.size()) + " top-level parts (" + list +
                                  "); pick one with --part NAME, or --merge to fit them as one rigid body");
       }
       run(c, top, nullptr);
@@ -681,17 +681,17 @@ std::string readInputFile(const std::string& path, std::uintmax_t max_bytes) {
   const std::string name = printable(path);
   // Non-blocking: opening a FIFO must not wait for a writer (it is refused below).
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) throw std::runtime_error(name + ": cannot open the file (" + std::strerror(errno) + ")");
+  if (fd < 0) throw InputError(name + ": cannot open the file (" + std::strerror(errno) + ")");
   struct Close {
     int fd;
     ~Close() { ::close(fd); }
   } close_fd{fd};
   struct stat st {};
-  if (::fstat(fd, &st) != 0) throw std::runtime_error(name + ": cannot open the file (" + std::strerror(errno) + ")");
-  if (S_ISDIR(st.st_mode)) throw std::runtime_error(name + ": is a directory, not a file");
-  if (!S_ISREG(st.st_mode)) throw std::runtime_error(name + ": not a regular file (a device, FIFO or socket)");
+  if (::fstat(fd, &st) != 0) throw InputError(name + ": cannot open the file (" + std::strerror(errno) + ")");
+  if (S_ISDIR(st.st_mode)) throw InputError(name + ": is a directory, not a file");
+  if (!S_ISREG(st.st_mode)) throw InputError(name + ": not a regular file (a device, FIFO or socket)");
   auto too_large = [&](std::uintmax_t size) {
-    return std::runtime_error(name + ": " + std::to_string(size) + " bytes is more than the limit of " +
+    return InputError(name + ": " + std::to_string(size) + " bytes is more than the limit of " +
                               std::to_string(max_bytes >> 20) + " MiB");
   };
   if (static_cast<std::uintmax_t>(st.st_size) > max_bytes) throw too_large(static_cast<std::uintmax_t>(st.st_size));
@@ -705,7 +705,7 @@ std::string readInputFile(const std::string& path, std::uintmax_t max_bytes) {
     const ssize_t n = ::read(fd, data.data() + used, data.size() - used);
     if (n < 0) {
       if (errno == EINTR) continue;
-      throw std::runtime_error(name + ": cannot read the file (" + std::strerror(errno) + ")");
+      throw InputError(name + ": cannot read the file (" + std::strerror(errno) + ")");
     }
     if (n == 0) break;
     used += static_cast<std::size_t>(n);
@@ -718,7 +718,7 @@ std::string readInputFile(const std::string& path, std::uintmax_t max_bytes) {
 Part readPart(const std::string& path, const ReadOptions& options) {
   const std::string name = printable(path);
   if (!options.scale.allFinite() || (options.scale.array() == 0.0).any())
-    throw std::runtime_error(name + ": scale " + number(options.scale.x()) + " " + number(options.scale.y()) + " " +
+    throw PartError(name + ": scale " + number(options.scale.x()) + " " + number(options.scale.y()) + " " +
                              number(options.scale.z()) + ": factors must be finite and non-zero");
   std::string extension = std::filesystem::path(path).extension().string();
   for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
@@ -726,20 +726,20 @@ Part readPart(const std::string& path, const ReadOptions& options) {
   // Coin's STL reader fails on the second different STL file in a process: STL is read here.
   Part part = extension == ".stl" ? readStl(data, name, options.scale) : readScene(data, name, options);
   if (part.triangles == 0 && part.primitives == 0)
-    throw std::runtime_error(name + (options.part.empty() ? "" : " (part " + printable(options.part) + ")") +
+    throw PartError(name + (options.part.empty() ? "" : " (part " + printable(options.part) + ")") +
                              ": no triangles or solid primitives (nothing to fit)");
   for (const Vec3& p : part.points)
-    if (!p.allFinite()) throw std::runtime_error(name + ": non-finite vertex coordinates");
+    if (!p.allFinite()) throw PartError(name + ": non-finite vertex coordinates");
   for (const Sphere& b : part.balls)
     if (!b.center.allFinite() || !std::isfinite(b.radius))
-      throw std::runtime_error(name + ": non-finite sphere (a scale or radius overflows)");
+      throw PartError(name + ": non-finite sphere (a scale or radius overflows)");
   double max_abs = 0.0;
   for (const Vec3& p : part.points) max_abs = std::max(max_abs, p.cwiseAbs().maxCoeff());
   for (const Sphere& b : part.balls) max_abs = std::max(max_abs, b.center.cwiseAbs().maxCoeff() + b.radius);
   // Coin and STL store single-precision coordinates (Coin its matrices too): cover their rounding.
   part.coordinate_guard = 1e-6 * max_abs;
   if (!std::isfinite(part.coordinate_guard))
-    throw std::runtime_error(name + ": coordinates too large (their extent overflows)");
+    throw PartError(name + ": coordinates too large (their extent overflows)");
   return part;
 }
 

@@ -48,7 +48,7 @@ std::string resolveMesh(const std::string& urdf_path, const std::string& link, c
     const std::string package = rest.substr(0, slash);
     auto it = options.packages.find(package);
     if (it == options.packages.end())
-      throw std::runtime_error(where + ": unknown package '" + package + "' (give --package-path " + package +
+      throw UrdfError(where + ": unknown package '" + package + "' (give --package-path " + package +
                                "=DIR)");
     return (fs::path(it->second) / (slash == std::string::npos ? "" : rest.substr(slash + 1))).string();
   }
@@ -84,8 +84,8 @@ Part linkPart(const std::string& urdf_path, const urdf::Link& link, const Import
         Part m;
         try {
           m = readPart(file, {.merge = true, .scale = Vec3(mesh.scale.x, mesh.scale.y, mesh.scale.z)});
-        } catch (const std::runtime_error& e) {
-          throw std::runtime_error(urdf_path + ": link " + link.name + ": " + e.what());
+        } catch (const PartError& e) {
+          throw PartError(urdf_path + ": link " + link.name + ": " + e.what());
         }
         for (Vec3& p : m.points) p = t * p;
         for (Sphere& s : m.balls) s.center = t * s.center;  // rigid: radii unchanged
@@ -99,7 +99,7 @@ Part linkPart(const std::string& urdf_path, const urdf::Link& link, const Import
 
 void loadXml(tinyxml2::XMLDocument& doc, const std::string& text, const std::string& path) {
   if (doc.Parse(text.data(), text.size()) == tinyxml2::XML_SUCCESS) return;
-  throw std::runtime_error(path + ":" + std::to_string(doc.ErrorLineNum()) + ": malformed XML (" +
+  throw UrdfError(path + ":" + std::to_string(doc.ErrorLineNum()) + ": malformed XML (" +
                            tinyxml2::XMLDocument::ErrorIDToName(doc.ErrorID()) + ")");
 }
 
@@ -143,8 +143,8 @@ UrdfParse parseWithUrdfdom(const std::string& text) {
 struct Place {
   const std::string& path;
   std::string what;
-  std::runtime_error error(const tinyxml2::XMLElement* e, const std::string& problem) const {
-    return std::runtime_error(path + ":" + std::to_string(e->GetLineNum()) + ": " + what + problem);
+  UrdfError error(const tinyxml2::XMLElement* e, const std::string& problem) const {
+    return UrdfError(path + ":" + std::to_string(e->GetLineNum()) + ": " + what + problem);
   }
 };
 
@@ -264,18 +264,18 @@ std::vector<std::array<std::string, 2>> readSrdf(const tinyxml2::XMLDocument& do
                                                  const std::set<std::string>& links,
                                                  const std::set<std::string>& bodies) {
   const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
-  if (!robot) throw std::runtime_error(path + ": not an SRDF file (no <robot> element)");
+  if (!robot) throw UrdfError(path + ": not an SRDF file (no <robot> element)");
   std::vector<std::array<std::string, 2>> out;
   for (const tinyxml2::XMLElement* e = robot->FirstChildElement("disable_collisions"); e;
        e = e->NextSiblingElement("disable_collisions")) {
     const char* a = e->Attribute("link1");
     const char* b = e->Attribute("link2");
     if (!a || !b)
-      throw std::runtime_error(path + ":" + std::to_string(e->GetLineNum()) +
+      throw UrdfError(path + ":" + std::to_string(e->GetLineNum()) +
                                ": disable_collisions needs link1 and link2");
     for (const char* l : {a, b})
       if (!links.count(l))
-        throw std::runtime_error(path + ":" + std::to_string(e->GetLineNum()) + ": link '" + l +
+        throw UrdfError(path + ":" + std::to_string(e->GetLineNum()) + ": link '" + l +
                                  "' is not in the URDF");
     if (bodies.count(a) && bodies.count(b) && std::string(a) != b) out.push_back({a, b});
   }
@@ -296,7 +296,7 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
   const UrdfParse parsed = parseWithUrdfdom(urdf_text);
   const urdf::ModelInterfaceSharedPtr& urdf = parsed.model;
   if (!urdf || !urdf->getRoot())
-    throw std::runtime_error(path + ": not a valid URDF (" +
+    throw UrdfError(path + ": not a valid URDF (" +
                              (parsed.error.empty() ? std::string("urdfdom rejected it") : "urdfdom: " + parsed.error) + ")");
   // urdfdom drops every collision of a link when one of them does not parse: whatever slipped
   // through the checks above must not become a link without geometry.
@@ -304,7 +304,7 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     const urdf::LinkConstSharedPtr link = urdf->getLink(name);
     const std::size_t kept = link ? link->collision_array.size() : 0;
     if (kept != static_cast<std::size_t>(count))
-      throw std::runtime_error(path + ":" + std::to_string(collisionLine(doc, name)) + ": link '" + printable(name) +
+      throw UrdfError(path + ":" + std::to_string(collisionLine(doc, name)) + ": link '" + printable(name) +
                                "': " + std::to_string(count) + " <collision> elements but urdfdom read " +
                                std::to_string(kept) + (parsed.error.empty() ? "" : " (" + parsed.error + ")"));
   }
@@ -328,12 +328,12 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
         case urdf::Joint::PRISMATIC: kind = "prismatic"; break;
         case urdf::Joint::FIXED: kind = "fixed"; break;
         case urdf::Joint::FLOATING:
-          throw std::runtime_error(path + ": joint " + j->name +
+          throw UrdfError(path + ": joint " + j->name +
                                    " is floating: not supported (fixed, revolute, continuous, prismatic)");
         case urdf::Joint::PLANAR:
-          throw std::runtime_error(path + ": joint " + j->name +
+          throw UrdfError(path + ": joint " + j->name +
                                    " is planar: not supported (fixed, revolute, continuous, prismatic)");
-        default: throw std::runtime_error(path + ": joint " + j->name + " has an unknown type");
+        default: throw UrdfError(path + ": joint " + j->name + " has an unknown type");
       }
       const urdf::Pose& o = j->parent_to_joint_origin_transform;
       double r, p, y;
@@ -392,7 +392,7 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
   try {
     (void)parseModel(text, path + " (imported)");
   } catch (const ModelError& e) {
-    throw std::runtime_error(std::string("the imported model does not load: ") + e.what());
+    throw UrdfError(std::string("the imported model does not load: ") + e.what());
   }
   if (options.progress) options.progress(1.0);
   return text;

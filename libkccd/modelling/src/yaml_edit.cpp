@@ -15,7 +15,7 @@ YAML::Node load(const std::string& text, const std::string& source) {
   try {
     return YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw std::runtime_error(source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    throw EditError(source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
 }
 
@@ -121,7 +121,7 @@ void check(const std::string& text, const std::string& source) {
   try {
     (void)parseModel(text, source + " (edited)");
   } catch (const ModelError& e) {
-    throw std::runtime_error(std::string("the edited model would not load: ") + e.what());
+    throw EditError(std::string("the edited model would not load: ") + e.what());
   }
 }
 
@@ -173,13 +173,13 @@ std::string withBodyGeometry(const std::string& text, const std::string& source,
                              const std::string& points_yaml, const std::string& radius_yaml) {
   const YAML::Node root = load(text, source);
   const YAML::Node bodies = root["bodies"];
-  if (!bodies || !bodies.IsSequence()) throw std::runtime_error(source + ": no bodies list");
+  if (!bodies || !bodies.IsSequence()) throw EditError(source + ": no bodies list");
   for (const YAML::Node& b : bodies) {
     if (!b.IsMap() || !b["name"] || b["name"].Scalar() != body) continue;
     // Edit the later of the two values first so the earlier positions stay valid.
     Found points, radius;
     if (!findKey(b, "points", points) || !findKey(b, "radius", radius))
-      throw std::runtime_error(source + ":" + std::to_string(b.Mark().line + 1) + ": body " + body +
+      throw EditError(source + ":" + std::to_string(b.Mark().line + 1) + ": body " + body +
                                " has no points/radius to replace");
     std::string out = text;
     if (points.key.Mark().pos > radius.key.Mark().pos) {
@@ -192,7 +192,7 @@ std::string withBodyGeometry(const std::string& text, const std::string& source,
     check(out, source);
     return out;
   }
-  throw std::runtime_error(source + ": no body named '" + body + "'");
+  throw EditError(source + ": no body named '" + body + "'");
 }
 
 std::string withIgnoreList(const std::string& text, const std::string& source,
@@ -209,7 +209,7 @@ std::string withIgnoreList(const std::string& text, const std::string& source,
       out += "pairs:\n  ignore: " + flowPairs(pairs, 11) + "\n";
     }
   } else if (!section.value.IsMap()) {
-    throw std::runtime_error(source + ":" + std::to_string(section.value.Mark().line + 1) + ": pairs is not a map");
+    throw EditError(source + ":" + std::to_string(section.value.Mark().line + 1) + ": pairs is not a map");
   } else {
     Found ignore;
     if (findKey(section.value, "ignore", ignore)) {

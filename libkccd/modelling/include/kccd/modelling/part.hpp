@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "kccd/input_error.hpp"
 #include "kccd/ssch.hpp"
 
 namespace kccd::modelling {
@@ -37,6 +38,12 @@ struct Part {
   void append(const Part& other);
 };
 
+/// A CAD part or mesh file that cannot be read: one line naming the file and the place.
+class PartError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 /// Which part of a file to read.
 struct ReadOptions {
   std::string part;    ///< name of a DEF'd node to read alone; empty: the whole file
@@ -45,7 +52,7 @@ struct ReadOptions {
 };
 
 /// Reads an Open Inventor (.iv, ASCII or binary), VRML 1/2 (.wrl) or STL file through Coin3D,
-/// all transforms applied. Throws std::runtime_error with a one-line message naming the file.
+/// all transforms applied. Throws PartError with a one-line message naming the file.
 ///
 /// Refused with that error rather than read: anything but a regular file of at most
 /// kMaxInputBytes (binary Open Inventor: kMaxBinaryInventorBytes); ASCII scenes nested deeper than
@@ -60,7 +67,7 @@ inline constexpr std::uintmax_t kMaxBinaryInventorBytes = 4ull << 20;    ///< se
 inline constexpr int kMaxNesting = 256;                                  ///< braces and brackets, or groups
 
 /// The whole content of an input file: regular files only (no directories, devices or FIFOs),
-/// at most `max_bytes`. Throws std::runtime_error naming the file.
+/// at most `max_bytes`. Throws InputError naming the file.
 std::string readInputFile(const std::string& path, std::uintmax_t max_bytes = kMaxInputBytes);
 
 /// `text` fit for a one-line message: control bytes and DEL written as \xNN.

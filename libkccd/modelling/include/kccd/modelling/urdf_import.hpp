@@ -6,7 +6,15 @@
 #include <map>
 #include <string>
 
+#include "kccd/input_error.hpp"
+
 namespace kccd::modelling {
+
+/// A URDF or SRDF file that cannot be imported: one line naming the file, line and element.
+class UrdfError : public InputError {
+ public:
+  using InputError::InputError;
+};
 
 struct ImportOptions {
   std::string srdf;                             ///< optional SRDF: disable_collisions -> ignore
@@ -17,7 +25,7 @@ struct ImportOptions {
 };
 
 /// Converts the URDF file at `path` into `kccd: 1` model text (checked by loading it back).
-/// Throws std::runtime_error with one line naming the file and the element on any problem:
+/// Throws UrdfError (or PartError for a collision mesh) with one line naming the file and the element on any problem:
 /// unreadable XML, unsupported joint kinds (floating, planar), unresolved or unreadable meshes.
 std::string importUrdf(const std::string& path, const ImportOptions& options = {});
 

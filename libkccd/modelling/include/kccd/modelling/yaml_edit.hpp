@@ -8,12 +8,19 @@
 #include <string>
 #include <vector>
 
+#include "kccd/input_error.hpp"
 #include "kccd/ssch.hpp"
 
 namespace kccd::modelling {
 
+/// An in-place model edit that cannot be made: one line naming the file and the place.
+class EditError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 /// Replaces the `points` and `radius` of body `body` in model text (`source` names it in
-/// messages) with the given YAML texts and returns the edited text. Throws std::runtime_error
+/// messages) with the given YAML texts and returns the edited text. Throws EditError
 /// when the body is missing or the edited model would not load.
 std::string withBodyGeometry(const std::string& text, const std::string& source, const std::string& body,
                              const std::string& points_yaml, const std::string& radius_yaml);

@@ -1,0 +1,121 @@
+#include "cli_args.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <regex>
+#include <sstream>
+
+#include "cli_output.hpp"
+#include "kccd/modelling/fit.hpp"
+
+namespace kccd::cli {
+
+std::string optionMessage(const std::string& text) {
+  // CLI11 writes bounds such as DBL_MAX with every digit: shorten long numbers.
+  static const std::regex long_number("[-+]?[0-9]{16,}(\\.[0-9]*)?(e[-+]?[0-9]+)?");
+  std::string out;
+  auto it = std::sregex_iterator(text.begin(), text.end(), long_number);
+  std::size_t last = 0;
+  for (; it != std::sregex_iterator(); ++it) {
+    out += text.substr(last, it->position() - last);
+    out += format(std::strtod(it->str().c_str(), nullptr), 6);
+    last = it->position() + it->length();
+  }
+  out += text.substr(last);
+  // CLI11's phrasing, said plainly.
+  static const std::pair<std::regex, const char*> plain[] = {
+      {std::regex("^(\\S+): [0-9]+ required \\S+ missing$"), "$1: needs a value"},
+      {std::regex("^The following arguments? (was|were) not expected: (.*)$"), "unknown option or extra argument: $2"},
+      {std::regex("^--([A-Za-z-]+): Value (.*) not in range (.*) to (.*)$"), "--$1: expected a whole number from $3 to $4, got '$2'"},
+      {std::regex("^(.*) is required$"), "$1 is required"},
+  };
+  for (const auto& [pattern, replacement] : plain)
+    if (std::regex_match(out, pattern)) {
+      out = std::regex_replace(out, pattern, replacement);
+      break;
+    }
+  return oneLine(out);
+}
+
+CLI::Validator finiteIn(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& text) -> std::string {
+        const char* begin = text.c_str();
+        char* end = nullptr;
+        const double v = std::strtod(begin, &end);
+        if (text.empty() || end != begin + text.size()) return "'" + printable(text, 40) + "' is not a number";
+        if (!std::isfinite(v)) return "must be a finite number, got '" + printable(text, 40) + "'";
+        if (v < lo || v > hi) return "must be in [" + format(lo, 6) + ", " + format(hi, 6) + "], got " + format(v, 6);
+        return std::string();
+      },
+      "NUMBER in [" + format(lo, 6) + ", " + format(hi, 6) + "]");
+}
+
+std::vector<double> parseList(const std::string& text, const std::string& option) {
+  std::vector<double> out;
+  std::stringstream ss(text);
+  std::string item;
+  int index = 0;
+  while (std::getline(ss, item, ',')) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    while (used < item.size() && std::isspace(static_cast<unsigned char>(item[used]))) ++used;
+    if (used == 0 || used != item.size())
+      throw UsageError(option + ": value " + std::to_string(index + 1) + " ('" + printable(item, 40) + "') is not a number");
+    out.push_back(v);
+    ++index;
+  }
+  if (!text.empty() && text.back() == ',') throw UsageError(option + ": trailing comma");
+  return out;
+}
+
+namespace {
+
+std::vector<double> stateVector(const Model& m, const std::string& text, const std::string& option, bool finite) {
+  std::vector<double> v = parseList(text, option);
+  if (static_cast<int>(v.size()) != m.stateSize()) {
+    std::string names;
+    for (const std::string& n : m.stateNames()) names += (names.empty() ? "" : ", ") + n;
+    throw UsageError(option + " has " + std::to_string(v.size()) + " values but model '" + m.name + "' has " +
+                     std::to_string(m.stateSize()) + " state values (" + names + ")");
+  }
+  for (std::size_t i = 0; finite && i < v.size(); ++i)
+    if (!std::isfinite(v[i]))
+      throw UsageError(option + ": value " + std::to_string(i + 1) + " (" + m.stateNames()[i] + ") is not finite");
+  return v;
+}
+
+}  // namespace
+
+StateBox parseStateBox(const Model& m, const std::string& state, const std::string& lower, const std::string& upper,
+                       const std::string& missing, bool finite) {
+  StateBox box;
+  if (m.stateSize() == 0 && lower.empty() && upper.empty()) {  // only fixed joints: one configuration
+    if (!state.empty()) stateVector(m, state, "--state", finite);  // explains a value given anyway
+    box.point = true;
+    return box;
+  }
+  if (!state.empty()) {
+    if (!lower.empty() || !upper.empty()) throw UsageError("give either --state or --lower/--upper, not both");
+    box.lower = box.upper = stateVector(m, state, "--state", finite);
+    box.point = true;
+    return box;
+  }
+  if (lower.empty() || upper.empty()) throw UsageError(missing);
+  box.lower = stateVector(m, lower, "--lower", finite);
+  box.upper = stateVector(m, upper, "--upper", finite);
+  return box;
+}
+
+void checkCorePoints(int k) {
+  if (k < 1 || k > modelling::kMaxCorePoints)
+    throw UsageError("--points: the number of core points K must be 1 ... " +
+                     std::to_string(modelling::kMaxCorePoints) + " (got " + std::to_string(k) + ")");
+}
+
+}  // namespace kccd::cli

@@ -1,0 +1,44 @@
+// Command-line arguments of the kccd subcommands: the option error, validators and readable
+// parser messages, number lists and interval boxes.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "kccd/input_error.hpp"
+#include "kccd/model.hpp"
+
+namespace kccd::cli {
+
+/// A bad option or argument: printed as one line, exit status BadInput (an InputError like the
+/// readers' errors, so main maps them in one place).
+class UsageError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
+/// A command-line parser message made readable: one line, huge bounds (DBL_MAX) written short.
+std::string optionMessage(const std::string& text);
+
+/// An option validator: a finite number in [lo, hi] (NaN and infinities are refused).
+CLI::Validator finiteIn(double lo, double hi);
+
+/// Parses "a,b,c" into numbers; `option` names the flag in error messages.
+std::vector<double> parseList(const std::string& text, const std::string& option);
+
+/// The interval box from `--state` (a single configuration) or `--lower`/`--upper`, each checked
+/// against the model's state size; `missing` is the message when neither is complete. With
+/// `finite`, NaN and infinite values are rejected too (else they reach the query as a status).
+struct StateBox {
+  std::vector<double> lower, upper;
+  bool point = false;  ///< given with --state
+};
+StateBox parseStateBox(const Model& m, const std::string& state, const std::string& lower, const std::string& upper,
+                       const std::string& missing, bool finite);
+
+/// Checks a `--points` value (the number of core points of a fit).
+void checkCorePoints(int k);
+
+}  // namespace kccd::cli

@@ -1,0 +1,29 @@
+// Files the kccd subcommands read and write: models with one-line errors, outputs renamed into
+// place, locked in-place edits.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "kccd/model.hpp"
+
+namespace kccd::cli {
+
+/// Loads a model, turning every failure into one line on stderr (throws UsageError); with `text`,
+/// also returns the file's text as it was read.
+Model loadOrExplain(const std::string& path, std::string* text = nullptr);
+
+/// Writes `text` to `path` through a new uniquely named file in the same folder and a rename:
+/// readers never see a partial file. A symbolic link stays a link (its target is replaced) and an
+/// existing file keeps its mode. Throws UsageError naming the path.
+void writeFileAtomically(const std::string& path, const std::string& text);
+
+/// Replaces the text of the file at `path` by `edit(text)`, atomically, holding an exclusive lock
+/// (flock) on the file from the read to the rename, so concurrent edits of one file apply one after
+/// the other and none is lost. With `expected`, the edit is refused when the file no longer holds
+/// that text. An error from `edit` (an InputError) passes through; a failed read or write is a
+/// UsageError naming the file; either way the file stays as it was.
+void editFile(const std::string& path, const std::function<std::string(const std::string&)>& edit,
+              const std::string* expected = nullptr);
+
+}  // namespace kccd::cli

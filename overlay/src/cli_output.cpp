@@ -1,0 +1,67 @@
+#include "cli_output.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
+#include "kccd/input_error.hpp"
+
+namespace kccd::cli {
+
+std::string oneLine(const std::string& text) {
+  std::string flat = text;
+  for (char& c : flat)
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+  while (!flat.empty() && flat.back() == ' ') flat.pop_back();
+  return printable(flat, 400);
+}
+
+nlohmann::json number(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr); }
+
+nlohmann::json vec3(const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+
+namespace {
+double nowSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
+Progress::Progress(std::string what, bool quiet)
+    : what_(std::move(what)), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0), last_time_(nowSeconds()) {}
+
+Progress::~Progress() { finish(); }
+
+void Progress::update(double fraction) {
+  if (quiet_ || finished_) return;
+  fraction = std::clamp(fraction, 0.0, 1.0);
+  const double t = nowSeconds();
+  if (tty_) {
+    if (fraction - last_ < 0.01 && fraction < 1.0) return;
+    const int width = 30, filled = static_cast<int>(fraction * width);
+    std::cerr << "\r" << what_ << " [" << std::string(filled, '#') << std::string(width - filled, ' ') << "] "
+              << static_cast<int>(fraction * 100) << "%" << std::flush;
+    shown_ = true;
+  } else if (t - last_time_ >= 5.0) {
+    std::cerr << what_ << ": " << static_cast<int>(fraction * 100) << "%\n";
+    last_time_ = t;
+  }
+  last_ = fraction;
+}
+
+void Progress::finish() {
+  if (finished_) return;
+  finished_ = true;
+  if (shown_) std::cerr << "\r" << std::string(what_.size() + 40, ' ') << "\r" << std::flush;
+}
+
+std::string format(double value, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+  return buf;
+}
+
+}  // namespace kccd::cli
