@@ -22,6 +22,7 @@
 #include "kccd/render/scene.hpp"
 #include "kccd/render/ssch_mesh.hpp"
 #include "support/cameras.hpp"
+#include "support/silhouette.hpp"
 #include "support/golden.hpp"
 
 namespace {
@@ -29,6 +30,7 @@ namespace {
 using namespace kccd;
 using namespace kccd::render;
 using namespace kccd::calib;
+using kccd::testing::cpuSilhouette;
 using kccd::testing::cvProject;
 using kccd::testing::lookAt;
 using kccd::testing::randomCamera;
@@ -266,52 +268,6 @@ TEST(RenderMesh, CacheReusesUnchangedShapes) {
 // ---------------------------------------------------------------------------------------------
 // Masks against an independent CPU silhouette
 
-// The silhouette of an SSCH from dense sphere samples projected with cv::projectPoints: balls of
-// the radius centred on a dense set of points of the core hull (vertices, edges, triangles),
-// each ball's rim sampled densely, projected, and its convex outline filled at 5x resolution
-// (pixel (x, y) is the 7x pixel (7x + 3, 7y + 3)), so the fill follows pixel centres to ~0.1 px.
-cv::Mat cpuSilhouette(const Camera& c, const std::vector<Vec3>& pts, double radius) {
-  const int k = 7;
-  cv::Mat big = cv::Mat::zeros(c.height * k, c.width * k, CV_8UC1);
-  std::vector<Vec3> centres = pts;
-  const double step = radius / 6.0;
-  for (std::size_t i = 0; i < pts.size(); ++i)
-    for (std::size_t j = i + 1; j < pts.size(); ++j)
-      for (std::size_t l = j; l < pts.size(); ++l) {
-        // Points of the triangle (i, j, l) (an edge when l == j) at spacing <= step.
-        const double len = std::max((pts[j] - pts[i]).norm(), (pts[l] - pts[i]).norm());
-        const int n = std::max(1, static_cast<int>(std::ceil(len / step)));
-        for (int a = 0; a <= n; ++a)
-          for (int b = 0; a + b <= n; ++b) {
-            const double s = static_cast<double>(a) / n, t = static_cast<double>(b) / n;
-            centres.push_back(pts[i] + s * (pts[j] - pts[i]) + t * (pts[l] - pts[i]));
-          }
-      }
-  std::vector<cv::Point3d> sphere;
-  const int m = 1500;
-  for (int i = 0; i < m; ++i) {  // Fibonacci sphere
-    const double z = 1.0 - (2.0 * i + 1.0) / m, rr = std::sqrt(1.0 - z * z), phi = i * 2.399963229728653;
-    sphere.emplace_back(rr * std::cos(phi), rr * std::sin(phi), z);
-  }
-  std::vector<cv::Point3d> world(sphere.size());
-  std::vector<cv::Point2d> img;
-  for (const Vec3& ce : centres) {
-    for (std::size_t i = 0; i < sphere.size(); ++i)
-      world[i] = cv::Point3d(ce.x(), ce.y(), ce.z()) + radius * sphere[i];
-    cv::projectPoints(world, c.rvec, c.tvec, c.camera_matrix, c.distortion, img);
-    std::vector<cv::Point> fixed;
-    for (const cv::Point2d& p : img)
-      fixed.emplace_back(static_cast<int>(std::lround((p.x * k + (k - 1) / 2.0) * 256)),
-                         static_cast<int>(std::lround((p.y * k + (k - 1) / 2.0) * 256)));
-    std::vector<cv::Point> hull;
-    cv::convexHull(fixed, hull);
-    cv::fillConvexPoly(big, hull, cv::Scalar(1), cv::LINE_8, 8);
-  }
-  cv::Mat out(c.height, c.width, CV_8UC1);
-  for (int y = 0; y < c.height; ++y)
-    for (int x = 0; x < c.width; ++x) out.at<uchar>(y, x) = big.at<uchar>(y * k + k / 2, x * k + k / 2);
-  return out;
-}
 
 TEST(RenderMask, MatchesIndependentCpuSilhouette) {
   std::mt19937_64 rng(31);

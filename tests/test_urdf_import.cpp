@@ -1,0 +1,112 @@
+// URDF/SRDF import of the test robot and its errors.
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "kccd/input_error.hpp"
+#include "kccd/model.hpp"
+#include "kccd/modelling/urdf_import.hpp"
+#include "support/reference_distance.hpp"
+
+namespace km = kccd::modelling;
+using kccd::Model;
+using kccd::Vec3;
+
+TEST(UrdfImport, TestRobot) {
+  const std::string dir = std::string(KCCD_TEST_DATA_DIR) + "/urdf";
+  km::ImportOptions opt;
+  opt.srdf = dir + "/two_link.srdf";
+  opt.points = 4;
+  opt.packages["kccd_test"] = dir;
+  const std::string text = km::importUrdf(dir + "/two_link.urdf", opt);
+  const Model m = kccd::parseModel(text, "imported");
+  EXPECT_EQ(m.name, "two_link");
+  ASSERT_EQ(m.joints.size(), 4u);
+  const kccd::Joint& yaw = m.joints[m.jointIndex("yaw")];
+  EXPECT_EQ(yaw.type, kccd::JointType::Revolute);
+  EXPECT_EQ(yaw.parent, kccd::kWorld);
+  ASSERT_TRUE(yaw.limits);
+  EXPECT_DOUBLE_EQ((*yaw.limits)[0], -2.0);
+  EXPECT_NEAR((yaw.origin.translation() - Vec3(0, 0, 0.1)).norm(), 0, 1e-12);
+  EXPECT_NEAR((yaw.origin.linear() - Eigen::AngleAxisd(0.5, Vec3::UnitZ()).toRotationMatrix()).norm(), 0, 1e-9);
+  const kccd::Joint& lift = m.joints[m.jointIndex("lift")];
+  EXPECT_EQ(lift.type, kccd::JointType::Prismatic);
+  EXPECT_EQ(lift.parent, m.jointIndex("yaw"));
+  const kccd::Joint& spin = m.joints[m.jointIndex("spin")];
+  EXPECT_EQ(spin.type, kccd::JointType::Revolute);  // continuous: no limits
+  EXPECT_FALSE(spin.limits);
+  EXPECT_NEAR((spin.axis - Vec3::UnitX()).norm(), 0, 1e-12);
+  EXPECT_EQ(m.joints[m.jointIndex("tip")].type, kccd::JointType::Fixed);
+  ASSERT_EQ(m.bodies.size(), 4u);  // `marker` has no collision geometry
+  EXPECT_EQ(m.bodies[m.bodyIndex("base")].frame, kccd::kWorld);
+  EXPECT_EQ(m.bodies[m.bodyIndex("tool")].frame, m.jointIndex("spin"));
+  EXPECT_EQ(m.stateSize(), 3);
+
+  // The fitted bodies contain the true collision geometry (in each link's frame).
+  auto contains = [&](const std::string& body, const std::vector<Vec3>& pts) {
+    const kccd::Body& b = m.bodies[m.bodyIndex(body)];
+    for (const Vec3& p : pts)
+      EXPECT_LE(static_cast<double>(kccd::testing::referencePointHullDistance(p, b.points)), b.radius)
+          << body << " misses " << p.transpose();
+  };
+  std::vector<Vec3> box;
+  for (int i = 0; i < 8; ++i) box.emplace_back(i & 1 ? 0.2 : -0.2, i & 2 ? 0.15 : -0.15, i & 4 ? 0.1 : 0.0);
+  contains("base", box);
+  std::vector<Vec3> rim;
+  for (int i = 0; i < 360; ++i) {
+    const double a = i * std::numbers::pi / 180;
+    rim.emplace_back(0.05 * std::cos(a), 0.05 * std::sin(a), i % 2 ? 0.5 : 0.0);
+  }
+  contains("column", rim);
+  // Slider: the sphere, and the STL bar (scaled by 0.5, rotated by pitch 90 degrees).
+  std::vector<Vec3> slider{Vec3(0.14, 0, 0), Vec3(0.06, 0, 0), Vec3(0.1, 0.04, 0), Vec3(0.1, 0, -0.04)};
+  const Eigen::Matrix3d pitch = Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitY()).toRotationMatrix();
+  for (const Vec3& v : {Vec3(-0.1, -0.02, 0), Vec3(0.1, 0.02, 0), Vec3(0, 0, 0.2)}) slider.push_back(pitch * (0.5 * v));
+  contains("slider", slider);
+  // Tool: the cone from package://, turned from +y to -x: apex at the origin, base rim at x = 0.1.
+  std::vector<Vec3> cone{Vec3(0, 0, 0)};
+  for (int i = 0; i < 360; ++i) {
+    const double a = i * std::numbers::pi / 180;
+    cone.emplace_back(0.1, 0.03 * std::cos(a), 0.03 * std::sin(a));
+  }
+  contains("tool", cone);
+
+  // SRDF: adjacent pairs ignored; a pair naming a link without geometry dropped.
+  const std::string ignore = text.substr(text.find("ignore:"));
+  EXPECT_NE(ignore.find("[base, column]"), std::string::npos);
+  EXPECT_NE(ignore.find("[slider, tool]"), std::string::npos);
+  EXPECT_EQ(ignore.find("marker"), std::string::npos);
+  EXPECT_EQ(m.pairs.size(), 4u);
+}
+
+TEST(UrdfImport, ClearErrors) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "kccd_test_urdf";
+  std::filesystem::create_directories(dir);
+  auto message = [](const std::string& path, const km::ImportOptions& o = {}) {
+    try {
+      km::importUrdf(path, o);
+    } catch (const kccd::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string link = "<link name=\"a\"><collision><geometry><sphere radius=\"0.1\"/></geometry></collision></link>";
+  std::ofstream(dir / "floating.urdf") << "<robot name=\"r\">" << link
+                                       << "<link name=\"b\"/><joint name=\"free\" type=\"floating\"><parent link=\"a\"/>"
+                                          "<child link=\"b\"/></joint></robot>";
+  EXPECT_NE(message((dir / "floating.urdf").string()).find("joint free is floating: not supported"), std::string::npos);
+  std::ofstream(dir / "planar.urdf") << "<robot name=\"r\">" << link
+                                     << "<link name=\"b\"/><joint name=\"slide\" type=\"planar\"><parent link=\"a\"/>"
+                                        "<child link=\"b\"/><axis xyz=\"0 0 1\"/></joint></robot>";
+  EXPECT_NE(message((dir / "planar.urdf").string()).find("planar"), std::string::npos);
+  std::ofstream(dir / "broken.urdf") << "<robot name=\"r\">\n<link name=\"a\">\n</robot>\n";
+  EXPECT_NE(message((dir / "broken.urdf").string()).find("broken.urdf:"), std::string::npos);
+  std::ofstream(dir / "package.urdf") << "<robot name=\"r\"><link name=\"a\"><collision><geometry>"
+                                         "<mesh filename=\"package://nowhere/m.stl\"/></geometry></collision></link></robot>";
+  EXPECT_NE(message((dir / "package.urdf").string()).find("unknown package 'nowhere' (give --package-path nowhere=DIR)"),
+            std::string::npos);
+  EXPECT_NE(message((dir / "missing.urdf").string()).find("cannot open"), std::string::npos);
+}
