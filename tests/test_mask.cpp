@@ -1,0 +1,181 @@
+// Label masks against an independent CPU silhouette, nearest-body labels, degenerate and
+// undrawable volumes, tiny images, and the GL context.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <random>
+
+#include <sys/stat.h>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "kccd/checker.hpp"
+#include "kccd/calib/camera.hpp"
+#include "kccd/render/projection.hpp"
+#include "kccd/render/renderer.hpp"
+#include "kccd/render/scene.hpp"
+#include "kccd/render/ssch_mesh.hpp"
+#include "support/cameras.hpp"
+#include "support/silhouette.hpp"
+#include "support/golden.hpp"
+
+namespace {
+
+using namespace kccd;
+using namespace kccd::render;
+using namespace kccd::calib;
+using kccd::testing::cpuSilhouette;
+using kccd::testing::cvProject;
+using kccd::testing::lookAt;
+using kccd::testing::randomCamera;
+
+TEST(RenderCamera, TinyImagesRender) {
+  for (const auto& [w, h] : {std::pair{8, 3}, std::pair{3, 8}, std::pair{1, 1}}) {
+    Camera c = lookAt(Vec3(2, 0, 0), Vec3(0, 0, 0), w, h, 3.0 * w, {-0.1, 0.01, 0, 0, 0});
+    c.camera_matrix(0, 2) = (w - 1) / 2.0;
+    c.camera_matrix(1, 2) = (h - 1) / 2.0;
+    Renderer r(c);
+    const std::vector<Vec3> ball = {Vec3(0, 0, 0)};
+    const Volume v[] = {{ball, 1.5, VolumeStatus::Clear, "ball"}};  // wider than the view
+    const Frame f = r.render(v, Style{.labels = true, .legend = true});
+    EXPECT_EQ(f.bgra.cols, w);
+    EXPECT_EQ(f.bgra.rows, h);
+    EXPECT_EQ(f.pixels[0], w * h) << w << "x" << h;
+  }
+}
+
+
+// ---------------------------------------------------------------------------------------------
+// Masks against an independent CPU silhouette
+
+
+TEST(RenderMask, MatchesIndependentCpuSilhouette) {
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  double worst_iou = 1.0, worst_boundary = 0.0;
+  for (int trial = 0; trial < 12; ++trial) {
+    const Camera c = randomCamera(rng, trial % 4 != 3);  // mostly with distortion
+    std::vector<Vec3> pts;
+    const int n = 1 + trial % 4;
+    for (int i = 0; i < n; ++i) pts.push_back(Vec3(0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng)));
+    const double radius = 0.15 + 0.1 * std::abs(u(rng));
+    const cv::Mat cpu = cpuSilhouette(c, pts, radius);
+    Renderer r(c);
+    const Volume v{pts, radius, VolumeStatus::Clear, ""};
+    const Frame f = r.render(std::span<const Volume>(&v, 1), Style{}, false, true);
+    const cv::Mat gl = f.mask > 0, ref = cpu > 0;
+    const double inter = cv::countNonZero(gl & ref), uni = cv::countNonZero(gl | ref);
+    const double iou = inter / uni;
+    worst_iou = std::min(worst_iou, iou);
+    // Containment up to a one-pixel boundary: every CPU pixel is in the mask or next to it.
+    cv::Mat grown;
+    cv::dilate(gl, grown, cv::Mat::ones(3, 3, CV_8U));
+    const int outside = cv::countNonZero(ref & ~grown);
+    const int boundary = cv::countNonZero(ref & ~gl);
+    SCOPED_TRACE("trial " + std::to_string(trial) + ": mask " + std::to_string(cv::countNonZero(gl)) + " px, CPU " +
+                 std::to_string(cv::countNonZero(ref)) + " px, common " + std::to_string(static_cast<int>(inter)));
+    EXPECT_GT(uni, 2000);
+    EXPECT_GE(iou, 0.98);
+    EXPECT_EQ(outside, 0);
+    EXPECT_LE(boundary, 0.02 * cv::countNonZero(ref));
+    worst_boundary = std::max(worst_boundary, static_cast<double>(boundary) / cv::countNonZero(ref));
+  }
+  std::cout << "mask vs CPU silhouette: worst IoU " << worst_iou << ", CPU pixels outside the mask (all within 1 px): at most "
+            << 100.0 * worst_boundary << "% of the silhouette\n";
+}
+
+TEST(RenderMask, NearestBodyWinsAndLabelsAreIndexPlusOne) {
+  const Camera c = lookAt(Vec3(2, 0, 0), Vec3(0, 0, 0), 160, 120, 150, {0, 0, 0, 0, 0});
+  Renderer r(c);
+  const std::vector<Vec3> far = {Vec3(-0.3, 0, 0)}, near = {Vec3(0.3, 0.1, 0)};
+  // The far one first in the list, so drawing order alone would let it win.
+  const Volume v[] = {{far, 0.25, VolumeStatus::Clear, "far"}, {near, 0.15, VolumeStatus::Colliding, "near"}};
+  const Frame f = r.render(v, Style{.legend = false}, true, true);
+  const cv::Point centre_near(static_cast<int>(std::lround(r.projection().project(near[0]).x())),
+                              static_cast<int>(std::lround(r.projection().project(near[0]).y())));
+  EXPECT_EQ(f.mask.at<uchar>(centre_near), 2);
+  EXPECT_EQ(f.mask.at<uchar>(0, 0), 0);
+  EXPECT_GT(f.pixels[0], 0);
+  EXPECT_GT(f.pixels[1], 0);
+  EXPECT_EQ(f.pixels[0] + f.pixels[1], cv::countNonZero(f.mask));
+  // Straight alpha: the fill of the near body alone shows its colour at the fill opacity.
+  const cv::Point far_only(static_cast<int>(std::lround(r.projection().project(far[0]).x())) - 10,
+                           static_cast<int>(std::lround(r.projection().project(far[0]).y())));
+  ASSERT_EQ(f.mask.at<uchar>(far_only), 1);
+  const cv::Vec4b px = f.bgra.at<cv::Vec4b>(far_only);
+  EXPECT_NEAR(px[3], 0.35 * 255, 2);
+  const cv::Scalar green = statusColour(VolumeStatus::Clear);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(px[ch], green[ch], 3) << ch;
+  EXPECT_EQ(f.bgra.at<cv::Vec4b>(c.height - 1, c.width - 1)[3], 0);
+}
+
+TEST(RenderMask, DegenerateVolumesAreVisible) {
+  const Camera c = lookAt(Vec3(1.5, -1.0, 1.0), Vec3(0, 0, 0), 160, 120, 150, {-0.1, 0.01, 0, 0, 0});
+  Renderer r(c);
+  const std::vector<Vec3> square = {Vec3(-0.3, -0.3, 0), Vec3(0.3, -0.3, 0), Vec3(0.3, 0.3, 0), Vec3(-0.3, 0.3, 0)};
+  const std::vector<Vec3> segment = {Vec3(-0.4, 0.4, 0.2), Vec3(0.4, 0.4, 0.2)};
+  const std::vector<Vec3> point = {Vec3(0, 0, 0.5)};
+  const Volume v[] = {{square, 0.0, VolumeStatus::Clear, ""},
+                      {segment, 0.0, VolumeStatus::Clear, ""},
+                      {point, 0.05, VolumeStatus::Clear, ""}};
+  const Frame f = r.render(v, Style{}, true, true);
+  EXPECT_GT(f.pixels[0], 500);  // a flat square seen at an angle
+  EXPECT_GT(f.pixels[2], 20);    // a ball
+  EXPECT_GT(f.pixels[1], 0);    // a radius-0 segment, drawn 1 mm thick
+  EXPECT_GT(cv::countNonZero(f.mask), 500);
+}
+
+TEST(RenderMask, VolumesThatCannotBeDrawnAreReported) {
+  // Camera at x = 2 looking along -x: camera z = -world x, camera x = world -y (right).
+  const Camera c = lookAt(Vec3(2, 0, 0), Vec3(0, 0, 0), 160, 120, 150, {0, 0, 0, 0, 0});
+  Renderer r(c);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<Vec3> behind = {Vec3(5, 0, 0)}, far = {Vec3(-2e7, 0, 0)}, bad = {Vec3(nan, 0, 0)},
+                          distant = {Vec3(-500, 0, 0)}, off_axis = {Vec3(1.9999, -1e5, 0)};
+  const Volume v[] = {{behind, 0.5, VolumeStatus::Clear, "behind"},  {far, 1e3, VolumeStatus::Clear, "far"},
+                      {bad, 0.1, VolumeStatus::Clear, "bad"},        {distant, 30, VolumeStatus::Clear, "distant"},
+                      {off_axis, 0.01, VolumeStatus::Clear, "off axis"}};
+  const Frame f = r.render(v, Style{.labels = true}, true, true);
+  EXPECT_EQ(f.visibility[0], Visibility::BehindCamera);
+  EXPECT_EQ(f.visibility[1], Visibility::BeyondFar);
+  EXPECT_EQ(f.visibility[2], Visibility::NotFinite);
+  EXPECT_EQ(f.visibility[3], Visibility::Drawn);
+  EXPECT_EQ(f.visibility[4], Visibility::Drawn);  // its label (centre at ~1e11 px) is skipped
+  EXPECT_EQ(f.pixels[0] + f.pixels[1] + f.pixels[2], 0);
+  EXPECT_GT(f.pixels[3], 50);  // 500 m away, beyond the default far plane (100 m): still drawn
+  EXPECT_GT(f.far, 500.0);
+  // 1 cm from the camera (closer than the default near plane, 5 cm): a ball of 2 cm radius
+  // seen from 1 cm covers the whole view, not clipped away by the near plane.
+  const std::vector<Vec3> close = {Vec3(1.97, 0, 0)};
+  const Volume u[] = {{close, 0.02, VolumeStatus::Clear, "close"}};
+  const Frame e = r.render(u, Style{}, true, true);
+  EXPECT_EQ(e.visibility[0], Visibility::Drawn);
+  EXPECT_LT(e.near, 0.01);
+  EXPECT_EQ(e.pixels[0], c.width * c.height);
+  EXPECT_STREQ(toString(Visibility::BeyondFar), "beyond far plane");
+
+  // A volume containing the camera fills the view in the mask and tints the colour layer.
+  const std::vector<Vec3> room = {Vec3(0, 0, 0)}, ball = {Vec3(0, 0, 0)};
+  const Volume w[] = {{ball, 0.3, VolumeStatus::Clear, "ball"}, {room, 5.0, VolumeStatus::Colliding, "room"}};
+  const Frame g = r.render(w, Style{.legend = false}, true, true);
+  EXPECT_EQ(g.visibility[1], Visibility::FillsView);
+  EXPECT_EQ(g.pixels[1], c.width * c.height);
+  EXPECT_EQ(cv::countNonZero(g.mask == 2), c.width * c.height);
+  EXPECT_NEAR(g.bgra.at<cv::Vec4b>(0, 0)[3], 0.35 * 255, 2);
+  EXPECT_GT(g.bgra.at<cv::Vec4b>(c.height / 2, c.width / 2)[3], g.bgra.at<cv::Vec4b>(0, 0)[3]);  // the ball shows through
+}
+
+
+TEST(RenderContext, ReportsItsRenderer) {
+  const auto ctx = GlContext::make();
+  EXPECT_FALSE(ctx->renderer().empty());
+  std::cout << "renderer: " << ctx->renderer() << "\n";
+}
+
+}  // namespace
