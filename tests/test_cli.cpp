@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/files.hpp"
 #include "support/run_program.hpp"
 
 namespace {
@@ -132,13 +133,6 @@ std::string scratchCopy(const std::string& from, const std::string& name) {
   return to;
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 }  // namespace
 
 TEST(Cli, FitJsonContractAndErrors) {
@@ -242,7 +236,7 @@ TEST(Cli, FitWritesIntoAModel) {
   const std::string model = scratchCopy(kDemo, "fit_model.yaml");
   const Outcome r = runKccd("fit " + kModels + "simple/cone.iv --points 4 -q --model " + model + " --body forearm");
   ASSERT_EQ(r.code, 0) << r.err;
-  const std::string text = slurp(model);
+  const std::string text = kccd::testing::readText(model);
   EXPECT_NE(text.find("# A small, readable example"), std::string::npos);  // comments kept
   const Outcome info = runKccd("info " + model + " --json");
   ASSERT_EQ(info.code, 0) << info.err;

@@ -3,13 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <limits>
-#include <map>
 #include <random>
-
-#include <sys/stat.h>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -20,8 +14,6 @@
 #include "kccd/render/renderer.hpp"
 #include "kccd/render/scene.hpp"
 #include "kccd/render/ssch_mesh.hpp"
-#include "support/cameras.hpp"
-#include "support/silhouette.hpp"
 #include "support/golden.hpp"
 
 namespace {
@@ -29,10 +21,6 @@ namespace {
 using namespace kccd;
 using namespace kccd::render;
 using namespace kccd::calib;
-using kccd::testing::cpuSilhouette;
-using kccd::testing::cvProject;
-using kccd::testing::lookAt;
-using kccd::testing::randomCamera;
 
 const std::string kData = KCCD_DATA_DIR;
 

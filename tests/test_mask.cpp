@@ -4,26 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <limits>
-#include <map>
 #include <random>
-
-#include <sys/stat.h>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "kccd/checker.hpp"
 #include "kccd/calib/camera.hpp"
 #include "kccd/render/projection.hpp"
 #include "kccd/render/renderer.hpp"
-#include "kccd/render/scene.hpp"
-#include "kccd/render/ssch_mesh.hpp"
 #include "support/cameras.hpp"
 #include "support/silhouette.hpp"
-#include "support/golden.hpp"
 
 namespace {
 
@@ -31,7 +22,6 @@ using namespace kccd;
 using namespace kccd::render;
 using namespace kccd::calib;
 using kccd::testing::cpuSilhouette;
-using kccd::testing::cvProject;
 using kccd::testing::lookAt;
 using kccd::testing::randomCamera;
 
@@ -50,10 +40,8 @@ TEST(RenderCamera, TinyImagesRender) {
   }
 }
 
-
 // ---------------------------------------------------------------------------------------------
 // Masks against an independent CPU silhouette
-
 
 TEST(RenderMask, MatchesIndependentCpuSilhouette) {
   std::mt19937_64 rng(31);
@@ -170,7 +158,6 @@ TEST(RenderMask, VolumesThatCannotBeDrawnAreReported) {
   EXPECT_NEAR(g.bgra.at<cv::Vec4b>(0, 0)[3], 0.35 * 255, 2);
   EXPECT_GT(g.bgra.at<cv::Vec4b>(c.height / 2, c.width / 2)[3], g.bgra.at<cv::Vec4b>(0, 0)[3]);  // the ball shows through
 }
-
 
 TEST(RenderContext, ReportsItsRenderer) {
   const auto ctx = GlContext::make();

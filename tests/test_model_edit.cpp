@@ -9,25 +9,14 @@
 
 #include "kccd/model.hpp"
 #include "kccd/modelling/yaml_edit.hpp"
+#include "support/files.hpp"
 
 namespace km = kccd::modelling;
 using kccd::Model;
 using kccd::Vec3;
 
-namespace {
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-
-}  // namespace
-
 TEST(YamlEdit, BodyGeometryKeepsEverythingElse) {
-  const std::string text = readFile(std::string(KCCD_DATA_DIR) + "/demo_arm.yaml");
+  const std::string text = kccd::testing::readText(std::string(KCCD_DATA_DIR) + "/demo_arm.yaml");
   const std::string edited =
       km::withBodyGeometry(text, "demo_arm.yaml", "forearm", "[[0, 0, 0], [0.1, 0.2, 0.3]]", "0.0625");
   const Model m = kccd::parseModel(edited, "edited");

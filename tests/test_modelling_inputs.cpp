@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/files.hpp"
+
 #include "kccd/modelling/part.hpp"
 #include "kccd/modelling/urdf_import.hpp"
 
@@ -237,10 +239,7 @@ std::string consoleOf(const std::function<void()>& f) {
   ::dup2(err, 2);
   ::close(out);
   ::close(err);
-  std::ifstream in(file);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return kccd::testing::readText(file);
 }
 
 }  // namespace

@@ -4,36 +4,20 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <limits>
-#include <map>
 #include <random>
 
-#include <sys/stat.h>
-
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgproc.hpp>
 
-#include "kccd/checker.hpp"
 #include "kccd/calib/camera.hpp"
 #include "kccd/render/projection.hpp"
 #include "kccd/render/renderer.hpp"
-#include "kccd/render/scene.hpp"
 #include "kccd/render/ssch_mesh.hpp"
-#include "support/cameras.hpp"
-#include "support/silhouette.hpp"
-#include "support/golden.hpp"
 
 namespace {
 
 using namespace kccd;
 using namespace kccd::render;
 using namespace kccd::calib;
-using kccd::testing::cpuSilhouette;
-using kccd::testing::cvProject;
-using kccd::testing::lookAt;
-using kccd::testing::randomCamera;
 
 // ---------------------------------------------------------------------------------------------
 // Meshes

@@ -8,16 +8,17 @@
 
 #include <unistd.h>
 
-#include "input_file.hpp"
+#include "fuzz_support.hpp"
 #include "kccd/input_error.hpp"
 #include "kccd/calib/camera.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = kccd::fuzz::writeInput("fuzz_camera", "camera.yaml", data, size);
   try {
-    const kccd::render::Camera camera = kccd::calib::loadCamera(path);
+    const kccd::calib::Camera camera = kccd::calib::loadCamera(path);
     camera.validate(path);  // a loaded camera is a valid one
-  } catch (const kccd::InputError&) {
+  } catch (const kccd::InputError& e) {
+    kccd::fuzz::checkMessage(e.what(), path);
   }
   std::remove(path.c_str());
   return 0;

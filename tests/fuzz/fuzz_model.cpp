@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "fuzz_support.hpp"
 #include "kccd/checker.hpp"
 #include "kccd/model.hpp"
 
@@ -18,10 +19,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const kccd::QueryResult& r = checker.query(zero, zero, {.type = kccd::QueryType::Distances});
     if (r.status != kccd::Status::Ok && !r.collision) std::abort();  // a failed status must say "unsafe"
   } catch (const kccd::ModelError& e) {
-    const std::string msg = e.what();
-    if (msg.rfind("fuzz.yaml", 0) != 0) std::abort();  // names the file
-    for (const char c : msg)
-      if (static_cast<unsigned char>(c) < 0x20) std::abort();  // one printable line
+    kccd::fuzz::checkMessage(e.what(), "fuzz.yaml");
   }
   return 0;
 }

@@ -12,7 +12,8 @@
 
 #include <unistd.h>
 
-#include "input_file.hpp"
+#include "fuzz_support.hpp"
+#include "kccd/input_error.hpp"
 #include "kccd/modelling/part.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -22,12 +23,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       kccd::fuzz::writeInput("fuzz_part", std::string("input") + extensions[data[0] % 3], data + 1, size - 1);
   try {
     (void)kccd::modelling::readPart(path, {.merge = (data[0] & 4) != 0});
-  } catch (const std::runtime_error& e) {
-    const std::string message = e.what();
-    if (message.find('\n') != std::string::npos) {
-      std::fprintf(stderr, "multi-line message: %s\n", message.c_str());
-      std::abort();
-    }
+  } catch (const kccd::InputError& e) {
+    kccd::fuzz::checkMessage(e.what(), path);
   }
   return 0;
 }

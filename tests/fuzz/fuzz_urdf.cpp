@@ -12,7 +12,8 @@
 
 #include <unistd.h>
 
-#include "input_file.hpp"
+#include "fuzz_support.hpp"
+#include "kccd/input_error.hpp"
 #include "kccd/modelling/urdf_import.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -20,12 +21,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     // One core point: the fit stays quick; meshes are looked up next to the input (none there).
     (void)kccd::modelling::importUrdf(path, {.points = 1});
-  } catch (const std::runtime_error& e) {
-    const std::string message = e.what();
-    if (message.find('\n') != std::string::npos) {
-      std::fprintf(stderr, "multi-line message: %s\n", message.c_str());
-      std::abort();
-    }
+  } catch (const kccd::InputError& e) {
+    kccd::fuzz::checkMessage(e.what(), path);
   }
   return 0;
 }

@@ -1,8 +1,11 @@
-// The fuzz targets' one helper: readers take a path, so each input is written to a file.
+// What every fuzz target shares: writing the input to a file (readers take a path) and the
+// contract every input error must keep.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -24,6 +27,17 @@ inline std::string writeInput(const char* target, const std::string& name, const
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   return path;
+}
+
+/// The error contract: one printable line that starts with the file's name. Anything else aborts
+/// (a finding).
+inline void checkMessage(const std::string& message, const std::string& file) {
+  bool ok = message.rfind(file, 0) == 0;
+  for (const char c : message) ok = ok && static_cast<unsigned char>(c) >= 0x20 && c != 0x7f;
+  if (!ok) {
+    std::fprintf(stderr, "input error breaks the one-line contract: %s\n", message.c_str());
+    std::abort();
+  }
 }
 
 }  // namespace kccd::fuzz
