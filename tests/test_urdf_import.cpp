@@ -109,4 +109,10 @@ TEST(UrdfImport, ClearErrors) {
   EXPECT_NE(message((dir / "package.urdf").string()).find("unknown package 'nowhere' (give --package-path nowhere=DIR)"),
             std::string::npos);
   EXPECT_NE(message((dir / "missing.urdf").string()).find("cannot open"), std::string::npos);
+  // A mesh that is not there: the message starts with the URDF and names the link and the mesh.
+  std::ofstream(dir / "mesh.urdf") << "<robot name=\"r\"><link name=\"a\"><collision><geometry>"
+                                      "<mesh filename=\"meshes/none.stl\"/></geometry></collision></link></robot>";
+  const std::string missing_mesh = message((dir / "mesh.urdf").string());
+  EXPECT_EQ(missing_mesh.rfind((dir / "mesh.urdf").string() + ": link a: ", 0), 0u) << missing_mesh;
+  EXPECT_NE(missing_mesh.find("none.stl: cannot open the file"), std::string::npos) << missing_mesh;
 }

@@ -84,8 +84,8 @@ Part linkPart(const std::string& urdf_path, const urdf::Link& link, const Import
         Part m;
         try {
           m = readPart(file, {.merge = true, .scale = Vec3(mesh.scale.x, mesh.scale.y, mesh.scale.z)});
-        } catch (const PartError& e) {
-          throw PartError(urdf_path + ": link " + link.name + ": " + e.what());
+        } catch (const InputError& e) {  // the mesh file's own error, placed in the URDF
+          throw UrdfError(urdf_path + ": link " + link.name + ": " + e.what());
         }
         for (Vec3& p : m.points) p = t * p;
         for (Sphere& s : m.balls) s.center = t * s.center;  // rigid: radii unchanged

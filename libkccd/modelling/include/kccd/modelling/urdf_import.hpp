@@ -25,7 +25,7 @@ struct ImportOptions {
 };
 
 /// Converts the URDF file at `path` into `kccd: 1` model text (checked by loading it back).
-/// Throws UrdfError (or PartError for a collision mesh) with one line naming the file and the element on any problem:
+/// Throws UrdfError with one line naming the file and the element on any problem:
 /// unreadable XML, unsupported joint kinds (floating, planar), unresolved or unreadable meshes.
 std::string importUrdf(const std::string& path, const ImportOptions& options = {});
 
