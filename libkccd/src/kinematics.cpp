@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "kccd/rotation.hpp"
+
 namespace kccd {
 
 bool framePoses(const Model& model, std::span<const double> state, std::span<Pose> poses) noexcept {
@@ -18,9 +20,7 @@ bool framePoses(const Model& model, std::span<const double> state, std::span<Pos
       case JointType::Prismatic: motion.translation() = q[0] * joint.axis; break;
       case JointType::Translation3d: motion.translation() = Vec3(q[0], q[1], q[2]); break;
       case JointType::Rotation3d: {
-        const Vec3 v(q[0], q[1], q[2]);
-        const double angle = v.norm();
-        if (angle > 0.0) motion.linear() = Eigen::AngleAxisd(angle, v / angle).toRotationMatrix();
+        motion.linear() = rotationFromVector(Vec3(q[0], q[1], q[2]));
         break;
       }
     }

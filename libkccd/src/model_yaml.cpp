@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "kccd/model.hpp"
+#include "kccd/rotation.hpp"
 #include "kccd/yaml_document.hpp"
 
 namespace kccd {
@@ -93,10 +94,7 @@ Pose parseOrigin(const Reader& r, const YAML::Node& n, const std::string& field)
   if (n["xyz"]) pose.translation() = r.point(n["xyz"], field + ".xyz");
   if (n["rpy"]) {
     const Vec3 rpy = r.vec3(n["rpy"], field + ".rpy");
-    // URDF convention: fixed-axis roll about x, then pitch about y, then yaw about z.
-    pose.linear() = (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
-                     Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
-                        .toRotationMatrix();
+    pose.linear() = rotationFromRpy(rpy);
   }
   return pose;
 }

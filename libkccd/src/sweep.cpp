@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "kccd/rotation.hpp"
+
 namespace kccd::detail {
 namespace {
 
@@ -177,7 +179,7 @@ Rotation3 rotation3(const Box3& box) {
   const double reach = box.reach + 8.0 * kEps * angle;
   if (!(reach < kPi)) return {Eigen::Matrix3d::Identity(), kPi};
   if (angle == 0.0) return {Eigen::Matrix3d::Identity(), reach};
-  return {Eigen::AngleAxisd(angle, box.centre / angle).toRotationMatrix(), reach};
+  return {rotationAboutVector(box.centre, angle), reach};
 }
 
 // A rotation by at most `reach` radians moves a point p by at most the returned factor times |p|.

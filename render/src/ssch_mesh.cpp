@@ -2,56 +2,26 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <map>
 #include <mutex>
 #include <stdexcept>
 
-extern "C" {
-#include <libqhull_r/qhull_ra.h>
-}
+#include "kccd/hull/qhull.hpp"
+#include "kccd/hull/sphere_polytope.hpp"
 
 namespace kccd::render {
 namespace {
 
 SpherePolytope makeSphere(int level) {
-  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  for (Vec3& p : v) p.normalize();
-  std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                       {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                       {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                       {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-  for (int l = 0; l < level; ++l) {
-    std::map<std::pair<int, int>, int> mid;
-    auto midpoint = [&](int a, int b) {
-      const auto key = std::minmax(a, b);
-      auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      v.push_back((v[a] + v[b]).normalized());
-      mid.emplace(key, static_cast<int>(v.size()) - 1);
-      return static_cast<int>(v.size()) - 1;
-    };
-    std::vector<std::array<int, 3>> next;
-    for (const auto& t3 : f) {
-      const int a = midpoint(t3[0], t3[1]), b = midpoint(t3[1], t3[2]), c = midpoint(t3[2], t3[0]);
-      next.push_back({t3[0], a, c});
-      next.push_back({t3[1], b, a});
-      next.push_back({t3[2], c, b});
-      next.push_back({a, b, c});
-    }
-    f = std::move(next);
-  }
+  const hull::Icosphere ico = hull::icosphere(level);
+  const std::vector<Vec3>& v = ico.vertices;
   SpherePolytope s;
-  double min_plane = 1.0, max_angle = 0.0;
-  for (auto& t3 : f) {
-    if ((v[t3[1]] - v[t3[0]]).cross(v[t3[2]] - v[t3[0]]).dot(v[t3[0]]) < 0.0) std::swap(t3[1], t3[2]);
+  double max_angle = 0.0;
+  for (const auto& t3 : ico.triangles) {
     s.triangles.push_back({static_cast<std::uint32_t>(t3[0]), static_cast<std::uint32_t>(t3[1]),
                            static_cast<std::uint32_t>(t3[2])});
     const Vec3 n = (v[t3[1]] - v[t3[0]]).cross(v[t3[2]] - v[t3[0]]).normalized();
-    min_plane = std::min(min_plane, std::abs(n.dot(v[t3[0]])));
     for (int k = 0; k < 3; ++k) max_angle = std::max(max_angle, std::acos(std::clamp(std::abs(n.dot(v[t3[k]])), -1.0, 1.0)));
   }
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> owner;  // directed edge -> triangle
@@ -62,9 +32,8 @@ SpherePolytope makeSphere(int level) {
     for (int k = 0; k < 3; ++k) nb[k] = owner.at({tri[(k + 1) % 3], tri[k]});
     s.neighbours.push_back(nb);
   }
-  s.vertices = std::move(v);
-  // A tiny relative guard so rounding in the scaled vertices never moves a face inside the ball.
-  s.scale = (1.0 / min_plane) * (1.0 + 1e-12);
+  s.vertices = v;
+  s.scale = hull::circumscribedScale(ico);
   s.cone_chord = 2.0 * std::sin(max_angle / 2.0) * (1.0 + 1e-9) + 1e-12;
   return s;
 }
@@ -185,7 +154,7 @@ Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, doubl
   for (std::size_t i = 0; i < k; ++i)
     for (std::size_t j = 0; j < k; ++j) dist[i * k + j] = (points[i] - points[j]).norm();
   const double slack = 1e-12 * (1.0 + extent);
-  std::vector<coordT> coords;
+  std::vector<double> coords;
   coords.reserve(sphere.vertices.size() * 3 * 2);
   for (const Vec3& v : sphere.vertices) {
     std::size_t best = 0;
@@ -208,28 +177,21 @@ Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, doubl
   mesh.level = level;
   mesh.mesh_radius = big_r;
   mesh.hull_input = n;
-  qhT qh_storage;
-  qhT* qh = &qh_storage;
-  FILE* devnull = std::fopen("/dev/null", "w");
-  qh_zero(qh, devnull);
-  char options[] = "qhull Qt";
-  const int code = qh_new_qhull(qh, 3, n, coords.data(), False, options, nullptr, devnull);
+  const hull::QhullResult result = hull::convexHull3(coords);
+  const int code = result.code;
   if (code == 0) {
     std::vector<int> index(static_cast<std::size_t>(n), -1);
-    auto vertexIndex = [&](vertexT* vx) {
-      const int id = qh_pointid(qh, vx->point);
+    auto vertexIndex = [&](int id) {
       if (index[id] < 0) {
         index[id] = static_cast<int>(mesh.vertices.size());
-        mesh.vertices.emplace_back(vx->point[0], vx->point[1], vx->point[2]);
+        mesh.vertices.emplace_back(coords[3 * id], coords[3 * id + 1], coords[3 * id + 2]);
       }
       return static_cast<std::uint32_t>(index[id]);
     };
-    facetT* facet;
-    FORALLfacets {
+    for (const hull::QhullFacet& facet : result.facets) {
       std::vector<std::uint32_t> ids;
-      vertexT *vertex, **vertexp;
-      FOREACHvertex_(facet->vertices) ids.push_back(vertexIndex(vertex));
-      const Vec3 normal(facet->normal[0], facet->normal[1], facet->normal[2]);
+      for (const int id : facet.vertices) ids.push_back(vertexIndex(id));
+      const Vec3& normal = facet.normal;
       for (std::size_t k = 1; k + 1 < ids.size(); ++k) {
         std::array<std::uint32_t, 3> t{ids[0], ids[k], ids[k + 1]};
         const Vec3 n3 =
@@ -240,10 +202,6 @@ Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, doubl
       }
     }
   }
-  qh_freeqhull(qh, !qh_ALL);
-  int curlong = 0, totlong = 0;
-  qh_memfreeshort(qh, &curlong, &totlong);
-  std::fclose(devnull);
   if (code != 0 || mesh.triangles.empty())
     throw std::runtime_error("buildSschMesh: qhull failed (code " + std::to_string(code) + ")");
 

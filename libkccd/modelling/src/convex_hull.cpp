@@ -2,26 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <numbers>
 #include <stdexcept>
 
-#include <Eigen/Eigenvalues>
-
-extern "C" {
-#include <libqhull_r/qhull_ra.h>
-}
+#include "kccd/hull/principal.hpp"
+#include "kccd/hull/qhull.hpp"
 
 namespace kccd::modelling {
 namespace {
 
-FILE* nullFile() {
-  static FILE* f = std::fopen("/dev/null", "w");
-  return f;
-}
-
-// Principal frame of a centred point set: columns sorted by decreasing spread.
+// Principal frame of a point set: columns sorted by decreasing spread.
 struct Principal {
   Vec3 centroid;
   Eigen::Matrix3d axes;
@@ -29,14 +20,10 @@ struct Principal {
 };
 
 Principal principal(std::span<const Vec3> points) {
+  const hull::PrincipalFrame frame = hull::principalFrame(points);
   Principal p;
-  p.centroid = Vec3::Zero();
-  for (const Vec3& v : points) p.centroid += v;
-  p.centroid /= static_cast<double>(points.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Vec3& v : points) cov += (v - p.centroid) * (v - p.centroid).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-  for (int i = 0; i < 3; ++i) p.axes.col(i) = eig.eigenvectors().col(2 - i);
+  p.centroid = frame.mean;
+  for (int i = 0; i < 3; ++i) p.axes.col(i) = frame.axes.col(2 - i);
   Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
   for (const Vec3& v : points) {
     const Vec3 c = p.axes.transpose() * (v - p.centroid);
@@ -106,35 +93,21 @@ ConvexHull lowDimensional(std::span<const Vec3> points, const Principal& p, int 
 }
 
 bool solid(std::span<const Vec3> points, ConvexHull& h) {
-  std::vector<coordT> coords;
+  std::vector<double> coords;
   coords.reserve(points.size() * 3);
   for (const Vec3& v : points) coords.insert(coords.end(), {v.x(), v.y(), v.z()});
-  qhT qh_qh;
-  qhT* qh = &qh_qh;
-  QHULL_LIB_CHECK
-  qh_zero(qh, nullFile());
-  char flags[] = "qhull Qt";
-  const int exitcode = qh_new_qhull(qh, 3, static_cast<int>(points.size()), coords.data(), False, flags, nullptr,
-                                    nullFile());
-  bool ok = exitcode == 0;
+  const hull::QhullResult result = hull::convexHull3(coords);
+  const bool ok = result.code == 0;
   if (ok) {
-    facetT* facet;
-    vertexT *vertex, **vertexp;
-    FORALLvertices h.vertices.push_back(qh_pointid(qh, vertex->point));
-    FORALLfacets {
-      std::array<int, 3> t{};
-      int n = 0;
-      FOREACHvertex_(facet->vertices) if (n < 3) t[n++] = qh_pointid(qh, vertex->point);
-      if (n != 3) continue;
-      const Vec3 normal(facet->normal[0], facet->normal[1], facet->normal[2]);
+    h.vertices = result.vertices;
+    for (const hull::QhullFacet& facet : result.facets) {
+      if (facet.vertices.size() < 3) continue;
+      std::array<int, 3> t{facet.vertices[0], facet.vertices[1], facet.vertices[2]};
       const Vec3 cross = (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]);
-      if (cross.dot(normal) < 0) std::swap(t[1], t[2]);
+      if (cross.dot(facet.normal) < 0) std::swap(t[1], t[2]);
       h.triangles.push_back(t);
     }
   }
-  qh_freeqhull(qh, !qh_ALL);
-  int curlong = 0, totlong = 0;
-  qh_memfreeshort(qh, &curlong, &totlong);
   if (!ok || h.triangles.size() < 4) return false;
   // Volume, area and the edge term from the triangles (coplanar neighbours contribute 0).
   const Vec3 inside = points[h.triangles[0][0]];

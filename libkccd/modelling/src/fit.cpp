@@ -7,9 +7,8 @@
 #include <random>
 #include <stdexcept>
 
-#include <Eigen/Eigenvalues>
-
 #include "kccd/distance.hpp"
+#include "kccd/hull/principal.hpp"
 #include "kccd/modelling/convex_hull.hpp"
 #include "kccd/modelling/yaml_edit.hpp"
 
@@ -89,22 +88,6 @@ class Objective {
   GjkOptions options_{.max_iterations = 64, .relative_tolerance = 1e-7};
 };
 
-// Mean and principal axes (eigenvectors, increasing spread) of a point set.
-struct Principal {
-  Vec3 mean = Vec3::Zero();
-  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
-};
-
-Principal principalAxes(const std::vector<Vec3>& points) {
-  Principal p;
-  for (const Vec3& v : points) p.mean += v;
-  p.mean /= static_cast<double>(points.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Vec3& v : points) cov += (v - p.mean) * (v - p.mean).transpose();
-  p.axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
-  return p;
-}
-
 // What a covering radius is measured against: the hull vertices of the part's points (the
 // hull is computed once per part), its balls and its input rounding guard.
 struct Cover {
@@ -160,7 +143,7 @@ Constraints buildConstraints(const Part& part, const Cover& cover, int& hull_ver
   for (const Vec3& v : all) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
   c.center = (lo + hi) / 2.0;
   c.diameter = (hi - lo).norm();
-  c.axes = principalAxes(all).axes;
+  c.axes = hull::principalFrame(all).axes;
   return c;
 }
 
@@ -370,7 +353,7 @@ FitResult fit(const Part& part, const FitOptions& options) {
   result.sphere_volume = sschVolume(centre, coverRadius(centre, cover));
 
   const std::vector<Vec3> samples = part.samples(42);
-  const Principal pca = principalAxes(samples);
+  const hull::PrincipalFrame pca = hull::principalFrame(samples);
   const Vec3& mean = pca.mean;
   result.capsule_volume = INFINITY;
   std::vector<Vec3> capsule;
