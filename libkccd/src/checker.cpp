@@ -7,7 +7,9 @@
 #include <cmath>
 #include <limits>
 
+#include "bounding_sphere.hpp"
 #include "kccd/distance.hpp"
+#include "rounding.hpp"
 #include "sweep.hpp"
 
 namespace kccd {
@@ -15,39 +17,30 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 using Clock = std::chrono::steady_clock;
+using detail::shrunkBound;
 
 }  // namespace
 
-const char* toString(Status status) {
-  switch (status) {
-    case Status::Ok: return "ok";
-    case Status::WrongStateSize: return "wrong_state_size";
-    case Status::NonFiniteState: return "non_finite_state";
-    case Status::LowerAboveUpper: return "lower_above_upper";
-    case Status::ExactNeedsPoint: return "exact_needs_point_interval";
-    case Status::NumericalFailure: return "numerical_failure";
-  }
-  return "?";
-}
-
-const char* toString(QueryType type) {
-  switch (type) {
-    case QueryType::Collision: return "collision";
-    case QueryType::Closest: return "closest";
-    case QueryType::NClosest: return "nclosest";
-    case QueryType::Distances: return "distances";
-  }
-  return "?";
-}
-
 Checker::Checker(const Model& model) : model_(model) {
-  const int nb = static_cast<int>(model.bodies.size());
+  layoutVolumes();
+  computeReach();
   const int np = static_cast<int>(model.pairs.size());
   const int ns = model.stateSize();
-  const int budget = model.point_budget;
+  order_.resize(np);
+  out_.resize(np);
+  fresh_.assign(np, 0);
+  nbest_.assign(np, 0.0);
+  lower_.assign(ns, 0.0);
+  upper_.assign(ns, 0.0);
+}
 
-  // Levels per body: level 0 is the body in its own frame, level l+1 the volume swept through
-  // the joint of level l and expressed in that joint's parent frame, up to the world.
+// Levels per body: level 0 is the body in its own frame, level l+1 the volume swept through the
+// joint of level l and expressed in that joint's parent frame, up to the world. Every level gets
+// its room in one arena of points, and the scratch space is sized for the widest sweep.
+void Checker::layoutVolumes() {
+  const Model& model = model_;
+  const int nb = static_cast<int>(model.bodies.size());
+  const int budget = model.point_budget;
   int max_points = budget;
   int arena = 0;
   for (int b = 0; b < nb; ++b) {
@@ -86,9 +79,15 @@ Checker::Checker(const Model& model) : model_(model) {
   scratch_rho_.resize(max_points);
   scratch_level_.resize(max_points);
   scratch_order_.resize(max_points);
+}
 
-  // Per pair: the level of the LCA frame on each body's path, and how far each state value can
-  // move the pair's core points per unit change (for keeping stored bounds valid).
+// Per pair: the level of the LCA frame on each body's path, and how far each state value can
+// move the pair's core points per unit change (for keeping stored bounds valid); then the empty
+// any-time table with room for each stored bound's box.
+void Checker::computeReach() {
+  const Model& model = model_;
+  const int np = static_cast<int>(model.pairs.size());
+  const int ns = model.stateSize();
   std::vector<double> dense(static_cast<std::size_t>(np) * ns, 0.0);
   for (int p = 0; p < np; ++p) {
     const BodyPair& pair = model.pairs[p];
@@ -131,12 +130,6 @@ Checker::Checker(const Model& model) : model_(model) {
   }
   table_.assign(np, Entry{});
   box_.assign(2 * reach_.size(), 0.0);
-  order_.resize(np);
-  out_.resize(np);
-  fresh_.assign(np, 0);
-  nbest_.assign(np, 0.0);
-  lower_.assign(ns, 0.0);
-  upper_.assign(ns, 0.0);
 }
 
 void Checker::reset() noexcept {
@@ -172,16 +165,16 @@ bool Checker::validate(std::span<const double> lower, std::span<const double> up
   return true;
 }
 
-const Checker::Volume* Checker::volume(int body, int level) noexcept {
+const Checker::Volume* Checker::volume(int body, int level, Box box) noexcept {
   const int idx = level_begin_[body] + level;
   Volume& v = volumes_[idx];
   if (level == 0 || v.stamp == cycle_) return &v;
-  const Volume* below = volume(body, level - 1);
+  const Volume* below = volume(body, level - 1, box);
   if (below == nullptr) return nullptr;
   const Joint& joint = model_.joints[path_[idx - 1]];
   double radius = below->radius;
   const detail::SweepWork work{scratch_rho_.data(), scratch_level_.data(), scratch_order_.data()};
-  int n = detail::sweepJoint(joint, lower_.data() + joint.state_offset, upper_.data() + joint.state_offset,
+  int n = detail::sweepJoint(joint, box.lower.data() + joint.state_offset, box.upper.data() + joint.state_offset,
                              view(*below).points, scratch_.data(), radius, v.capacity, work);
   if (n < 0) return nullptr;
   n = detail::reduceToBudget(scratch_.data(), n, v.capacity, scratch_dist_.data(), radius);
@@ -199,15 +192,15 @@ SschView Checker::view(const Volume& v) const noexcept {
   return {{points_.data() + v.offset, static_cast<std::size_t>(v.count)}, v.radius};
 }
 
-const Sphere* Checker::sphere(int body, int level) noexcept {
+const Sphere* Checker::sphere(int body, int level, Box box) noexcept {
   const int idx = level_begin_[body] + level;
   Volume& v = volumes_[idx];
   if (level == 0 || v.sphere_stamp == cycle_) return &v.swept_sphere;
-  const Sphere* below = sphere(body, level - 1);
+  const Sphere* below = sphere(body, level - 1, box);
   if (below == nullptr) return nullptr;
   const Joint& joint = model_.joints[path_[idx - 1]];
-  v.swept_sphere =
-      detail::sweepSphere(joint, lower_.data() + joint.state_offset, upper_.data() + joint.state_offset, *below);
+  v.swept_sphere = detail::sweepSphere(joint, box.lower.data() + joint.state_offset,
+                                       box.upper.data() + joint.state_offset, *below);
   if (!v.swept_sphere.center.allFinite() || !std::isfinite(v.swept_sphere.radius)) return nullptr;
   v.sphere_stamp = cycle_;
   return &v.swept_sphere;
@@ -217,13 +210,13 @@ SschView Checker::sweptVolume(int body, int frame) noexcept {
   if (body < 0 || body >= static_cast<int>(levels_.size())) return {};
   for (int level = 0; level < levels_[body]; ++level) {
     if (path_[level_begin_[body] + level] != frame) continue;
-    const Volume* v = volume(body, level);
+    const Volume* v = volume(body, level, Box{lower_, upper_});
     return v == nullptr ? SschView{} : view(*v);
   }
   return {};
 }
 
-double Checker::refresh(int p, double stop_above) noexcept {
+double Checker::refresh(int p, double stop_above, Box box) noexcept {
   const BodyPair& pair = model_.pairs[p];
   Entry& e = table_[p];
   const int la = pair_level_[2 * p], lb = pair_level_[2 * p + 1];
@@ -235,18 +228,18 @@ double Checker::refresh(int p, double stop_above) noexcept {
     return 0.0;
   };
   auto sphereGap = [](const Sphere& x, const Sphere& y) {
-    return std::max(0.0, ((x.center - y.center).norm() - x.radius - y.radius) * (1.0 - 1e-12));
+    return std::max(0.0, shrunkBound((x.center - y.center).norm() - x.radius - y.radius));
   };
   // Cheapest first: spheres swept without sweeping any point often prove the pair clear.
-  const Sphere* sa = sphere(pair.a, la);
-  const Sphere* sb = sphere(pair.b, lb);
+  const Sphere* sa = sphere(pair.a, la, box);
+  const Sphere* sb = sphere(pair.b, lb, box);
   if (sa == nullptr || sb == nullptr) return fail();
   double bound = sphereGap(*sa, *sb);
   e.gjk = false;
   if (bound < stop_above) {
     // Then the spheres around the swept points, then GJK on the points themselves.
-    const Volume* va = volume(pair.a, la);
-    const Volume* vb = volume(pair.b, lb);
+    const Volume* va = volume(pair.a, la, box);
+    const Volume* vb = volume(pair.b, lb, box);
     if (va == nullptr || vb == nullptr) return fail();
     bound = std::max(bound, sphereGap(va->bound, vb->bound));
     if (bound < stop_above) {
@@ -267,13 +260,13 @@ double Checker::refresh(int p, double stop_above) noexcept {
   e.bound = bound;
   e.current = bound;
   for (int k = reach_begin_[p]; k < reach_begin_[p + 1]; ++k) {
-    box_[2 * k] = lower_[reach_state_[k]];
-    box_[2 * k + 1] = upper_[reach_state_[k]];
+    box_[2 * k] = box.lower[reach_state_[k]];
+    box_[2 * k + 1] = box.upper[reach_state_[k]];
   }
   return bound;
 }
 
-void Checker::publish(int p, PairDistance& out) const noexcept {
+void Checker::report(int p, PairDistance& out) const noexcept {
   const Entry& e = table_[p];
   out.pair = p;
   out.distance = e.current;
@@ -298,10 +291,40 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   ++cycle_;
   std::copy(lower.begin(), lower.end(), lower_.begin());
   std::copy(upper.begin(), upper.end(), upper_.begin());
-  const int np = static_cast<int>(model_.pairs.size());
+  const Box box{lower_, upper_};
 
-  // Carry every stored bound over to this box: unchanged while the box stays inside the stored
-  // one, otherwise lowered by the most the pair's points can have moved (ALGORITHMS.md 5).
+  carryBounds(box);
+  const int candidates = orderCandidates(options.type, margin);
+
+  // Budgets beyond kMaxBudgetUs (and NaN) mean unlimited: converting them to clock ticks would overflow.
+  Budget budget;
+  budget.timed = options.budget_us > 0.0 && options.budget_us <= kMaxBudgetUs;
+  budget.deadline =
+      start + (budget.timed
+                   ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::micro>(options.budget_us))
+                   : Clock::duration::zero());
+  budget.max_pairs = options.max_pairs;
+  std::fill(fresh_.begin(), fresh_.end(), 0);
+
+  const int np = static_cast<int>(model_.pairs.size());
+  const int n_wanted = std::clamp(options.n, 1, std::max(np, 1));  // NClosest
+  int hit = -1;  // Collision: the pair reported
+  switch (options.type) {
+    case QueryType::Collision: hit = refineCollision(candidates, margin, budget, box); break;
+    case QueryType::Closest: refineClosest(candidates, margin, budget, box); break;
+    case QueryType::NClosest: refineNClosest(n_wanted, budget, box); break;
+    case QueryType::Distances: refineDistances(budget, box); break;
+  }
+
+  publishAnswer(options.type, margin, hit, n_wanted);
+  result_.stats.time_us = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+  return result_;
+}
+
+// Carries every stored bound over to this box: unchanged while the box stays inside the stored
+// one, otherwise lowered by the most the pair's points can have moved (ALGORITHMS.md 5).
+void Checker::carryBounds(Box box) noexcept {
+  const int np = static_cast<int>(model_.pairs.size());
   for (int p = 0; p < np; ++p) {
     Entry& e = table_[p];
     if (!e.valid) {
@@ -311,104 +334,106 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
     double moved = 0.0;
     for (int k = reach_begin_[p]; k < reach_begin_[p + 1]; ++k) {
       const int st = reach_state_[k];
-      const double grow = std::max({0.0, box_[2 * k] - lower[st], upper[st] - box_[2 * k + 1]});
+      const double grow = std::max({0.0, box_[2 * k] - box.lower[st], box.upper[st] - box_[2 * k + 1]});
       if (grow > 0.0) moved += reach_[k] * grow;
     }
-    e.current = moved == 0.0 ? e.bound : std::max(0.0, (e.bound - moved) * (1.0 - 1e-12));
+    e.current = moved == 0.0 ? e.bound : std::max(0.0, shrunkBound(e.bound - moved));
     if (!std::isfinite(e.current)) e.current = 0.0;
   }
-  // Refinement order: smallest bound first. Collision and closest queries only ever refine
-  // pairs within the margin, so only those need sorting.
+}
+
+// Refinement order: smallest bound first, in order_. Collision and closest queries only ever
+// refine pairs within the margin, so only those are sorted (and counted); the others come after
+// them. Returns the number of sorted candidates at the front of order_.
+int Checker::orderCandidates(QueryType type, double margin) noexcept {
+  const int np = static_cast<int>(model_.pairs.size());
   for (int p = 0; p < np; ++p) order_[p] = p;
-  auto by_bound = [this](int x, int y) { return table_[x].current < table_[y].current; };
   auto sorted_end = order_.end();
-  if (options.type == QueryType::Collision || options.type == QueryType::Closest) {
+  if (type == QueryType::Collision || type == QueryType::Closest) {
     sorted_end = std::partition(order_.begin(), order_.end(), [&](int x) { return table_[x].current <= margin; });
   }
-  std::sort(order_.begin(), sorted_end, by_bound);
+  std::sort(order_.begin(), sorted_end, [this](int x, int y) { return table_[x].current < table_[y].current; });
+  return static_cast<int>(sorted_end - order_.begin());
+}
 
-  // Budgets beyond kMaxBudgetUs (and NaN) mean unlimited: converting them to clock ticks would overflow.
-  const bool timed = options.budget_us > 0.0 && options.budget_us <= kMaxBudgetUs;
-  const Clock::time_point deadline =
-      start + (timed ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::micro>(options.budget_us))
-                     : Clock::duration::zero());
-  auto expired = [&]() {
-    if ((options.max_pairs >= 0 && result_.stats.pairs_checked >= options.max_pairs) ||
-        (timed && Clock::now() > deadline)) {
-      result_.stats.budget_exhausted = true;
-      return true;
-    }
-    return false;
-  };
-  std::fill(fresh_.begin(), fresh_.end(), 0);
-  auto run = [&](int p, double stop_above) {
-    refresh(p, stop_above);
-    fresh_[p] = 1;
-  };
-
-  int count = 0;  // pairs reported
-  const int n_wanted = std::clamp(options.n, 1, std::max(np, 1));  // NClosest
-  switch (options.type) {
-    case QueryType::Collision: {
-      int hit = -1;
-      for (auto it = order_.begin(); it != sorted_end; ++it) {
-        const int p = *it;  // every pair after sorted_end clears the margin already
-        if (expired()) {
-          hit = p;
-          break;
-        }
-        run(p, margin);
-        if (table_[p].current <= margin) {
-          hit = p;
-          break;
-        }
-      }
-      if (hit >= 0) publish(hit, out_[count++]);
-      break;
-    }
-    case QueryType::Closest: {
-      double best = kInf;
-      for (auto it = order_.begin(); it != sorted_end; ++it) {
-        const int p = *it;
-        if (table_[p].current >= best) break;
-        if (expired()) break;
-        run(p, std::min(best, margin));
-        best = std::min(best, table_[p].current);
-      }
-      break;
-    }
-    case QueryType::NClosest: {
-      const int n = n_wanted;
-      // best[0..fresh) holds the smallest fresh bounds so far, sorted.
-      int fresh = 0;
-      double* best = nbest_.data();
-      for (int p : order_) {
-        const double nth = fresh >= n ? best[n - 1] : kInf;
-        if (table_[p].current >= nth) break;
-        if (expired()) break;
-        run(p, nth);
-        const double d = table_[p].current;
-        int k = std::min(fresh, n - 1);
-        if (fresh < n || d < best[k]) {
-          while (k > 0 && best[k - 1] > d) {
-            best[k] = best[k - 1];
-            --k;
-          }
-          best[k] = d;
-          fresh = std::min(fresh + 1, n);
-        }
-      }
-      break;
-    }
-    case QueryType::Distances:
-      for (int p : order_) {
-        if (expired()) break;
-        run(p, kInf);
-      }
-      break;
+// True when a budget stops refinement (and records that it did).
+bool Checker::expired(const Budget& budget) noexcept {
+  if ((budget.max_pairs >= 0 && result_.stats.pairs_checked >= budget.max_pairs) ||
+      (budget.timed && Clock::now() > budget.deadline)) {
+    result_.stats.budget_exhausted = true;
+    return true;
   }
+  return false;
+}
 
-  // The answer: every bound in the table is valid for this box.
+// Recomputes one pair's bound for this query and marks it fresh.
+void Checker::refine(int p, double stop_above, Box box) noexcept {
+  refresh(p, stop_above, box);
+  fresh_[p] = 1;
+}
+
+// Collision: refines candidates until one is proven within the margin (or a budget runs out,
+// which makes the next candidate the answer). Every pair after the candidates clears the margin
+// already. Returns the pair to report, or -1 when none collides.
+int Checker::refineCollision(int candidates, double margin, const Budget& budget, Box box) noexcept {
+  for (int i = 0; i < candidates; ++i) {
+    const int p = order_[i];
+    if (expired(budget)) return p;
+    refine(p, margin, box);
+    if (table_[p].current <= margin) return p;
+  }
+  return -1;
+}
+
+// Closest: refines candidates, smallest bound first, until the next stored bound cannot beat the
+// best one refined so far.
+void Checker::refineClosest(int candidates, double margin, const Budget& budget, Box box) noexcept {
+  double best = kInf;
+  for (int i = 0; i < candidates; ++i) {
+    const int p = order_[i];
+    if (table_[p].current >= best) break;
+    if (expired(budget)) break;
+    refine(p, std::min(best, margin), box);
+    best = std::min(best, table_[p].current);
+  }
+}
+
+// NClosest: refines pairs, smallest bound first, until the next stored bound cannot beat the n-th
+// smallest refined one. nbest_[0..fresh) holds the smallest fresh bounds so far, sorted.
+void Checker::refineNClosest(int n, const Budget& budget, Box box) noexcept {
+  int fresh = 0;
+  double* best = nbest_.data();
+  for (int p : order_) {
+    const double nth = fresh >= n ? best[n - 1] : kInf;
+    if (table_[p].current >= nth) break;
+    if (expired(budget)) break;
+    refine(p, nth, box);
+    const double d = table_[p].current;
+    int k = std::min(fresh, n - 1);
+    if (fresh < n || d < best[k]) {
+      while (k > 0 && best[k - 1] > d) {
+        best[k] = best[k - 1];
+        --k;
+      }
+      best[k] = d;
+      fresh = std::min(fresh + 1, n);
+    }
+  }
+}
+
+// Distances: refines every pair to its full bound, smallest stored bound first.
+void Checker::refineDistances(const Budget& budget, Box box) noexcept {
+  for (int p : order_) {
+    if (expired(budget)) break;
+    refine(p, kInf, box);
+  }
+}
+
+// The answer: every bound in the table is valid for this box. Reports the pairs the query type
+// asks for into out_ and sets the result's distance, collision flag and pair list.
+void Checker::publishAnswer(QueryType type, double margin, int hit, int n_wanted) noexcept {
+  const int np = static_cast<int>(model_.pairs.size());
+  int count = 0;  // pairs reported
   double min_distance = kInf;
   int argmin = -1;
   for (int p = 0; p < np; ++p) {
@@ -417,20 +442,20 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
       argmin = p;
     }
   }
-  if (options.type == QueryType::Closest && argmin >= 0 && min_distance <= margin) {
-    publish(argmin, out_[count++]);
-  } else if (options.type == QueryType::NClosest) {
-    std::sort(order_.begin(), order_.end(), by_bound);
-    for (int k = 0; k < std::min(n_wanted, np); ++k) publish(order_[k], out_[count++]);
-  } else if (options.type == QueryType::Distances) {
-    for (int p = 0; p < np; ++p) publish(p, out_[count++]);
+  if (type == QueryType::Collision && hit >= 0) {
+    report(hit, out_[count++]);
+  } else if (type == QueryType::Closest && argmin >= 0 && min_distance <= margin) {
+    report(argmin, out_[count++]);
+  } else if (type == QueryType::NClosest) {
+    std::sort(order_.begin(), order_.end(), [this](int x, int y) { return table_[x].current < table_[y].current; });
+    for (int k = 0; k < std::min(n_wanted, np); ++k) report(order_[k], out_[count++]);
+  } else if (type == QueryType::Distances) {
+    for (int p = 0; p < np; ++p) report(p, out_[count++]);
   }
   if (result_.status != Status::Ok) min_distance = 0.0;
   result_.min_distance = min_distance;
   result_.collision = result_.status != Status::Ok || min_distance <= margin;
   result_.pairs = std::span<const PairDistance>(out_.data(), static_cast<std::size_t>(count));
-  result_.stats.time_us = std::chrono::duration<double, std::micro>(Clock::now() - start).count();
-  return result_;
 }
 
 }  // namespace kccd

@@ -10,11 +10,10 @@
 #include <limits>
 
 #include "kccd/distance.hpp"
+#include "rounding.hpp"
 
 namespace kccd {
 namespace {
-
-constexpr double kEps = std::numeric_limits<double>::epsilon();
 
 // The current simplex: up to four vertices of D with the indices of the points that made them.
 // Unused slots stay finite (zero): the sub-algorithm weighs all four slots.
@@ -243,8 +242,8 @@ DistanceResult distance(const SschView& a, const SschView& b, const GjkOptions& 
 
   // Rounding guard: the dot products behind a bound err by a few ulps of the coordinates.
   const double radii = a.radius + b.radius;
-  const double guard = 32.0 * kEps * (scale_a + scale_b) + 4.0 * kEps * radii;
-  const double overlap_tol = 16.0 * kEps * (scale_a + scale_b);
+  const double guard = detail::roundingGuard(scale_a + scale_b, 32) + detail::roundingGuard(radii, 4);
+  const double overlap_tol = detail::roundingGuard(scale_a + scale_b, 16);
   const double overlap_vv = overlap_tol * overlap_tol;
   const double tol = std::max(options.relative_tolerance, 0.0);
 

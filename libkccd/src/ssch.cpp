@@ -1,12 +1,13 @@
 #include "kccd/ssch.hpp"
 
+#include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <string>
 
+#include "bounding_sphere.hpp"
 #include "kccd/distance.hpp"
-#include "sweep.hpp"
+#include "rounding.hpp"
 
 namespace kccd {
 
@@ -43,7 +44,7 @@ Ssch Ssch::pruned(double tolerance) const {
   std::vector<Vec3> kept = points_;
   double scale = 0.0;
   for (const Vec3& p : kept) scale = std::max(scale, p.cwiseAbs().maxCoeff());
-  const double guard = 64.0 * std::numeric_limits<double>::epsilon() * scale;
+  const double guard = detail::roundingGuard(scale, 64);
   double growth = 0.0;
   // A point is dropped when the hull of the remaining points comes within tolerance of it; the
   // upper bound of that distance (GJK's |v|) is added to the radius, so nothing is lost.
@@ -63,5 +64,23 @@ Ssch Ssch::pruned(double tolerance) const {
 }
 
 Sphere Ssch::boundingSphere() const { return detail::boundingSphere(points_, radius_); }
+
+namespace detail {
+
+Sphere boundingSphere(std::span<const Vec3> pts, double radius) noexcept {
+  Vec3 lo = pts[0], hi = pts[0];
+  for (const Vec3& p : pts) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  Sphere s;
+  s.center = 0.5 * (lo + hi);
+  double r = 0.0;
+  for (const Vec3& p : pts) r = std::max(r, (p - s.center).squaredNorm());
+  s.radius = roundedUp(std::sqrt(r), 4) + radius;
+  return s;
+}
+
+}  // namespace detail
 
 }  // namespace kccd

@@ -2,14 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
+#include "rounding.hpp"
 
 #include "kccd/rotation.hpp"
 
 namespace kccd::detail {
 namespace {
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr double kPi = 3.141592653589793;
 constexpr double kTwoPi = 6.283185307179586;
 
@@ -34,10 +33,10 @@ Arc revoluteArc(double lo, double hi) {
   const double width = hi - lo;  // may be +inf for ends near the double range: a full turn
   if (!(width < kTwoPi)) return {-kPi, kTwoPi};
   if (width == 0.0) return {lo, 0.0};  // a single angle: evaluated directly, exactly
-  if (std::abs(lo) <= kTwoPi) return {lo, std::min(kTwoPi, width * (1.0 + 2.0 * kEps) + 4.0 * kEps * kTwoPi)};
-  const double start_error = 16.0 * kEps * kTwoPi;
+  if (std::abs(lo) <= kTwoPi) return {lo, std::min(kTwoPi, roundedUp(width, 2) + roundingGuard(kTwoPi, 4))};
+  const double start_error = roundingGuard(kTwoPi, 16);
   const double start = std::atan2(std::sin(lo), std::cos(lo)) - start_error;
-  return {start, std::min(kTwoPi, width * (1.0 + 2.0 * kEps) + 2.0 * start_error)};
+  return {start, std::min(kTwoPi, roundedUp(width, 2) + 2.0 * start_error)};
 }
 
 double maxNorm(std::span<const Vec3> pts) {
@@ -73,7 +72,7 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
       const Vec3 radial = in[i] - axial;
       out[i] = rot * (axial + c * radial + s * a.cross(radial)) + t;
     }
-    radius += 32.0 * kEps * (in_norm + t.norm());
+    radius += roundingGuard(in_norm + t.norm(), 32);
     return n_in;
   }
   const double step = width / pieces;
@@ -148,7 +147,7 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
   }
   // Rounding: the outputs (at most |p| / cos(step / 2) + |t| from the origin) err by a few ulps.
   if (!std::isfinite(growth)) return -1;
-  radius += growth * (1.0 + 8.0 * kEps) + 32.0 * kEps * (in_norm / half_cos + t.norm());
+  radius += roundedUp(growth, 8) + roundingGuard(in_norm / half_cos + t.norm(), 32);
   return n;
 }
 
@@ -176,7 +175,7 @@ struct Rotation3 {
 
 Rotation3 rotation3(const Box3& box) {
   const double angle = box.centre.stableNorm();
-  const double reach = box.reach + 8.0 * kEps * angle;
+  const double reach = box.reach + roundingGuard(angle, 8);
   if (!(reach < kPi)) return {Eigen::Matrix3d::Identity(), kPi};
   if (angle == 0.0) return {Eigen::Matrix3d::Identity(), reach};
   return {rotationAboutVector(box.centre, angle), reach};
@@ -212,13 +211,13 @@ int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span
       for (const Vec3& p : in) out[n++] = p + lo[0] * joint.axis;
       if (hi[0] > lo[0])
         for (const Vec3& p : in) out[n++] = p + hi[0] * joint.axis;
-      radius += 8.0 * kEps * (in_norm + std::max(std::abs(lo[0]), std::abs(hi[0])));
+      radius += roundingGuard(in_norm + std::max(std::abs(lo[0]), std::abs(hi[0])), 8);
       break;
     case JointType::Translation3d: {
       // Translate by the box centre; the ball around it covers the box and the error bound.
       const Box3 box = box3(joint, lo, hi);
       for (const Vec3& p : in) out[n++] = p + box.centre;
-      radius += box.reach + 8.0 * kEps * (in_norm + box.centre.norm());
+      radius += box.reach + roundingGuard(in_norm + box.centre.norm(), 8);
       break;
     }
     case JointType::Rotation3d: {
@@ -226,7 +225,7 @@ int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span
       // rotationChord() |p|.
       const Rotation3 r3 = rotation3(box3(joint, lo, hi));
       for (const Vec3& p : in) out[n++] = r3.rot * p;
-      radius += rotationChord(r3.reach) * in_norm * (1.0 + 4.0 * kEps) + 16.0 * kEps * in_norm;
+      radius += roundedUp(rotationChord(r3.reach) * in_norm, 4) + roundingGuard(in_norm, 16);
       break;
     }
   }
@@ -238,7 +237,7 @@ int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span
     out[k] = rot * out[k] + t;
     out_norm = std::max(out_norm, out[k].cwiseAbs().maxCoeff());
   }
-  radius += 8.0 * kEps * (out_norm + t.norm());
+  radius += roundingGuard(out_norm + t.norm(), 8);
   if (!std::isfinite(out_norm) || !std::isfinite(radius)) return -1;
   return n;
 }
@@ -272,7 +271,7 @@ int reduceToBudget(Vec3* pts, int n, int budget, double* dist, double& radius) n
   double worst = 0.0;
   for (int i = budget; i < n; ++i) worst = std::max(worst, dist[i]);
   // Each dropped point lies within sqrt(worst) of a kept one, hence of their hull.
-  radius += std::sqrt(worst) * (1.0 + 4.0 * kEps);
+  radius += roundedUp(std::sqrt(worst), 4);
   return budget;
 }
 
@@ -298,43 +297,29 @@ Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const
         out.center = axial + std::cos(0.5 * width) * (std::cos(mid) * radial + std::sin(mid) * a.cross(radial));
         out.radius += rho * std::sin(0.5 * width);
       }
-      out.radius += 16.0 * kEps * c.norm();
+      out.radius += roundingGuard(c.norm(), 16);
       break;
     }
     case JointType::Prismatic:
       out.center = c + 0.5 * (lo[0] + hi[0]) * joint.axis;
-      out.radius += 0.5 * (hi[0] - lo[0]) + 8.0 * kEps * (c.norm() + std::abs(lo[0]) + std::abs(hi[0]));
+      out.radius += 0.5 * (hi[0] - lo[0]) + roundingGuard(c.norm() + std::abs(lo[0]) + std::abs(hi[0]), 8);
       break;
     case JointType::Translation3d: {
       const Box3 box = box3(joint, lo, hi);
       out.center = c + box.centre;
-      out.radius += box.reach + 8.0 * kEps * (c.norm() + out.center.norm());
+      out.radius += box.reach + roundingGuard(c.norm() + out.center.norm(), 8);
       break;
     }
     case JointType::Rotation3d: {
       const Rotation3 r3 = rotation3(box3(joint, lo, hi));
       out.center = r3.rot * c;
-      out.radius += rotationChord(r3.reach) * c.norm() * (1.0 + 4.0 * kEps) + 16.0 * kEps * c.norm();
+      out.radius += roundedUp(rotationChord(r3.reach) * c.norm(), 4) + roundingGuard(c.norm(), 16);
       break;
     }
   }
   out.center = joint.origin * out.center;
-  out.radius += 8.0 * kEps * (out.center.norm() + joint.origin.translation().norm());
+  out.radius += roundingGuard(out.center.norm() + joint.origin.translation().norm(), 8);
   return out;
-}
-
-Sphere boundingSphere(std::span<const Vec3> pts, double radius) noexcept {
-  Vec3 lo = pts[0], hi = pts[0];
-  for (const Vec3& p : pts) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  Sphere s;
-  s.center = 0.5 * (lo + hi);
-  double r = 0.0;
-  for (const Vec3& p : pts) r = std::max(r, (p - s.center).squaredNorm());
-  s.radius = std::sqrt(r) * (1.0 + 4.0 * kEps) + radius;
-  return s;
 }
 
 }  // namespace kccd::detail

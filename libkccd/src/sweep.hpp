@@ -38,7 +38,4 @@ Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const
 /// `dist` needs room for n values.
 int reduceToBudget(Vec3* pts, int n, int budget, double* dist, double& radius) noexcept;
 
-/// A sphere containing S(pts, radius).
-Sphere boundingSphere(std::span<const Vec3> pts, double radius) noexcept;
-
 }  // namespace kccd::detail

@@ -2,75 +2,15 @@
 // query never allocates and never throws; any status other than Ok means "unsafe, stop".
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include "kccd/model.hpp"
+#include "kccd/query.hpp"
 
 namespace kccd {
-
-/// Outcome of a query. Anything but Ok must be treated as a collision.
-enum class Status : std::uint8_t {
-  Ok,
-  WrongStateSize,     ///< lower/upper length differs from Model::stateSize()
-  NonFiniteState,     ///< NaN or infinite state value
-  LowerAboveUpper,    ///< an interval with lower > upper
-  ExactNeedsPoint,    ///< a joint with `sweep: exact` was given a non-zero-width interval
-  NumericalFailure,   ///< a swept volume became non-finite (e.g. overflow)
-};
-const char* toString(Status status);
-
-/// The questions a query can answer, cheapest first.
-enum class QueryType : std::uint8_t {
-  Collision,  ///< is any pair within the margin?
-  Closest,    ///< the pair with the smallest distance, when it is within the margin
-  NClosest,   ///< the N pairs with the smallest distances, with witness points
-  Distances,  ///< every checked pair
-};
-const char* toString(QueryType type);
-
-/// The largest time budget a query honours (about 11.6 days, in microseconds); larger is unlimited.
-inline constexpr double kMaxBudgetUs = 1e12;
-
-/// What a query asks and how long it may take.
-struct QueryOptions {
-  QueryType type = QueryType::Collision;
-  int n = 1;               ///< for NClosest
-  double margin = -1.0;    ///< distances <= margin count as collision; < 0 or NaN: the model's margin
-  double budget_us = 0.0;  ///< time budget in microseconds; <= 0, NaN or > kMaxBudgetUs: unlimited
-  int max_pairs = -1;      ///< work budget: recompute at most this many pairs; < 0: unlimited
-};
-
-/// One pair in a result. `distance` is a lower bound over the whole interval box.
-struct PairDistance {
-  int pair = -1;            ///< index into Model::pairs
-  double distance = 0.0;
-  bool fresh = false;       ///< recomputed in this query (else carried over from earlier ones)
-  bool has_witness = false; ///< fresh and computed by GJK: witness points are valid
-  Vec3 witness_a = Vec3::Zero();  ///< closest points found, in the pair's LCA frame
-  Vec3 witness_b = Vec3::Zero();
-};
-
-struct QueryStats {
-  double time_us = 0.0;
-  int pairs_checked = 0;    ///< pairs whose bound was recomputed
-  int gjk_calls = 0;
-  int volumes_swept = 0;
-  bool budget_exhausted = false;  ///< a time or work budget stopped refinement (answer still conservative)
-};
-
-/// The answer to one query; its pair list is a view into the Checker's buffers, valid until
-/// the next query.
-struct QueryResult {
-  Status status = Status::Ok;
-  QueryType type = QueryType::Collision;
-  bool collision = true;          ///< some pair's bound is <= margin (or status is not Ok)
-  double min_distance = 0.0;      ///< smallest lower bound over all pairs (+inf without pairs)
-  double margin = 0.0;
-  std::span<const PairDistance> pairs;  ///< per type: the colliding pair, the closest, the N closest, or all
-  QueryStats stats;
-};
 
 /// Holds the per-cycle swept volumes and the any-time table of pair bounds. Bounds are reused
 /// across queries while they stay valid lower bounds for the new interval box.
@@ -114,12 +54,40 @@ class Checker {
     Vec3 witness_a = Vec3::Zero(), witness_b = Vec3::Zero();
   };
 
+  // The interval box of one query: the lower and upper end of every state value.
+  struct Box {
+    std::span<const double> lower, upper;
+  };
+  // When refinement must stop: a deadline (when timed) and a number of recomputed pairs.
+  struct Budget {
+    bool timed = false;
+    std::chrono::steady_clock::time_point deadline;
+    int max_pairs = -1;  // < 0: unlimited
+  };
+
+  // Construction, in order: where every volume lives, then how far each state value moves a pair.
+  void layoutVolumes();
+  void computeReach();
+
+  // A query, in order: validate the box, carry stored bounds over to it, order the candidate
+  // pairs, refine them per query type, publish the answer.
   bool validate(std::span<const double> lower, std::span<const double> upper) noexcept;
-  const Volume* volume(int body, int level) noexcept;
+  void carryBounds(Box box) noexcept;
+  int orderCandidates(QueryType type, double margin) noexcept;
+  int refineCollision(int candidates, double margin, const Budget& budget, Box box) noexcept;
+  void refineClosest(int candidates, double margin, const Budget& budget, Box box) noexcept;
+  void refineNClosest(int n, const Budget& budget, Box box) noexcept;
+  void refineDistances(const Budget& budget, Box box) noexcept;
+  void publishAnswer(QueryType type, double margin, int hit, int n_wanted) noexcept;
+
+  // Helpers of the phases.
+  bool expired(const Budget& budget) noexcept;
+  void refine(int pair, double stop_above, Box box) noexcept;
+  double refresh(int pair, double stop_above, Box box) noexcept;
+  void report(int pair, PairDistance& out) const noexcept;
+  const Volume* volume(int body, int level, Box box) noexcept;
   SschView view(const Volume& v) const noexcept;
-  const Sphere* sphere(int body, int level) noexcept;
-  double refresh(int pair, double stop_above) noexcept;
-  void publish(int pair, PairDistance& out) const noexcept;
+  const Sphere* sphere(int body, int level, Box box) noexcept;
 
   const Model& model_;
   std::vector<Vec3> points_;                 // arena of every volume's points
@@ -141,7 +109,7 @@ class Checker {
   std::vector<PairDistance> out_;
   std::vector<std::uint8_t> fresh_;          // per pair: recomputed in this query
   std::vector<double> nbest_;
-  std::vector<double> lower_, upper_;
+  std::vector<double> lower_, upper_;        // the box of the last query (for sweptVolume())
   std::uint64_t cycle_ = 1;                  // volumes stamped with it are current (0: never)
   QueryResult result_;
 };

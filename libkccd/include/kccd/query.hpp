@@ -1,0 +1,74 @@
+// The value types of a query: what it asks (QueryOptions) and what it answers (QueryResult).
+// Plain data with no behaviour beyond naming; the Checker (kccd/checker.hpp) runs queries.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "kccd/ssch.hpp"
+
+namespace kccd {
+
+/// Outcome of a query. Anything but Ok must be treated as a collision.
+enum class Status : std::uint8_t {
+  Ok,
+  WrongStateSize,     ///< lower/upper length differs from Model::stateSize()
+  NonFiniteState,     ///< NaN or infinite state value
+  LowerAboveUpper,    ///< an interval with lower > upper
+  ExactNeedsPoint,    ///< a joint with `sweep: exact` was given a non-zero-width interval
+  NumericalFailure,   ///< a swept volume became non-finite (e.g. overflow)
+};
+const char* toString(Status status);
+
+/// The questions a query can answer, cheapest first.
+enum class QueryType : std::uint8_t {
+  Collision,  ///< is any pair within the margin?
+  Closest,    ///< the pair with the smallest distance, when it is within the margin
+  NClosest,   ///< the N pairs with the smallest distances, with witness points
+  Distances,  ///< every checked pair
+};
+const char* toString(QueryType type);
+
+/// The largest time budget a query honours (about 11.6 days, in microseconds); larger is unlimited.
+inline constexpr double kMaxBudgetUs = 1e12;
+
+/// What a query asks and how long it may take.
+struct QueryOptions {
+  QueryType type = QueryType::Collision;
+  int n = 1;               ///< for NClosest
+  double margin = -1.0;    ///< distances <= margin count as collision; < 0 or NaN: the model's margin
+  double budget_us = 0.0;  ///< time budget in microseconds; <= 0, NaN or > kMaxBudgetUs: unlimited
+  int max_pairs = -1;      ///< work budget: recompute at most this many pairs; < 0: unlimited
+};
+
+/// One pair in a result. `distance` is a lower bound over the whole interval box.
+struct PairDistance {
+  int pair = -1;            ///< index into Model::pairs
+  double distance = 0.0;
+  bool fresh = false;       ///< recomputed in this query (else carried over from earlier ones)
+  bool has_witness = false; ///< fresh and computed by GJK: witness points are valid
+  Vec3 witness_a = Vec3::Zero();  ///< closest points found, in the pair's LCA frame
+  Vec3 witness_b = Vec3::Zero();
+};
+
+struct QueryStats {
+  double time_us = 0.0;
+  int pairs_checked = 0;    ///< pairs whose bound was recomputed
+  int gjk_calls = 0;
+  int volumes_swept = 0;
+  bool budget_exhausted = false;  ///< a time or work budget stopped refinement (answer still conservative)
+};
+
+/// The answer to one query; its pair list is a view into the Checker's buffers, valid until
+/// the next query.
+struct QueryResult {
+  Status status = Status::Ok;
+  QueryType type = QueryType::Collision;
+  bool collision = true;          ///< some pair's bound is <= margin (or status is not Ok)
+  double min_distance = 0.0;      ///< smallest lower bound over all pairs (+inf without pairs)
+  double margin = 0.0;
+  std::span<const PairDistance> pairs;  ///< per type: the colliding pair, the closest, the N closest, or all
+  QueryStats stats;
+};
+
+}  // namespace kccd
