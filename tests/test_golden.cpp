@@ -62,18 +62,18 @@ class RenderGolden : public ::testing::Test {
 Model* RenderGolden::model_ = nullptr;
 Renderer* RenderGolden::renderer_ = nullptr;
 
-const kccd::test::GoldenTolerance kMaskTolerance{0, 0.0025, 4};
+const kccd::testing::GoldenTolerance kMaskTolerance{0, 0.0025, 4};
 
 TEST_F(RenderGolden, DemoArmStatic) {
   const Frame f = draw({0.3, 0.4, 0.6}, {0.3, 0.4, 0.6}, Style{.labels = false, .legend = false});
-  EXPECT_TRUE(kccd::test::compareGolden(f.bgra, "demo_static_rgba", renderer_->rendererString()));
-  EXPECT_TRUE(kccd::test::compareGolden(f.mask, "demo_static_mask", renderer_->rendererString(), kMaskTolerance));
+  EXPECT_TRUE(kccd::testing::compareGolden(f.bgra, "demo_static_rgba", renderer_->rendererString()));
+  EXPECT_TRUE(kccd::testing::compareGolden(f.mask, "demo_static_mask", renderer_->rendererString(), kMaskTolerance));
 }
 
 TEST_F(RenderGolden, DemoArmSwept) {
   const Frame f = draw({-0.5, 0.0, 0.0}, {0.5, 0.1, 0.2}, Style{.labels = true, .legend = true});
-  EXPECT_TRUE(kccd::test::compareGolden(f.bgra, "demo_swept_rgba", renderer_->rendererString()));
-  EXPECT_TRUE(kccd::test::compareGolden(f.mask, "demo_swept_mask", renderer_->rendererString(), kMaskTolerance));
+  EXPECT_TRUE(kccd::testing::compareGolden(f.bgra, "demo_swept_rgba", renderer_->rendererString()));
+  EXPECT_TRUE(kccd::testing::compareGolden(f.mask, "demo_swept_mask", renderer_->rendererString(), kMaskTolerance));
 }
 
 // Static frames place each body's own (cached) mesh with its pose: the same pixels as meshes

@@ -9,7 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-namespace kccd::test {
+namespace kccd::testing {
 namespace {
 
 namespace fs = std::filesystem;
@@ -96,4 +96,4 @@ void storeRenderer(const std::string& renderer) {
                                        << actual_path << ", diff " << diff_path << renderer_note;
 }
 
-}  // namespace kccd::test
+}  // namespace kccd::testing

@@ -17,7 +17,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
-namespace kccd::test {
+namespace kccd::testing {
 
 struct GoldenTolerance {
   int threshold = 24;           ///< per-channel difference that counts a pixel as different
@@ -29,4 +29,4 @@ struct GoldenTolerance {
 ::testing::AssertionResult compareGolden(const cv::Mat& actual, const std::string& name, const std::string& renderer,
                                          const GoldenTolerance& tolerance = {});
 
-}  // namespace kccd::test
+}  // namespace kccd::testing
