@@ -171,7 +171,8 @@ TEST(CalibPose, MisclicksAreRejectedByName) {
     const PoseResult r = solvePose(intrinsicsOf(s.truth), pts);
     ASSERT_EQ(r.status, PoseStatus::Solved) << "case " << c << ": " << r.message;
     const std::set<std::string> rejected(r.rejected.begin(), r.rejected.end());
-    for (const auto& name : misclicked) EXPECT_TRUE(rejected.count(name)) << "case " << c << ": " << name << " kept; " << r.message;
+    for (const auto& name : misclicked)
+      EXPECT_TRUE(rejected.count(name)) << "case " << c << ": " << name << " kept; " << r.message;
     false_rejections += static_cast<int>(rejected.size()) - bad;
     for (const Residual& res : r.residuals)
       if (misclicked.count(res.name)) {
@@ -196,9 +197,10 @@ TEST(CalibPose, MisclicksAreRejectedByName) {
     rot_ref.push_back(rotationErrorDeg(ref.rvec, s.truth.rvec));
     pos_ref.push_back(positionError(ref, s.truth));
   }
-  std::printf("20 %% misclicks, %d cases: median rotation error %.3f deg (true inliers only %.3f), position %.2f mm "
-              "(%.2f mm); %d good points rejected\n",
-              cases, median(rot), median(rot_ref), 1000 * median(pos), 1000 * median(pos_ref), false_rejections);
+  std::printf(
+      "20 %% misclicks, %d cases: median rotation error %.3f deg (true inliers only %.3f), position %.2f mm "
+      "(%.2f mm); %d good points rejected\n",
+      cases, median(rot), median(rot_ref), 1000 * median(pos), 1000 * median(pos_ref), false_rejections);
   EXPECT_LE(median(rot), 1.5 * median(rot_ref));
   EXPECT_LE(median(pos), 1.5 * median(pos_ref));
   EXPECT_LE(false_rejections, 3);
@@ -233,9 +235,10 @@ TEST(CalibPose, SigmasAreHonest) {
     ratio.push_back(*r3.camera.rotation_sigma_deg / *r1.camera.rotation_sigma_deg);
     rot_sigma.push_back(*r1.camera.rotation_sigma_deg);
   }
-  std::printf("%d cases at 1 px: rotation error <= 3 sigma in %.1f %%, position in %.1f %%; median rotation sigma %.3f deg; "
-              "3 px / 1 px sigma ratio median %.2f\n",
-              cases, 100.0 * rot_ok / cases, 100.0 * pos_ok / cases, median(rot_sigma), median(ratio));
+  std::printf(
+      "%d cases at 1 px: rotation error <= 3 sigma in %.1f %%, position in %.1f %%; median rotation sigma %.3f deg; "
+      "3 px / 1 px sigma ratio median %.2f\n",
+      cases, 100.0 * rot_ok / cases, 100.0 * pos_ok / cases, median(rot_sigma), median(ratio));
   EXPECT_GE(rot_ok, 0.9 * cases);
   EXPECT_GE(pos_ok, 0.9 * cases);
   EXPECT_EQ(larger, cases);
@@ -365,6 +368,8 @@ TEST(CalibPose, TooFewInliers) {
   EXPECT_EQ(r.status, PoseStatus::TooFewInliers) << r.message;
   EXPECT_NE(r.message.find("only"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("check the labels"), std::string::npos) << r.message;
+  ASSERT_EQ(r.residuals.size(), pts.size());
+  EXPECT_GE(r.rejected.size(), 6u);
 }
 
 TEST(CalibPose, TagsOnAWallSolve) {

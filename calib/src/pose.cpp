@@ -35,7 +35,8 @@ Spread spread3(const std::vector<cv::Point3d>& p) {
   for (const auto& q : p) out.centroid += cv::Vec3d(q.x, q.y, q.z) / n;
   cv::Mat a(n, 3, CV_64F);
   for (int i = 0; i < n; ++i)
-    for (int j = 0; j < 3; ++j) a.at<double>(i, j) = (cv::Vec3d(p[i].x, p[i].y, p[i].z) - out.centroid)[j] / std::sqrt(n);
+    for (int j = 0; j < 3; ++j)
+      a.at<double>(i, j) = (cv::Vec3d(p[i].x, p[i].y, p[i].z) - out.centroid)[j] / std::sqrt(n);
   cv::Mat w, u, vt;
   cv::SVD::compute(a, w, u, vt);
   for (int j = 0; j < std::min(3, w.rows); ++j) out.s[j] = w.at<double>(j);
@@ -72,7 +73,8 @@ std::vector<double> pixelResiduals(const Camera& cam, const cv::Vec3d& rvec, con
   std::vector<double> res(world.size());
   for (std::size_t i = 0; i < world.size(); ++i) {
     const cv::Vec3d x = r * cv::Vec3d(world[i].x, world[i].y, world[i].z) + tvec;
-    res[i] = x[2] > 0 ? std::hypot(proj[i].x - pixel[i].x, proj[i].y - pixel[i].y) : std::numeric_limits<double>::infinity();
+    res[i] =
+        x[2] > 0 ? std::hypot(proj[i].x - pixel[i].x, proj[i].y - pixel[i].y) : std::numeric_limits<double>::infinity();
     if (!std::isfinite(res[i])) res[i] = std::numeric_limits<double>::infinity();
   }
   return res;
@@ -96,7 +98,7 @@ cv::Vec3d logRotation(const cv::Matx33d& r) {
   const cv::Vec3d w(r(2, 1) - r(1, 2), r(0, 2) - r(2, 0), r(1, 0) - r(0, 1));
   const double s = 0.5 * cv::norm(w), c = 0.5 * (r(0, 0) + r(1, 1) + r(2, 2) - 1.0);
   if (s < 1e-3 && c > 0) return 0.5 * w * (1.0 + s * s / 6.0);  // theta / sin(theta) to second order
-  if (s < 1e-12) {  // theta near pi: cv::Rodrigues handles it
+  if (s < 1e-12) {                                              // theta near pi: cv::Rodrigues handles it
     cv::Vec3d v;
     cv::Rodrigues(r, v);
     return v;
@@ -162,11 +164,16 @@ std::string rejectedText(const std::vector<Correspondence>& pts, const std::vect
 
 const char* toString(PoseStatus status) {
   switch (status) {
-    case PoseStatus::Solved: return "solved";
-    case PoseStatus::TooFewPoints: return "too few points";
-    case PoseStatus::Collinear: return "collinear points";
-    case PoseStatus::PoorGeometry: return "poor geometry";
-    case PoseStatus::TooFewInliers: return "too few inliers";
+    case PoseStatus::Solved:
+      return "solved";
+    case PoseStatus::TooFewPoints:
+      return "too few points";
+    case PoseStatus::Collinear:
+      return "collinear points";
+    case PoseStatus::PoorGeometry:
+      return "poor geometry";
+    case PoseStatus::TooFewInliers:
+      return "too few inliers";
   }
   return "unknown";
 }
@@ -220,7 +227,8 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   };
   if (collinear(world)) {
     result.status = PoseStatus::Collinear;
-    result.message = "the " + std::to_string(n) + " world points lie (nearly) on one line: add at least two points off that line";
+    result.message =
+        "the " + std::to_string(n) + " world points lie (nearly) on one line: add at least two points off that line";
     return result;
   }
 
@@ -240,8 +248,9 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
     const cv::Vec2d s = spread2(pick(norm, candidates));
     if (candidates.size() >= 3 && s[1] < options.min_spread_ratio * s[0]) {
       result.status = PoseStatus::PoorGeometry;
-      result.message = "the points appear on one line in the image (the camera is nearly in their plane): "
-                       "add points off that line or view them from another side";
+      result.message =
+          "the points appear on one line in the image (the camera is nearly in their plane): "
+          "add points off that line or view them from another side";
       return result;
     }
   }
@@ -308,16 +317,22 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   };
   const auto tooFewInliers = [&](int count, const std::vector<double>& res, const std::vector<char>& in) {
     result.status = PoseStatus::TooFewInliers;
-    result.message = "only " + std::to_string(count) + " of " + std::to_string(n) + " points agree on one pose within " +
-                     num(options.ransac_threshold_px) + " px, at least " + std::to_string(need) +
-                     " needed: check the labels or add points";
+    result.message = "only " + std::to_string(count) + " of " + std::to_string(n) +
+                     " points agree on one pose within " + num(options.ransac_threshold_px) + " px, at least " +
+                     std::to_string(need) + " needed: check the labels or add points";
     if (!res.empty()) {
       fillResiduals(res, in);
       result.message += " (outside: " + rejectedText(points, res, in) + ")";
     }
     return result;
   };
-  if (best_count < need) return tooFewInliers(std::max(best_count, 0), {}, {});
+  if (best_count < need) {
+    if (best_count < 0) return tooFewInliers(0, {}, {});
+    const std::vector<double> res = pixelResiduals(cam, best_r, best_t, world, pixel);
+    std::vector<char> in(n, 0);
+    for (int i : candidates) in[i] = res[i] <= options.ransac_threshold_px;
+    return tooFewInliers(static_cast<int>(std::count(in.begin(), in.end(), 1)), res, in);
+  }
 
   // ---- SQPnP + LM on the inliers, re-selecting inliers by their true pixel residual until stable
   cv::Vec3d rvec = best_r, tvec = best_t;
@@ -391,11 +406,12 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   const cv::Mat jtj = j6.t() * j6;
   cv::Mat w, u, vt;
   cv::SVD::compute(jtj, w, u, vt);
-  const double cond_ok = w.at<double>(5) > 1e-12 * w.at<double>(0);
+  const bool cond_ok = w.at<double>(5) > 1e-12 * w.at<double>(0);
   const std::string at_noise = " at " + num(std::max(std::sqrt(sigma2), options.noise_floor_px)) + " px noise";
   if (!cond_ok) {
     result.status = PoseStatus::PoorGeometry;
-    result.message = "the pose is not determined by these points: add points spread over the view and in depth" + rejected;
+    result.message =
+        "the pose is not determined by these points: add points spread over the view and in depth" + rejected;
     return result;
   }
   cv::Matx66d inv;
@@ -417,7 +433,8 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) g(r, 3 + c) = -rmat(c, r);
   const auto sigmas = [&](const cv::Matx66d& s) {
-    return std::pair<double, double>(std::sqrt(largestEigen(a * s * a.t())) * 180.0 / kPi, std::sqrt(largestEigen(g * s * g.t())));
+    return std::pair<double, double>(std::sqrt(largestEigen(a * s * a.t())) * 180.0 / kPi,
+                                     std::sqrt(largestEigen(g * s * g.t())));
   };
   const auto [rot_sigma, pos_sigma] = sigmas(cov);
   const double gate2 = std::max(sigma2, options.noise_floor_px * options.noise_floor_px);

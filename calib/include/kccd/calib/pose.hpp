@@ -14,9 +14,9 @@ namespace kccd::calib {
 
 /// One observed point: where it is in the world and where it was seen in the image.
 struct Correspondence {
-  std::string name;    ///< unique, non-empty; used to report rejected points
-  cv::Point2d pixel;   ///< OpenCV convention: pixel centres at integer coordinates
-  cv::Point3d world;   ///< metres
+  std::string name;   ///< unique, non-empty; used to report rejected points
+  cv::Point2d pixel;  ///< OpenCV convention: pixel centres at integer coordinates
+  cv::Point3d world;  ///< metres
 };
 
 /// Tuning of solvePose. The defaults suit hand-labelled points with a few pixels of error.
@@ -48,16 +48,16 @@ enum class PoseStatus : std::uint8_t {
 /// Reprojection residual of one correspondence under the returned pose (or the best pose found).
 struct Residual {
   std::string name;
-  double px = 0.0;      ///< distance between the pixel and the projected world point
+  double px = 0.0;      ///< distance between the pixel and the projected world point; inf behind the camera
   bool inlier = false;  ///< used in the final fit
 };
 
 /// The outcome of solvePose.
 struct PoseResult {
   PoseStatus status = PoseStatus::TooFewPoints;
-  std::string message;             ///< one line: what was found, and for a failure what to add
-  Camera camera;                   ///< the intrinsics with rvec/tvec and the quality figures (Solved only)
-  std::vector<Residual> residuals; ///< per correspondence, in input order (empty before any pose is found)
+  std::string message;                ///< one line: what was found, and for a failure what to add
+  Camera camera;                      ///< the intrinsics with rvec/tvec and the quality figures (Solved only)
+  std::vector<Residual> residuals;    ///< per correspondence, in input order, under the best pose found (empty if none)
   std::vector<std::string> rejected;  ///< names of the correspondences left out of the fit
   cv::Matx66d covariance = cv::Matx66d::zeros();  ///< of (rvec, tvec), Solved only
   int inliers = 0;
@@ -69,7 +69,8 @@ struct PoseResult {
 /// sigma^2 (J^T J)^-1 with sigma^2 = SSE / (2N - 6). Never returns Solved for a degenerate or
 /// ill-conditioned set. Throws InputError for unusable input: a non-finite coordinate, an empty
 /// or repeated name (the message names it), bad options, or invalid intrinsics (CameraError).
-PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>& points, const PoseOptions& options = {});
+PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>& points,
+                     const PoseOptions& options = {});
 
 /// Name of a status ("solved", "too few points", ...).
 const char* toString(PoseStatus status);
