@@ -10,7 +10,12 @@
 
 #include <sys/stat.h>
 
+#include <apriltag/apriltag.h>
+#include <apriltag/common/image_u8.h>
+#include <apriltag/tag36h11.h>
+
 #include "kccd/calib/labels.hpp"
+#include "kccd/calib/tag_detect.hpp"
 #include "kccd/calib/tag_layout.hpp"
 #include "kccd/model.hpp"
 
@@ -294,6 +299,65 @@ TEST(CalibLabels, EveryMistakeIsOneLineNamingThePlaceAndField) {
   }
   const std::string missing = ::testing::TempDir() + "/kccd_no_such_labels.yaml";
   EXPECT_EQ(errorOf<LabelsError>([&] { loadLabels(missing); }), missing + ": file: cannot open the labels file (no such file)");
+}
+
+// ---------------------------------------------------------------------------------------------
+// AprilTag detection and correspondences
+
+// Draws tag `id` upright (as apriltag_to_image renders it), `scale` pixels a cell, its bitmap's
+// top-left pixel at (x0, y0). Returns where the black square's corners lie in OpenCV's pixel
+// convention, in the tag-frame order (-,-), (+,-), (+,+), (-,+) with tag y up: bottom-left,
+// bottom-right, top-right, top-left as seen.
+std::array<cv::Point2d, 4> drawTag(cv::Mat& image, apriltag_family_t* family, int id, int x0, int y0, int scale) {
+  image_u8_t* bitmap = apriltag_to_image(family, static_cast<uint32_t>(id));
+  for (int r = 0; r < bitmap->height; ++r)
+    for (int c = 0; c < bitmap->width; ++c)
+      image(cv::Rect(x0 + c * scale, y0 + r * scale, scale, scale)) = bitmap->buf[r * bitmap->stride + c];
+  const int border = (bitmap->width - static_cast<int>(family->width_at_border)) / 2;
+  const double lo_x = x0 + border * scale - 0.5, hi_x = x0 + (bitmap->width - border) * scale - 0.5;
+  const double lo_y = y0 + border * scale - 0.5, hi_y = y0 + (bitmap->height - border) * scale - 0.5;
+  image_u8_destroy(bitmap);
+  return {cv::Point2d(lo_x, hi_y), cv::Point2d(hi_x, hi_y), cv::Point2d(hi_x, lo_y), cv::Point2d(lo_x, lo_y)};
+}
+
+TEST(CalibTagDetect, CornersLandWhereTheyWereDrawn) {
+  apriltag_family_t* family = tag36h11_create();
+  cv::Mat image(480, 640, CV_8UC1, cv::Scalar(255));
+  const std::array<cv::Point2d, 4> drawn3 = drawTag(image, family, 3, 40, 60, 17);
+  const std::array<cv::Point2d, 4> drawn42 = drawTag(image, family, 42, 300, 200, 23);
+  const std::array<cv::Point2d, 4> drawn500 = drawTag(image, family, 500, 420, 20, 12);
+  tag36h11_destroy(family);
+  const std::vector<TagDetection> found = detectTags(image);
+  ASSERT_EQ(found.size(), 3u);
+  for (const TagDetection& d : found) {
+    const std::array<cv::Point2d, 4>& drawn = d.id == 3 ? drawn3 : d.id == 42 ? drawn42 : drawn500;
+    ASSERT_TRUE(d.id == 3 || d.id == 42 || d.id == 500) << d.id;
+    EXPECT_EQ(d.hamming, 0);
+    for (std::size_t k = 0; k < 4; ++k)
+      EXPECT_LT(cv::norm(d.corners[k] - drawn[k]), 0.5) << "tag " << d.id << " corner " << k << " at " << d.corners[k] << ", drawn " << drawn[k];
+  }
+
+  const TagLayout layout = parseTagLayout(
+      "tags:\n"
+      "  - {id: 3, size: 0.16, xyz: [1, 0, 0], rpy: [0, 0, 0]}\n"
+      "  - {id: 42, size: 0.2, xyz: [0, 1, 0], rpy: [0, 0, 1.0]}\n"
+      "  - {id: 7, size: 0.2, xyz: [0, 1, 0], rpy: [0, 0, 0]}\n",
+      "layout.yaml");
+  const TagCorrespondences corr = tagCorrespondences(found, layout, "frame.png");
+  EXPECT_EQ(corr.unknown_ids, std::vector<int>{500});
+  ASSERT_EQ(corr.points.size(), 8u);
+  for (const Correspondence& c : corr.points) {
+    const int id = c.name.rfind("tag3.", 0) == 0 ? 3 : 42;
+    const std::size_t k = static_cast<std::size_t>(c.name.back() - '0');
+    ASSERT_EQ(c.name, "tag" + std::to_string(id) + ".c" + std::to_string(k));
+    EXPECT_LT(cv::norm(c.pixel - (id == 3 ? drawn3 : drawn42)[k]), 0.5) << c.name;
+    EXPECT_EQ(c.world, layout.find(id)->corners()[k]) << c.name;
+  }
+
+  const std::vector<TagDetection> twice{found[0], found[1], found[0]};
+  EXPECT_EQ(errorOf<TagDetectionError>([&] { tagCorrespondences(twice, layout, "frame.png"); }),
+            "frame.png: tags: tag " + std::to_string(found[0].id) + " is detected twice (each id may appear once: is it printed twice?)");
+  EXPECT_THROW(detectTags(cv::Mat(10, 10, CV_8UC3)), std::invalid_argument);
 }
 
 }  // namespace
