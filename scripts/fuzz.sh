@@ -30,8 +30,8 @@ ci_runs() {  # inputs per target in --ci mode (about 15 s each on this project's
   case "$1" in
     fuzz_model) echo 30000 ;;
     fuzz_camera) echo 200000 ;;
-    fuzz_tags) echo TAGS_RUNS ;;
-    fuzz_labels) echo LABELS_RUNS ;;
+    fuzz_tags) echo 140000 ;;
+    fuzz_labels) echo 130000 ;;
     fuzz_part) echo 30000 ;;
     fuzz_urdf) echo 4000 ;;
   esac
