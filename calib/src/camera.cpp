@@ -1,13 +1,7 @@
 #include "kccd/calib/camera.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <optional>
 #include <sstream>
 
@@ -15,6 +9,7 @@
 #include <opencv2/core/eigen.hpp>
 
 #include "kccd/yaml_document.hpp"
+#include "yaml_input.hpp"
 
 namespace kccd::calib {
 namespace {
@@ -31,37 +26,15 @@ constexpr int kMaxMatrixSide = 16;  // rows, cols of a matrix in a camera file
   throw CameraError(source + ":" + std::to_string(line) + ": " + field + ": " + problem);
 }
 
-// The whole file, read without blocking on anything that is not a regular file (a FIFO, a
-// device, a directory) and bounded in size.
+// The whole file (a bounded regular file, never blocking on a FIFO or device), errors as CameraError.
 std::string readCameraFile(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) {
-    const int err = errno;
-    fail(path, "file", std::string("cannot open the camera file (") + (err == ENOENT ? "no such file" : std::strerror(err)) + ")");
+  try {
+    return detail::readInputFile(path, kMaxCameraFileBytes, "camera file");
+  } catch (const CameraError&) {
+    throw;
+  } catch (const InputError& e) {
+    throw CameraError(e.what());
   }
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) fail(path, "file", std::string("cannot read the camera file (") + std::strerror(errno) + ")");
-  if (!S_ISREG(st.st_mode)) fail(path, "file", "not a regular file");
-  if (st.st_size > static_cast<off_t>(kMaxCameraFileBytes))
-    fail(path, "file", "larger than " + std::to_string(kMaxCameraFileBytes >> 10) + " KiB (a camera file is a few hundred bytes)");
-  std::string text;
-  char buffer[8192];
-  for (;;) {
-    const ssize_t n = ::read(fd, buffer, sizeof buffer);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      fail(path, "file", std::string("cannot read the camera file (") + std::strerror(errno) + ")");
-    }
-    if (n == 0) break;
-    text.append(buffer, static_cast<std::size_t>(n));
-    if (text.size() > kMaxCameraFileBytes)
-      fail(path, "file", "larger than " + std::to_string(kMaxCameraFileBytes >> 10) + " KiB (a camera file is a few hundred bytes)");
-  }
-  return text;
 }
 
 // Structure before OpenCV parses anything: text only, OpenCV's `%YAML:1.x` header, then one YAML
@@ -223,7 +196,6 @@ void undistortPixels(const Camera& camera, const cv::Mat& pixels, cv::Mat& norma
     valid[i] = 1;
   }
 }
-
 
 bool Camera::distorted() const {
   return std::any_of(distortion.begin(), distortion.end(), [](double d) { return d != 0.0; });
