@@ -115,4 +115,17 @@ TEST(UrdfImport, ClearErrors) {
   const std::string missing_mesh = message((dir / "mesh.urdf").string());
   EXPECT_EQ(missing_mesh.rfind((dir / "mesh.urdf").string() + ": link a: ", 0), 0u) << missing_mesh;
   EXPECT_NE(missing_mesh.find("none.stl: cannot open the file"), std::string::npos) << missing_mesh;
+  // A moving joint with a zero axis (found by fuzz_urdf), and a model the loader refuses (a link
+  // beyond the 1e6 m bound): both start with the URDF's name.
+  const std::string two_links = "<link name=\"b\"><collision><geometry><sphere radius=\"0.1\"/></geometry></collision></link>";
+  std::ofstream(dir / "axis.urdf") << "<robot name=\"r\">" << link << two_links
+                                   << "<joint name=\"j\" type=\"continuous\"><parent link=\"a\"/><child link=\"b\"/>"
+                                      "<axis xyz=\"0 0 0\"/></joint></robot>";
+  const std::string zero = message((dir / "axis.urdf").string());
+  EXPECT_EQ(zero.rfind((dir / "axis.urdf").string() + ":1: joint 'j': axis xyz: zero axis", 0), 0u) << zero;
+  std::ofstream(dir / "far.urdf") << "<robot name=\"r\">" << link << two_links
+                                  << "<joint name=\"j\" type=\"fixed\"><parent link=\"a\"/><child link=\"b\"/>"
+                                     "<origin xyz=\"2e6 0 0\"/></joint></robot>";
+  const std::string far = message((dir / "far.urdf").string());
+  EXPECT_EQ(far.rfind((dir / "far.urdf").string() + ": the imported model does not load: ", 0), 0u) << far;
 }

@@ -239,7 +239,12 @@ std::map<std::string, int> checkCollisions(const tinyxml2::XMLDocument& doc, con
     const char* name = joint->Attribute("name");
     const Place at{path, "joint '" + printable(name ? name : "") + "': "};
     checkOrigin(at, joint);
-    if (const tinyxml2::XMLElement* axis = joint->FirstChildElement("axis")) numbers(at, axis, "xyz", 3, {1, 0, 0});
+    if (const tinyxml2::XMLElement* axis = joint->FirstChildElement("axis")) {
+      const std::vector<double> a = numbers(at, axis, "xyz", 3, {1, 0, 0});
+      const char* type = joint->Attribute("type");
+      const bool moves = type && std::string(type) != "fixed";
+      if (moves && a[0] == 0.0 && a[1] == 0.0 && a[2] == 0.0) throw at.error(axis, "axis xyz: zero axis");
+    }
     if (const tinyxml2::XMLElement* limit = joint->FirstChildElement("limit")) {
       numbers(at, limit, "lower", 1, {0});
       numbers(at, limit, "upper", 1, {0});
@@ -392,7 +397,7 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
   try {
     (void)parseModel(text, path + " (imported)");
   } catch (const ModelError& e) {
-    throw UrdfError(std::string("the imported model does not load: ") + e.what());
+    throw UrdfError(path + ": the imported model does not load: " + e.what());
   }
   if (options.progress) options.progress(1.0);
   return text;
