@@ -9,15 +9,9 @@
 #include <opencv2/core.hpp>
 
 #include "kccd/calib/camera.hpp"
+#include "kccd/calib/correspondence.hpp"
 
 namespace kccd::calib {
-
-/// One observed point: where it is in the world and where it was seen in the image.
-struct Correspondence {
-  std::string name;   ///< unique, non-empty; used to report rejected points
-  cv::Point2d pixel;  ///< OpenCV convention: pixel centres at integer coordinates
-  cv::Point3d world;  ///< metres
-};
 
 /// Tuning of solvePose. The defaults suit hand-labelled points with a few pixels of error.
 struct PoseOptions {

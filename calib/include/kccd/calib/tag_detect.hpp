@@ -9,6 +9,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "kccd/calib/correspondence.hpp"
 #include "kccd/calib/tag_layout.hpp"
 #include "kccd/input_error.hpp"
 
@@ -36,16 +37,9 @@ struct TagDetection {
 /// detector's order. Throws std::invalid_argument for an image that is not CV_8UC1 or is empty.
 std::vector<TagDetection> detectTags(const cv::Mat& gray);
 
-/// A pixel and the world point it shows, named after its source ("tag3.c0" .. "tag3.c3").
-struct Correspondence {
-  std::string name;
-  cv::Point2d pixel;
-  cv::Point3d world;
-};
-
 /// The correspondences of detected tags that the layout places, and the ids it does not know.
 struct TagCorrespondences {
-  std::vector<Correspondence> points;  ///< 4 per known tag, in detection then corner order
+  std::vector<Correspondence> points;  ///< 4 per known tag, in detection then corner order, named "tag3.c0" .. "tag3.c3"
   std::vector<int> unknown_ids;        ///< detected ids not in the layout, ascending, each once
 };
 
