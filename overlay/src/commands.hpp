@@ -25,5 +25,6 @@ Runner addFit(CLI::App& app);
 Runner addPairs(CLI::App& app);
 Runner addImport(CLI::App& app);
 Runner addRender(CLI::App& app);
+Runner addCalib(CLI::App& app);
 
 }  // namespace kccd::cli

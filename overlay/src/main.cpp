@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   add(kccd::cli::addPairs);
   add(kccd::cli::addImport);
   add(kccd::cli::addRender);
+  add(kccd::cli::addCalib);
   if (argc > 1 && argv[1][0] != '-') {  // CLI11 would only say that a subcommand is required
     std::string names;
     bool known = false;
