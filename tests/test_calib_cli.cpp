@@ -5,6 +5,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <sstream>
 #include <random>
 #include <string>
 #include <vector>
@@ -14,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/kinematics.hpp"
@@ -261,6 +264,66 @@ TEST_F(CalibCli, BadInputIsOneLineExitTwo) {
     EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << "\n" << r.err;
     EXPECT_FALSE(fs::exists(out("c.yaml")));
   }
+}
+
+}  // namespace
+
+namespace {
+
+TEST_F(CalibCli, SheetNumbersCandidatesAndWritesAFillableTemplate) {
+  // A frame with a few strong corners (dark squares) where the arm stands.
+  cv::Mat frame(truth_.height, truth_.width, CV_8UC3, cv::Scalar(200, 200, 200));
+  const std::vector<cv::Point> squares{{200, 150}, {900, 500}, {400, 550}};
+  for (const cv::Point& p : squares) cv::rectangle(frame, p, p + cv::Point(60, 60), cv::Scalar(20, 20, 20), cv::FILLED);
+  cv::imwrite(out("frame.png"), frame);
+  const Outcome r = runKccd("calib sheet --image " + out("frame.png") + " --model " + kDemo + " --camera " + kCamera +
+                            " --state 0.3,0.4,0.6 -o " + out("sheet.png") + " --template " + out("labels.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const cv::Mat sheet = cv::imread(out("sheet.png"), cv::IMREAD_COLOR);
+  ASSERT_EQ(sheet.size(), frame.size());
+  EXPECT_GT(cv::norm(sheet, frame, cv::NORM_L1), 0.0);
+  std::ifstream in(out("labels.yaml"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // Every square's 4 corners are candidates, within a pixel of where they were drawn.
+  // (a filled rectangle covers pixels p ... p + 60: its edges are at p - 0.5 and p + 60.5)
+  int near = 0;
+  for (const cv::Point& p : squares)
+    for (const cv::Point2d& c : {cv::Point2d(p.x - 0.5, p.y - 0.5), cv::Point2d(p.x + 60.5, p.y - 0.5), cv::Point2d(p.x - 0.5, p.y + 60.5),
+                                 cv::Point2d(p.x + 60.5, p.y + 60.5)})
+      for (std::size_t at = text.find("pixel: ["); at != std::string::npos; at = text.find("pixel: [", at + 1)) {
+        const double u = std::stod(text.substr(at + 8)), v = std::stod(text.substr(text.find(',', at) + 1));
+        near += std::hypot(u - c.x, v - c.y) < 0.25;
+      }
+  EXPECT_GE(near, 12) << text;
+  // The model's points: world points for fixed bodies, body points with the state for links,
+  // where the camera projects them.
+  EXPECT_NE(text.find("{name: table.0, pixel: [527.6"), std::string::npos) << text;
+  EXPECT_NE(text.find("world: [0.45, -0.4, 0.1]"), std::string::npos) << text;
+  EXPECT_NE(text.find("body: gripper, point: [0.34, -0.04, 0], state: [0.3, 0.4, 0.6]"), std::string::npos) << text;
+  // Uncommented, the template with its placeholders filled in is a labels file kccd calib reads.
+  std::string filled;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    const bool model_point = line.find("name: table.") != std::string::npos || line.find("name: gripper.") != std::string::npos ||
+                             line.find("name: post.") != std::string::npos || line.find("name: pedestal.") != std::string::npos;
+    if (model_point)
+      filled += line.substr(1, line.find("  # projected") - 1) + "\n";
+    else if (line.rfind("#", 0) != 0)
+      filled += line + "\n";
+  }
+  write("filled.yaml", filled);
+  const Outcome solve = runKccd("calib --intrinsics " + kCamera + " --labels " + out("filled.yaml") + " --model " + kDemo + " -o " +
+                                out("cam.yaml") + " --json");
+  ASSERT_EQ(solve.code, 0) << solve.err << filled;
+  const kccd::calib::Camera c = kccd::calib::loadCamera(out("cam.yaml"));
+  EXPECT_LT(rotationErrorDeg(c.rvec, truth_.rvec), 0.05);
+  // Bad input.
+  Outcome bad = runKccd("calib sheet --image " + out("frame.png") + " --model " + kDemo + " -o " + out("s.png"));
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--model: needs --camera"), std::string::npos) << bad.err;
+  bad = runKccd("calib sheet --image " + out("frame.png") + " -o " + out("s.jpg"));
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_FALSE(fs::exists(out("s.png")));
 }
 
 }  // namespace

@@ -424,8 +424,11 @@ Exit runSheet(const SheetArgs& a) {
         const Body* b = nullptr;
         for (const Body& bb : model->bodies) b = bb.name == body ? &bb : b;
         const Vec3& q = b->points[k];
-        t += "#  - {name: " + p.name + ", pixel: " + yamlPixel(p.pixel) + ", body: " + body + ", point: [" + format(q.x(), 10) + ", " +
-             format(q.y(), 10) + ", " + format(q.z(), 10) + "]" + (state.empty() ? "" : ", state: [" + st + "]") +
+        auto xyz = [](const Vec3& v) { return "[" + format(v.x(), 10) + ", " + format(v.y(), 10) + ", " + format(v.z(), 10) + "]"; };
+        // Points of world-fixed bodies are world points; the others are placed by the state.
+        t += "#  - {name: " + p.name + ", pixel: " + yamlPixel(p.pixel) +
+             (b->frame == kWorld ? ", world: " + xyz(q)
+                                 : ", body: " + body + ", point: " + xyz(q) + (state.empty() ? "" : ", state: [" + st + "]")) +
              "}  # projected: click the real point\n";
       }
     }
