@@ -241,11 +241,16 @@ StateLog parseStateLog(std::string_view text, const std::string& source, const M
 
   Lines lines(text, parser);
   std::string_view line;
-  if (!lines.next(line)) parser.fail(1, kNoColumn, {}, "empty file (expected a header line)");
+  lines.next(line);  // the text is not empty: a header line or an error
   const std::vector<Column> columns = parseHeader(line, parser, model, ignore_columns, log);
   const bool velocities = std::any_of(log.logged_velocity.begin(), log.logged_velocity.end(), [](std::uint8_t v) { return v != 0; });
 
-  const std::size_t expected_rows = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
+  // Room for the rows the text can hold: each needs a byte per number, the commas and a line end,
+  // so the numbers take at most about 4 bytes per byte of text, however hostile the text.
+  const std::size_t parsed = static_cast<std::size_t>(std::count_if(
+      columns.begin(), columns.end(), [](const Column& c) { return c.kind != Column::Kind::Ignored; }));
+  const std::size_t expected_rows = std::min(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1,
+                                             text.size() / (parsed + columns.size()) + 1);
   log.times.reserve(expected_rows);
   log.values.reserve(expected_rows * n);
   if (velocities) log.velocities.reserve(expected_rows * n);
