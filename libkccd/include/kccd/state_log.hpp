@@ -89,7 +89,8 @@ const char* toString(StateMatch match);
 /// neighbour within max_gap. Such a slope can be +-infinity for absurd logs (jumps near 1e300
 /// within a subnormal time step); treat a non-finite velocity as unsafe.
 /// `state` must have log.stateSize() values and `velocity` that many or none
-/// (std::invalid_argument otherwise). On None both are left unchanged. Never allocates.
+/// (std::invalid_argument otherwise). On None both are left unchanged. Allocates nothing when
+/// the sizes are right (a binary search over the times).
 StateMatch stateAt(const StateLog& log, double time, double max_gap, std::span<double> state,
                    std::span<double> velocity = {});
 
