@@ -246,7 +246,8 @@ StateLog parseStateLog(std::string_view text, const std::string& source, const M
   const bool velocities = std::any_of(log.logged_velocity.begin(), log.logged_velocity.end(), [](std::uint8_t v) { return v != 0; });
 
   // Room for the rows the text can hold: each needs a byte per number, the commas and a line end,
-  // so the numbers take at most about 4 bytes per byte of text, however hostile the text.
+  // so the numbers take at most about 4 bytes per byte of text (8 with velocity columns, stored
+  // for every value), however hostile the text.
   const std::size_t parsed = static_cast<std::size_t>(std::count_if(
       columns.begin(), columns.end(), [](const Column& c) { return c.kind != Column::Kind::Ignored; }));
   const std::size_t expected_rows = std::min(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1,

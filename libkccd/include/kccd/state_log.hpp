@@ -22,8 +22,8 @@ class StateLogError : public InputError {
   using InputError::InputError;
 };
 
-/// Largest state log file loadStateLog() reads. The parsed log takes up to about 4 bytes per
-/// byte of text (8 per number, at least 2 bytes of text per number).
+/// Largest state log file loadStateLog() reads. The parsed log takes at most about 4 bytes per
+/// byte of text (8 per number, at least 2 bytes of text per number), 8 with velocity columns.
 inline constexpr std::size_t kMaxStateLogBytes = std::size_t{1} << 30;
 /// Largest magnitude of any number in a log (times and values): differences stay finite.
 inline constexpr double kMaxStateLogMagnitude = 1e300;
