@@ -20,7 +20,7 @@ while [ $# -gt 0 ]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_model fuzz_camera fuzz_tags fuzz_labels fuzz_part fuzz_urdf)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_model fuzz_states fuzz_camera fuzz_tags fuzz_labels fuzz_part fuzz_urdf)
 bash scripts/install-deps.sh --fuzz
 CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DKCCD_BUILD_FUZZERS=ON -DKCCD_BUILD_TESTS=OFF -DKCCD_BUILD_BENCHMARKS=OFF >/dev/null
@@ -29,6 +29,7 @@ cmake --build build-fuzz -j "${KCCD_JOBS:-2}" --target "${targets[@]}"
 ci_runs() {  # inputs per target in --ci mode (about 15 s each on this project's machines)
   case "$1" in
     fuzz_model) echo 30000 ;;
+    fuzz_states) echo 180000 ;;
     fuzz_camera) echo 200000 ;;
     fuzz_tags) echo 140000 ;;
     fuzz_labels) echo 130000 ;;
@@ -40,6 +41,7 @@ ci_runs() {  # inputs per target in --ci mode (about 15 s each on this project's
 seeds() {  # extra seed files from data/ per target
   case "$1" in
     fuzz_model) ls data/*.yaml | grep -v camera ;;
+    fuzz_states) ;;
     fuzz_camera) ls data/*camera*.yaml ;;
     fuzz_tags) ;;
     fuzz_labels) ;;
@@ -54,10 +56,10 @@ for t in "${targets[@]}"; do
   rm -rf "$corpus" && mkdir -p "$corpus"
   [ -d "tests/fuzz/corpus/${t#fuzz_}" ] && cp -r "tests/fuzz/corpus/${t#fuzz_}/." "$corpus/"
   for f in $(seeds "$t"); do cp "$f" "$corpus/"; done
-  # Leaks: checked for the model loader (our code only); the readers built on Coin3D, OpenCV and
-  # urdfdom keep per-process caches the leak checker would report on every input (the ASan test
-  # suite checks our own code on those paths, with tests/lsan.supp).
-  leaks=0; [ "$t" = fuzz_model ] && leaks=1
+  # Leaks: checked for the model loader and the state log reader (our code only); the readers
+  # built on Coin3D, OpenCV and urdfdom keep per-process caches the leak checker would report on
+  # every input (the ASan test suite checks our own code on those paths, with tests/lsan.supp).
+  leaks=0; case "$t" in fuzz_model|fuzz_states) leaks=1 ;; esac
   limits=(-max_total_time="$seconds")
   if [ $ci -eq 1 ]; then
     limits+=(-seed=1 -runs="$(ci_runs "$t")")

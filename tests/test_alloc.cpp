@@ -7,6 +7,7 @@
 #include <random>
 
 #include "kccd/checker.hpp"
+#include "kccd/state_log.hpp"
 #include "support/random_model.hpp"
 
 // The replacements below pair malloc with free; GCC's -Wmismatched-new-delete cannot see that
@@ -64,6 +65,28 @@ TEST(NoAllocation, QueriesAllocateNothingOnceSetUp) {
     ASSERT_EQ(g_allocations - start, 0) << "case " << i;
   }
   EXPECT_EQ(queries, 300 * 12);
+}
+
+TEST(NoAllocation, StateAtAllocatesNothing) {
+  const Model m = parseModel(
+      "kccd: 1\njoints:\n  - {name: a, parent: world, type: revolute, axis: [0, 0, 1]}\n"
+      "  - {name: b, parent: a, type: prismatic, axis: [1, 0, 0]}\n"
+      "bodies:\n  - {name: t, frame: b, points: [[0, 0, 0]], radius: 0.1}\n",
+      "m.yaml");
+  const StateLog plain = parseStateLog("time,a,b\n0,3.1,0\n0.1,-3.1,1\n0.3,0,2\n", "log.csv", m);
+  const StateLog rates = parseStateLog("time,a,b,b.vel\n0,3.1,0,1\n0.1,-3.1,1,2\n0.3,0,2,3\n", "log.csv", m);
+  std::vector<double> state(2), velocity(2);
+  const long start = g_allocations;
+  int found = 0;
+  for (const StateLog* log : {&plain, &rates})
+    for (const double t : {-1.0, 0.0, 0.05, 0.1, 0.2, 0.3, 0.4, std::nan("")}) {
+      found += stateAt(*log, t, 0.15, state, velocity) != StateMatch::None;
+      found += stateAt(*log, t, 0.15, state) != StateMatch::None;
+    }
+  EXPECT_EQ(g_allocations - start, 0);
+  // 0, 0.05, 0.1 and 0.3 have a state (0.2 lies in a 0.2 s gap), but no rate at 0.3 (no neighbour
+  // within 0.15 s, and `a` has no velocity column).
+  EXPECT_EQ(found, 2 * (4 + 3));
 }
 
 }  // namespace
