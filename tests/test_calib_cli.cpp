@@ -327,3 +327,50 @@ TEST_F(CalibCli, SheetNumbersCandidatesAndWritesAFillableTemplate) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST_F(CalibCli, BodyLabelsPlacedByTheStateLogAtTheFrameTime) {
+  // The arm moves linearly in joint space: at t = 1.25 s it is at (0.3, 0.4, 0.6), halfway between
+  // the samples at 1.2 s and 1.3 s.
+  std::string log = "time,shoulder_yaw,shoulder_pitch,elbow\n";
+  for (int i = 0; i <= 30; ++i) {
+    const double t = 0.1 * i, d = t - 1.25;
+    log += fmt(t) + "," + fmt(0.3 + 0.2 * d) + "," + fmt(0.4 - 0.1 * d) + "," + fmt(0.6 + 0.3 * d) + "\n";
+  }
+  write("log.csv", log);
+  std::mt19937_64 rng(21);
+  write("labels.yaml", bodyLabels(rng, {0.3, 0.4, 0.6}, false, ""));
+  const std::string base = "calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --model " + kDemo + " --states " +
+                           out("log.csv") + " -o " + out("cam.yaml");
+  Outcome r = runKccd(base + " --time 1.25");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const kccd::calib::Camera c = kccd::calib::loadCamera(out("cam.yaml"));
+  EXPECT_LT(rotationErrorDeg(c.rvec, truth_.rvec), 0.1);
+  EXPECT_LT(cv::norm(centre(c) - centre(truth_)), 0.005);
+  // The wrong time places the links elsewhere: the fixed bodies still agree, every gripper point
+  // is rejected.
+  r = runKccd(base + " --time 2.5 --json");
+  const nlohmann::json wrong = nlohmann::json::parse(r.out);
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* name : {"gripper0", "gripper1", "gripper2", "gripper3"})
+    EXPECT_NE(std::find(wrong["rejected"].begin(), wrong["rejected"].end(), name), wrong["rejected"].end()) << name << r.out;
+  // Outside the log, beyond --max-gap, a missing --time, a typo in a column: one line, exit 2.
+  r = runKccd(base + " --time 7");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("has no sample within --max-gap"), std::string::npos) << r.err;
+  r = runKccd(base);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--time"), std::string::npos) << r.err;
+  write("typo.csv", "time,shoulder_yaw,shoulder_pitch,elbow,elbo\n0,0,0,0,0\n");
+  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --model " + kDemo + " --states " + out("typo.csv") +
+              " --time 0 -o " + out("cam2.yaml"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(out("typo.csv") + ":1:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("elbo"), std::string::npos) << r.err;
+  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --model " + kDemo + " --states " + out("typo.csv") +
+              " --ignore-columns elbo --time 0 -o " + out("cam2.yaml"));
+  EXPECT_NE(r.code, 2) << r.err;
+}
+
+}  // namespace

@@ -24,6 +24,7 @@
 #include "kccd/kinematics.hpp"
 #include "kccd/render/renderer.hpp"
 #include "kccd/render/scene.hpp"
+#include "kccd/state_log.hpp"
 
 namespace kccd::cli {
 namespace {
@@ -88,6 +89,9 @@ std::vector<cv::Point3d> corePoints(const Model& m, std::span<const double> stat
 struct CalibArgs {
   std::string intrinsics, tags, model, output, check;
   std::vector<std::string> images, labels, states;
+  std::string state_log, ignore_columns;
+  std::vector<double> times;
+  double max_gap = 0.0;  // 0: 1.5 x the log's median period
   double threshold = 8.0, magnify = 20.0;
   int min_inliers = 6;
   bool json = false, quiet = false;
@@ -132,6 +136,24 @@ Gathered gather(const CalibArgs& a, const calib::Camera& cam, const std::optiona
     throw UsageError("--state: given " + std::to_string(a.states.size()) + " times for " + std::to_string(n) +
                      " frames: give it once (all frames) or once per frame");
   if (!a.states.empty() && !model) throw UsageError("--state: needs --model");
+  if (!a.state_log.empty() && !model) throw UsageError("--states: needs --model");
+  if (!a.state_log.empty() && !a.states.empty()) throw UsageError("--state and --states: give one of them");
+  if (a.state_log.empty() != a.times.empty())
+    throw UsageError(a.state_log.empty() ? "--time: needs --states LOG.csv" : "--states: give each frame's time with --time");
+  if (!a.times.empty() && a.times.size() != n)
+    throw UsageError("--time: given " + std::to_string(a.times.size()) + " times for " + std::to_string(n) + " frames: give one per frame");
+  std::optional<StateLog> log;
+  double max_gap = a.max_gap;
+  if (!a.state_log.empty()) {
+    std::vector<std::string> ignore;
+    for (std::size_t at = 0; at <= a.ignore_columns.size() && !a.ignore_columns.empty();) {
+      const std::size_t comma = std::min(a.ignore_columns.find(',', at), a.ignore_columns.size());
+      ignore.push_back(a.ignore_columns.substr(at, comma - at));
+      at = comma + 1;
+    }
+    log = loadStateLog(a.state_log, *model, ignore);
+    if (max_gap == 0.0) max_gap = 1.5 * log->medianPeriod();
+  }
 
   std::optional<calib::TagLayout> layout;
   if (!a.tags.empty()) layout = calib::loadTagLayout(a.tags);
@@ -142,8 +164,11 @@ Gathered gather(const CalibArgs& a, const calib::Camera& cam, const std::optiona
     if (!a.states.empty()) {
       const std::string& text = a.states[a.states.size() == 1 ? 0 : f];
       fr.state = parseStateBox(*model, text, "", "", "", true).lower;
-    } else if (model && model->stateSize() == 0) {
-      fr.state.clear();
+    } else if (log) {
+      fr.state.assign(static_cast<std::size_t>(model->stateSize()), 0.0);
+      if (stateAt(*log, a.times[f], max_gap, fr.state) == StateMatch::None)
+        throw UsageError("--time " + format(a.times[f]) + ": " + a.state_log + " has no sample within --max-gap " + format(max_gap) +
+                         " s of it (the log covers " + format(log->times.front()) + " ... " + format(log->times.back()) + " s)");
     }
     if (!a.images.empty()) {
       fr.image = a.images[f];
@@ -175,7 +200,7 @@ Gathered gather(const CalibArgs& a, const calib::Camera& cam, const std::optiona
           throw UsageError(l.where + ": " + l.name + ": a body label needs --model (the model places its body)");
         } else if (l.state) {
           world = calib::worldPoint(*model, l);
-        } else if (!a.states.empty() || model->stateSize() == 0) {
+        } else if (!a.states.empty() || log || model->stateSize() == 0) {
           world = calib::worldPoint(*model, l, fr.state);
         } else {
           throw UsageError(l.where + ": " + l.name + ": a body label needs a state: give state: [...] in the label or --state");
@@ -465,6 +490,14 @@ Runner addCalib(CLI::App& app) {
                   "The robot's state in the frames (comma-separated; once for all frames, or once per frame) for body labels "
                   "without their own state, and for the check image")
       ->allow_extra_args(false);
+  sub->add_option("--states", a->state_log,
+                  "State log (CSV: time and one column per state value, see kccd info) placing the body labels at each frame's --time");
+  sub->add_option("--time", a->times, "Each frame's time in the state log's clock (s; once per frame)")
+      ->allow_extra_args(false)
+      ->check(finiteIn(-1e300, 1e300));
+  sub->add_option("--max-gap", a->max_gap, "No state when the log has no sample this close (s; default 1.5 x its median period)")
+      ->check(finiteIn(0, 1e300));
+  sub->add_option("--ignore-columns", a->ignore_columns, "Comma-separated state log columns to skip (an unknown column is an error)");
   sub->add_option("-o,--output", a->output, "Camera file to write (intrinsics, pose, quality); written only when solved; required");
   sub->add_option("--check", a->check,
                   "Check image (.png): the frame, the model at the state, every point seen (o), projected (+) and its residual "
