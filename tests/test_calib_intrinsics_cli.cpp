@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include <unistd.h>
@@ -17,6 +18,7 @@
 #include "kccd/calib/camera.hpp"
 #include "kccd/calib/intrinsics.hpp"
 #include "support/run_program.hpp"
+#include "support/tag_scene.hpp"
 
 namespace {
 
@@ -112,6 +114,129 @@ TEST_F(IntrinsicsCli, NoBoardInTheImagesIsNotSolvableAndWritesNothing) {
   ASSERT_EQ(j["views"].size(), 3u);
   EXPECT_EQ(j["views"][0]["tags"], 0);
   EXPECT_EQ(j["rejected"].size(), 3u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Images of a grid board rendered through a known distorted camera (tests/support/tag_scene).
+
+// 640 x 480, visible barrel distortion.
+Camera trueCamera() {
+  Camera c;
+  c.width = 640;
+  c.height = 480;
+  c.camera_matrix = cv::Matx33d(560.0, 0.0, 324.5, 0.0, 556.0, 236.0, 0.0, 0.0, 1.0);
+  c.distortion = {-0.24, 0.09, 0.0006, -0.0004, -0.02};
+  return c;
+}
+
+// The camera's pose for a view of `board`: the board centre at `at` in the camera, facing it,
+// tilted by `tilt_deg` about the in-plane axis at `axis_deg`, rolled by `roll_deg`.
+Camera viewOf(const Board& board, double tilt_deg, double axis_deg, double roll_deg, cv::Vec3d at) {
+  Camera c = trueCamera();
+  const cv::Matx33d flip(1, 0, 0, 0, -1, 0, 0, 0, -1);
+  cv::Matx33d roll, tilt;
+  cv::Rodrigues(cv::Vec3d(0, 0, roll_deg * kPi / 180), roll);
+  const double a = axis_deg * kPi / 180;
+  cv::Rodrigues(cv::Vec3d(std::cos(a), std::sin(a), 0) * (tilt_deg * kPi / 180), tilt);
+  const cv::Matx33d r = tilt * flip * roll;
+  cv::Vec3d centre(0, 0, 0);
+  for (const Tag& t : board.layout.tags) centre += cv::Vec3d(t.xyz.x(), t.xyz.y(), t.xyz.z());
+  centre /= static_cast<double>(board.layout.tags.size());
+  cv::Rodrigues(r, c.rvec);
+  c.tvec = at - r * centre;
+  return c;
+}
+
+TEST_F(IntrinsicsCli, RecoversTheCameraFromRenderedImagesOfAGridBoard) {
+  const Board board = Board::grid(TagGrid{.cols = 6, .rows = 4, .tag_size = 0.04, .spacing = 0.012});
+  kccd::testing::TagSceneOptions scene;
+  scene.blur_sigma = 0.6;
+  scene.noise_sigma = 2.0;
+  // Eight views: tilted 25-40 deg about different axes, the board in the centre and towards the corners.
+  const struct {
+    double tilt, axis, roll, x, y, z;
+  } poses[] = {{30, 0, 5, 0.0, 0.0, 0.42},       {35, 90, -8, 0.06, -0.04, 0.45},  {30, 45, 12, -0.08, 0.06, 0.46},
+               {40, 135, -4, 0.09, 0.07, 0.5},   {25, 200, 6, -0.1, -0.06, 0.48},  {35, 270, -10, 0.0, 0.08, 0.44},
+               {30, 315, 3, 0.1, -0.07, 0.5},    {38, 160, 15, -0.09, 0.02, 0.47}};
+  std::string images;
+  int n = 0;
+  for (const auto& p : poses) {
+    scene.seed = static_cast<std::uint64_t>(++n);
+    const cv::Mat image = kccd::testing::renderTagScene(viewOf(board, p.tilt, p.axis, p.roll, {p.x, p.y, p.z}), board.layout, scene);
+    const std::string name = path("view" + std::to_string(n) + ".png");
+    ASSERT_TRUE(cv::imwrite(name, image));
+    images += " " + name;
+  }
+  const std::string out = path("camera.yaml");
+  const Outcome r = runKccd("calib intrinsics --image" + images + kGrid + " -o " + out + " --json");
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["status"], "solved");
+  EXPECT_EQ(j["output"], out);
+  EXPECT_EQ(j["views"].size(), 8u);
+  EXPECT_EQ(j["used"].size(), 8u);
+  EXPECT_TRUE(j["rejected"].empty());
+  EXPECT_LT(j["rms_px"].get<double>(), 0.5);
+  EXPECT_EQ(j["std_dev"]["distortion"].size(), 5u);
+  for (const auto& v : j["views"]) {
+    EXPECT_GE(v["tags"].get<int>(), 12) << v["image"];
+    EXPECT_GT(v["tilt_deg"].get<double>(), 20.0) << v["image"];
+  }
+
+  const Camera c = loadCamera(out);
+  const Camera t = trueCamera();
+  const cv::Matx33d& k = c.camera_matrix;
+  std::ostringstream summary;
+  summary << "fx " << k(0, 0) << " (" << 100 * (k(0, 0) / 560.0 - 1) << " %), fy " << k(1, 1) << " (" << 100 * (k(1, 1) / 556.0 - 1)
+          << " %), cx " << k(0, 2) - 324.5 << " px, cy " << k(1, 2) - 236.0 << " px, k1 " << c.distortion[0] - t.distortion[0]
+          << ", rms " << j["rms_px"] << " px";
+  std::printf("recovered from rendered images: %s\n", summary.str().c_str());
+  EXPECT_EQ(c.width, 640);
+  EXPECT_EQ(c.height, 480);
+  EXPECT_NEAR(k(0, 0), 560.0, 0.005 * 560.0) << summary.str();
+  EXPECT_NEAR(k(1, 1), 556.0, 0.005 * 556.0) << summary.str();
+  EXPECT_NEAR(k(0, 2), 324.5, 2.0) << summary.str();
+  EXPECT_NEAR(k(1, 2), 236.0, 2.0) << summary.str();
+  ASSERT_EQ(c.distortion.size(), 5u);
+  EXPECT_NEAR(c.distortion[0], t.distortion[0], 0.02) << summary.str();
+  EXPECT_EQ(c.rvec, cv::Vec3d(0, 0, 0));
+  EXPECT_EQ(c.tvec, cv::Vec3d(0, 0, 0));
+  ASSERT_TRUE(c.reprojection_rms_px.has_value());
+  EXPECT_NEAR(*c.reprojection_rms_px, j["rms_px"].get<double>(), 1e-9);
+  std::ifstream in(out);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("avg_reprojection_error:"), std::string::npos) << text;
+  EXPECT_NE(text.find("nr_of_frames: 8"), std::string::npos) << text;
+
+  // The same images with --fix-k3 and in text form: k3 stays 0, the summary names the file.
+  const Outcome fixed = runKccd("calib intrinsics -q --fix-k3 --image" + images + kGrid + " -o " + path("fixed.yaml"));
+  ASSERT_EQ(fixed.code, 0) << fixed.err;
+  EXPECT_NE(fixed.out.find("wrote " + path("fixed.yaml")), std::string::npos) << fixed.out;
+  EXPECT_EQ(loadCamera(path("fixed.yaml")).distortion[4], 0.0);
+
+  // An image of another size among them: bad input, naming it; nothing written.
+  cv::imwrite(path("other.png"), cv::Mat(240, 320, CV_8UC1, cv::Scalar(128)));
+  const Outcome mixed = runKccd("calib intrinsics --image" + images + " " + path("other.png") + kGrid + " -o " + path("mixed.yaml"));
+  EXPECT_EQ(mixed.code, 2);
+  EXPECT_NE(mixed.err.find(path("other.png") + ": image: 320x240 differs"), std::string::npos) << mixed.err;
+  EXPECT_FALSE(fs::exists(path("mixed.yaml")));
+}
+
+TEST_F(IntrinsicsCli, FaceOnImagesAreNotSolvable) {
+  const Board board = Board::grid(TagGrid{.cols = 6, .rows = 4, .tag_size = 0.04, .spacing = 0.012});
+  std::string images;
+  const double shifts[][2] = {{0, 0}, {0.05, 0.03}, {-0.05, -0.03}, {0.04, -0.04}};
+  for (int i = 0; i < 4; ++i) {
+    const cv::Mat image = kccd::testing::renderTagScene(viewOf(board, 2.0, 90.0 * i, 0, {shifts[i][0], shifts[i][1], 0.45}), board.layout);
+    const std::string name = path("flat" + std::to_string(i) + ".png");
+    ASSERT_TRUE(cv::imwrite(name, image));
+    images += " " + name;
+  }
+  const Outcome r = runKccd("calib intrinsics --image" + images + kGrid + " -o " + path("camera.yaml"));
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_NE(r.err.find("kccd: intrinsics fronto-parallel: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("tilt the board"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("camera.yaml")));
 }
 
 }  // namespace
