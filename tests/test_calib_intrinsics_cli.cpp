@@ -220,6 +220,15 @@ TEST_F(IntrinsicsCli, RecoversTheCameraFromRenderedImagesOfAGridBoard) {
   EXPECT_EQ(mixed.code, 2);
   EXPECT_NE(mixed.err.find(path("other.png") + ": image: 320x240 differs"), std::string::npos) << mixed.err;
   EXPECT_FALSE(fs::exists(path("mixed.yaml")));
+
+  // The board described with the wrong first id: no board tags, and the message says which ids were seen.
+  const Outcome wrong = runKccd("calib intrinsics --image" + images + kGrid + " --first-id 100 -o " + path("wrong.yaml"));
+  EXPECT_EQ(wrong.code, 4);
+  EXPECT_NE(wrong.err.find("too few views"), std::string::npos) << wrong.err;
+  EXPECT_NE(wrong.err.find("the images show tags 0, 1, 2"), std::string::npos) << wrong.err;
+  EXPECT_NE(wrong.err.find("--first-id"), std::string::npos) << wrong.err;
+  EXPECT_EQ(std::count(wrong.err.begin(), wrong.err.end(), '\n'), 1) << wrong.err;
+  EXPECT_FALSE(fs::exists(path("wrong.yaml")));
 }
 
 TEST_F(IntrinsicsCli, FaceOnImagesAreNotSolvable) {

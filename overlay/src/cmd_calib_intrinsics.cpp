@@ -1,5 +1,6 @@
 // `kccd calib intrinsics --image A.png B.png ... (--board LAYOUT.yaml | --grid CxR --tag-size S
 // --spacing D) -o CAMERA.yaml`: camera intrinsics from several images of a planar AprilTag board.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <regex>
 #include <sstream>
 
+#include <stdlib.h>
 #include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -98,7 +100,11 @@ bool sameFile(const std::string& a, const std::string& b) {
 // The camera file text: saveCamera's layout (so it reads back with loadCamera, as checked here),
 // plus the fields OpenCV's calibration sample writes.
 std::string cameraText(const calib::Camera& camera, const calib::IntrinsicsResult& r) {
-  const fs::path tmp = fs::temp_directory_path() / ("kccd-intrinsics-" + std::to_string(::getpid()) + ".yaml");
+  std::string name = (fs::temp_directory_path() / "kccd-intrinsics-XXXXXX.yaml").string();
+  const int fd = ::mkstemps(name.data(), 5);
+  if (fd < 0) throw std::runtime_error("cannot create a temporary file in " + fs::temp_directory_path().string());
+  ::close(fd);
+  const fs::path tmp = name;
   struct Remove {
     fs::path p;
     ~Remove() {
@@ -226,7 +232,20 @@ Exit runIntrinsics(const IntrinsicsArgs& args) {
     }
   }
   if (!solved) {
-    std::cerr << "kccd: intrinsics " << calib::toString(r.status) << ": " << oneLine(r.message) << "\n";
+    // Tags that are not on the board usually mean a wrong --grid, --first-id or --board.
+    std::vector<int> foreign;
+    for (const auto& ids : unknown) foreign.insert(foreign.end(), ids.begin(), ids.end());
+    std::sort(foreign.begin(), foreign.end());
+    foreign.erase(std::unique(foreign.begin(), foreign.end()), foreign.end());
+    std::string hint;
+    if (r.status == calib::IntrinsicsStatus::TooFewViews && !foreign.empty()) {
+      hint = " (the images show tag";
+      hint += foreign.size() == 1 ? " " : "s ";
+      for (std::size_t i = 0; i < std::min<std::size_t>(foreign.size(), 8); ++i) hint += (i ? ", " : "") + std::to_string(foreign[i]);
+      if (foreign.size() > 8) hint += ", ...";
+      hint += " that the board does not have: check --grid, --first-id or --board)";
+    }
+    std::cerr << "kccd: intrinsics " << calib::toString(r.status) << ": " << oneLine(r.message) << hint << "\n";
     return Exit::NotSolvable;
   }
   return Exit::Ok;
