@@ -24,8 +24,12 @@ step $kccd query data/humanoid.yaml --lower $lower --upper $upper --type collisi
 step $kccd render data/demo_arm.yaml --camera data/demo_camera.yaml --state 0.3,0.4,0.6 --labels -o build-demo/demo_static.png
 step $kccd render data/demo_arm.yaml --camera data/demo_camera.yaml --lower -0.5,0,0 --upper 0.5,0,0 -o build-demo/demo_swept.png
 step $kccd render data/demo_arm.yaml --camera data/demo_camera.yaml --lower -0.5,0,0 --upper 0.5,0,0 --mask -o build-demo/demo_swept_mask.png
-echo "images in build-demo/: demo_static.png, demo_swept.png (RGBA layers), demo_swept_mask.png (labels)"
+# Calibration: the camera's pose from 16 labelled points (one misclicked), with its uncertainty,
+# and a check image of every point, its reprojection and the model's volumes at the state.
+step $kccd calib --intrinsics data/demo_camera.yaml --labels data/demo_labels.yaml --model data/demo_arm.yaml \
+  --state 0.3,0.4,0.6 -o build-demo/calibrated_camera.yaml --check build-demo/calib_check.png
 # Modelling: a conservative SSCH for a CAD part (8 core points), and which pairs of the demo arm
 # can never meet anywhere inside the joint limits (proven with the same sweeps).
 step $kccd fit data/parts/gripper.iv --points 8 --name gripper --frame elbow -q
 step $kccd pairs data/demo_arm.yaml -q
+echo "images in build-demo/: demo_static.png, demo_swept.png (RGBA layers), demo_swept_mask.png (labels), calib_check.png"

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <sstream>
 
@@ -313,9 +314,8 @@ Camera loadCamera(const std::string& path) {
   return c;
 }
 
-void saveCamera(const Camera& camera, const std::string& path) {
-  cv::FileStorage fs(path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
-  if (!fs.isOpened()) throw CameraError(path + ": cannot write camera file");
+std::string cameraText(const Camera& camera) {
+  cv::FileStorage fs(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   fs << "image_width" << camera.width << "image_height" << camera.height;
   fs << "camera_matrix" << cv::Mat(camera.camera_matrix);
   fs << "distortion_coefficients" << cv::Mat(camera.distortion).reshape(1, 1);
@@ -323,6 +323,15 @@ void saveCamera(const Camera& camera, const std::string& path) {
   if (camera.reprojection_rms_px) fs << "reprojection_rms_px" << *camera.reprojection_rms_px;
   if (camera.rotation_sigma_deg) fs << "rotation_sigma_deg" << *camera.rotation_sigma_deg;
   if (camera.position_sigma_m) fs << "position_sigma_m" << *camera.position_sigma_m;
+  return fs.releaseAndGetString();
+}
+
+void saveCamera(const Camera& camera, const std::string& path) {
+  const std::string text = cameraText(camera);
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) throw CameraError(path + ": cannot write camera file");
+  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  if (std::fclose(f) != 0 || !ok) throw CameraError(path + ": cannot write camera file");
 }
 
 }  // namespace kccd::calib

@@ -497,4 +497,34 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   return result;
 }
 
+double projectedSigmaPx(const Camera& camera, const cv::Matx66d& covariance, const std::vector<cv::Point3d>& world) {
+  double worst = 0.0;
+  const cv::Matx33d r = [&] {
+    cv::Matx33d m;
+    cv::Rodrigues(camera.rvec, m);
+    return m;
+  }();
+  std::vector<cv::Point3d> front;
+  for (const cv::Point3d& p : world) {
+    const cv::Vec3d c = r * cv::Vec3d(p.x, p.y, p.z) + camera.tvec;
+    if (std::isfinite(c[2]) && c[2] > 1e-9) front.push_back(p);
+  }
+  if (front.empty()) return 0.0;
+  std::vector<cv::Point2d> image;
+  cv::Mat jacobian;
+  cv::projectPoints(front, camera.rvec, camera.tvec, camera.camera_matrix, camera.distortion, image, jacobian);
+  const cv::Matx66d& c = covariance;
+  for (std::size_t i = 0; i < front.size(); ++i) {
+    cv::Matx<double, 2, 6> j;
+    for (int row = 0; row < 2; ++row)
+      for (int col = 0; col < 6; ++col) j(row, col) = jacobian.at<double>(static_cast<int>(2 * i) + row, col);
+    const cv::Matx22d m = j * c * j.t();
+    // Largest eigenvalue of a symmetric 2x2 matrix, in closed form.
+    const double mean = 0.5 * (m(0, 0) + m(1, 1));
+    const double half = std::hypot(0.5 * (m(0, 0) - m(1, 1)), m(0, 1));
+    worst = std::max(worst, std::sqrt(std::max(0.0, mean + half)));
+  }
+  return worst;
+}
+
 }  // namespace kccd::calib

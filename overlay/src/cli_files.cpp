@@ -5,10 +5,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
 
 #include "cli_args.hpp"
 
@@ -118,6 +122,27 @@ void editFile(const std::string& path, const std::function<std::string(const std
   const std::string edited = edit(text);  // an EditError names the file and place itself
   struct stat st {};
   replaceFile(target, path, edited, fstat(fd, &st) == 0 ? (st.st_mode & 07777) : newFileMode());
+}
+
+void checkOutputPath(const std::string& path, const std::string& option, const std::string& extension) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != extension) throw UsageError(option + " " + path + ": the output must be a " + extension + " file");
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  if (!dir.empty() && !std::filesystem::is_directory(dir))
+    throw UsageError(option + " " + path + ": directory " + dir.string() + " does not exist");
+}
+
+void writePngAtomically(const std::string& path, const cv::Mat& image, const std::string& option) {
+  std::vector<uchar> png;
+  bool ok = false;
+  try {
+    ok = cv::imencode(".png", image, png);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  if (!ok) throw UsageError(option + " " + path + ": cannot encode the image");
+  writeFileAtomically(path, std::string(png.begin(), png.end()));
 }
 
 }  // namespace kccd::cli

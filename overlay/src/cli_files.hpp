@@ -5,6 +5,8 @@
 #include <functional>
 #include <string>
 
+#include <opencv2/core.hpp>
+
 #include "kccd/model.hpp"
 
 namespace kccd::cli {
@@ -17,6 +19,14 @@ Model loadOrExplain(const std::string& path, std::string* text = nullptr);
 /// readers never see a partial file. A symbolic link stays a link (its target is replaced) and an
 /// existing file keeps its mode. Throws UsageError naming the path.
 void writeFileAtomically(const std::string& path, const std::string& text);
+
+/// Checks an output path before any work: its extension (lower-cased) is `extension` and its folder
+/// exists. Throws UsageError "<option> <path>: ...".
+void checkOutputPath(const std::string& path, const std::string& option, const std::string& extension);
+
+/// Encodes `image` as PNG in memory and writes it with writeFileAtomically. Throws UsageError
+/// "<option> <path>: ..." when it cannot be encoded or written.
+void writePngAtomically(const std::string& path, const cv::Mat& image, const std::string& option);
 
 /// Replaces the text of the file at `path` by `edit(text)`, atomically, holding an exclusive lock
 /// (flock) on the file from the read to the rename, so concurrent edits of one file apply one after

@@ -26,32 +26,11 @@ struct RenderArgs {
   double supersample = 1.0;
 };
 
-// Encodes the PNG in memory and writes it through a temporary file and a rename, so a failed
-// run never leaves a partial file.
-void writePng(const cv::Mat& image, const std::string& path) {
-  std::vector<uchar> png;
-  bool ok = false;
-  try {
-    ok = cv::imencode(".png", image, png);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  if (!ok) throw UsageError("-o " + path + ": cannot encode the image");
-  writeFileAtomically(path, std::string(png.begin(), png.end()));
-}
-
 Exit runRender(const RenderArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
   const Model m = loadOrExplain(args.model);
   const calib::Camera camera = calib::loadCamera(args.camera);
-  {
-    std::string ext = std::filesystem::path(args.output).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext != ".png") throw UsageError("-o " + args.output + ": the output must be a .png file");
-    const std::filesystem::path dir = std::filesystem::path(args.output).parent_path();
-    if (!dir.empty() && !std::filesystem::is_directory(dir))
-      throw UsageError("-o " + args.output + ": directory " + dir.string() + " does not exist");
-  }
+  checkOutputPath(args.output, "-o", ".png");
   const StateBox box =
       parseStateBox(m, args.state, args.lower, args.upper,
                     "give the configuration with --state (static volumes) or --lower and --upper (swept volumes)", true);
@@ -85,7 +64,7 @@ Exit runRender(const RenderArgs& args) {
   const auto t1 = std::chrono::steady_clock::now();
   const render::Frame frame = renderer->render(volumes, style, !args.mask, true);
   const auto t2 = std::chrono::steady_clock::now();
-  writePng(args.mask ? frame.mask : frame.bgra, args.output);
+  writePngAtomically(args.output, args.mask ? frame.mask : frame.bgra, "-o");
 
   const double total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const double frame_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();

@@ -36,11 +36,7 @@ int main(int argc, char** argv) {
   add(kccd::cli::addPairs);
   add(kccd::cli::addImport);
   add(kccd::cli::addRender);
-  {  // TEMPORARY (branch calib-intrinsics): a bare `calib` hosting only `calib intrinsics`, until cmd_calib.cpp lands.
-    CLI::App* calib = app.add_subcommand("calib", "Camera calibration");
-    calib->require_subcommand(1);
-    commands.emplace_back(calib, kccd::cli::addCalibIntrinsics(*calib));
-  }
+  add(kccd::cli::addCalib);
   if (argc > 1 && argv[1][0] != '-') {  // CLI11 would only say that a subcommand is required
     std::string names;
     bool known = false;

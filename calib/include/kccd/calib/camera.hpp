@@ -60,7 +60,9 @@ struct Camera {
 /// top level is a mapping without repeated keys. Throws CameraError (an InputError), never
 /// anything else for any file content.
 Camera loadCamera(const std::string& path);
-/// Writes a camera file in the same layout, quality figures included when known.
+/// The text of a camera file in the same layout, quality figures included when known.
+std::string cameraText(const Camera& camera);
+/// Writes cameraText(camera) to `path` (not atomically: tools write through a temporary file).
 void saveCamera(const Camera& camera, const std::string& path);
 
 /// Normalised image coordinates of the pixel centres `pixels` (n x 1, CV_64FC2) through the

@@ -66,6 +66,12 @@ struct PoseResult {
 PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>& points,
                      const PoseOptions& options = {});
 
+/// The reprojection uncertainty of world points under a solved pose: for each point, the square
+/// root of the largest eigenvalue of J C J^T (J: the 2x6 derivative of its projection with respect
+/// to rvec, tvec; C: the pose covariance), in pixels; the largest over the points (points behind
+/// the camera are skipped; 0 when none is in front).
+double projectedSigmaPx(const Camera& camera, const cv::Matx66d& covariance, const std::vector<cv::Point3d>& world);
+
 /// Name of a status ("solved", "too few points", ...).
 const char* toString(PoseStatus status);
 

@@ -1,0 +1,13 @@
+// Putting a rendered layer onto a camera frame.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+namespace kccd::render {
+
+/// Blends a straight-alpha BGRA layer (Frame::bgra) over a BGR frame of the same size, in place:
+/// out = layer * a + frame * (1 - a), a = alpha / 255, rounded to nearest. Throws
+/// std::invalid_argument when the types (CV_8UC3, CV_8UC4) or sizes do not match.
+void compositeOver(cv::Mat& frame_bgr, const cv::Mat& layer_bgra);
+
+}  // namespace kccd::render

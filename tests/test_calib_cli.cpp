@@ -1,0 +1,329 @@
+// End-to-end: `kccd calib` as an operator runs it (labels, body labels, several frames, the camera
+// file, JSON, the check image, exit codes and one-line errors).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "kccd/calib/camera.hpp"
+#include "kccd/kinematics.hpp"
+#include "kccd/model.hpp"
+#include "support/golden.hpp"
+#include "support/run_program.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using kccd::testing::Outcome;
+
+const std::string kData = KCCD_DATA_DIR;
+const std::string kDemo = kData + "/demo_arm.yaml";
+const std::string kCamera = kData + "/demo_camera.yaml";
+
+Outcome runKccd(const std::string& args) { return kccd::testing::runProgram(std::string(KCCD_CLI) + " " + args); }
+
+// Uniform in [lo, hi) from the raw generator output: the same numbers with every standard library.
+double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1.0p-53;
+}
+
+double rotationErrorDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
+  cv::Matx33d ra, rb;
+  cv::Rodrigues(a, ra);
+  cv::Rodrigues(b, rb);
+  const cv::Matx33d d = ra.t() * rb;
+  const double c = std::clamp((d(0, 0) + d(1, 1) + d(2, 2) - 1.0) / 2.0, -1.0, 1.0);
+  return std::acos(c) * 180.0 / M_PI;
+}
+
+cv::Vec3d centre(const kccd::calib::Camera& c) {
+  cv::Matx33d r;
+  cv::Rodrigues(c.rvec, r);
+  return -(r.t() * c.tvec);
+}
+
+cv::Point2d project(const kccd::calib::Camera& c, const cv::Point3d& p) {
+  std::vector<cv::Point2d> out;
+  cv::projectPoints(std::vector<cv::Point3d>{p}, c.rvec, c.tvec, c.camera_matrix, c.distortion, out);
+  return out[0];
+}
+
+std::string fmt(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6f", v);
+  return buf;
+}
+
+class CalibCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(::testing::TempDir()) / ("kccd_calib_cli_" + std::to_string(getpid()));
+    fs::create_directories(dir_);
+    truth_ = kccd::calib::loadCamera(kCamera);
+    model_ = kccd::loadModel(kDemo);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string out(const std::string& name) const { return (dir_ / name).string(); }
+  void write(const std::string& name, const std::string& text) const { std::ofstream(out(name)) << text; }
+
+  // `n` world points in the cell that the sample camera sees, with 0.5 px noise; the names listed
+  // in `misclicks` are moved 40-90 px.
+  std::string worldLabels(std::mt19937_64& rng, int n, const std::vector<int>& misclicks = {}) const {
+    std::string t = "labels:\n";
+    int made = 0;
+    while (made < n) {
+      const cv::Point3d p(uniform(rng, -0.6, 0.9), uniform(rng, -0.7, 0.7), uniform(rng, 0.0, 1.3));
+      cv::Point2d px = project(truth_, p);
+      if (px.x < 20 || px.y < 20 || px.x > truth_.width - 20 || px.y > truth_.height - 20) continue;
+      px += cv::Point2d(uniform(rng, -0.5, 0.5), uniform(rng, -0.5, 0.5));
+      if (std::find(misclicks.begin(), misclicks.end(), made) != misclicks.end()) {
+        const double a = uniform(rng, 0, 2 * M_PI), r = uniform(rng, 40, 90);
+        px += cv::Point2d(r * std::cos(a), r * std::sin(a));
+      }
+      t += "  - {name: w" + std::to_string(made) + ", pixel: [" + fmt(px.x) + ", " + fmt(px.y) + "], world: [" + fmt(p.x) + ", " +
+           fmt(p.y) + ", " + fmt(p.z) + "]}\n";
+      ++made;
+    }
+    return t;
+  }
+
+  // Labels of every core point of the arm's bodies at `state` (0.3 px noise); the state written
+  // into each label when `with_state`.
+  std::string bodyLabels(std::mt19937_64& rng, const std::vector<double>& state, bool with_state, const std::string& prefix) const {
+    std::vector<kccd::Pose> poses(model_.joints.size());
+    EXPECT_TRUE(kccd::framePoses(model_, state, poses));
+    std::string st;
+    for (double v : state) st += (st.empty() ? "" : ", ") + fmt(v);
+    std::string t = "labels:\n";
+    for (const kccd::Body& b : model_.bodies)
+      for (std::size_t k = 0; k < b.points.size(); ++k) {
+        const kccd::Vec3 w = kccd::framePose(poses, b.frame) * b.points[k];
+        cv::Point2d px = project(truth_, {w.x(), w.y(), w.z()});
+        px += cv::Point2d(uniform(rng, -0.3, 0.3), uniform(rng, -0.3, 0.3));
+        const kccd::Vec3& q = b.points[k];
+        t += "  - {name: " + prefix + b.name + std::to_string(k) + ", pixel: [" + fmt(px.x) + ", " + fmt(px.y) + "], body: " + b.name +
+             ", point: [" + fmt(q.x()) + ", " + fmt(q.y()) + ", " + fmt(q.z()) + "]" + (with_state ? ", state: [" + st + "]" : "") + "}\n";
+      }
+    return t;
+  }
+
+  fs::path dir_;
+  kccd::calib::Camera truth_;
+  kccd::Model model_;
+};
+
+TEST_F(CalibCli, LabelsSolveRejectMisclicksAndWriteTheCamera) {
+  std::mt19937_64 rng(7);
+  write("labels.yaml", worldLabels(rng, 14, {3, 9}));
+  const Outcome r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --model " + kDemo +
+                            " --state 0.3,0.4,0.6 -o " + out("cam.yaml") + " --check " + out("check.png") + " --json");
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["status"], "solved");
+  EXPECT_EQ(j["rejected"], nlohmann::json::array({"w3", "w9"}));
+  EXPECT_EQ(j["inliers"], 12);
+  ASSERT_EQ(j["residuals"].size(), 14u);
+  EXPECT_GT(j["residuals"][3]["px"].get<double>(), 30.0);
+  EXPECT_FALSE(j["residuals"][3]["inlier"].get<bool>());
+  EXPECT_LT(j["reprojection_rms_px"].get<double>(), 0.6);
+  EXPECT_GT(j["volume_sigma_px"].get<double>(), 0.0);
+  // The camera file: the sample camera's intrinsics, the true pose within its stated sigmas.
+  const kccd::calib::Camera c = kccd::calib::loadCamera(out("cam.yaml"));
+  EXPECT_EQ(c.width, truth_.width);
+  EXPECT_EQ(c.camera_matrix, truth_.camera_matrix);
+  ASSERT_TRUE(c.rotation_sigma_deg && c.position_sigma_m && c.reprojection_rms_px);
+  EXPECT_DOUBLE_EQ(*c.rotation_sigma_deg, j["rotation_sigma_deg"].get<double>());
+  EXPECT_LT(rotationErrorDeg(c.rvec, truth_.rvec), std::max(0.02, 4 * *c.rotation_sigma_deg));
+  EXPECT_LT(cv::norm(centre(c) - centre(truth_)), std::max(0.002, 4 * *c.position_sigma_m));
+  // The check image: the frame size, and what it shows stays as reviewed.
+  const cv::Mat check = cv::imread(out("check.png"), cv::IMREAD_COLOR);
+  ASSERT_EQ(check.cols, truth_.width);
+  EXPECT_TRUE(kccd::testing::compareGolden(check, "calib_check_labels", j["renderer"].get<std::string>()));
+}
+
+TEST_F(CalibCli, BodyLabelsPlacedByTheirStateOrByStateOption) {
+  std::mt19937_64 rng(11);
+  // State in the labels.
+  write("own.yaml", bodyLabels(rng, {0.3, 0.4, 0.6}, true, ""));
+  Outcome r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("own.yaml") + " --model " + kDemo + " -o " + out("a.yaml") + " -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "");
+  kccd::calib::Camera c = kccd::calib::loadCamera(out("a.yaml"));
+  EXPECT_LT(rotationErrorDeg(c.rvec, truth_.rvec), 0.1);
+  EXPECT_LT(cv::norm(centre(c) - centre(truth_)), 0.005);
+  // State from --state; a wrong state moves the points and the solve does not agree.
+  write("plain.yaml", bodyLabels(rng, {-0.4, 0.9, -0.5}, false, ""));
+  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("plain.yaml") + " --model " + kDemo + " --state=-0.4,0.9,-0.5 -o " +
+              out("b.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  c = kccd::calib::loadCamera(out("b.yaml"));
+  EXPECT_LT(rotationErrorDeg(c.rvec, truth_.rvec), 0.1);
+  // Without any state: one line naming the label's place.
+  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("plain.yaml") + " --model " + kDemo + " -o " + out("c.yaml"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(out("plain.yaml") + ":2:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("needs a state"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out("c.yaml")));
+  // Without the model.
+  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("own.yaml") + " -o " + out("c.yaml"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("needs --model"), std::string::npos) << r.err;
+}
+
+TEST_F(CalibCli, SeveralFramesAddUp) {
+  // Each frame alone sees the arm in one pose; together they span more of the view and depth.
+  std::mt19937_64 rng(5);
+  write("f1.yaml", bodyLabels(rng, {0.9, 0.2, 0.1}, false, ""));
+  write("f2.yaml", bodyLabels(rng, {-0.9, 1.2, -1.0}, false, ""));
+  write("f3.yaml", bodyLabels(rng, {0.0, -0.8, 1.4}, false, ""));
+  auto sigma = [&](const std::string& args) {
+    const Outcome r = runKccd("calib --intrinsics " + kCamera + " --model " + kDemo + " " + args + " --json -o " + out("x.yaml"));
+    EXPECT_EQ(r.code, 0) << r.err;
+    return r.code == 0 ? nlohmann::json::parse(r.out) : nlohmann::json();
+  };
+  const nlohmann::json one = sigma("--labels " + out("f1.yaml") + " --state 0.9,0.2,0.1");
+  const nlohmann::json all = sigma("--labels " + out("f1.yaml") + " --labels " + out("f2.yaml") + " --labels " + out("f3.yaml") +
+                                   " --state 0.9,0.2,0.1 --state=-0.9,1.2,-1.0 --state 0.0,-0.8,1.4");
+  ASSERT_TRUE(one.is_object() && all.is_object());
+  EXPECT_LT(all["rotation_sigma_deg"].get<double>(), one["rotation_sigma_deg"].get<double>());
+  EXPECT_LT(all["position_sigma_m"].get<double>(), one["position_sigma_m"].get<double>());
+  ASSERT_EQ(all["frames"].size(), 3u);
+  EXPECT_EQ(all["residuals"][0]["name"].get<std::string>().rfind("f1/", 0), 0u);
+  EXPECT_EQ(all["residuals"].back()["name"].get<std::string>().rfind("f3/", 0), 0u);
+  // A state count that matches neither one nor every frame.
+  const Outcome r = runKccd("calib --intrinsics " + kCamera + " --model " + kDemo + " --labels " + out("f1.yaml") + " --labels " +
+                            out("f2.yaml") + " --labels " + out("f3.yaml") + " --state 0,0,0 --state 0,0,0 -o " + out("y.yaml"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--state: given 2 times for 3 frames"), std::string::npos) << r.err;
+}
+
+TEST_F(CalibCli, NotSolvableWritesNothingAndSaysWhatToAdd) {
+  std::mt19937_64 rng(3);
+  write("few.yaml", worldLabels(rng, 3));
+  Outcome r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("few.yaml") + " -o " + out("cam.yaml") + " --check " +
+                      out("check.png"));
+  EXPECT_EQ(r.code, 4);
+  EXPECT_NE(r.err.find("kccd: calib: 3 points given, at least"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1);
+  EXPECT_FALSE(fs::exists(out("cam.yaml")));
+  EXPECT_FALSE(fs::exists(out("check.png")));
+  // Half the points misclicked: too few agree.
+  write("bad.yaml", worldLabels(rng, 8, {0, 2, 4, 6}));
+  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("bad.yaml") + " -o " + out("cam.yaml") + " --json");
+  EXPECT_EQ(r.code, 4);
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["status"], "too few inliers");
+  EXPECT_FALSE(j.contains("rotation_sigma_deg"));
+  EXPECT_FALSE(fs::exists(out("cam.yaml")));
+}
+
+TEST_F(CalibCli, BadInputIsOneLineExitTwo) {
+  std::mt19937_64 rng(9);
+  write("l.yaml", worldLabels(rng, 8));
+  const std::string l = " --labels " + out("l.yaml");
+  struct Case {
+    std::string args, expect;
+  };
+  cv::imwrite(out("small.png"), cv::Mat(100, 200, CV_8UC3, cv::Scalar(128, 128, 128)));
+  write("not_image.png", "hello");
+  const std::vector<Case> cases{
+      {"--intrinsics " + kCamera + l, "-o CAMERA.yaml is required"},
+      {l + " -o " + out("c.yaml"), "--intrinsics CAMERA.yaml is required"},
+      {"--intrinsics " + kCamera + " -o " + out("c.yaml"), "give --image FRAME"},
+      {"--intrinsics " + kCamera + l + " -o " + out("c.txt"), "must be a .yaml or .yml file"},
+      {"--intrinsics " + kCamera + l + " -o " + out("nodir/c.yaml"), "does not exist"},
+      {"--intrinsics " + kCamera + l + " -o " + out("c.yaml") + " --check " + out("c.jpg"), "must be a .png file"},
+      {"--intrinsics " + out("missing.yaml") + l + " -o " + out("c.yaml"), out("missing.yaml")},
+      {"--intrinsics " + kCamera + " --labels " + out("missing.yaml") + " -o " + out("c.yaml"), out("missing.yaml")},
+      {"--intrinsics " + kCamera + " --image " + out("small.png") + l + " -o " + out("c.yaml"), "the image is 200x100 but the camera"},
+      {"--intrinsics " + kCamera + " --image " + out("not_image.png") + l + " -o " + out("c.yaml"), "not an image OpenCV can read"},
+      {"--intrinsics " + kCamera + " --image " + out("small.png") + " -o " + out("c.yaml"), "give --tags LAYOUT and/or --labels"},
+      {"--intrinsics " + kCamera + l + " --tags " + kCamera + " -o " + out("c.yaml"), "--tags: needs --image"},
+      {"--intrinsics " + kCamera + l + " --state 0,0,0 -o " + out("c.yaml"), "--state: needs --model"},
+      {"--intrinsics " + kCamera + l + " --model " + kDemo + " --state 0,0 -o " + out("c.yaml"), "has 2 values"},
+      {"--intrinsics " + kCamera + l + " --threshold nan -o " + out("c.yaml"), "--threshold"},
+  };
+  for (const Case& c : cases) {
+    const Outcome r = runKccd("calib " + c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("kccd: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out("c.yaml")));
+  }
+}
+
+}  // namespace
+
+namespace {
+
+TEST_F(CalibCli, SheetNumbersCandidatesAndWritesAFillableTemplate) {
+  // A frame with a few strong corners (dark squares) where the arm stands.
+  cv::Mat frame(truth_.height, truth_.width, CV_8UC3, cv::Scalar(200, 200, 200));
+  const std::vector<cv::Point> squares{{200, 150}, {900, 500}, {400, 550}};
+  for (const cv::Point& p : squares) cv::rectangle(frame, p, p + cv::Point(60, 60), cv::Scalar(20, 20, 20), cv::FILLED);
+  cv::imwrite(out("frame.png"), frame);
+  const Outcome r = runKccd("calib sheet --image " + out("frame.png") + " --model " + kDemo + " --camera " + kCamera +
+                            " --state 0.3,0.4,0.6 -o " + out("sheet.png") + " --template " + out("labels.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const cv::Mat sheet = cv::imread(out("sheet.png"), cv::IMREAD_COLOR);
+  ASSERT_EQ(sheet.size(), frame.size());
+  EXPECT_GT(cv::norm(sheet, frame, cv::NORM_L1), 0.0);
+  std::ifstream in(out("labels.yaml"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // Every square's 4 corners are candidates, within a pixel of where they were drawn.
+  // (a filled rectangle covers pixels p ... p + 60: its edges are at p - 0.5 and p + 60.5)
+  int near = 0;
+  for (const cv::Point& p : squares)
+    for (const cv::Point2d& c : {cv::Point2d(p.x - 0.5, p.y - 0.5), cv::Point2d(p.x + 60.5, p.y - 0.5), cv::Point2d(p.x - 0.5, p.y + 60.5),
+                                 cv::Point2d(p.x + 60.5, p.y + 60.5)})
+      for (std::size_t at = text.find("pixel: ["); at != std::string::npos; at = text.find("pixel: [", at + 1)) {
+        const double u = std::stod(text.substr(at + 8)), v = std::stod(text.substr(text.find(',', at) + 1));
+        near += std::hypot(u - c.x, v - c.y) < 0.25;
+      }
+  EXPECT_GE(near, 12) << text;
+  // The model's points: world points for fixed bodies, body points with the state for links,
+  // where the camera projects them.
+  EXPECT_NE(text.find("{name: table.0, pixel: [527.6"), std::string::npos) << text;
+  EXPECT_NE(text.find("world: [0.45, -0.4, 0.1]"), std::string::npos) << text;
+  EXPECT_NE(text.find("body: gripper, point: [0.34, -0.04, 0], state: [0.3, 0.4, 0.6]"), std::string::npos) << text;
+  // Uncommented, the template with its placeholders filled in is a labels file kccd calib reads.
+  std::string filled;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    const bool model_point = line.find("name: table.") != std::string::npos || line.find("name: gripper.") != std::string::npos ||
+                             line.find("name: post.") != std::string::npos || line.find("name: pedestal.") != std::string::npos;
+    if (model_point)
+      filled += line.substr(1, line.find("  # projected") - 1) + "\n";
+    else if (line.rfind("#", 0) != 0)
+      filled += line + "\n";
+  }
+  write("filled.yaml", filled);
+  const Outcome solve = runKccd("calib --intrinsics " + kCamera + " --labels " + out("filled.yaml") + " --model " + kDemo + " -o " +
+                                out("cam.yaml") + " --json");
+  ASSERT_EQ(solve.code, 0) << solve.err << filled;
+  const kccd::calib::Camera c = kccd::calib::loadCamera(out("cam.yaml"));
+  EXPECT_LT(rotationErrorDeg(c.rvec, truth_.rvec), 0.05);
+  // Bad input.
+  Outcome bad = runKccd("calib sheet --image " + out("frame.png") + " --model " + kDemo + " -o " + out("s.png"));
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--model: needs --camera"), std::string::npos) << bad.err;
+  bad = runKccd("calib sheet --image " + out("frame.png") + " -o " + out("s.jpg"));
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_FALSE(fs::exists(out("s.png")));
+}
+
+}  // namespace
