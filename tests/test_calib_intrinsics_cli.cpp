@@ -208,6 +208,25 @@ TEST_F(IntrinsicsCli, RecoversTheCameraFromRenderedImagesOfAGridBoard) {
   EXPECT_NE(text.find("avg_reprojection_error:"), std::string::npos) << text;
   EXPECT_NE(text.find("nr_of_frames: 8"), std::string::npos) << text;
 
+  // The file is the --intrinsics of a pose solve: the first view's pose from its tags (the grid as a layout file).
+  {
+    std::ofstream layout(path("grid.yaml"));
+    layout << "tags:\n";
+    for (const Tag& t : board.layout.tags)
+      layout << "  - {id: " << t.id << ", size: " << t.size << ", xyz: [" << t.xyz.x() << ", " << t.xyz.y() << ", 0], rpy: [0, 0, 0]}\n";
+  }
+  const Outcome pose = runKccd("calib --intrinsics " + out + " --image " + path("view1.png") + " --tags " + path("grid.yaml") +
+                               " -o " + path("posed.yaml") + " -q");
+  ASSERT_EQ(pose.code, 0) << pose.err;
+  const Camera posed = loadCamera(path("posed.yaml"));
+  const Camera truth1 = viewOf(board, poses[0].tilt, poses[0].axis, poses[0].roll, {poses[0].x, poses[0].y, poses[0].z});
+  cv::Matx33d r_posed, r_truth;
+  cv::Rodrigues(posed.rvec, r_posed);
+  cv::Rodrigues(truth1.rvec, r_truth);
+  const double angle = cv::norm(cv::Mat(r_posed.t() * r_truth) - cv::Mat(cv::Matx33d::eye()));  // ~ rotation angle (rad) * sqrt(2)
+  EXPECT_LT(angle, 0.01) << posed.rvec << " vs " << truth1.rvec;
+  EXPECT_LT(cv::norm(posed.tvec - truth1.tvec), 0.003) << posed.tvec << " vs " << truth1.tvec;
+
   // The same images with --fix-k3 and in text form: k3 stays 0, the summary names the file.
   const Outcome fixed = runKccd("calib intrinsics -q --fix-k3 --image" + images + kGrid + " -o " + path("fixed.yaml"));
   ASSERT_EQ(fixed.code, 0) << fixed.err;

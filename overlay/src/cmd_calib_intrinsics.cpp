@@ -4,14 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <iterator>
 #include <memory>
 #include <regex>
 #include <sstream>
 
-#include <stdlib.h>
 #include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -97,46 +94,25 @@ bool sameFile(const std::string& a, const std::string& b) {
   return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec);
 }
 
-// The camera file text: saveCamera's layout (so it reads back with loadCamera, as checked here),
-// plus the fields OpenCV's calibration sample writes.
-std::string cameraText(const calib::Camera& camera, const calib::IntrinsicsResult& r) {
-  std::string name = (fs::temp_directory_path() / "kccd-intrinsics-XXXXXX.yaml").string();
-  const int fd = ::mkstemps(name.data(), 5);
-  if (fd < 0) throw std::runtime_error("cannot create a temporary file in " + fs::temp_directory_path().string());
-  ::close(fd);
-  const fs::path tmp = name;
-  struct Remove {
-    fs::path p;
-    ~Remove() {
-      std::error_code ec;
-      fs::remove(p, ec);
-    }
-  } remove{tmp};
-  calib::saveCamera(camera, tmp.string());
-  std::ifstream in(tmp, std::ios::binary);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in.good() && !in.eof()) throw std::runtime_error("cannot read back the camera file " + tmp.string());
+// The camera file text: cameraText's layout (what loadCamera reads), plus the fields OpenCV's
+// calibration sample writes.
+std::string cameraFileText(const calib::Camera& camera, const calib::IntrinsicsResult& r) {
+  std::string text = calib::cameraText(camera);
   if (!text.empty() && text.back() != '\n') text += '\n';
   std::ostringstream extra;
   extra.precision(17);
   extra << "avg_reprojection_error: " << r.rms_px << "\n";
   extra << "nr_of_frames: " << r.used.size() << "\n";
-  text += extra.str();
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    if (!out.good()) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  calib::loadCamera(tmp.string());  // what is written must read back
-  return text;
+  return text + extra.str();
 }
 
 Exit runIntrinsics(const IntrinsicsArgs& args) {
   const calib::Board board = boardFrom(args);
   if (args.images.empty()) throw UsageError("give the images: --image A.png B.png ... (at least 3 views of the board)");
   {
-    const fs::path dir = fs::path(args.output).parent_path();
-    if (!dir.empty() && !fs::is_directory(dir)) throw UsageError("-o " + args.output + ": directory " + dir.string() + " does not exist");
+    const std::string ext = fs::path(args.output).extension().string();
+    if (ext != ".yaml" && ext != ".yml") throw UsageError("-o " + args.output + ": the camera file must be a .yaml or .yml file");
+    checkOutputPath(args.output, "-o", ext);
     for (const std::string& in : args.images)
       if (sameFile(args.output, in)) throw UsageError("-o " + args.output + ": is the input image " + in);
     if (!args.board.empty() && sameFile(args.output, args.board))
@@ -177,7 +153,7 @@ Exit runIntrinsics(const IntrinsicsArgs& args) {
   options.rational = args.rational;
   const calib::IntrinsicsResult r = calib::calibrateIntrinsics(views, size, options);
   const bool solved = r.status == calib::IntrinsicsStatus::Solved;
-  if (solved) writeFileAtomically(args.output, cameraText(r.camera, r));
+  if (solved) writeFileAtomically(args.output, cameraFileText(r.camera, r));
 
   const cv::Matx33d& k = r.camera.camera_matrix;
   if (args.json) {
@@ -284,7 +260,7 @@ Runner addCalibIntrinsics(CLI::App& calib) {
       "near the image corners and edges in some views as well as in the centre; at least two whole tags\n"
       "per image. Face-on views alone cannot give the focal length.\n"
       "Output: the camera file (image size, camera_matrix, distortion_coefficients k1 k2 p1 p2 k3,\n"
-      "rvec = tvec = 0, reprojection_rms_px and avg_reprojection_error); pass it to kccd calib for the pose.\n"
+      "rvec = tvec = 0, reprojection_rms_px and avg_reprojection_error): kccd calib --intrinsics reads it.\n"
       "A view that fits far worse than the others is left out and named.\n"
       "Exit status: 0 written; 2 bad input (unreadable image, images of different sizes, a board layout\n"
       "whose tags are not in one plane); 4 not solvable: too few views, face-on views only, or an\n"
