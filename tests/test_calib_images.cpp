@@ -11,6 +11,9 @@
 #include <string>
 #include <vector>
 
+#include <apriltag/apriltag.h>
+#include <apriltag/common/image_u8.h>
+#include <apriltag/tag36h11.h>
 #include <opencv2/calib3d.hpp>
 
 #include "kccd/calib/pose.hpp"
@@ -102,6 +105,47 @@ TEST(TagScene, PixelCentresAtIntegers) {
   EXPECT_EQ(half.at<uchar>(239, 240), 130);  // (250 + 10) / 2
   EXPECT_EQ(half.at<uchar>(239, 241), 10);
   EXPECT_EQ(half.at<uchar>(239, 220), 189);  // (128 + 250) / 2, rounded
+}
+
+// Through a strongly distorted lens, every cell centre of tilted tags, projected by
+// cv::projectPoints, lands in a pixel of that cell's grey (the renderer inverts the lens itself).
+TEST(TagScene, CellCentresLandWhereOpenCVProjectsThem) {
+  const Camera c = frontCamera(960, 540, 700, 481.7, 268.2, {-0.25, 0.08, 0.001, -0.0015, -0.01});
+  TagLayout layout;
+  layout.tags.push_back(frontTag(7, 0.30, -0.55, -0.25, 1.3, 0.4));
+  layout.tags.push_back(frontTag(77, 0.25, 0.55, 0.2, 1.2, -0.2));
+  layout.tags.push_back(frontTag(377, 0.35, 0.0, 0.0, 1.6, 1.0));
+  layout.tags[0].rpy = Vec3(kPi + 0.5, 0.3, 0.4);  // tilted 30 deg, turned
+  layout.tags[1].rpy = Vec3(kPi - 0.4, -0.4, -0.2);
+  TagSceneOptions o;
+  o.white = 240;
+  o.black = 20;
+  o.background = 128;
+  const cv::Mat img = renderTagScene(c, layout, o);
+  apriltag_family_t* family = tag36h11_create();
+  int checked = 0;
+  for (const Tag& tag : layout.tags) {
+    image_u8_t* bitmap = apriltag_to_image(family, static_cast<uint32_t>(tag.id));
+    const double cell = tag.size / family->width_at_border;
+    const Pose pose = tag.pose();
+    for (int row = 0; row < bitmap->height; ++row)
+      for (int col = 0; col < bitmap->width; ++col) {
+        // Bitmap row 0 is the top of the printed tag (tag +y), column 0 its left (tag -x).
+        const Vec3 p = pose * Vec3((col + 0.5 - 0.5 * bitmap->width) * cell, (0.5 * bitmap->height - row - 0.5) * cell, 0.0);
+        std::vector<cv::Point2d> projected;
+        cv::projectPoints(std::vector<cv::Point3d>{{p.x(), p.y(), p.z()}}, c.rvec, c.tvec, c.camera_matrix, c.distortion,
+                          projected);
+        const cv::Point2d q = projected[0];
+        const int u = static_cast<int>(std::lround(q.x)), v = static_cast<int>(std::lround(q.y));
+        ASSERT_TRUE(u >= 1 && v >= 1 && u < c.width - 1 && v < c.height - 1) << "tag " << tag.id << " out of view";
+        const int expected = bitmap->buf[row * bitmap->stride + col] >= 128 ? 240 : 20;
+        EXPECT_EQ(img.at<uchar>(v, u), expected) << "tag " << tag.id << " cell (" << row << ", " << col << ") at " << q;
+        ++checked;
+      }
+    image_u8_destroy(bitmap);
+  }
+  tag36h11_destroy(family);
+  EXPECT_EQ(checked, 300);
 }
 
 // Detected corners of fronto-parallel tags (random sub-pixel positions, turned in their plane)
