@@ -70,7 +70,7 @@ struct Lens {
   }
 
   double jacobianDet(double x, double y) const {
-    const double h = 1e-7 * std::max(1.0, std::hypot(x, y));
+    const double h = 1e-7 * std::max(1.0, std::abs(x) + std::abs(y));
     const cv::Vec2d f = distort(x, y), fxh = distort(x + h, y), fyh = distort(x, y + h);
     return (fxh[0] - f[0]) * (fyh[1] - f[1]) - (fyh[0] - f[0]) * (fxh[1] - f[1]);
   }
@@ -84,14 +84,14 @@ struct Lens {
       if (!std::isfinite(eu) || !std::isfinite(ev)) return false;
       if (std::abs(eu) < tol && std::abs(ev) < tol) return it > 0 || !check_fold || jacobianDet(x, y) > 0;
       if (it == max_iter) break;
-      const double h = 1e-7 * std::max(1.0, std::hypot(x, y));
+      const double h = 1e-7 * std::max(1.0, std::abs(x) + std::abs(y));
       const cv::Vec2d fxh = distort(x + h, y), fyh = distort(x, y + h);
       const double a = (fxh[0] - f[0]) / h, c = (fxh[1] - f[1]) / h, b = (fyh[0] - f[0]) / h, d = (fyh[1] - f[1]) / h;
       const double det = a * d - b * c;
       if (!(det > 0)) return false;
       double dx = (d * eu - b * ev) / det, dy = (a * ev - c * eu) / det;
       // Damping: never move more than a quarter of the distance from the axis (plus a little) at once.
-      const double lim = 0.25 * std::hypot(x, y) + 0.05, len = std::hypot(dx, dy);
+      const double lim = 0.25 * std::sqrt(x * x + y * y) + 0.05, len = std::sqrt(dx * dx + dy * dy);
       if (len > lim) dx *= lim / len, dy *= lim / len;
       x -= dx, y -= dy;
     }
@@ -188,6 +188,8 @@ struct PlacedTag {
   int cells = 10;               // bitmap width in cells
   std::vector<float> value;     // cells x cells grey levels, row 0 at the top of the printed tag (tag +y)
   std::array<cv::Vec3d, 4> outline;  // the bitmap's outer corners in the camera frame
+  // Pixel box holding the tag's whole image (every pixel when its outline leaves the trusted field).
+  double u_lo = -1e300, u_hi = 1e300, v_lo = -1e300, v_hi = 1e300;
 };
 
 constexpr int kBackground = -1;
@@ -198,11 +200,13 @@ struct Hit {
   float value = 0;
 };
 
-inline Hit castRay(const std::vector<PlacedTag>& tags, double x, double y) {
+// The nearest front-facing tag cell on the ray (x, y, 1) of pixel position (u, v).
+inline Hit castRay(const std::vector<PlacedTag>& tags, double u, double v, double x, double y) {
   Hit hit;
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t t = 0; t < tags.size(); ++t) {
     const PlacedTag& p = tags[t];
+    if (u < p.u_lo || u > p.u_hi || v < p.v_lo || v > p.v_hi) continue;
     const double nd = p.n[0] * x + p.n[1] * y + p.n[2];
     if (!(nd < 0)) continue;        // parallel to the plane or reaching its back
     const double depth = p.n_o / nd;  // n_o < 0 for a front-facing tag: depth > 0
@@ -273,13 +277,14 @@ std::vector<PlacedTag> placeTags(const Camera& camera, const TagLayout& layout, 
 // Marks (in `mixed`, width x height) every pixel that a tag outline edge may cross: the 3 x 3
 // pixels around samples at most 0.25 px apart along the edge's image. The edge's pinhole image is
 // the straight segment between its projected ends (clipped to z > 0 and to the trusted field).
-void markOutlines(const std::vector<PlacedTag>& tags, const RayGrid& g, const Lens& lens, std::vector<unsigned char>& mixed) {
+// Sets each tag's pixel box from the same samples when no edge needed clipping.
+void markOutlines(std::vector<PlacedTag>& tags, const RayGrid& g, const Lens& lens, std::vector<unsigned char>& mixed) {
   const int w = g.width, h = g.height;
   const double eps = 1e-6;
   // Largest pixels-per-normalised-unit of the lens over the field, bounded from the corner grid.
   double scale = std::max(lens.fx, lens.fy);
-  for (int j = 0; j + 1 <= h; j += std::max(1, h / 32))
-    for (int i = 0; i + 1 <= w; i += std::max(1, w / 32)) {
+  for (int j = 0; j < h; j += std::max(1, h / 32))
+    for (int i = 0; i < w; i += std::max(1, w / 32)) {
       const std::size_t a = static_cast<std::size_t>(j) * (w + 1) + i;
       if (!g.valid[a] || !g.valid[a + 1] || !g.valid[a + w + 1]) continue;
       const double dx = cv::norm(g.ray[a + 1] - g.ray[a]), dy = cv::norm(g.ray[a + w + 1] - g.ray[a]);
@@ -287,9 +292,12 @@ void markOutlines(const std::vector<PlacedTag>& tags, const RayGrid& g, const Le
       if (dy > 0) scale = std::max(scale, 1.0 / dy);
     }
   scale *= 2;  // margin for the parts of the field between grid samples and beyond the image
-  for (const PlacedTag& p : tags)
+  for (PlacedTag& p : tags) {
+    bool whole = true;  // every edge in front of the camera and in the trusted field
+    double u_lo = 1e300, u_hi = -1e300, v_lo = 1e300, v_hi = -1e300;
     for (std::size_t c = 0; c < 4; ++c) {
       cv::Vec3d a = p.outline[c], b = p.outline[(c + 1) % 4];
+      if (a[2] < eps || b[2] < eps) whole = false;
       if (a[2] < eps && b[2] < eps) continue;
       if (a[2] < eps) std::swap(a, b);
       if (b[2] < eps) b = a + (b - a) * ((a[2] - eps) / (a[2] - b[2]));
@@ -308,18 +316,28 @@ void markOutlines(const std::vector<PlacedTag>& tags, const RayGrid& g, const Le
         if (pp < 0) t0 = std::max(t0, r);
         else t1 = std::min(t1, r);
       }
-      if (!visible || t0 > t1) continue;
+      if (t0 > 0 || t1 < 1) whole = false;
+      if (!visible || t0 > t1) {
+        whole = false;
+        continue;
+      }
       const double len = std::hypot(dx, dy) * (t1 - t0);
-      const long n = std::min<long>(1L << 22, static_cast<long>(std::ceil(len * scale / 0.25)) + 1);
+      const double steps = std::ceil(len * scale / 0.25) + 1;
+      if (!(steps >= 1)) continue;
+      const long n = static_cast<long>(std::min(4194304.0, steps));
       for (long s = 0; s <= n; ++s) {
         const double t = t0 + (t1 - t0) * static_cast<double>(s) / static_cast<double>(n);
         const cv::Vec2d q = lens.distort(x0 + t * dx, y0 + t * dy);
+        u_lo = std::min(u_lo, q[0]), u_hi = std::max(u_hi, q[0]), v_lo = std::min(v_lo, q[1]), v_hi = std::max(v_hi, q[1]);
+        if (!(std::abs(q[0]) < 1e9 && std::abs(q[1]) < 1e9)) continue;
         const long ui = std::lround(q[0]), vi = std::lround(q[1]);
         for (long vv = vi - 1; vv <= vi + 1; ++vv)
           for (long uu = ui - 1; uu <= ui + 1; ++uu)
             if (uu >= 0 && vv >= 0 && uu < w && vv < h) mixed[static_cast<std::size_t>(vv) * w + uu] = 1;
       }
     }
+    if (whole) p.u_lo = u_lo - 2, p.u_hi = u_hi + 2, p.v_lo = v_lo - 2, p.v_hi = v_hi + 2;
+  }
 }
 
 cv::Mat backgroundImage(const Camera& camera, const TagSceneOptions& o) {
@@ -385,9 +403,12 @@ cv::Mat renderTagScene(const calib::Camera& camera, const calib::TagLayout& layo
   const std::shared_ptr<const RayGrid> grid_ptr = rayGrid(camera);
   const RayGrid& g = *grid_ptr;
   const Lens lens(camera);
-  const std::vector<PlacedTag> tags = placeTags(camera, layout, o);
+  std::vector<PlacedTag> tags = placeTags(camera, layout, o);
   const cv::Mat bg = backgroundImage(camera, o);
   const int w = camera.width, h = camera.height, w1 = w + 1, h1 = h + 1;
+
+  std::vector<unsigned char> mixed(static_cast<std::size_t>(w) * h, 0);
+  markOutlines(tags, g, lens, mixed);
 
   // Keys of the corner rays.
   std::vector<int> key(static_cast<std::size_t>(w1) * h1, kBackground);
@@ -400,14 +421,11 @@ cv::Mat renderTagScene(const calib::Camera& camera, const calib::TagLayout& layo
           key[at] = kInvalid;
           continue;
         }
-        const Hit hit = castRay(tags, g.ray[at][0], g.ray[at][1]);
+        const Hit hit = castRay(tags, i - 0.5, j - 0.5, g.ray[at][0], g.ray[at][1]);
         key[at] = hit.key;
         corner_value[at] = hit.value;
       }
   });
-  std::vector<unsigned char> mixed(static_cast<std::size_t>(w) * h, 0);
-  markOutlines(tags, g, lens, mixed);
-
   cv::Mat image(h, w, CV_32F);
   const int s = o.supersample;
   cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
@@ -435,8 +453,9 @@ cv::Mat renderTagScene(const calib::Camera& camera, const calib::TagLayout& layo
             const cv::Vec2d top = g.ray[a] * (1 - fu) + g.ray[b] * fu, bottom = g.ray[c] * (1 - fu) + g.ray[d] * fu;
             const cv::Vec2d guess = top * (1 - fv) + bottom * fv;
             double x = guess[0], y = guess[1];
-            if (!lens.undistort(i - 0.5 + fu, j - 0.5 + fv, x, y, 10, 1e-8, false)) x = guess[0], y = guess[1];
-            const Hit hit = castRay(tags, x, y);
+            const double su = i - 0.5 + fu, sv = j - 0.5 + fv;
+            if (!lens.undistort(su, sv, x, y, 10, 1e-8, false)) x = guess[0], y = guess[1];
+            const Hit hit = castRay(tags, su, sv, x, y);
             sum += hit.key == kBackground ? back[i] : hit.value;
           }
         out[i] = static_cast<float>(sum / (s * s));
