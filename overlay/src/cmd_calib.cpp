@@ -528,8 +528,12 @@ Runner addCalib(CLI::App& app) {
   sheet->add_option("-o,--output", s->output, "Sheet image (.png)")->required();
   sheet->add_option("--template", s->labels_template, "Labels file (.yaml) to fill in: every candidate, commented out");
 
-  return [sheet, a, s]() -> Exit {
+  const Runner intrinsics = addCalibIntrinsics(*sub);
+  CLI::App* intrinsics_sub = sub->get_subcommand("intrinsics");
+
+  return [sheet, a, s, intrinsics, intrinsics_sub]() -> Exit {
     if (sheet->parsed()) return runSheet(*s);
+    if (intrinsics_sub->parsed()) return intrinsics();
     if (a->intrinsics.empty()) throw UsageError("calib: --intrinsics CAMERA.yaml is required (see kccd calib --help)");
     if (a->output.empty()) throw UsageError("calib: -o CAMERA.yaml is required (see kccd calib --help)");
     return runCalib(*a);

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Turns the JSON output of bench_gjk / bench_engine into the Markdown tables of the README.
+"""Turns the JSON output of bench_gjk / bench_engine / bench_calib into the Markdown tables of the README.
 
-Usage: tables.py gjk.json engine.json
+Usage: tables.py gjk.json engine.json [calib.json]
+       tables.py --calib calib.json
 """
 import json
 import re
@@ -87,7 +88,37 @@ def engine_tables(rows):
     return "\n".join(out)
 
 
+def calib_table(rows):
+    """Median ms of each calibration benchmark and its ratio to detection alone, from one run."""
+    med = {r["run_name"].split("/")[0]: r for r in rows if r.get("aggregate_name") == "median"}
+    if not med:  # a run without repetitions
+        med = {r["name"].split("/")[0]: r for r in rows if r.get("run_type", "iteration") == "iteration"}
+    scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}
+
+    def ms(r):
+        return r["real_time"] * scale[r.get("time_unit", "ns")]
+
+    base = med.get("BM_DetectTags")
+    out = ["| step | ms per frame | ratio to detection |", "|---|---|---|"]
+    names = {"BM_DetectTags": "detectTags (baseline)",
+             "BM_DetectAndSolve": "detectTags + tagCorrespondences + solvePose",
+             "BM_Solve": "solvePose alone (32 points)"}
+    for key, label in names.items():
+        r = med.get(key)
+        if r is None:
+            continue
+        ratio = f"{ms(r) / ms(base):.2f}" if base else "-"
+        out.append(f"| {label} | {ms(r):.1f} | {ratio} |")
+    return "\n".join(out)
+
+
 if __name__ == "__main__":
+    if sys.argv[1] == "--calib":
+        print(calib_table(load(sys.argv[2])))
+        sys.exit(0)
     print(gjk_table(load(sys.argv[1])))
     print()
     print(engine_tables(load(sys.argv[2])))
+    if len(sys.argv) > 3:
+        print()
+        print(calib_table(load(sys.argv[3])))
