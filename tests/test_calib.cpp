@@ -53,6 +53,36 @@ TEST(CalibCamera, RoundTripsThroughSave) {
   EXPECT_EQ(d.tvec, c.tvec);
 }
 
+TEST(CalibCamera, OpenCvCalibrationOutputWithoutAPoseLoadsAsIntrinsics) {
+  // What OpenCV's calibration sample writes: no rvec/tvec, and fields of its own.
+  const std::string path = ::testing::TempDir() + "/kccd_cam_opencv.yaml";
+  std::ofstream(path) << "%YAML:1.0\n---\ncalibration_time: \"Mon 23 Nov 2026\"\nnr_of_frames: 12\nimage_width: 640\n"
+                         "image_height: 480\nflags: 0\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+                         "   data: [ 600., 0., 319.5, 0., 600., 239.5, 0., 0., 1. ]\n"
+                         "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
+                         "   data: [ -0.2, 0.05, 0., 0., 0. ]\navg_reprojection_error: 0.31\n";
+  const Camera c = loadCamera(path, CameraPose::Optional);
+  EXPECT_EQ(c.width, 640);
+  EXPECT_EQ(c.rvec, cv::Vec3d(0, 0, 0));
+  EXPECT_EQ(c.tvec, cv::Vec3d(0, 0, 0));
+  EXPECT_DOUBLE_EQ(c.distortion[0], -0.2);
+  // Rendering needs the pose.
+  try {
+    loadCamera(path);
+    ADD_FAILURE() << "a camera without a pose loaded where one is required";
+  } catch (const CameraError& e) {
+    EXPECT_NE(std::string(e.what()).find("rvec: missing"), std::string::npos) << e.what();
+  }
+  // Half a pose is an error either way.
+  std::ofstream(path, std::ios::app) << "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0., 0., 1. ]\n";
+  try {
+    loadCamera(path, CameraPose::Optional);
+    ADD_FAILURE() << "tvec without rvec loaded";
+  } catch (const CameraError& e) {
+    EXPECT_NE(std::string(e.what()).find("rvec: missing"), std::string::npos) << e.what();
+  }
+}
+
 std::string cameraText(const std::string& replace_key = "", const std::string& with = "") {
   std::map<std::string, std::string> fields = {
       {"image_width", "image_width: 320\n"},

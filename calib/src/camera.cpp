@@ -273,7 +273,7 @@ void Camera::validate(const std::string& source) const {
              " pixels, more than " + std::to_string(kMaxPinholeSide) + " a side");
 }
 
-Camera loadCamera(const std::string& path) {
+Camera loadCamera(const std::string& path, CameraPose pose) {
   const std::string text = readCameraFile(path);
   checkCameraText(text, path);
   cv::FileStorage fs;
@@ -298,8 +298,11 @@ Camera loadCamera(const std::string& path) {
     const cv::Mat d = readMatrix(fs, path, "distortion_coefficients");
     if (d.rows != 1 && d.cols != 1) fail(path, "distortion_coefficients", "must be a row or a column");
     c.distortion.assign(d.begin<double>(), d.end<double>());
-    c.rvec = readVec3(fs, path, "rvec");
-    c.tvec = readVec3(fs, path, "tvec");
+    const bool has_pose = !fs["rvec"].empty() || !fs["tvec"].empty();
+    if (has_pose || pose == CameraPose::Required) {
+      c.rvec = readVec3(fs, path, "rvec");
+      c.tvec = readVec3(fs, path, "tvec");
+    }
     c.reprojection_rms_px = readQuality(fs, path, "reprojection_rms_px");
     c.rotation_sigma_deg = readQuality(fs, path, "rotation_sigma_deg");
     c.position_sigma_m = readQuality(fs, path, "position_sigma_m");

@@ -61,7 +61,7 @@ void checkImageSize(const cv::Mat& img, const calib::Camera& cam, const std::str
 
 // The camera file from --intrinsics with the bad-input message naming the option.
 calib::Camera loadIntrinsics(const std::string& path) {
-  calib::Camera cam = calib::loadCamera(path);
+  calib::Camera cam = calib::loadCamera(path, calib::CameraPose::Optional);
   cam.rvec = cam.tvec = cv::Vec3d(0, 0, 0);
   cam.reprojection_rms_px.reset();
   cam.rotation_sigma_deg.reset();

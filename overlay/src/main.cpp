@@ -51,7 +51,16 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {  // --help, --version: printed, exit 0
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    const std::string help = argc > 1 && argv[1][0] != '-' ? std::string("kccd ") + argv[1] + " --help" : "kccd --help";
+    // The help of the (nested) subcommand the line was for.
+    std::string help = "kccd";
+    const CLI::App* at = &app;
+    for (int i = 1; i < argc && argv[i][0] != '-'; ++i) {
+      const auto subs = at->get_subcommands([&](const CLI::App* s) { return s->get_name() == argv[i]; });
+      if (subs.empty()) break;
+      at = subs.front();
+      help += std::string(" ") + argv[i];
+    }
+    help += " --help";
     return fail(Exit::BadInput, kccd::cli::optionMessage(e.what()) + " (see " + help + ")");
   }
   try {

@@ -3,6 +3,7 @@
 // overlay all use this one model.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -54,12 +55,17 @@ struct Camera {
   void validate(const std::string& source) const;
 };
 
+/// Whether a camera file must hold a pose: rendering needs one; calibrating from intrinsics also
+/// reads OpenCV's own calibration output, which has none (rvec = tvec = 0 then). A file with one
+/// of rvec, tvec and not the other is an error either way.
+enum class CameraPose : std::uint8_t { Required, Optional };
+
 /// Reads an OpenCV FileStorage camera file (image_width, image_height, camera_matrix,
 /// distortion_coefficients, rvec, tvec) and validates it. The file must be a regular text file
 /// of at most kMaxCameraFileBytes starting with `%YAML:1.x`, holding one YAML document whose
 /// top level is a mapping without repeated keys. Throws CameraError (an InputError), never
 /// anything else for any file content.
-Camera loadCamera(const std::string& path);
+Camera loadCamera(const std::string& path, CameraPose pose = CameraPose::Required);
 /// The text of a camera file in the same layout, quality figures included when known.
 std::string cameraText(const Camera& camera);
 /// Writes cameraText(camera) to `path` (not atomically: tools write through a temporary file).
