@@ -69,7 +69,8 @@ TEST(TagScene, LensModelMatchesOpenCV) {
     for (int i = 0; i < 50; ++i) {
       const cv::Point3d p(0.6 * u(rng), 0.45 * u(rng), 1.0);
       std::vector<cv::Point2d> ref;
-      cv::projectPoints(std::vector<cv::Point3d>{p}, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), c.camera_matrix, c.distortion, ref);
+      cv::projectPoints(std::vector<cv::Point3d>{p}, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), c.camera_matrix,
+                        c.distortion, ref);
       const cv::Point2d mine = kccd::testing::distortNormalised(c, cv::Point2d(p.x, p.y));
       EXPECT_LT(cv::norm(mine - ref[0]), 1e-9) << d.size() << " coefficients at " << p;
     }
@@ -131,10 +132,11 @@ TEST(TagScene, CellCentresLandWhereOpenCVProjectsThem) {
     for (int row = 0; row < bitmap->height; ++row)
       for (int col = 0; col < bitmap->width; ++col) {
         // Bitmap row 0 is the top of the printed tag (tag +y), column 0 its left (tag -x).
-        const Vec3 p = pose * Vec3((col + 0.5 - 0.5 * bitmap->width) * cell, (0.5 * bitmap->height - row - 0.5) * cell, 0.0);
+        const Vec3 p =
+            pose * Vec3((col + 0.5 - 0.5 * bitmap->width) * cell, (0.5 * bitmap->height - row - 0.5) * cell, 0.0);
         std::vector<cv::Point2d> projected;
-        cv::projectPoints(std::vector<cv::Point3d>{{p.x(), p.y(), p.z()}}, c.rvec, c.tvec, c.camera_matrix, c.distortion,
-                          projected);
+        cv::projectPoints(std::vector<cv::Point3d>{{p.x(), p.y(), p.z()}}, c.rvec, c.tvec, c.camera_matrix,
+                          c.distortion, projected);
         const cv::Point2d q = projected[0];
         const int u = static_cast<int>(std::lround(q.x)), v = static_cast<int>(std::lround(q.y));
         ASSERT_TRUE(u >= 1 && v >= 1 && u < c.width - 1 && v < c.height - 1) << "tag " << tag.id << " out of view";
@@ -163,8 +165,10 @@ TEST(TagScene, DetectedCornersMatchProjection) {
   for (int frame = 0; frame < 8; ++frame) {
     const Camera c = frontCamera(800, 600, 900.0 + 100 * u(rng), 399.5 + u(rng), 299.5 + u(rng));
     TagLayout layout;
-    layout.tags.push_back(frontTag(1 + frame, 0.10 + 0.06 * u(rng), -0.25 + 0.05 * u(rng), -0.15 + 0.05 * u(rng), 1.2, turn()));
-    layout.tags.push_back(frontTag(100 + frame, 0.08 + 0.04 * u(rng), 0.2 + 0.05 * u(rng), 0.1 + 0.05 * u(rng), 1.0, turn()));
+    layout.tags.push_back(
+        frontTag(1 + frame, 0.10 + 0.06 * u(rng), -0.25 + 0.05 * u(rng), -0.15 + 0.05 * u(rng), 1.2, turn()));
+    layout.tags.push_back(
+        frontTag(100 + frame, 0.08 + 0.04 * u(rng), 0.2 + 0.05 * u(rng), 0.1 + 0.05 * u(rng), 1.0, turn()));
     layout.tags.push_back(frontTag(300 + frame, 0.15 + 0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng), 1.5, turn()));
     TagSceneOptions o;
     o.seed = static_cast<std::uint64_t>(frame + 1);
@@ -182,14 +186,14 @@ TEST(TagScene, DetectedCornersMatchProjection) {
         const cv::Point2d e = d.corners[k] - truth[t][k];
         worst = std::max(worst, cv::norm(e));
         sum_x += e.x, sum_y += e.y, sum_sq += e.dot(e), ++corners;
-        EXPECT_LT(cv::norm(e), 0.3) << "frame " << frame << " tag " << d.id << " corner " << k << ": detected " << d.corners[k]
-                                    << ", projected " << truth[t][k];
+        EXPECT_LT(cv::norm(e), 0.3) << "frame " << frame << " tag " << d.id << " corner " << k << ": detected "
+                                    << d.corners[k] << ", projected " << truth[t][k];
       }
     }
   }
   const double rms = std::sqrt(sum_sq / corners), offset = std::hypot(sum_x, sum_y) / corners;
-  std::printf("fronto-parallel tags: %d corners, RMS error %.4f px, largest %.4f px, mean offset (%.4f, %.4f) px\n", corners,
-              rms, worst, sum_x / corners, sum_y / corners);
+  std::printf("fronto-parallel tags: %d corners, RMS error %.4f px, largest %.4f px, mean offset (%.4f, %.4f) px\n",
+              corners, rms, worst, sum_x / corners, sum_y / corners);
   RecordProperty("fronto_parallel_corner_rms_px", std::to_string(rms));
   RecordProperty("fronto_parallel_worst_corner_px", std::to_string(worst));
   EXPECT_LT(rms, 0.1);
@@ -304,15 +308,16 @@ RandomView randomView(std::mt19937_64& rng, int width, int height) {
     c.width = width;
     c.height = height;
     const double fx = 600.0 + 800.0 * u(rng), fy = fx * (1.0 + 0.01 * (u(rng) - 0.5));
-    const double cx = (width - 1) / 2.0 + 0.03 * width * (u(rng) - 0.5), cy = (height - 1) / 2.0 + 0.03 * height * (u(rng) - 0.5);
+    const double cx = (width - 1) / 2.0 + 0.03 * width * (u(rng) - 0.5),
+                 cy = (height - 1) / 2.0 + 0.03 * height * (u(rng) - 0.5);
     c.camera_matrix = cv::Matx33d(fx, 0, cx, 0, fy, cy, 0, 0, 1);
     c.distortion = {-0.25 + 0.35 * u(rng), 0.1 * (u(rng) - 0.5), 0.002 * (u(rng) - 0.5), 0.002 * (u(rng) - 0.5),
                     0.02 * (u(rng) - 0.5)};
     const double azimuth = (25.0 + 40.0 * u(rng)) * kPi / 180.0, elevation = (20.0 + 35.0 * u(rng)) * kPi / 180.0;
     const double distance = 1.5 + 2.5 * u(rng);
     const Vec3 target(0.45 + 0.2 * (u(rng) - 0.5), 0.45 + 0.2 * (u(rng) - 0.5), 0.3 + 0.2 * (u(rng) - 0.5));
-    const Vec3 eye = target + distance * Vec3(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
-                                              std::sin(elevation));
+    const Vec3 eye = target + distance * Vec3(std::cos(elevation) * std::cos(azimuth),
+                                              std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
     const Vec3 z = (target - eye).normalized(), x0 = z.cross(Vec3::UnitZ()).normalized(), y0 = z.cross(x0);
     const double roll = 0.35 * (u(rng) - 0.5);
     const Vec3 x = std::cos(roll) * x0 + std::sin(roll) * y0, y = z.cross(x);
@@ -351,7 +356,7 @@ TEST(CalibImages, PoseOfRandomCamerasFromRenderedFrames) {
   constexpr int kCameras = 100;
   std::mt19937_64 rng(20261123);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<double> rot, pos, rms;
+  std::vector<double> rot, pos, rms, rot_ratio, pos_ratio;  // errors, and errors over the reported sigmas
   int honest_rot = 0, honest_pos = 0, solved = 0, tags_placed = 0, tags_found = 0;
   double render_s = 0, detect_s = 0, solve_s = 0;
   const auto start = std::chrono::steady_clock::now();
@@ -380,7 +385,8 @@ TEST(CalibImages, PoseOfRandomCamerasFromRenderedFrames) {
     const PoseResult r = solvePose(intrinsics, corr.points);
     solve_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t3).count();
     if (r.status != PoseStatus::Solved) {
-      ADD_FAILURE() << "camera " << i << " (" << found.size() << " of " << view.layout.tags.size() << " tags found): " << r.message;
+      ADD_FAILURE() << "camera " << i << " (" << found.size() << " of " << view.layout.tags.size()
+                    << " tags found): " << r.message;
       continue;
     }
     ++solved;
@@ -389,6 +395,8 @@ TEST(CalibImages, PoseOfRandomCamerasFromRenderedFrames) {
     rot.push_back(e_rot);
     pos.push_back(e_pos);
     rms.push_back(*r.camera.reprojection_rms_px);
+    rot_ratio.push_back(e_rot / *r.camera.rotation_sigma_deg);
+    pos_ratio.push_back(e_pos / *r.camera.position_sigma_m);
     honest_rot += e_rot <= 3.0 * *r.camera.rotation_sigma_deg;
     honest_pos += e_pos <= 3.0 * *r.camera.position_sigma_m;
   }
@@ -400,9 +408,11 @@ TEST(CalibImages, PoseOfRandomCamerasFromRenderedFrames) {
   std::printf(
       "%d cameras (1280x720), %d solved, %d of %d tags found: rotation error median %.4f deg, p90 %.4f deg; "
       "position error median %.3f mm, p90 %.3f mm; RMS median %.3f px; true error within 3 sigma: rotation %.0f%%, "
-      "position %.0f%%; %.1f s (rendering %.1f s, detection %.1f s, solving %.1f s)\n",
+      "position %.0f%% (error / sigma median %.2f and %.2f, largest %.2f and %.2f); %.1f s (rendering %.1f s, "
+      "detection %.1f s, solving %.1f s)\n",
       kCameras, solved, tags_found, tags_placed, rot50, rot90, 1000 * pos50, 1000 * pos90, percentile(rms, 0.5),
-      100 * honest_r, 100 * honest_p, seconds, render_s, detect_s, solve_s);
+      100 * honest_r, 100 * honest_p, percentile(rot_ratio, 0.5), percentile(pos_ratio, 0.5),
+      percentile(rot_ratio, 1.0), percentile(pos_ratio, 1.0), seconds, render_s, detect_s, solve_s);
   RecordProperty("cameras", kCameras);
   RecordProperty("solved", solved);
   RecordProperty("rotation_error_median_deg", std::to_string(rot50));

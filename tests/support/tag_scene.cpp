@@ -77,7 +77,8 @@ struct Lens {
 
   // Newton's method from (x, y) for the normalised point that distorts to pixel (u, v); true when
   // it lands within `tol` px with a non-folding (positive determinant) Jacobian.
-  bool undistort(double u, double v, double& x, double& y, int max_iter = 30, double tol = 1e-8, bool check_fold = true) const {
+  bool undistort(double u, double v, double& x, double& y, int max_iter = 30, double tol = 1e-8,
+                 bool check_fold = true) const {
     for (int it = 0; it <= max_iter; ++it) {
       const cv::Vec2d f = distort(x, y);
       const double eu = f[0] - u, ev = f[1] - v;
@@ -104,7 +105,7 @@ struct RayGrid {
   int width = 0, height = 0;
   cv::Matx33d k;
   std::vector<double> distortion;
-  std::vector<cv::Vec2d> ray;      // (width + 1) x (height + 1), corner (i - 0.5, j - 0.5) at j * (width + 1) + i
+  std::vector<cv::Vec2d> ray;  // (width + 1) x (height + 1), corner (i - 0.5, j - 0.5) at j * (width + 1) + i
   std::vector<unsigned char> valid;
   double x_lo = 0, x_hi = 0, y_lo = 0, y_hi = 0;  // the field the inversion is trusted in (normalised)
 
@@ -115,7 +116,8 @@ struct RayGrid {
 
 std::shared_ptr<const RayGrid> buildRayGrid(const Camera& camera) {
   auto grid = std::make_shared<RayGrid>();
-  grid->width = camera.width, grid->height = camera.height, grid->k = camera.camera_matrix, grid->distortion = camera.distortion;
+  grid->width = camera.width, grid->height = camera.height, grid->k = camera.camera_matrix,
+  grid->distortion = camera.distortion;
   const Lens lens(camera);
   const int w1 = camera.width + 1, h1 = camera.height + 1;
   // As calib::undistortPixels: at most one image size of extra field beyond the image on each side.
@@ -153,8 +155,10 @@ std::shared_ptr<const RayGrid> buildRayGrid(const Camera& camera) {
         g.valid[at] = ok ? 1 : 0;
         if (ok) {
           g.ray[at] = cv::Vec2d(x, y);
-          if (i > 0 && g.valid[at - 1]) ppx = px, ppy = py, have_prev = true;
-          else have_prev = false;
+          if (i > 0 && g.valid[at - 1])
+            ppx = px, ppy = py, have_prev = true;
+          else
+            have_prev = false;
           px = x, py = y;
         } else {
           have_prev = false;
@@ -183,10 +187,10 @@ std::shared_ptr<const RayGrid> rayGrid(const Camera& camera) {
 struct PlacedTag {
   cv::Vec3d origin, ex, ey, n;  // centre and axes in the camera frame
   double n_o = 0, ex_o = 0, ey_o = 0;
-  double inv_cell = 0;          // cells per metre
-  double half = 5;              // half the bitmap's width in cells
-  int cells = 10;               // bitmap width in cells
-  std::vector<float> value;     // cells x cells grey levels, row 0 at the top of the printed tag (tag +y)
+  double inv_cell = 0;               // cells per metre
+  double half = 5;                   // half the bitmap's width in cells
+  int cells = 10;                    // bitmap width in cells
+  std::vector<float> value;          // cells x cells grey levels, row 0 at the top of the printed tag (tag +y)
   std::array<cv::Vec3d, 4> outline;  // the bitmap's outer corners in the camera frame
   // Pixel box holding the tag's whole image (every pixel when its outline leaves the trusted field).
   double u_lo = -1e300, u_hi = 1e300, v_lo = -1e300, v_hi = 1e300;
@@ -208,7 +212,7 @@ inline Hit castRay(const std::vector<PlacedTag>& tags, double u, double v, doubl
     const PlacedTag& p = tags[t];
     if (u < p.u_lo || u > p.u_hi || v < p.v_lo || v > p.v_hi) continue;
     const double nd = p.n[0] * x + p.n[1] * y + p.n[2];
-    if (!(nd < 0)) continue;        // parallel to the plane or reaching its back
+    if (!(nd < 0)) continue;          // parallel to the plane or reaching its back
     const double depth = p.n_o / nd;  // n_o < 0 for a front-facing tag: depth > 0
     if (!(depth < best)) continue;
     const double a = depth * (p.ex[0] * x + p.ex[1] * y + p.ex[2]) - p.ex_o;
@@ -268,7 +272,8 @@ std::vector<PlacedTag> placeTags(const Camera& camera, const TagLayout& layout, 
     image_u8_destroy(bitmap);
     const double e = p.half / p.inv_cell;  // half the bitmap's edge, metres
     const double corner[4][2] = {{-e, -e}, {e, -e}, {e, e}, {-e, e}};
-    for (int c = 0; c < 4; ++c) p.outline[static_cast<std::size_t>(c)] = p.origin + corner[c][0] * p.ex + corner[c][1] * p.ey;
+    for (int c = 0; c < 4; ++c)
+      p.outline[static_cast<std::size_t>(c)] = p.origin + corner[c][0] * p.ex + corner[c][1] * p.ey;
     out.push_back(std::move(p));
   }
   return out;
@@ -313,8 +318,10 @@ void markOutlines(std::vector<PlacedTag>& tags, const RayGrid& g, const Lens& le
           continue;
         }
         const double r = qq / pp;
-        if (pp < 0) t0 = std::max(t0, r);
-        else t1 = std::min(t1, r);
+        if (pp < 0)
+          t0 = std::max(t0, r);
+        else
+          t1 = std::min(t1, r);
       }
       if (t0 > 0 || t1 < 1) whole = false;
       if (!visible || t0 > t1) {
@@ -328,7 +335,8 @@ void markOutlines(std::vector<PlacedTag>& tags, const RayGrid& g, const Lens& le
       for (long s = 0; s <= n; ++s) {
         const double t = t0 + (t1 - t0) * static_cast<double>(s) / static_cast<double>(n);
         const cv::Vec2d q = lens.distort(x0 + t * dx, y0 + t * dy);
-        u_lo = std::min(u_lo, q[0]), u_hi = std::max(u_hi, q[0]), v_lo = std::min(v_lo, q[1]), v_hi = std::max(v_hi, q[1]);
+        u_lo = std::min(u_lo, q[0]), u_hi = std::max(u_hi, q[0]), v_lo = std::min(v_lo, q[1]),
+        v_hi = std::max(v_hi, q[1]);
         if (!(std::abs(q[0]) < 1e9 && std::abs(q[1]) < 1e9)) continue;
         const long ui = std::lround(q[0]), vi = std::lround(q[1]);
         for (long vv = vi - 1; vv <= vi + 1; ++vv)
