@@ -15,6 +15,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr std::size_t kMaxTriples = 2000;  // P3P samples; fewer triples than this are all tried
+constexpr std::size_t kMinTriples = 200;   // sampled triples tried before the adaptive stop
 
 std::string num(double v, int digits = 3) {
   char buf[64];
@@ -259,7 +260,8 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   const int m = static_cast<int>(candidates.size());
   std::vector<std::array<int, 3>> triples;
   const double total = static_cast<double>(m) * (m - 1) * (m - 2) / 6.0;
-  if (total <= kMaxTriples) {
+  const bool sampled = total > kMaxTriples;
+  if (!sampled) {
     for (int a = 0; a < m; ++a)
       for (int b = a + 1; b < m; ++b)
         for (int c = b + 1; c < m; ++c) triples.push_back({a, b, c});
@@ -275,7 +277,15 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   int best_count = -1;
   double best_cost = std::numeric_limits<double>::infinity();
   cv::Vec3d best_r, best_t;
-  for (const auto& tri : triples) {
+  for (std::size_t tried = 0; tried < triples.size(); ++tried) {
+    // Sampled triples stop early once, at the best inlier ratio w so far, a triple of inliers
+    // would have been drawn with probability 1 - 1e-6 (at least kMinTriples are always tried).
+    if (sampled && tried >= kMinTriples && best_count > 0) {
+      const double w = static_cast<double>(best_count) / m;
+      const double p = w * w * w;
+      if (p >= 1.0 || static_cast<double>(tried) >= std::log(1e-6) / std::log1p(-p)) break;
+    }
+    const auto& tri = triples[tried];
     std::vector<cv::Point3d> w3;
     std::vector<cv::Point2d> i3;
     for (int k : tri) w3.push_back(world[candidates[k]]), i3.push_back(norm[candidates[k]]);
