@@ -249,7 +249,7 @@ TEST_F(CalibCli, BadInputIsOneLineExitTwo) {
       {"--intrinsics " + out("missing.yaml") + l + " -o " + out("c.yaml"), out("missing.yaml")},
       {"--intrinsics " + kCamera + " --labels " + out("missing.yaml") + " -o " + out("c.yaml"), out("missing.yaml")},
       {"--intrinsics " + kCamera + " --image " + out("small.png") + l + " -o " + out("c.yaml"), "the image is 200x100 but the camera"},
-      {"--intrinsics " + kCamera + " --image " + out("not_image.png") + l + " -o " + out("c.yaml"), "not an image OpenCV can read"},
+      {"--intrinsics " + kCamera + " --image " + out("not_image.png") + l + " -o " + out("c.yaml"), "image: not an image OpenCV can decode"},
       {"--intrinsics " + kCamera + " --image " + out("small.png") + " -o " + out("c.yaml"), "give --tags LAYOUT and/or --labels"},
       {"--intrinsics " + kCamera + l + " --tags " + kCamera + " -o " + out("c.yaml"), "--tags: needs --image"},
       {"--intrinsics " + kCamera + l + " --state 0,0,0 -o " + out("c.yaml"), "--state: needs --model"},

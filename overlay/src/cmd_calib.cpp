@@ -1,7 +1,5 @@
 // `kccd calib`: the camera's pose in the world from AprilTags and labelled points in one or more
 // frames, with its quality and a check image; `kccd calib sheet`: a labelling aid.
-#include <sys/stat.h>
-
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -17,6 +15,7 @@
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
+#include "kccd/calib/image_file.hpp"
 #include "kccd/calib/labels.hpp"
 #include "kccd/calib/pose.hpp"
 #include "kccd/calib/tag_detect.hpp"
@@ -29,28 +28,10 @@
 namespace kccd::cli {
 namespace {
 
-constexpr std::uintmax_t kMaxImageBytes = 1ull << 30;
-
 std::string num(double v, int digits = 3) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*g", digits, v);
   return buf;
-}
-
-// An image file as OpenCV reads it (BGR), or one line saying why not.
-cv::Mat readImage(const std::string& path, const std::string& option) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) throw UsageError(option + " " + path + ": no such file");
-  if (!S_ISREG(st.st_mode)) throw UsageError(option + " " + path + ": not a regular file");
-  if (static_cast<std::uintmax_t>(st.st_size) > kMaxImageBytes) throw UsageError(option + " " + path + ": larger than 1 GiB");
-  cv::Mat img;
-  try {
-    img = cv::imread(path, cv::IMREAD_COLOR);
-  } catch (const cv::Exception&) {
-    img.release();
-  }
-  if (img.empty()) throw UsageError(option + " " + path + ": not an image OpenCV can read (PNG, JPEG, TIFF, ...)");
-  return img;
 }
 
 void checkImageSize(const cv::Mat& img, const calib::Camera& cam, const std::string& path, const std::string& camera_path) {
@@ -172,7 +153,7 @@ Gathered gather(const CalibArgs& a, const calib::Camera& cam, const std::optiona
     }
     if (!a.images.empty()) {
       fr.image = a.images[f];
-      fr.bgr = readImage(fr.image, "--image");
+      fr.bgr = calib::readImageFile(fr.image, calib::ImageColour::Bgr);
       checkImageSize(fr.bgr, cam, fr.image, a.intrinsics);
       if (layout) {
         cv::Mat gray;
@@ -381,7 +362,7 @@ Exit runSheet(const SheetArgs& a) {
   }
   if (!a.model.empty() && a.camera.empty())
     throw UsageError("--model: needs --camera (a camera file with a rough pose) to project the model's points");
-  const cv::Mat bgr = readImage(a.image, "--image");
+  const cv::Mat bgr = calib::readImageFile(a.image, calib::ImageColour::Bgr);
   std::optional<calib::Camera> cam;
   if (!a.camera.empty()) {
     cam = calib::loadCamera(a.camera);

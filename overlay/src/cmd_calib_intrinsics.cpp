@@ -11,12 +11,12 @@
 
 #include <unistd.h>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "cli_args.hpp"
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
+#include "kccd/calib/image_file.hpp"
 #include "kccd/calib/intrinsics.hpp"
 
 namespace kccd::cli {
@@ -68,26 +68,7 @@ calib::Board boardFrom(const IntrinsicsArgs& args) {
 }
 
 // One image as 8-bit grey; every failure names the file.
-cv::Mat readImage(const std::string& path) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) throw UsageError(path + ": image: no such file");
-  if (!fs::is_regular_file(st)) throw UsageError(path + ": image: not a regular file");
-  if (::access(path.c_str(), R_OK) != 0) throw UsageError(path + ": image: cannot be read (permission denied)");
-  cv::Mat gray;
-  try {
-    gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  } catch (const cv::Exception&) {
-    gray.release();
-  }
-  if (gray.empty()) throw UsageError(path + ": image: not an image OpenCV can decode (PNG, JPEG, TIFF, BMP, ...)");
-  if (gray.cols > calib::kMaxImageSide || gray.rows > calib::kMaxImageSide ||
-      static_cast<long>(gray.cols) * gray.rows > calib::kMaxImagePixels)
-    throw UsageError(path + ": image: " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows) +
-                     " is larger than a camera file allows (" + std::to_string(calib::kMaxImageSide) + " a side, " +
-                     std::to_string(calib::kMaxImagePixels) + " pixels)");
-  return gray;
-}
+cv::Mat readImage(const std::string& path) { return calib::readImageFile(path, calib::ImageColour::Grey); }
 
 bool sameFile(const std::string& a, const std::string& b) {
   std::error_code ec;

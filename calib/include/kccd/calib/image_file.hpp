@@ -1,0 +1,36 @@
+// Reading a camera frame from an image file (PNG, JPEG, TIFF, BMP, ... as OpenCV decodes them),
+// for the calibration commands.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "kccd/input_error.hpp"
+
+namespace kccd::calib {
+
+/// An image file that cannot be used: one line "path: image: problem".
+class ImageError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
+inline constexpr std::size_t kMaxImageFileBytes = std::size_t{256} << 20;  ///< encoded size
+
+/// The pixels an image decodes to: 8-bit BGR (`grey` false) or 8-bit grey.
+enum class ImageColour : std::uint8_t { Bgr, Grey };
+
+/// Decodes an encoded image held in memory; `source` names it in messages. The image must decode
+/// and fit a camera (Camera::validate's bounds: kMaxImageSide a side, kMaxImagePixels). Throws
+/// ImageError, never anything else for any bytes.
+cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& source, ImageColour colour);
+
+/// Reads a regular file of at most kMaxImageFileBytes (a FIFO or device is refused without
+/// blocking) and decodes it with decodeImage. Throws ImageError.
+cv::Mat readImageFile(const std::string& path, ImageColour colour);
+
+}  // namespace kccd::calib

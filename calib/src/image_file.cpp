@@ -1,0 +1,49 @@
+#include "kccd/calib/image_file.hpp"
+
+#include <filesystem>
+#include <system_error>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "kccd/calib/camera.hpp"
+#include "yaml_input.hpp"
+
+namespace kccd::calib {
+
+cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& source, ImageColour colour) {
+  const auto fail = [&](const std::string& problem) { throw ImageError(source + ": image: " + problem); };
+  if (bytes.empty()) fail("empty file");
+  cv::Mat img;
+  try {
+    const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
+    img = cv::imdecode(encoded, colour == ImageColour::Grey ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+  } catch (const cv::Exception&) {
+    img.release();
+  } catch (const std::bad_alloc&) {
+    img.release();
+  }
+  if (img.empty()) fail("not an image OpenCV can decode (PNG, JPEG, TIFF, BMP, ...)");
+  if (img.cols > kMaxImageSide || img.rows > kMaxImageSide || static_cast<long>(img.cols) * img.rows > kMaxImagePixels)
+    fail(std::to_string(img.cols) + "x" + std::to_string(img.rows) + " is larger than a camera file allows (" +
+         std::to_string(kMaxImageSide) + " a side, " + std::to_string(kMaxImagePixels) + " pixels)");
+  return img;
+}
+
+cv::Mat readImageFile(const std::string& path, ImageColour colour) {
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(st)) throw ImageError(path + ": image: no such file");
+  if (!std::filesystem::is_regular_file(st)) throw ImageError(path + ": image: not a regular file");
+  std::string bytes;
+  try {
+    bytes = detail::readInputFile(path, kMaxImageFileBytes, "image");
+  } catch (const InputError& e) {  // "path: file: problem"
+    std::string msg = e.what();
+    const std::size_t at = msg.find(": file: ", path.size());
+    if (at != std::string::npos) msg.replace(at, 8, ": image: ");
+    throw ImageError(msg);
+  }
+  return decodeImage({reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()}, path, colour);
+}
+
+}  // namespace kccd::calib
