@@ -21,6 +21,7 @@
 #include "kccd/calib/camera.hpp"
 #include "kccd/kinematics.hpp"
 #include "kccd/model.hpp"
+#include "support/cameras.hpp"
 #include "support/golden.hpp"
 #include "support/run_program.hpp"
 
@@ -28,6 +29,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using kccd::testing::Outcome;
+using kccd::testing::rotationErrorDeg;
+const auto centre = [](const kccd::calib::Camera& c) { return kccd::testing::cameraCentre(c); };
 
 const std::string kData = KCCD_DATA_DIR;
 const std::string kDemo = kData + "/demo_arm.yaml";
@@ -38,21 +41,6 @@ Outcome runKccd(const std::string& args) { return kccd::testing::runProgram(std:
 // Uniform in [lo, hi) from the raw generator output: the same numbers with every standard library.
 double uniform(std::mt19937_64& rng, double lo, double hi) {
   return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1.0p-53;
-}
-
-double rotationErrorDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
-  cv::Matx33d ra, rb;
-  cv::Rodrigues(a, ra);
-  cv::Rodrigues(b, rb);
-  const cv::Matx33d d = ra.t() * rb;
-  const double c = std::clamp((d(0, 0) + d(1, 1) + d(2, 2) - 1.0) / 2.0, -1.0, 1.0);
-  return std::acos(c) * 180.0 / M_PI;
-}
-
-cv::Vec3d centre(const kccd::calib::Camera& c) {
-  cv::Matx33d r;
-  cv::Rodrigues(c.rvec, r);
-  return -(r.t() * c.tvec);
 }
 
 cv::Point2d project(const kccd::calib::Camera& c, const cv::Point3d& p) {

@@ -18,6 +18,7 @@
 
 #include "kccd/calib/pose.hpp"
 #include "kccd/calib/tag_detect.hpp"
+#include "support/cameras.hpp"
 #include "support/tag_scene.hpp"
 
 namespace {
@@ -25,6 +26,7 @@ namespace {
 using namespace kccd;
 using namespace kccd::calib;
 using kccd::testing::projectTagCorners;
+using kccd::testing::rotationErrorDeg;
 using kccd::testing::renderTagScene;
 using kccd::testing::TagSceneOptions;
 
@@ -217,15 +219,6 @@ TEST(TagScene, RejectsBadInput) {
 // ---------------------------------------------------------------------------------------------
 // The pose of random cameras from rendered frames
 
-double rotationErrorDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
-  cv::Matx33d ra, rb;
-  cv::Rodrigues(a, ra);
-  cv::Rodrigues(b, rb);
-  const cv::Matx33d d = ra * rb.t();
-  const double s = 0.5 * std::hypot(d(2, 1) - d(1, 2), d(0, 2) - d(2, 0), d(1, 0) - d(0, 1));
-  return std::atan2(s, 0.5 * (d(0, 0) + d(1, 1) + d(2, 2) - 1.0)) * 180.0 / kPi;
-}
-
 cv::Vec3d cameraCentre(const Camera& c) {
   cv::Matx33d r;
   cv::Rodrigues(c.rvec, r);
@@ -318,17 +311,7 @@ RandomView randomView(std::mt19937_64& rng, int width, int height) {
     const Vec3 target(0.45 + 0.2 * (u(rng) - 0.5), 0.45 + 0.2 * (u(rng) - 0.5), 0.3 + 0.2 * (u(rng) - 0.5));
     const Vec3 eye = target + distance * Vec3(std::cos(elevation) * std::cos(azimuth),
                                               std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
-    const Vec3 z = (target - eye).normalized(), x0 = z.cross(Vec3::UnitZ()).normalized(), y0 = z.cross(x0);
-    const double roll = 0.35 * (u(rng) - 0.5);
-    const Vec3 x = std::cos(roll) * x0 + std::sin(roll) * y0, y = z.cross(x);
-    Eigen::Matrix3d r;
-    r.row(0) = x, r.row(1) = y, r.row(2) = z;
-    cv::Matx33d rc;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) rc(i, j) = r(i, j);
-    cv::Rodrigues(rc, c.rvec);
-    const Vec3 t = -(r * eye);
-    c.tvec = cv::Vec3d(t.x(), t.y(), t.z());
+    c = kccd::testing::placedAt(c, eye, target, 0.35 * (u(rng) - 0.5));
     try {
       c.validate("random camera");
     } catch (const CameraError&) {

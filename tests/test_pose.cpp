@@ -21,6 +21,7 @@ using namespace kccd;
 using namespace kccd::calib;
 using kccd::testing::lookAt;
 using kccd::testing::randomCamera;
+using kccd::testing::rotationErrorDeg;
 
 struct Scene {
   Camera truth;
@@ -73,23 +74,8 @@ std::vector<Correspondence> withNoise(std::vector<Correspondence> pts, std::mt19
   return pts;
 }
 
-double rotationErrorDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
-  cv::Matx33d ra, rb;
-  cv::Rodrigues(a, ra);
-  cv::Rodrigues(b, rb);
-  const cv::Matx33d d = ra * rb.t();
-  const double s = 0.5 * std::hypot(d(2, 1) - d(1, 2), d(0, 2) - d(2, 0), d(1, 0) - d(0, 1));
-  return std::atan2(s, 0.5 * (d(0, 0) + d(1, 1) + d(2, 2) - 1.0)) * 180.0 / CV_PI;
-}
-
-cv::Vec3d centre(const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
-  cv::Matx33d r;
-  cv::Rodrigues(rvec, r);
-  return -(r.t() * tvec);
-}
-
 double positionError(const Camera& a, const Camera& b) {
-  return cv::norm(centre(a.rvec, a.tvec) - centre(b.rvec, b.tvec));
+  return cv::norm(kccd::testing::cameraCentre(a) - kccd::testing::cameraCentre(b));
 }
 
 double median(std::vector<double> v) {

@@ -13,6 +13,7 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "support/cameras.hpp"
 #include "kccd/calib/pose.hpp"
 #include "kccd/calib/tag_detect.hpp"
 #include "support/tag_scene.hpp"
@@ -24,19 +25,7 @@ using namespace kccd::calib;
 constexpr double kPi = 3.141592653589793;
 
 Camera benchCamera() {
-  const Vec3 eye(2.0, 1.6, 1.35), target(0.45, 0.45, 0.3);
-  const Vec3 z = (target - eye).normalized(), x = z.cross(Vec3::UnitZ()).normalized(), y = z.cross(x);
-  cv::Matx33d r;
-  for (int j = 0; j < 3; ++j) r(0, j) = x[j], r(1, j) = y[j], r(2, j) = z[j];
-  Camera c;
-  c.width = 1280;
-  c.height = 720;
-  c.camera_matrix = cv::Matx33d(1000, 0, 641.3, 0, 1000, 358.2, 0, 0, 1);
-  c.distortion = {-0.11, 0.06, 0.0006, -0.0004, -0.01};
-  cv::Rodrigues(r, c.rvec);
-  const Vec3 t = -(Eigen::Matrix3d::Map(r.val).transpose() * eye);
-  c.tvec = cv::Vec3d(t.x(), t.y(), t.z());
-  return c;
+  return kccd::testing::hdCamera(Vec3(2.0, 1.6, 1.35), Vec3(0.45, 0.45, 0.3));
 }
 
 // Three tags on the floor (z = 0), three on the wall x = 0, two on the wall y = 0; two tilted.

@@ -15,6 +15,7 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "support/cameras.hpp"
 #include "kccd/checker.hpp"
 #include "kccd/render/renderer.hpp"
 #include "kccd/render/scene.hpp"
@@ -32,19 +33,7 @@ const Model& humanoid() {
 
 Camera benchCamera() {
   // 3.2 m in front and to the side of the humanoid, looking at its chest.
-  const Vec3 eye(3.0, -1.2, 1.6), target(0.0, 0.0, 1.1);
-  const Vec3 z = (target - eye).normalized(), x = z.cross(Vec3::UnitZ()).normalized(), y = z.cross(x);
-  cv::Matx33d r;
-  for (int j = 0; j < 3; ++j) r(0, j) = x[j], r(1, j) = y[j], r(2, j) = z[j];
-  Camera c;
-  c.width = 1280;
-  c.height = 720;
-  c.camera_matrix = cv::Matx33d(1000, 0, 641.3, 0, 1000, 358.2, 0, 0, 1);
-  c.distortion = {-0.11, 0.06, 0.0006, -0.0004, -0.01};
-  cv::Rodrigues(r, c.rvec);
-  const Vec3 t = -(Eigen::Matrix3d::Map(r.val).transpose() * eye);
-  c.tvec = cv::Vec3d(t.x(), t.y(), t.z());
-  return c;
+  return kccd::testing::hdCamera(Vec3(3.0, -1.2, 1.6), Vec3(0.0, 0.0, 1.1));
 }
 
 // Boxes around random states within the joint limits; width 0 for static frames.

@@ -14,10 +14,12 @@ namespace kccd::testing {
 
 using calib::Camera;
 
-// A camera at `eye` looking at `target` (z up in the world), OpenCV axes.
-inline Camera lookAt(const Vec3& eye, const Vec3& target, int w, int h, double f, std::vector<double> dist) {
+// `c` with its pose set to look from `eye` at `target` (z up in the world), OpenCV axes, turned
+// by `roll` radians about the viewing direction.
+inline Camera placedAt(Camera c, const Vec3& eye, const Vec3& target, double roll = 0.0) {
   const Vec3 z = (target - eye).normalized();
-  const Vec3 x = z.cross(Vec3::UnitZ()).normalized();
+  const Vec3 x0 = z.cross(Vec3::UnitZ()).normalized();
+  const Vec3 x = std::cos(roll) * x0 + std::sin(roll) * z.cross(x0);
   const Vec3 y = z.cross(x);
   Eigen::Matrix3d r;
   r.row(0) = x;
@@ -26,15 +28,47 @@ inline Camera lookAt(const Vec3& eye, const Vec3& target, int w, int h, double f
   cv::Matx33d rc;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) rc(i, j) = r(i, j);
+  cv::Rodrigues(rc, c.rvec);
+  const Vec3 t = -(r * eye);
+  c.tvec = cv::Vec3d(t.x(), t.y(), t.z());
+  return c;
+}
+
+// A camera at `eye` looking at `target` (z up in the world), OpenCV axes.
+inline Camera lookAt(const Vec3& eye, const Vec3& target, int w, int h, double f, std::vector<double> dist) {
   Camera c;
   c.width = w;
   c.height = h;
   c.camera_matrix = cv::Matx33d(f, 0, (w - 1) / 2.0 + 1.3, 0, f * 1.01, (h - 1) / 2.0 - 0.7, 0, 0, 1);
   c.distortion = std::move(dist);
-  cv::Rodrigues(rc, c.rvec);
-  const Vec3 t = -(r * eye);
-  c.tvec = cv::Vec3d(t.x(), t.y(), t.z());
-  return c;
+  return placedAt(std::move(c), eye, target);
+}
+
+// The benchmarks' camera: 1280 x 720, f 1000 px, mild barrel distortion, at `eye` looking at `target`.
+inline Camera hdCamera(const Vec3& eye, const Vec3& target) {
+  Camera c;
+  c.width = 1280;
+  c.height = 720;
+  c.camera_matrix = cv::Matx33d(1000, 0, 641.3, 0, 1000, 358.2, 0, 0, 1);
+  c.distortion = {-0.11, 0.06, 0.0006, -0.0004, -0.01};
+  return placedAt(std::move(c), eye, target);
+}
+
+// The angle between two rotations (Rodrigues vectors), degrees; accurate for tiny angles too.
+inline double rotationErrorDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
+  cv::Matx33d ra, rb;
+  cv::Rodrigues(a, ra);
+  cv::Rodrigues(b, rb);
+  const cv::Matx33d d = ra * rb.t();
+  const double s = 0.5 * std::hypot(d(2, 1) - d(1, 2), d(0, 2) - d(2, 0), d(1, 0) - d(0, 1));
+  return std::atan2(s, 0.5 * (d(0, 0) + d(1, 1) + d(2, 2) - 1.0)) * 180.0 / CV_PI;
+}
+
+// Where the camera is in the world.
+inline cv::Vec3d cameraCentre(const Camera& c) {
+  cv::Matx33d r;
+  cv::Rodrigues(c.rvec, r);
+  return -(r.t() * c.tvec);
 }
 
 inline cv::Point2d cvProject(const Camera& c, const Vec3& p) {
