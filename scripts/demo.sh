@@ -27,7 +27,8 @@ step $kccd render data/demo_arm.yaml --camera data/demo_camera.yaml --lower -0.5
 # Calibration: the camera's pose from 16 labelled points (one misclicked), with its uncertainty,
 # and a check image of every point, its reprojection and the model's volumes at the state.
 step $kccd calib --intrinsics data/demo_camera.yaml --labels data/demo_labels.yaml --model data/demo_arm.yaml \
-  --state 0.3,0.4,0.6 -o build-demo/calibrated_camera.yaml --check build-demo/calib_check.png
+  --state 0.3,0.4,0.6 -o build-demo/calibrated_camera.yaml --check build-demo/calib_check.png \
+  --truth data/demo_camera.yaml
 # Modelling: a conservative SSCH for a CAD part (8 core points), and which pairs of the demo arm
 # can never meet anywhere inside the joint limits (proven with the same sweeps).
 step $kccd fit data/parts/gripper.iv --points 8 --name gripper --frame elbow -q

@@ -136,6 +136,13 @@ TEST_F(CalibCli, LabelsSolveRejectMisclicksAndWriteTheCamera) {
   EXPECT_DOUBLE_EQ(*c.rotation_sigma_deg, j["rotation_sigma_deg"].get<double>());
   EXPECT_LT(rotationErrorDeg(c.rvec, truth_.rvec), std::max(0.02, 4 * *c.rotation_sigma_deg));
   EXPECT_LT(cv::norm(centre(c) - centre(truth_)), std::max(0.002, 4 * *c.position_sigma_m));
+  // --truth reports the same errors.
+  const Outcome t = runKccd("calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --truth " + kCamera + " -o " +
+                            out("cam2.yaml") + " --json");
+  ASSERT_EQ(t.code, 0) << t.err;
+  const nlohmann::json jt = nlohmann::json::parse(t.out);
+  EXPECT_NEAR(jt["truth_error"]["rotation_deg"].get<double>(), rotationErrorDeg(c.rvec, truth_.rvec), 1e-9);
+  EXPECT_NEAR(jt["truth_error"]["position_m"].get<double>(), cv::norm(centre(c) - centre(truth_)), 1e-9);
   // The check image: the frame size, and what it shows stays as reviewed.
   const cv::Mat check = cv::imread(out("check.png"), cv::IMREAD_COLOR);
   ASSERT_EQ(check.cols, truth_.width);

@@ -68,7 +68,7 @@ std::vector<cv::Point3d> corePoints(const Model& m, std::span<const double> stat
 // kccd calib
 
 struct CalibArgs {
-  std::string intrinsics, tags, model, output, check;
+  std::string intrinsics, tags, model, output, check, truth;
   std::vector<std::string> images, labels, states;
   std::string state_log, ignore_columns;
   std::vector<double> times;
@@ -228,6 +228,8 @@ Exit runCalib(const CalibArgs& a) {
   }
   if (!a.check.empty()) checkOutputPath(a.check, "--check", ".png");
   const calib::Camera intrinsics = loadIntrinsics(a.intrinsics);
+  std::optional<calib::Camera> truth;
+  if (!a.truth.empty()) truth = calib::loadCamera(a.truth);
   std::optional<Model> model;
   if (!a.model.empty()) model = loadOrExplain(a.model);
   const Gathered g = gather(a, intrinsics, model);
@@ -243,6 +245,19 @@ Exit runCalib(const CalibArgs& a) {
   const std::vector<double>* state = nullptr;
   if (model && !g.frames.empty() && (static_cast<int>(g.frames[0].state.size()) == model->stateSize())) state = &g.frames[0].state;
   if (solved && model && state) volume_sigma = calib::projectedSigmaPx(r.camera, r.covariance, corePoints(*model, *state));
+
+  // Against a known camera (synthetic recordings): the rotation and camera position errors.
+  std::optional<std::pair<double, double>> truth_error;
+  if (solved && truth) {
+    cv::Matx33d ra, rb;
+    cv::Rodrigues(r.camera.rvec, ra);
+    cv::Rodrigues(truth->rvec, rb);
+    const cv::Matx33d d = ra * rb.t();
+    const double sin_half2 = 0.5 * std::hypot(d(2, 1) - d(1, 2), d(0, 2) - d(2, 0), d(1, 0) - d(0, 1));
+    const double angle = std::atan2(sin_half2, 0.5 * (d(0, 0) + d(1, 1) + d(2, 2) - 1.0)) * 180.0 / CV_PI;
+    const cv::Vec3d ca = -(ra.t() * r.camera.tvec), cb = -(rb.t() * truth->tvec);
+    truth_error = std::make_pair(angle, cv::norm(ca - cb));
+  }
 
   std::vector<int> unknown;
   for (const Frame& f : g.frames) unknown.insert(unknown.end(), f.unknown_ids.begin(), f.unknown_ids.end());
@@ -324,10 +339,15 @@ Exit runCalib(const CalibArgs& a) {
       j["camera_position"] = {centre[0], centre[1], centre[2]};
       if (!a.check.empty()) j["check"] = a.check;
       if (!renderer_name.empty()) j["renderer"] = renderer_name;
+      if (truth_error) j["truth_error"] = {{"rotation_deg", truth_error->first}, {"position_m", truth_error->second}};
     }
     std::cout << j.dump(2) << "\n";
   } else if (!a.quiet) {
     std::cout << (solved ? "" : "not solved: ") << r.message << "\n";
+    if (truth_error)
+      std::cout << "against " << a.truth << ": rotation " << num(truth_error->first) << " deg (" << num(truth_error->first / *r.camera.rotation_sigma_deg, 2)
+                << " sigma), position " << num(truth_error->second * 1000) << " mm (" << num(truth_error->second / *r.camera.position_sigma_m, 2)
+                << " sigma)\n";
     if (volume_sigma) std::cout << "model volumes at the state: +-" << num(*volume_sigma) << " px (1 sigma, worst core point)\n";
     if (!unknown.empty()) {
       std::cout << "tags not in the layout (ignored):";
@@ -483,6 +503,7 @@ Runner addCalib(CLI::App& app) {
   sub->add_option("--check", a->check,
                   "Check image (.png): the frame, the model at the state, every point seen (o), projected (+) and its residual "
                   "magnified; with several frames also NAME_2.png, ...");
+  sub->add_option("--truth", a->truth, "A known camera file (e.g. from kccd synth): also report the error against it");
   sub->add_option("--threshold", a->threshold, "RANSAC: a point farther than this from its projection is rejected (px)")
       ->check(finiteIn(0.1, 1000))
       ->capture_default_str();
