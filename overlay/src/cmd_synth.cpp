@@ -85,8 +85,10 @@ struct Trajectory {
     for (const Event& e : events) {
       const double x = (t - e.time) / e.half_width;
       if (!(std::abs(x) < 1.0) || e.beta == 0.0) continue;
-      const double b = e.beta * 0.5 * (1.0 + std::cos(M_PI * x));
-      const double db = -e.beta * 0.5 * M_PI / e.half_width * std::sin(M_PI * x);
+      // b = beta c^2 with c = (1 + cos(pi x)) / 2: position, velocity and acceleration continuous.
+      const double c = 0.5 * (1.0 + std::cos(M_PI * x)), dc = -0.5 * M_PI / e.half_width * std::sin(M_PI * x);
+      const double b = e.beta * c * c;
+      const double db = 2.0 * e.beta * c * dc;
       for (std::size_t i = 0; i < n; ++i) {
         const double base = q[i], base_d = qd[i];
         q[i] = (1.0 - b) * base + b * e.goal[i];
@@ -125,6 +127,7 @@ struct DistanceProbe {
   Checker checker;
   explicit DistanceProbe(const Model& m) : model(m), checker(m) {}
   double operator()(std::span<const double> q, int* pair = nullptr) {
+    checker.reset();  // every state on its own: the answer does not depend on the order of queries
     const QueryResult& r = checker.query(q, q, QueryOptions{.type = QueryType::Distances});
     if (r.status != Status::Ok) return -1.0;
     if (pair) {
@@ -166,13 +169,15 @@ Trajectory searchTrajectory(const Model& m, const SynthArgs& a, double t0, doubl
 
   // Event times: near, collision, near (a near one instead of the collision with --no-collision).
   const double span = a.seconds;
-  const double w = std::clamp(0.11 * span, 0.05, 0.6);
+  // Bumps last at least half a second (a robot's pace), so a short recording has fewer of them.
+  const double w = std::clamp(0.11 * span, 0.25, 0.6);
   std::vector<Event> plan;
   for (const auto& [f, kind] : {std::pair{0.25, Event::Near}, std::pair{0.6, Event::Collision}, std::pair{0.87, Event::Near}}) {
     Event e;
     e.kind = a.no_collision ? Event::Near : kind;
     e.time = f * span;
     e.half_width = w;
+    if (!plan.empty() && e.time - plan.back().time < 2.0 * w) continue;
     plan.push_back(e);
   }
 
@@ -213,7 +218,11 @@ Trajectory searchTrajectory(const Model& m, const SynthArgs& a, double t0, doubl
       bool found = false;
       for (int tries = 0; tries < 300 && !found; ++tries) {
         e.goal.assign(n, 0.0);
-        for (int i = 0; i < n; ++i) e.goal[i] = uniform(lim.lo[i], lim.hi[i]) * 0.85 + 0.15 * tr.centre[i];
+        // Within 1.5 rad (0.3 m) of the centre: joint speeds stay those of a robot at work.
+        for (int i = 0; i < n; ++i) {
+          const double reach = lim.amplitude[i] * 5.0;
+          e.goal[i] = std::clamp(tr.centre[i] + uniform(-reach, reach), lim.lo[i], lim.hi[i]);
+        }
         if (!(probe(e.goal) <= 0.0)) continue;
         if (e.kind == Event::Collision) {  // a goal well inside the collision: a contact of some duration
           std::vector<double> part(n);
