@@ -343,6 +343,7 @@ calib::Camera defaultCamera(const Box3& box, int width, int height) {
 
 struct Room {
   double floor_z = 0, wall_x = 0, wall_y = 0;
+  double sx = 1, sy = 1;  // the side of the walls the camera is on (+1: towards +x / +y)
   std::vector<calib::SceneSurface> surfaces;
   calib::SceneLight light;
 };
@@ -359,41 +360,46 @@ const Eigen::Matrix3d& floorAxes() {
   static const Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
   return r;
 }
-Eigen::Matrix3d wallXAxes() {  // the wall facing +x: seen from +x, right is +y
+// The wall across x facing sx * x: seen from its front, right is sx * y.
+Eigen::Matrix3d wallXAxes(double sx) {
   Eigen::Matrix3d r;
-  r.col(0) = Vec3::UnitY(), r.col(1) = Vec3::UnitZ(), r.col(2) = Vec3::UnitX();
+  r.col(0) = sx * Vec3::UnitY(), r.col(1) = Vec3::UnitZ(), r.col(2) = sx * Vec3::UnitX();
   return r;
 }
-Eigen::Matrix3d wallYAxes() {  // the wall facing +y: seen from +y, right is -x
+// The wall across y facing sy * y: seen from its front, right is -sy * x.
+Eigen::Matrix3d wallYAxes(double sy) {
   Eigen::Matrix3d r;
-  r.col(0) = -Vec3::UnitX(), r.col(1) = Vec3::UnitZ(), r.col(2) = Vec3::UnitY();
+  r.col(0) = -sy * Vec3::UnitX(), r.col(1) = Vec3::UnitZ(), r.col(2) = sy * Vec3::UnitY();
   return r;
 }
 
-Room makeRoom(const Box3& box) {
+// A floor below the robot and two walls beyond it, on the far side from the camera at `eye`.
+Room makeRoom(const Box3& box, const Vec3& eye) {
   Room room;
-  room.floor_z = box.lo.z() - 0.002;
-  room.wall_x = box.lo.x() - 0.7;
-  room.wall_y = box.lo.y() - 0.7;
-  const double size = 12.0, height = 3.2;
   const Vec3 c = 0.5 * (box.lo + box.hi);
+  room.sx = eye.x() >= c.x() ? 1.0 : -1.0;
+  room.sy = eye.y() >= c.y() ? 1.0 : -1.0;
+  room.floor_z = box.lo.z() - 0.002;
+  room.wall_x = room.sx > 0 ? box.lo.x() - 0.7 : box.hi.x() + 0.7;
+  room.wall_y = room.sy > 0 ? box.lo.y() - 0.7 : box.hi.y() + 0.7;
+  const double size = 12.0, height = 3.2;
   calib::SceneSurface floor;
-  floor.pose = poseOf(floorAxes(), Vec3(room.wall_x + size, room.wall_y + size, room.floor_z));
+  floor.pose = poseOf(floorAxes(), Vec3(c.x(), c.y(), room.floor_z));
   floor.half_x = floor.half_y = size;
   floor.colour = cv::Scalar(118, 128, 138);
   floor.tile_colour = cv::Scalar(104, 113, 124);
   floor.tile = 0.5;
   calib::SceneSurface wx;
-  wx.pose = poseOf(wallXAxes(), Vec3(room.wall_x, room.wall_y + size, room.floor_z + 0.5 * height));
+  wx.pose = poseOf(wallXAxes(room.sx), Vec3(room.wall_x, c.y(), room.floor_z + 0.5 * height));
   wx.half_x = size, wx.half_y = 0.5 * height;
   wx.colour = cv::Scalar(196, 204, 210);
   calib::SceneSurface wy;
-  wy.pose = poseOf(wallYAxes(), Vec3(room.wall_x + size, room.wall_y, room.floor_z + 0.5 * height));
+  wy.pose = poseOf(wallYAxes(room.sy), Vec3(c.x(), room.wall_y, room.floor_z + 0.5 * height));
   wy.half_x = size, wy.half_y = 0.5 * height;
   wy.colour = cv::Scalar(170, 186, 200);
   room.surfaces = {floor, wx, wy};
   room.light.on = true;
-  room.light.position = Vec3(c.x() + 0.6, c.y() + 0.9, room.floor_z + height - 0.2);
+  room.light.position = Vec3(c.x() + room.sx * 0.6, c.y() + room.sy * 0.9, room.floor_z + height - 0.2);
   room.light.ambient = 0.5;
   room.light.diffuse = 0.65;
   room.light.reference = height - 0.2;
@@ -426,17 +432,19 @@ calib::TagLayout makeTags(const Room& room, const Box3& box, const calib::Camera
     t.rpy = rpyOf(axes);
     candidates.push_back({t, surface});
   };
-  const double reach = std::max(box.hi.x() - room.wall_x, box.hi.y() - room.wall_y) + 1.0;
+  const double sx = room.sx, sy = room.sy;
+  const double reach = std::max(box.hi.x() - box.lo.x(), box.hi.y() - box.lo.y()) + 1.7;
   for (int row = 0; row < 3; ++row)
     for (int col = 0; col < 6; ++col) {
       const double h = room.floor_z + 0.35 + row * 0.55 + 0.1 * (col % 2);
       const double along = 0.3 + col * reach / 5.5;
-      add(wallXAxes(), Vec3(room.wall_x + 0.001, room.wall_y + along, h), 1);
-      add(wallYAxes(), Vec3(room.wall_x + along, room.wall_y + 0.001, h), 2);
+      add(wallXAxes(sx), Vec3(room.wall_x + sx * 0.001, room.wall_y + sy * along, h), 1);
+      add(wallYAxes(sy), Vec3(room.wall_x + sx * along, room.wall_y + sy * 0.001, h), 2);
     }
   for (int i = 0; i < 6; ++i)
     for (int j = 0; j < 6; ++j) {
-      const Vec3 at(room.wall_x + 0.4 + i * reach / 5.0, room.wall_y + 0.4 + j * reach / 5.0, room.floor_z + 0.001);
+      const Vec3 at(room.wall_x + sx * (0.4 + i * reach / 5.0), room.wall_y + sy * (0.4 + j * reach / 5.0),
+                    room.floor_z + 0.001);
       if (at.x() > box.lo.x() - size && at.x() < box.hi.x() + size && at.y() > box.lo.y() - size &&
           at.y() < box.hi.y() + size)
         continue;  // under the robot
@@ -445,10 +453,14 @@ calib::TagLayout makeTags(const Room& room, const Box3& box, const calib::Camera
   cv::Mat covered;
   cv::dilate(robot_mask > 0, covered, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(15, 15)));
   const Pose w2c = cam.worldToCamera();
+  const Vec3 eye = w2c.inverse().translation();
   std::vector<Candidate> kept;
   int per_surface[3] = {0, 0, 0};
   for (const Candidate& c : candidates) {
     if (per_surface[c.surface] >= 6) continue;
+    // Seen from its front, at most 75 degrees off its normal.
+    const Vec3 to_eye = (eye - c.tag.xyz).normalized();
+    if (!(c.tag.pose().linear().col(2).dot(to_eye) > 0.26)) continue;
     const auto corners = c.tag.corners();
     // The whole bitmap (one white cell around the black square) must be in front and in view.
     std::vector<cv::Point3d> outer;
@@ -686,7 +698,7 @@ Exit runSynth(const SynthArgs& a) {
   const StateLog log = parseStateLog(log_text, "states.csv", m);
   const Box3 box = robotBox(m, log);
   const calib::Camera camera = given ? *given : defaultCamera(box, a.width, a.height);
-  const Room room = makeRoom(box);
+  const Room room = makeRoom(box, camera.worldToCamera().inverse().translation());
 
   // Per frame: the logged state at the frame's log time, its distances.
   const double max_gap = 1.5 * dt;
