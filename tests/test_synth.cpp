@@ -259,6 +259,7 @@ TEST_F(Synth, BadInputIsOneLineExitTwo) {
       {"synth " + kHumanoid + " -o " + dir("nowhere/x"), "does not exist"},
       {"synth " + kHumanoid + " -o " + dir("full"), "--force"},
       {"synth " + kHumanoid + " -o " + dir("x") + " --camera " + dir("nothing.yaml"), "nothing.yaml"},
+      {"synth " + kHumanoid + " -o " + dir("x") + " --camera " + dir("a") + "/camera_true.yaml --width 640", "--width"},
   };
   for (const Case& c : cases) {
     const Outcome r = runKccd(c.args);

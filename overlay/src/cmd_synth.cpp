@@ -56,6 +56,7 @@ struct SynthArgs {
   std::uint64_t seed = 1;
   std::string codec = "ffv1";
   bool no_collision = false, force = false, quiet = false;
+  bool size_given = false;  // --width or --height on the command line
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -564,7 +565,7 @@ class Writer {
   ~Writer() { finish(); }
   void push(int index, cv::Mat frame, cv::Mat mask) {
     std::unique_lock<std::mutex> lock(mutex_);
-    space_.wait(lock, [&] { return queue_.size() < 2 || failed_; });
+    space_.wait(lock, [&] { return queue_.size() < 2; });
     queue_.push_back({index, std::move(frame), std::move(mask)});
     ready_.notify_one();
   }
@@ -630,7 +631,7 @@ class Writer {
   std::mutex mutex_;
   std::condition_variable ready_, space_;
   std::deque<Item> queue_;
-  bool done_ = false, failed_ = false;
+  bool done_ = false;
   int written_ = 0;
   std::string error_;
   std::thread thread_;
@@ -682,7 +683,8 @@ Exit runSynth(const SynthArgs& a) {
   // The camera (given, or placed after the trajectory is known).
   std::optional<calib::Camera> given;
   if (!a.camera.empty()) {
-    given = calib::loadCamera(a.camera);  // its size wins: --width/--height only shape the default camera
+    if (a.size_given) throw UsageError("--width/--height shape the default camera; the camera file " + a.camera + " fixes the size");
+    given = calib::loadCamera(a.camera);
   } else if (a.width < 64 || a.height < 64 || a.width > 4096 || a.height > 4096) {
     throw UsageError("--width/--height: must be 64 ... 4096 pixels");
   }
@@ -909,12 +911,15 @@ Runner addSynth(CLI::App& app) {
   sub->add_option("--camera", a->camera, "Camera file to film with (default: one placed to see the robot, the floor and two walls)");
   sub->add_option("--seconds", a->seconds, "Length of the recording (s)")->capture_default_str()->check(finiteIn(0.04, 600));
   sub->add_option("--fps", a->fps, "Video frame rate")->capture_default_str()->check(finiteIn(1, 240));
-  sub->add_option("--width", a->width, "Image width of the default camera (px)")->capture_default_str()->check(CLI::Range(64, 4096));
-  sub->add_option("--height", a->height, "Image height of the default camera (px)")->capture_default_str()->check(CLI::Range(64, 4096));
+  CLI::Option* width = sub->add_option("--width", a->width, "Image width of the default camera (px)")
+                           ->capture_default_str()->check(CLI::Range(64, 4096));
+  CLI::Option* height = sub->add_option("--height", a->height, "Image height of the default camera (px)")
+                            ->capture_default_str()->check(CLI::Range(64, 4096));
   sub->add_option("--seed", a->seed, "Seed of the trajectory search and the noise")->capture_default_str();
   sub->add_option("--codec", a->codec, "ffv1 (video.mkv, lossless), mjpg (video.avi) or mp4v (video.mp4)")->capture_default_str();
   sub->add_option("--log-rate", a->log_rate, "State log rate (Hz; must differ from --fps)")->capture_default_str()->check(finiteIn(1, 10000));
-  sub->add_option("--time-offset", a->time_offset, "Log clock minus video clock (s)")->capture_default_str()->check(finiteIn(-10, 10));
+  sub->add_option("--time-offset", a->time_offset, "Log clock minus video clock (s; the log starts at log time 0)")
+      ->capture_default_str()->check(finiteIn(0, 10));
   sub->add_option("--visible-scale", a->shrink, "Radius of the visible geometry as a fraction of the SSCH radius")
       ->capture_default_str()->check(finiteIn(0.1, 0.95));
   sub->add_option("--blur", a->blur, "Gaussian blur of every frame (sigma, px)")->capture_default_str()->check(finiteIn(0, 10));
@@ -929,7 +934,10 @@ Runner addSynth(CLI::App& app) {
       "clock offset, rates, per-frame state and smallest distance, collision frames).\n"
       "Collision means a smallest distance bound <= 0 at the logged state of the frame.\n"
       "Exit status: 0 written, 2 bad input (or no trajectory found for this model and seed).");
-  return [a] { return runSynth(*a); };
+  return [a, width, height] {
+    a->size_given = width->count() > 0 || height->count() > 0;
+    return runSynth(*a);
+  };
 }
 
 }  // namespace kccd::cli
