@@ -36,7 +36,7 @@ Outcome runKccd(const std::string& args) { return kccd::testing::runProgram(std:
 
 const std::string kData = KCCD_DATA_DIR;
 const std::string kHumanoid = kData + "/humanoid.yaml";
-constexpr double kSeconds = 1.6;
+constexpr double kSeconds = 2.4;
 constexpr double kFps = 25.0;
 
 // One recording shared by the tests (the synthesis is the slow part).
@@ -113,15 +113,20 @@ TEST_F(Synth, StateLogHasRateOffsetAndVelocities) {
   EXPECT_NEAR(log.medianPeriod(), 1.0 / rate, 1e-9);
   ASSERT_TRUE(log.hasVelocities());
   for (std::uint8_t v : log.logged_velocity) EXPECT_EQ(v, 1);
-  // Velocities agree with the values' central differences (smooth motion).
+  // Velocities integrate to the values: each step's change against the trapezoid rule (its error,
+  // h^3 / 12 times the jerk, stays below 1e-3 rad for this motion at 125 Hz).
   const std::size_t n = log.stateSize();
-  double worst = 0;
-  for (std::size_t r = 1; r + 1 < log.rows(); ++r)
+  double worst = 0, fastest = 0;
+  for (std::size_t r = 0; r + 1 < log.rows(); ++r)
     for (std::size_t i = 0; i < n; ++i) {
-      const double diff = (log.values[(r + 1) * n + i] - log.values[(r - 1) * n + i]) / (log.times[r + 1] - log.times[r - 1]);
-      worst = std::max(worst, std::abs(diff - log.velocities[r * n + i]));
+      const double h = log.times[r + 1] - log.times[r];
+      const double step = log.values[(r + 1) * n + i] - log.values[r * n + i];
+      const double integral = 0.5 * h * (log.velocities[r * n + i] + log.velocities[(r + 1) * n + i]);
+      worst = std::max(worst, std::abs(step - integral));
+      fastest = std::max(fastest, std::abs(log.velocities[r * n + i]));
     }
-  EXPECT_LT(worst, 0.05);
+  EXPECT_LT(worst, 2e-3);
+  EXPECT_GT(fastest, 0.1);  // it moves
   // Each frame's state is the log's state at video time + offset.
   std::vector<double> s(n);
   for (const json& f : j["frames"]) {

@@ -67,6 +67,7 @@ struct SynthArgs {
 struct Event {
   enum Kind { Near, Collision } kind = Near;
   double time = 0.0, half_width = 0.5, beta = 0.0;
+  double plateau = 0.0;  // fraction of the half width held at the full blend
   std::vector<double> goal;
   double min_distance = 0.0;  // over the log samples in its window
 };
@@ -86,10 +87,12 @@ struct Trajectory {
     for (const Event& e : events) {
       const double x = (t - e.time) / e.half_width;
       if (!(std::abs(x) < 1.0) || e.beta == 0.0) continue;
-      // b = beta c^2 with c = (1 + cos(pi x)) / 2: position, velocity and acceleration continuous.
-      const double c = 0.5 * (1.0 + std::cos(M_PI * x)), dc = -0.5 * M_PI / e.half_width * std::sin(M_PI * x);
-      const double b = e.beta * c * c;
-      const double db = 2.0 * e.beta * c * dc;
+      // b = beta S(u), S the smootherstep 6u^5 - 15u^4 + 10u^3 of u = (1 - |x|) / (1 - plateau)
+      // clamped to 1: position, velocity and acceleration continuous, held at the top.
+      const double u = std::min(1.0, (1.0 - std::abs(x)) / (1.0 - e.plateau));
+      const double b = e.beta * u * u * u * (u * (6.0 * u - 15.0) + 10.0);
+      const double du = u < 1.0 ? -(x > 0 ? 1.0 : -1.0) / ((1.0 - e.plateau) * e.half_width) : 0.0;
+      const double db = e.beta * 30.0 * u * u * (u - 1.0) * (u - 1.0) * du;
       for (std::size_t i = 0; i < n; ++i) {
         const double base = q[i], base_d = qd[i];
         q[i] = (1.0 - b) * base + b * e.goal[i];
@@ -171,16 +174,20 @@ Trajectory searchTrajectory(const Model& m, const SynthArgs& a, double t0, doubl
   // Event times: near, collision, near (a near one instead of the collision with --no-collision).
   const double span = a.seconds;
   // Bumps last at least half a second (a robot's pace), so a short recording has fewer of them.
-  const double w = std::clamp(0.11 * span, 0.25, 0.6);
+  const double w = std::clamp(0.12 * span, 0.35, 0.9);
   std::vector<Event> plan;
-  for (const auto& [f, kind] : {std::pair{0.25, Event::Near}, std::pair{0.6, Event::Collision}, std::pair{0.87, Event::Near}}) {
+  // The collision (or the middle near one) first; the others where they fit.
+  for (const auto& [f, kind] : {std::pair{0.6, Event::Collision}, std::pair{0.25, Event::Near}, std::pair{0.87, Event::Near}}) {
     Event e;
     e.kind = a.no_collision ? Event::Near : kind;
     e.time = f * span;
     e.half_width = w;
-    if (!plan.empty() && e.time - plan.back().time < 2.0 * w) continue;
-    plan.push_back(e);
+    e.plateau = e.kind == Event::Near ? 0.3 : 0.1;
+    bool fits = true;
+    for (const Event& p : plan) fits = fits && std::abs(e.time - p.time) >= 2.0 * w;
+    if (fits) plan.push_back(e);
   }
+  std::sort(plan.begin(), plan.end(), [](const Event& x, const Event& y) { return x.time < y.time; });
 
   for (int attempt = 0; attempt < 40; ++attempt) {
     Trajectory tr;
@@ -219,9 +226,9 @@ Trajectory searchTrajectory(const Model& m, const SynthArgs& a, double t0, doubl
       bool found = false;
       for (int tries = 0; tries < 300 && !found; ++tries) {
         e.goal.assign(n, 0.0);
-        // Within 1.5 rad (0.3 m) of the centre: joint speeds stay those of a robot at work.
+        // Within 1.05 rad (0.18 m) of the centre: joint speeds stay those of a robot at work.
         for (int i = 0; i < n; ++i) {
-          const double reach = lim.amplitude[i] * 5.0;
+          const double reach = lim.amplitude[i] * 3.5;
           e.goal[i] = std::clamp(tr.centre[i] + uniform(-reach, reach), lim.lo[i], lim.hi[i]);
         }
         if (!(probe(e.goal) <= 0.0)) continue;
@@ -231,6 +238,7 @@ Trajectory searchTrajectory(const Model& m, const SynthArgs& a, double t0, doubl
           if (!(probe(part) <= 0.0)) continue;
         }
         Trajectory with = tr;
+        int collision_frames = 0;
         const double from = e.time - e.half_width, to = e.time + e.half_width;
         if (e.kind == Event::Collision) {
           // The smallest blend that collides, then a little more: one short, clear contact.
@@ -242,6 +250,7 @@ Trajectory searchTrajectory(const Model& m, const SynthArgs& a, double t0, doubl
             (minOver(with, from, to) <= 0.0 ? hi : lo) = e.beta;
           }
           // Then deeper until the contact lasts about 0.12 to 0.3 s.
+          // Frames (at video times) must show it: at least two of them when the window allows.
           const double first = hi;
           for (const double f : {0.15, 0.3, 0.5, 0.75, 1.0}) {
             e.beta = std::min(1.0, first + f * (1.0 - first));
@@ -254,7 +263,12 @@ Trajectory searchTrajectory(const Model& m, const SynthArgs& a, double t0, doubl
               with.at(t, q, qd);
               touching += probe(q) <= 0.0;
             }
-            if (touching * dt >= std::min(0.12, 0.3 * e.half_width)) break;
+            collision_frames = 0;
+            for (int i = static_cast<int>(std::ceil(from * a.fps)); i / a.fps <= to; ++i) {
+              with.at(i / a.fps, q, qd);
+              collision_frames += probe(q) <= 0.0;
+            }
+            if (touching * dt >= std::min(0.12, 0.3 * e.half_width) && collision_frames >= 2) break;
           }
         } else {
           double lo = 0.0, hi = 1.0;
@@ -270,7 +284,7 @@ Trajectory searchTrajectory(const Model& m, const SynthArgs& a, double t0, doubl
         with.events.push_back(e);
         e.min_distance = minOver(with, from, to);
         if (e.kind == Event::Collision)
-          found = e.min_distance <= 0.0;
+          found = e.min_distance <= 0.0 && collision_frames >= 1;
         else
           found = e.min_distance > 0.3 * near_target && e.min_distance <= 1.6 * near_target && e.min_distance <= margin;
       }
@@ -693,38 +707,48 @@ Exit runSynth(const SynthArgs& a) {
   const int frames = static_cast<int>(std::floor(a.seconds * a.fps + 1e-9));
   const double duration = (frames - 1) / a.fps;
   const double dt = 1.0 / a.log_rate;
-  const Trajectory trajectory = searchTrajectory(m, a, -a.time_offset, duration + 0.1, dt);
+  // The search works on the analytic motion; the frames show the logged one. A trajectory whose
+  // frames do not have exactly the wanted collision intervals is searched again (another stream).
+  const double max_gap = 1.5 * dt;
+  Trajectory trajectory;
+  std::string log_text;
+  StateLog log;
+  std::vector<std::vector<double>> states(frames, std::vector<double>(m.stateSize()));
+  std::vector<double> min_distance(frames);
+  std::vector<int> closest(frames, -1);
+  std::vector<std::array<int, 2>> intervals;
+  DistanceProbe probe(m);
+  for (int round = 0;; ++round) {
+    SynthArgs ar = a;
+    ar.seed = a.seed + 0x51ED270B27ull * static_cast<std::uint64_t>(round);
+    trajectory = searchTrajectory(m, ar, -a.time_offset, duration + 0.1, dt);
+    log_text = stateLogText(m, trajectory, a.time_offset, a.log_rate, duration);
+    log = parseStateLog(log_text, "states.csv", m);
+    // Per frame: the logged state at the frame's log time, its distances.
+    for (int i = 0; i < frames; ++i) {
+      const double t = i / a.fps;
+      if (stateAt(log, t + a.time_offset, max_gap, states[i]) == StateMatch::None)
+        throw std::logic_error("synth: the log misses frame " + std::to_string(i));
+      min_distance[i] = probe(states[i], &closest[i]);
+    }
+    intervals.clear();
+    for (int i = 0; i < frames; ++i)
+      if (min_distance[i] <= 0.0) {
+        if (!intervals.empty() && intervals.back()[1] == i - 1)
+          intervals.back()[1] = i;
+        else
+          intervals.push_back({i, i});
+      }
+    if (intervals.size() == (a.no_collision ? 0u : 1u)) break;
+    if (round == 7)
+      throw UsageError(a.model + ": the trajectories found have " + std::to_string(intervals.size()) +
+                       " collision intervals at this frame rate (try another --seed, --fps or --seconds)");
+  }
   const auto t_traj = Clock::now();
-
-  const std::string log_text = stateLogText(m, trajectory, a.time_offset, a.log_rate, duration);
-  const StateLog log = parseStateLog(log_text, "states.csv", m);
   const Box3 box = robotBox(m, log);
   const calib::Camera camera = given ? *given : defaultCamera(box, a.width, a.height);
   const Room room = makeRoom(box, camera.worldToCamera().inverse().translation());
 
-  // Per frame: the logged state at the frame's log time, its distances.
-  const double max_gap = 1.5 * dt;
-  std::vector<std::vector<double>> states(frames, std::vector<double>(m.stateSize()));
-  std::vector<double> min_distance(frames);
-  std::vector<int> closest(frames, -1);
-  DistanceProbe probe(m);
-  for (int i = 0; i < frames; ++i) {
-    const double t = i / a.fps;
-    if (stateAt(log, t + a.time_offset, max_gap, states[i]) == StateMatch::None)
-      throw std::logic_error("synth: the log misses frame " + std::to_string(i));
-    min_distance[i] = probe(states[i], &closest[i]);
-  }
-  std::vector<std::array<int, 2>> intervals;
-  for (int i = 0; i < frames; ++i)
-    if (min_distance[i] <= 0.0) {
-      if (!intervals.empty() && intervals.back()[1] == i - 1)
-        intervals.back()[1] = i;
-      else
-        intervals.push_back({i, i});
-    }
-  if (intervals.size() != (a.no_collision ? 0u : 1u))
-    throw UsageError(a.model + ": the trajectory has " + std::to_string(intervals.size()) +
-                     " collision intervals at this frame rate (try another --seed or --fps)");
 
   // Renderer: the visible geometry, shaded, with its label mask.
   render::RenderOptions ro;
