@@ -6,8 +6,8 @@
 
 #include <unistd.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -97,7 +97,8 @@ TEST_F(Synth, WritesEveryFile) {
   const std::string intr = kccd::testing::readText(dir("a") + "/intrinsics.yaml");
   EXPECT_EQ(intr.find("rvec"), std::string::npos);
   EXPECT_THROW(kccd::calib::loadCamera(dir("a") + "/intrinsics.yaml"), kccd::calib::CameraError);
-  const kccd::calib::Camera k = kccd::calib::loadCamera(dir("a") + "/intrinsics.yaml", kccd::calib::CameraPose::Optional);
+  const kccd::calib::Camera k =
+      kccd::calib::loadCamera(dir("a") + "/intrinsics.yaml", kccd::calib::CameraPose::Optional);
   EXPECT_EQ(k.camera_matrix, cam.camera_matrix);
   EXPECT_EQ(k.distortion, cam.distortion);
 }
@@ -154,8 +155,10 @@ TEST_F(Synth, CollisionFramesCollideAtTheLoggedState) {
     const kccd::QueryResult& r = checker.query(s, s, kccd::QueryOptions{.type = kccd::QueryType::Distances});
     ASSERT_EQ(r.status, kccd::Status::Ok);
     EXPECT_DOUBLE_EQ(r.min_distance, static_cast<double>(f["min_distance"]));
-    if (r.min_distance <= 0.0) colliding.push_back(f["index"]);
-    else if (r.min_distance <= m.safety_margin) near.push_back(f["index"]);
+    if (r.min_distance <= 0.0)
+      colliding.push_back(f["index"]);
+    else if (r.min_distance <= m.safety_margin)
+      near.push_back(f["index"]);
   }
   EXPECT_EQ(colliding, j["collision"]["frames"].get<std::vector<int>>());
   EXPECT_EQ(near, j["near_collision_frames"].get<std::vector<int>>());
@@ -208,8 +211,8 @@ TEST_F(Synth, CalibrationRecoversTheTrueCamera) {
   ASSERT_FALSE(video.empty());
   const std::string frame = dir("frame0.png"), solved = dir("solved.yaml");
   ASSERT_TRUE(cv::imwrite(frame, video[0]));
-  const Outcome r = runKccd("calib --intrinsics " + dir("a") + "/intrinsics.yaml --image " + frame + " --tags " + dir("a") +
-                            "/tags.yaml -o " + solved + " -q");
+  const Outcome r = runKccd("calib --intrinsics " + dir("a") + "/intrinsics.yaml --image " + frame + " --tags " +
+                            dir("a") + "/tags.yaml -o " + solved + " -q");
   ASSERT_EQ(r.code, 0) << r.err << r.out;
   const kccd::calib::Camera truth = kccd::calib::loadCamera(dir("a") + "/camera_true.yaml");
   const kccd::calib::Camera got = kccd::calib::loadCamera(solved);
@@ -242,7 +245,8 @@ TEST_F(Synth, SameSeedSameFiles) {
 }
 
 TEST_F(Synth, NoCollisionOption) {
-  const Outcome r = runKccd("synth " + kHumanoid + " -o " + dir("c") + " --seconds 1 --fps 20 --seed 5 --no-collision -q");
+  const Outcome r =
+      runKccd("synth " + kHumanoid + " -o " + dir("c") + " --seconds 1 --fps 20 --seed 5 --no-collision -q");
   ASSERT_EQ(r.code, 0) << r.err;
   const json j = summary("c");
   EXPECT_TRUE(j["collision"]["frames"].empty());

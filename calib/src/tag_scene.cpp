@@ -188,10 +188,10 @@ std::shared_ptr<const RayGrid> rayGrid(const Camera& camera) {
 struct PlacedTag {
   cv::Vec3d origin, ex, ey, n;  // centre and axes in the camera frame
   double n_o = 0, ex_o = 0, ey_o = 0;
-  double inv_cell = 0;               // cells per metre
-  double half = 5;                   // half the bitmap's width in cells
-  int cells = 10;                    // bitmap width in cells
-  std::vector<cv::Vec3f> value;      // cells x cells colours, row 0 at the top of the printed tag (tag +y)
+  double inv_cell = 0;           // cells per metre
+  double half = 5;               // half the bitmap's width in cells
+  int cells = 10;                // bitmap width in cells
+  std::vector<cv::Vec3f> value;  // cells x cells colours, row 0 at the top of the printed tag (tag +y)
   // Surfaces: a rectangle of half extents half_x, half_y (metres) with checker tiles.
   bool surface = false;
   double half_x = 0, half_y = 0, inv_tile = 0;
@@ -235,7 +235,8 @@ inline Hit castRay(const std::vector<PlacedTag>& tags, const Light& light, doubl
       best = depth;
       best_t = t;
       if (p.inv_tile > 0) {
-        const long ia = static_cast<long>(std::floor(a * p.inv_tile)), ib = static_cast<long>(std::floor(b * p.inv_tile));
+        const long ia = static_cast<long>(std::floor(a * p.inv_tile)),
+                   ib = static_cast<long>(std::floor(b * p.inv_tile));
         const bool odd = ((ia + ib) & 1) != 0;
         hit.key = static_cast<int>(t) * 1024 + static_cast<int>(((ia & 31) << 5) | (ib & 31));
         hit.value = odd ? p.tile_colour : p.colour;
@@ -330,13 +331,14 @@ std::vector<PlacedTag> placeTags(const Camera& camera, const TagLayout& layout, 
     p.ey = cv::Vec3d(r_cs(0, 1), r_cs(1, 1), r_cs(2, 1));
     p.n = cv::Vec3d(r_cs(0, 2), r_cs(1, 2), r_cs(2, 2));
     p.n_o = p.n.dot(p.origin);
-    if (p.n_o == 0) continue;  // seen edge-on
+    if (p.n_o == 0) continue;                   // seen edge-on
     if (p.n_o > 0) p.n = -p.n, p.n_o = -p.n_o;  // seen from its back: drawn all the same
     p.ex_o = p.ex.dot(p.origin);
     p.ey_o = p.ey.dot(p.origin);
     p.half_x = s.half_x, p.half_y = s.half_y;
     p.inv_tile = s.tile > 0 ? 1.0 / s.tile : 0.0;
-    p.colour = cv::Vec3f(static_cast<float>(s.colour[0]), static_cast<float>(s.colour[1]), static_cast<float>(s.colour[2]));
+    p.colour =
+        cv::Vec3f(static_cast<float>(s.colour[0]), static_cast<float>(s.colour[1]), static_cast<float>(s.colour[2]));
     p.tile_colour = cv::Vec3f(static_cast<float>(s.tile_colour[0]), static_cast<float>(s.tile_colour[1]),
                               static_cast<float>(s.tile_colour[2]));
     out.push_back(std::move(p));
@@ -364,7 +366,7 @@ void markOutlines(std::vector<PlacedTag>& tags, const RayGrid& g, const Lens& le
   scale *= 2;  // margin for the parts of the field between grid samples and beyond the image
   for (PlacedTag& p : tags) {
     if (p.surface) continue;  // large: their edges are found by the corner keys
-    bool whole = true;  // every edge in front of the camera and in the trusted field
+    bool whole = true;        // every edge in front of the camera and in the trusted field
     double u_lo = 1e300, u_hi = -1e300, v_lo = 1e300, v_hi = -1e300;
     for (std::size_t c = 0; c < 4; ++c) {
       cv::Vec3d a = p.outline[c], b = p.outline[(c + 1) % 4];

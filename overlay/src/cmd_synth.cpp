@@ -177,7 +177,8 @@ Trajectory searchTrajectory(const Model& m, const SynthArgs& a, double t0, doubl
   const double w = std::clamp(0.12 * span, 0.35, 0.9);
   std::vector<Event> plan;
   // The collision (or the middle near one) first; the others where they fit.
-  for (const auto& [f, kind] : {std::pair{0.6, Event::Collision}, std::pair{0.25, Event::Near}, std::pair{0.87, Event::Near}}) {
+  for (const auto& [f, kind] :
+       {std::pair{0.6, Event::Collision}, std::pair{0.25, Event::Near}, std::pair{0.87, Event::Near}}) {
     Event e;
     e.kind = a.no_collision ? Event::Near : kind;
     e.time = f * span;
@@ -288,7 +289,9 @@ Trajectory searchTrajectory(const Model& m, const SynthArgs& a, double t0, doubl
         else
           found = e.min_distance > 0.3 * near_target && e.min_distance <= 1.6 * near_target && e.min_distance <= margin;
       }
-      if (debug) std::fprintf(stderr, "event %d at %.2f: found %d beta %.3f min %.4f\n", int(e.kind), e.time, int(found), e.beta, e.min_distance);
+      if (debug)
+        std::fprintf(stderr, "event %d at %.2f: found %d beta %.3f min %.4f\n", int(e.kind), e.time, int(found), e.beta,
+                     e.min_distance);
       if (!found) {
         ok = false;
         break;
@@ -337,7 +340,8 @@ calib::Camera defaultCamera(const Box3& box, int width, int height) {
   calib::Camera c;
   c.width = width, c.height = height;
   const double f = 0.8 * width;
-  c.camera_matrix = cv::Matx33d(f, 0, 0.5 * width - 0.5 + 0.0031 * width, 0, f, 0.5 * height - 0.5 - 0.0029 * height, 0, 0, 1);
+  c.camera_matrix =
+      cv::Matx33d(f, 0, 0.5 * width - 0.5 + 0.0031 * width, 0, f, 0.5 * height - 0.5 - 0.0029 * height, 0, 0, 1);
   c.distortion = {-0.12, 0.07, 0.0005, -0.0003, -0.015};
   const Vec3 target = 0.5 * (box.lo + box.hi);
   const double radius = std::max(0.4, 0.5 * (box.hi - box.lo).norm());
@@ -497,7 +501,8 @@ calib::TagLayout makeTags(const Room& room, const Box3& box, const calib::Camera
     }
     if (!inside || edge < 30.0) continue;
     std::vector<cv::Point> poly;
-    for (const cv::Point2d& p : px) poly.emplace_back(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
+    for (const cv::Point2d& p : px)
+      poly.emplace_back(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
     cv::Mat area = cv::Mat::zeros(covered.size(), CV_8U);
     cv::fillConvexPoly(area, poly, cv::Scalar(255));
     if (cv::countNonZero(area & covered) > 0) continue;
@@ -574,14 +579,20 @@ cv::Scalar bodyColour(const Model& m, std::size_t i) {
 class Writer {
  public:
   Writer(cv::VideoWriter& video, std::string mask_dir, double blur, double noise, std::uint64_t seed)
-      : video_(video), mask_dir_(std::move(mask_dir)), blur_(blur), noise_(noise), seed_(seed),
-        thread_([this] { loop(); }) {}
+      : video_(video), mask_dir_(std::move(mask_dir)), blur_(blur), noise_(noise), seed_(seed), thread_([this] {
+          loop();
+        }) {}
   ~Writer() { finish(); }
   void push(int index, cv::Mat frame, cv::Mat mask) {
     std::unique_lock<std::mutex> lock(mutex_);
     space_.wait(lock, [&] { return queue_.size() < 2; });
     queue_.push_back({index, std::move(frame), std::move(mask)});
     ready_.notify_one();
+  }
+  /// Lens vignetting: a gain per pixel (CV_8UC3, 255 = 1) applied before blur and noise.
+  void setVignette(cv::Mat gain) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    vignette_ = std::move(gain);
   }
   void finish() {
     {
@@ -612,6 +623,7 @@ class Writer {
       }
       if (!error_.empty()) continue;
       cv::Mat f = item.frame;
+      if (!vignette_.empty()) cv::multiply(f, vignette_, f, 1.0 / 255.0);
       if (blur_ > 0) cv::GaussianBlur(f, f, cv::Size(0, 0), blur_, blur_, cv::BORDER_REFLECT);
       if (noise_ > 0) {
         cv::Mat noisy, n(f.size(), CV_16SC3);
@@ -640,6 +652,7 @@ class Writer {
   }
   cv::VideoWriter& video_;
   std::string mask_dir_;
+  cv::Mat vignette_;
   double blur_, noise_;
   std::uint64_t seed_;
   std::mutex mutex_;
@@ -690,14 +703,16 @@ Exit runSynth(const SynthArgs& a) {
     throw UsageError("-o " + a.output + ": give a folder name");
   const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
   std::error_code ec;
-  if (!fs::is_directory(parent, ec)) throw UsageError("-o " + a.output + ": folder " + parent.string() + " does not exist");
+  if (!fs::is_directory(parent, ec))
+    throw UsageError("-o " + a.output + ": folder " + parent.string() + " does not exist");
   if (fs::exists(out, ec) && !(fs::is_directory(out, ec) && fs::is_empty(out, ec)) && !a.force)
     throw UsageError("-o " + a.output + ": exists and is not an empty folder (use --force to replace it)");
 
   // The camera (given, or placed after the trajectory is known).
   std::optional<calib::Camera> given;
   if (!a.camera.empty()) {
-    if (a.size_given) throw UsageError("--width/--height shape the default camera; the camera file " + a.camera + " fixes the size");
+    if (a.size_given)
+      throw UsageError("--width/--height shape the default camera; the camera file " + a.camera + " fixes the size");
     given = calib::loadCamera(a.camera);
   } else if (a.width < 64 || a.height < 64 || a.width > 4096 || a.height > 4096) {
     throw UsageError("--width/--height: must be 64 ... 4096 pixels");
@@ -749,7 +764,6 @@ Exit runSynth(const SynthArgs& a) {
   const calib::Camera camera = given ? *given : defaultCamera(box, a.width, a.height);
   const Room room = makeRoom(box, camera.worldToCamera().inverse().translation());
 
-
   // Renderer: the visible geometry, shaded, with its label mask.
   render::RenderOptions ro;
   ro.supersample = 2.0;
@@ -785,8 +799,8 @@ Exit runSynth(const SynthArgs& a) {
     layout = makeTags(room, box, camera, f0.mask, visible_tags);
   }
   if (layout.tags.size() < 4)
-    throw UsageError("camera: it sees fewer than 4 whole tags of the synthetic room (" + std::to_string(layout.tags.size()) +
-                     "); point it at the robot from farther away");
+    throw UsageError("camera: it sees fewer than 4 whole tags of the synthetic room (" +
+                     std::to_string(layout.tags.size()) + "); point it at the robot from farther away");
 
   // The static background: floor, walls, tags, light.
   calib::TagSceneOptions so;
@@ -815,6 +829,19 @@ Exit runSynth(const SynthArgs& a) {
   int written = 0;
   {
     Writer writer(video, mask_dir, a.blur, a.noise, a.seed);
+    {
+      // Natural vignetting: 1 - 0.25 r^2, r the distance from the principal point over the half diagonal.
+      cv::Mat gain(camera.height, camera.width, CV_8UC3);
+      const double cx = camera.camera_matrix(0, 2), cy = camera.camera_matrix(1, 2);
+      const double half_diagonal2 = 0.25 * (static_cast<double>(camera.width) * camera.width +
+                                            static_cast<double>(camera.height) * camera.height);
+      for (int v = 0; v < camera.height; ++v)
+        for (int u = 0; u < camera.width; ++u) {
+          const double r2 = ((u - cx) * (u - cx) + (v - cy) * (v - cy)) / half_diagonal2;
+          gain.at<cv::Vec3b>(v, u) = cv::Vec3b::all(cv::saturate_cast<uchar>(255.0 * (1.0 - 0.25 * std::min(r2, 2.0))));
+        }
+      writer.setVignette(gain);
+    }
     for (int i = 0; i < frames; ++i) {
       const auto r0 = Clock::now();
       const std::vector<render::Volume> visible = volumesAt(states[i], a.shrink);
@@ -831,7 +858,8 @@ Exit runSynth(const SynthArgs& a) {
   }
   video.release();
   progress.finish();
-  if (written != frames) throw std::runtime_error("synth: wrote " + std::to_string(written) + " of " + std::to_string(frames) + " frames");
+  if (written != frames)
+    throw std::runtime_error("synth: wrote " + std::to_string(written) + " of " + std::to_string(frames) + " frames");
 
   // Text outputs.
   writeFileAtomically(tmp.path + "/states.csv", log_text);
@@ -846,17 +874,25 @@ Exit runSynth(const SynthArgs& a) {
   j["model_name"] = m.name;
   j["seed"] = a.seed;
   j["margin"] = m.safety_margin;
-  j["video"] = {{"file", video_name}, {"codec", a.codec}, {"fps", a.fps}, {"frames", frames},
-                {"width", camera.width}, {"height", camera.height},
-                {"frame_time", "frame i is at video time i / fps"}, {"blur_sigma_px", a.blur}, {"noise_sigma", a.noise}};
-  j["state_log"] = {{"file", "states.csv"}, {"rate_hz", a.log_rate}, {"rows", log.rows()}, {"velocity_columns", true},
+  j["video"] = {{"file", video_name},
+                {"codec", a.codec},
+                {"fps", a.fps},
+                {"frames", frames},
+                {"width", camera.width},
+                {"height", camera.height},
+                {"frame_time", "frame i is at video time i / fps"},
+                {"blur_sigma_px", a.blur},
+                {"noise_sigma", a.noise}};
+  j["state_log"] = {{"file", "states.csv"},         {"rate_hz", a.log_rate},
+                    {"rows", log.rows()},           {"velocity_columns", true},
                     {"time_offset", a.time_offset}, {"clock", "log time = video time + time_offset"}};
   const Pose c2w = camera.worldToCamera().inverse();
-  j["camera"] = {{"file", "camera_true.yaml"}, {"intrinsics_file", "intrinsics.yaml"}, {"given", !a.camera.empty()},
-                 {"rvec", vecJson(camera.rvec)}, {"tvec", vecJson(camera.tvec)},
-                 {"position", vec3(c2w.translation())}};
+  j["camera"] = {{"file", "camera_true.yaml"},   {"intrinsics_file", "intrinsics.yaml"},
+                 {"given", !a.camera.empty()},   {"rvec", vecJson(camera.rvec)},
+                 {"tvec", vecJson(camera.tvec)}, {"position", vec3(c2w.translation())}};
   j["tags"] = {{"file", "tags.yaml"}, {"count", layout.tags.size()}, {"visible_in_first_frame", visible_tags}};
-  j["masks"] = {{"folder", "masks"}, {"pattern", "frame_%06d.png"},
+  j["masks"] = {{"folder", "masks"},
+                {"pattern", "frame_%06d.png"},
                 {"labels", "0 background, i + 1 where body i's visible geometry is nearest (model order)"},
                 {"visible_radius_scale", a.shrink}};
   j["render"] = {{"supersample", ro.supersample}, {"mask_supersample", ro.mask_supersample}};
@@ -865,10 +901,13 @@ Exit runSynth(const SynthArgs& a) {
   for (int i = 0; i < frames; ++i) {
     const double d = min_distance[i];
     const char* status = d <= 0.0 ? "colliding" : d <= m.safety_margin ? "within_margin" : "clear";
-    if (d <= 0.0) coll.push_back(i);
-    else if (d <= m.safety_margin) near.push_back(i);
-    nlohmann::json fj = {{"index", i}, {"time", i / a.fps}, {"log_time", i / a.fps + a.time_offset},
-                         {"min_distance", number(d)}, {"status", status}, {"state", states[i]}};
+    if (d <= 0.0)
+      coll.push_back(i);
+    else if (d <= m.safety_margin)
+      near.push_back(i);
+    nlohmann::json fj = {
+        {"index", i},       {"time", i / a.fps}, {"log_time", i / a.fps + a.time_offset}, {"min_distance", number(d)},
+        {"status", status}, {"state", states[i]}};
     if (closest[i] >= 0)
       fj["closest_pair"] = {m.bodies[m.pairs[closest[i]].a].name, m.bodies[m.pairs[closest[i]].b].name};
     frames_json.push_back(fj);
@@ -880,12 +919,18 @@ Exit runSynth(const SynthArgs& a) {
   j["near_collision_frames"] = near;
   nlohmann::json ev = nlohmann::json::array();
   for (const Event& e : trajectory.events)
-    ev.push_back({{"kind", e.kind == Event::Collision ? "collision" : "near"}, {"time", e.time},
-                  {"half_width", e.half_width}, {"blend", e.beta}, {"min_distance", number(e.min_distance)}});
+    ev.push_back({{"kind", e.kind == Event::Collision ? "collision" : "near"},
+                  {"time", e.time},
+                  {"half_width", e.half_width},
+                  {"plateau", e.plateau},
+                  {"blend", e.beta},
+                  {"min_distance", number(e.min_distance)}});
   j["events"] = ev;
   j["frames"] = frames_json;
-  j["timing"] = {{"total_s", seconds(t_start, t_end)}, {"trajectory_s", seconds(t_start, t_traj)},
-                 {"background_s", seconds(t_traj, t_bg)}, {"render_ms_per_frame", 1e3 * render_s / frames},
+  j["timing"] = {{"total_s", seconds(t_start, t_end)},
+                 {"trajectory_s", seconds(t_start, t_traj)},
+                 {"background_s", seconds(t_traj, t_bg)},
+                 {"render_ms_per_frame", 1e3 * render_s / frames},
                  {"renderer", renderer->rendererString()}};
   writeFileAtomically(tmp.path + "/synth.json", j.dump(1) + "\n");
 
@@ -897,7 +942,8 @@ Exit runSynth(const SynthArgs& a) {
       std::string old = (parent / ("." + out.filename().string() + ".old-XXXXXX")).string();
       if (!mkdtemp(old.data())) throw UsageError("-o " + a.output + ": cannot move the old folder aside");
       fs::remove(old, ec);
-      if (std::rename(out.c_str(), old.c_str()) != 0) throw UsageError("-o " + a.output + ": cannot move the old folder aside");
+      if (std::rename(out.c_str(), old.c_str()) != 0)
+        throw UsageError("-o " + a.output + ": cannot move the old folder aside");
       if (std::rename(tmp.path.c_str(), out.c_str()) != 0) {
         std::rename(old.c_str(), out.c_str());
         throw UsageError("-o " + a.output + ": cannot rename the new folder into place");
@@ -907,7 +953,8 @@ Exit runSynth(const SynthArgs& a) {
     }
   }
   if (!tmp.keep) {
-    if (std::rename(tmp.path.c_str(), out.c_str()) != 0) throw UsageError("-o " + a.output + ": cannot rename the new folder into place");
+    if (std::rename(tmp.path.c_str(), out.c_str()) != 0)
+      throw UsageError("-o " + a.output + ": cannot rename the new folder into place");
     tmp.keep = true;
   }
   if (!a.quiet) {
@@ -931,23 +978,38 @@ Runner addSynth(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "synth", "Synthetic recording with ground truth: video, state log, true camera, tags, masks, summary");
   sub->add_option("model", a->model, "Model file (YAML, kccd: 1)")->required();
-  sub->add_option("-o,--output", a->output, "Output folder (created; complete only when the command succeeds)")->required();
-  sub->add_option("--camera", a->camera, "Camera file to film with (default: one placed to see the robot, the floor and two walls)");
-  sub->add_option("--seconds", a->seconds, "Length of the recording (s)")->capture_default_str()->check(finiteIn(0.04, 600));
+  sub->add_option("-o,--output", a->output, "Output folder (created; complete only when the command succeeds)")
+      ->required();
+  sub->add_option("--camera", a->camera,
+                  "Camera file to film with (default: one placed to see the robot, the floor and two walls)");
+  sub->add_option("--seconds", a->seconds, "Length of the recording (s)")
+      ->capture_default_str()
+      ->check(finiteIn(0.04, 600));
   sub->add_option("--fps", a->fps, "Video frame rate")->capture_default_str()->check(finiteIn(1, 240));
   CLI::Option* width = sub->add_option("--width", a->width, "Image width of the default camera (px)")
-                           ->capture_default_str()->check(CLI::Range(64, 4096));
+                           ->capture_default_str()
+                           ->check(CLI::Range(64, 4096));
   CLI::Option* height = sub->add_option("--height", a->height, "Image height of the default camera (px)")
-                            ->capture_default_str()->check(CLI::Range(64, 4096));
+                            ->capture_default_str()
+                            ->check(CLI::Range(64, 4096));
   sub->add_option("--seed", a->seed, "Seed of the trajectory search and the noise")->capture_default_str();
-  sub->add_option("--codec", a->codec, "ffv1 (video.mkv, lossless), mjpg (video.avi) or mp4v (video.mp4)")->capture_default_str();
-  sub->add_option("--log-rate", a->log_rate, "State log rate (Hz; must differ from --fps)")->capture_default_str()->check(finiteIn(1, 10000));
+  sub->add_option("--codec", a->codec, "ffv1 (video.mkv, lossless), mjpg (video.avi) or mp4v (video.mp4)")
+      ->capture_default_str();
+  sub->add_option("--log-rate", a->log_rate, "State log rate (Hz; must differ from --fps)")
+      ->capture_default_str()
+      ->check(finiteIn(1, 10000));
   sub->add_option("--time-offset", a->time_offset, "Log clock minus video clock (s; the log starts at log time 0)")
-      ->capture_default_str()->check(finiteIn(0, 10));
+      ->capture_default_str()
+      ->check(finiteIn(0, 10));
   sub->add_option("--visible-scale", a->shrink, "Radius of the visible geometry as a fraction of the SSCH radius")
-      ->capture_default_str()->check(finiteIn(0.1, 0.95));
-  sub->add_option("--blur", a->blur, "Gaussian blur of every frame (sigma, px)")->capture_default_str()->check(finiteIn(0, 10));
-  sub->add_option("--noise", a->noise, "Gaussian sensor noise (sigma, grey levels)")->capture_default_str()->check(finiteIn(0, 50));
+      ->capture_default_str()
+      ->check(finiteIn(0.1, 0.95));
+  sub->add_option("--blur", a->blur, "Gaussian blur of every frame (sigma, px)")
+      ->capture_default_str()
+      ->check(finiteIn(0, 10));
+  sub->add_option("--noise", a->noise, "Gaussian sensor noise (sigma, grey levels)")
+      ->capture_default_str()
+      ->check(finiteIn(0, 50));
   sub->add_flag("--no-collision", a->no_collision, "Only near-collisions, no real one");
   sub->add_flag("--force", a->force, "Replace an existing output folder");
   sub->add_flag("-q,--quiet", a->quiet, "No progress and no summary line");

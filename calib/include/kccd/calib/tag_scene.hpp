@@ -19,11 +19,11 @@ namespace kccd::calib {
 /// A flat rectangle behind the tags (a floor, a wall), drawn from whichever side the camera is on.
 /// Tags fixed to it must lie slightly in front of it (nearest hit wins).
 struct SceneSurface {
-  Pose pose = Pose::Identity();          ///< surface frame -> world; the rectangle is in its x-y plane
-  double half_x = 1.0, half_y = 1.0;     ///< half extents along the surface's x and y, metres
-  cv::Scalar colour{200, 200, 200};      ///< BGR, 0..255
-  double tile = 0.0;                     ///< checker tiles of this edge (metres); 0: plain
-  cv::Scalar tile_colour{180, 180, 180}; ///< the other tiles' colour
+  Pose pose = Pose::Identity();           ///< surface frame -> world; the rectangle is in its x-y plane
+  double half_x = 1.0, half_y = 1.0;      ///< half extents along the surface's x and y, metres
+  cv::Scalar colour{200, 200, 200};       ///< BGR, 0..255
+  double tile = 0.0;                      ///< checker tiles of this edge (metres); 0: plain
+  cv::Scalar tile_colour{180, 180, 180};  ///< the other tiles' colour
 };
 
 /// A point light: every surface and tag hit is scaled by ambient + diffuse * cos(incidence) *
@@ -32,20 +32,20 @@ struct SceneLight {
   bool on = false;
   Vec3 position = Vec3::Zero();  ///< world, metres
   double ambient = 1.0, diffuse = 0.0;
-  double reference = 1.0;        ///< distance at which the diffuse term is `diffuse` at normal incidence
+  double reference = 1.0;  ///< distance at which the diffuse term is `diffuse` at normal incidence
 };
 
 /// How a tag scene is drawn. Grey levels are 0..255; the image is rounded and clipped to 8 bits
 /// after blur and noise.
 struct TagSceneOptions {
-  int supersample = 4;        ///< s: s x s sub-pixel rays (n-rooks pattern) in pixels at cell edges (1..16)
-  double white = 230.0;       ///< the tags' white cells
-  double black = 25.0;        ///< the tags' black cells
-  double background = 200.0;  ///< grey behind the tags (where no tag is hit)
-  bool texture = false;       ///< a smooth random grey texture plus clutter (shapes, lines) behind the tags
-  double blur_sigma = 0.0;    ///< Gaussian blur of the whole image, pixels (0: none)
-  double noise_sigma = 0.0;   ///< additive Gaussian noise, grey levels (0: none)
-  std::uint64_t seed = 1;     ///< texture, clutter and noise
+  int supersample = 4;                 ///< s: s x s sub-pixel rays (n-rooks pattern) in pixels at cell edges (1..16)
+  double white = 230.0;                ///< the tags' white cells
+  double black = 25.0;                 ///< the tags' black cells
+  double background = 200.0;           ///< grey behind the tags (where no tag is hit)
+  bool texture = false;                ///< a smooth random grey texture plus clutter (shapes, lines) behind the tags
+  double blur_sigma = 0.0;             ///< Gaussian blur of the whole image, pixels (0: none)
+  double noise_sigma = 0.0;            ///< additive Gaussian noise, grey levels (0: none)
+  std::uint64_t seed = 1;              ///< texture, clutter and noise
   std::vector<SceneSurface> surfaces;  ///< floor and walls (none: only the background grey)
   SceneLight light;                    ///< lighting of tags and surfaces (off: unlit)
 };
