@@ -54,6 +54,7 @@ cv::Scalar statusColour(VolumeStatus status) {
 struct Renderer::Gl {
   GLuint ms_fbo = 0, ms_colour = 0;
   GLuint resolve_fbo = 0, resolve_colour = 0;
+  GLuint ms_depth = 0, resolve_depth = 0;  // depth for the shaded (opaque) look
   GLuint mask_fbo = 0, mask_colour = 0, mask_depth = 0;
   int samples = 0;
   int width = 0, height = 0;
@@ -89,12 +90,16 @@ struct Renderer::Gl {
     glGenFramebuffers(1, &resolve_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, resolve_colour);
+    resolve_depth = renderbuffer(GL_DEPTH_COMPONENT24, 0, w, h);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, resolve_depth);
     check(resolve_fbo, "colour");
     if (samples > 1) {
       ms_colour = renderbuffer(GL_RGBA8, samples, w, h);
       glGenFramebuffers(1, &ms_fbo);
       glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
       glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ms_colour);
+      ms_depth = renderbuffer(GL_DEPTH_COMPONENT24, samples, w, h);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth);
       check(ms_fbo, "multisample colour");
     }
     mask_colour = renderbuffer(GL_RGBA8, 0, mw, mh);
@@ -108,9 +113,9 @@ struct Renderer::Gl {
   }
   ~Gl() {
     const GLuint fbos[] = {ms_fbo, resolve_fbo, mask_fbo};
-    const GLuint rbs[] = {ms_colour, resolve_colour, mask_colour, mask_depth};
+    const GLuint rbs[] = {ms_colour, resolve_colour, mask_colour, mask_depth, ms_depth, resolve_depth};
     glDeleteFramebuffers(3, fbos);
-    glDeleteRenderbuffers(4, rbs);
+    glDeleteRenderbuffers(6, rbs);
   }
 };
 
@@ -119,6 +124,8 @@ struct Renderer::Gl {
 struct Renderer::Prepared {
   int index = 0;
   VolumeStatus status = VolumeStatus::NoState;
+  cv::Scalar colour;      // fill colour (BGR)
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // volume frame -> camera
   std::shared_ptr<const Mesh> mesh;
   std::vector<float> vertices;
   std::vector<std::uint32_t> outline;
@@ -175,6 +182,7 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     Prepared& p = out[i];
     p.index = static_cast<int>(i);
     p.status = v.status;
+    p.colour = v.colour[0] >= 0 ? v.colour : statusColour(v.status);
     p.mesh.reset();
     p.vertices.clear();
     p.outline.clear();
@@ -184,6 +192,7 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     // Tessellation fine enough that the circumscribed sphere polytope lies at most
     // tolerance_px outside the true surface, as seen from the closest point of the volume.
     const Pose to_camera = world_to_camera_ * v.pose;
+    p.rotation = to_camera.linear();
     cam_points.clear();
     double zmin = 1e300, zmax = -1e300;
     Vec3 centre = Vec3::Zero();
@@ -319,7 +328,14 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   glBindFramebuffer(GL_FRAMEBUFFER, gl_->samples > 1 ? gl_->ms_fbo : gl_->resolve_fbo);
   setCamera(projection_, near, far);
   glClearColor(0, 0, 0, 0);
-  glClear(GL_COLOR_BUFFER_BIT);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (style.shaded) {
+    std::vector<const Prepared*> all;
+    for (const Prepared& p : bodies)
+      if (p.mesh) all.push_back(&p);
+    drawShaded(all, style.ambient);
+  } else {
   glDisable(GL_DEPTH_TEST);
   glEnable(GL_BLEND);
   // Premultiplied result on a transparent clear; converted to straight alpha after read-back.
@@ -330,7 +346,7 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
     if (p.mesh) order.push_back(&p);
   std::sort(order.begin(), order.end(), [](const Prepared* a, const Prepared* b) { return a->depth > b->depth; });
   for (const Prepared* p : order) {
-    const cv::Scalar c = statusColour(p->status);  // BGR, drawn as GL's RGB (see the read-back)
+    const cv::Scalar c = p->colour;  // BGR, drawn as GL's RGB (see the read-back)
     glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
     drawTriangles(*p->mesh, p->vertices);
   }
@@ -338,7 +354,7 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   glEnable(GL_LINE_SMOOTH);  // coverage in alpha, blended like the fill
   glHint(GL_LINE_SMOOTH_HINT, GL_NICEST);
   for (const Prepared* p : order) {
-    const cv::Scalar c = statusColour(p->status) * 0.7;
+    const cv::Scalar c = p->colour * 0.7;
     glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
     glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
     glDrawElements(GL_LINES, static_cast<GLsizei>(p->outline.size()), GL_UNSIGNED_INT, p->outline.data());
@@ -347,11 +363,12 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   // Volumes containing the camera tint the whole view, in front of everything else.
   for (const Prepared& p : bodies)
     if (p.fills) {
-      const cv::Scalar c = statusColour(p.status);
+      const cv::Scalar c = p.colour;
       glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
       fillViewport();
     }
   glDisable(GL_BLEND);
+  }
   if (gl_->samples > 1) {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->ms_fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, gl_->resolve_fbo);
@@ -392,6 +409,42 @@ cv::Mat Renderer::drawMask(const std::vector<Prepared>& bodies, double near, dou
   glReadPixels(0, 0, w, h, GL_RED, GL_UNSIGNED_BYTE, mask.data);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return mask;
+}
+
+// Opaque volumes, depth-tested, each vertex lit by Lambert's law with the normal averaged over its
+// triangles (smooth shading of the tessellated surface).
+void Renderer::drawShaded(const std::vector<const Prepared*>& order, double ambient) {
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_BLEND);
+  glShadeModel(GL_SMOOTH);
+  glEnableClientState(GL_COLOR_ARRAY);
+  // Light from the camera's upper left (camera frame: x right, y down, z forward), towards the scene.
+  const Vec3 to_light = Vec3(-0.45, -0.6, -1.0).normalized();
+  std::vector<Vec3> normals;
+  std::vector<float> colours;
+  for (const Prepared* p : order) {
+    const Mesh& m = *p->mesh;
+    normals.assign(m.vertices.size(), Vec3::Zero());
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+      for (const std::uint32_t k : m.triangles[t]) normals[k] += m.normals[t];
+    colours.resize(m.vertices.size() * 4);
+    for (std::size_t k = 0; k < m.vertices.size(); ++k) {
+      const Vec3 n = (p->rotation * normals[k]).normalized();
+      const double lambert = std::max(0.0, n.dot(to_light));
+      // A little rim darkening where the surface turns away from the camera (edges read as edges).
+      const Vec3 view = -Vec3(p->vertices[3 * k], p->vertices[3 * k + 1], p->vertices[3 * k + 2]).normalized();
+      const double facing = std::clamp(n.dot(view), 0.0, 1.0);
+      const double shade = (ambient + (1.0 - ambient) * lambert) * (0.75 + 0.25 * std::sqrt(facing));
+      for (int c = 0; c < 3; ++c) colours[4 * k + c] = static_cast<float>(std::min(1.0, p->colour[c] / 255.0 * shade));
+      colours[4 * k + 3] = 1.0f;
+    }
+    glColorPointer(4, GL_FLOAT, 0, colours.data());
+    glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.triangles.size() * 3), GL_UNSIGNED_INT, m.triangles.data());
+  }
+  glDisableClientState(GL_COLOR_ARRAY);
+  glDisable(GL_DEPTH_TEST);
 }
 
 Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool want_colour, bool want_mask) {

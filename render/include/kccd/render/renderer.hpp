@@ -49,6 +49,8 @@ struct Volume {
   VolumeStatus status = VolumeStatus::NoState;
   std::string label;  ///< shown with Style::labels
   Pose pose = Pose::Identity();
+  /// BGR fill colour overriding the status colour (used when colour[0] >= 0), e.g. for Style::shaded.
+  cv::Scalar colour{-1, -1, -1, -1};
 };
 
 /// The look of the colour layer.
@@ -57,6 +59,10 @@ struct Style {
   double outline_width = 2.0;  ///< outline width in output pixels (opaque, anti-aliased: smoothed lines)
   bool labels = false;         ///< body names at the projected volume centres
   bool legend = true;          ///< colour legend in the top-left corner
+  /// Opaque, lit volumes instead of the tinted overlay look: depth-tested, smooth (Gouraud) Lambert
+  /// shading by a light at the camera's upper left; fill_alpha and outline_width are not used.
+  bool shaded = false;
+  double ambient = 0.35;       ///< shaded: the unlit fraction of the colour
 };
 
 /// Renderer settings fixed at construction.
@@ -121,6 +127,7 @@ class Renderer {
   void prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame);
   cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style, double near, double far);
   cv::Mat drawMask(const std::vector<Prepared>& bodies, double near, double far);
+  static void drawShaded(const std::vector<const Prepared*>& order, double ambient);
   void decorate(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility,
                 const Style& style);
   static cv::Mat drawLegend(double scale, int thick);

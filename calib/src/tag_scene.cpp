@@ -5,8 +5,9 @@
 // corner), cached per intrinsics. A ray is intersected with every front-facing tag plane; the
 // nearest hit gives a (tag, cell) key. A pixel whose four corners share one key and that no tag
 // outline crosses lies inside one cell (cells are convex) and takes its value; every other pixel
-// is the mean of supersample^2 rays, each solved exactly at its sub-pixel position.
-#include "support/tag_scene.hpp"
+// is the mean of supersample^2 rays, each solved exactly at its sub-pixel position. Surfaces
+// (floor, walls) are cast like tags, their checker tiles taking the place of the tag cells.
+#include "kccd/calib/tag_scene.hpp"
 
 #include <apriltag/apriltag.h>
 #include <apriltag/common/image_u8.h>
@@ -24,7 +25,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
-namespace kccd::testing {
+namespace kccd::calib {
 namespace {
 
 using calib::Camera;
@@ -187,10 +188,14 @@ std::shared_ptr<const RayGrid> rayGrid(const Camera& camera) {
 struct PlacedTag {
   cv::Vec3d origin, ex, ey, n;  // centre and axes in the camera frame
   double n_o = 0, ex_o = 0, ey_o = 0;
-  double inv_cell = 0;               // cells per metre
-  double half = 5;                   // half the bitmap's width in cells
-  int cells = 10;                    // bitmap width in cells
-  std::vector<float> value;          // cells x cells grey levels, row 0 at the top of the printed tag (tag +y)
+  double inv_cell = 0;           // cells per metre
+  double half = 5;               // half the bitmap's width in cells
+  int cells = 10;                // bitmap width in cells
+  std::vector<cv::Vec3f> value;  // cells x cells colours, row 0 at the top of the printed tag (tag +y)
+  // Surfaces: a rectangle of half extents half_x, half_y (metres) with checker tiles.
+  bool surface = false;
+  double half_x = 0, half_y = 0, inv_tile = 0;
+  cv::Vec3f colour, tile_colour;
   std::array<cv::Vec3d, 4> outline;  // the bitmap's outer corners in the camera frame
   // Pixel box holding the tag's whole image (every pixel when its outline leaves the trusted field).
   double u_lo = -1e300, u_hi = 1e300, v_lo = -1e300, v_hi = 1e300;
@@ -201,13 +206,21 @@ constexpr int kInvalid = -2;
 
 struct Hit {
   int key = kBackground;  // tag * 1024 + cell, or kBackground
-  float value = 0;
+  cv::Vec3f value;
 };
 
-// The nearest front-facing tag cell on the ray (x, y, 1) of pixel position (u, v).
-inline Hit castRay(const std::vector<PlacedTag>& tags, double u, double v, double x, double y) {
+// The light in the camera frame.
+struct Light {
+  bool on = false;
+  cv::Vec3d position;
+  double ambient = 1, diffuse = 0, reference2 = 1;
+};
+
+// The nearest front-facing tag cell or surface tile on the ray (x, y, 1) of pixel position (u, v).
+inline Hit castRay(const std::vector<PlacedTag>& tags, const Light& light, double u, double v, double x, double y) {
   Hit hit;
   double best = std::numeric_limits<double>::infinity();
+  std::size_t best_t = 0;
   for (std::size_t t = 0; t < tags.size(); ++t) {
     const PlacedTag& p = tags[t];
     if (u < p.u_lo || u > p.u_hi || v < p.v_lo || v > p.v_hi) continue;
@@ -217,12 +230,38 @@ inline Hit castRay(const std::vector<PlacedTag>& tags, double u, double v, doubl
     if (!(depth < best)) continue;
     const double a = depth * (p.ex[0] * x + p.ex[1] * y + p.ex[2]) - p.ex_o;
     const double b = depth * (p.ey[0] * x + p.ey[1] * y + p.ey[2]) - p.ey_o;
+    if (p.surface) {
+      if (!(std::abs(a) <= p.half_x && std::abs(b) <= p.half_y)) continue;
+      best = depth;
+      best_t = t;
+      if (p.inv_tile > 0) {
+        const long ia = static_cast<long>(std::floor(a * p.inv_tile)),
+                   ib = static_cast<long>(std::floor(b * p.inv_tile));
+        const bool odd = ((ia + ib) & 1) != 0;
+        hit.key = static_cast<int>(t) * 1024 + static_cast<int>(((ia & 31) << 5) | (ib & 31));
+        hit.value = odd ? p.tile_colour : p.colour;
+      } else {
+        hit.key = static_cast<int>(t) * 1024;
+        hit.value = p.colour;
+      }
+      continue;
+    }
     const double gx = a * p.inv_cell + p.half, gy = p.half - b * p.inv_cell;
     if (!(gx >= 0 && gx < p.cells && gy >= 0 && gy < p.cells)) continue;
     const int col = static_cast<int>(gx), row = static_cast<int>(gy);
     best = depth;
+    best_t = t;
     hit.key = static_cast<int>(t) * 1024 + row * p.cells + col;
     hit.value = p.value[static_cast<std::size_t>(row * p.cells + col)];
+  }
+  if (light.on && hit.key != kBackground) {
+    const PlacedTag& p = tags[best_t];
+    const cv::Vec3d point(best * x, best * y, best);
+    const cv::Vec3d to_light = light.position - point;
+    const double d2 = to_light.dot(to_light);
+    const double cosine = std::max(0.0, -p.n.dot(to_light)) / std::sqrt(d2);  // n points away from the camera side
+    const double shade = light.ambient + light.diffuse * cosine * light.reference2 / d2;
+    hit.value *= static_cast<float>(shade);
   }
   return hit;
 }
@@ -268,12 +307,40 @@ std::vector<PlacedTag> placeTags(const Camera& camera, const TagLayout& layout, 
     for (int row = 0; row < p.cells; ++row)
       for (int col = 0; col < p.cells; ++col)
         p.value[static_cast<std::size_t>(row * p.cells + col)] =
-            static_cast<float>(bitmap->buf[row * bitmap->stride + col] >= 128 ? o.white : o.black);
+            cv::Vec3f::all(static_cast<float>(bitmap->buf[row * bitmap->stride + col] >= 128 ? o.white : o.black));
     image_u8_destroy(bitmap);
     const double e = p.half / p.inv_cell;  // half the bitmap's edge, metres
     const double corner[4][2] = {{-e, -e}, {e, -e}, {e, e}, {-e, e}};
     for (int c = 0; c < 4; ++c)
       p.outline[static_cast<std::size_t>(c)] = p.origin + corner[c][0] * p.ex + corner[c][1] * p.ey;
+    out.push_back(std::move(p));
+  }
+  for (const SceneSurface& s : o.surfaces) {
+    if (!(s.half_x > 0 && s.half_y > 0 && std::isfinite(s.half_x) && std::isfinite(s.half_y) && s.tile >= 0 &&
+          std::isfinite(s.tile)))
+      throw std::invalid_argument("renderTagScene: a surface needs positive finite extents and a tile size >= 0");
+    PlacedTag p;
+    p.surface = true;
+    cv::Matx33d r_ws;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) r_ws(i, j) = s.pose.linear()(i, j);
+    const cv::Vec3d t_ws(s.pose.translation().x(), s.pose.translation().y(), s.pose.translation().z());
+    const cv::Matx33d r_cs = r_cw * r_ws;
+    p.origin = r_cw * t_ws + camera.tvec;
+    p.ex = cv::Vec3d(r_cs(0, 0), r_cs(1, 0), r_cs(2, 0));
+    p.ey = cv::Vec3d(r_cs(0, 1), r_cs(1, 1), r_cs(2, 1));
+    p.n = cv::Vec3d(r_cs(0, 2), r_cs(1, 2), r_cs(2, 2));
+    p.n_o = p.n.dot(p.origin);
+    if (p.n_o == 0) continue;                   // seen edge-on
+    if (p.n_o > 0) p.n = -p.n, p.n_o = -p.n_o;  // seen from its back: drawn all the same
+    p.ex_o = p.ex.dot(p.origin);
+    p.ey_o = p.ey.dot(p.origin);
+    p.half_x = s.half_x, p.half_y = s.half_y;
+    p.inv_tile = s.tile > 0 ? 1.0 / s.tile : 0.0;
+    p.colour =
+        cv::Vec3f(static_cast<float>(s.colour[0]), static_cast<float>(s.colour[1]), static_cast<float>(s.colour[2]));
+    p.tile_colour = cv::Vec3f(static_cast<float>(s.tile_colour[0]), static_cast<float>(s.tile_colour[1]),
+                              static_cast<float>(s.tile_colour[2]));
     out.push_back(std::move(p));
   }
   return out;
@@ -298,7 +365,8 @@ void markOutlines(std::vector<PlacedTag>& tags, const RayGrid& g, const Lens& le
     }
   scale *= 2;  // margin for the parts of the field between grid samples and beyond the image
   for (PlacedTag& p : tags) {
-    bool whole = true;  // every edge in front of the camera and in the trusted field
+    if (p.surface) continue;  // large: their edges are found by the corner keys
+    bool whole = true;        // every edge in front of the camera and in the trusted field
     double u_lo = 1e300, u_hi = -1e300, v_lo = 1e300, v_hi = -1e300;
     for (std::size_t c = 0; c < 4; ++c) {
       cv::Vec3d a = p.outline[c], b = p.outline[(c + 1) % 4];
@@ -403,7 +471,10 @@ std::vector<std::array<cv::Point2d, 4>> projectTagCorners(const calib::Camera& c
   return out;
 }
 
-cv::Mat renderTagScene(const calib::Camera& camera, const calib::TagLayout& layout, const TagSceneOptions& o) {
+namespace {
+
+// The scene as 3-channel floats, blurred and with noise.
+cv::Mat renderScene(const calib::Camera& camera, const calib::TagLayout& layout, const TagSceneOptions& o) {
   camera.validate("renderTagScene camera");
   if (o.supersample < 1 || o.supersample > 16 || !(o.blur_sigma >= 0) || !(o.noise_sigma >= 0) ||
       !std::isfinite(o.blur_sigma) || !std::isfinite(o.noise_sigma))
@@ -412,7 +483,21 @@ cv::Mat renderTagScene(const calib::Camera& camera, const calib::TagLayout& layo
   const RayGrid& g = *grid_ptr;
   const Lens lens(camera);
   std::vector<PlacedTag> tags = placeTags(camera, layout, o);
-  const cv::Mat bg = backgroundImage(camera, o);
+  cv::Mat bg;
+  {
+    const cv::Mat grey = backgroundImage(camera, o);
+    cv::merge(std::vector<cv::Mat>{grey, grey, grey}, bg);
+  }
+  Light light;
+  if (o.light.on) {
+    const Pose w2c = camera.worldToCamera();
+    const Vec3 l = w2c * o.light.position;
+    light.on = true;
+    light.position = cv::Vec3d(l.x(), l.y(), l.z());
+    light.ambient = o.light.ambient;
+    light.diffuse = o.light.diffuse;
+    light.reference2 = o.light.reference * o.light.reference;
+  }
   const int w = camera.width, h = camera.height, w1 = w + 1, h1 = h + 1;
 
   std::vector<unsigned char> mixed(static_cast<std::size_t>(w) * h, 0);
@@ -420,7 +505,7 @@ cv::Mat renderTagScene(const calib::Camera& camera, const calib::TagLayout& layo
 
   // Keys of the corner rays.
   std::vector<int> key(static_cast<std::size_t>(w1) * h1, kBackground);
-  std::vector<float> corner_value(key.size(), 0.0f);
+  std::vector<cv::Vec3f> corner_value(key.size());
   cv::parallel_for_(cv::Range(0, h1), [&](const cv::Range& rows) {
     for (int j = rows.start; j < rows.end; ++j)
       for (int i = 0; i < w1; ++i) {
@@ -429,17 +514,17 @@ cv::Mat renderTagScene(const calib::Camera& camera, const calib::TagLayout& layo
           key[at] = kInvalid;
           continue;
         }
-        const Hit hit = castRay(tags, i - 0.5, j - 0.5, g.ray[at][0], g.ray[at][1]);
+        const Hit hit = castRay(tags, light, i - 0.5, j - 0.5, g.ray[at][0], g.ray[at][1]);
         key[at] = hit.key;
         corner_value[at] = hit.value;
       }
   });
-  cv::Mat image(h, w, CV_32F);
+  cv::Mat image(h, w, CV_32FC3);
   const int s = o.supersample;
   cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
     for (int j = rows.start; j < rows.end; ++j) {
-      float* out = image.ptr<float>(j);
-      const float* back = bg.ptr<float>(j);
+      cv::Vec3f* out = image.ptr<cv::Vec3f>(j);
+      const cv::Vec3f* back = bg.ptr<cv::Vec3f>(j);
       for (int i = 0; i < w; ++i) {
         const std::size_t a = static_cast<std::size_t>(j) * w1 + i, b = a + 1, c = a + w1, d = c + 1;
         const int k = key[a];
@@ -452,7 +537,7 @@ cv::Mat renderTagScene(const calib::Camera& camera, const calib::TagLayout& layo
           continue;
         }
         // Sub-pixel rays: bilinear start from the corner rays, then solved exactly.
-        double sum = 0;
+        cv::Vec3d sum(0, 0, 0);
         for (int sy = 0; sy < s; ++sy)
           for (int sx = 0; sx < s; ++sx) {
             // Stratified in s x s cells and in s^2 columns and rows ("n-rooks"): an edge along a
@@ -463,24 +548,54 @@ cv::Mat renderTagScene(const calib::Camera& camera, const calib::TagLayout& layo
             double x = guess[0], y = guess[1];
             const double su = i - 0.5 + fu, sv = j - 0.5 + fv;
             if (!lens.undistort(su, sv, x, y, 10, 1e-8, false)) x = guess[0], y = guess[1];
-            const Hit hit = castRay(tags, su, sv, x, y);
-            sum += hit.key == kBackground ? back[i] : hit.value;
+            const Hit hit = castRay(tags, light, su, sv, x, y);
+            const cv::Vec3f& add = hit.key == kBackground ? back[i] : hit.value;
+            sum += cv::Vec3d(add[0], add[1], add[2]);
           }
-        out[i] = static_cast<float>(sum / (s * s));
+        sum *= 1.0 / (s * s);
+        out[i] = cv::Vec3f(static_cast<float>(sum[0]), static_cast<float>(sum[1]), static_cast<float>(sum[2]));
       }
     }
   });
 
   if (o.blur_sigma > 0) cv::GaussianBlur(image, image, cv::Size(0, 0), o.blur_sigma, o.blur_sigma, cv::BORDER_REFLECT);
+  return image;
+}
+
+cv::Mat addNoise(cv::Mat image, const TagSceneOptions& o) {
   if (o.noise_sigma > 0) {
-    cv::Mat noise(image.size(), CV_32F);
+    cv::Mat noise(image.size(), image.type());
     cv::RNG rng(o.seed);
     rng.fill(noise, cv::RNG::NORMAL, 0.0, o.noise_sigma);
     image += noise;
   }
   cv::Mat out;
-  image.convertTo(out, CV_8U);  // rounds and clips
+  image.convertTo(out, image.channels() == 1 ? CV_8U : CV_8UC3);  // rounds and clips
   return out;
 }
 
-}  // namespace kccd::testing
+bool allGrey(const TagSceneOptions& o) {
+  for (const SceneSurface& s : o.surfaces)
+    if (s.colour[0] != s.colour[1] || s.colour[1] != s.colour[2] || s.tile_colour[0] != s.tile_colour[1] ||
+        s.tile_colour[1] != s.tile_colour[2])
+      return false;
+  return true;
+}
+
+}  // namespace
+
+cv::Mat renderTagScene(const calib::Camera& camera, const calib::TagLayout& layout, const TagSceneOptions& o) {
+  const cv::Mat bgr = renderScene(camera, layout, o);
+  cv::Mat grey;
+  if (allGrey(o))
+    cv::extractChannel(bgr, grey, 0);
+  else
+    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  return addNoise(grey, o);
+}
+
+cv::Mat renderTagSceneBgr(const calib::Camera& camera, const calib::TagLayout& layout, const TagSceneOptions& o) {
+  return addNoise(renderScene(camera, layout, o), o);
+}
+
+}  // namespace kccd::calib

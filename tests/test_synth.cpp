@@ -1,0 +1,284 @@
+// End-to-end: `kccd synth` writes a recording whose truth holds — the visible geometry lies inside
+// the SSCHs, the state log has the documented rate, offset and velocities, the reported collision
+// frames collide, calibration on the first frame recovers the true camera, and the same seed gives
+// the same files.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "kccd/calib/camera.hpp"
+#include "kccd/checker.hpp"
+#include "kccd/render/renderer.hpp"
+#include "kccd/render/scene.hpp"
+#include "kccd/state_log.hpp"
+#include "support/files.hpp"
+#include "support/run_program.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using kccd::testing::Outcome;
+using nlohmann::json;
+
+Outcome runKccd(const std::string& args) { return kccd::testing::runProgram(std::string(KCCD_CLI) + " " + args); }
+
+const std::string kData = KCCD_DATA_DIR;
+const std::string kHumanoid = kData + "/humanoid.yaml";
+constexpr double kSeconds = 2.4;
+constexpr double kFps = 25.0;
+
+// One recording shared by the tests (the synthesis is the slow part).
+class Synth : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = new fs::path(fs::path(::testing::TempDir()) / ("kccd_synth_" + std::to_string(getpid())));
+    fs::create_directories(*root_);
+    run_ = new Outcome(runKccd("synth " + kHumanoid + " -o " + dir("a") + " --seconds " + std::to_string(kSeconds) +
+                               " --fps 25 --seed 3 -q"));
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*root_);
+    delete root_;
+    delete run_;
+  }
+  void SetUp() override { ASSERT_EQ(run_->code, 0) << run_->err; }
+  static std::string dir(const std::string& name) { return (*root_ / name).string(); }
+  static json summary(const std::string& name = "a") {
+    return json::parse(kccd::testing::readText(dir(name) + "/synth.json"));
+  }
+  static inline fs::path* root_ = nullptr;
+  static inline Outcome* run_ = nullptr;
+};
+
+std::vector<cv::Mat> readVideo(const std::string& path) {
+  cv::VideoCapture cap(path);
+  std::vector<cv::Mat> frames;
+  cv::Mat f;
+  while (cap.read(f)) frames.push_back(f.clone());
+  return frames;
+}
+
+TEST_F(Synth, WritesEveryFile) {
+  for (const char* f : {"video.mkv", "states.csv", "camera_true.yaml", "intrinsics.yaml", "tags.yaml", "synth.json"})
+    EXPECT_TRUE(fs::is_regular_file(dir("a") + "/" + f)) << f;
+  const json j = summary();
+  const int frames = j["video"]["frames"];
+  EXPECT_EQ(frames, static_cast<int>(std::floor(kSeconds * kFps + 1e-9)));
+  EXPECT_EQ(j["frames"].size(), static_cast<std::size_t>(frames));
+  const std::vector<cv::Mat> video = readVideo(dir("a") + "/video.mkv");
+  ASSERT_EQ(video.size(), static_cast<std::size_t>(frames));
+  const kccd::calib::Camera cam = kccd::calib::loadCamera(dir("a") + "/camera_true.yaml");
+  EXPECT_EQ(video[0].cols, cam.width);
+  EXPECT_EQ(video[0].rows, cam.height);
+  for (int i = 0; i < frames; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/masks/frame_%06d.png", i);
+    const cv::Mat mask = cv::imread(dir("a") + name, cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(mask.type(), CV_8UC1) << name;
+    EXPECT_EQ(mask.size(), video[0].size());
+  }
+  // Nothing but the folder is left beside it (the temporary folder was renamed).
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(*root_)) entries += e.path().filename().string().rfind(".a.", 0) == 0;
+  EXPECT_EQ(entries, 0);
+  // The intrinsics file has no pose and loads as intrinsics only.
+  const std::string intr = kccd::testing::readText(dir("a") + "/intrinsics.yaml");
+  EXPECT_EQ(intr.find("rvec"), std::string::npos);
+  EXPECT_THROW(kccd::calib::loadCamera(dir("a") + "/intrinsics.yaml"), kccd::calib::CameraError);
+  const kccd::calib::Camera k =
+      kccd::calib::loadCamera(dir("a") + "/intrinsics.yaml", kccd::calib::CameraPose::Optional);
+  EXPECT_EQ(k.camera_matrix, cam.camera_matrix);
+  EXPECT_EQ(k.distortion, cam.distortion);
+}
+
+TEST_F(Synth, StateLogHasRateOffsetAndVelocities) {
+  const json j = summary();
+  const kccd::Model m = kccd::loadModel(kHumanoid);
+  const kccd::StateLog log = kccd::loadStateLog(dir("a") + "/states.csv", m);
+  const double rate = j["state_log"]["rate_hz"], offset = j["state_log"]["time_offset"];
+  EXPECT_EQ(rate, 125.0);
+  EXPECT_EQ(offset, 0.137);
+  EXPECT_NE(rate, static_cast<double>(j["video"]["fps"]));
+  EXPECT_NEAR(log.medianPeriod(), 1.0 / rate, 1e-9);
+  ASSERT_TRUE(log.hasVelocities());
+  for (std::uint8_t v : log.logged_velocity) EXPECT_EQ(v, 1);
+  // Velocities integrate to the values: each step's change against the trapezoid rule (its error,
+  // h^3 / 12 times the jerk, stays below 1e-3 rad for this motion at 125 Hz).
+  const std::size_t n = log.stateSize();
+  double worst = 0, fastest = 0;
+  for (std::size_t r = 0; r + 1 < log.rows(); ++r)
+    for (std::size_t i = 0; i < n; ++i) {
+      const double h = log.times[r + 1] - log.times[r];
+      const double step = log.values[(r + 1) * n + i] - log.values[r * n + i];
+      const double integral = 0.5 * h * (log.velocities[r * n + i] + log.velocities[(r + 1) * n + i]);
+      worst = std::max(worst, std::abs(step - integral));
+      fastest = std::max(fastest, std::abs(log.velocities[r * n + i]));
+    }
+  EXPECT_LT(worst, 2e-3);
+  EXPECT_GT(fastest, 0.1);  // it moves
+  // Each frame's state is the log's state at video time + offset.
+  std::vector<double> s(n);
+  for (const json& f : j["frames"]) {
+    const double t = f["time"];
+    ASSERT_NE(kccd::stateAt(log, t + offset, 1.5 / rate, s), kccd::StateMatch::None) << t;
+    const std::vector<double> logged = f["state"];
+    for (std::size_t i = 0; i < n; ++i) ASSERT_DOUBLE_EQ(logged[i], s[i]) << "frame " << f["index"] << " value " << i;
+  }
+  // The log starts at or before the first frame's log time and ends after the last one's.
+  EXPECT_LE(log.times.front(), offset);
+  EXPECT_GE(log.times.back(), static_cast<double>(j["frames"].back()["time"]) + offset);
+}
+
+TEST_F(Synth, CollisionFramesCollideAtTheLoggedState) {
+  const json j = summary();
+  const kccd::Model m = kccd::loadModel(kHumanoid);
+  const kccd::StateLog log = kccd::loadStateLog(dir("a") + "/states.csv", m);
+  const double offset = j["state_log"]["time_offset"];
+  kccd::Checker checker(m);
+  std::vector<double> s(log.stateSize());
+  std::vector<int> colliding, near;
+  for (const json& f : j["frames"]) {
+    ASSERT_NE(kccd::stateAt(log, static_cast<double>(f["time"]) + offset, 1.5 / 125.0, s), kccd::StateMatch::None);
+    checker.reset();  // each frame on its own, as synth evaluates it
+    const kccd::QueryResult& r = checker.query(s, s, kccd::QueryOptions{.type = kccd::QueryType::Distances});
+    ASSERT_EQ(r.status, kccd::Status::Ok);
+    EXPECT_DOUBLE_EQ(r.min_distance, static_cast<double>(f["min_distance"]));
+    if (r.min_distance <= 0.0)
+      colliding.push_back(f["index"]);
+    else if (r.min_distance <= m.safety_margin)
+      near.push_back(f["index"]);
+  }
+  EXPECT_EQ(colliding, j["collision"]["frames"].get<std::vector<int>>());
+  EXPECT_EQ(near, j["near_collision_frames"].get<std::vector<int>>());
+  ASSERT_FALSE(colliding.empty());
+  EXPECT_EQ(colliding.back() - colliding.front() + 1, static_cast<int>(colliding.size())) << "one interval";
+  ASSERT_EQ(j["collision"]["intervals"].size(), 1u);
+  // A near-collision outside the collision's neighbourhood (an approach of its own).
+  int apart = 0;
+  for (int f : near) apart += f < colliding.front() - 3 || f > colliding.back() + 3;
+  EXPECT_GE(apart, 1);
+}
+
+// The visible geometry (the masks) never shows outside the full volumes: every frame's visible
+// mask pixels are covered by the label mask of the full SSCHs drawn by the normal renderer at the
+// same state with the same options. Both masks sample pixel centres (no anti-aliasing) through the
+// same pinhole image and map, and each visible mesh lies inside its full mesh (same core points,
+// radius scaled by 0.8, tessellation error 0.3 % of the radius outwards at most), so no boundary
+// allowance is needed: 0 violations.
+TEST_F(Synth, VisibleGeometryLiesInsideTheVolumes) {
+  const json j = summary();
+  const kccd::Model m = kccd::loadModel(kHumanoid);
+  const kccd::calib::Camera cam = kccd::calib::loadCamera(dir("a") + "/camera_true.yaml");
+  kccd::render::RenderOptions ro;
+  ro.supersample = j["render"]["supersample"];
+  ro.mask_supersample = j["render"]["mask_supersample"];
+  kccd::render::Renderer renderer(cam, ro);
+  kccd::Checker checker(m);
+  long visible_total = 0;
+  for (const json& f : j["frames"]) {
+    const std::vector<double> s = f["state"];
+    checker.query(s, s, kccd::QueryOptions{.type = kccd::QueryType::Distances});
+    const std::vector<kccd::render::Volume> full = kccd::render::staticSceneVolumes(m, checker, s, {});
+    const kccd::render::Frame frame = renderer.render(full, {}, false, true);
+    char name[32];
+    std::snprintf(name, sizeof name, "/masks/frame_%06d.png", static_cast<int>(f["index"]));
+    const cv::Mat visible = cv::imread(dir("a") + name, cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(visible.size(), frame.mask.size());
+    const cv::Mat outside = (visible > 0) & (frame.mask == 0);
+    EXPECT_EQ(cv::countNonZero(outside), 0) << name;
+    const int shown = cv::countNonZero(visible);
+    visible_total += shown;
+    EXPECT_LT(shown, cv::countNonZero(frame.mask)) << name << ": strictly smaller";
+  }
+  EXPECT_GT(visible_total, 0);
+}
+
+// `kccd calib` on the first frame, with the written intrinsics and tag layout, recovers the camera.
+TEST_F(Synth, CalibrationRecoversTheTrueCamera) {
+  const std::vector<cv::Mat> video = readVideo(dir("a") + "/video.mkv");
+  ASSERT_FALSE(video.empty());
+  const std::string frame = dir("frame0.png"), solved = dir("solved.yaml");
+  ASSERT_TRUE(cv::imwrite(frame, video[0]));
+  const Outcome r = runKccd("calib --intrinsics " + dir("a") + "/intrinsics.yaml --image " + frame + " --tags " +
+                            dir("a") + "/tags.yaml -o " + solved + " -q");
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  const kccd::calib::Camera truth = kccd::calib::loadCamera(dir("a") + "/camera_true.yaml");
+  const kccd::calib::Camera got = kccd::calib::loadCamera(solved);
+  cv::Matx33d rt, rg;
+  cv::Rodrigues(truth.rvec, rt);
+  cv::Rodrigues(got.rvec, rg);
+  cv::Vec3d angle;
+  cv::Rodrigues(rg * rt.t(), angle);
+  const cv::Vec3d ct = -(rt.t() * truth.tvec), cg = -(rg.t() * got.tvec);
+  EXPECT_LT(cv::norm(angle) * 180.0 / M_PI, 0.05);
+  EXPECT_LT(cv::norm(ct - cg), 0.005);
+}
+
+TEST_F(Synth, SameSeedSameFiles) {
+  const Outcome r = runKccd("synth " + kHumanoid + " -o " + dir("b") + " --seconds " + std::to_string(kSeconds) +
+                            " --fps 25 --seed 3 -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* f : {"states.csv", "camera_true.yaml", "intrinsics.yaml", "tags.yaml"})
+    EXPECT_EQ(kccd::testing::readText(dir("a") + "/" + f), kccd::testing::readText(dir("b") + "/" + f)) << f;
+  json ja = summary("a"), jb = summary("b");
+  ja.erase("timing"), jb.erase("timing");
+  EXPECT_EQ(ja, jb);
+  for (const auto& e : fs::directory_iterator(dir("a") + "/masks"))
+    EXPECT_EQ(kccd::testing::readText(e.path().string()),
+              kccd::testing::readText(dir("b") + "/masks/" + e.path().filename().string()))
+        << e.path();
+  const std::vector<cv::Mat> va = readVideo(dir("a") + "/video.mkv"), vb = readVideo(dir("b") + "/video.mkv");
+  ASSERT_EQ(va.size(), vb.size());
+  for (std::size_t i = 0; i < va.size(); ++i) EXPECT_EQ(cv::norm(va[i], vb[i], cv::NORM_INF), 0.0) << i;
+}
+
+TEST_F(Synth, NoCollisionOption) {
+  const Outcome r =
+      runKccd("synth " + kHumanoid + " -o " + dir("c") + " --seconds 1 --fps 20 --seed 5 --no-collision -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = summary("c");
+  EXPECT_TRUE(j["collision"]["frames"].empty());
+  EXPECT_EQ(j["video"]["frames"], 20);
+  for (const json& f : j["frames"]) EXPECT_GT(static_cast<double>(f["min_distance"]), 0.0);
+}
+
+TEST_F(Synth, BadInputIsOneLineExitTwo) {
+  struct Case {
+    std::string args, says;
+  };
+  fs::create_directories(dir("full"));
+  { std::ofstream(dir("full") + "/keep.txt") << "mine"; }
+  const Case cases[] = {
+      {"synth " + kData + "/no_such_model.yaml -o " + dir("x"), "no_such_model.yaml"},
+      {"synth " + kHumanoid + " -o " + dir("x") + " --codec h265", "--codec"},
+      {"synth " + kHumanoid + " -o " + dir("x") + " --fps 0", "--fps"},
+      {"synth " + kHumanoid + " -o " + dir("x") + " --log-rate 25", "--log-rate"},
+      {"synth " + kHumanoid + " -o " + dir("nowhere/x"), "does not exist"},
+      {"synth " + kHumanoid + " -o " + dir("full"), "--force"},
+      {"synth " + kHumanoid + " -o " + dir("x") + " --camera " + dir("nothing.yaml"), "nothing.yaml"},
+      {"synth " + kHumanoid + " -o " + dir("x") + " --camera " + dir("a") + "/camera_true.yaml --width 640", "--width"},
+  };
+  for (const Case& c : cases) {
+    const Outcome r = runKccd(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("kccd: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir("x")));
+  }
+  EXPECT_EQ(kccd::testing::readText(dir("full") + "/keep.txt"), "mine");
+}
+
+}  // namespace
