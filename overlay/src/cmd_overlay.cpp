@@ -28,6 +28,7 @@
 #include <sstream>
 #include <thread>
 
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -196,6 +197,7 @@ struct FrameRecord {
   bool not_finite = false;       // a volume could not be drawn (overflow): unsafe
   double min_distance = std::numeric_limits<double>::quiet_NaN();
   std::vector<std::array<int, 2>> pairs;  // within the margin (body indices)
+  std::vector<double> values;             // the state used (empty without one)
   bool selected = false, written = false;
   bool unsafe() const { return query != Status::Ok || braking_failed || not_finite; }
 };
@@ -255,6 +257,7 @@ class FrameWorker {
         volumes.push_back(render::Volume{b.points, b.radius * (1.0 + 1e-9) + 1e-9, render::VolumeStatus::NoState, b.name});
       }
     } else {
+      rec.values.assign(q_.begin(), q_.end());
       bool box_ok = true;
       if (s_.args.swept) {
         box_ok = brakingIntervals(m, q_, v_, s_.braking, lo_, hi_);
@@ -455,9 +458,13 @@ Exit runOverlay(OverlayArgs& a) {
     shared.braking.assign(static_cast<std::size_t>(model.stateSize()), p);
   }
 
+  // Errors are reported once, by kccd: FFmpeg's and OpenCV's own log lines are silenced (set
+  // OPENCV_FFMPEG_LOGLEVEL to see FFmpeg's). FFmpeg reads videos, OpenCV's image reader sequences.
+  setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   cv::VideoCapture cap;
   try {
-    cap.open(a.video);
+    cap.open(a.video, a.video.find('%') != std::string::npos ? cv::CAP_IMAGES : cv::CAP_FFMPEG);
   } catch (const cv::Exception&) {
   }
   if (!cap.isOpened()) throw UsageError("--video " + a.video + ": cannot open the video (not a video OpenCV reads, or missing)");
@@ -690,6 +697,8 @@ Exit runOverlay(OverlayArgs& a) {
       f["state"] = stateName(r.match);
       f["status"] = toString(r.status);
       f["min_distance"] = number(r.min_distance);
+      f["state_values"] = nlohmann::json::array();
+      for (double v : r.values) f["state_values"].push_back(number(v));
       f["pairs_within_margin"] = nlohmann::json::array();
       for (const auto& p : r.pairs) f["pairs_within_margin"].push_back({model.bodies[p[0]].name, model.bodies[p[1]].name});
       if (r.match != StateMatch::None)
