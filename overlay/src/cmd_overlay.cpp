@@ -216,6 +216,8 @@ struct Shared {
   const StateLog& log;
   double max_gap = 0.0;
   std::vector<BrakingParams> braking;  // per state value (with --swept)
+  render::RenderOptions render_options;
+  std::optional<render::Projection> projection;  // made once, copied by every worker's Renderer
 };
 
 // Queries, renders and composites frames; one per thread (its Renderer's GL context is current
@@ -230,7 +232,7 @@ class FrameWorker {
         lo_(s.model.stateSize()),
         hi_(s.model.stateSize()) {
     try {
-      renderer_ = std::make_unique<render::Renderer>(s.camera);
+      renderer_ = std::make_unique<render::Renderer>(*s.projection, s.render_options);
     } catch (const calib::CameraError& e) {
       std::string msg = e.what();
       if (msg.rfind("camera: ", 0) == 0) msg = msg.substr(8);
@@ -462,6 +464,17 @@ Exit runOverlay(OverlayArgs& a) {
   // OPENCV_FFMPEG_LOGLEVEL to see FFmpeg's). FFmpeg reads videos, OpenCV's image reader sequences.
   setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  // No mask is drawn: its finer pinhole image (and its per-pixel distortion map) is not built. The
+  // colour pass's map is built once here for every worker.
+  shared.render_options.mask_supersample = shared.render_options.supersample;
+  try {
+    shared.projection.emplace(camera, shared.render_options.supersample);
+  } catch (const calib::CameraError& e) {
+    std::string msg = e.what();
+    if (msg.rfind("camera: ", 0) == 0) msg = msg.substr(8);
+    throw UsageError(a.camera + ": " + msg);
+  }
+
   cv::VideoCapture cap;
   try {
     cap.open(a.video, a.video.find('%') != std::string::npos ? cv::CAP_IMAGES : cv::CAP_FFMPEG);
@@ -508,6 +521,7 @@ Exit runOverlay(OverlayArgs& a) {
   std::condition_variable cv;
   std::deque<FrameJob> todo;
   std::map<std::size_t, FrameJob> done;
+  std::vector<cv::Mat> spare;  // written frames' buffers, decoded into again (no allocation per frame)
   std::size_t in_flight = 0, decoded = 0;
   bool reader_done = false, abort = false;
   std::exception_ptr error;
@@ -528,6 +542,13 @@ Exit runOverlay(OverlayArgs& a) {
         }
         FrameJob job;
         job.index = index;
+        {
+          std::lock_guard lock(mu);
+          if (!spare.empty()) {
+            job.bgr = std::move(spare.back());
+            spare.pop_back();
+          }
+        }
         bool got = false;
         try {
           got = cap.read(job.bgr);
@@ -644,6 +665,7 @@ Exit runOverlay(OverlayArgs& a) {
       records.push_back(std::move(job.record));
       {
         std::lock_guard lock(mu);
+        if (job.bgr.u != nullptr && job.bgr.u->refcount == 1) spare.push_back(std::move(job.bgr));
         --in_flight;
         cv.notify_all();
       }
