@@ -4,6 +4,7 @@
 // the overlay pixels against `kccd render` composited over the same frame.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -386,6 +387,48 @@ TEST_F(OverlayCli, UnsafeQueryStatusExitsThreeAndWritesEverything) {
   EXPECT_EQ(readVideo(out("out.mkv")).size(), static_cast<std::size_t>(kFrames));
   EXPECT_EQ(j["frames"][1]["status"], "colliding");
   EXPECT_GE(j["unsafe"].get<int>(), 1);
+}
+
+TEST_F(OverlayCli, AutoTimeOffsetFindsTheShift) {
+  // A log with bursts of motion at 20 Hz, and a recording of it made by drawing the arm at log time
+  // t + 0.5 s onto a still scene: the search over [0, 1] s must find 0.5 s (grid step 0.025 s).
+  auto ramp = [](double t, double a, double b) { return std::clamp((t - a) / (b - a), 0.0, 1.0); };
+  std::string text = "time,shoulder_yaw,shoulder_pitch,elbow\n";
+  for (int k = 0; k <= 90; ++k) {
+    const double t = k * 0.05;
+    const double yaw = -1.2 + 0.8 * ramp(t, 0.6, 1.0) - 0.5 * ramp(t, 1.8, 2.0) + 0.6 * ramp(t, 2.6, 3.2);
+    const double elbow = 0.3 + 0.6 * ramp(t, 1.2, 1.4) - 0.4 * ramp(t, 3.4, 3.6);
+    char row[128];
+    std::snprintf(row, sizeof row, "%.2f,%.6f,-0.3,%.6f\n", t, yaw, elbow);
+    text += row;
+  }
+  writeText(log_, text);
+  {
+    cv::VideoWriter vw(out("input_still.mkv"), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), kFps,
+                       cv::Size(kW, kH), true);
+    ASSERT_TRUE(vw.isOpened());
+    for (int i = 0; i < 36; ++i) vw.write(syntheticFrame(0));
+  }
+  const Outcome rec = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_still.mkv") +
+                              " --states " + log_ + " -q --plain --time-offset 0.5 -o " + out("input_rec.mkv"));
+  ASSERT_EQ(rec.code, 0) << rec.err;
+  const Outcome r = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_rec.mkv") + " --states " +
+                            log_ + " -q --time-offset auto:0:1 --report " + out("report.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(readText(out("report.json")));
+  EXPECT_NEAR(j["time_offset"].get<double>(), 0.5, 0.03) << j["time_offset_auto"].dump();
+  EXPECT_GT(j["time_offset_auto"]["correlation"].get<double>(), 0.6);
+  EXPECT_NEAR(j["frames"][3]["log_time"].get<double>(), 0.3 + j["time_offset"].get<double>(), 1e-9);
+
+  // A still video follows no motion: an error, not a guess.
+  const Outcome still = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_still.mkv") +
+                                " --states " + log_ + " -q --time-offset auto:0:1 --report " + out("r2.json"));
+  EXPECT_EQ(still.code, 2);
+  EXPECT_EQ(lines(still.err), 1) << still.err;
+  EXPECT_FALSE(fs::exists(out("r2.json")));
+  const Outcome bad = runKccd(base() + " --time-offset auto:1:0 --report " + out("r3.json"));
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_EQ(lines(bad.err), 1) << bad.err;
 }
 
 }  // namespace

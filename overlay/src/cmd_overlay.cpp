@@ -51,6 +51,7 @@ namespace fs = std::filesystem;
 
 struct OverlayArgs {
   std::string model, camera, video, states, output, png_dir, report, frames, frame_times, ignore_columns, codec;
+  std::string time_offset_text = "0";  // seconds, or auto:A:B
   double time_offset = 0.0, max_gap = 0.0, fps = 0.0;
   double latency = 0.01, deceleration = 5.0, max_acceleration = 0.0, position_error = 0.0, velocity_error = 0.0;
   bool swept = false, plain = false, quiet = false, json = false;
@@ -426,6 +427,118 @@ int fourccFor(const std::string& output, const std::string& codec) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// --time-offset auto:A:B
+
+struct AutoOffset {
+  double lo = 0.0, hi = 0.0;
+};
+
+// "S" (seconds) or "auto:A:B"; returns the range for auto, and sets `offset` otherwise.
+std::optional<AutoOffset> parseTimeOffset(const std::string& text, double& offset) {
+  auto num = [&](const std::string& t, double& out) {
+    char* end = nullptr;
+    out = std::strtod(t.c_str(), &end);
+    return !t.empty() && end == t.c_str() + t.size() && std::isfinite(out) && std::fabs(out) <= 1e9;
+  };
+  if (text.rfind("auto:", 0) == 0) {
+    const std::string rest = text.substr(5);
+    const std::size_t colon = rest.find(':');
+    AutoOffset r;
+    if (colon == std::string::npos || !num(rest.substr(0, colon), r.lo) || !num(rest.substr(colon + 1), r.hi) || !(r.lo < r.hi))
+      throw UsageError("--time-offset " + text + ": expected auto:A:B with A < B (seconds, the range searched)");
+    return r;
+  }
+  if (!num(text, offset)) throw UsageError("--time-offset " + text + ": expected seconds (within 1e9) or auto:A:B");
+  return std::nullopt;
+}
+
+// Finds the offset in [range.lo, range.hi] at which the image motion between consecutive frames
+// (mean absolute difference of downscaled grey frames) best follows the robot's motion in the log
+// between the same two instants (sum of the absolute changes of the state values): the largest
+// Pearson correlation on a grid of half the smaller of the frame and log periods. Throws
+// UsageError when too few frames have states or nothing correlates. Returns the offset and
+// writes the correlation to `score`.
+double findTimeOffset(const OverlayArgs& a, const StateLog& log, double max_gap, const std::vector<double>& frame_times,
+                      double fps, AutoOffset range, double& score) {
+  cv::VideoCapture cap;
+  try {
+    cap.open(a.video, a.video.find('%') != std::string::npos ? cv::CAP_IMAGES : cv::CAP_FFMPEG);
+  } catch (const cv::Exception&) {
+  }
+  if (!cap.isOpened()) throw UsageError("--video " + a.video + ": cannot open the video (not a video OpenCV reads, or missing)");
+  // Pair k: frames k and k + 1, their times and the image motion between them.
+  std::vector<double> t0, t1, motion;
+  cv::Mat frame, grey, small, previous;
+  double previous_time = 0.0;
+  for (std::size_t i = 0;; ++i) {
+    bool got = false;
+    try {
+      got = cap.read(frame);
+    } catch (const cv::Exception&) {
+      got = false;
+    }
+    if (!got || frame.empty()) break;  // the main pass reports a short or damaged video
+    const double t = !frame_times.empty() ? (i < frame_times.size() ? frame_times[i] : std::numeric_limits<double>::quiet_NaN())
+                                          : static_cast<double>(i) / fps;
+    if (frame.channels() == 3) cv::cvtColor(frame, grey, cv::COLOR_BGR2GRAY);
+    else if (frame.channels() == 4) cv::cvtColor(frame, grey, cv::COLOR_BGRA2GRAY);
+    else grey = frame;
+    cv::resize(grey, small, cv::Size(std::max(1, grey.cols / 8), std::max(1, grey.rows / 8)), 0, 0, cv::INTER_AREA);
+    small.convertTo(small, CV_32F);
+    if (!previous.empty() && previous.size() == small.size() && std::isfinite(t) && std::isfinite(previous_time)) {
+      t0.push_back(previous_time);
+      t1.push_back(t);
+      motion.push_back(cv::norm(small, previous, cv::NORM_L1) / static_cast<double>(small.total()));
+    }
+    std::swap(previous, small);
+    previous_time = t;
+  }
+  if (motion.size() < 10) throw UsageError("--time-offset auto: needs at least 11 frames, the video has " + std::to_string(motion.size() + 1));
+
+  double frame_period = (t1.back() - t0.front()) / static_cast<double>(motion.size());
+  double log_period = log.medianPeriod() > 0 ? log.medianPeriod() : frame_period;
+  const double step = 0.5 * std::min(frame_period, log_period);
+  const double steps = std::ceil((range.hi - range.lo) / step);
+  if (!(steps <= 200000)) throw UsageError("--time-offset auto: the range is more than 200000 steps of " + format(step, 3) + " s");
+  const std::size_t n = log.stateSize();
+  std::vector<double> qa(n), qb(n), speed(motion.size());
+  std::vector<std::uint8_t> has(motion.size());
+  double best = -2.0, best_offset = range.lo;
+  std::size_t best_pairs = 0;
+  for (long k = 0; k <= static_cast<long>(steps); ++k) {
+    const double offset = std::min(range.hi, range.lo + static_cast<double>(k) * step);
+    std::size_t m = 0;
+    double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+    for (std::size_t p = 0; p < motion.size(); ++p) {
+      if (stateAt(log, t0[p] + offset, max_gap, qa) == StateMatch::None || stateAt(log, t1[p] + offset, max_gap, qb) == StateMatch::None)
+        continue;
+      double d = 0.0;
+      for (std::size_t v = 0; v < n; ++v) d += std::fabs(qb[v] - qa[v]);
+      const double x = motion[p];
+      sx += x, sy += d, sxx += x * x, syy += d * d, sxy += x * d;
+      ++m;
+    }
+    if (m < 10) continue;
+    const double mm = static_cast<double>(m);
+    const double cov = sxy - sx * sy / mm, vx = sxx - sx * sx / mm, vy = syy - sy * sy / mm;
+    if (!(vx > 0 && vy > 0)) continue;
+    const double r = cov / std::sqrt(vx * vy);
+    if (r > best) {
+      best = r;
+      best_offset = offset;
+      best_pairs = m;
+    }
+  }
+  if (best < 0.3)
+    throw UsageError("--time-offset auto:" + format(range.lo) + ":" + format(range.hi) +
+                     ": no offset in the range makes the video's motion follow the log's (best correlation " +
+                     (best > -2.0 ? format(best, 2) : std::string("none: too few frames with a state")) + "); give the offset");
+  (void)best_pairs;
+  score = best;
+  return best_offset;
+}
+
+// ---------------------------------------------------------------------------------------------
 // The run
 
 Exit runOverlay(OverlayArgs& a) {
@@ -443,6 +556,8 @@ Exit runOverlay(OverlayArgs& a) {
   }
   if (!a.report.empty()) checkOutputPath(a.report, "--report", ".json");
   const FrameSelection selection = parseFrames(a.frames);
+  const std::optional<AutoOffset> auto_offset = parseTimeOffset(a.time_offset_text, a.time_offset);
+  double auto_score = 0.0;
   const std::vector<std::string> ignore = splitCommas(a.ignore_columns);
   const StateLog log = loadStateLog(a.states, model, ignore);
   double max_gap = a.max_gap > 0.0 ? a.max_gap : 1.5 * log.medianPeriod();
@@ -492,6 +607,7 @@ Exit runOverlay(OverlayArgs& a) {
     std::sort(steps.begin(), steps.end());
     writer_fps = steps.empty() ? 25.0 : 1.0 / steps[steps.size() / 2];
   }
+  if (auto_offset) a.time_offset = findTimeOffset(a, log, max_gap, frame_times, fps, *auto_offset, auto_score);
   const double declared_count = cap.get(cv::CAP_PROP_FRAME_COUNT);
   const std::size_t expected =
       declared_count > 0 && declared_count < 1e9 ? static_cast<std::size_t>(std::llround(declared_count)) : 0;
@@ -703,6 +819,7 @@ Exit runOverlay(OverlayArgs& a) {
   j["unsafe"] = unsafe;
   j["volumes"] = a.swept ? "swept" : "static";
   j["time_offset"] = a.time_offset;
+  if (auto_offset) j["time_offset_auto"] = {{"range", {auto_offset->lo, auto_offset->hi}}, {"correlation", auto_score}};
   j["max_gap"] = max_gap;
   j["fps"] = fps > 0 ? nlohmann::json(fps) : nlohmann::json(nullptr);
   j["margin"] = model.safety_margin;
@@ -747,7 +864,9 @@ Exit runOverlay(OverlayArgs& a) {
     if (!a.output.empty()) std::cout << " to " << a.output;
     if (!a.png_dir.empty()) std::cout << (a.output.empty() ? " to " : " and ") << a.png_dir;
     std::cout << "; clear " << records.size() - no_state - colliding - within << ", within margin " << within << ", colliding "
-              << colliding << ", no state " << no_state << "; " << format(records.size() / std::max(seconds, 1e-9), 3)
+              << colliding << ", no state " << no_state << "; "
+              << (auto_offset ? "time offset " + format(a.time_offset, 6) + " s (auto, correlation " + format(auto_score, 3) + "); " : "")
+              << ""<< format(records.size() / std::max(seconds, 1e-9), 3)
               << " frames/s with " << jobs << " jobs\n";
   }
   if (unsafe > 0) {
@@ -783,9 +902,10 @@ Runner addOverlay(CLI::App& app) {
   sub->add_option("--report", a->report, "Per-frame report (.json): state match, status, min distance, pairs within the margin");
   sub->add_option("--frame-times", a->frame_times, "CSV 'frame,time': each frame's time in seconds (default: index / fps)");
   sub->add_option("--fps", a->fps, "Frame rate of the input (default: the video's own)")->check(finiteIn(1e-6, 1e6));
-  sub->add_option("--time-offset", a->time_offset, "Added to each frame's time to get the state log's time (s)")
-      ->capture_default_str()
-      ->check(finiteIn(-1e12, 1e12));
+  sub->add_option("--time-offset", a->time_offset_text,
+                  "Added to each frame's time to get the state log's time (s); auto:A:B searches [A, B] for the offset at which "
+                  "the image motion best follows the logged motion")
+      ->capture_default_str();
   sub->add_option("--max-gap", a->max_gap, "No state when no two log samples this close bracket the time (s; default 1.5 x the log's median period)")
       ->check(finiteIn(0, 1e300));
   sub->add_option("--ignore-columns", a->ignore_columns, "Comma-separated state log columns to skip (an unknown column is an error)");
