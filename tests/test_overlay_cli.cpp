@@ -363,12 +363,14 @@ TEST_F(OverlayCli, BadStateLogsNameFileLineColumn) {
 TEST_F(OverlayCli, BadOptions) {
   for (const std::string& extra : {std::string(" -o ") + out("out.gif"), " --frames 5:2 -o " + out("out.mkv"),
                                    " --frames x -o " + out("out.mkv"), std::string(""),
-                                   " -o " + out("nowhere/out.mkv"), " --report " + out("r.txt")}) {
+                                   " -o " + out("nowhere/out.mkv"), " --report " + out("r.txt"),
+                                   " -o " + out("in.mkv")}) {
     const Outcome r = runKccd(base() + extra);
     EXPECT_EQ(r.code, 2) << extra;
     EXPECT_EQ(lines(r.err), 1) << r.err;
     EXPECT_TRUE(outputs().empty()) << extra;
   }
+  EXPECT_EQ(readVideo(video_).size(), static_cast<std::size_t>(kFrames));  // the input is untouched
 }
 
 TEST_F(OverlayCli, UnsafeQueryStatusExitsThreeAndWritesEverything) {
@@ -386,6 +388,8 @@ TEST_F(OverlayCli, UnsafeQueryStatusExitsThreeAndWritesEverything) {
   EXPECT_EQ(j["frames_written"], kFrames);
   EXPECT_EQ(readVideo(out("out.mkv")).size(), static_cast<std::size_t>(kFrames));
   EXPECT_EQ(j["frames"][1]["status"], "colliding");
+  EXPECT_EQ(j["frames"][1]["query_status"], "exact_needs_point_interval");
+  EXPECT_TRUE(j["frames"][1]["min_distance"].is_null());  // no bound for an unsafe status
   EXPECT_GE(j["unsafe"].get<int>(), 1);
 }
 

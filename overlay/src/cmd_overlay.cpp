@@ -277,7 +277,8 @@ class FrameWorker {
       checker_.reset();
       const QueryResult& r = checker_.query(lo_, hi_, QueryOptions{.type = QueryType::Distances});
       rec.query = r.status;
-      rec.min_distance = r.min_distance;
+      // A bound only for the box the run is about: none for an unsafe status or a missing braking box.
+      if (r.status == Status::Ok && box_ok) rec.min_distance = r.min_distance;
       for (const PairDistance& pd : r.pairs)
         if (pd.distance <= r.margin) rec.pairs.push_back({m.pairs[pd.pair].a, m.pairs[pd.pair].b});
       if (r.status != Status::Ok || !box_ok || r.min_distance <= 0.0)
@@ -294,6 +295,7 @@ class FrameWorker {
     }
     const render::Frame layer = renderer_->render(volumes, style_, true, false);
     for (render::Visibility v : layer.visibility) rec.not_finite |= v == render::Visibility::NotFinite;
+    if (rec.not_finite) rec.status = FrameStatus::Colliding;  // an overflowed volume is unsafe
     render::compositeOver(job.bgr, layer.bgra);
     if (!s_.args.plain) drawStatusLine(job.bgr, rec);
   }
@@ -555,6 +557,13 @@ Exit runOverlay(OverlayArgs& a) {
     checkOutputPath(a.output, "-o", ext);
   }
   if (!a.report.empty()) checkOutputPath(a.report, "--report", ".json");
+  {  // inputs stay untouched: no output may replace one
+    std::error_code ec;
+    for (const std::string& in : {a.video, a.states, a.model, a.camera, a.frame_times})
+      for (const std::string& outp : {a.output, a.report})
+        if (!in.empty() && !outp.empty() && fs::equivalent(in, outp, ec))
+          throw UsageError(outp + ": is an input of this run (" + in + "); write the output elsewhere");
+  }
   const FrameSelection selection = parseFrames(a.frames);
   const std::optional<AutoOffset> auto_offset = parseTimeOffset(a.time_offset_text, a.time_offset);
   double auto_score = 0.0;
