@@ -35,18 +35,24 @@ Progress::Progress(std::string what, bool quiet)
 
 Progress::~Progress() { finish(); }
 
-void Progress::update(double fraction) {
+void Progress::update(double fraction, const std::string& detail) {
   if (quiet_ || finished_) return;
   fraction = std::clamp(fraction, 0.0, 1.0);
   const double t = nowSeconds();
   if (tty_) {
-    if (fraction - last_ < 0.01 && fraction < 1.0) return;
+    // At most 1 % steps, and with a detail at most every 0.2 s (it changes every frame).
+    if (fraction - last_ < 0.01 && fraction < 1.0 && (detail.empty() || t - last_time_ < 0.2)) return;
+    last_time_ = t;
     const int width = 30, filled = static_cast<int>(fraction * width);
-    std::cerr << "\r" << what_ << " [" << std::string(filled, '#') << std::string(width - filled, ' ') << "] "
-              << static_cast<int>(fraction * 100) << "%" << std::flush;
+    std::string line = what_ + " [" + std::string(filled, '#') + std::string(width - filled, ' ') + "] " +
+                       std::to_string(static_cast<int>(fraction * 100)) + "%" + (detail.empty() ? "" : " " + detail);
+    const std::size_t len = line.size();
+    if (len < shown_width_) line += std::string(shown_width_ - len, ' ');
+    shown_width_ = std::max(shown_width_, len);
+    std::cerr << "\r" << line << std::flush;
     shown_ = true;
   } else if (t - last_time_ >= 5.0) {
-    std::cerr << what_ << ": " << static_cast<int>(fraction * 100) << "%\n";
+    std::cerr << what_ << ": " << static_cast<int>(fraction * 100) << "%" << (detail.empty() ? "" : " " + detail) << "\n";
     last_time_ = t;
   }
   last_ = fraction;
@@ -55,7 +61,7 @@ void Progress::update(double fraction) {
 void Progress::finish() {
   if (finished_) return;
   finished_ = true;
-  if (shown_) std::cerr << "\r" << std::string(what_.size() + 40, ' ') << "\r" << std::flush;
+  if (shown_) std::cerr << "\r" << std::string(std::max(what_.size() + 40, shown_width_), ' ') << "\r" << std::flush;
 }
 
 std::string format(double value, int digits) {

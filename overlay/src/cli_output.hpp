@@ -22,8 +22,8 @@ class Progress {
  public:
   Progress(std::string what, bool quiet);
   ~Progress();
-  /// Reports the fraction done (0 ... 1).
-  void update(double fraction);
+  /// Reports the fraction done (0 ... 1); `detail` (e.g. rate and time left) follows the bar.
+  void update(double fraction, const std::string& detail = {});
   /// Ends the display (also done by the destructor).
   void finish();
 
@@ -32,6 +32,7 @@ class Progress {
   bool quiet_, tty_, shown_ = false, finished_ = false;
   double last_ = -1.0;
   double last_time_ = 0.0;
+  std::size_t shown_width_ = 0;
 };
 
 /// Prints a number with `digits` significant digits (nearest).

@@ -27,6 +27,7 @@ Runner addImport(CLI::App& app);
 Runner addRender(CLI::App& app);
 Runner addCalib(CLI::App& app);
 Runner addSynth(CLI::App& app);
+Runner addOverlay(CLI::App& app);
 /// `intrinsics`, registered on the `calib` subcommand app.
 Runner addCalibIntrinsics(CLI::App& calib);
 

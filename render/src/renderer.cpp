@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
+#include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
 
@@ -136,10 +137,16 @@ struct Renderer::Prepared {
 };
 
 Renderer::Renderer(const Camera& camera, const RenderOptions& options)
+    : Renderer(Projection(camera, options.supersample), options) {}
+
+Renderer::Renderer(const Projection& projection, const RenderOptions& options)
     : options_(options),
-      projection_(camera, options.supersample),
+      projection_(projection),
       context_(GlContext::make()),
-      world_to_camera_(camera.worldToCamera()) {
+      world_to_camera_(projection.camera().worldToCamera()) {
+  if (projection.supersample() != options.supersample)
+    throw std::invalid_argument("Renderer: the projection's supersample differs from RenderOptions::supersample");
+  const Camera& camera = projection_.camera();
   GLint max_renderbuffer = 0, viewport[2] = {0, 0};
   glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
   glGetIntegerv(GL_MAX_VIEWPORT_DIMS, viewport);

@@ -108,6 +108,10 @@ class Renderer {
   /// when the pinhole image exceeds this GL's renderbuffer or viewport limit; the mask pass then
   /// falls back to the colour pass's scale before giving up).
   explicit Renderer(const Camera& camera, const RenderOptions& options = {});
+  /// The same with the colour pass's projection made once elsewhere, e.g. shared by the renderers
+  /// of several threads (a copy shares its read-only distortion maps, whose set-up dominates the
+  /// construction). Its supersample must be options.supersample (std::invalid_argument otherwise).
+  Renderer(const Projection& projection, const RenderOptions& options);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;

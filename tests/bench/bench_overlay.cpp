@@ -1,0 +1,200 @@
+// Throughput of `kccd overlay` next to a plain transcode of the same video with the same codec,
+// measured in one run: makes a 1280x720 recording of the humanoid (mp4v .mp4, textured frames so
+// the codec does real work) with a 100 Hz state log, then times
+//   1. the plain transcode: decode -> encode, pipelined on two threads (the baseline),
+//   2. `kccd overlay` with static volumes,
+//   3. `kccd overlay --swept`,
+// and prints frames per second and the ratios. Usage:
+//   bench_overlay KCCD_BINARY [--frames N] [--jobs J] [--dir WORKDIR] [--codec mp4v|MJPG|FFV1]
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "kccd/calib/camera.hpp"
+#include "kccd/model.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// The sample camera's lens, placed 4.6 m from the humanoid so that all of it is in view.
+kccd::calib::Camera benchCamera() {
+  kccd::calib::Camera c = kccd::calib::loadCamera(std::string(KCCD_DATA_DIR) + "/demo_camera.yaml");
+  const cv::Vec3d eye(3.6, -2.6, 1.7), target(0.1, 0.0, 1.0), up(0, 0, 1);
+  const cv::Vec3d z = cv::normalize(target - eye);
+  const cv::Vec3d x = cv::normalize(z.cross(up));
+  const cv::Vec3d y = z.cross(x);
+  const cv::Matx33d r(x[0], x[1], x[2], y[0], y[1], y[2], z[0], z[1], z[2]);
+  cv::Mat rvec;
+  cv::Rodrigues(cv::Mat(r), rvec);
+  c.rvec = cv::Vec3d(rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2));
+  c.tvec = -(r * eye);
+  return c;
+}
+
+int fourcc(const std::string& codec) { return cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]); }
+
+std::string extensionFor(const std::string& codec) {
+  if (codec == "FFV1") return ".mkv";
+  if (codec == "MJPG") return ".avi";
+  return ".mp4";
+}
+
+void makeVideo(const std::string& path, const std::string& codec, int frames, double fps) {
+  cv::VideoWriter vw(path, cv::CAP_FFMPEG, fourcc(codec), fps, cv::Size(1280, 720), true);
+  if (!vw.isOpened()) throw std::runtime_error("cannot write " + path);
+  cv::Mat noise(720, 1280, CV_8UC3);
+  cv::RNG rng(7);
+  for (int i = 0; i < frames; ++i) {
+    cv::Mat f(720, 1280, CV_8UC3);
+    for (int y = 0; y < 720; ++y) {
+      cv::Vec3b* row = f.ptr<cv::Vec3b>(y);
+      for (int x = 0; x < 1280; ++x) row[x] = cv::Vec3b(uchar((x + 3 * i) / 5), uchar(y / 3), uchar((x + y + 5 * i) / 8));
+    }
+    rng.fill(noise, cv::RNG::UNIFORM, 0, 24);
+    f += noise;
+    vw.write(f);
+  }
+}
+
+// Slow sinusoids within the joint limits at 100 Hz (the arms swing, the torso turns).
+void makeLog(const std::string& path, const kccd::Model& m, double seconds) {
+  std::ofstream out(path);
+  out << "time";
+  for (const std::string& n : m.stateNames()) out << "," << n;
+  out << "\n";
+  char buf[64];
+  for (int k = 0; k <= static_cast<int>(seconds * 100) + 1; ++k) {
+    const double t = k * 0.01;
+    out << k / 100 << "." << (k % 100 < 10 ? "0" : "") << k % 100;
+    for (std::size_t j = 0; j < m.joints.size(); ++j) {
+      const auto& joint = m.joints[j];
+      const std::array<double, 2> lim = joint.limits.value_or(std::array<double, 2>{-1.0, 1.0});
+      const double lo = lim[0], hi = lim[1];
+      const double mid = 0.5 * (lo + hi), amp = 0.35 * (hi - lo);
+      std::snprintf(buf, sizeof buf, ",%.6f", mid + amp * std::sin(0.8 * t + 0.7 * static_cast<double>(j)));
+      out << buf;
+    }
+    out << "\n";
+  }
+}
+
+// Decode and encode on two threads with a bounded queue: the plain transcode's best.
+double transcode(const std::string& in, const std::string& out, const std::string& codec, int& frames) {
+  const auto t0 = Clock::now();
+  cv::VideoCapture cap(in, cv::CAP_FFMPEG);
+  cv::VideoWriter vw(out, cv::CAP_FFMPEG, fourcc(codec), cap.get(cv::CAP_PROP_FPS), cv::Size(1280, 720), true);
+  std::mutex mu;
+  std::condition_variable cv;
+  std::deque<cv::Mat> queue;
+  bool done = false;
+  std::thread reader([&] {
+    for (;;) {
+      cv::Mat f;
+      const bool ok = cap.read(f);
+      std::unique_lock lock(mu);
+      cv.wait(lock, [&] { return queue.size() < 8; });
+      if (!ok) {
+        done = true;
+        cv.notify_all();
+        return;
+      }
+      queue.push_back(std::move(f));
+      cv.notify_all();
+    }
+  });
+  frames = 0;
+  for (;;) {
+    cv::Mat f;
+    {
+      std::unique_lock lock(mu);
+      cv.wait(lock, [&] { return !queue.empty() || done; });
+      if (queue.empty()) break;
+      f = std::move(queue.front());
+      queue.pop_front();
+      cv.notify_all();
+    }
+    vw.write(f);
+    ++frames;
+  }
+  reader.join();
+  vw.release();
+  return since(t0);
+}
+
+double runOverlay(const std::string& command) {
+  const auto t0 = Clock::now();
+  const int rc = std::system(command.c_str());
+  const double s = since(t0);
+  if (rc != 0) throw std::runtime_error("failed (" + std::to_string(rc) + "): " + command);
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::cerr << "usage: bench_overlay KCCD_BINARY [--frames N] [--jobs J] [--dir WORKDIR] [--codec mp4v|MJPG|FFV1]\n";
+    return 2;
+  }
+  const std::string kccd = argv[1];
+  int frames = 150, jobs = 0;
+  std::string dir = (fs::temp_directory_path() / "kccd_bench_overlay").string(), codec = "mp4v";
+  for (int i = 2; i + 1 < argc; i += 2) {
+    const std::string k = argv[i], v = argv[i + 1];
+    if (k == "--frames") frames = std::stoi(v);
+    else if (k == "--jobs") jobs = std::stoi(v);
+    else if (k == "--dir") dir = v;
+    else if (k == "--codec") codec = v;
+  }
+  try {
+    fs::create_directories(dir);
+    const double fps = 30.0;
+    const std::string ext = extensionFor(codec);
+    const std::string model = std::string(KCCD_DATA_DIR) + "/humanoid.yaml", camera = dir + "/camera.yaml",
+                      video = dir + "/in" + ext, log = dir + "/states.csv";
+    kccd::calib::saveCamera(benchCamera(), camera);
+    makeLog(log, kccd::loadModel(model), frames / fps + 1.0);
+    makeVideo(video, codec, frames, fps);
+
+    int plain_frames = 0;
+    const double plain = transcode(video, dir + "/plain" + ext, codec, plain_frames);
+    const std::string base = kccd + " overlay " + model + " --camera " + camera + " --video " + video + " --states " + log +
+                             " --quiet" + (jobs > 0 ? " --jobs " + std::to_string(jobs) : "");
+    const double stat = runOverlay(base + " -o " + dir + "/static" + ext + " --codec " + codec);
+    const double swept = runOverlay(base + " --swept -o " + dir + "/swept" + ext + " --codec " + codec);
+
+    const unsigned hw = std::thread::hardware_concurrency();
+    const double f_plain = plain_frames / plain, f_static = frames / stat, f_swept = frames / swept;
+    std::printf("bench_overlay: %d frames 1280x720, codec %s, humanoid (26 bodies), %u hardware threads, jobs %s\n",
+                frames, codec.c_str(), hw, jobs > 0 ? std::to_string(jobs).c_str() : "default");
+    std::printf("  plain transcode (decode + encode): %7.1f fps\n", f_plain);
+    std::printf("  kccd overlay, static volumes:      %7.1f fps  (%.0f %% of the transcode)\n", f_static, 100 * f_static / f_plain);
+    std::printf("  kccd overlay --swept:              %7.1f fps  (%.0f %% of the transcode)\n", f_swept, 100 * f_swept / f_plain);
+    std::printf("{\"frames\": %d, \"codec\": \"%s\", \"plain_fps\": %.2f, \"static_fps\": %.2f, \"swept_fps\": %.2f, "
+                "\"static_ratio\": %.3f, \"swept_ratio\": %.3f}\n",
+                frames, codec.c_str(), f_plain, f_static, f_swept, f_static / f_plain, f_swept / f_plain);
+    if (plain_frames != frames) std::fprintf(stderr, "bench_overlay: the transcode saw %d frames, not %d\n", plain_frames, frames);
+  } catch (const std::exception& e) {
+    std::cerr << "bench_overlay: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
