@@ -307,7 +307,7 @@ class FrameWorker {
     std::snprintf(buf, sizeof buf, "t %.3f s", rec.time + s_.args.time_offset);
     s << buf;
     if (rec.match == StateMatch::None) {
-      s << "  NO STATE (no log sample within " << format(s_.max_gap, 3) << " s)";
+      s << "  NO STATE (outside the log or in a gap longer than " << format(s_.max_gap, 3) << " s)";
     } else {
       s << " (" << stateName(rec.match) << ")" << (s_.args.swept ? "  swept" : "");
       if (rec.unsafe()) {
