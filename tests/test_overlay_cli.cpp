@@ -436,3 +436,25 @@ TEST_F(OverlayCli, AutoTimeOffsetFindsTheShift) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST_F(OverlayCli, ContactSheetShowsSpreadFramesAndTheCollidingOne) {
+  const Outcome r = runKccd(base() + " --contact-sheet " + out("sheet.png") + " --contact-frames 4 --report " + out("report.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const cv::Mat sheet = cv::imread(out("sheet.png"));
+  ASSERT_FALSE(sheet.empty());
+  // 4 tiles of 320 px in one row (4 px gaps), each with a caption strip.
+  EXPECT_EQ(sheet.cols, 4 * 324 + 4);
+  const auto j = nlohmann::json::parse(readText(out("report.json")));
+  EXPECT_EQ(j["contact_sheet"], out("sheet.png"));
+  // No frame drawn: nothing to put on a sheet, and nothing written.
+  const Outcome none = runKccd(base() + " --contact-sheet " + out("none.png") + " --frames 100:200");
+  EXPECT_EQ(none.code, 2) << none.err;
+  EXPECT_NE(none.err.find("no frame was drawn"), std::string::npos) << none.err;
+  EXPECT_FALSE(fs::exists(out("none.png")));
+  const Outcome jpg = runKccd(base() + " --contact-sheet " + out("sheet.jpg"));
+  EXPECT_EQ(jpg.code, 2);
+}
+
+}  // namespace

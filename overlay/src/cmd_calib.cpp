@@ -9,6 +9,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "calib_drawing.hpp"
 #include "cli_args.hpp"
@@ -70,8 +71,9 @@ std::vector<cv::Point3d> corePoints(const Model& m, std::span<const double> stat
 struct CalibArgs {
   std::string intrinsics, tags, model, output, check, truth;
   std::vector<std::string> images, labels, states;
-  std::string state_log, ignore_columns;
+  std::string state_log, ignore_columns, video;
   std::vector<double> times;
+  std::vector<int> video_frames;
   double max_gap = 0.0;  // 0: 1.5 x the log's median period
   double threshold = 8.0, magnify = 20.0;
   int min_inliers = 6;
@@ -104,14 +106,62 @@ std::string prefixed(const std::string& name, std::size_t frame, std::size_t fra
   return frames > 1 ? "f" + std::to_string(frame + 1) + "/" + name : name;
 }
 
+// Frames `wanted` (ascending after sorting) of a video, read in order (seeking is not reliable in
+// every codec); also the video's frame rate (0 when it does not say).
+std::vector<cv::Mat> readVideoFrames(const std::string& path, const std::vector<int>& wanted, double& fps) {
+  if (!std::filesystem::is_regular_file(path)) throw UsageError("--video " + path + ": no such file");
+  cv::VideoCapture capture;
+  try {
+    capture.open(path, cv::CAP_FFMPEG);
+  } catch (const cv::Exception&) {
+  }
+  if (!capture.isOpened()) throw UsageError("--video " + path + ": not a video OpenCV can read");
+  fps = capture.get(cv::CAP_PROP_FPS);
+  const int last = *std::max_element(wanted.begin(), wanted.end());
+  std::vector<cv::Mat> out(wanted.size());
+  cv::Mat frame;
+  for (int i = 0; i <= last; ++i) {
+    bool ok = false;
+    try {
+      ok = capture.read(frame);
+    } catch (const cv::Exception&) {
+      ok = false;
+    }
+    if (!ok || frame.empty())
+      throw UsageError("--frame " + std::to_string(last) + ": " + path + " has only " + std::to_string(i) + " readable frames");
+    for (std::size_t k = 0; k < wanted.size(); ++k)
+      if (wanted[k] == i) out[k] = frame.type() == CV_8UC3 ? frame.clone() : cv::Mat();
+  }
+  for (const cv::Mat& m : out)
+    if (m.empty()) throw UsageError("--video " + path + ": frames are not 8-bit colour images");
+  return out;
+}
+
 Gathered gather(const CalibArgs& a, const calib::Camera& cam, const std::optional<Model>& model) {
-  const std::size_t n = a.images.empty() ? a.labels.size() : a.images.size();
+  // The pictures: image files, or frames of a video.
+  std::vector<std::string> picture_names = a.images;
+  std::vector<cv::Mat> video_pictures;
+  std::vector<double> times = a.times;
+  if (!a.video.empty()) {
+    if (!a.images.empty()) throw UsageError("--video: give --image files or --video with --frame, not both");
+    if (a.video_frames.empty()) throw UsageError("--video: say which frames with --frame N (repeat for several)");
+    double fps = 0.0;
+    video_pictures = readVideoFrames(a.video, a.video_frames, fps);
+    for (int f : a.video_frames) picture_names.push_back(a.video + "#" + std::to_string(f));
+    if (!a.state_log.empty() && times.empty()) {
+      if (!(fps > 0.0)) throw UsageError("--video " + a.video + ": no frame rate: give each frame's time with --time");
+      for (int f : a.video_frames) times.push_back(f / fps);
+    }
+  } else if (!a.video_frames.empty()) {
+    throw UsageError("--frame: needs --video");
+  }
+  const std::size_t n = picture_names.empty() ? a.labels.size() : picture_names.size();
   if (n == 0) throw UsageError("give --image FRAME (with --tags and/or --labels) or --labels LABELS (see kccd calib --help)");
-  if (!a.images.empty() && !a.labels.empty() && a.labels.size() != a.images.size())
-    throw UsageError("--labels: given " + std::to_string(a.labels.size()) + " times for " + std::to_string(a.images.size()) +
+  if (!picture_names.empty() && !a.labels.empty() && a.labels.size() != picture_names.size())
+    throw UsageError("--labels: given " + std::to_string(a.labels.size()) + " times for " + std::to_string(picture_names.size()) +
                      " images: give one labels file per --image, in the same order");
-  if (!a.tags.empty() && a.images.empty()) throw UsageError("--tags: needs --image (tags are detected in the images)");
-  if (!a.images.empty() && a.tags.empty() && a.labels.empty())
+  if (!a.tags.empty() && picture_names.empty()) throw UsageError("--tags: needs --image (tags are detected in the images)");
+  if (!picture_names.empty() && a.tags.empty() && a.labels.empty())
     throw UsageError("--image: give --tags LAYOUT and/or --labels LABELS to say what the image shows");
   if (!a.states.empty() && a.states.size() != 1 && a.states.size() != n)
     throw UsageError("--state: given " + std::to_string(a.states.size()) + " times for " + std::to_string(n) +
@@ -119,10 +169,10 @@ Gathered gather(const CalibArgs& a, const calib::Camera& cam, const std::optiona
   if (!a.states.empty() && !model) throw UsageError("--state: needs --model");
   if (!a.state_log.empty() && !model) throw UsageError("--states: needs --model");
   if (!a.state_log.empty() && !a.states.empty()) throw UsageError("--state and --states: give one of them");
-  if (a.state_log.empty() != a.times.empty())
+  if (a.state_log.empty() != times.empty())
     throw UsageError(a.state_log.empty() ? "--time: needs --states LOG.csv" : "--states: give each frame's time with --time");
-  if (!a.times.empty() && a.times.size() != n)
-    throw UsageError("--time: given " + std::to_string(a.times.size()) + " times for " + std::to_string(n) + " frames: give one per frame");
+  if (!times.empty() && times.size() != n)
+    throw UsageError("--time: given " + std::to_string(times.size()) + " times for " + std::to_string(n) + " frames: give one per frame");
   std::optional<StateLog> log;
   double max_gap = a.max_gap;
   if (!a.state_log.empty()) {
@@ -147,13 +197,13 @@ Gathered gather(const CalibArgs& a, const calib::Camera& cam, const std::optiona
       fr.state = parseStateBox(*model, text, "", "", "", true).lower;
     } else if (log) {
       fr.state.assign(static_cast<std::size_t>(model->stateSize()), 0.0);
-      if (stateAt(*log, a.times[f], max_gap, fr.state) == StateMatch::None)
-        throw UsageError("--time " + format(a.times[f]) + ": " + a.state_log + " has no sample within --max-gap " + format(max_gap) +
+      if (stateAt(*log, times[f], max_gap, fr.state) == StateMatch::None)
+        throw UsageError("--time " + format(times[f]) + ": " + a.state_log + " has no sample within --max-gap " + format(max_gap) +
                          " s of it (the log covers " + format(log->times.front()) + " ... " + format(log->times.back()) + " s)");
     }
-    if (!a.images.empty()) {
-      fr.image = a.images[f];
-      fr.bgr = calib::readImageFile(fr.image, calib::ImageColour::Bgr);
+    if (!picture_names.empty()) {
+      fr.image = picture_names[f];
+      fr.bgr = video_pictures.empty() ? calib::readImageFile(fr.image, calib::ImageColour::Bgr) : video_pictures[f];
       checkImageSize(fr.bgr, cam, fr.image, a.intrinsics);
       if (layout) {
         cv::Mat gray;
@@ -206,7 +256,7 @@ cv::Mat volumesLayer(const Model& m, const calib::Camera& cam, std::span<const d
   try {
     render::Renderer renderer(cam);
     render::Style style;
-    style.labels = true;
+    style.labels = m.bodies.size() <= 12;  // names of many bodies only cover each other
     renderer_name = renderer.rendererString();
     return renderer.render(volumes, style, true, false).bgra;
   } catch (const calib::CameraError& e) {
@@ -484,6 +534,10 @@ Runner addCalib(CLI::App& app) {
   auto a = std::make_shared<CalibArgs>();
   sub->add_option("--intrinsics", a->intrinsics, "Camera file with the intrinsics and lens distortion (its pose is ignored); required");
   sub->add_option("--image", a->images, "A frame from the fixed camera (repeat for several frames)")->allow_extra_args(false);
+  sub->add_option("--video", a->video, "A recording from the fixed camera: its frames given by --frame are the frames");
+  sub->add_option("--frame", a->video_frames, "Frame index in --video (from 0; repeat for several frames)")
+      ->allow_extra_args(false)
+      ->check(CLI::Range(0, 100000000));
   sub->add_option("--tags", a->tags, "Tag layout: where the AprilTags are in the world");
   sub->add_option("--labels", a->labels, "Labelled points (repeat: one file per --image, same order)")->allow_extra_args(false);
   sub->add_option("--model", a->model, "Model file placing the body labels (and drawn in the check image)");
@@ -493,7 +547,7 @@ Runner addCalib(CLI::App& app) {
       ->allow_extra_args(false);
   sub->add_option("--states", a->state_log,
                   "State log (CSV: time and one column per state value, see kccd info) placing the body labels at each frame's --time");
-  sub->add_option("--time", a->times, "Each frame's time in the state log's clock (s; once per frame)")
+  sub->add_option("--time", a->times, "Each frame's time in the state log's clock (s; once per frame; with --video default frame / fps)")
       ->allow_extra_args(false)
       ->check(finiteIn(-1e300, 1e300));
   sub->add_option("--max-gap", a->max_gap, "No state when the log has no sample this close (s; default 1.5 x its median period)")

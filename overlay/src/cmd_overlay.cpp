@@ -36,6 +36,7 @@
 #include "cli_args.hpp"
 #include "cli_files.hpp"
 #include "cli_output.hpp"
+#include "contact_sheet.hpp"
 #include "commands.hpp"
 #include "kccd/braking.hpp"
 #include "kccd/checker.hpp"
@@ -50,7 +51,8 @@ namespace {
 namespace fs = std::filesystem;
 
 struct OverlayArgs {
-  std::string model, camera, video, states, output, png_dir, report, frames, frame_times, ignore_columns, codec;
+  std::string model, camera, video, states, output, png_dir, report, frames, frame_times, ignore_columns, codec, contact_sheet;
+  int contact_frames = 12;
   std::string time_offset_text = "0";  // seconds, or auto:A:B
   double time_offset = 0.0, max_gap = 0.0, fps = 0.0;
   double latency = 0.01, deceleration = 5.0, max_acceleration = 0.0, position_error = 0.0, velocity_error = 0.0;
@@ -548,8 +550,9 @@ Exit runOverlay(OverlayArgs& a) {
   // Every input and option is checked before any frame is decoded.
   const Model model = loadOrExplain(a.model);
   const calib::Camera camera = calib::loadCamera(a.camera);
-  if (a.output.empty() && a.png_dir.empty() && a.report.empty())
-    throw UsageError("nothing to write: give -o VIDEO, --png-dir DIR and/or --report FILE");
+  if (a.output.empty() && a.png_dir.empty() && a.report.empty() && a.contact_sheet.empty())
+    throw UsageError("nothing to write: give -o VIDEO, --png-dir DIR, --report FILE and/or --contact-sheet FILE");
+  if (!a.contact_sheet.empty()) checkOutputPath(a.contact_sheet, "--contact-sheet", ".png");
   if (!a.output.empty()) {
     const std::string ext = lowerExtension(a.output);
     if (ext != ".mp4" && ext != ".mkv" && ext != ".avi")
@@ -750,6 +753,7 @@ Exit runOverlay(OverlayArgs& a) {
   // The writer: frames in input order.
   std::vector<FrameRecord> records;
   std::size_t written = 0;
+  ContactSheet sheet(static_cast<std::size_t>(a.contact_frames), 320);
   Progress progress("overlay", a.quiet);
   const auto t_frames = std::chrono::steady_clock::now();
   try {
@@ -785,6 +789,16 @@ Exit runOverlay(OverlayArgs& a) {
         if (writer.isOpened() || !png_tmp.empty()) {
           job.record.written = true;
           ++written;
+        }
+        if (!a.contact_sheet.empty()) {
+          const FrameRecord& r = job.record;
+          std::string caption = "#" + std::to_string(job.index) + "  " + format(r.time, 4) + " s  " + toString(r.status);
+          if (std::isfinite(r.min_distance)) caption += "  " + format(r.min_distance * 1000, 3) + " mm";
+          // The most critical frame is always on the sheet: colliding first, then the nearest.
+          const double priority = r.unsafe() || r.status == FrameStatus::Colliding ? -1.0
+                                  : std::isfinite(r.min_distance)                  ? r.min_distance
+                                                                                   : std::numeric_limits<double>::infinity();
+          sheet.add(job.index, job.bgr, caption, priority);
         }
       }
       records.push_back(std::move(job.record));
@@ -834,6 +848,12 @@ Exit runOverlay(OverlayArgs& a) {
   j["margin"] = model.safety_margin;
   if (!a.output.empty()) j["video"] = a.output;
   if (!a.png_dir.empty()) j["png_dir"] = a.png_dir;
+  if (!a.contact_sheet.empty()) {
+    const cv::Mat picture = sheet.compose();
+    if (picture.empty()) throw UsageError("--contact-sheet " + a.contact_sheet + ": no frame was drawn (see --frames)");
+    writePngAtomically(a.contact_sheet, picture, "--contact-sheet");
+    j["contact_sheet"] = a.contact_sheet;
+  }
   if (!a.report.empty()) {
     nlohmann::json frames = nlohmann::json::array();
     for (std::size_t i = 0; i < records.size(); ++i) {
@@ -908,6 +928,9 @@ Runner addOverlay(CLI::App& app) {
   sub->add_option("-o,--output", a->output, "Output video (.mp4: mp4v, .mkv: FFV1 lossless, .avi: MJPG; see --codec)");
   sub->add_option("--png-dir", a->png_dir, "Also (or only) write frame_%06d.png (input frame numbers) into this new or empty folder");
   sub->add_option("--frames", a->frames, "Frames to draw and write: FIRST:END:STEP (from 0, END exclusive; all frames are still checked and reported)");
+  sub->add_option("--contact-sheet", a->contact_sheet,
+                  "A .png of --contact-frames drawn frames spread over the run, the most critical one included, captioned");
+  sub->add_option("--contact-frames", a->contact_frames, "Frames on the contact sheet")->check(CLI::Range(1, 64))->capture_default_str();
   sub->add_option("--report", a->report, "Per-frame report (.json): state match, status, min distance, pairs within the margin");
   sub->add_option("--frame-times", a->frame_times, "CSV 'frame,time': each frame's time in seconds (default: index / fps)");
   sub->add_option("--fps", a->fps, "Frame rate of the input (default: the video's own)")->check(finiteIn(1e-6, 1e6));
