@@ -847,6 +847,9 @@ Exit runSynth(const SynthArgs& a) {
     std::string pattern = (parent / ("." + out.filename().string() + ".tmp-XXXXXX")).string();
     if (!mkdtemp(pattern.data())) throw UsageError("-o " + a.output + ": cannot create a folder beside it");
     tmp.path = pattern;
+    const mode_t mask = umask(0);  // mkdtemp makes it private; the result is an ordinary folder
+    umask(mask);
+    ::chmod(tmp.path.c_str(), 0777 & ~mask);
   }
   const std::string mask_dir = tmp.path + "/masks";
   fs::create_directory(mask_dir);
