@@ -22,6 +22,7 @@
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/render/composite.hpp"
+#include "support/golden.hpp"
 #include "support/run_program.hpp"
 
 namespace {
@@ -455,6 +456,22 @@ TEST_F(OverlayCli, ContactSheetShowsSpreadFramesAndTheCollidingOne) {
   EXPECT_FALSE(fs::exists(out("none.png")));
   const Outcome jpg = runKccd(base() + " --contact-sheet " + out("sheet.jpg"));
   EXPECT_EQ(jpg.code, 2);
+}
+
+}  // namespace
+
+namespace {
+
+// What an operator sees stays as reviewed: a colliding frame (status line, legend, red volumes)
+// and a frame without a state (only the fixed bodies, grey; "NO STATE").
+TEST_F(OverlayCli, SelectedFramesMatchGoldenImages) {
+  const Outcome r = runKccd(base() + " --png-dir " + out("pngs") + " --frames 4:8:3");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Outcome info = runKccd("render " + kDemo + " --camera " + camera_ + " --state 0,0,0 --json -o " + out("r.png"));
+  ASSERT_EQ(info.code, 0) << info.err;
+  const std::string renderer = nlohmann::json::parse(info.out)["renderer"];
+  EXPECT_TRUE(kccd::testing::compareGolden(cv::imread(out("pngs/frame_000004.png")), "overlay_frame4_colliding", renderer));
+  EXPECT_TRUE(kccd::testing::compareGolden(cv::imread(out("pngs/frame_000007.png")), "overlay_frame7_no_state", renderer));
 }
 
 }  // namespace

@@ -282,3 +282,38 @@ TEST_F(Synth, BadInputIsOneLineExitTwo) {
 }
 
 }  // namespace
+
+namespace {
+
+// The main job's chain, end to end: the camera calibrated from the recording's tags, each frame's
+// state matched from the log by time (log clock = video clock + the offset), the volumes drawn
+// as the overlay draws them: every pixel of the robot's visible geometry lies inside them.
+TEST_F(Synth, CalibratedOverlayCoversTheVisibleGeometry) {
+  const json j = summary();
+  const std::string solved = dir("overlay_camera.yaml");
+  const Outcome r = runKccd("calib --intrinsics " + dir("a") + "/intrinsics.yaml --video " + dir("a") + "/video.mkv --frame 0 --tags " +
+                            dir("a") + "/tags.yaml -o " + solved + " -q");
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  const kccd::Model m = kccd::loadModel(kHumanoid);
+  const kccd::StateLog log = kccd::loadStateLog(dir("a") + "/states.csv", m);
+  const double offset = j["state_log"]["time_offset"], fps = j["video"]["fps"];
+  kccd::render::Renderer renderer(kccd::calib::loadCamera(solved));  // the overlay's default options
+  kccd::Checker checker(m);
+  std::vector<double> s(static_cast<std::size_t>(m.stateSize()));
+  int frames_checked = 0;
+  for (const json& f : j["frames"]) {
+    const int index = f["index"];
+    if (kccd::stateAt(log, index / fps + offset, 1.5 * log.medianPeriod(), s) == kccd::StateMatch::None) continue;
+    checker.query(s, s, kccd::QueryOptions{.type = kccd::QueryType::Distances});
+    const kccd::render::Frame frame = renderer.render(kccd::render::staticSceneVolumes(m, checker, s, {}), {}, false, true);
+    char name[32];
+    std::snprintf(name, sizeof name, "/masks/frame_%06d.png", index);
+    const cv::Mat visible = cv::imread(dir("a") + name, cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(visible.size(), frame.mask.size());
+    EXPECT_EQ(cv::countNonZero((visible > 0) & (frame.mask == 0)), 0) << name;
+    ++frames_checked;
+  }
+  EXPECT_EQ(frames_checked, static_cast<int>(j["frames"].size()));  // the log covers every frame
+}
+
+}  // namespace
