@@ -204,6 +204,21 @@ TEST_F(OverlayCli, FrameTimesAndImageSequence) {
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("no time for frame 2"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(out("r2.json")));
+  // A gap or a huge frame number is refused at its line (no table sized by the number).
+  for (const std::string& rows : {std::string("0,0.0\n5,0.5\n"), std::string("0,0.0\n100000000,1.0\n")}) {
+    writeText(out("input_times.csv"), "frame,time\n" + rows);
+    const Outcome gap = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_seq/frame_%06d.png") +
+                                " --states " + log_ + " -q --frame-times " + out("input_times.csv") + " --report " + out("r3.json"));
+    EXPECT_EQ(gap.code, 2);
+    EXPECT_NE(gap.err.find(out("input_times.csv") + ":3:1: column 'frame': expected frame 1"), std::string::npos) << gap.err;
+    EXPECT_EQ(lines(gap.err), 1) << gap.err;
+  }
+  // Not a regular file: refused without reading.
+  const Outcome dir = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_seq/frame_%06d.png") +
+                              " --states " + log_ + " -q --frame-times " + out("input_seq") + " --report " + out("r3.json"));
+  EXPECT_EQ(dir.code, 2);
+  EXPECT_NE(dir.err.find("not a regular file"), std::string::npos) << dir.err;
+  EXPECT_FALSE(fs::exists(out("r3.json")));
 }
 
 TEST_F(OverlayCli, PngDirWithFrames) {

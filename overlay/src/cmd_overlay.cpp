@@ -105,9 +105,15 @@ FrameSelection parseFrames(const std::string& text) {
   return s;
 }
 
-// `--frame-times FILE`: CSV with the header `frame,time`, one row per frame, both increasing.
-// Returns the time per frame number (NaN for a frame without a row).
+// `--frame-times FILE`: CSV with the header `frame,time`, one row per frame from frame 0 in order,
+// times increasing. Returns the time per frame number. Every decoded frame needs its time, so a
+// missing row is an error at once (naming the line), and memory stays bounded by the file's size.
 std::vector<double> loadFrameTimes(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) throw UsageError("--frame-times " + path + ": no such file");
+  if (!fs::is_regular_file(st)) throw UsageError("--frame-times " + path + ": not a regular file");
+  if (fs::file_size(path, ec) > (std::uintmax_t{1} << 30)) throw UsageError("--frame-times " + path + ": larger than 1 GiB");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw UsageError("--frame-times " + path + ": cannot read the file");
   std::vector<double> times;
@@ -140,7 +146,9 @@ std::vector<double> loadFrameTimes(const std::string& path) {
     const std::string tcol = std::to_string(comma + 2);
     if (t.empty() || end != t.c_str() + t.size() || !std::isfinite(time) || std::fabs(time) > 1e300)
       throw UsageError(where + tcol + ": column 'time': not a finite number: '" + oneLine(t) + "'");
-    if (frame <= last_frame) throw UsageError(where + "1: column 'frame': frame numbers must increase");
+    if (frame != last_frame + 1)
+      throw UsageError(where + "1: column 'frame': expected frame " + std::to_string(last_frame + 1) + ", found " +
+                       std::to_string(frame) + " (one row per frame, from 0, in order)");
     if (!(time > last_time)) throw UsageError(where + tcol + ": column 'time': times must increase strictly");
     last_frame = frame;
     last_time = time;
