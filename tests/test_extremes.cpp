@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -299,6 +300,7 @@ bool runCase(std::uint64_t seed, Tally& tally, std::string& why) {
       QueryOptions opt;
       opt.type = static_cast<QueryType>(t);
       opt.n = 1 + uniformInt(rng, 0, std::max(0, np - 1));
+      opt.exact_below = fresh ? std::numeric_limits<double>::infinity() : -1.0;
       const QueryResult& r = c.query(lower, upper, opt);
       answers.push_back({r.type, r.status, r.collision, r.min_distance, {r.pairs.begin(), r.pairs.end()}});
       ++tally.queries;

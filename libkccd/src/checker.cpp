@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "bounding_sphere.hpp"
+#include "chain_support.hpp"
 #include "kccd/distance.hpp"
 #include "rounding.hpp"
 #include "sweep.hpp"
@@ -16,6 +17,9 @@ namespace kccd {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Nodes one support search of the exact stage may visit (bounds its time; a search stopped early
+// still gives a valid bound).
+constexpr int kExactNodes = 4096;
 using Clock = std::chrono::steady_clock;
 using detail::shrunkBound;
 
@@ -32,7 +36,25 @@ Checker::Checker(const Model& model) : model_(model) {
   nbest_.assign(np, 0.0);
   lower_.assign(ns, 0.0);
   upper_.assign(ns, 0.0);
+  // The exact stage.
+  const int nj = static_cast<int>(model.joints.size());
+  joint_maps_.resize(nj);
+  joint_maps_stamp_.assign(nj, 0);
+  int max_levels = 0;
+  for (int l : levels_) max_levels = std::max(max_levels, l);
+  for (int variant = 0; variant < 2; ++variant) {
+    chain_[variant].resize(volumes_.size());
+    chain_stamp_[variant].assign(volumes_.size(), 0);
+    chain_radius_[variant].assign(volumes_.size(), 0.0);
+    chain_tangent_[variant].assign(volumes_.size(), 0);
+  }
+  for (const Body& body : model.bodies) base_sphere_.push_back(detail::boundingSphere(body.points, 0.0));
+  chain_stack_.resize(detail::chainStackSize(max_levels));
+  chain_choice_.assign(std::max(max_levels, 1), 0);
+  chain_best_.assign(std::max(max_levels, 1), 0);
 }
+
+Checker::~Checker() = default;
 
 // Levels per body: level 0 is the body in its own frame, level l+1 the volume swept through the
 // joint of level l and expressed in that joint's parent frame, up to the world. Every level gets
@@ -76,9 +98,7 @@ void Checker::layoutVolumes() {
   for (const Joint& j : model.joints) expansion = std::max(expansion, detail::sweepExpansion(j));
   scratch_.resize(static_cast<std::size_t>(expansion) * max_points);
   scratch_dist_.resize(scratch_.size());
-  scratch_rho_.resize(max_points);
-  scratch_level_.resize(max_points);
-  scratch_order_.resize(max_points);
+  scratch_order_.resize(scratch_.size());
 }
 
 // Per pair: the level of the LCA frame on each body's path, and how far each state value can
@@ -173,11 +193,14 @@ const Checker::Volume* Checker::volume(int body, int level, Box box) noexcept {
   if (below == nullptr) return nullptr;
   const Joint& joint = model_.joints[path_[idx - 1]];
   double radius = below->radius;
-  const detail::SweepWork work{scratch_rho_.data(), scratch_level_.data(), scratch_order_.data()};
-  int n = detail::sweepJoint(joint, box.lower.data() + joint.state_offset, box.upper.data() + joint.state_offset,
-                             view(*below).points, scratch_.data(), radius, v.capacity, work);
+  const double* lo = box.lower.data() + joint.state_offset;
+  const double* hi = box.upper.data() + joint.state_offset;
+  const Sphere* below_sphere = sphere(body, level - 1, box);
+  if (below_sphere == nullptr) return nullptr;
+  int n = detail::sweepJoint(joint, lo, hi, view(*below).points, scratch_.data(), radius, v.capacity,
+                             scratch_dist_.data(), *below_sphere);
   if (n < 0) return nullptr;
-  n = detail::reduceToBudget(scratch_.data(), n, v.capacity, scratch_dist_.data(), radius);
+  n = detail::reduceToBudget(scratch_.data(), n, v.capacity, scratch_dist_.data(), scratch_order_.data(), radius);
   std::copy(scratch_.begin(), scratch_.begin() + n, points_.begin() + v.offset);
   v.count = n;
   v.radius = radius;
@@ -214,6 +237,93 @@ SschView Checker::sweptVolume(int body, int frame) noexcept {
     return v == nullptr ? SschView{} : view(*v);
   }
   return {};
+}
+
+const detail::JointMaps* Checker::jointMaps(int joint, Box box) noexcept {
+  if (joint_maps_stamp_[joint] != cycle_) {
+    const Joint& j = model_.joints[joint];
+    joint_maps_[joint] = detail::jointMaps(j, box.lower.data() + j.state_offset, box.upper.data() + j.state_offset);
+    joint_maps_stamp_[joint] = cycle_;
+  }
+  return &joint_maps_[joint];
+}
+
+// The chain of `body` up to `level` (levels swept, as in volume()); variant 0 covers every revolute
+// joint by chords, variant 1 by each joint's mode (accurate: chords and tangent apexes).
+bool Checker::chain(int body, int level, int variant, Box box, detail::ChainView& out) noexcept {
+  const int begin = level_begin_[body];
+  const Body& b = model_.bodies[body];
+  std::vector<detail::ChainLevel>& levels = chain_[variant];
+  double radius = b.radius;
+  bool tangent = false;
+  for (int l = 1; l <= level; ++l) {
+    const int idx = begin + l;
+    if (chain_stamp_[variant][idx] != cycle_) {
+      const int joint = path_[idx - 1];
+      const Sphere& below = l == 1 ? base_sphere_[body] : levels[idx - 1].core;
+      const bool apexes = variant == 1 && model_.joints[joint].sweep == SweepMode::Accurate;
+      const Sphere* swept = sphere(body, l - 1, box);
+      if (swept == nullptr) return false;
+      levels[idx] = detail::chainLevel(*jointMaps(joint, box), apexes, below, *swept);
+      const double below_radius = l == 1 ? b.radius : chain_radius_[variant][idx - 1];
+      chain_radius_[variant][idx] = below_radius + levels[idx].growth;
+      chain_tangent_[variant][idx] =
+          (l > 1 && chain_tangent_[variant][idx - 1]) || levels[idx].count != levels[idx].maps->chord_count;
+      if (!levels[idx].core.center.allFinite() || !std::isfinite(levels[idx].core.radius) ||
+          !std::isfinite(chain_radius_[variant][idx]))
+        return false;
+      chain_stamp_[variant][idx] = cycle_;
+    }
+    radius = chain_radius_[variant][idx];
+    tangent = chain_tangent_[variant][idx] != 0;
+  }
+  (void)tangent;
+  out.points = b.points;
+  out.base = base_sphere_[body];
+  out.levels = std::span<const detail::ChainLevel>(levels.data() + begin + 1, static_cast<std::size_t>(level));
+  out.radius = radius;
+  return true;
+}
+
+// Refines a pair's bound with the exact stage: the chord chains first, then (when an accurate
+// joint adds apexes) the chains in each joint's mode; the bound is the best of all. Returns false
+// on a numerical failure.
+bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexcept {
+  const BodyPair& pair = model_.pairs[p];
+  Entry& e = table_[p];
+  const int la = pair_level_[2 * p], lb = pair_level_[2 * p + 1];
+  const detail::ChainWork work{chain_stack_.data(), chain_choice_.data(), chain_best_.data()};
+  for (int variant = 0; variant < 2; ++variant) {
+    if (bound >= stop_above) break;
+    detail::ChainView ca, cb;
+    if (!chain(pair.a, la, variant, box, ca) || !chain(pair.b, lb, variant, box, cb)) return false;
+    if (variant == 1 && (la == 0 || !chain_tangent_[1][level_begin_[pair.a] + la]) &&
+        (lb == 0 || !chain_tangent_[1][level_begin_[pair.b] + lb]))
+      break;  // no apexes anywhere: the same chains as variant 0
+    detail::SetsInfo info;
+    info.scale_a = detail::chainExtent(ca);
+    info.scale_b = detail::chainExtent(cb);
+    info.start_a = ca.levels.empty() ? ca.base.center : ca.levels.back().core.center;
+    info.start_b = cb.levels.empty() ? cb.base.center : cb.levels.back().core.center;
+    auto support_a = [&](const Vec3& dir) { return detail::chainSupport(ca, dir, work, kExactNodes); };
+    auto support_b = [&](const Vec3& dir) { return detail::chainSupport(cb, dir, work, kExactNodes); };
+    GjkOptions opt;
+    opt.stop_above = stop_above;
+    opt.warm_start = &e.direction;
+    opt.max_iterations = 64;
+    opt.relative_tolerance = 1e-9;
+    const DistanceResult d = detail::gjkDistance(support_a, support_b, ca.radius, cb.radius, info, opt);
+    ++result_.stats.exact_calls;
+    if (d.status == GjkStatus::InvalidInput || !std::isfinite(d.distance)) return false;
+    if (d.distance > bound) {
+      bound = d.distance;
+      e.witness_a = d.witness_a;
+      e.witness_b = d.witness_b;
+      e.gjk = true;
+    }
+    e.direction = d.direction;
+  }
+  return true;
 }
 
 double Checker::refresh(int p, double stop_above, Box box) noexcept {
@@ -254,6 +364,7 @@ double Checker::refresh(int p, double stop_above, Box box) noexcept {
       e.witness_a = d.witness_a;
       e.witness_b = d.witness_b;
       e.gjk = true;
+      if (bound < std::min(stop_above, exact_below_) && !exactStage(p, stop_above, box, bound)) return fail();
     }
   }
   e.valid = true;
@@ -283,6 +394,7 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   result_.type = options.type;
   result_.margin = options.margin >= 0.0 ? options.margin : model_.safety_margin;
   const double margin = result_.margin;
+  exact_below_ = std::isnan(options.exact_below) ? 0.0 : options.exact_below < 0.0 ? margin : options.exact_below;
   if (!validate(lower, upper)) {
     result_.collision = true;
     result_.min_distance = 0.0;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include "rounding.hpp"
 
 #include "kccd/rotation.hpp"
@@ -11,6 +13,7 @@ namespace {
 
 constexpr double kPi = 3.141592653589793;
 constexpr double kTwoPi = 6.283185307179586;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Pieces for a revolute interval of width `width` (capped at a full turn).
 int revolutePieces(double width) {
@@ -45,15 +48,13 @@ double maxNorm(std::span<const Vec3> pts) {
   return m;
 }
 
-// Revolute sweep in the joint frame. Each point's arc is covered at one of three levels:
-//   tangent  - chord ends plus tangent apexes (2*pieces + 1 points), exact cover;
-//   chord    - chord ends (pieces + 1 points), radius grows by the sagitta rho (1 - cos(step / 2));
-//   single   - the arc's middle point (1 point), radius grows by the half-arc chord 2 rho sin(w / 4).
-// The sweep mode sets the best level (accurate: tangent, fast: chord). When the budget cannot hold
-// every point at that level, points far from the axis keep the finer levels first, which keeps the
-// radius growth (the largest error over all points) as small as the budget allows.
+// Revolute sweep in the joint frame (the point volumes of the first stage, whatever the joint's
+// mode): each point's arc is covered by its chords (pieces + 1 points) and the radius grows by the
+// largest sagitta rho (1 - cos(step / 2)), an error second order in the interval width. The point
+// budget is applied by reduceToBudget(), whose error is measured against the hull of the kept
+// points. Tangent apexes (accurate joints) are used by the exact stage (jointMaps()).
 int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in, Vec3* out, double& radius,
-                  int budget, SweepWork work) {
+                  int budget, double* rho, double rho_bound) {
   const Vec3& a = j.axis;
   const Arc arc = revoluteArc(lo, hi);
   lo = arc.start;
@@ -76,76 +77,58 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
     return n_in;
   }
   const double step = width / pieces;
-  double c_end[5], s_end[5], c_mid[4], s_mid[4];
+  double c_end[5], s_end[5];
   for (int k = 0; k <= pieces; ++k) {
     c_end[k] = std::cos(lo + k * step);
     s_end[k] = std::sin(lo + k * step);
   }
   const double half_cos = std::cos(0.5 * step);
-  for (int k = 0; k < pieces; ++k) {
-    c_mid[k] = std::cos(lo + (k + 0.5) * step) / half_cos;
-    s_mid[k] = std::sin(lo + (k + 0.5) * step) / half_cos;
-  }
   const double c_centre = std::cos(lo + 0.5 * width), s_centre = std::sin(lo + 0.5 * width);
   const double sagitta = 1.0 - half_cos;                   // per unit rho
   const double half_chord = 2.0 * std::sin(0.25 * width);  // per unit rho
-
-  // Levels: 0 single, 1 chord, 2 tangent. Start everyone at the mode's level; if that does not
-  // fit, start at single and refine the points farthest from the axis first.
-  const int top = j.sweep == SweepMode::Accurate ? 2 : 1;
-  const int cost[3] = {1, pieces + 1, 2 * pieces + 1};
-  int* level = work.level;
-  double* rho = work.rho;
-  int* order = work.order;
-  const bool fits = n_in * cost[top] <= budget;
-  for (int i = 0; i < n_in; ++i) {
-    rho[i] = (in[i] - a.dot(in[i]) * a).norm();
-    level[i] = fits ? top : 0;
-    order[i] = i;
-  }
-  if (!fits) {
-    std::sort(order, order + n_in, [rho](int x, int y) { return rho[x] > rho[y]; });
-    int total = n_in;
-    for (int up = 1; up <= top; ++up) {
-      for (int k = 0; k < n_in; ++k) {
-        const int i = order[k];
-        const int extra = cost[up] - cost[up - 1];
-        if (level[i] != up - 1 || total + extra > budget) break;
-        level[i] = up;
-        total += extra;
-      }
+  // Chords for the points farthest from the axis, as many as the budget holds; the arc's middle
+  // point (radius growth rho * 2 sin(w / 4)) for the rest.
+  for (int i = 0; i < n_in; ++i) rho[i] = (in[i] - a.dot(in[i]) * a).norm();
+  double chord_from = 0.0;  // points with rho >= chord_from get chords
+  const int chords_fit = std::min(n_in, (budget - n_in) / pieces);
+  if (chords_fit < n_in) {
+    // The chords_fit-th largest rho.
+    std::copy(rho, rho + n_in, rho + n_in);
+    double* r = rho + n_in;
+    if (chords_fit <= 0) {
+      chord_from = kInf;
+    } else {
+      std::nth_element(r, r + (chords_fit - 1), r + n_in, std::greater<double>());
+      chord_from = r[chords_fit - 1];
     }
   }
-  double growth = 0.0;
+  double mid_growth = 0.0;
   int n = 0;
+  int chords = 0;
   for (int i = 0; i < n_in; ++i) {
     const Vec3& p = in[i];
     const Vec3 axial = a.dot(p) * a;
     const Vec3 radial = p - axial;
     if (rho[i] <= 1e-12 * (1.0 + p.norm())) {  // on the axis: it stays within 2 rho of itself
       out[n++] = rot * p + t;
-      growth = std::max(growth, 2.0 * rho[i]);
+      mid_growth = std::max(mid_growth, 2.0 * rho[i]);
       continue;
     }
     const Vec3 A = rot * axial + t;
     const Vec3 B = rot * radial;
     const Vec3 C = rot * a.cross(radial);
-    switch (level[i]) {
-      case 0:
-        out[n++] = A + c_centre * B + s_centre * C;
-        growth = std::max(growth, rho[i] * half_chord);
-        break;
-      case 1:
-        for (int k = 0; k <= pieces; ++k) out[n++] = A + c_end[k] * B + s_end[k] * C;
-        growth = std::max(growth, rho[i] * sagitta);
-        break;
-      default:
-        for (int k = 0; k <= pieces; ++k) out[n++] = A + c_end[k] * B + s_end[k] * C;
-        for (int k = 0; k < pieces; ++k) out[n++] = A + c_mid[k] * B + s_mid[k] * C;
-        break;
+    if (rho[i] >= chord_from && chords < chords_fit) {
+      for (int k = 0; k <= pieces; ++k) out[n++] = A + c_end[k] * B + s_end[k] * C;
+      ++chords;
+    } else {
+      out[n++] = A + c_centre * B + s_centre * C;
+      mid_growth = std::max(mid_growth, rho[i] * half_chord);
     }
   }
-  // Rounding: the outputs (at most |p| / cos(step / 2) + |t| from the origin) err by a few ulps.
+  // The growth: the sagitta of the farthest point the volume can hold (rho_bound, from the swept
+  // sphere below: the same value the exact stage uses, so that its chord chains stay inside these
+  // volumes), plus the middle points' distance to their chord ends.
+  const double growth = roundedUp(rho_bound * sagitta, 4) + mid_growth;  // Rounding: the outputs (at most |p| / cos(step / 2) + |t| from the origin) err by a few ulps.
   if (!std::isfinite(growth)) return -1;
   radius += roundedUp(growth, 8) + roundingGuard(in_norm / half_cos + t.norm(), 32);
   return n;
@@ -184,21 +167,87 @@ Rotation3 rotation3(const Box3& box) {
 // A rotation by at most `reach` radians moves a point p by at most the returned factor times |p|.
 double rotationChord(double reach) { return reach >= kPi ? 2.0 : 2.0 * std::sin(0.5 * reach); }
 
+// Distance from p to the segment [a, b] (exact up to rounding; a == b allowed).
+double segmentDistance(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 e = b - a;
+  const double ee = e.squaredNorm();
+  const double t = ee > 0.0 ? std::clamp((p - a).dot(e) / ee, 0.0, 1.0) : 0.0;
+  return (p - (a + t * e)).norm();
+}
+
+// Distance from p to the triangle (a, b, c), degenerate triangles included.
+double triangleDistance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e1 = b - a, e2 = c - a, w = p - a;
+  const double d11 = e1.squaredNorm(), d12 = e1.dot(e2), d22 = e2.squaredNorm();
+  const double det = d11 * d22 - d12 * d12;
+  if (det > 1e-24 * d11 * d22) {
+    const double w1 = w.dot(e1), w2 = w.dot(e2);
+    const double s = (d22 * w1 - d12 * w2) / det, t = (d11 * w2 - d12 * w1) / det;
+    if (s >= 0.0 && t >= 0.0 && s + t <= 1.0) return (p - (a + s * e1 + t * e2)).norm();
+  }
+  return std::min({segmentDistance(p, a, b), segmentDistance(p, b, c), segmentDistance(p, a, c)});
+}
+
+// True when p lies inside the tetrahedron (a, b, c, d) (by barycentric coordinates).
+bool insideTetrahedron(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  Eigen::Matrix3d m;
+  m << b - a, c - a, d - a;
+  const double det = m.determinant();
+  const double scale = (b - a).norm() * (c - a).norm() * (d - a).norm();
+  if (!(std::abs(det) > 1e-12 * scale)) return false;
+  const Vec3 l = m.inverse() * (p - a);
+  return l.minCoeff() >= 0.0 && l.sum() <= 1.0;
+}
+
+// An upper bound on the distance from p to conv(kept[0..k)), or any value <= `enough` once one is
+// found (the caller only needs to know that the distance is at most `enough`): distances to the
+// simplices spanned by its four nearest kept points (inside their tetrahedron: 0), cheapest first.
+double hullDistanceBound(const Vec3& p, const Vec3* kept, int k, double enough) {
+  int near[4] = {-1, -1, -1, -1};
+  double near_sq[4] = {kInf, kInf, kInf, kInf};
+  for (int i = 0; i < k; ++i) {
+    double d = (kept[i] - p).squaredNorm();
+    if (d >= near_sq[3]) continue;
+    int idx = i;
+    for (int m = 0; m < 4; ++m) {
+      if (d < near_sq[m]) {
+        std::swap(d, near_sq[m]);
+        std::swap(idx, near[m]);
+      }
+    }
+  }
+  double best = std::sqrt(near_sq[0]);
+  if (best <= enough || near[1] < 0) return best;
+  const Vec3 &a = kept[near[0]], &b = kept[near[1]];
+  best = std::min(best, segmentDistance(p, a, b));
+  if (best <= enough || near[2] < 0) return best;
+  const Vec3& c = kept[near[2]];
+  best = std::min(best, triangleDistance(p, a, b, c));
+  if (best <= enough || near[3] < 0) return best;
+  const Vec3& d = kept[near[3]];
+  if (insideTetrahedron(p, a, b, c, d)) return 0.0;
+  return std::min({best, triangleDistance(p, a, b, d), triangleDistance(p, a, c, d), triangleDistance(p, b, c, d)});
+}
+
 }  // namespace
 
 int sweepExpansion(const Joint& joint) noexcept {
   const int pieces = revolutePieces(kTwoPi);
   switch (joint.type) {
-    case JointType::Revolute: return joint.sweep == SweepMode::Accurate ? 2 * pieces + 1 : pieces + 1;
+    case JointType::Revolute: return pieces + 1;
     case JointType::Prismatic: return 2;
     default: return 1;
   }
 }
 
+double rhoBound(const Vec3& axis, const Sphere& s) noexcept {
+  return (s.center - axis.dot(s.center) * axis).norm() + s.radius;
+}
+
 int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span<const Vec3> in, Vec3* out,
-               double& radius, int budget, SweepWork work) noexcept {
+               double& radius, int budget, double* rho, const Sphere& below) noexcept {
   if (joint.type == JointType::Revolute)  // writes straight into the parent frame
-    return sweepRevolute(joint, lo[0], hi[0], in, out, radius, budget, work);
+    return sweepRevolute(joint, lo[0], hi[0], in, out, radius, budget, rho, rhoBound(joint.axis, below));
   int n = 0;
   const double in_norm = maxNorm(in);
   switch (joint.type) {
@@ -225,7 +274,8 @@ int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span
       // rotationChord() |p|.
       const Rotation3 r3 = rotation3(box3(joint, lo, hi));
       for (const Vec3& p : in) out[n++] = r3.rot * p;
-      radius += roundedUp(rotationChord(r3.reach) * in_norm, 4) + roundingGuard(in_norm, 16);
+      const double extent = std::max(in_norm, below.center.norm() + below.radius);
+      radius += roundedUp(rotationChord(r3.reach) * extent, 4) + roundingGuard(extent, 16);
       break;
     }
   }
@@ -242,7 +292,7 @@ int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span
   return n;
 }
 
-int reduceToBudget(Vec3* pts, int n, int budget, double* dist, double& radius) noexcept {
+int reduceToBudget(Vec3* pts, int n, int budget, double* dist, int* order, double& radius) noexcept {
   if (n <= budget) return n;
   // Start from the point farthest from the centroid: an extreme point of the set.
   Vec3 centroid = Vec3::Zero();
@@ -268,11 +318,90 @@ int reduceToBudget(Vec3* pts, int n, int budget, double* dist, double& radius) n
     std::swap(dist[k], dist[best]);
     for (int i = k + 1; i < n; ++i) dist[i] = std::min(dist[i], (pts[i] - pts[k]).squaredNorm());
   }
-  double worst = 0.0;
-  for (int i = budget; i < n; ++i) worst = std::max(worst, dist[i]);
-  // Each dropped point lies within sqrt(worst) of a kept one, hence of their hull.
-  radius += roundedUp(std::sqrt(worst), 4);
+  // The radius grows by the largest distance from a dropped point to the hull of the kept ones,
+  // bounded from above by its distance to a point of that hull (hullDistanceBound). Dropped points
+  // are bounded worst first, and only while their distance to the nearest kept point (itself a
+  // bound) exceeds the growth found so far.
+  double growth = 0.0;
+  double extent = 0.0;
+  for (int i = 0; i < n; ++i) extent = std::max(extent, pts[i].cwiseAbs().maxCoeff());
+  // Dropped points in order of their distance to the nearest kept point, largest first.
+  const int dropped = n - budget;
+  for (int i = 0; i < dropped; ++i) order[i] = budget + i;
+  std::sort(order, order + dropped, [dist](int x, int y) { return dist[x] > dist[y]; });
+  for (int i = 0; i < dropped; ++i) {
+    const int q = order[i];
+    if (dist[q] <= growth * growth) break;
+    growth = std::max(growth, std::min(std::sqrt(dist[q]), hullDistanceBound(pts[q], pts, budget, growth)));
+  }
+  // Every dropped point lies within `growth` of conv(kept) (the bounds are exact distances to
+  // points of that hull, computed to a few ulps of the coordinates).
+  radius += roundedUp(growth, 8) + roundingGuard(extent, 64);
   return budget;
+}
+
+JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi) noexcept {
+  JointMaps m;
+  const Eigen::Matrix3d& rot = joint.origin.linear();
+  const Vec3& t = joint.origin.translation();
+  m.axis = joint.axis;
+  auto add = [&m](const Eigen::Matrix3d& lin, const Vec3& off, double scale) {
+    m.lin[m.count] = lin;
+    m.off[m.count] = off;
+    m.scale[m.count] = scale;
+    ++m.count;
+  };
+  m.offset_norm = t.norm();
+  switch (joint.type) {
+    case JointType::Fixed: add(rot, t, 1.0); break;
+    case JointType::Revolute: {
+      const Vec3& a = joint.axis;
+      const Eigen::Matrix3d axial = a * a.transpose();
+      const Eigen::Matrix3d radial = Eigen::Matrix3d::Identity() - axial;
+      Eigen::Matrix3d cross;
+      cross << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+      auto rotation = [&](double c, double s) -> Eigen::Matrix3d { return rot * (axial + c * radial + s * cross); };
+      const Arc arc = revoluteArc(lo[0], hi[0]);
+      const int pieces = revolutePieces(arc.width);
+      if (pieces == 0) {
+        add(rotation(std::cos(arc.start), std::sin(arc.start)), t, 1.0);
+        break;
+      }
+      m.revolute = true;
+      const double step = arc.width / pieces;
+      const double half_cos = std::cos(0.5 * step);
+      for (int k = 0; k <= pieces; ++k) add(rotation(std::cos(arc.start + k * step), std::sin(arc.start + k * step)), t, 1.0);
+      m.chord_count = m.count;
+      // Tangent apexes: the middle direction scaled by 1 / cos(step / 2) (the operator norm).
+      const double apex_scale = roundedUp(1.0 / half_cos, 4);
+      for (int k = 0; k < pieces; ++k) {
+        const double mid = arc.start + (k + 0.5) * step;
+        add(rotation(std::cos(mid) / half_cos, std::sin(mid) / half_cos), t, apex_scale);
+      }
+      m.sagitta = roundedUp(1.0 - half_cos, 8) + 8.0 * kEps;
+      return m;
+    }
+    case JointType::Prismatic:
+      add(rot, rot * (lo[0] * joint.axis) + t, 1.0);
+      if (hi[0] > lo[0]) add(rot, rot * (hi[0] * joint.axis) + t, 1.0);
+      m.offset_norm += std::max(std::abs(lo[0]), std::abs(hi[0]));
+      break;
+    case JointType::Translation3d: {
+      const Box3 box = box3(joint, lo, hi);
+      add(rot, rot * box.centre + t, 1.0);
+      m.fixed_growth = box.reach;
+      m.offset_norm += box.centre.norm();
+      break;
+    }
+    case JointType::Rotation3d: {
+      const Rotation3 r3 = rotation3(box3(joint, lo, hi));
+      add(rot * r3.rot, t, 1.0);
+      m.point_growth = roundedUp(rotationChord(r3.reach), 4);
+      break;
+    }
+  }
+  m.chord_count = m.count;
+  return m;
 }
 
 Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const Sphere& in) noexcept {

@@ -13,29 +13,52 @@ inline constexpr double kMaxPieceAngle = 1.5707963267948966;  // pi / 2
 /// How many output points one input point can become in sweepJoint() (worst case).
 int sweepExpansion(const Joint& joint) noexcept;
 
-/// Scratch space for sweepJoint(): room for one value per input point in each array.
-struct SweepWork {
-  double* rho;
-  int* level;
-  int* order;
-};
-
 /// Sweeps S(in, radius) through `joint` over the box [lo, hi] (joint.dof values each) and maps
 /// the result into the joint's parent frame. Writes the core points to `out` (room for
-/// sweepExpansion() * in.size()) and returns their count; `radius` grows as needed. A revolute
-/// sweep refines its points' arcs only as far as `budget` output points allow (coarser arcs add
-/// radius instead). Returns -1 when a value is not finite. The caller checks sweep-mode rules
-/// (exact needs lo == hi).
+/// sweepExpansion() * in.size()) and returns their count; `radius` grows as needed. Returns -1 when
+/// a value is not finite. The caller checks sweep-mode rules (exact needs lo == hi).
+/// `below` is a sphere containing the input volume (the swept sphere of the level below): growths
+/// that depend on how far points can lie from the axis or origin use it, as the exact stage does.
+/// A revolute sweep covers the arcs of the points farthest from the axis by chords and the others
+/// by their middle point, as far as `budget` output points allow; `rho` needs room for 2 n values.
 int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span<const Vec3> in, Vec3* out,
-               double& radius, int budget, SweepWork work) noexcept;
+               double& radius, int budget, double* rho, const Sphere& below) noexcept;
+
+/// The largest distance from the axis (through the origin) of a point of sphere s.
+double rhoBound(const Vec3& axis, const Sphere& s) noexcept;
+
+/// The affine maps x -> lin x + off whose images of a point set cover a joint's motion over the
+/// box [lo, hi] and map into the parent frame (ALGORITHMS.md 2): chord ends (rigid), then for a
+/// revolute joint the tangent apexes (radial part scaled by 1 / cos(step / 2)). Covering with the
+/// first `chord_count` maps needs the radius to grow by `sagitta` times the distance from the
+/// axis; every cover adds `fixed_growth` plus `point_growth` times the distance from the joint
+/// frame's origin (3-DOF joints: the box around its centre).
+struct JointMaps {
+  static constexpr int kMax = 9;
+  int count = 0;
+  int chord_count = 0;
+  Eigen::Matrix3d lin[kMax];
+  Vec3 off[kMax];
+  double scale[kMax];        ///< bound on the operator norm of lin
+  bool revolute = false;     ///< a revolute interval of non-zero width (sagitta applies)
+  Vec3 axis = Vec3::UnitZ();
+  double sagitta = 0.0;
+  double fixed_growth = 0.0;
+  double point_growth = 0.0;
+  double offset_norm = 0.0;  ///< bound on |off|
+};
+
+/// The vertex maps of `joint` over [lo, hi] (values finite; the caller checks).
+JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi) noexcept;
 
 /// A sphere containing every position of sphere `in` under the joint's motion over [lo, hi],
 /// in the joint's parent frame (cheap: no points are swept).
 Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const Sphere& in) noexcept;
 
 /// Keeps at most `budget` of the n points (farthest-point selection) in pts[0..k) and grows
-/// `radius` by the largest distance from a dropped point to a kept one. Returns k.
-/// `dist` needs room for n values.
-int reduceToBudget(Vec3* pts, int n, int budget, double* dist, double& radius) noexcept;
+/// `radius` by an upper bound on the largest distance from a dropped point to the hull of the
+/// kept ones. Returns k.
+/// `dist` and `order` need room for n values.
+int reduceToBudget(Vec3* pts, int n, int budget, double* dist, int* order, double& radius) noexcept;
 
 }  // namespace kccd::detail

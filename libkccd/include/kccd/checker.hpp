@@ -10,6 +10,13 @@
 #include "kccd/model.hpp"
 #include "kccd/query.hpp"
 
+namespace kccd::detail {
+struct JointMaps;
+struct ChainLevel;
+struct ChainEntry;
+struct ChainView;
+}  // namespace kccd::detail
+
 namespace kccd {
 
 /// Holds the per-cycle swept volumes and the any-time table of pair bounds. Bounds are reused
@@ -18,6 +25,9 @@ class Checker {
  public:
   /// Preallocates everything for `model` (which must outlive the Checker).
   explicit Checker(const Model& model);
+  ~Checker();
+  Checker(const Checker&) = delete;
+  Checker& operator=(const Checker&) = delete;
 
   /// Answers one query for the interval box [lower, upper] (both of length stateSize()).
   /// Never allocates, never throws.
@@ -84,6 +94,9 @@ class Checker {
   bool expired(const Budget& budget) noexcept;
   void refine(int pair, double stop_above, Box box) noexcept;
   double refresh(int pair, double stop_above, Box box) noexcept;
+  bool exactStage(int pair, double stop_above, Box box, double& bound) noexcept;
+  const detail::JointMaps* jointMaps(int joint, Box box) noexcept;
+  bool chain(int body, int level, int variant, Box box, detail::ChainView& out) noexcept;
   void report(int pair, PairDistance& out) const noexcept;
   const Volume* volume(int body, int level, Box box) noexcept;
   SschView view(const Volume& v) const noexcept;
@@ -103,8 +116,19 @@ class Checker {
   std::vector<double> box_;                  // per reach entry: the stored bound's lower, upper
   std::vector<Vec3> scratch_;
   std::vector<double> scratch_dist_;
-  std::vector<double> scratch_rho_;
-  std::vector<int> scratch_level_, scratch_order_;
+  std::vector<int> scratch_order_;
+  // The exact stage: per joint its vertex maps for this query, per body and level the chain
+  // level (variant 0: chords only; 1: each joint's own mode), and the search's scratch.
+  std::vector<detail::JointMaps> joint_maps_;
+  std::vector<std::uint64_t> joint_maps_stamp_;
+  std::vector<detail::ChainLevel> chain_[2];
+  std::vector<std::uint64_t> chain_stamp_[2];
+  std::vector<double> chain_radius_[2];      // per body and level: radius of the chain up to it
+  std::vector<std::uint8_t> chain_tangent_[2];  // per body and level: some level uses apexes
+  std::vector<Sphere> base_sphere_;          // per body: sphere around its core points
+  std::vector<detail::ChainEntry> chain_stack_;
+  std::vector<int> chain_choice_, chain_best_;
+  double exact_below_ = 0.0;
   std::vector<int> order_;
   std::vector<PairDistance> out_;
   std::vector<std::uint8_t> fresh_;          // per pair: recomputed in this query

@@ -39,6 +39,11 @@ struct QueryOptions {
   double margin = -1.0;    ///< distances <= margin count as collision; < 0 or NaN: the model's margin
   double budget_us = 0.0;  ///< time budget in microseconds; <= 0, NaN or > kMaxBudgetUs: unlimited
   int max_pairs = -1;      ///< work budget: recompute at most this many pairs; < 0: unlimited
+  /// The exact stage (swept volumes without a point budget, searched by branch and bound) refines
+  /// a pair whose point-volume bound is below this and below what the query still needs to know.
+  /// < 0 (default): the margin, so every verdict is decided by the exact stage; +inf: every
+  /// pair of a Distances query (tightest, slowest); 0 or NaN: never (point volumes only).
+  double exact_below = -1.0;
 };
 
 /// One pair in a result. `distance` is a lower bound over the whole interval box.
@@ -55,6 +60,7 @@ struct QueryStats {
   double time_us = 0.0;
   int pairs_checked = 0;    ///< pairs whose bound was recomputed
   int gjk_calls = 0;
+  int exact_calls = 0;      ///< distance computations of the exact stage
   int volumes_swept = 0;
   bool budget_exhausted = false;  ///< a time or work budget stopped refinement (answer still conservative)
 };

@@ -1,0 +1,147 @@
+#include "chain_support.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "rounding.hpp"
+
+namespace kccd::detail {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// The chain's sphere below level l (level 0: the body's own).
+const Sphere& sphereBelow(const ChainView& c, int l) { return l == 0 ? c.base : c.levels[static_cast<std::size_t>(l) - 1].core; }
+
+}  // namespace
+
+ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, const Sphere& swept) noexcept {
+  ChainLevel out;
+  out.maps = &maps;
+  out.count = tangent ? maps.count : maps.chord_count;
+  // Images of the sphere below: ball(lin c + off, scale R) for every map; one sphere around them.
+  Vec3 lo = Vec3::Constant(kInf), hi = Vec3::Constant(-kInf);
+  Vec3 centres[JointMaps::kMax];
+  for (int v = 0; v < out.count; ++v) {
+    centres[v] = maps.lin[v] * below.center + maps.off[v];
+    lo = lo.cwiseMin(centres[v]);
+    hi = hi.cwiseMax(centres[v]);
+    out.max_scale = std::max(out.max_scale, maps.scale[v]);
+  }
+  out.core.center = 0.5 * lo + 0.5 * hi;
+  double reach = 0.0;
+  for (int v = 0; v < out.count; ++v) reach = std::max(reach, (centres[v] - out.core.center).norm() + below.radius * maps.scale[v]);
+  const double extent = below.center.norm() + below.radius;  // |x| bound in the joint frame
+  out.core.radius = roundedUp(reach, 8) + roundingGuard(extent * out.max_scale + maps.offset_norm, 32);
+  // What the cover adds to the radius: the sagitta of the farthest point from the axis (chords of
+  // a revolute joint), the 3-DOF joints' box reach, and rounding of the mapped points.
+  const double swept_extent = swept.center.norm() + swept.radius;
+  double growth = maps.fixed_growth + maps.point_growth * std::max(extent, swept_extent);
+  if (maps.revolute && !tangent) growth += maps.sagitta * rhoBound(maps.axis, swept);
+  out.growth = roundedUp(growth, 8) + roundingGuard(std::max(extent, swept_extent) * out.max_scale + maps.offset_norm, 32);
+  return out;
+}
+
+int chainStackSize(int levels) noexcept { return levels * JointMaps::kMax + 1; }
+
+double chainExtent(const ChainView& chain) noexcept {
+  const Sphere& top = sphereBelow(chain, static_cast<int>(chain.levels.size()));
+  return top.center.norm() + top.radius;
+}
+
+SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork work, int max_nodes, long* nodes) noexcept {
+  const int depth = static_cast<int>(chain.levels.size());
+  const double dn = dir.norm();
+  const Vec3 d = dn > 0.0 ? Vec3(dir / dn) : Vec3::UnitX();
+  const std::span<const Vec3> pts = chain.points;
+  const int np = static_cast<int>(pts.size());
+
+  // The best leaf: its value d.x, the choice per level and the point index.
+  double best = -kInf;
+  int best_point = 0;
+  double overflow = -kInf;  // largest bound left unexplored when the node limit stops the search
+  int visited = 0;
+
+  auto leaf = [&](const Vec3& row, double offset) {
+    int arg = 0;
+    double value = row.dot(pts[0]);
+    for (int i = 1; i < np; ++i) {
+      const double x = row.dot(pts[static_cast<std::size_t>(i)]);
+      if (x > value) {
+        value = x;
+        arg = i;
+      }
+    }
+    value += offset;
+    if (value > best) {
+      best = value;
+      best_point = arg;
+      std::copy(work.choice, work.choice + depth, work.best_choice);
+    }
+  };
+  if (depth == 0) {
+    leaf(d, 0.0);
+  } else {
+    ChainEntry* stack = work.stack;
+    int top = 0;
+    // Pushes the children of a node at `level` (maps of that level still to choose) in ascending
+    // bound order, so that the most promising child is popped first.
+    auto expand = [&](int level, const Vec3& row, double offset) {
+      const ChainLevel& lv = chain.levels[static_cast<std::size_t>(level) - 1];
+      const Sphere& s = sphereBelow(chain, level - 1);
+      const int first = top;
+      for (int v = 0; v < lv.count; ++v) {
+        ChainEntry e;
+        e.row = lv.maps->lin[v].transpose() * row;
+        e.offset = offset + row.dot(lv.maps->off[v]);
+        e.bound = e.offset + e.row.dot(s.center) + e.row.norm() * s.radius;
+        e.level = level;
+        e.choice = v;
+        int k = top++;
+        while (k > first && stack[k - 1].bound > e.bound) {
+          stack[k] = stack[k - 1];
+          --k;
+        }
+        stack[k] = e;
+      }
+    };
+    expand(depth, d, 0.0);
+    while (top > 0) {
+      const ChainEntry e = stack[--top];
+      if (e.bound <= best) continue;
+      if (++visited > max_nodes) {
+        overflow = std::max(overflow, e.bound);
+        for (int k = 0; k < top; ++k) overflow = std::max(overflow, stack[k].bound);
+        break;
+      }
+      work.choice[e.level - 1] = e.choice;
+      if (e.level == 1) {
+        leaf(e.row, e.offset);
+      } else {
+        expand(e.level - 1, e.row, e.offset);
+      }
+    }
+  }
+  if (nodes != nullptr) *nodes += visited;
+
+  // The point: the body point mapped up through the chosen maps.
+  Vec3 x = pts[static_cast<std::size_t>(best_point)];
+  std::uint64_t key = static_cast<std::uint64_t>(best_point);
+  double scale = 1.0;
+  for (int l = 0; l < depth; ++l) {
+    const ChainLevel& lv = chain.levels[static_cast<std::size_t>(l)];
+    const int v = work.best_choice[l];
+    x = lv.maps->lin[v] * x + lv.maps->off[v];
+    key = key * 10u + static_cast<std::uint64_t>(v) + 1u;
+    scale *= lv.max_scale;
+  }
+  // Rounding: values and the point are sums of products through `depth` levels of magnitude at
+  // most the chain's extent (grown by the maps' norms).
+  const double guard = roundingGuard((chainExtent(chain) + 1e-300) * scale, 16 * (depth + 2));
+  const double value = d.dot(x);
+  const double upper = std::max(best, overflow);
+  return SupportHit{x, key, std::max(0.0, upper - value) + guard};
+}
+
+}  // namespace kccd::detail

@@ -1,0 +1,64 @@
+// The exact stage: a body's swept volume through the joints up to an ancestor frame, kept as the
+// core points under every combination of the joints' vertex maps (no point budget, nothing
+// dropped), and its support function by branch and bound. Internal.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "gjk_core.hpp"
+#include "kccd/ssch.hpp"
+#include "sweep.hpp"
+
+namespace kccd::detail {
+
+/// One level of a chain: the maps of the joint swept there (the first `count` of them), the radius
+/// the cover adds at this level, and a sphere containing the core set after this level.
+struct ChainLevel {
+  const JointMaps* maps = nullptr;
+  int count = 0;
+  double growth = 0.0;
+  Sphere core;
+  double max_scale = 1.0;  ///< largest operator norm among the maps used
+};
+
+/// The next level of a chain whose core set lies in `below` (the previous level's core sphere),
+/// covering the joint with its chord maps only (`tangent` false) or with chords and apexes.
+/// Growths use `swept`, the swept sphere of the level below (as the point volumes do).
+ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, const Sphere& swept) noexcept;
+
+/// A body swept through levels[0..n): core points in the body frame, their sphere, the levels
+/// (levels[0] is the joint nearest the body) and the radius of the whole volume.
+struct ChainView {
+  std::span<const Vec3> points;
+  Sphere base;
+  std::span<const ChainLevel> levels;
+  double radius = 0.0;
+};
+
+/// Scratch space for chainSupport(), sized by chainWorkSize() for the longest chain.
+struct ChainEntry {
+  Vec3 row;
+  double offset;
+  double bound;
+  int level;
+  int choice;
+};
+struct ChainWork {
+  ChainEntry* stack;
+  int* choice;
+  int* best_choice;
+};
+int chainStackSize(int levels) noexcept;
+
+/// The support of the chain's core set in direction `dir` (any length): the best point found and
+/// the slack by which the true support value may exceed its value along dir / |dir| (0 when the
+/// search completed, up to rounding). The search stops after `max_nodes` nodes with a valid slack.
+/// `nodes` (if not null) accumulates the nodes visited.
+SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork work, int max_nodes,
+                        long* nodes = nullptr) noexcept;
+
+/// A bound on |x| for every core point x of the chain (for rounding guards).
+double chainExtent(const ChainView& chain) noexcept;
+
+}  // namespace kccd::detail
