@@ -93,8 +93,8 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
   const int chords_fit = std::min(n_in, (budget - n_in) / pieces);
   if (chords_fit < n_in) {
     // The chords_fit-th largest rho.
-    std::copy(rho, rho + n_in, rho + n_in);
     double* r = rho + n_in;
+    for (int i = 0; i < n_in; ++i) r[i] = rho[i];
     if (chords_fit <= 0) {
       chord_from = kInf;
     } else {
