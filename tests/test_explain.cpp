@@ -7,8 +7,8 @@
 #include <iomanip>
 #include <limits>
 #include <numbers>
-#include <sstream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
