@@ -51,7 +51,7 @@ bool runCase(std::uint64_t seed, Tally& tally, std::string& why) {
   QueryOptions opt;
   opt.type = QueryType::Distances;
   // Every third case refines every pair by the exact stage, every third none.
-  opt.exact_below = seed % 3 == 0 ? std::numeric_limits<double>::infinity() : seed % 3 == 1 ? -1.0 : 0.0;
+  opt.exact_below = seed % 3 == 0 ? std::numeric_limits<double>::infinity() : seed % 3 == 1 ? -1.0 : -std::numeric_limits<double>::infinity();
   const QueryResult& r = checker.query(lower, upper, opt);
   if (r.status != Status::Ok) {
     why = std::string("status ") + toString(r.status);
@@ -137,7 +137,7 @@ TEST(Conservative, CarriedOverBoundsStayValidAcrossCycles) {
       opt.type = static_cast<QueryType>(std::uniform_int_distribution<int>(0, 3)(rng));
       opt.n = 1 + static_cast<int>(u(rng) * np);
       opt.max_pairs = u(rng) < 0.3 ? -1 : static_cast<int>(u(rng) * np);
-      opt.exact_below = u(rng) < 0.5 ? -1.0 : u(rng) < 0.5 ? std::numeric_limits<double>::infinity() : 0.1 * u(rng);
+      opt.exact_below = u(rng) < 0.5 ? -1.0 : u(rng) < 0.5 ? std::numeric_limits<double>::infinity() : 0.1 * u(rng) - 0.01;
       ASSERT_EQ(checker.query(lower, upper, opt).status, Status::Ok);
       // Read the whole table for this box without recomputing anything.
       QueryOptions peek;

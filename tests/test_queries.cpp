@@ -111,6 +111,78 @@ TEST(Queries, BudgetsOnlyLoosenBounds) {
   }
 }
 
+// The knobs are monotone. Accurate runs everything fast runs (the same point volumes and chord
+// chains) plus the apex chains, so its bound is never below fast's, for every pair and query
+// type. The point budget only shapes the first stage; the exact stage's chord chains lie inside
+// every budget's point volumes, so every bound the exact stage decides is the same whatever the
+// budget (up to GJK's tolerance) and so is every verdict.
+TEST(Queries, KnobsAreMonotone) {
+  std::mt19937_64 rng(2024);
+  auto withMode = [](Model m, SweepMode mode) {
+    for (Joint& j : m.joints)
+      if (j.sweep != SweepMode::Exact) j.sweep = mode;
+    return m;
+  };
+  long compared = 0, tighter = 0, budget_checks = 0;
+  for (int i = 0; i < 1500; ++i) {
+    const Model base = testing::randomModel(rng, 6, 5);
+    if (base.pairs.empty()) continue;
+    std::vector<double> lower, upper;
+    testing::randomBox(rng, base, lower, upper);
+    const double margin = 0.05 * static_cast<double>(i % 7);
+    for (const double exact_below : {-1.0, std::numeric_limits<double>::infinity()}) {
+      for (int t = 0; t < 4; ++t) {
+        QueryOptions o = options(static_cast<QueryType>(t), 2, margin);
+        o.exact_below = exact_below;
+        // Modes at the same budget.
+        const Model fast = withMode(base, SweepMode::Fast), accurate = withMode(base, SweepMode::Accurate);
+        Checker cf(fast), ca(accurate);
+        const QueryResult& rf = cf.query(lower, upper, o);
+        const QueryResult& ra = ca.query(lower, upper, o);
+        ASSERT_EQ(rf.status, Status::Ok);
+        ASSERT_EQ(ra.status, Status::Ok);
+        if (!rf.collision) EXPECT_FALSE(ra.collision) << "case " << i;
+        if (t == 3) {
+          ASSERT_EQ(rf.pairs.size(), ra.pairs.size());
+          for (std::size_t k = 0; k < rf.pairs.size(); ++k) {
+            ++compared;
+            EXPECT_GE(ra.pairs[k].distance, rf.pairs[k].distance) << "case " << i << " pair " << k;
+            tighter += ra.pairs[k].distance > rf.pairs[k].distance;
+          }
+        }
+        // Budgets in the same mode.
+        const Model& m = i % 2 ? fast : accurate;
+        std::vector<double> previous;
+        bool previous_clear = false;
+        for (const int budget : {4, 8, 16, 64}) {
+          Model mb = m;
+          mb.point_budget = budget;
+          Checker c(mb);
+          const QueryResult& r = c.query(lower, upper, o);
+          ASSERT_EQ(r.status, Status::Ok);
+          if (previous_clear) EXPECT_FALSE(r.collision) << "case " << i << " budget " << budget;
+          previous_clear = !r.collision;
+          if (t != 3) continue;
+          std::vector<double> d;
+          for (const PairDistance& pd : r.pairs) d.push_back(pd.distance);
+          for (std::size_t k = 0; k < previous.size(); ++k) {
+            // Every bound the exact stage decided (all of them for exact_below = inf) may differ
+            // only by the exact stage's tolerance.
+            const double refined = exact_below < 0.0 ? margin : exact_below;
+            if (previous[k] > refined && d[k] > refined) continue;
+            ++budget_checks;
+            EXPECT_GE(d[k], previous[k] - 1e-6 * (1.0 + previous[k])) << "case " << i << " budget " << budget;
+          }
+          previous = d;
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 1000);
+  EXPECT_GT(tighter, compared / 100);  // apexes do tighten bounds
+  EXPECT_GT(budget_checks, 1000);
+}
+
 TEST(Queries, ReusesBoundsWhenTheBoxShrinks) {
   std::mt19937_64 rng(79);
   const Model m = testing::randomModel(rng, 4, 5);

@@ -294,7 +294,7 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
   const int la = pair_level_[2 * p], lb = pair_level_[2 * p + 1];
   const detail::ChainWork work{chain_stack_.data(), chain_choice_.data(), chain_best_.data()};
   for (int variant = 0; variant < 2; ++variant) {
-    if (bound >= stop_above) break;
+    if (bound > stop_above) break;
     detail::ChainView ca, cb;
     if (!chain(pair.a, la, variant, box, ca) || !chain(pair.b, lb, variant, box, cb)) return false;
     if (variant == 1 && (la == 0 || !chain_tangent_[1][level_begin_[pair.a] + la]) &&
@@ -346,13 +346,13 @@ double Checker::refresh(int p, double stop_above, Box box) noexcept {
   if (sa == nullptr || sb == nullptr) return fail();
   double bound = sphereGap(*sa, *sb);
   e.gjk = false;
-  if (bound < stop_above) {
+  if (bound <= stop_above) {
     // Then the spheres around the swept points, then GJK on the points themselves.
     const Volume* va = volume(pair.a, la, box);
     const Volume* vb = volume(pair.b, lb, box);
     if (va == nullptr || vb == nullptr) return fail();
     bound = std::max(bound, sphereGap(va->bound, vb->bound));
-    if (bound < stop_above) {
+    if (bound <= stop_above) {
       GjkOptions opt;
       opt.stop_above = stop_above;
       opt.warm_start = &e.direction;
@@ -364,7 +364,7 @@ double Checker::refresh(int p, double stop_above, Box box) noexcept {
       e.witness_a = d.witness_a;
       e.witness_b = d.witness_b;
       e.gjk = true;
-      if (bound < std::min(stop_above, exact_below_) && !exactStage(p, stop_above, box, bound)) return fail();
+      if (bound <= std::min(stop_above, exact_below_) && !exactStage(p, stop_above, box, bound)) return fail();
     }
   }
   e.valid = true;
@@ -394,7 +394,9 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   result_.type = options.type;
   result_.margin = options.margin >= 0.0 ? options.margin : model_.safety_margin;
   const double margin = result_.margin;
-  exact_below_ = std::isnan(options.exact_below) ? 0.0 : options.exact_below < 0.0 ? margin : options.exact_below;
+  exact_below_ = std::isnan(options.exact_below) || options.exact_below == -kInf ? -kInf
+                 : options.exact_below < 0.0                                  ? margin
+                                                                              : options.exact_below;
   if (!validate(lower, upper)) {
     result_.collision = true;
     result_.min_distance = 0.0;

@@ -40,9 +40,9 @@ struct QueryOptions {
   double budget_us = 0.0;  ///< time budget in microseconds; <= 0, NaN or > kMaxBudgetUs: unlimited
   int max_pairs = -1;      ///< work budget: recompute at most this many pairs; < 0: unlimited
   /// The exact stage (swept volumes without a point budget, searched by branch and bound) refines
-  /// a pair whose point-volume bound is below this and below what the query still needs to know.
-  /// < 0 (default): the margin, so every verdict is decided by the exact stage; +inf: every
-  /// pair of a Distances query (tightest, slowest); 0 or NaN: never (point volumes only).
+  /// a pair whose point-volume bound is at most this and at most what the query still needs to
+  /// know. Negative (default): the margin, so every verdict is decided by the exact stage; +inf:
+  /// every pair of a Distances query (tightest, slowest); -inf or NaN: never (point volumes only).
   double exact_below = -1.0;
 };
 
