@@ -21,7 +21,7 @@
 // what the model's joint error bounds (industrial_cell's mock-up pose) cost before any sweeping.
 //
 // Usage: bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]
-//                    [--repeats R] [--seed S] [--oracle own|library|both]
+//                    [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]
 //                    [--markdown F] [--csv F] [--plot F.png]
 #include <algorithm>
 #include <chrono>
@@ -63,11 +63,12 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 enum class Oracle { Own, Library, Both };
 
 struct Options {
-  int boxes = 64;
+  int boxes = 256;  // per box set
   std::vector<int> budgets{4, 8, 12, 16, 24, 32, 48, 64};
   std::vector<std::string> scenes{"humanoid", "industrial_cell"};
   int repeats = 3;
   std::uint64_t seed = 1;
+  int search_effort = 1;  // multiplies the own search's samples, starts and steps
 #ifdef KCCD_BENCH_WITH_EXPLAIN
   Oracle oracle = Oracle::Both;
 #else
@@ -104,7 +105,7 @@ Options parseOptions(int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "--help") {
       std::printf("bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]\n"
-                  "            [--repeats R] [--seed S] [--oracle own|library|both]\n"
+                  "            [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]\n"
                   "            [--markdown F] [--csv F] [--plot F.png]\n");
       std::exit(0);
     }
@@ -127,6 +128,8 @@ Options parseOptions(int argc, char** argv) {
       if (o.scenes.empty()) usageError("--scenes: expected a comma-separated list");
     } else if (a == "--repeats") {
       o.repeats = static_cast<int>(parseWhole(a, v, 1, 1000));
+    } else if (a == "--search-effort") {
+      o.search_effort = static_cast<int>(parseWhole(a, v, 1, 64));
     } else if (a == "--seed") {
       o.seed = static_cast<std::uint64_t>(parseWhole(a, v, 0, 1L << 40));
     } else if (a == "--oracle") {
@@ -316,8 +319,13 @@ struct CrossCheck {
   double max_difference_mm = 0.0;
 };
 
-void searchBox(const Model& nominal, kccd::bench::BoxSearch& own, Oracle oracle, const Box& box,
+void searchBox(const Model& nominal, kccd::bench::BoxSearch& own, const Options& o, const Box& box,
                std::uint64_t seed, BoxRecord& rec, CrossCheck& cross, long& evaluations) {
+  const Oracle oracle = o.oracle;
+  kccd::bench::BoxSearchOptions own_options;
+  own_options.samples *= o.search_effort;
+  own_options.starts *= o.search_effort;
+  own_options.max_evaluations *= o.search_effort;
   const std::size_t pairs = nominal.pairs.size();
   rec.found.assign(pairs, kInf);
   rec.centre_distance.assign(pairs, kInf);
@@ -328,7 +336,8 @@ void searchBox(const Model& nominal, kccd::bench::BoxSearch& own, Oracle oracle,
     const int pair = static_cast<int>(p);
     double found = kInf, own_found = kInf, library_found = kInf;
     if (oracle != Oracle::Library) {
-      const auto r = own.closest(pair, box.lower, box.upper, {.seed = seed * 1000003 + p});
+      own_options.seed = seed * 1000003 + p;
+      const auto r = own.closest(pair, box.lower, box.upper, own_options);
       own_found = r.distance;
       evaluations += r.evaluations;
     }
@@ -461,7 +470,7 @@ SetSummary runSet(const std::string& scene, const BoxSet& set, int set_index, co
   const auto t1 = Clock::now();
   kccd::bench::BoxSearch own(base);
   for (std::size_t i = 0; i < boxes.size(); ++i)
-    searchBox(base, own, o.oracle, boxes[i], seed + i, recs[i], sum.cross, sum.evaluations);
+    searchBox(base, own, o, boxes[i], seed + i, recs[i], sum.cross, sum.evaluations);
   sum.seconds_queries = std::chrono::duration<double>(t1 - t0).count();
   sum.seconds_search = std::chrono::duration<double>(Clock::now() - t1).count();
 
