@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "kccd/checker.hpp"
+#include "kccd/kinematics.hpp"
 #include "trade_oracle.hpp"
 #ifdef KCCD_BENCH_WITH_OPENCV
 #include "trade_plot.hpp"
@@ -313,19 +314,66 @@ void measureBox(std::vector<Setting>& settings, Checker& exact, const Box& box, 
   rec.point_bounds = distancesBounds(exact, box, true);
 }
 
-// The closest configurations of the pairs that may be near, by the chosen search(es).
-struct CrossCheck {
+// Checks of the searches: the two searches against each other (with --oracle both), and every
+// found configuration re-measured by the exact Checker (a proven lower bound there, so it must not
+// exceed the found distance; without joint error bounds the two should agree).
+struct SearchCheck {
   long pairs = 0, own_lower = 0, library_lower = 0;  // lower by more than 0.1 mm than the other
   double max_difference_mm = 0.0;
+  long rechecked = 0, exact_above_found = 0;
+  double max_found_minus_exact_mm = 0.0;             // over pairs whose bodies have no error bound
 };
 
-void searchBox(const Model& nominal, kccd::bench::BoxSearch& own, const Options& o, const Box& box,
-               std::uint64_t seed, BoxRecord& rec, CrossCheck& cross, long& evaluations) {
-  const Oracle oracle = o.oracle;
-  kccd::bench::BoxSearchOptions own_options;
-  own_options.samples *= o.search_effort;
-  own_options.starts *= o.search_effort;
-  own_options.max_evaluations *= o.search_effort;
+struct Found {
+  double distance = kInf;
+  std::vector<double> state;
+};
+
+// The closest configuration of one pair inside the box by the chosen search(es): the smaller.
+Found closestInBox(const Model& nominal, kccd::bench::BoxSearch& own, const Options& o, int pair, const Box& box,
+                   std::uint64_t seed, SearchCheck& check, long& evaluations) {
+  Found own_found, library_found;
+  if (o.oracle != Oracle::Library) {
+    kccd::bench::BoxSearchOptions opt;
+    opt.samples *= o.search_effort;
+    opt.starts *= o.search_effort;
+    opt.max_evaluations *= o.search_effort;
+    opt.seed = seed;
+    auto r = own.closest(pair, box.lower, box.upper, opt);
+    own_found = {r.distance, std::move(r.state)};
+    evaluations += r.evaluations;
+  }
+#ifdef KCCD_BENCH_WITH_EXPLAIN
+  if (o.oracle != Oracle::Own) {
+    kccd::ClosestConfiguration r = kccd::closestConfiguration(nominal, pair, box.lower, box.upper, {.seed = seed});
+    library_found = {r.distance, std::move(r.state)};
+    evaluations += r.evaluations;
+  }
+#else
+  (void)nominal;
+#endif
+  if (o.oracle == Oracle::Both) {
+    ++check.pairs;
+    const double diff = 1000.0 * (own_found.distance - library_found.distance);
+    if (diff < -0.1) ++check.own_lower;
+    if (diff > 0.1) ++check.library_lower;
+    check.max_difference_mm = std::max(check.max_difference_mm, std::abs(diff));
+  }
+  return own_found.distance <= library_found.distance ? own_found : library_found;
+}
+
+// The exact Checker's bound for `pair` at one configuration.
+double exactBoundAt(Checker& exact, int pair, const std::vector<double>& state) {
+  exact.reset();
+  const QueryResult& r = exact.query(state, state, {.type = QueryType::Distances});
+  for (const PairDistance& p : r.pairs)
+    if (p.pair == pair) return p.distance;
+  return kInf;
+}
+
+// Searches every pair whose best bound over all settings is below kNear (the others cannot be near).
+void searchBox(const Model& nominal, kccd::bench::BoxSearch& own, Checker& exact, const Options& o, const Box& box,
+               std::uint64_t seed, BoxRecord& rec, SearchCheck& check, long& evaluations) {
   const std::size_t pairs = nominal.pairs.size();
   rec.found.assign(pairs, kInf);
   rec.centre_distance.assign(pairs, kInf);
@@ -334,31 +382,18 @@ void searchBox(const Model& nominal, kccd::bench::BoxSearch& own, const Options&
     for (const auto& b : rec.bounds) best_bound = std::min(best_bound, b[p]);
     if (best_bound >= kNear) continue;
     const int pair = static_cast<int>(p);
-    double found = kInf, own_found = kInf, library_found = kInf;
-    if (oracle != Oracle::Library) {
-      own_options.seed = seed * 1000003 + p;
-      const auto r = own.closest(pair, box.lower, box.upper, own_options);
-      own_found = r.distance;
-      evaluations += r.evaluations;
-    }
-#ifdef KCCD_BENCH_WITH_EXPLAIN
-    if (oracle != Oracle::Own) {
-      const auto r = kccd::closestConfiguration(nominal, pair, box.lower, box.upper, {.seed = seed * 1000003 + p});
-      library_found = r.distance;
-      evaluations += r.evaluations;
-    }
-#endif
-    found = std::min(own_found, library_found);
-    if (oracle == Oracle::Both) {
-      ++cross.pairs;
-      const double diff = 1000.0 * (own_found - library_found);
-      if (diff < -0.1) ++cross.own_lower;
-      if (diff > 0.1) ++cross.library_lower;
-      cross.max_difference_mm = std::max(cross.max_difference_mm, std::abs(diff));
-    }
-    rec.found[p] = found;
+    const Found f = closestInBox(nominal, own, o, pair, box, seed * 1000003 + p, check, evaluations);
+    rec.found[p] = f.distance;
     rec.centre_distance[p] = own.distanceAt(pair, box.centre);
-    if (found <= nominal.safety_margin) rec.within = true;
+    if (f.distance <= nominal.safety_margin) rec.within = true;
+
+    const double at_found = exactBoundAt(exact, pair, f.state);
+    ++check.rechecked;
+    if (at_found > f.distance + 1e-9) ++check.exact_above_found;
+    const BodyPair& bp = nominal.pairs[p];
+    if (!hasErrorBound(nominal, nominal.bodies[static_cast<std::size_t>(bp.a)].frame) &&
+        !hasErrorBound(nominal, nominal.bodies[static_cast<std::size_t>(bp.b)].frame))
+      check.max_found_minus_exact_mm = std::max(check.max_found_minus_exact_mm, 1000.0 * (f.distance - at_found));
   }
 }
 
@@ -394,7 +429,7 @@ struct SetSummary {
   long near_pairs = 0;
   std::vector<Row> rows;               // per setting, then the point-state row
   std::vector<Violation> violations;
-  CrossCheck cross;
+  SearchCheck check;
   long evaluations = 0;
   double seconds_queries = 0.0, seconds_search = 0.0;
 };
@@ -470,7 +505,7 @@ SetSummary runSet(const std::string& scene, const BoxSet& set, int set_index, co
   const auto t1 = Clock::now();
   kccd::bench::BoxSearch own(base);
   for (std::size_t i = 0; i < boxes.size(); ++i)
-    searchBox(base, own, o, boxes[i], seed + i, recs[i], sum.cross, sum.evaluations);
+    searchBox(base, own, exact, o, boxes[i], seed + i, recs[i], sum.check, sum.evaluations);
   sum.seconds_queries = std::chrono::duration<double>(t1 - t0).count();
   sum.seconds_search = std::chrono::duration<double>(Clock::now() - t1).count();
 
@@ -614,7 +649,7 @@ int main(int argc, char** argv) {
   std::vector<SetSummary> sets;
   std::string md = "## Speed / accuracy trade (bench_trade)\n\n" + markdownNotes(o);
   std::cout << md << std::flush;
-  long violations = 0;
+  long violations = 0, search_faults = 0;
   for (const std::string& scene : o.scenes) {
     const Model m = loadModel(std::string(KCCD_DATA_DIR) + "/" + scene + ".yaml");
     for (int k = 0; k < 2; ++k) {
@@ -622,9 +657,13 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "bench_trade: %s: queries %.1f s, search %.1f s (%ld distance evaluations, %s)\n",
                    setTitle(s).c_str(), s.seconds_queries, s.seconds_search, s.evaluations, oracleName(o.oracle));
       if (o.oracle == Oracle::Both)
-        std::fprintf(stderr, "bench_trade:   cross-check over %ld pairs: own search lower by > 0.1 mm %ld times, "
+        std::fprintf(stderr, "bench_trade:   searches compared over %ld pairs: own lower by > 0.1 mm %ld times, "
                              "library lower %ld times, largest difference %.3f mm\n",
-                     s.cross.pairs, s.cross.own_lower, s.cross.library_lower, s.cross.max_difference_mm);
+                     s.check.pairs, s.check.own_lower, s.check.library_lower, s.check.max_difference_mm);
+      std::fprintf(stderr, "bench_trade:   found configurations re-measured by the exact Checker: %ld, its bound above the "
+                           "found distance %ld times; found - exact bound at most %.6f mm (pairs without error bounds)\n",
+                   s.check.rechecked, s.check.exact_above_found, s.check.max_found_minus_exact_mm);
+      search_faults += s.check.exact_above_found;
       reportViolations(s, m);
       for (const Row& r : s.rows) violations += r.violations;
       const std::string table = markdownTable(s, m.safety_margin);
@@ -643,9 +682,12 @@ int main(int argc, char** argv) {
 #ifdef KCCD_BENCH_WITH_OPENCV
   if (!o.plot.empty()) writePlot(o.plot, sets, 2);
 #endif
+  if (search_faults > 0)
+    std::fprintf(stderr, "\n!!!!!!!! bench_trade: %ld found distances below the exact bound at their own configuration: "
+                         "the search is wrong, the looseness figures are not trustworthy !!!!!!!!\n", search_faults);
   if (violations > 0) {
     std::fprintf(stderr, "\n!!!!!!!! bench_trade: %ld BOUND VIOLATIONS (see above) !!!!!!!!\n", violations);
     return 3;
   }
-  return 0;
+  return search_faults > 0 ? 4 : 0;
 }
