@@ -547,7 +547,15 @@ std::string markdownTable(const SetSummary& s, double margin) {
   std::ostringstream md;
   md << "### " << setTitle(s) << "\n\n"
      << s.boxes << " boxes: " << s.clear << " truly clear, " << s.within << " within the margin (" << margin
-     << " m); " << s.near_pairs << " near pair-boxes (found < " << kNear << " m).\n\n"
+     << " m); " << s.near_pairs << " near pair-boxes (found < " << kNear << " m). Search: " << s.check.rechecked
+     << " found configurations re-measured by the exact Checker, its bound above the found distance "
+     << s.check.exact_above_found << " times, found - exact bound at most " << num(s.check.max_found_minus_exact_mm, "%.6f")
+     << " mm (pairs without joint error bounds)";
+  if (s.check.pairs > 0)
+    md << "; own search vs kccd::closestConfiguration over " << s.check.pairs << " pairs: own lower by > 0.1 mm "
+       << s.check.own_lower << " times, library lower " << s.check.library_lower << " times, largest difference "
+       << num(s.check.max_difference_mm, "%.3f") << " mm";
+  md << ".\n\n"
      << "| mode | budget | distances µs | collision µs clear (med / p90) | collision µs within (med / p90) "
         "| clear / point state | looseness mm (med / p90) | false alarms % boxes (of clear) | false alarms % pairs |\n"
      << "|---|---|---|---|---|---|---|---|---|\n";
