@@ -410,7 +410,7 @@ double quantile(std::vector<double> v, double q) {
 struct Row {
   std::string mode;
   int budget = 0;
-  double distances_us = kNaN;
+  double distances_us = kNaN, distances_clear_us = kNaN, distances_within_us = kNaN;  // medians
   double clear_med = kNaN, clear_p90 = kNaN, within_med = kNaN, within_p90 = kNaN;
   double ratio = kNaN;  // collision on truly clear boxes / point-state collision on the same boxes
   double loose_med = kNaN, loose_p90 = kNaN;
@@ -437,7 +437,7 @@ struct SetSummary {
 // Statistics of one setting's bounds and times over all boxes (`point`: the point-state query).
 Row summarise(const std::vector<BoxRecord>& recs, double margin, int setting, bool point,
               std::vector<Violation>& violations) {
-  std::vector<double> dist_us, clear_us, within_us, point_clear_us, loose;
+  std::vector<double> dist_us, dist_clear_us, dist_within_us, clear_us, within_us, point_clear_us, loose;
   long alarms = 0, clear_boxes = 0, pair_alarms = 0, clear_pairs = 0;
   Row row;
   for (std::size_t i = 0; i < recs.size(); ++i) {
@@ -446,6 +446,7 @@ Row summarise(const std::vector<BoxRecord>& recs, double margin, int setting, bo
     const std::vector<double>& bounds = point ? r.point_bounds : r.bounds[static_cast<std::size_t>(setting)];
     const std::vector<double>& truth = point ? r.centre_distance : r.found;
     dist_us.push_back(t.distances_us);
+    (r.within ? dist_within_us : dist_clear_us).push_back(t.distances_us);
     (r.within ? within_us : clear_us).push_back(t.collision_us);
     if (!r.within) point_clear_us.push_back(r.point.collision_us);
     bool alarm = false;
@@ -468,6 +469,8 @@ Row summarise(const std::vector<BoxRecord>& recs, double margin, int setting, bo
     }
   }
   row.distances_us = quantile(dist_us, 0.5);
+  row.distances_clear_us = quantile(dist_clear_us, 0.5);
+  row.distances_within_us = quantile(dist_within_us, 0.5);
   row.clear_med = quantile(clear_us, 0.5);
   row.clear_p90 = quantile(clear_us, 0.9);
   row.within_med = quantile(within_us, 0.5);
@@ -570,8 +573,8 @@ std::string markdownTable(const SetSummary& s, double margin) {
 
 std::string markdownNotes(const Options& o) {
   std::ostringstream md;
-  md << "Cold queries (table reset), the fastest of " << o.repeats
-     << " runs per box, median / p90 over the boxes (nearest rank). "
+  md << "Cold queries (table reset before each; the same box repeated, so CPU caches are warm), the fastest of "
+     << o.repeats << " runs per box, median / p90 over the boxes (nearest rank). "
         "\"clear\"/\"within\": boxes whose closest found configuration is beyond / within the margin. "
         "\"clear / point state\": median collision query on the truly clear boxes over the median exact "
         "collision query at the same boxes' centres. Looseness: found distance minus bound over near pairs "
@@ -585,6 +588,7 @@ std::string markdownNotes(const Options& o) {
 std::string csvText(const std::vector<SetSummary>& sets) {
   std::ostringstream c;
   c << "scene,set,mode,budget,boxes,clear_boxes,within_boxes,near_pairs,distances_us_median,"
+       "distances_clear_us_median,distances_within_us_median,"
        "collision_clear_us_median,collision_clear_us_p90,collision_within_us_median,collision_within_us_p90,"
        "clear_over_point_state,looseness_mm_median,looseness_mm_p90,false_alarm_boxes_pct,"
        "false_alarm_clear_boxes_pct,false_alarm_pairs_pct,violations\n";
@@ -592,7 +596,8 @@ std::string csvText(const std::vector<SetSummary>& sets) {
     for (const Row& r : s.rows)
       c << s.scene << "," << s.set << "," << (r.mode.rfind("point", 0) == 0 ? "point_state" : r.mode) << ","
         << r.budget << "," << s.boxes << "," << s.clear << "," << s.within << "," << s.near_pairs << ","
-        << num(r.distances_us, "%.3f") << "," << num(r.clear_med, "%.3f") << "," << num(r.clear_p90, "%.3f") << ","
+        << num(r.distances_us, "%.3f") << "," << num(r.distances_clear_us, "%.3f") << ","
+        << num(r.distances_within_us, "%.3f") << "," << num(r.clear_med, "%.3f") << "," << num(r.clear_p90, "%.3f") << ","
         << num(r.within_med, "%.3f") << "," << num(r.within_p90, "%.3f") << "," << num(r.ratio, "%.4f") << ","
         << num(r.loose_med, "%.4f") << "," << num(r.loose_p90, "%.4f") << "," << num(r.alarm_boxes_pct, "%.2f")
         << "," << num(r.alarm_clear_pct, "%.2f") << "," << num(r.alarm_pairs_pct, "%.2f") << "," << r.violations
