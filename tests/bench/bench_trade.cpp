@@ -539,6 +539,9 @@ std::string num(double v, const char* fmt = "%.1f") {
   return buf;
 }
 
+// A CSV field: empty when there is no value.
+std::string csvNum(double v, const char* fmt) { return std::isfinite(v) ? num(v, fmt) : std::string(); }
+
 std::string setTitle(const SetSummary& s) {
   for (const BoxSet& b : kSets)
     if (s.set == b.name) return s.scene + ", " + b.name + " boxes (revolute widths " + num(b.min_deg, "%g") + "-" +
@@ -596,11 +599,11 @@ std::string csvText(const std::vector<SetSummary>& sets) {
     for (const Row& r : s.rows)
       c << s.scene << "," << s.set << "," << (r.mode.rfind("point", 0) == 0 ? "point_state" : r.mode) << ","
         << r.budget << "," << s.boxes << "," << s.clear << "," << s.within << "," << s.near_pairs << ","
-        << num(r.distances_us, "%.3f") << "," << num(r.distances_clear_us, "%.3f") << ","
-        << num(r.distances_within_us, "%.3f") << "," << num(r.clear_med, "%.3f") << "," << num(r.clear_p90, "%.3f") << ","
-        << num(r.within_med, "%.3f") << "," << num(r.within_p90, "%.3f") << "," << num(r.ratio, "%.4f") << ","
-        << num(r.loose_med, "%.4f") << "," << num(r.loose_p90, "%.4f") << "," << num(r.alarm_boxes_pct, "%.2f")
-        << "," << num(r.alarm_clear_pct, "%.2f") << "," << num(r.alarm_pairs_pct, "%.2f") << "," << r.violations
+        << csvNum(r.distances_us, "%.3f") << "," << csvNum(r.distances_clear_us, "%.3f") << ","
+        << csvNum(r.distances_within_us, "%.3f") << "," << csvNum(r.clear_med, "%.3f") << "," << csvNum(r.clear_p90, "%.3f") << ","
+        << csvNum(r.within_med, "%.3f") << "," << csvNum(r.within_p90, "%.3f") << "," << csvNum(r.ratio, "%.4f") << ","
+        << csvNum(r.loose_med, "%.4f") << "," << csvNum(r.loose_p90, "%.4f") << "," << csvNum(r.alarm_boxes_pct, "%.2f")
+        << "," << csvNum(r.alarm_clear_pct, "%.2f") << "," << csvNum(r.alarm_pairs_pct, "%.2f") << "," << r.violations
         << "\n";
   return c.str();
 }
