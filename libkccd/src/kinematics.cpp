@@ -6,26 +6,26 @@
 
 namespace kccd {
 
+Pose jointMotion(const Joint& joint, const double* q) noexcept {
+  Pose motion = Pose::Identity();
+  switch (joint.type) {
+    case JointType::Fixed: break;
+    case JointType::Revolute: motion.linear() = Eigen::AngleAxisd(q[0], joint.axis).toRotationMatrix(); break;
+    case JointType::Prismatic: motion.translation() = q[0] * joint.axis; break;
+    case JointType::Translation3d: motion.translation() = Vec3(q[0], q[1], q[2]); break;
+    case JointType::Rotation3d: motion.linear() = rotationFromVector(Vec3(q[0], q[1], q[2])); break;
+  }
+  return motion;
+}
+
 bool framePoses(const Model& model, std::span<const double> state, std::span<Pose> poses) noexcept {
   if (static_cast<int>(state.size()) != model.stateSize() || poses.size() != model.joints.size()) return false;
   for (double v : state)
     if (!std::isfinite(v)) return false;
   for (std::size_t j = 0; j < model.joints.size(); ++j) {
     const Joint& joint = model.joints[j];
-    const double* q = state.data() + joint.state_offset;
-    Pose motion = Pose::Identity();
-    switch (joint.type) {
-      case JointType::Fixed: break;
-      case JointType::Revolute: motion.linear() = Eigen::AngleAxisd(q[0], joint.axis).toRotationMatrix(); break;
-      case JointType::Prismatic: motion.translation() = q[0] * joint.axis; break;
-      case JointType::Translation3d: motion.translation() = Vec3(q[0], q[1], q[2]); break;
-      case JointType::Rotation3d: {
-        motion.linear() = rotationFromVector(Vec3(q[0], q[1], q[2]));
-        break;
-      }
-    }
     const Pose& parent = framePose(poses, joint.parent);
-    poses[j] = parent * joint.origin * motion;
+    poses[j] = parent * joint.origin * jointMotion(joint, state.data() + joint.state_offset);
   }
   return true;
 }

@@ -8,6 +8,7 @@
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/checker.hpp"
+#include "kccd/explain.hpp"
 
 namespace kccd::cli {
 namespace {
@@ -20,6 +21,7 @@ struct QueryArgs {
   double margin = -1.0;
   double budget_us = 0.0;
   bool json = false;
+  bool explain = false;
 };
 
 QueryType parseType(const std::string& t) {
@@ -28,6 +30,44 @@ QueryType parseType(const std::string& t) {
   if (t == "nclosest") return QueryType::NClosest;
   if (t == "distances") return QueryType::Distances;
   throw UsageError("--type: unknown query type '" + t + "' (collision, closest, nclosest, distances)");
+}
+
+// The configuration as {state name: value}.
+nlohmann::json stateObject(const Model& m, const std::vector<double>& state) {
+  nlohmann::json o = nlohmann::json::object();
+  for (std::size_t i = 0; i < state.size(); ++i) o[m.stateNames()[i]] = state[i];
+  return o;
+}
+
+nlohmann::json explainJson(const Model& m, const std::vector<PairExplanation>& explained) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const PairExplanation& e : explained) {
+    const BodyPair& p = m.pairs[static_cast<std::size_t>(e.pair)];
+    out.push_back({{"a", m.bodies[static_cast<std::size_t>(p.a)].name},
+                   {"b", m.bodies[static_cast<std::size_t>(p.b)].name},
+                   {"bound", e.bound},
+                   {"distance", number(e.closest.distance)},
+                   {"verdict", toString(e.verdict)},
+                   {"state", stateObject(m, e.closest.state)},
+                   {"point_a", vec3(e.closest.point_a)},
+                   {"point_b", vec3(e.closest.point_b)},
+                   {"evaluations", e.closest.evaluations}});
+  }
+  return out;
+}
+
+void printExplain(const Model& m, const std::vector<PairExplanation>& explained, double margin) {
+  std::cout << "explain: " << explained.size() << " flagged pair" << (explained.size() == 1 ? "" : "s")
+            << " (bound <= margin " << margin << " m); closest configuration found by local search\n";
+  for (const PairExplanation& e : explained) {
+    const BodyPair& p = m.pairs[static_cast<std::size_t>(e.pair)];
+    std::cout << "  " << m.bodies[static_cast<std::size_t>(p.a)].name << " - "
+              << m.bodies[static_cast<std::size_t>(p.b)].name << ": bound " << e.bound << " m, found "
+              << e.closest.distance << " m: " << toString(e.verdict) << "\n    at";
+    for (std::size_t i = 0; i < e.closest.state.size(); ++i)
+      std::cout << (i == 0 ? " " : ", ") << m.stateNames()[i] << " = " << format(e.closest.state[i]);
+    std::cout << "\n";
+  }
 }
 
 Exit runQuery(const QueryArgs& args) {
@@ -45,6 +85,9 @@ Exit runQuery(const QueryArgs& args) {
   opt.margin = args.margin;
   opt.budget_us = args.budget_us;
   const QueryResult& r = checker.query(lower, upper, opt);
+  const bool explain = args.explain && r.status == Status::Ok;
+  const std::vector<PairExplanation> explained =
+      explain ? explainFlagged(m, lower, upper, args.margin) : std::vector<PairExplanation>{};
 
   if (args.json) {
     nlohmann::json j;
@@ -67,6 +110,7 @@ Exit runQuery(const QueryArgs& args) {
     j["stats"] = {{"time_us", r.stats.time_us}, {"pairs_checked", r.stats.pairs_checked},
                   {"gjk_calls", r.stats.gjk_calls}, {"volumes_swept", r.stats.volumes_swept},
                   {"budget_exhausted", r.stats.budget_exhausted}};
+    if (explain) j["explain"] = explainJson(m, explained);
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << "status " << toString(r.status) << ": "
@@ -81,6 +125,7 @@ Exit runQuery(const QueryArgs& args) {
     }
     std::cout << "time " << r.stats.time_us << " us, " << r.stats.pairs_checked << " pairs checked, "
               << r.stats.gjk_calls << " GJK calls" << (r.stats.budget_exhausted ? ", budget exhausted" : "") << "\n";
+    if (explain) printExplain(m, explained, r.margin);
   }
   if (r.status != Status::Ok) {
     std::cerr << "kccd: query status " << toString(r.status) << " (unsafe)\n";
@@ -108,6 +153,11 @@ Runner addQuery(CLI::App& app) {
   sub->add_option("--budget-us", args->budget_us, "Time budget in microseconds (default: unlimited)")
       ->check(finiteIn(0.0, kMaxBudgetUs));
   sub->add_flag("--json", args->json, "Machine-readable output");
+  sub->add_flag("--explain", args->explain,
+                "For every pair whose bound is <= the margin, search the box for its closest configuration and "
+                "print it with a verdict: 'real' (that configuration is within the margin: a proven collision) or "
+                "'possible' (none found within it; a local search, not a proof of safety). JSON: an \"explain\" "
+                "array of {a, b, bound, distance, verdict, state, point_a, point_b}");
   sub->footer("Exit status: 0 answered (collision or not), 2 bad input, 3 unsafe query status.");
   return [args] { return runQuery(*args); };
 }

@@ -8,6 +8,10 @@
 
 namespace kccd {
 
+/// The motion of one joint in its own frame at its state values `q` (joint.dof of them): the
+/// pose its child frame has in the joint frame. Never allocates.
+Pose jointMotion(const Joint& joint, const double* q) noexcept;
+
 /// The pose of every joint frame in the world at `state` (error bounds not applied): frame j's
 /// coordinates map to world coordinates by poses[j]. Returns false, leaving `poses` unspecified,
 /// when `state` or `poses` has the wrong length or a state value is not finite. Never allocates.
