@@ -5,7 +5,13 @@
 // every sweep mode (fast, accurate) and point budget answers a distances query and a collision
 // query per box (cold: table reset; the fastest of --repeats runs). Per pair whose best bound over
 // all settings is below kNear, a search inside the box finds a configuration and its distance
-// ("found"): an upper bound on the pair's true smallest distance. Then, per setting:
+// ("found"): an upper bound on the pair's true smallest distance. Two searches run (--oracle both,
+// the default): kccd::closestConfiguration (kccd/explain.hpp) and this program's own sampling +
+// compass descent (trade_oracle.hpp), kept as a cross-check; found is the smaller of the two (both
+// are distances at configurations inside the box), and how often and by how much they differ is
+// reported. Every found configuration is re-measured by the exact Checker: its lower bound there
+// must not exceed the found distance (else the run fails: the search would be wrong).
+// Then, per setting:
 //   looseness   = found - bound (mm), over near pairs (found < kNear, found > 0): median and p90;
 //   false alarm = a box where some pair's bound <= margin while no found distance is <= margin
 //                 (% of all boxes, and of the truly clear ones); per pair: a near pair clear of the
@@ -39,14 +45,11 @@
 #include <vector>
 
 #include "kccd/checker.hpp"
+#include "kccd/explain.hpp"
 #include "kccd/kinematics.hpp"
 #include "trade_oracle.hpp"
 #ifdef KCCD_BENCH_WITH_OPENCV
 #include "trade_plot.hpp"
-#endif
-#if __has_include("kccd/explain.hpp")
-#include "kccd/explain.hpp"
-#define KCCD_BENCH_WITH_EXPLAIN 1
 #endif
 
 namespace {
@@ -70,11 +73,7 @@ struct Options {
   int repeats = 3;
   std::uint64_t seed = 1;
   int search_effort = 1;  // multiplies the own search's samples, starts and steps
-#ifdef KCCD_BENCH_WITH_EXPLAIN
   Oracle oracle = Oracle::Both;
-#else
-  Oracle oracle = Oracle::Own;
-#endif
   std::string markdown, csv, plot;
 };
 
@@ -135,12 +134,9 @@ Options parseOptions(int argc, char** argv) {
       o.seed = static_cast<std::uint64_t>(parseWhole(a, v, 0, 1L << 40));
     } else if (a == "--oracle") {
       if (v == "own") o.oracle = Oracle::Own;
-      else if (v == "library" || v == "both") {
-#ifndef KCCD_BENCH_WITH_EXPLAIN
-        usageError("--oracle " + v + ": this build has no kccd/explain.hpp (closestConfiguration)");
-#endif
-        o.oracle = v == "library" ? Oracle::Library : Oracle::Both;
-      } else {
+      else if (v == "library") o.oracle = Oracle::Library;
+      else if (v == "both") o.oracle = Oracle::Both;
+      else {
         usageError("--oracle: expected own, library or both, got '" + v + "'");
       }
     } else if (a == "--markdown") {
@@ -343,15 +339,11 @@ Found closestInBox(const Model& nominal, kccd::bench::BoxSearch& own, const Opti
     own_found = {r.distance, std::move(r.state)};
     evaluations += r.evaluations;
   }
-#ifdef KCCD_BENCH_WITH_EXPLAIN
   if (o.oracle != Oracle::Own) {
     kccd::ClosestConfiguration r = kccd::closestConfiguration(nominal, pair, box.lower, box.upper, {.seed = seed});
     library_found = {r.distance, std::move(r.state)};
     evaluations += r.evaluations;
   }
-#else
-  (void)nominal;
-#endif
   if (o.oracle == Oracle::Both) {
     ++check.pairs;
     const double diff = 1000.0 * (own_found.distance - library_found.distance);
