@@ -67,7 +67,7 @@ double niceStep(double range, int count) {
 
 void drawFrame(cv::Mat& img, const Axes& ax, const std::string& ylabel, bool xlabels) {
   for (int k = static_cast<int>(std::floor(ax.lx0)); k <= static_cast<int>(std::ceil(ax.lx1)); ++k)
-    for (double m : {1.0, 2.0, 3.0, 5.0, 7.0}) {
+    for (double m : {1.0, 1.5, 2.0, 3.0, 5.0, 7.0}) {
       const double x = m * std::pow(10.0, k);
       if (std::log10(x) < ax.lx0 - 1e-9 || std::log10(x) > ax.lx1 + 1e-9) continue;
       const cv::Point p = ax.at(x, ax.y0);
