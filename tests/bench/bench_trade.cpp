@@ -663,7 +663,7 @@ const char* oracleName(Oracle o) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   const Options o = parseOptions(argc, argv);
   const auto start = Clock::now();
   std::vector<SetSummary> sets;
@@ -710,4 +710,7 @@ int main(int argc, char** argv) {
     return 3;
   }
   return search_faults > 0 ? 4 : 0;
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "bench_trade: %s\n", e.what());
+  return 1;
 }
