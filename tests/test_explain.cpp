@@ -7,8 +7,8 @@
 #include <iomanip>
 #include <limits>
 #include <numbers>
-#include <sstream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -124,6 +124,43 @@ TEST(Explain, TwoLinkArmFindsTheStretchedPose) {
   EXPECT_NEAR(c.distance, 0.35, 1e-7);
   EXPECT_NEAR(c.state[0], 0.3, 1e-3);
   EXPECT_NEAR(c.state[1], 0.0, 1e-3);
+}
+
+TEST(Explain, PrismaticTranslationAndRotationJointsReachTheirMinima) {
+  const Model m = parseModel(R"(kccd: 1
+name: free_joints
+safety_margin: 0.01
+joints:
+  - {name: slide, parent: world, type: prismatic, axis: [1, 0, 0]}
+  - {name: pose, parent: world, type: translation3d, origin: {xyz: [5, 0, 0]}, error: 0.01}
+  - {name: turn, parent: world, type: rotation3d, origin: {xyz: [-5, 0, 0]}, error: 0.01}
+bodies:
+  - {name: slider, frame: slide, points: [[0, 0, 0]], radius: 0.05}
+  - {name: slide_ball, frame: world, points: [[1.5, 0.5, 0]], radius: 0.1}
+  - {name: carried, frame: pose, points: [[0, 0, 0]], radius: 0.05}
+  - {name: pose_ball, frame: world, points: [[6, 1, 1]], radius: 0.1}
+  - {name: turned, frame: turn, points: [[1, 0, 0]], radius: 0.05}
+  - {name: turn_ball, frame: world, points: [[-5, 1.2, 0.6]], radius: 0.1}
+pairs:
+  check: none
+  include: [[slider, slide_ball], [carried, pose_ball], [turned, turn_ball]]
+)",
+                             "free_joints.yaml");
+  // slide, pose.x/y/z, turn.x/y/z
+  const std::vector<double> lower{0.0, 0.0, 0.0, 0.0, -0.2, -1.0, 0.0}, upper{2.0, 0.3, 0.3, 0.3, 0.2, 1.0, 2.0};
+  // The slider passes the ball's foot at 1.5: 0.5 m from its centre.
+  const ClosestConfiguration slide = closestConfiguration(m, pairOf(m, "slider", "slide_ball"), lower, upper);
+  EXPECT_NEAR(slide.distance, 0.5 - 0.15, 1e-9);
+  EXPECT_NEAR(slide.state[0], 1.5, 1e-6);
+  // The carried ball goes to the box corner nearest (1, 1, 1) away.
+  const ClosestConfiguration pose = closestConfiguration(m, pairOf(m, "carried", "pose_ball"), lower, upper);
+  EXPECT_NEAR(pose.distance, std::sqrt(3.0) * 0.7 - 0.15, 1e-9);
+  for (int i = 1; i <= 3; ++i) EXPECT_NEAR(pose.state[static_cast<std::size_t>(i)], 0.3, 1e-9);
+  // The point 1 m from the rotation centre reaches the unit sphere's point towards (0, 1.2, 0.6),
+  // a rotation by pi/2 about (0, -1, 2) / sqrt(5), inside the box.
+  const ClosestConfiguration turn = closestConfiguration(m, pairOf(m, "turned", "turn_ball"), lower, upper);
+  EXPECT_NEAR(turn.distance, std::sqrt(1.8) - 1.0 - 0.15, 1e-7);
+  for (const ClosestConfiguration* c : {&slide, &pose, &turn}) expectInside(*c, lower, upper);
 }
 
 TEST(Explain, UnlimitedRevoluteIntervalsAreSearchedOverOneTurn) {

@@ -17,10 +17,10 @@ namespace {
 
 constexpr double kFullTurn = 2.0 * std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kArmijo = 1e-4;           // sufficient decrease, as a fraction of the predicted one
-constexpr int kMaxHalvings = 40;           // backtracking steps before a descent gives up
-constexpr double kStepTolerance = 1e-10;   // a step this small (rad or m) ends a descent
-constexpr double kRotationStep = 1e-6;     // central-difference step for rotation3d (rad)
+constexpr double kArmijo = 1e-4;          // sufficient decrease, as a fraction of the predicted one
+constexpr int kMaxHalvings = 40;          // backtracking steps before a descent gives up
+constexpr double kStepTolerance = 1e-10;  // a step this small (rad or m) ends a descent
+constexpr double kRotationStep = 1e-6;    // central-difference step for rotation3d (rad)
 
 // One searched state value and the window it is searched in (inside its interval).
 struct Variable {
@@ -140,17 +140,22 @@ class PairFunction {
   // dx/dq_k of a point x (LCA frame) moved by joint j at its state values q.
   static Vec3 velocity(const Joint& j, const Placed& p, const double* q, int k, const Vec3& x) {
     switch (j.type) {
-      case JointType::Fixed: return Vec3::Zero();
-      case JointType::Revolute: return (p.before.linear() * j.axis).cross(x - p.before.translation());
-      case JointType::Prismatic: return p.before.linear() * j.axis;
-      case JointType::Translation3d: return p.before.linear().col(k);
+      case JointType::Fixed:
+        return Vec3::Zero();
+      case JointType::Revolute:
+        return (p.before.linear() * j.axis).cross(x - p.before.translation());
+      case JointType::Prismatic:
+        return p.before.linear() * j.axis;
+      case JointType::Translation3d:
+        return p.before.linear().col(k);
       case JointType::Rotation3d: {
         // x = before * R(v) * y with y fixed in the joint frame; dR/dv_k by central differences.
         const Eigen::Matrix3d r = p.after.linear();
         const Vec3 v(q[0], q[1], q[2]);
         Vec3 step = Vec3::Zero();
         step[k] = kRotationStep;
-        const Eigen::Matrix3d dr = (rotationFromVector(v + step) - rotationFromVector(v - step)) / (2.0 * kRotationStep);
+        const Eigen::Matrix3d dr =
+            (rotationFromVector(v + step) - rotationFromVector(v - step)) / (2.0 * kRotationStep);
         const Vec3 y = r.transpose() * (x - p.after.translation());
         return p.before.linear() * (dr * y);
       }
@@ -191,12 +196,13 @@ class Search {
          const SearchOptions& options)
       : f_(model, pair), options_(options), slot_(static_cast<std::size_t>(model.stateSize()), -1) {
     state_.resize(lower.size());
-    for (std::size_t i = 0; i < lower.size(); ++i) state_[i] = std::clamp(0.5 * lower[i] + 0.5 * upper[i], lower[i], upper[i]);
+    for (std::size_t i = 0; i < lower.size(); ++i)
+      state_[i] = std::clamp(0.5 * lower[i] + 0.5 * upper[i], lower[i], upper[i]);
     for (int s : f_.stateIndices()) {
       if (slot_[static_cast<std::size_t>(s)] >= 0) continue;
       slot_[static_cast<std::size_t>(s)] = static_cast<int>(vars_.size());
-      vars_.push_back(window(s, lower[static_cast<std::size_t>(s)], upper[static_cast<std::size_t>(s)],
-                             isRevolute(model, s)));
+      vars_.push_back(
+          window(s, lower[static_cast<std::size_t>(s)], upper[static_cast<std::size_t>(s)], isRevolute(model, s)));
     }
     for (const Variable& v : vars_) {
       state_[static_cast<std::size_t>(v.index)] = std::clamp(0.5 * v.lo + 0.5 * v.hi, v.lo, v.hi);
@@ -324,14 +330,14 @@ class Search {
 
   PairFunction f_;
   SearchOptions options_;
-  std::vector<int> slot_;          // per state index: its variable, or -1
+  std::vector<int> slot_;  // per state index: its variable, or -1
   std::vector<Variable> vars_;
-  std::vector<double> state_;      // the full state being evaluated
-  std::vector<double> gradient_;   // per variable, at the last evaluation
+  std::vector<double> state_;     // the full state being evaluated
+  std::vector<double> gradient_;  // per variable, at the last evaluation
   std::vector<double> centre_gradient_;
-  std::vector<double> x_, g_;      // the descent's point and its gradient (per variable)
-  double width_ = 0.0;             // widest window
-  ClosestConfiguration best_;      // the best configuration seen (points in the LCA frame)
+  std::vector<double> x_, g_;  // the descent's point and its gradient (per variable)
+  double width_ = 0.0;         // widest window
+  ClosestConfiguration best_;  // the best configuration seen (points in the LCA frame)
 };
 
 }  // namespace
@@ -352,9 +358,12 @@ ClosestConfiguration closestConfiguration(const Model& model, int pair, std::spa
 
 const char* toString(PairVerdict verdict) {
   switch (verdict) {
-    case PairVerdict::Clear: return "clear";
-    case PairVerdict::Possible: return "possible";
-    case PairVerdict::Real: return "real";
+    case PairVerdict::Clear:
+      return "clear";
+    case PairVerdict::Possible:
+      return "possible";
+    case PairVerdict::Real:
+      return "real";
   }
   return "possible";
 }

@@ -45,7 +45,7 @@ nlohmann::json explainJson(const Model& m, const std::vector<PairExplanation>& e
     const BodyPair& p = m.pairs[static_cast<std::size_t>(e.pair)];
     out.push_back({{"a", m.bodies[static_cast<std::size_t>(p.a)].name},
                    {"b", m.bodies[static_cast<std::size_t>(p.b)].name},
-                   {"bound", e.bound},
+                   {"bound", number(e.bound)},
                    {"distance", number(e.closest.distance)},
                    {"verdict", toString(e.verdict)},
                    {"state", stateObject(m, e.closest.state)},

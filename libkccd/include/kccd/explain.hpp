@@ -12,22 +12,22 @@ namespace kccd {
 
 /// How hard closestConfiguration() searches.
 struct SearchOptions {
-  int starts = 12;           ///< descents: the box centre, the corner down the gradient, then random points (>= 1)
-  int max_steps = 200;       ///< accepted steps per descent (>= 0)
-  std::uint64_t seed = 1;    ///< the random starts; the same seed gives the same answer
-  double stop_below = 0.0;   ///< stop the whole search once a distance <= this is found
+  int starts = 12;          ///< descents: the box centre, the corner down the gradient, then random points (>= 1)
+  int max_steps = 200;      ///< accepted steps per descent (>= 0)
+  std::uint64_t seed = 1;   ///< the random starts; the same seed gives the same answer
+  double stop_below = 0.0;  ///< stop the whole search once a distance <= this is found
 };
 
 /// The closest configuration found for one pair.
 struct ClosestConfiguration {
-  int pair = -1;               ///< index into Model::pairs
+  int pair = -1;  ///< index into Model::pairs
   /// SSCH distance of the pair at `state` (rounded up): an upper bound on the pair's smallest
   /// distance over the box; +inf when no configuration could be evaluated.
   double distance = 0.0;
-  std::vector<double> state;   ///< a configuration inside [lower, upper] (every value within its interval)
-  Vec3 point_a = Vec3::Zero(); ///< closest point of body a in world coordinates at `state`
-  Vec3 point_b = Vec3::Zero(); ///< closest point of body b in world coordinates at `state`
-  int evaluations = 0;         ///< distance evaluations spent
+  std::vector<double> state;    ///< a configuration inside [lower, upper] (every value within its interval)
+  Vec3 point_a = Vec3::Zero();  ///< closest point of body a in world coordinates at `state`
+  Vec3 point_b = Vec3::Zero();  ///< closest point of body b in world coordinates at `state`
+  int evaluations = 0;          ///< distance evaluations spent
 };
 
 /// Searches [lower, upper] for the configuration with the smallest distance of `pair`: projected
@@ -54,9 +54,9 @@ PairVerdict verdict(double bound, double found, double margin) noexcept;
 
 /// One flagged pair explained.
 struct PairExplanation {
-  int pair = -1;                  ///< index into Model::pairs
-  double bound = 0.0;             ///< the Checker's lower bound over the box
-  ClosestConfiguration closest;   ///< the closest configuration found
+  int pair = -1;                 ///< index into Model::pairs
+  double bound = 0.0;            ///< the Checker's lower bound over the box
+  ClosestConfiguration closest;  ///< the closest configuration found
   PairVerdict verdict = PairVerdict::Possible;
 };
 
