@@ -1,0 +1,718 @@
+// The speed/accuracy trade of the sweep modes and point budgets, measured against a search for
+// each pair's closest configuration inside the box.
+//
+// For each scene and box set (N random braking boxes around configurations clear of the margin),
+// every sweep mode (fast, accurate) and point budget answers a distances query and a collision
+// query per box (cold: table reset; the fastest of --repeats runs). Per pair whose best bound over
+// all settings is below kNear, a search inside the box finds a configuration and its distance
+// ("found"): an upper bound on the pair's true smallest distance. Two searches run (--oracle both,
+// the default): kccd::closestConfiguration (kccd/explain.hpp) and this program's own sampling +
+// compass descent (trade_oracle.hpp), kept as a cross-check; found is the smaller of the two (both
+// are distances at configurations inside the box), and how often and by how much they differ is
+// reported. Every found configuration is re-measured by the exact Checker: its lower bound there
+// must not exceed the found distance (else the run fails: the search would be wrong).
+// Then, per setting:
+//   looseness   = found - bound (mm), over near pairs (found < kNear, found > 0): median and p90;
+//   false alarm = a box where some pair's bound <= margin while no found distance is <= margin
+//                 (% of all boxes, and of the truly clear ones); per pair: a pair clear of the
+//                 margin (found > margin; unsearched pairs count as clear) whose bound is <= margin,
+//                 % of all such pairs of all boxes (the CSV column false_alarm_far_pairs counts the
+//                 flagged pairs found at kNear or farther: their looseness is not in the statistics);
+//   violation   = a bound above found + 1e-9 (must never happen; printed loudly).
+// "Truly clear" and "within" are decided by the found distances: a box with a found distance <= the
+// margin is certainly within it; a box counted as clear is clear as far as the search can tell
+// (a search that misses a closer configuration makes looseness and false alarms look larger).
+// Pairs whose best bound is >= kNear are not searched: their true distance is >= kNear, so they
+// are never near and never within the margin.
+// The point-state row is the exact collision / distances query at the box centre (zero width);
+// its looseness column compares its bound with the nominal distance at the centre, which shows
+// what the model's joint error bounds (industrial_cell's mock-up pose) cost before any sweeping.
+//
+// Usage: bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]
+//                    [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]
+//                    [--markdown F] [--csv F] [--plot F.png]
+// Exit status: 0 done, 1 error, 2 bad option, 3 a bound violation, 4 a found distance below the
+// exact bound at its own configuration (a wrong search).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "kccd/checker.hpp"
+#include "kccd/explain.hpp"
+#include "kccd/kinematics.hpp"
+#include "trade_oracle.hpp"
+#ifdef KCCD_BENCH_WITH_OPENCV
+#include "trade_plot.hpp"
+#endif
+
+namespace {
+
+using namespace kccd;
+using Clock = std::chrono::steady_clock;
+constexpr double kDeg = 3.141592653589793 / 180.0;
+constexpr double kNear = 0.3;  // m: pairs closer than this count as near
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// ---------------------------------------------------------------------------------------------
+// Options
+
+enum class Oracle { Own, Library, Both };
+
+struct Options {
+  int boxes = 256;  // per box set
+  std::vector<int> budgets{4, 8, 12, 16, 24, 32, 48, 64};
+  std::vector<std::string> scenes{"humanoid", "industrial_cell"};
+  int repeats = 3;
+  std::uint64_t seed = 1;
+  int search_effort = 1;  // multiplies the own search's samples, starts and steps
+  Oracle oracle = Oracle::Both;
+  std::string markdown, csv, plot;
+};
+
+[[noreturn]] void usageError(const std::string& message) {
+  std::fprintf(stderr, "bench_trade: %s\n", message.c_str());
+  std::exit(2);
+}
+
+[[noreturn]] void fail(const std::string& message) {
+  std::fprintf(stderr, "bench_trade: %s\n", message.c_str());
+  std::exit(1);
+}
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+long parseWhole(const std::string& option, const std::string& v, long lo, long hi) {
+  char* end = nullptr;
+  const long x = std::strtol(v.c_str(), &end, 10);
+  if (v.empty() || *end != '\0' || x < lo || x > hi)
+    usageError(option + ": expected a whole number from " + std::to_string(lo) + " to " + std::to_string(hi) +
+               ", got '" + v + "'");
+  return x;
+}
+
+Options parseOptions(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--help") {
+      std::printf("bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]\n"
+                  "            [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]\n"
+                  "            [--markdown F] [--csv F] [--plot F.png]\n");
+      std::exit(0);
+    }
+    if (a == "--quick") {
+      o.boxes = 6;
+      o.budgets = {4, 12, 64};
+      o.repeats = 1;
+      continue;
+    }
+    if (i + 1 >= argc) usageError(a + ": unknown option or missing value (see --help)");
+    const std::string v = argv[++i];
+    if (a == "--n") {
+      o.boxes = static_cast<int>(parseWhole(a, v, 1, 100000));
+    } else if (a == "--budgets") {
+      o.budgets.clear();
+      for (const std::string& b : splitList(v)) o.budgets.push_back(static_cast<int>(parseWhole(a, b, 1, 4096)));
+      if (o.budgets.empty()) usageError("--budgets: expected a comma-separated list");
+    } else if (a == "--scenes") {
+      o.scenes = splitList(v);
+      if (o.scenes.empty()) usageError("--scenes: expected a comma-separated list");
+    } else if (a == "--repeats") {
+      o.repeats = static_cast<int>(parseWhole(a, v, 1, 1000));
+    } else if (a == "--search-effort") {
+      o.search_effort = static_cast<int>(parseWhole(a, v, 1, 64));
+    } else if (a == "--seed") {
+      o.seed = static_cast<std::uint64_t>(parseWhole(a, v, 0, 1L << 40));
+    } else if (a == "--oracle") {
+      if (v == "own") o.oracle = Oracle::Own;
+      else if (v == "library") o.oracle = Oracle::Library;
+      else if (v == "both") o.oracle = Oracle::Both;
+      else {
+        usageError("--oracle: expected own, library or both, got '" + v + "'");
+      }
+    } else if (a == "--markdown") {
+      o.markdown = v;
+    } else if (a == "--csv") {
+      o.csv = v;
+    } else if (a == "--plot") {
+#ifndef KCCD_BENCH_WITH_OPENCV
+      usageError("--plot: this build has no OpenCV");
+#endif
+      o.plot = v;
+    } else {
+      usageError(a + ": unknown option (see --help)");
+    }
+  }
+  return o;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Boxes
+
+struct BoxSet {
+  const char* name;
+  double min_deg, max_deg;  // width range of every revolute joint's interval
+};
+constexpr BoxSet kSets[] = {{"narrow", 1.0, 5.0}, {"wide", 2.0, 20.0}};
+
+struct Box {
+  std::vector<double> lower, upper, centre;
+};
+
+// A random configuration inside the joint limits and a braking box around it, drawn as
+// bench_engine draws its boxes, with the revolute width range of `set` (translation3d 1-5 cm,
+// rotation3d up to 2 degrees, prismatic up to 2 cm, as there).
+Box randomBox(std::mt19937_64& rng, const Model& m, const BoxSet& set) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Box box;
+  box.centre.assign(static_cast<std::size_t>(m.stateSize()), 0.0);
+  box.lower = box.upper = box.centre;
+  for (const Joint& j : m.joints)
+    for (int k = 0; k < j.dof; ++k) {
+      const auto s = static_cast<std::size_t>(j.state_offset + k);
+      double c = 0.0, width = 0.0;
+      if (j.type == JointType::Revolute) {
+        const double a = j.limits ? (*j.limits)[0] : -3.0, b = j.limits ? (*j.limits)[1] : 3.0;
+        c = a + (b - a) * u(rng);
+        width = (set.min_deg + (set.max_deg - set.min_deg) * u(rng)) * kDeg;
+      } else if (j.type == JointType::Translation3d) {  // the cable robot's workspace
+        const double lo_ws[3] = {1.0, -1.0, 1.2}, hi_ws[3] = {2.2, 1.0, 2.0};
+        c = lo_ws[k] + (hi_ws[k] - lo_ws[k]) * u(rng);
+        width = 0.01 + 0.04 * u(rng);
+      } else if (j.type == JointType::Rotation3d) {
+        c = (u(rng) - 0.5) * 2.0;
+        width = 2.0 * kDeg * u(rng);
+      } else {
+        c = 0.1 * u(rng);
+        width = 0.02 * u(rng);
+      }
+      box.centre[s] = c;
+      box.lower[s] = c - 0.5 * width;
+      box.upper[s] = c + 0.5 * width;
+    }
+  return box;
+}
+
+// `n` boxes whose centre's static clearance (exact distances query) exceeds the margin.
+std::vector<Box> drawBoxes(const Model& exact, const BoxSet& set, int n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  Checker statics(exact);
+  std::vector<Box> out;
+  while (static_cast<int>(out.size()) < n) {
+    for (int tries = 0;; ++tries) {
+      if (tries > 100000) fail("no configuration clear of the margin found for " + exact.name);
+      Box b = randomBox(rng, exact, set);
+      statics.reset();
+      const QueryResult& r = statics.query(b.centre, b.centre, {.type = QueryType::Distances});
+      if (r.status == Status::Ok && r.min_distance > exact.safety_margin) {
+        out.push_back(std::move(b));
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Settings and timed queries
+
+// A copy of `base` with every non-fixed joint swept in `mode` and, when budget > 0, that point budget.
+std::unique_ptr<Model> variant(const Model& base, SweepMode mode, int budget) {
+  auto m = std::make_unique<Model>(base);
+  for (Joint& j : m->joints)
+    if (j.type != JointType::Fixed) j.sweep = mode;
+  if (budget > 0) m->point_budget = budget;
+  return m;
+}
+
+struct Setting {
+  SweepMode mode;
+  int budget;
+  std::unique_ptr<Model> model;
+  std::unique_ptr<Checker> checker;
+};
+
+std::vector<Setting> makeSettings(const Model& base, const std::vector<int>& budgets) {
+  std::vector<Setting> out;
+  for (SweepMode mode : {SweepMode::Fast, SweepMode::Accurate})
+    for (int budget : budgets) {
+      Setting s{mode, budget, variant(base, mode, budget), nullptr};
+      s.checker = std::make_unique<Checker>(*s.model);
+      out.push_back(std::move(s));
+    }
+  return out;
+}
+
+// The cold time of one query (table reset before each run): the fastest of `repeats` runs, in us.
+double coldTime(Checker& checker, const Box& box, bool at_centre, QueryType type, int repeats) {
+  const std::vector<double>& lo = at_centre ? box.centre : box.lower;
+  const std::vector<double>& hi = at_centre ? box.centre : box.upper;
+  double best = kInf;
+  for (int r = 0; r < repeats; ++r) {
+    checker.reset();
+    const auto t0 = Clock::now();
+    const QueryResult& res = checker.query(lo, hi, {.type = type});
+    const double us = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
+    if (res.status != Status::Ok) fail(std::string("unexpected query status ") + toString(res.status));
+    best = std::min(best, us);
+  }
+  return best;
+}
+
+// Every pair's bound of a distances query on `box` (by pair index).
+std::vector<double> distancesBounds(Checker& checker, const Box& box, bool at_centre) {
+  checker.reset();
+  const QueryResult& r = checker.query(at_centre ? box.centre : box.lower, at_centre ? box.centre : box.upper,
+                                       {.type = QueryType::Distances});
+  std::vector<double> out(checker.model().pairs.size(), 0.0);
+  for (const PairDistance& p : r.pairs) out[static_cast<std::size_t>(p.pair)] = p.distance;
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Per box measurements
+
+struct Timing {
+  double distances_us = 0.0, collision_us = 0.0;
+};
+
+struct BoxRecord {
+  std::vector<Timing> times;                 // per setting
+  std::vector<std::vector<double>> bounds;   // per setting, per pair
+  Timing point;                              // exact query at the centre
+  std::vector<double> point_bounds;          // per pair
+  std::vector<double> found;                 // per pair; +inf when not searched (best bound >= kNear)
+  std::vector<double> centre_distance;       // per searched pair: nominal distance at the centre
+  bool within = false;                       // some found distance <= margin
+};
+
+void measureBox(std::vector<Setting>& settings, Checker& exact, const Box& box, int repeats, BoxRecord& rec) {
+  // Settings interleaved per box, so that load on the shared machine hits them alike.
+  for (Setting& s : settings) {
+    Timing t;
+    t.distances_us = coldTime(*s.checker, box, false, QueryType::Distances, repeats);
+    t.collision_us = coldTime(*s.checker, box, false, QueryType::Collision, repeats);
+    rec.times.push_back(t);
+    rec.bounds.push_back(distancesBounds(*s.checker, box, false));
+  }
+  rec.point.distances_us = coldTime(exact, box, true, QueryType::Distances, repeats);
+  rec.point.collision_us = coldTime(exact, box, true, QueryType::Collision, repeats);
+  rec.point_bounds = distancesBounds(exact, box, true);
+}
+
+// Checks of the searches: the two searches against each other (with --oracle both), and every
+// found configuration re-measured by the exact Checker (a proven lower bound there, so it must not
+// exceed the found distance; without joint error bounds the two should agree).
+struct SearchCheck {
+  long pairs = 0, own_lower = 0, library_lower = 0;  // lower by more than 0.1 mm than the other
+  double max_difference_mm = 0.0;
+  long rechecked = 0, exact_above_found = 0;
+  double max_found_minus_exact_mm = 0.0;             // over pairs whose bodies have no error bound
+};
+
+struct Found {
+  double distance = kInf;
+  std::vector<double> state;
+};
+
+// The closest configuration of one pair inside the box by the chosen search(es): the smaller.
+Found closestInBox(const Model& nominal, kccd::bench::BoxSearch& own, const Options& o, int pair, const Box& box,
+                   std::uint64_t seed, SearchCheck& check, long& evaluations) {
+  Found own_found, library_found;
+  if (o.oracle != Oracle::Library) {
+    kccd::bench::BoxSearchOptions opt;
+    opt.samples *= o.search_effort;
+    opt.starts *= o.search_effort;
+    opt.max_evaluations *= o.search_effort;
+    opt.seed = seed;
+    auto r = own.closest(pair, box.lower, box.upper, opt);
+    own_found = {r.distance, std::move(r.state)};
+    evaluations += r.evaluations;
+  }
+  if (o.oracle != Oracle::Own) {
+    kccd::ClosestConfiguration r = kccd::closestConfiguration(nominal, pair, box.lower, box.upper, {.seed = seed});
+    library_found = {r.distance, std::move(r.state)};
+    evaluations += r.evaluations;
+  }
+  if (o.oracle == Oracle::Both) {
+    ++check.pairs;
+    const double diff = 1000.0 * (own_found.distance - library_found.distance);
+    if (diff < -0.1) ++check.own_lower;
+    if (diff > 0.1) ++check.library_lower;
+    check.max_difference_mm = std::max(check.max_difference_mm, std::abs(diff));
+  }
+  return own_found.distance <= library_found.distance ? own_found : library_found;
+}
+
+// The exact Checker's bound for `pair` at one configuration.
+double exactBoundAt(Checker& exact, int pair, const std::vector<double>& state) {
+  exact.reset();
+  const QueryResult& r = exact.query(state, state, {.type = QueryType::Distances});
+  for (const PairDistance& p : r.pairs)
+    if (p.pair == pair) return p.distance;
+  return kInf;
+}
+
+// Searches every pair whose best bound over all settings is below kNear (the others cannot be near).
+void searchBox(const Model& nominal, kccd::bench::BoxSearch& own, Checker& exact, const Options& o, const Box& box,
+               std::uint64_t seed, BoxRecord& rec, SearchCheck& check, long& evaluations) {
+  const std::size_t pairs = nominal.pairs.size();
+  rec.found.assign(pairs, kInf);
+  rec.centre_distance.assign(pairs, kInf);
+  for (std::size_t p = 0; p < pairs; ++p) {
+    double best_bound = kInf;
+    for (const auto& b : rec.bounds) best_bound = std::min(best_bound, b[p]);
+    if (best_bound >= kNear) continue;
+    const int pair = static_cast<int>(p);
+    const Found f = closestInBox(nominal, own, o, pair, box, seed * 1000003 + p, check, evaluations);
+    rec.found[p] = f.distance;
+    rec.centre_distance[p] = own.distanceAt(pair, box.centre);
+    if (f.distance <= nominal.safety_margin) rec.within = true;
+
+    const double at_found = exactBoundAt(exact, pair, f.state);
+    ++check.rechecked;
+    if (at_found > f.distance + 1e-9) ++check.exact_above_found;
+    const BodyPair& bp = nominal.pairs[p];
+    if (!hasErrorBound(nominal, nominal.bodies[static_cast<std::size_t>(bp.a)].frame) &&
+        !hasErrorBound(nominal, nominal.bodies[static_cast<std::size_t>(bp.b)].frame))
+      check.max_found_minus_exact_mm = std::max(check.max_found_minus_exact_mm, 1000.0 * (f.distance - at_found));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Statistics
+
+// Nearest-rank quantile of `v` (sorted here); NaN when empty.
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))];
+}
+
+struct Row {
+  std::string mode;
+  int budget = 0;
+  double distances_us = kNaN, distances_clear_us = kNaN, distances_within_us = kNaN;  // medians
+  double clear_med = kNaN, clear_p90 = kNaN, within_med = kNaN, within_p90 = kNaN;
+  double ratio = kNaN;  // collision on truly clear boxes / point-state collision on the same boxes
+  double loose_med = kNaN, loose_p90 = kNaN;
+  double alarm_boxes_pct = kNaN, alarm_clear_pct = kNaN, alarm_pairs_pct = kNaN;
+  long far_alarms = 0;  // pairs with found >= kNear (not near) whose bound is within the margin
+  long violations = 0;
+};
+
+struct Violation {
+  int box, setting, pair;
+  double bound, found;
+};
+
+struct SetSummary {
+  std::string scene, set;
+  int boxes = 0, clear = 0, within = 0;
+  long near_pairs = 0;
+  std::vector<Row> rows;               // per setting, then the point-state row
+  std::vector<Violation> violations;
+  SearchCheck check;
+  long evaluations = 0;
+  double seconds_queries = 0.0, seconds_search = 0.0;
+};
+
+// Statistics of one setting's bounds and times over all boxes (`point`: the point-state query).
+Row summarise(const std::vector<BoxRecord>& recs, double margin, int setting, bool point,
+              std::vector<Violation>& violations) {
+  std::vector<double> dist_us, dist_clear_us, dist_within_us, clear_us, within_us, point_clear_us, loose;
+  long alarms = 0, clear_boxes = 0, pair_alarms = 0, clear_pairs = 0;
+  Row row;
+  for (std::size_t i = 0; i < recs.size(); ++i) {
+    const BoxRecord& r = recs[i];
+    const Timing& t = point ? r.point : r.times[static_cast<std::size_t>(setting)];
+    const std::vector<double>& bounds = point ? r.point_bounds : r.bounds[static_cast<std::size_t>(setting)];
+    const std::vector<double>& truth = point ? r.centre_distance : r.found;
+    dist_us.push_back(t.distances_us);
+    (r.within ? dist_within_us : dist_clear_us).push_back(t.distances_us);
+    (r.within ? within_us : clear_us).push_back(t.collision_us);
+    if (!r.within) point_clear_us.push_back(r.point.collision_us);
+    bool alarm = false;
+    for (std::size_t p = 0; p < bounds.size(); ++p) {
+      alarm = alarm || bounds[p] <= margin;
+      if (!point && truth[p] > margin) {  // truly clear (never searched: found >= kNear, bound too)
+        ++clear_pairs;
+        pair_alarms += bounds[p] <= margin ? 1 : 0;
+        if (truth[p] >= kNear && bounds[p] <= margin) ++row.far_alarms;
+      }
+      if (!std::isfinite(truth[p])) continue;  // never searched: bound >= kNear in every setting
+      if (bounds[p] > truth[p] + 1e-9) {
+        ++row.violations;
+        violations.push_back({static_cast<int>(i), point ? -1 : setting, static_cast<int>(p), bounds[p], truth[p]});
+      }
+      if (truth[p] < kNear && truth[p] > 0.0) loose.push_back(1000.0 * (truth[p] - bounds[p]));
+    }
+    if (!r.within) {
+      ++clear_boxes;
+      alarms += alarm ? 1 : 0;
+    }
+  }
+  row.distances_us = quantile(dist_us, 0.5);
+  row.distances_clear_us = quantile(dist_clear_us, 0.5);
+  row.distances_within_us = quantile(dist_within_us, 0.5);
+  row.clear_med = quantile(clear_us, 0.5);
+  row.clear_p90 = quantile(clear_us, 0.9);
+  row.within_med = quantile(within_us, 0.5);
+  row.within_p90 = quantile(within_us, 0.9);
+  row.ratio = row.clear_med / quantile(point_clear_us, 0.5);
+  row.loose_med = quantile(loose, 0.5);
+  row.loose_p90 = quantile(loose, 0.9);
+  if (!point) {
+    row.alarm_boxes_pct = 100.0 * static_cast<double>(alarms) / static_cast<double>(recs.size());
+    if (clear_boxes > 0) row.alarm_clear_pct = 100.0 * static_cast<double>(alarms) / static_cast<double>(clear_boxes);
+    if (clear_pairs > 0) row.alarm_pairs_pct = 100.0 * static_cast<double>(pair_alarms) / static_cast<double>(clear_pairs);
+  }
+  return row;
+}
+
+// ---------------------------------------------------------------------------------------------
+// One scene and box set
+
+SetSummary runSet(const std::string& scene, const BoxSet& set, int set_index, const Options& o) {
+  const Model base = loadModel(std::string(KCCD_DATA_DIR) + "/" + scene + ".yaml");
+  const auto exact_model = variant(base, SweepMode::Exact, 0);
+  Checker exact(*exact_model);
+  std::vector<Setting> settings = makeSettings(base, o.budgets);
+  std::uint64_t seed = o.seed * 1000003 + static_cast<std::uint64_t>(set_index);
+  for (char c : scene) seed = seed * 31 + static_cast<unsigned char>(c);  // the same boxes on every platform
+  const std::vector<Box> boxes = drawBoxes(*exact_model, set, o.boxes, seed);
+
+  SetSummary sum;
+  sum.scene = scene;
+  sum.set = set.name;
+  sum.boxes = static_cast<int>(boxes.size());
+  std::vector<BoxRecord> recs(boxes.size());
+  const auto t0 = Clock::now();
+  for (std::size_t i = 0; i < boxes.size(); ++i) measureBox(settings, exact, boxes[i], o.repeats, recs[i]);
+  const auto t1 = Clock::now();
+  kccd::bench::BoxSearch own(base);
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    searchBox(base, own, exact, o, boxes[i], seed + i, recs[i], sum.check, sum.evaluations);
+  sum.seconds_queries = std::chrono::duration<double>(t1 - t0).count();
+  sum.seconds_search = std::chrono::duration<double>(Clock::now() - t1).count();
+
+  for (const BoxRecord& r : recs) {
+    (r.within ? sum.within : sum.clear) += 1;
+    for (double f : r.found) sum.near_pairs += f < kNear ? 1 : 0;
+  }
+  for (std::size_t s = 0; s < settings.size(); ++s) {
+    Row row = summarise(recs, base.safety_margin, static_cast<int>(s), false, sum.violations);
+    row.mode = toString(settings[s].mode);
+    row.budget = settings[s].budget;
+    sum.rows.push_back(row);
+  }
+  Row point = summarise(recs, base.safety_margin, -1, true, sum.violations);
+  point.mode = "point state (centre)";
+  point.budget = base.point_budget;
+  sum.rows.push_back(point);
+  return sum;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Output
+
+std::string num(double v, const char* fmt = "%.1f") {
+  if (!std::isfinite(v)) return "-";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
+// A CSV field: empty when there is no value.
+std::string csvNum(double v, const char* fmt) { return std::isfinite(v) ? num(v, fmt) : std::string(); }
+
+std::string setTitle(const SetSummary& s) {
+  for (const BoxSet& b : kSets)
+    if (s.set == b.name) return s.scene + ", " + b.name + " boxes (revolute widths " + num(b.min_deg, "%g") + "-" +
+                                num(b.max_deg, "%g") + " deg)";
+  return s.scene + ", " + s.set;
+}
+
+std::string markdownTable(const SetSummary& s, double margin) {
+  std::ostringstream md;
+  md << "### " << setTitle(s) << "\n\n"
+     << s.boxes << " boxes: " << s.clear << " truly clear, " << s.within << " within the margin (" << margin
+     << " m); " << s.near_pairs << " near pair-boxes (found < " << kNear << " m). Search: " << s.check.rechecked
+     << " found configurations re-measured by the exact Checker, its bound above the found distance "
+     << s.check.exact_above_found << " times, found - exact bound at most " << num(s.check.max_found_minus_exact_mm, "%.6f")
+     << " mm (pairs without joint error bounds)";
+  if (s.check.pairs > 0)
+    md << "; own search vs kccd::closestConfiguration over " << s.check.pairs << " pairs: own lower by > 0.1 mm "
+       << s.check.own_lower << " times, library lower " << s.check.library_lower << " times, largest difference "
+       << num(s.check.max_difference_mm, "%.3f") << " mm";
+  md << ".\n\n"
+     << "| mode | budget | distances µs | collision µs clear (med / p90) | collision µs within (med / p90) "
+        "| clear / point state | looseness mm (med / p90) | false alarms % boxes (of clear) | false alarms % pairs "
+        "| flagged pairs found >= 0.3 m |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Row& r : s.rows)
+    md << "| " << r.mode << " | " << r.budget << " | " << num(r.distances_us) << " | " << num(r.clear_med) << " / "
+       << num(r.clear_p90) << " | " << num(r.within_med) << " / " << num(r.within_p90) << " | "
+       << num(r.ratio, "%.2f") << " | " << num(r.loose_med) << " / " << num(r.loose_p90) << " | "
+       << num(r.alarm_boxes_pct) << " (" << num(r.alarm_clear_pct) << ") | " << num(r.alarm_pairs_pct, "%.2f") << " | "
+       << (r.mode.rfind("point", 0) == 0 ? std::string("-") : std::to_string(r.far_alarms)) << " |\n";
+  md << "\n";
+  return md.str();
+}
+
+std::string markdownNotes(const Options& o) {
+  std::ostringstream md;
+  md << "Cold queries (table reset before each; the same box repeated, so CPU caches are warm), the fastest of "
+     << o.repeats << " runs per box, median / p90 over the boxes (nearest rank). "
+        "\"clear\"/\"within\": boxes whose closest found configuration is beyond / within the margin. "
+        "\"clear / point state\": median collision query on the truly clear boxes over the median exact "
+        "collision query at the same boxes' centres. Looseness: found distance minus bound over near pairs "
+        "(found < 0.3 m, not touching); for the point-state row, the nominal distance at the centre minus "
+        "the exact bound there (the cost of joint error bounds). False alarms: boxes where some bound is "
+        "within the margin but no found distance is, as % of all boxes (and of the truly clear ones); "
+        "pairs: % of all checked pairs (of all boxes) that are clear of the margin and flagged within it "
+        "(flagged pairs found 0.3 m or farther, left out of the looseness: CSV false_alarm_far_pairs).\n\n";
+  return md.str();
+}
+
+std::string csvText(const std::vector<SetSummary>& sets) {
+  std::ostringstream c;
+  c << "scene,set,mode,budget,boxes,clear_boxes,within_boxes,near_pairs,distances_us_median,"
+       "distances_clear_us_median,distances_within_us_median,"
+       "collision_clear_us_median,collision_clear_us_p90,collision_within_us_median,collision_within_us_p90,"
+       "clear_over_point_state,looseness_mm_median,looseness_mm_p90,false_alarm_boxes_pct,"
+       "false_alarm_clear_boxes_pct,false_alarm_pairs_pct,false_alarm_far_pairs,violations\n";
+  for (const SetSummary& s : sets)
+    for (const Row& r : s.rows)
+      c << s.scene << "," << s.set << "," << (r.mode.rfind("point", 0) == 0 ? "point_state" : r.mode) << ","
+        << r.budget << "," << s.boxes << "," << s.clear << "," << s.within << "," << s.near_pairs << ","
+        << csvNum(r.distances_us, "%.3f") << "," << csvNum(r.distances_clear_us, "%.3f") << ","
+        << csvNum(r.distances_within_us, "%.3f") << "," << csvNum(r.clear_med, "%.3f") << "," << csvNum(r.clear_p90, "%.3f") << ","
+        << csvNum(r.within_med, "%.3f") << "," << csvNum(r.within_p90, "%.3f") << "," << csvNum(r.ratio, "%.4f") << ","
+        << csvNum(r.loose_med, "%.4f") << "," << csvNum(r.loose_p90, "%.4f") << "," << csvNum(r.alarm_boxes_pct, "%.2f")
+        << "," << csvNum(r.alarm_clear_pct, "%.2f") << "," << csvNum(r.alarm_pairs_pct, "%.2f") << ","
+        << (r.mode.rfind("point", 0) == 0 ? std::string() : std::to_string(r.far_alarms)) << "," << r.violations
+        << "\n";
+  return c.str();
+}
+
+void writeFile(const std::string& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary);
+  f << text;
+  f.close();
+  if (!f) {
+    std::fprintf(stderr, "bench_trade: could not write %s\n", path.c_str());
+    std::exit(1);
+  }
+}
+
+void reportViolations(const SetSummary& s, const Model& m) {
+  if (s.violations.empty()) return;
+  std::fprintf(stderr, "\n!!!!!!!! %zu BOUND VIOLATIONS in %s: a bound above a distance found inside the box !!!!!!!!\n",
+               s.violations.size(), setTitle(s).c_str());
+  for (std::size_t i = 0; i < std::min<std::size_t>(20, s.violations.size()); ++i) {
+    const Violation& v = s.violations[i];
+    const BodyPair& p = m.pairs[static_cast<std::size_t>(v.pair)];
+    std::fprintf(stderr, "  box %d setting %s pair %s-%s: bound %.9f m > found %.9f m\n", v.box,
+                 v.setting < 0 ? "point state" : s.rows[static_cast<std::size_t>(v.setting)].mode.c_str(),
+                 m.bodies[static_cast<std::size_t>(p.a)].name.c_str(), m.bodies[static_cast<std::size_t>(p.b)].name.c_str(),
+                 v.bound, v.found);
+  }
+}
+
+#ifdef KCCD_BENCH_WITH_OPENCV
+void writePlot(const std::string& path, const std::vector<SetSummary>& sets, int columns) {
+  std::vector<kccd::bench::TradeCell> cells;
+  for (const SetSummary& s : sets) {
+    kccd::bench::TradeCell cell{setTitle(s) + ", " + std::to_string(s.boxes) + " boxes", {}};
+    for (const Row& r : s.rows) {
+      if (r.mode.rfind("point", 0) == 0) continue;
+      if (cell.series.empty() || cell.series.back().label != r.mode) cell.series.push_back({r.mode, {}});
+      cell.series.back().points.push_back({r.budget, r.distances_us, r.loose_p90, r.alarm_boxes_pct});
+    }
+    cells.push_back(std::move(cell));
+  }
+  std::string error;
+  if (!kccd::bench::writeTradePlot(path, "KCCD sweep modes x point budgets: speed vs looseness and false alarms",
+                                   cells, columns, error)) {
+    std::fprintf(stderr, "bench_trade: %s\n", error.c_str());
+    std::exit(1);
+  }
+}
+#endif
+
+const char* oracleName(Oracle o) {
+  return o == Oracle::Own ? "own box search" : o == Oracle::Library ? "kccd::closestConfiguration" : "both (the smaller)";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) try {
+  const Options o = parseOptions(argc, argv);
+  const auto start = Clock::now();
+  std::vector<SetSummary> sets;
+  std::string md = "## Speed / accuracy trade (bench_trade)\n\n" + markdownNotes(o);
+  std::cout << md << std::flush;
+  long violations = 0, search_faults = 0;
+  for (const std::string& scene : o.scenes) {
+    const Model m = loadModel(std::string(KCCD_DATA_DIR) + "/" + scene + ".yaml");
+    for (int k = 0; k < 2; ++k) {
+      SetSummary s = runSet(scene, kSets[k], k, o);
+      std::fprintf(stderr, "bench_trade: %s: queries %.1f s, search %.1f s (%ld distance evaluations, %s)\n",
+                   setTitle(s).c_str(), s.seconds_queries, s.seconds_search, s.evaluations, oracleName(o.oracle));
+      if (o.oracle == Oracle::Both)
+        std::fprintf(stderr, "bench_trade:   searches compared over %ld pairs: own lower by > 0.1 mm %ld times, "
+                             "library lower %ld times, largest difference %.3f mm\n",
+                     s.check.pairs, s.check.own_lower, s.check.library_lower, s.check.max_difference_mm);
+      std::fprintf(stderr, "bench_trade:   found configurations re-measured by the exact Checker: %ld, its bound above the "
+                           "found distance %ld times; found - exact bound at most %.6f mm (pairs without error bounds)\n",
+                   s.check.rechecked, s.check.exact_above_found, s.check.max_found_minus_exact_mm);
+      search_faults += s.check.exact_above_found;
+      reportViolations(s, m);
+      for (const Row& r : s.rows) violations += r.violations;
+      const std::string table = markdownTable(s, m.safety_margin);
+      std::cout << table << std::flush;
+      md += table;
+      sets.push_back(std::move(s));
+    }
+  }
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const std::string footer = "Search: " + std::string(oracleName(o.oracle)) + ". Violations (bound above a found "
+                             "distance): " + std::to_string(violations) + ". Run time " + num(seconds) + " s.\n";
+  std::cout << footer;
+  md += footer;
+  if (!o.markdown.empty()) writeFile(o.markdown, md);
+  if (!o.csv.empty()) writeFile(o.csv, csvText(sets));
+#ifdef KCCD_BENCH_WITH_OPENCV
+  if (!o.plot.empty()) writePlot(o.plot, sets, 2);
+#endif
+  if (search_faults > 0)
+    std::fprintf(stderr, "\n!!!!!!!! bench_trade: %ld found distances below the exact bound at their own configuration: "
+                         "the search is wrong, the looseness figures are not trustworthy !!!!!!!!\n", search_faults);
+  if (violations > 0) {
+    std::fprintf(stderr, "\n!!!!!!!! bench_trade: %ld BOUND VIOLATIONS (see above) !!!!!!!!\n", violations);
+    return 3;
+  }
+  return search_faults > 0 ? 4 : 0;
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "bench_trade: %s\n", e.what());
+  return 1;
+}
