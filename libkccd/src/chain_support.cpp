@@ -10,13 +10,17 @@ namespace kccd::detail {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Relative tolerance of a support value (times the chain's extent).
+constexpr double kSupportTolerance = 1e-5;
 
 // The chain's sphere below level l (level 0: the body's own).
 const Sphere& sphereBelow(const ChainView& c, int l) { return l == 0 ? c.base : c.levels[static_cast<std::size_t>(l) - 1].core; }
 
 }  // namespace
 
-ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, const Sphere& swept) noexcept {
+ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, const Sphere& swept,
+                      bool below_in_swept, double below_overshoot, const Vec3& below_box_centre,
+                      const Vec3& below_box_half) noexcept {
   ChainLevel out;
   out.maps = &maps;
   out.count = tangent ? maps.count : maps.chord_count;
@@ -30,16 +34,40 @@ ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, 
     out.max_scale = std::max(out.max_scale, maps.scale[v]);
   }
   out.core.center = 0.5 * lo + 0.5 * hi;
+  // The box: images of the box below (centre lin c + off, half-sizes |lin| h), one box around them.
+  Vec3 blo = Vec3::Constant(kInf), bhi = Vec3::Constant(-kInf);
+  for (int v = 0; v < out.count; ++v) {
+    const Vec3 c = maps.lin[v] * below_box_centre + maps.off[v];
+    const Vec3 h = maps.lin[v].cwiseAbs() * below_box_half;
+    blo = blo.cwiseMin(c - h);
+    bhi = bhi.cwiseMax(c + h);
+  }
+  out.box_centre = 0.5 * blo + 0.5 * bhi;
+  const double box_guard = roundingGuard(blo.cwiseAbs().maxCoeff() + bhi.cwiseAbs().maxCoeff() + maps.offset_norm, 32);
+  out.box_half = (0.5 * (bhi - blo)).array() + box_guard;
+  out.has_box = out.box_centre.allFinite() && out.box_half.allFinite();
   double reach = 0.0;
   for (int v = 0; v < out.count; ++v) reach = std::max(reach, (centres[v] - out.core.center).norm() + below.radius * maps.scale[v]);
   const double extent = below.center.norm() + below.radius;  // |x| bound in the joint frame
   out.core.radius = roundedUp(reach, 8) + roundingGuard(extent * out.max_scale + maps.offset_norm, 32);
   // What the cover adds to the radius: the sagitta of the farthest point from the axis (chords of
-  // a revolute joint), the 3-DOF joints' box reach, and rounding of the mapped points.
+  // a revolute joint), the 3-DOF joints' box reach, and rounding of the mapped points. A core set
+  // of chords only lies in the hull of the true swept core, hence in `swept` (the same sphere the
+  // point volumes use); apexes below reach beyond it, and then the core's own sphere counts too.
   const double swept_extent = swept.center.norm() + swept.radius;
-  double growth = maps.fixed_growth + maps.point_growth * std::max(extent, swept_extent);
-  if (maps.revolute && !tangent) growth += maps.sagitta * rhoBound(maps.axis, swept);
+  const double point_extent = below_in_swept ? swept_extent : std::max(extent, swept_extent);
+  double growth = maps.fixed_growth + maps.point_growth * point_extent;
+  if (maps.revolute && !tangent) {
+    const double rho = below_in_swept ? rhoBound(maps.axis, swept)
+                                      : std::max(rhoBound(maps.axis, swept), rhoBound(maps.axis, below));
+    growth += maps.sagitta * rho;
+  }
   out.growth = roundedUp(growth, 8) + roundingGuard(std::max(extent, swept_extent) * out.max_scale + maps.offset_norm, 32);
+  // A map moves a point within e of a true position to within scale * e of the mapped true
+  // position; an apex lies rho (1 / cos - 1) beyond the arc's middle, a true position.
+  double overshoot = below_overshoot * out.max_scale;
+  if (maps.revolute && tangent) overshoot += maps.apex_excess * rhoBound(maps.axis, swept);
+  out.overshoot = overshoot == 0.0 ? 0.0 : roundedUp(overshoot, 8) + roundingGuard(swept_extent, 32);
   return out;
 }
 
@@ -61,7 +89,12 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork work,
   double best = -kInf;
   int best_point = 0;
   double overflow = -kInf;  // largest bound left unexplored when the node limit stops the search
+  double pruned = -kInf;    // largest bound pruned within the tolerance of the best leaf
   int visited = 0;
+  // Branches whose bound exceeds the best leaf by at most this are not explored: near-ties are
+  // common (directions where several maps give almost the same value), and the slack they leave
+  // costs the distance bound at most this much per support.
+  const double tolerance = kSupportTolerance * chainExtent(chain);
 
   auto leaf = [&](const Vec3& row, double offset) {
     int arg = 0;
@@ -90,12 +123,17 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork work,
     auto expand = [&](int level, const Vec3& row, double offset) {
       const ChainLevel& lv = chain.levels[static_cast<std::size_t>(level) - 1];
       const Sphere& s = sphereBelow(chain, level - 1);
+      const ChainLevel* hull = level >= 2 ? &chain.levels[static_cast<std::size_t>(level) - 2] : nullptr;
       const int first = top;
       for (int v = 0; v < lv.count; ++v) {
         ChainEntry e;
         e.row = lv.maps->lin[v].transpose() * row;
         e.offset = offset + row.dot(lv.maps->off[v]);
-        e.bound = e.offset + e.row.dot(s.center) + e.row.norm() * s.radius;
+        const double row_norm = e.row.norm();
+        e.bound = e.offset + e.row.dot(s.center) + row_norm * s.radius;
+        if (hull != nullptr && hull->has_box) {
+          e.bound = std::min(e.bound, e.offset + e.row.dot(hull->box_centre) + e.row.cwiseAbs().dot(hull->box_half));
+        }
         e.level = level;
         e.choice = v;
         int k = top++;
@@ -109,7 +147,10 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork work,
     expand(depth, d, 0.0);
     while (top > 0) {
       const ChainEntry e = stack[--top];
-      if (e.bound <= best) continue;
+      if (e.bound <= best + tolerance) {  // cannot beat the best leaf by more than the tolerance
+        if (e.bound > best) pruned = std::max(pruned, e.bound);
+        continue;
+      }
       if (++visited > max_nodes) {
         overflow = std::max(overflow, e.bound);
         for (int k = 0; k < top; ++k) overflow = std::max(overflow, stack[k].bound);
@@ -140,7 +181,7 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork work,
   // most the chain's extent (grown by the maps' norms).
   const double guard = roundingGuard((chainExtent(chain) + 1e-300) * scale, 16 * (depth + 2));
   const double value = d.dot(x);
-  const double upper = std::max(best, overflow);
+  const double upper = std::max({best, overflow, pruned});
   return SupportHit{x, key, std::max(0.0, upper - value) + guard};
 }
 

@@ -20,12 +20,23 @@ struct ChainLevel {
   double growth = 0.0;
   Sphere core;
   double max_scale = 1.0;  ///< largest operator norm among the maps used
+  /// How far the core set may lie beyond the true swept core (apexes reach past their arcs).
+  double overshoot = 0.0;
+  /// A box around the core set (the images of the box below), often tighter than `core`.
+  bool has_box = false;
+  Vec3 box_centre = Vec3::Zero();
+  Vec3 box_half = Vec3::Zero();
 };
 
 /// The next level of a chain whose core set lies in `below` (the previous level's core sphere),
 /// covering the joint with its chord maps only (`tangent` false) or with chords and apexes.
-/// Growths use `swept`, the swept sphere of the level below (as the point volumes do).
-ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, const Sphere& swept) noexcept;
+/// Growths use `swept`, the swept sphere of the level below (as the point volumes do), which holds
+/// the core set when no level below used apexes (`below_in_swept`); otherwise `below` counts too.
+/// `below_overshoot` is the level below's overshoot (0 for the body itself); the box below holds
+/// the core set below.
+ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, const Sphere& swept,
+                      bool below_in_swept, double below_overshoot, const Vec3& below_box_centre,
+                      const Vec3& below_box_half) noexcept;
 
 /// A body swept through levels[0..n): core points in the body frame, their sphere, the levels
 /// (levels[0] is the joint nearest the body) and the radius of the whole volume.

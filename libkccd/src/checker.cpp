@@ -48,7 +48,16 @@ Checker::Checker(const Model& model) : model_(model) {
     chain_radius_[variant].assign(volumes_.size(), 0.0);
     chain_tangent_[variant].assign(volumes_.size(), 0);
   }
-  for (const Body& body : model.bodies) base_sphere_.push_back(detail::boundingSphere(body.points, 0.0));
+  for (const Body& body : model.bodies) {
+    base_sphere_.push_back(detail::boundingSphere(body.points, 0.0));
+    Vec3 lo = body.points[0], hi = body.points[0];
+    for (const Vec3& p : body.points) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    base_box_.push_back(0.5 * lo + 0.5 * hi);
+    base_box_.push_back(0.5 * (hi - lo) + Vec3::Constant(detail::roundingGuard(lo.cwiseAbs().maxCoeff() + hi.cwiseAbs().maxCoeff(), 4)));
+  }
   chain_stack_.resize(detail::chainStackSize(max_levels));
   chain_choice_.assign(std::max(max_levels, 1), 0);
   chain_best_.assign(std::max(max_levels, 1), 0);
@@ -264,7 +273,12 @@ bool Checker::chain(int body, int level, int variant, Box box, detail::ChainView
       const bool apexes = variant == 1 && model_.joints[joint].sweep == SweepMode::Accurate;
       const Sphere* swept = sphere(body, l - 1, box);
       if (swept == nullptr) return false;
-      levels[idx] = detail::chainLevel(*jointMaps(joint, box), apexes, below, *swept);
+      const bool below_in_swept = l == 1 || chain_tangent_[variant][idx - 1] == 0;
+      const double below_overshoot = l == 1 ? 0.0 : levels[idx - 1].overshoot;
+      const Vec3& box_centre = l == 1 ? base_box_[2 * body] : levels[idx - 1].box_centre;
+      const Vec3& box_half = l == 1 ? base_box_[2 * body + 1] : levels[idx - 1].box_half;
+      levels[idx] = detail::chainLevel(*jointMaps(joint, box), apexes, below, *swept, below_in_swept, below_overshoot,
+                                       box_centre, box_half);
       const double below_radius = l == 1 ? b.radius : chain_radius_[variant][idx - 1];
       chain_radius_[variant][idx] = below_radius + levels[idx].growth;
       chain_tangent_[variant][idx] =
@@ -293,6 +307,11 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
   Entry& e = table_[p];
   const int la = pair_level_[2 * p], lb = pair_level_[2 * p + 1];
   const detail::ChainWork work{chain_stack_.data(), chain_choice_.data(), chain_best_.data()};
+  // Once a chain is proven within the margin it cannot clear the pair: a collision query, and any
+  // query that asks the exact stage for verdicts only (exact_below up to the margin), needs no more.
+  const double stop_below =
+      result_.type == QueryType::Collision || exact_below_ <= result_.margin ? result_.margin : -kInf;
+  double chord_upper = kInf;  // upper bound on the distance of the chord chains' cores
   for (int variant = 0; variant < 2; ++variant) {
     if (bound > stop_above) break;
     detail::ChainView ca, cb;
@@ -300,6 +319,9 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
     if (variant == 1 && (la == 0 || !chain_tangent_[1][level_begin_[pair.a] + la]) &&
         (lb == 0 || !chain_tangent_[1][level_begin_[pair.b] + lb]))
       break;  // no apexes anywhere: the same chains as variant 0
+    // The apex chains hold the chord chains' cores (chord ends are among their maps) with smaller
+    // radii: when the chord cores are proven close enough, the apex chains are within the margin too.
+    if (variant == 1 && chord_upper - ca.radius - cb.radius <= stop_below) break;
     detail::SetsInfo info;
     info.scale_a = detail::chainExtent(ca);
     info.scale_b = detail::chainExtent(cb);
@@ -309,12 +331,14 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
     auto support_b = [&](const Vec3& dir) { return detail::chainSupport(cb, dir, work, kExactNodes); };
     GjkOptions opt;
     opt.stop_above = stop_above;
+    opt.stop_below = stop_below;
     opt.warm_start = &e.direction;
     opt.max_iterations = 64;
     opt.relative_tolerance = 1e-9;
     const DistanceResult d = detail::gjkDistance(support_a, support_b, ca.radius, cb.radius, info, opt);
     ++result_.stats.exact_calls;
     if (d.status == GjkStatus::InvalidInput || !std::isfinite(d.distance)) return false;
+    if (variant == 0) chord_upper = d.hull_upper;
     if (d.distance > bound) {
       bound = d.distance;
       e.witness_a = d.witness_a;

@@ -219,6 +219,11 @@ DistanceResult gjkDistance(const SupportA& sa, const SupportB& sb, double ra, do
   } else {
     for (; iter < options.max_iterations; ++iter) {
       const double vv = v.squaredNorm();
+      // v is a point of the difference of the supports' hulls: |v| bounds the distance from above.
+      if (s.size > 0 && std::sqrt(vv) - radii + guard <= options.stop_below) {
+        status = GjkStatus::StoppedEarly;
+        break;
+      }
       const SupportHit ha = sa(-v);
       const SupportHit hb = sb(v);
       const Vec3 w = ha.point - hb.point;
@@ -228,6 +233,7 @@ DistanceResult gjkDistance(const SupportA& sa, const SupportB& sb, double ra, do
         status = GjkStatus::StoppedEarly;
         break;
       }
+
       if (s.size > 0 && vv - vw <= tol * vv) {
         status = GjkStatus::Converged;
         break;

@@ -379,6 +379,7 @@ JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi) noex
         add(rotation(std::cos(mid) / half_cos, std::sin(mid) / half_cos), t, apex_scale);
       }
       m.sagitta = roundedUp(1.0 - half_cos, 8) + 8.0 * kEps;
+      m.apex_excess = roundedUp(apex_scale - 1.0, 8) + 8.0 * kEps;
       return m;
     }
     case JointType::Prismatic:

@@ -43,6 +43,7 @@ struct JointMaps {
   bool revolute = false;     ///< a revolute interval of non-zero width (sagitta applies)
   Vec3 axis = Vec3::UnitZ();
   double sagitta = 0.0;
+  double apex_excess = 0.0;  ///< an apex lies at most this times rho beyond its arc (1 / cos - 1)
   double fixed_growth = 0.0;
   double point_growth = 0.0;
   double offset_norm = 0.0;  ///< bound on |off|

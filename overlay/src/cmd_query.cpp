@@ -1,6 +1,8 @@
 // `kccd query MODEL --lower .. --upper ..`: one conservative query over an interval box.
+#include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 
 #include "cli_args.hpp"
@@ -20,9 +22,24 @@ struct QueryArgs {
   int n = 1;
   double margin = -1.0;
   double budget_us = 0.0;
+  std::string exact = "margin";
   bool json = false;
   bool explain = false;
 };
+
+// --exact: which pairs the exact stage refines (QueryOptions::exact_below).
+double parseExact(const std::string& e) {
+  if (e == "margin") return -1.0;
+  if (e == "all") return std::numeric_limits<double>::infinity();
+  if (e == "off") return -std::numeric_limits<double>::infinity();
+  try {
+    std::size_t used = 0;
+    const double d = std::stod(e, &used);
+    if (used == e.size() && std::isfinite(d) && d >= 0.0 && d <= kMaxModelLength) return d;
+  } catch (const std::exception&) {
+  }
+  throw UsageError("--exact: expected margin, all, off or a distance from 0 to 1e6 m, got '" + printable(e) + "'");
+}
 
 QueryType parseType(const std::string& t) {
   if (t == "collision") return QueryType::Collision;
@@ -84,6 +101,7 @@ Exit runQuery(const QueryArgs& args) {
   opt.n = args.n;
   opt.margin = args.margin;
   opt.budget_us = args.budget_us;
+  opt.exact_below = parseExact(args.exact);
   const QueryResult& r = checker.query(lower, upper, opt);
   const bool explain = args.explain && r.status == Status::Ok;
   const std::vector<PairExplanation> explained =
@@ -108,7 +126,8 @@ Exit runQuery(const QueryArgs& args) {
       j["pairs"].push_back(o);
     }
     j["stats"] = {{"time_us", r.stats.time_us}, {"pairs_checked", r.stats.pairs_checked},
-                  {"gjk_calls", r.stats.gjk_calls}, {"volumes_swept", r.stats.volumes_swept},
+                  {"gjk_calls", r.stats.gjk_calls}, {"exact_calls", r.stats.exact_calls},
+                  {"volumes_swept", r.stats.volumes_swept},
                   {"budget_exhausted", r.stats.budget_exhausted}};
     if (explain) j["explain"] = explainJson(m, explained);
     std::cout << j.dump(2) << "\n";
@@ -124,7 +143,8 @@ Exit runQuery(const QueryArgs& args) {
                 << "\n";
     }
     std::cout << "time " << r.stats.time_us << " us, " << r.stats.pairs_checked << " pairs checked, "
-              << r.stats.gjk_calls << " GJK calls" << (r.stats.budget_exhausted ? ", budget exhausted" : "") << "\n";
+              << r.stats.gjk_calls << " GJK calls, " << r.stats.exact_calls << " exact-stage calls"
+              << (r.stats.budget_exhausted ? ", budget exhausted" : "") << "\n";
     if (explain) printExplain(m, explained, r.margin);
   }
   if (r.status != Status::Ok) {
@@ -152,6 +172,11 @@ Runner addQuery(CLI::App& app) {
       ->check(finiteIn(0.0, kMaxModelLength));
   sub->add_option("--budget-us", args->budget_us, "Time budget in microseconds (default: unlimited)")
       ->check(finiteIn(0.0, kMaxBudgetUs));
+  sub->add_option("--exact", args->exact,
+                  "Which pairs the exact stage refines (swept volumes with no point budget, tight, slower): "
+                  "margin (every pair whose bound is within the margin: decides every verdict), all (every pair: "
+                  "tight distances), off (point volumes only), or a distance in metres")
+      ->capture_default_str();
   sub->add_flag("--json", args->json, "Machine-readable output");
   sub->add_flag("--explain", args->explain,
                 "For every pair whose bound is <= the margin, search the box for its closest configuration and "

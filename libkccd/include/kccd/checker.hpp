@@ -126,6 +126,7 @@ class Checker {
   std::vector<double> chain_radius_[2];      // per body and level: radius of the chain up to it
   std::vector<std::uint8_t> chain_tangent_[2];  // per body and level: some level uses apexes
   std::vector<Sphere> base_sphere_;          // per body: sphere around its core points
+  std::vector<Vec3> base_box_;               // per body: centre and half-sizes of their box
   std::vector<detail::ChainEntry> chain_stack_;
   std::vector<int> chain_choice_, chain_best_;
   double exact_below_ = 0.0;

@@ -12,7 +12,7 @@ namespace kccd {
 enum class GjkStatus : std::uint8_t {
   Converged,       ///< lower and upper bound agree to the requested tolerance
   Overlap,         ///< the hulls intersect (distance 0)
-  StoppedEarly,    ///< the lower bound reached `GjkOptions::stop_above`
+  StoppedEarly,    ///< the lower bound reached `stop_above`, or the upper bound `stop_below`
   NoProgress,      ///< rounding stopped the descent; the bounds are valid but may be looser
   IterationLimit,  ///< `GjkOptions::max_iterations` reached; the bounds are valid
   InvalidInput,    ///< empty set, NaN/inf coordinate or negative radius: distance reported as 0
@@ -24,6 +24,9 @@ struct GjkOptions {
   double relative_tolerance = 1e-12;  ///< stop when (upper - lower) <= tol * upper
   /// Stop as soon as the SSCH distance is proven to be >= this (e.g. the safety margin).
   double stop_above = std::numeric_limits<double>::infinity();
+  /// Stop as soon as the volumes are proven to come within this distance of each other (two
+  /// points of them are): refining the lower bound further cannot lift it above this.
+  double stop_below = -std::numeric_limits<double>::infinity();
   /// Optional warm start: a separating direction (pointing from b to a), e.g. from the last cycle.
   const Vec3* warm_start = nullptr;
 };
