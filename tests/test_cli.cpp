@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -62,6 +63,39 @@ TEST(Cli, QueryJsonContract) {
   EXPECT_DOUBLE_EQ(j["min_distance"].get<double>(), min_d);
   EXPECT_EQ(j["collision"].get<bool>(), min_d <= j["margin"].get<double>());
   for (const char* key : {"time_us", "pairs_checked", "gjk_calls"}) EXPECT_TRUE(j["stats"][key].is_number()) << key;
+}
+
+TEST(Cli, QueryExactStageChoices) {
+  // A wide swing of the demo arm: the exact stage tightens every pair it refines, never loosens.
+  const std::string box = "query " + kDemo + " --lower -0.6,0.1,0.2 --upper 0.6,0.5,0.8 --type distances --json";
+  std::map<std::string, nlohmann::json> runs;
+  for (const char* exact : {"off", "margin", "all", "0.25"}) {
+    const Outcome r = runKccd(box + " --exact " + exact);
+    ASSERT_EQ(r.code, 0) << exact << ": " << r.err;
+    runs[exact] = nlohmann::json::parse(r.out);
+  }
+  EXPECT_EQ(runs["off"]["stats"]["exact_calls"], 0);
+  EXPECT_GT(runs["all"]["stats"]["exact_calls"].get<int>(), runs["off"]["stats"]["exact_calls"].get<int>());
+  ASSERT_EQ(runs["off"]["pairs"].size(), runs["all"]["pairs"].size());
+  int tighter = 0;
+  for (std::size_t k = 0; k < runs["off"]["pairs"].size(); ++k) {
+    const double off = runs["off"]["pairs"][k]["distance"], all = runs["all"]["pairs"][k]["distance"];
+    const double margin = runs["margin"]["pairs"][k]["distance"], quarter = runs["0.25"]["pairs"][k]["distance"];
+    EXPECT_GE(all, off);
+    EXPECT_GE(margin, off);
+    EXPECT_GE(quarter, margin - 1e-12);
+    tighter += all > off + 1e-6;
+  }
+  EXPECT_GT(tighter, 0);
+  // The default is the margin.
+  const auto plain = nlohmann::json::parse(runKccd(box).out);
+  EXPECT_EQ(plain["pairs"], runs["margin"]["pairs"]);
+  for (const char* bad : {"sometimes", "-1", "nan", "2e6"}) {
+    const Outcome r = runKccd(box + " --exact " + bad, true);
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_NE(r.out.find("--exact: expected margin, all, off or a distance"), std::string::npos) << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+  }
 }
 
 TEST(Cli, QueryTypesAndState) {

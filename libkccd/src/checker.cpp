@@ -19,7 +19,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Nodes one support search of the exact stage may visit (bounds its time; a search stopped early
 // still gives a valid bound).
-constexpr int kExactNodes = 4096;
+constexpr int kExactNodes = 2048;
 using Clock = std::chrono::steady_clock;
 using detail::shrunkBound;
 

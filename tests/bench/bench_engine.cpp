@@ -1,7 +1,7 @@
 // Engine benchmarks on the sample robots with typical braking intervals (2-20 degrees per joint):
 // - time per query type and sweep mode (cold: no reuse; warm: a moving robot reusing its table),
 //   median and 99.9th percentile of single queries;
-// - accuracy of each sweep mode: how far the bound lies below the sampled true minimum;
+// (the accuracy of each sweep mode and budget, against searched true minima: bench_trade);
 // - side by side: FCL checking the same volumes at 10 configurations sampled along the interval
 //   (what users do today), its time and the collisions it misses.
 #include <benchmark/benchmark.h>
@@ -178,39 +178,6 @@ std::vector<double> sampledMinimum(const Model& exact_model, const std::vector<d
   return best;
 }
 
-// Accuracy of a sweep mode: bound vs sampled true minimum, in mm (one pass, counters only).
-void BM_Accuracy(benchmark::State& state) {
-  const int scene = static_cast<int>(state.range(0));
-  const auto mode = static_cast<SweepMode>(state.range(1));
-  const auto model = sceneModel(scene, mode);
-  const auto exact_model = sceneModel(scene, SweepMode::Exact);
-  const Boxes& bx = boxes(scene, false, false);
-  std::vector<double> gaps;
-  long violations = 0;
-  for (auto _ : state) {
-    std::mt19937_64 rng(7);
-    gaps.clear();
-    for (int i = 0; i < 24; ++i) {
-      Checker checker(*model);
-      QueryOptions opt;
-      opt.type = QueryType::Distances;
-      const QueryResult& r = checker.query(bx.lower[i], bx.upper[i], opt);
-      const std::vector<double> truth = sampledMinimum(*exact_model, bx.lower[i], bx.upper[i], 400, rng);
-      for (const PairDistance& pd : r.pairs) {
-        if (truth[pd.pair] <= 0.0) continue;  // touching somewhere: any bound is 0 there
-        gaps.push_back(1000.0 * (truth[pd.pair] - pd.distance));
-        if (pd.distance > truth[pd.pair] + 1e-9) ++violations;
-      }
-    }
-  }
-  std::sort(gaps.begin(), gaps.end());
-  state.counters["gap_median_mm"] = gaps[gaps.size() / 2];
-  state.counters["gap_p90_mm"] = gaps[static_cast<std::size_t>(0.9 * gaps.size())];
-  state.counters["gap_max_mm"] = gaps.back();
-  state.counters["violations"] = static_cast<double>(violations);
-  state.SetLabel(std::string(kScenes[scene]) + " " + toString(mode));
-}
-
 #ifdef KCCD_BENCH_WITH_FCL
 // FCL on the same volumes: hull distance minus both radii at 10 configurations evenly spaced
 // from the lower to the upper end of the box, stopping at the first pair within the margin.
@@ -340,7 +307,6 @@ void QueryArgs(benchmark::internal::Benchmark* b) {
 }  // namespace
 
 BENCHMARK(BM_Query)->Apply(QueryArgs)->UseManualTime()->MinTime(0.3);
-BENCHMARK(BM_Accuracy)->ArgsProduct({{0, 1}, {1, 2}})->ArgNames({"scene", "mode"})->Iterations(1);
 #ifdef KCCD_BENCH_WITH_FCL
 BENCHMARK(BM_FclSampled10)->Arg(0)->Arg(1)->ArgName("scene")->UseManualTime()->MinTime(0.3);
 BENCHMARK(BM_MissedCollisions)->Arg(0)->Arg(1)->ArgName("scene")->Iterations(1);

@@ -30,6 +30,7 @@
 //
 // Usage: bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]
 //                    [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]
+//                    [--exact margin|all|off]
 //                    [--markdown F] [--csv F] [--plot F.png]
 // Exit status: 0 done, 1 error, 2 bad option, 3 a bound violation, 4 a found distance below the
 // exact bound at its own configuration (a wrong search).
@@ -78,8 +79,12 @@ struct Options {
   std::uint64_t seed = 1;
   int search_effort = 1;  // multiplies the own search's samples, starts and steps
   Oracle oracle = Oracle::Both;
+  double exact_below = -1.0;  // QueryOptions::exact_below of the measured queries
   std::string markdown, csv, plot;
 };
+
+// The measured queries' exact stage (--exact), the same for every setting.
+double g_exact_below = -1.0;
 
 [[noreturn]] void usageError(const std::string& message) {
   std::fprintf(stderr, "bench_trade: %s\n", message.c_str());
@@ -115,7 +120,7 @@ Options parseOptions(int argc, char** argv) {
     if (a == "--help") {
       std::printf("bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]\n"
                   "            [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]\n"
-                  "            [--markdown F] [--csv F] [--plot F.png]\n");
+                  "            [--exact margin|all|off] [--markdown F] [--csv F] [--plot F.png]\n");
       std::exit(0);
     }
     if (a == "--quick") {
@@ -147,6 +152,13 @@ Options parseOptions(int argc, char** argv) {
       else if (v == "both") o.oracle = Oracle::Both;
       else {
         usageError("--oracle: expected own, library or both, got '" + v + "'");
+      }
+    } else if (a == "--exact") {
+      if (v == "margin") o.exact_below = -1.0;
+      else if (v == "all") o.exact_below = kInf;
+      else if (v == "off") o.exact_below = -kInf;
+      else {
+        usageError("--exact: expected margin, all or off, got '" + v + "'");
       }
     } else if (a == "--markdown") {
       o.markdown = v;
@@ -269,7 +281,7 @@ double coldTime(Checker& checker, const Box& box, bool at_centre, QueryType type
   for (int r = 0; r < repeats; ++r) {
     checker.reset();
     const auto t0 = Clock::now();
-    const QueryResult& res = checker.query(lo, hi, {.type = type});
+    const QueryResult& res = checker.query(lo, hi, {.type = type, .exact_below = g_exact_below});
     const double us = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
     if (res.status != Status::Ok) fail(std::string("unexpected query status ") + toString(res.status));
     best = std::min(best, us);
@@ -281,7 +293,7 @@ double coldTime(Checker& checker, const Box& box, bool at_centre, QueryType type
 std::vector<double> distancesBounds(Checker& checker, const Box& box, bool at_centre) {
   checker.reset();
   const QueryResult& r = checker.query(at_centre ? box.centre : box.lower, at_centre ? box.centre : box.upper,
-                                       {.type = QueryType::Distances});
+                                       {.type = QueryType::Distances, .exact_below = g_exact_below});
   std::vector<double> out(checker.model().pairs.size(), 0.0);
   for (const PairDistance& p : r.pairs) out[static_cast<std::size_t>(p.pair)] = p.distance;
   return out;
@@ -580,7 +592,9 @@ std::string markdownTable(const SetSummary& s, double margin) {
 
 std::string markdownNotes(const Options& o) {
   std::ostringstream md;
-  md << "Cold queries (table reset before each; the same box repeated, so CPU caches are warm), the fastest of "
+  md << "Exact stage: "
+     << (o.exact_below == kInf ? "every pair (--exact all)" : o.exact_below == -kInf ? "off (--exact off)" : "pairs within the margin (--exact margin, the default)")
+     << ". Cold queries (table reset before each; the same box repeated, so CPU caches are warm), the fastest of "
      << o.repeats << " runs per box, median / p90 over the boxes (nearest rank). "
         "\"clear\"/\"within\": boxes whose closest found configuration is beyond / within the margin. "
         "\"clear / point state\": median collision query on the truly clear boxes over the median exact "
@@ -667,6 +681,7 @@ const char* oracleName(Oracle o) {
 
 int main(int argc, char** argv) try {
   const Options o = parseOptions(argc, argv);
+  g_exact_below = o.exact_below;
   const auto start = Clock::now();
   std::vector<SetSummary> sets;
   std::string md = "## Speed / accuracy trade (bench_trade)\n\n" + markdownNotes(o);

@@ -56,17 +56,6 @@ def engine_tables(rows):
                     cells.append(f"{r['p50_us']:.1f} / {r['p99.9_us']:.1f}" if r else "-")
             out.append(f"| {mode} | " + " | ".join(cells) + " |")
         out.append("")
-    acc = [r for r in rows if r["name"].startswith("BM_Accuracy")]
-    if acc:
-        out.append("Accuracy: how far the bound lies below the smallest distance found by 400 exact samples "
-                   "of the box (corners and interior), over all pairs that never touch in the samples, 24 boxes.\n")
-        out.append("| scene | sweep mode | median (mm) | 90th percentile (mm) | max (mm) | bound above a sample |")
-        out.append("|---|---|---|---|---|---|")
-        for r in acc:
-            m = re.match(r"BM_Accuracy/scene:(\d)/mode:(\d)", r["name"])
-            out.append(f"| {scenes[int(m.group(1))]} | {modes[int(m.group(2))]} | {r['gap_median_mm']:.1f} | "
-                       f"{r['gap_p90_mm']:.1f} | {r['gap_max_mm']:.1f} | {int(r['violations'])} |")
-        out.append("")
     fcl = {int(re.search(r"scene:(\d)", r["name"]).group(1)): r for r in rows if r["name"].startswith("BM_FclSampled10")}
     miss = {int(re.search(r"scene:(\d)", r["name"]).group(1)): r for r in rows if r["name"].startswith("BM_MissedCollisions")}
     if fcl:
