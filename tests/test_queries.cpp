@@ -141,7 +141,9 @@ TEST(Queries, KnobsAreMonotone) {
         const QueryResult& ra = ca.query(lower, upper, o);
         ASSERT_EQ(rf.status, Status::Ok);
         ASSERT_EQ(ra.status, Status::Ok);
-        if (!rf.collision) EXPECT_FALSE(ra.collision) << "case " << i;
+        if (!rf.collision) {
+          EXPECT_FALSE(ra.collision) << "case " << i;
+        }
         if (t == 3) {
           ASSERT_EQ(rf.pairs.size(), ra.pairs.size());
           for (std::size_t k = 0; k < rf.pairs.size(); ++k) {
@@ -160,7 +162,9 @@ TEST(Queries, KnobsAreMonotone) {
           Checker c(mb);
           const QueryResult& r = c.query(lower, upper, o);
           ASSERT_EQ(r.status, Status::Ok);
-          if (previous_clear) EXPECT_FALSE(r.collision) << "case " << i << " budget " << budget;
+          if (previous_clear) {
+            EXPECT_FALSE(r.collision) << "case " << i << " budget " << budget;
+          }
           previous_clear = !r.collision;
           if (t != 3) continue;
           std::vector<double> d;
@@ -169,7 +173,9 @@ TEST(Queries, KnobsAreMonotone) {
             ++budget_checks;
             if (exact_below < 0.0) {
               // Verdicts only: a pair the bigger budget puts within the margin, the smaller one does too.
-              if (d[k] <= margin) EXPECT_LE(previous[k], margin) << "case " << i << " budget " << budget;
+              if (d[k] <= margin) {
+                EXPECT_LE(previous[k], margin) << "case " << i << " budget " << budget;
+              }
             } else {
               // Every pair refined: the same bound whatever the budget (up to the search tolerance).
               EXPECT_GE(d[k], previous[k] - 1e-6 * (1.0 + previous[k])) << "case " << i << " budget " << budget;
