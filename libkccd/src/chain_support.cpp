@@ -78,7 +78,7 @@ double chainExtent(const ChainView& chain) noexcept {
   return top.center.norm() + top.radius;
 }
 
-SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork work, int max_nodes, long* nodes) noexcept {
+SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work, int max_nodes, long* nodes) noexcept {
   const int depth = static_cast<int>(chain.levels.size());
   const double dn = dir.norm();
   const Vec3 d = dn > 0.0 ? Vec3(dir / dn) : Vec3::UnitX();
@@ -116,6 +116,18 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork work,
   if (depth == 0) {
     leaf(d, 0.0);
   } else {
+    if (work.warm) {  // the last best leaf first: its value prunes most of the tree at once
+      Vec3 row = d;
+      double offset = 0.0;
+      for (int level = depth; level >= 1; --level) {
+        const ChainLevel& lv = chain.levels[static_cast<std::size_t>(level) - 1];
+        const int v = std::clamp(work.best_choice[level - 1], 0, lv.count - 1);
+        work.choice[level - 1] = v;
+        offset += row.dot(lv.maps->off[v]);
+        row = lv.maps->lin[v].transpose() * row;
+      }
+      leaf(row, offset);
+    }
     ChainEntry* stack = work.stack;
     int top = 0;
     // Pushes the children of a node at `level` (maps of that level still to choose) in ascending
@@ -165,6 +177,7 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork work,
     }
   }
   if (nodes != nullptr) *nodes += visited;
+  work.warm = true;
 
   // The point: the body point mapped up through the chosen maps.
   Vec3 x = pts[static_cast<std::size_t>(best_point)];

@@ -58,15 +58,18 @@ struct ChainEntry {
 struct ChainWork {
   ChainEntry* stack;
   int* choice;
-  int* best_choice;
+  int* best_choice;  ///< the best leaf's map per level, kept for the next call
+  bool warm = false; ///< best_choice holds a leaf of this chain: start from it
 };
 int chainStackSize(int levels) noexcept;
 
 /// The support of the chain's core set in direction `dir` (any length): the best point found and
 /// the slack by which the true support value may exceed its value along dir / |dir| (0 when the
 /// search completed, up to rounding). The search stops after `max_nodes` nodes with a valid slack.
-/// `nodes` (if not null) accumulates the nodes visited.
-SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork work, int max_nodes,
+/// A warm `work` starts from its last best leaf (successive GJK directions differ little), which
+/// prunes most of the tree at once; `work` is left warm. `nodes` (if not null) accumulates the
+/// nodes visited.
+SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work, int max_nodes,
                         long* nodes = nullptr) noexcept;
 
 /// A bound on |x| for every core point x of the chain (for rounding guards).

@@ -60,7 +60,7 @@ Checker::Checker(const Model& model) : model_(model) {
   }
   chain_stack_.resize(detail::chainStackSize(max_levels));
   chain_choice_.assign(std::max(max_levels, 1), 0);
-  chain_best_.assign(std::max(max_levels, 1), 0);
+  chain_best_.assign(2 * static_cast<std::size_t>(std::max(max_levels, 1)), 0);
 }
 
 Checker::~Checker() = default;
@@ -306,7 +306,7 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
   const BodyPair& pair = model_.pairs[p];
   Entry& e = table_[p];
   const int la = pair_level_[2 * p], lb = pair_level_[2 * p + 1];
-  const detail::ChainWork work{chain_stack_.data(), chain_choice_.data(), chain_best_.data()};
+  const int max_levels = static_cast<int>(chain_choice_.size());
   // Once a chain is proven within the margin it cannot clear the pair: a collision query, and any
   // query that asks the exact stage for verdicts only (exact_below up to the margin), needs no more.
   const double stop_below =
@@ -327,8 +327,11 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
     info.scale_b = detail::chainExtent(cb);
     info.start_a = ca.levels.empty() ? ca.base.center : ca.levels.back().core.center;
     info.start_b = cb.levels.empty() ? cb.base.center : cb.levels.back().core.center;
-    auto support_a = [&](const Vec3& dir) { return detail::chainSupport(ca, dir, work, kExactNodes); };
-    auto support_b = [&](const Vec3& dir) { return detail::chainSupport(cb, dir, work, kExactNodes); };
+    // One work area per side (each keeps its chain's last best leaf); the stack is shared.
+    detail::ChainWork work_a{chain_stack_.data(), chain_choice_.data(), chain_best_.data()};
+    detail::ChainWork work_b{chain_stack_.data(), chain_choice_.data(), chain_best_.data() + max_levels};
+    auto support_a = [&](const Vec3& dir) { return detail::chainSupport(ca, dir, work_a, kExactNodes); };
+    auto support_b = [&](const Vec3& dir) { return detail::chainSupport(cb, dir, work_b, kExactNodes); };
     GjkOptions opt;
     opt.stop_above = stop_above;
     opt.stop_below = stop_below;
