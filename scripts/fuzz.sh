@@ -20,7 +20,7 @@ while [ $# -gt 0 ]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_model fuzz_states fuzz_camera fuzz_tags fuzz_labels fuzz_frame fuzz_part fuzz_urdf)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_model fuzz_states fuzz_frame_times fuzz_camera fuzz_tags fuzz_labels fuzz_frame fuzz_part fuzz_urdf)
 bash scripts/install-deps.sh --fuzz
 CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DKCCD_BUILD_FUZZERS=ON -DKCCD_BUILD_TESTS=OFF -DKCCD_BUILD_BENCHMARKS=OFF >/dev/null
@@ -30,6 +30,7 @@ ci_runs() {  # inputs per target in --ci mode (about 15 s each on this project's
   case "$1" in
     fuzz_model) echo 30000 ;;
     fuzz_states) echo 180000 ;;
+    fuzz_frame_times) echo 200000 ;;
     fuzz_frame) echo 3000 ;;
     fuzz_camera) echo 200000 ;;
     fuzz_tags) echo 140000 ;;
@@ -43,6 +44,7 @@ seeds() {  # extra seed files from data/ per target
   case "$1" in
     fuzz_model) ls data/*.yaml | grep -v camera ;;
     fuzz_states) ;;
+    fuzz_frame_times) ;;
     fuzz_camera) ls data/*camera*.yaml ;;
     fuzz_tags) ;;
     fuzz_labels) ;;
@@ -61,7 +63,7 @@ for t in "${targets[@]}"; do
   # Leaks: checked for the model loader and the state log reader (our code only); the readers
   # built on Coin3D, OpenCV and urdfdom keep per-process caches the leak checker would report on
   # every input (the ASan test suite checks our own code on those paths, with tests/lsan.supp).
-  leaks=0; case "$t" in fuzz_model|fuzz_states) leaks=1 ;; esac
+  leaks=0; case "$t" in fuzz_model|fuzz_states|fuzz_frame_times) leaks=1 ;; esac
   limits=(-max_total_time="$seconds")
   if [ $ci -eq 1 ]; then
     limits+=(-seed=1 -runs="$(ci_runs "$t")")

@@ -40,6 +40,7 @@
 #include "commands.hpp"
 #include "kccd/braking.hpp"
 #include "kccd/checker.hpp"
+#include "kccd/frame_times.hpp"
 #include "kccd/render/composite.hpp"
 #include "kccd/render/renderer.hpp"
 #include "kccd/render/scene.hpp"
@@ -105,59 +106,13 @@ FrameSelection parseFrames(const std::string& text) {
   return s;
 }
 
-// `--frame-times FILE`: CSV with the header `frame,time`, one row per frame from frame 0 in order,
-// times increasing. Returns the time per frame number. Every decoded frame needs its time, so a
-// missing row is an error at once (naming the line), and memory stays bounded by the file's size.
-std::vector<double> loadFrameTimes(const std::string& path) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) throw UsageError("--frame-times " + path + ": no such file");
-  if (!fs::is_regular_file(st)) throw UsageError("--frame-times " + path + ": not a regular file");
-  if (fs::file_size(path, ec) > (std::uintmax_t{1} << 30)) throw UsageError("--frame-times " + path + ": larger than 1 GiB");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw UsageError("--frame-times " + path + ": cannot read the file");
-  std::vector<double> times;
-  std::string line;
-  long line_no = 0, last_frame = -1;
-  double last_time = -std::numeric_limits<double>::infinity();
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line_no == 1) {
-      if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
-      if (line != "frame,time")
-        throw UsageError(path + ":1:1: the header must be 'frame,time' (found '" + oneLine(line) + "')");
-      continue;
-    }
-    if (line.empty()) {
-      if (in.peek() == std::char_traits<char>::eof()) break;
-      throw UsageError(path + ":" + std::to_string(line_no) + ":1: empty line");
-    }
-    const std::size_t comma = line.find(',');
-    const std::string where = path + ":" + std::to_string(line_no) + ":";
-    if (comma == std::string::npos || line.find(',', comma + 1) != std::string::npos)
-      throw UsageError(where + "1: expected two fields: frame,time");
-    const std::string f = line.substr(0, comma), t = line.substr(comma + 1);
-    if (f.empty() || f.size() > 12 || f.find_first_not_of("0123456789") != std::string::npos)
-      throw UsageError(where + "1: column 'frame': not a frame number: '" + oneLine(f) + "'");
-    const long frame = std::stol(f);
-    char* end = nullptr;
-    const double time = std::strtod(t.c_str(), &end);
-    const std::string tcol = std::to_string(comma + 2);
-    if (t.empty() || end != t.c_str() + t.size() || !std::isfinite(time) || std::fabs(time) > 1e300)
-      throw UsageError(where + tcol + ": column 'time': not a finite number: '" + oneLine(t) + "'");
-    if (frame != last_frame + 1)
-      throw UsageError(where + "1: column 'frame': expected frame " + std::to_string(last_frame + 1) + ", found " +
-                       std::to_string(frame) + " (one row per frame, from 0, in order)");
-    if (!(time > last_time)) throw UsageError(where + tcol + ": column 'time': times must increase strictly");
-    last_frame = frame;
-    last_time = time;
-    if (frame > 100000000) throw UsageError(where + "1: column 'frame': frame number too large");
-    times.resize(static_cast<std::size_t>(frame) + 1, std::numeric_limits<double>::quiet_NaN());
-    times[static_cast<std::size_t>(frame)] = time;
+// `--frame-times FILE` (kccd/frame_times.hpp), its mistakes named as the option's.
+std::vector<double> frameTimes(const std::string& path) {
+  try {
+    return loadFrameTimes(path);
+  } catch (const FrameTimesError& e) {
+    throw UsageError(std::string("--frame-times ") + e.what());
   }
-  if (times.empty()) throw UsageError("--frame-times " + path + ": no rows");
-  return times;
 }
 
 std::vector<std::string> splitCommas(const std::string& text) {
@@ -582,7 +537,7 @@ Exit runOverlay(OverlayArgs& a) {
   const StateLog log = loadStateLog(a.states, model, ignore);
   double max_gap = a.max_gap > 0.0 ? a.max_gap : 1.5 * log.medianPeriod();
   std::vector<double> frame_times;
-  if (!a.frame_times.empty()) frame_times = loadFrameTimes(a.frame_times);
+  if (!a.frame_times.empty()) frame_times = frameTimes(a.frame_times);
 
   Shared shared{a, model, camera, log, max_gap, {}};
   if (a.swept) {
