@@ -13,6 +13,17 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Relative tolerance of a support value (times the chain's extent).
 constexpr double kSupportTolerance = 1e-5;
 
+// The largest distance from the axis (through the origin) of a point of the box centre +- half.
+double rhoBoxBound(const Vec3& axis, const Vec3& centre, const Vec3& half) {
+  double rho = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 corner(centre.x() + ((k & 1) ? half.x() : -half.x()), centre.y() + ((k & 2) ? half.y() : -half.y()),
+                      centre.z() + ((k & 4) ? half.z() : -half.z()));
+    rho = std::max(rho, (corner - axis.dot(corner) * axis).norm());
+  }
+  return roundedUp(rho, 8);
+}
+
 // The chain's sphere below level l (level 0: the body's own).
 const Sphere& sphereBelow(const ChainView& c, int l) { return l == 0 ? c.base : c.levels[static_cast<std::size_t>(l) - 1].core; }
 
@@ -58,8 +69,10 @@ ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, 
   const double point_extent = below_in_swept ? swept_extent : std::max(extent, swept_extent);
   double growth = maps.fixed_growth + maps.point_growth * point_extent;
   if (maps.revolute && !tangent) {
-    const double rho = below_in_swept ? rhoBound(maps.axis, swept)
-                                      : std::max(rhoBound(maps.axis, swept), rhoBound(maps.axis, below));
+    // The core's own sphere and box hold it too: the smallest of the bounds serves (a smaller
+    // growth keeps the chord chain inside the point volumes, which use the swept sphere).
+    const double own = std::min(rhoBound(maps.axis, below), rhoBoxBound(maps.axis, below_box_centre, below_box_half));
+    const double rho = below_in_swept ? std::min(rhoBound(maps.axis, swept), own) : own;
     growth += maps.sagitta * rho;
   }
   out.growth = roundedUp(growth, 8) + roundingGuard(std::max(extent, swept_extent) * out.max_scale + maps.offset_norm, 32);
