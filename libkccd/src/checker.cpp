@@ -20,6 +20,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Nodes one support search of the exact stage may visit (bounds its time; a search stopped early
 // still gives a valid bound).
 constexpr int kExactNodes = 2048;
+// With QueryOptions::tight_volumes, a sweep whose radius growth exceeds this fraction of the swept
+// sphere's radius also tries the other cover (chords for every point, reduced to the budget).
+constexpr double kCoarseCover = 0.02;
 using Clock = std::chrono::steady_clock;
 using detail::shrunkBound;
 
@@ -107,6 +110,7 @@ void Checker::layoutVolumes() {
   for (const Joint& j : model.joints) expansion = std::max(expansion, detail::sweepExpansion(j));
   scratch_.resize(static_cast<std::size_t>(expansion) * max_points);
   scratch_dist_.resize(scratch_.size());
+  scratch_alt_.resize(scratch_.size());
   scratch_order_.resize(scratch_.size());
 }
 
@@ -206,11 +210,32 @@ const Checker::Volume* Checker::volume(int body, int level, Box box) noexcept {
   const double* hi = box.upper.data() + joint.state_offset;
   const Sphere* below_sphere = sphere(body, level - 1, box);
   if (below_sphere == nullptr) return nullptr;
+  const double below_radius = radius;
   int n = detail::sweepJoint(joint, lo, hi, view(*below).points, scratch_.data(), radius, v.capacity,
                              scratch_dist_.data(), *below_sphere);
   if (n < 0) return nullptr;
   n = detail::reduceToBudget(scratch_.data(), n, v.capacity, scratch_dist_.data(), scratch_order_.data(), radius);
-  std::copy(scratch_.begin(), scratch_.begin() + n, points_.begin() + v.offset);
+  const Vec3* kept = scratch_.data();
+  // With tight volumes asked for (display), when the budget made the cover coarse (middle points
+  // of wide arcs add first-order growth), the other cover may be tighter: chords for every point,
+  // then reduced to the budget with the distance of each dropped point to the kept points' hull.
+  // Both keep the exact stage's chord chains inside (reductions only grow the volume), so the
+  // smaller radius can be kept; it costs a farthest-point selection per sweep.
+  if (tight_volumes_ && radius - below_radius > kCoarseCover * (below_sphere->radius + 1e-9)) {
+    double alt_radius = below_radius;
+    int m = detail::sweepJoint(joint, lo, hi, view(*below).points, scratch_alt_.data(), alt_radius,
+                               std::numeric_limits<int>::max(), scratch_dist_.data(), *below_sphere);
+    if (m > 0) {
+      m = detail::reduceToBudget(scratch_alt_.data(), m, v.capacity, scratch_dist_.data(), scratch_order_.data(),
+                                 alt_radius);
+      if (alt_radius < radius) {
+        radius = alt_radius;
+        n = m;
+        kept = scratch_alt_.data();
+      }
+    }
+  }
+  std::copy(kept, kept + n, points_.begin() + v.offset);
   v.count = n;
   v.radius = radius;
   v.bound = detail::boundingSphere(view(v).points, radius);
@@ -421,6 +446,7 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   result_.type = options.type;
   result_.margin = options.margin >= 0.0 ? options.margin : model_.safety_margin;
   const double margin = result_.margin;
+  tight_volumes_ = options.tight_volumes;
   exact_below_ = std::isnan(options.exact_below) || options.exact_below == -kInf ? -kInf
                  : options.exact_below < 0.0                                  ? margin
                                                                               : options.exact_below;

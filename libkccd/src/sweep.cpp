@@ -128,7 +128,8 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
   // The growth: the sagitta of the farthest point the volume can hold (rho_bound, from the swept
   // sphere below: the same value the exact stage uses, so that its chord chains stay inside these
   // volumes), plus the middle points' distance to their chord ends.
-  const double growth = roundedUp(rho_bound * sagitta, 4) + mid_growth;  // Rounding: the outputs (at most |p| / cos(step / 2) + |t| from the origin) err by a few ulps.
+  const double growth = roundedUp(rho_bound * sagitta, 4) + mid_growth;
+  // Rounding: the outputs (at most |p| / cos(step / 2) + |t| from the origin) err by a few ulps.
   if (!std::isfinite(growth)) return -1;
   radius += roundedUp(growth, 8) + roundingGuard(in_norm / half_cos + t.norm(), 32);
   return n;

@@ -240,7 +240,7 @@ class FrameWorker {
       }
       // From scratch every frame: the answer does not depend on which worker had which frame.
       checker_.reset();
-      const QueryResult& r = checker_.query(lo_, hi_, QueryOptions{.type = QueryType::Distances});
+      const QueryResult& r = checker_.query(lo_, hi_, QueryOptions{.type = QueryType::Distances, .tight_volumes = true});
       rec.query = r.status;
       // A bound only for the box the run is about: none for an unsafe status or a missing braking box.
       if (r.status == Status::Ok && box_ok) rec.min_distance = r.min_distance;

@@ -39,7 +39,7 @@ Exit runRender(const RenderArgs& args) {
   if (m.bodies.size() > 255) throw UsageError(args.model + ": more than 255 bodies do not fit an 8-bit mask");
 
   Checker checker(m);
-  const QueryResult& r = checker.query(lower, upper, QueryOptions{.type = QueryType::Distances});
+  const QueryResult& r = checker.query(lower, upper, QueryOptions{.type = QueryType::Distances, .tight_volumes = true});
   const Status status = r.status;
   const double margin = r.margin;
   const std::vector<double> nearest = render::bodyDistances(m, r);

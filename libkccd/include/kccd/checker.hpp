@@ -116,6 +116,7 @@ class Checker {
   std::vector<double> box_;                  // per reach entry: the stored bound's lower, upper
   std::vector<Vec3> scratch_;
   std::vector<double> scratch_dist_;
+  std::vector<Vec3> scratch_alt_;            // the other cover of a sweep
   std::vector<int> scratch_order_;
   // The exact stage: per joint its vertex maps for this query, per body and level the chain
   // level (variant 0: chords only; 1: each joint's own mode), and the search's scratch.
@@ -130,6 +131,7 @@ class Checker {
   std::vector<detail::ChainEntry> chain_stack_;
   std::vector<int> chain_choice_, chain_best_;
   double exact_below_ = 0.0;
+  bool tight_volumes_ = false;
   std::vector<int> order_;
   std::vector<PairDistance> out_;
   std::vector<std::uint8_t> fresh_;          // per pair: recomputed in this query

@@ -44,6 +44,10 @@ struct QueryOptions {
   /// know. Negative (default): the margin, so every verdict is decided by the exact stage; +inf:
   /// every pair of a Distances query (tightest, slowest); -inf or NaN: never (point volumes only).
   double exact_below = -1.0;
+  /// Point volumes for display: where a sweep's budget forces a coarse cover, also try chords for
+  /// every point reduced to the budget by hull distance, and keep the tighter. Slower; the
+  /// verdicts do not change (the exact stage decides them).
+  bool tight_volumes = false;
 };
 
 /// One pair in a result. `distance` is a lower bound over the whole interval box.
