@@ -218,28 +218,47 @@ Mesh hullMesh(std::span<const Vec3> points, double radius, int level, double min
 }
 
 // Fills Mesh::edges and checks that the triangles close up: every edge is shared by exactly two
-// triangles that run along it in opposite directions, and V - E + F = 2.
+// triangles that run along it in opposite directions, and V - E + F = 2. Linear time: the
+// half-edges are bucketed by their lower vertex and paired within each (small) bucket.
 bool closeUp(Mesh& mesh) {
-  std::vector<std::array<std::uint32_t, 4>> half;  // low vertex, high vertex, triangle, forward
-  half.reserve(mesh.triangles.size() * 3);
+  const std::size_t nv = mesh.vertices.size();
+  std::vector<std::uint32_t> start(nv + 1, 0);
+  for (const auto& tri : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
+      if (a == b) return false;
+      ++start[std::min(a, b) + 1];
+    }
+  for (std::size_t i = 0; i < nv; ++i) start[i + 1] += start[i];
+  struct Half {
+    std::uint32_t hi, triangle;
+    bool forward;
+  };
+  std::vector<Half> half(start[nv]);
+  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
   for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
-      if (a == b) return false;
-      half.push_back({std::min(a, b), std::max(a, b), t, a < b ? 1u : 0u});
+      half[fill[std::min(a, b)]++] = Half{std::max(a, b), t, a < b};
     }
-  std::sort(half.begin(), half.end());
   mesh.edges.clear();
   mesh.edges.reserve(half.size() / 2);
-  for (std::size_t i = 0; i < half.size(); i += 2) {
-    if (i + 1 >= half.size() || half[i + 1][0] != half[i][0] || half[i + 1][1] != half[i][1]) return false;
-    if (i + 2 < half.size() && half[i + 2][0] == half[i][0] && half[i + 2][1] == half[i][1]) return false;
-    if (half[i][3] == half[i + 1][3]) return false;
-    mesh.edges.push_back({half[i][0], half[i][1], half[i][2], half[i + 1][2]});
+  for (std::uint32_t lo = 0; lo < nv; ++lo) {
+    const std::uint32_t begin = start[lo], end = start[lo + 1];
+    for (std::uint32_t i = begin; i < end; ++i) {
+      if (half[i].hi == UINT32_MAX) continue;  // already paired
+      std::uint32_t match = UINT32_MAX;
+      for (std::uint32_t j = i + 1; j < end; ++j)
+        if (half[j].hi == half[i].hi) {
+          if (match != UINT32_MAX || half[j].forward == half[i].forward) return false;
+          match = j;
+        }
+      if (match == UINT32_MAX) return false;
+      mesh.edges.push_back({lo, half[i].hi, half[i].triangle, half[match].triangle});
+      half[match].hi = UINT32_MAX;
+    }
   }
-  return static_cast<long>(mesh.vertices.size()) - static_cast<long>(mesh.edges.size()) +
-             static_cast<long>(mesh.triangles.size()) ==
-         2;
+  return static_cast<long>(nv) - static_cast<long>(mesh.edges.size()) + static_cast<long>(mesh.triangles.size()) == 2;
 }
 
 // The sphere polytope of a level turned by a fixed rotation, so that its face normals and the
@@ -250,6 +269,7 @@ struct TurnedSphere {
   std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from outside
   std::vector<Vec3> normals;                           // outward unit face normals
   std::vector<std::array<std::uint32_t, 4>> edges;     // u1, u2, triangle holding u1 -> u2, the other
+  std::vector<std::vector<std::uint32_t>> adjacent;    // vertices joined to each by an edge
 };
 
 const TurnedSphere& turnedSphere(int level) {
@@ -269,6 +289,11 @@ const TurnedSphere& turnedSphere(int level) {
         for (int k = 0; k < 3; ++k)
           if (tri[k] < tri[(k + 1) % 3])  // each edge once, from the triangle holding it low -> high
             q.edges.push_back({tri[k], tri[(k + 1) % 3], t, s.neighbours[t][k]});
+      }
+      q.adjacent.resize(q.vertices.size());
+      for (const auto& e : q.edges) {
+        q.adjacent[e[0]].push_back(e[1]);
+        q.adjacent[e[1]].push_back(e[0]);
       }
       levels.push_back(std::move(q));
     }
@@ -420,16 +445,20 @@ std::optional<Mesh> directMesh(const CoreHull& core, const TurnedSphere& q, doub
   const auto np = static_cast<std::uint32_t>(core.vertices.size());
   const auto nq = static_cast<std::uint32_t>(q.vertices.size());
   const std::size_t nt = q.triangles.size();
-  std::vector<double> dots(nt * np);
+  // The vertex of P supporting each triangle's normal, by climbing P's edges from the previous
+  // triangle's (a vertex no neighbour beats supports a convex polytope; the triangles of a
+  // level are listed patch by patch, so the climb is short).
   std::vector<std::uint32_t> support(nt);
+  std::uint32_t v = 0;
   for (std::size_t t = 0; t < nt; ++t) {
-    double* d = &dots[t * np];
-    std::uint32_t best = 0;
-    for (std::uint32_t i = 0; i < np; ++i) {
-      d[i] = q.normals[t].dot(core.vertices[i]);
-      if (d[i] > d[best]) best = i;
+    const Vec3& c = q.normals[t];
+    double best = c.dot(core.vertices[v]);
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (const std::uint32_t w : core.neighbours[v])
+        if (const double d = c.dot(core.vertices[w]); d > best) best = d, v = w, moved = true;
     }
-    support[t] = best;
+    support[t] = v;
   }
   Mesh mesh;
   std::vector<std::int32_t> id(static_cast<std::size_t>(np) * nq, -1);
@@ -456,15 +485,18 @@ std::optional<Mesh> directMesh(const CoreHull& core, const TurnedSphere& q, doub
     // The support of P along d(s) = (1 - s) n_left + s n_right, s from 0 to 1: from the current
     // vertex v, the next is the neighbour w whose advantage d(s)·(w - v) (linear in s) turns
     // positive first.
-    const double* dl = &dots[left * np];
-    const double* dr = &dots[right * np];
+    // The normal cone of a vertex is convex: when both ends have the same support, the whole
+    // arc does and the two patch triangles share the edge.
+    if (support[left] == support[right]) continue;
+    const Vec3 &cl = q.normals[left], &cr = q.normals[right];
     std::uint32_t v = support[left];
     double s = 0.0;
     for (std::uint32_t steps = 0;; ++steps) {
       std::int64_t next = -1;
       double at = 2.0;
       for (const std::uint32_t w : core.neighbours[v]) {
-        const double a = dl[w] - dl[v], b = dr[w] - dr[v];
+        const double a = cl.dot(core.vertices[w]) - cl.dot(core.vertices[v]);
+        const double b = cr.dot(core.vertices[w]) - cr.dot(core.vertices[v]);
         if (!(b > a)) continue;
         const double sw = std::max(s, a >= 0.0 ? 0.0 : -a / (b - a));
         if (sw <= 1.0 && sw < at) at = sw, next = w;
@@ -481,12 +513,17 @@ std::optional<Mesh> directMesh(const CoreHull& core, const TurnedSphere& q, doub
     }
     if (v != support[right]) return std::nullopt;
   }
+  std::uint32_t u = 0;
   for (std::size_t f = 0; f < core.facets.size(); ++f) {
     const Vec3& n = core.normals[f];
-    std::uint32_t u = 0;
-    double best = -2.0;
-    for (std::uint32_t j = 0; j < nq; ++j)
-      if (const double d = n.dot(q.vertices[j]); d > best) best = d, u = j;
+    // The vertex of Q supporting n, by climbing Q's edges (a vertex no neighbour beats is the
+    // support of a convex polytope), from the previous facet's (neighbouring facets are close).
+    double best = n.dot(q.vertices[u]);
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (const std::uint32_t j : q.adjacent[u])
+        if (const double d = n.dot(q.vertices[j]); d > best) best = d, u = j, moved = true;
+    }
     const auto& loop = core.facets[f];
     for (std::size_t k = 1; k + 1 < loop.size(); ++k)
       triangle(vertex(loop[0], u), vertex(loop[k], u), vertex(loop[k + 1], u), n);
