@@ -446,8 +446,8 @@ std::optional<Mesh> directMesh(const CoreHull& core, const TurnedSphere& q, doub
   const auto nq = static_cast<std::uint32_t>(q.vertices.size());
   const std::size_t nt = q.triangles.size();
   // The vertex of P supporting each triangle's normal, by climbing P's edges from the previous
-  // triangle's (a vertex no neighbour beats supports a convex polytope; the triangles of a
-  // level are listed patch by patch, so the climb is short).
+  // triangle's (a vertex no neighbour beats supports a convex polytope; consecutive triangles
+  // of a level are mostly neighbours, so the climb is short).
   std::vector<std::uint32_t> support(nt);
   std::uint32_t v = 0;
   for (std::size_t t = 0; t < nt; ++t) {
