@@ -9,6 +9,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "kccd/calib/camera.hpp"
+#include "kccd/distance.hpp"
 #include "kccd/render/projection.hpp"
 #include "kccd/render/renderer.hpp"
 #include "kccd/render/ssch_mesh.hpp"
@@ -97,6 +98,206 @@ TEST(RenderMesh, ContainsTheTrueVolume) {
         EXPECT_LE(nearest - r, allowed + 1e-9);
       }
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The direct construction: degenerate cores and random sets
+
+// Checks one mesh of the SSCH (points, r) built at `level`: closed and consistently wound,
+// convex, containing the true volume (every face plane clears the support of the SSCH in its
+// normal; sampled points of the true boundary inside every face plane), and no vertex farther
+// from conv(points) than the circumscribed radius allows.
+void checkMesh(const Mesh& m, const std::vector<Vec3>& points, double radius, int level, std::mt19937_64& rng) {
+  const double r = std::max(radius, kMinDrawRadius);
+  double extent = 0.0;
+  for (const Vec3& p : points) extent = std::max(extent, p.cwiseAbs().maxCoeff());
+  const double tiny = 1e-9 * (1.0 + extent);
+  ASSERT_GE(m.triangles.size(), 4u);
+  ASSERT_EQ(m.normals.size(), m.triangles.size());
+  for (const auto& e : m.edges) ASSERT_NE(e[2], e[3]);
+  ASSERT_EQ(static_cast<long>(m.vertices.size()) - static_cast<long>(m.edges.size()) + static_cast<long>(m.triangles.size()), 2);
+  ASSERT_EQ(m.edges.size() * 2, m.triangles.size() * 3);  // every edge has exactly two triangles
+  std::vector<double> offsets(m.triangles.size());
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const Vec3& n = m.normals[t];
+    ASSERT_NEAR(n.norm(), 1.0, 1e-12);
+    offsets[t] = n.dot(m.vertices[m.triangles[t][0]]);
+    double support = -1e300;
+    for (const Vec3& p : points) support = std::max(support, n.dot(p));
+    ASSERT_LE(support + r, offsets[t] + tiny) << "face " << t;
+    const auto& tri = m.triangles[t];
+    const Vec3 area = (m.vertices[tri[1]] - m.vertices[tri[0]]).cross(m.vertices[tri[2]] - m.vertices[tri[0]]);
+    ASSERT_GE(area.dot(n), -1e-12 * (1.0 + extent) * (1.0 + extent)) << "face " << t;
+    // Planar: the other two vertices lie on the face plane too.
+    for (int k = 1; k < 3; ++k) ASSERT_NEAR(n.dot(m.vertices[tri[k]]), offsets[t], tiny);
+  }
+  // Convex: every vertex under every face plane (a sample of the vertices for large meshes).
+  for (std::size_t i = 0; i < m.vertices.size(); i += 1 + m.vertices.size() / 200)
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+      ASSERT_LE(m.normals[t].dot(m.vertices[i]), offsets[t] + tiny) << "vertex " << i << " face " << t;
+  // Points of the true boundary: the support point of the core in a random direction d plus r d,
+  // and random points of the core hull (convex combinations) pushed out by r.
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < 200; ++k) {
+    const Vec3 d = Vec3(g(rng), g(rng), g(rng)).normalized();
+    Vec3 x;
+    if (k % 2 == 0) {
+      std::size_t best = 0;
+      for (std::size_t i = 1; i < points.size(); ++i)
+        if (d.dot(points[i]) > d.dot(points[best])) best = i;
+      x = points[best] + r * d;
+    } else {
+      Vec3 c = Vec3::Zero();
+      double total = 0.0;
+      for (const Vec3& p : points) {
+        const double w = -std::log(1.0 - u(rng));
+        c += w * p;
+        total += w;
+      }
+      x = c / total + r * d;
+    }
+    for (std::size_t t = 0; t < m.triangles.size(); ++t) ASSERT_LE(m.normals[t].dot(x), offsets[t] + tiny) << "sample " << k;
+  }
+  // Not much larger: every vertex within the circumscribed radius of conv(points).
+  const double allowed = r * spherePolytope(level).scale + 2e-6 * (1.0 + extent) * spherePolytope(level).scale;
+  for (const Vec3& v : m.vertices) {
+    const DistanceResult d = distance(SschView{points, 0.0}, SschView{std::span<const Vec3>(&v, 1), 0.0});
+    ASSERT_LE(d.distance, allowed * (1.0 + 1e-9) + tiny);
+  }
+}
+
+std::vector<Shape> degenerateShapes() {
+  const Vec3 a(0.3, -0.2, 0.9), b(0.7, 0.4, 0.5), c(-0.1, 0.6, 1.2), d(0.2, 0.1, 0.4);
+  const Vec3 n = (b - a).cross(c - a).normalized();
+  std::vector<Shape> s = {
+      {{a}, 0.1, "single point"},
+      {{a, a, a}, 0.05, "one point three times"},
+      {{a}, 0.0, "single point, radius 0"},
+      {{Vec3(0, 0, 0), Vec3(0, 0, 0.4)}, 0.05, "axis-aligned capsule"},
+      {{Vec3(0, 0, 0), Vec3(0, 0.1, 0), Vec3(0, 0.3, 0), Vec3(0, 0.3, 0)}, 0.04, "collinear with duplicates"},
+      {{a, b, a + 0.25 * (b - a), a + 0.7 * (b - a)}, 0.02, "collinear, oblique"},
+      {{a, b}, 0.0, "segment, radius 0"},
+      {{Vec3(0, 0, 0), Vec3(0.4, 0, 0), Vec3(0.4, 0.2, 0), Vec3(0, 0.2, 0), Vec3(0.2, 0.1, 0)}, 0.03, "axis-aligned slab"},
+      {{a, b, c, a + 0.3 * (b - a) + 0.3 * (c - a), b, c}, 0.02, "oblique triangle with duplicates"},
+      {{a, b, c}, 0.0, "triangle, radius 0"},
+      {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1), Vec3(1, 0, 1), Vec3(0, 1, 1), Vec3(1, 1, 0)}, 0.05, "axis-aligned cube"},
+      {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1), Vec3(1, 0, 1), Vec3(0, 1, 1), Vec3(1, 1, 0)}, 0.0, "cube, radius 0"},
+      {{a, b, c, d}, 0.0, "tetrahedron, radius 0"},
+      {{a, b, c, d, 0.5 * (a + b), 0.5 * (c + d), 0.25 * (a + b + c + d)}, 0.08, "tetrahedron with edge and inner points"},
+      {{Vec3(1000, 2000, -500), Vec3(1000.3, 2000, -500), Vec3(1000, 2000.2, -500.1), Vec3(1000.1, 2000.1, -499.8)}, 0.05, "far from the origin"},
+  };
+  for (const double thick : {1e-12, 1e-10, 1e-8, 1e-6, 1e-3}) {
+    s.push_back({{a, b, c, 0.3 * a + 0.3 * b + 0.4 * c + thick * n}, 0.02, "thin tetrahedron " + std::to_string(thick)});
+    const Vec3 side = (b - a).cross(n).normalized();
+    s.push_back({{a, b, a + 0.5 * (b - a) + thick * side}, 0.02, "thin triangle " + std::to_string(thick)});
+    s.push_back({{a, a + Vec3(thick, 0, 0), a + Vec3(0, thick, 0), a + Vec3(0, 0, thick)}, 0.02, "tiny tetrahedron " + std::to_string(thick)});
+  }
+  return s;
+}
+
+TEST(RenderMesh, DegenerateCores) {
+  std::mt19937_64 rng(5);
+  for (const Shape& sh : degenerateShapes())
+    for (int level = 0; level <= 4; ++level) {
+      SCOPED_TRACE(sh.what + ", level " + std::to_string(level));
+      const Mesh m = buildSschMesh(sh.points, sh.radius, level);
+      EXPECT_TRUE(m.direct);
+      checkMesh(m, sh.points, sh.radius, level, rng);
+    }
+  // A single point gives the sphere polytope itself, every vertex at the mesh radius.
+  const Vec3 p(0.3, -0.2, 0.9);
+  const Mesh ball = buildSschMesh(std::span<const Vec3>(&p, 1), 0.1, 2);
+  EXPECT_EQ(ball.vertices.size(), spherePolytope(2).vertices.size());
+  EXPECT_EQ(ball.triangles.size(), spherePolytope(2).triangles.size());
+  EXPECT_EQ(ball.hull_input, 0);
+  for (const Vec3& v : ball.vertices) EXPECT_NEAR((v - p).norm(), ball.mesh_radius, 1e-12);
+  // A capsule: two sphere halves (vertices at the mesh radius from an end point) and a tube
+  // (parallelograms joining the two halves, vertices within the mesh radius of the axis).
+  const std::vector<Vec3> seg = {Vec3(0, 0, 0), Vec3(0, 0, 0.4)};
+  const Mesh capsule = buildSschMesh(seg, 0.05, 3);
+  EXPECT_EQ(capsule.hull_input, 0);
+  for (const Vec3& v : capsule.vertices) {
+    const double to_end = std::min(v.norm(), (v - seg[1]).norm());
+    const double to_axis = Vec3(v.x(), v.y(), 0.0).norm();
+    EXPECT_TRUE(std::abs(to_end - capsule.mesh_radius) < 1e-12 || (to_axis <= capsule.mesh_radius + 1e-12 && to_axis >= 0.05 * 0.99));
+  }
+  // A flat square: both faces offset by at most the mesh radius, and no qhull at all.
+  const std::vector<Vec3> square = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)};
+  const Mesh slab = buildSschMesh(square, 0.02, 2);
+  EXPECT_EQ(slab.hull_input, 0);
+  double top = -1.0, bottom = 1.0;
+  for (const Vec3& v : slab.vertices) top = std::max(top, v.z()), bottom = std::min(bottom, v.z());
+  EXPECT_LE(top, slab.mesh_radius + 1e-12);
+  EXPECT_GE(top, 0.02);
+  EXPECT_NEAR(top, -bottom, 1e-12);
+}
+
+// Random core sets, many of them degenerate on purpose: points on a random line or plane, on
+// an integer grid (many coplanar and collinear subsets), clustered duplicates, thin noise
+// around a plane, far from the origin; random radii including 0.
+TEST(RenderMesh, RandomCoresFuzz) {
+  std::mt19937_64 rng(20261123);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  int fallbacks = 0, cases = 0;
+  for (int c = 0; c < 400; ++c) {
+    const int kind = c % 8;
+    const int n = 1 + static_cast<int>(rng() % 40);
+    const Vec3 o(u(rng), u(rng), u(rng));
+    const Vec3 e1 = Vec3(g(rng), g(rng), g(rng)).normalized();
+    const Vec3 e2 = e1.cross(Vec3(g(rng), g(rng), g(rng))).normalized();
+    const Vec3 e3 = e1.cross(e2);
+    std::vector<Vec3> pts;
+    for (int k = 0; k < n; ++k) {
+      switch (kind) {
+        case 0: pts.push_back(o + 0.5 * Vec3(u(rng), u(rng), u(rng))); break;
+        case 1: pts.push_back(o + 0.5 * u(rng) * e1); break;
+        case 2: pts.push_back(o + 0.5 * u(rng) * e1 + 0.5 * u(rng) * e2); break;
+        case 3: pts.push_back(0.1 * Vec3(static_cast<double>(rng() % 3), static_cast<double>(rng() % 3), static_cast<double>(rng() % 2))); break;
+        case 4: pts.push_back(k % 3 == 0 || pts.empty() ? o + 0.3 * Vec3(u(rng), u(rng), u(rng)) : pts[rng() % pts.size()]); break;
+        case 5: pts.push_back(o + 0.5 * u(rng) * e1 + 0.5 * u(rng) * e2 + std::pow(10.0, -3.0 - 9.0 * std::abs(u(rng))) * u(rng) * e3); break;
+        case 6: pts.push_back(Vec3(300, -200, 150) + 0.4 * Vec3(u(rng), u(rng), u(rng))); break;
+        default: pts.push_back(o + 0.3 * u(rng) * Vec3(0, 0, 1) + (k % 2) * 0.2 * Vec3(1, 0, 0)); break;  // axis-aligned
+      }
+    }
+    const double radius = c % 5 == 0 ? 0.0 : 0.2 * std::abs(u(rng));
+    const int level = static_cast<int>(rng() % 4);
+    SCOPED_TRACE("case " + std::to_string(c) + " kind " + std::to_string(kind) + ", " + std::to_string(n) + " points, level " +
+                 std::to_string(level));
+    const Mesh m = buildSschMesh(pts, radius, level);
+    ++cases;
+    if (!m.direct) ++fallbacks;
+    checkMesh(m, pts, radius, level, rng);
+    if (HasFatalFailure()) return;
+  }
+  EXPECT_EQ(fallbacks, 0) << "of " << cases;
+}
+
+// The direct construction is the same volume as the previous hull construction (both are the
+// Minkowski sum of the core hull and a sphere polytope of the same level, turned differently):
+// their vertices lie at the same distance from the core hull, and their volumes agree closely.
+TEST(RenderMesh, DirectAgreesWithHullConstruction) {
+  auto volume = [](const Mesh& m) {
+    double v = 0.0;
+    for (const auto& t : m.triangles) v += m.vertices[t[0]].dot(m.vertices[t[1]].cross(m.vertices[t[2]])) / 6.0;
+    return v;
+  };
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  for (int c = 0; c < 20; ++c) {
+    std::vector<Vec3> pts;
+    for (int k = 0; k < 3 + c; ++k) pts.emplace_back(u(rng), u(rng), u(rng));
+    const Mesh direct = buildSschMesh(pts, 0.1, 3);
+    useHullMeshing(true);
+    const Mesh hull = buildSschMesh(pts, 0.1, 3);
+    useHullMeshing(false);
+    EXPECT_TRUE(direct.direct);
+    EXPECT_FALSE(hull.direct);
+    EXPECT_NEAR(volume(direct), volume(hull), 2e-3 * volume(hull));
+    EXPECT_LE(direct.hull_input, static_cast<int>(pts.size()));
+    EXPECT_GT(hull.hull_input, 10 * static_cast<int>(pts.size()));
+  }
 }
 
 TEST(RenderMesh, TessellationErrorShrinksWithLevel) {

@@ -1,11 +1,15 @@
 #include "kccd/render/ssch_mesh.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
+
+#include <Eigen/Geometry>
 
 #include "kccd/hull/qhull.hpp"
 #include "kccd/hull/sphere_polytope.hpp"
@@ -125,7 +129,11 @@ const SpherePolytope& spherePolytope(int level) {
   return levels.at(static_cast<std::size_t>(std::clamp(level, 0, 5)));
 }
 
-Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, double min_radius) {
+namespace {
+
+// The previous construction, kept as the fallback of the direct one: the hull (qhull) of the
+// circumscribed sphere polytope around every core point that can give a vertex of the sum.
+Mesh hullMesh(std::span<const Vec3> points, double radius, int level, double min_radius) {
   if (points.empty()) throw std::invalid_argument("buildSschMesh: no core points");
   if (!allFinite(points) || !std::isfinite(radius) || radius < 0.0 || !(min_radius > 0.0))
     throw std::invalid_argument("buildSschMesh: non-finite point or bad radius");
@@ -206,6 +214,355 @@ Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, doubl
     throw std::runtime_error("buildSschMesh: qhull failed (code " + std::to_string(code) + ")");
 
   buildEdges(mesh);
+  return mesh;
+}
+
+// Fills Mesh::edges and checks that the triangles close up: every edge is shared by exactly two
+// triangles that run along it in opposite directions, and V - E + F = 2. Linear time: the
+// half-edges are bucketed by their lower vertex and paired within each (small) bucket.
+bool closeUp(Mesh& mesh) {
+  const std::size_t nv = mesh.vertices.size();
+  std::vector<std::uint32_t> start(nv + 1, 0);
+  for (const auto& tri : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
+      if (a == b) return false;
+      ++start[std::min(a, b) + 1];
+    }
+  for (std::size_t i = 0; i < nv; ++i) start[i + 1] += start[i];
+  struct Half {
+    std::uint32_t hi, triangle;
+    bool forward;
+  };
+  std::vector<Half> half(start[nv]);
+  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
+      half[fill[std::min(a, b)]++] = Half{std::max(a, b), t, a < b};
+    }
+  mesh.edges.clear();
+  mesh.edges.reserve(half.size() / 2);
+  for (std::uint32_t lo = 0; lo < nv; ++lo) {
+    const std::uint32_t begin = start[lo], end = start[lo + 1];
+    for (std::uint32_t i = begin; i < end; ++i) {
+      if (half[i].hi == UINT32_MAX) continue;  // already paired
+      std::uint32_t match = UINT32_MAX;
+      for (std::uint32_t j = i + 1; j < end; ++j)
+        if (half[j].hi == half[i].hi) {
+          if (match != UINT32_MAX || half[j].forward == half[i].forward) return false;
+          match = j;
+        }
+      if (match == UINT32_MAX) return false;
+      mesh.edges.push_back({lo, half[i].hi, half[i].triangle, half[match].triangle});
+      half[match].hi = UINT32_MAX;
+    }
+  }
+  return static_cast<long>(nv) - static_cast<long>(mesh.edges.size()) + static_cast<long>(mesh.triangles.size()) == 2;
+}
+
+// The sphere polytope of a level turned by a fixed rotation, so that its face normals and the
+// boundaries of its vertices' normal cones do not fall exactly on the axis-aligned directions
+// common in robot models (a tie there would make the direct construction fall back).
+struct TurnedSphere {
+  std::vector<Vec3> vertices;                          // on the unit sphere
+  std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from outside
+  std::vector<Vec3> normals;                           // outward unit face normals
+  std::vector<std::array<std::uint32_t, 4>> edges;     // u1, u2, triangle holding u1 -> u2, the other
+  std::vector<std::vector<std::uint32_t>> adjacent;    // vertices joined to each by an edge
+};
+
+const TurnedSphere& turnedSphere(int level) {
+  static std::once_flag once;
+  static std::vector<TurnedSphere> levels;
+  std::call_once(once, [] {
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.6180339887498949, Vec3(0.2718281828, 0.5772156649, 0.7071067812).normalized())
+                                     .toRotationMatrix();
+    for (int l = 0; l <= 5; ++l) {
+      const SpherePolytope& s = spherePolytope(l);
+      TurnedSphere q;
+      for (const Vec3& v : s.vertices) q.vertices.push_back((turn * v).normalized());
+      q.triangles = s.triangles;
+      for (std::uint32_t t = 0; t < q.triangles.size(); ++t) {
+        const auto& tri = q.triangles[t];
+        q.normals.push_back((q.vertices[tri[1]] - q.vertices[tri[0]]).cross(q.vertices[tri[2]] - q.vertices[tri[0]]).normalized());
+        for (int k = 0; k < 3; ++k)
+          if (tri[k] < tri[(k + 1) % 3])  // each edge once, from the triangle holding it low -> high
+            q.edges.push_back({tri[k], tri[(k + 1) % 3], t, s.neighbours[t][k]});
+      }
+      q.adjacent.resize(q.vertices.size());
+      for (const auto& e : q.edges) {
+        q.adjacent[e[0]].push_back(e[1]);
+        q.adjacent[e[1]].push_back(e[0]);
+      }
+      levels.push_back(std::move(q));
+    }
+  });
+  return levels.at(static_cast<std::size_t>(std::clamp(level, 0, 5)));
+}
+
+// The convex hull of the core points as the direct construction needs it: its vertices, the
+// vertices joined to each by a hull edge, and its facets (vertex loops counter-clockwise seen
+// from outside, with outward unit normals). A flat set has two facets (both sides), a collinear
+// set two vertices and one edge, a single point one vertex. Points within `tol` of a line or
+// plane are projected onto it and `inflate` is the largest distance moved.
+struct CoreHull {
+  std::vector<Vec3> vertices;
+  std::vector<std::vector<std::uint32_t>> neighbours;
+  std::vector<std::vector<std::uint32_t>> facets;
+  std::vector<Vec3> normals;
+  double inflate = 0.0;
+  int qhull_points = 0;
+};
+
+void link(CoreHull& h, std::uint32_t a, std::uint32_t b) {
+  auto add = [&](std::uint32_t x, std::uint32_t y) {
+    auto& n = h.neighbours[x];
+    if (std::find(n.begin(), n.end(), y) == n.end()) n.push_back(y);
+  };
+  add(a, b);
+  add(b, a);
+}
+
+std::optional<CoreHull> coreHull(std::span<const Vec3> input, double tol) {
+  std::vector<Vec3> pts(input.begin(), input.end());
+  std::sort(pts.begin(), pts.end(), [](const Vec3& a, const Vec3& b) {
+    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+  });
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  CoreHull h;
+  const Vec3 p0 = pts[0];
+  auto farthest = [&](auto&& dist) {
+    std::size_t best = 0;
+    double d = -1.0;
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      if (const double x = dist(pts[i]); x > d) d = x, best = i;
+    return std::pair{best, d};
+  };
+  const auto [i1, len] = farthest([&](const Vec3& p) { return (p - p0).norm(); });
+  if (len <= tol) {  // a single point
+    h.vertices = {p0};
+    h.neighbours.resize(1);
+    h.inflate = len;
+    return h;
+  }
+  const Vec3 e1 = (pts[i1] - p0) / len;
+  const auto [i2, off_line] = farthest([&](const Vec3& p) { return (p - p0 - e1 * e1.dot(p - p0)).norm(); });
+  if (off_line <= tol) {  // collinear: the segment between the extreme projections
+    double lo = 0.0, hi = 0.0;
+    for (const Vec3& p : pts) lo = std::min(lo, e1.dot(p - p0)), hi = std::max(hi, e1.dot(p - p0));
+    h.vertices = {p0 + lo * e1, p0 + hi * e1};
+    h.neighbours.resize(2);
+    link(h, 0, 1);
+    h.inflate = off_line;
+    return h;
+  }
+  const Vec3 n = e1.cross(pts[i2] - p0).normalized();
+  const auto [i3, off_plane] = farthest([&](const Vec3& p) { return std::abs(n.dot(p - p0)); });
+  if (off_plane <= tol) {  // flat: the polygon (monotone chain in the plane), seen from both sides
+    const Vec3 e2 = n.cross(e1);
+    std::vector<std::pair<double, double>> xy;
+    for (const Vec3& p : pts) xy.emplace_back(e1.dot(p - p0), e2.dot(p - p0));
+    std::sort(xy.begin(), xy.end());
+    xy.erase(std::unique(xy.begin(), xy.end()), xy.end());
+    auto turn = [](const auto& o, const auto& a, const auto& b) {
+      return (a.first - o.first) * (b.second - o.second) - (a.second - o.second) * (b.first - o.first);
+    };
+    std::vector<std::pair<double, double>> ring(2 * xy.size());
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < xy.size(); ++i) {
+      while (k >= 2 && turn(ring[k - 2], ring[k - 1], xy[i]) <= 0.0) --k;
+      ring[k++] = xy[i];
+    }
+    for (std::size_t i = xy.size() - 1, lower = k + 1; i-- > 0;) {
+      while (k >= lower && turn(ring[k - 2], ring[k - 1], xy[i]) <= 0.0) --k;
+      ring[k++] = xy[i];
+    }
+    ring.resize(k - 1);  // counter-clockwise about n (e1 x e2 = n)
+    if (ring.size() < 3) return std::nullopt;
+    const auto m = static_cast<std::uint32_t>(ring.size());
+    h.neighbours.resize(m);
+    std::vector<std::uint32_t> up, down;
+    for (std::uint32_t i = 0; i < m; ++i) {
+      h.vertices.push_back(p0 + ring[i].first * e1 + ring[i].second * e2);
+      link(h, i, (i + 1) % m);
+      up.push_back(i);
+      down.push_back(m - 1 - i);
+    }
+    h.facets = {up, down};
+    h.normals = {n, -n};
+    h.inflate = off_plane;
+    return h;
+  }
+  // Solid: qhull on the (few) distinct core points.
+  std::vector<double> coords;
+  for (const Vec3& p : pts) coords.insert(coords.end(), {p.x(), p.y(), p.z()});
+  h.qhull_points = static_cast<int>(pts.size());
+  const hull::QhullResult res = hull::convexHull3(coords);
+  if (res.code != 0 || res.facets.size() < 4) return std::nullopt;
+  std::vector<std::int64_t> index(pts.size(), -1);
+  auto vertex = [&](int id) {
+    if (index[id] < 0) {
+      index[id] = static_cast<std::int64_t>(h.vertices.size());
+      h.vertices.push_back(pts[id]);
+      h.neighbours.emplace_back();
+    }
+    return static_cast<std::uint32_t>(index[id]);
+  };
+  for (const hull::QhullFacet& f : res.facets) {
+    if (f.vertices.size() != 3) return std::nullopt;
+    std::vector<std::uint32_t> loop = {vertex(f.vertices[0]), vertex(f.vertices[1]), vertex(f.vertices[2])};
+    const Vec3& a = h.vertices[loop[0]];
+    if ((h.vertices[loop[1]] - a).cross(h.vertices[loop[2]] - a).dot(f.normal) < 0.0) std::swap(loop[1], loop[2]);
+    for (int k = 0; k < 3; ++k) link(h, loop[k], loop[(k + 1) % 3]);
+    h.facets.push_back(std::move(loop));
+    h.normals.push_back(f.normal);
+  }
+  // Every core point must lie (to rounding) under every facet plane.
+  double excess = 0.0;
+  for (std::size_t f = 0; f < h.facets.size(); ++f) {
+    const double offset = h.normals[f].dot(h.vertices[h.facets[f][0]]);
+    for (const Vec3& p : pts) excess = std::max(excess, h.normals[f].dot(p) - offset);
+  }
+  if (excess > tol) return std::nullopt;
+  return h;
+}
+
+// The Minkowski sum of the core hull P and the circumscribed sphere polytope Q (vertices
+// q_j = big_r u_j), built from the overlay of the two normal fans instead of a hull of all
+// p_i + q_j. Every face of P + Q is one of:
+//  - a spherical patch triangle v + t, for each triangle t of Q, v the vertex of P supporting
+//    the normal of t;
+//  - a strip parallelogram e + g, for each edge g of Q and each hull edge e = (v, w) of P whose
+//    arc of normals crosses g's arc of normals (from one neighbouring triangle's normal to the
+//    other's): found by following the support of P along that arc from vertex to vertex;
+//  - an offset facet f + q, for each facet f of P, q the vertex of Q supporting its normal.
+// Each face's plane has the normal it is built for, and its offset is the support of P plus
+// the support of Q (at least big_r / scale) in that normal, so the closed mesh contains
+// P + B(big_r / scale) and no vertex is farther than big_r from P. Returns nothing when
+// rounding makes the pieces disagree (the caller then takes the hull construction).
+std::optional<Mesh> directMesh(const CoreHull& core, const TurnedSphere& q, double big_r) {
+  const auto np = static_cast<std::uint32_t>(core.vertices.size());
+  const auto nq = static_cast<std::uint32_t>(q.vertices.size());
+  const std::size_t nt = q.triangles.size();
+  // The vertex of P supporting each triangle's normal, by climbing P's edges from the previous
+  // triangle's (a vertex no neighbour beats supports a convex polytope; consecutive triangles
+  // of a level are mostly neighbours, so the climb is short).
+  std::vector<std::uint32_t> support(nt);
+  std::uint32_t v = 0;
+  for (std::size_t t = 0; t < nt; ++t) {
+    const Vec3& c = q.normals[t];
+    double best = c.dot(core.vertices[v]);
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (const std::uint32_t w : core.neighbours[v])
+        if (const double d = c.dot(core.vertices[w]); d > best) best = d, v = w, moved = true;
+    }
+    support[t] = v;
+  }
+  Mesh mesh;
+  std::vector<std::int32_t> id(static_cast<std::size_t>(np) * nq, -1);
+  auto vertex = [&](std::uint32_t p, std::uint32_t u) {
+    std::int32_t& i = id[static_cast<std::size_t>(p) * nq + u];
+    if (i < 0) {
+      i = static_cast<std::int32_t>(mesh.vertices.size());
+      mesh.vertices.push_back(core.vertices[p] + big_r * q.vertices[u]);
+    }
+    return static_cast<std::uint32_t>(i);
+  };
+  auto triangle = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c, const Vec3& n) {
+    mesh.triangles.push_back({a, b, c});
+    mesh.normals.push_back(n);
+  };
+  mesh.triangles.reserve(nt + 2 * q.edges.size());
+  mesh.normals.reserve(nt + 2 * q.edges.size());
+  for (std::size_t t = 0; t < nt; ++t) {
+    const auto& tri = q.triangles[t];
+    const std::uint32_t v = support[t];
+    triangle(vertex(v, tri[0]), vertex(v, tri[1]), vertex(v, tri[2]), q.normals[t]);
+  }
+  for (const auto& [u1, u2, left, right] : q.edges) {
+    // The support of P along d(s) = (1 - s) n_left + s n_right, s from 0 to 1: from the current
+    // vertex v, the next is the neighbour w whose advantage d(s)·(w - v) (linear in s) turns
+    // positive first.
+    // The normal cone of a vertex is convex: when both ends have the same support, the whole
+    // arc does and the two patch triangles share the edge.
+    if (support[left] == support[right]) continue;
+    const Vec3 &cl = q.normals[left], &cr = q.normals[right];
+    std::uint32_t v = support[left];
+    double s = 0.0;
+    for (std::uint32_t steps = 0;; ++steps) {
+      std::int64_t next = -1;
+      double at = 2.0;
+      for (const std::uint32_t w : core.neighbours[v]) {
+        const double a = cl.dot(core.vertices[w]) - cl.dot(core.vertices[v]);
+        const double b = cr.dot(core.vertices[w]) - cr.dot(core.vertices[v]);
+        if (!(b > a)) continue;
+        const double sw = std::max(s, a >= 0.0 ? 0.0 : -a / (b - a));
+        if (sw <= 1.0 && sw < at) at = sw, next = w;
+      }
+      if (next < 0) break;
+      if (steps > np) return std::nullopt;
+      const auto w = static_cast<std::uint32_t>(next);
+      const Vec3 n = ((1.0 - at) * q.normals[left] + at * q.normals[right]).normalized();
+      const std::uint32_t v2 = vertex(v, u2), v1 = vertex(v, u1), w1 = vertex(w, u1), w2 = vertex(w, u2);
+      triangle(v2, v1, w1, n);
+      triangle(v2, w1, w2, n);
+      v = w;
+      s = at;
+    }
+    if (v != support[right]) return std::nullopt;
+  }
+  std::uint32_t u = 0;
+  for (std::size_t f = 0; f < core.facets.size(); ++f) {
+    const Vec3& n = core.normals[f];
+    // The vertex of Q supporting n, by climbing Q's edges (a vertex no neighbour beats is the
+    // support of a convex polytope), from the previous facet's (neighbouring facets are close).
+    double best = n.dot(q.vertices[u]);
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (const std::uint32_t j : q.adjacent[u])
+        if (const double d = n.dot(q.vertices[j]); d > best) best = d, u = j, moved = true;
+    }
+    const auto& loop = core.facets[f];
+    for (std::size_t k = 1; k + 1 < loop.size(); ++k)
+      triangle(vertex(loop[0], u), vertex(loop[k], u), vertex(loop[k + 1], u), n);
+  }
+  if (!closeUp(mesh)) return std::nullopt;
+  return mesh;
+}
+
+std::atomic<bool> g_hull_meshing{false};
+
+}  // namespace
+
+void useHullMeshing(bool on) { g_hull_meshing = on; }
+
+Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, double min_radius) {
+  if (points.empty()) throw std::invalid_argument("buildSschMesh: no core points");
+  if (!allFinite(points) || !std::isfinite(radius) || radius < 0.0 || !(min_radius > 0.0))
+    throw std::invalid_argument("buildSschMesh: non-finite point or bad radius");
+  if (g_hull_meshing) return hullMesh(points, radius, level, min_radius);
+  double extent = 0.0;
+  for (const Vec3& p : points) extent = std::max(extent, p.cwiseAbs().maxCoeff());
+  // Guard for the float conversion of vertices when drawing (a micrometre at 1 m), as before;
+  // sets within 1e-9 (1 + extent) of a point, line or plane are projected onto it.
+  const double pad = 1e-6 * (1.0 + extent);
+  const std::optional<CoreHull> core = coreHull(points, 1e-9 * (1.0 + extent));
+  int qhull_points = 0;
+  if (core) {
+    qhull_points = core->qhull_points;
+    const double big_r = (std::max(radius, min_radius) + pad + core->inflate) * spherePolytope(level).scale;
+    if (std::optional<Mesh> mesh = directMesh(*core, turnedSphere(level), big_r)) {
+      mesh->level = level;
+      mesh->mesh_radius = big_r;
+      mesh->hull_input = qhull_points;
+      mesh->direct = true;
+      return std::move(*mesh);
+    }
+  }
+  Mesh mesh = hullMesh(points, radius, level, min_radius);
+  mesh.hull_input += qhull_points;
   return mesh;
 }
 

@@ -5,6 +5,8 @@
 // - Static/moving: a new state every frame (every moving body's mesh is rebuilt);
 // - Swept:         a new braking box every frame (2-20 degrees per joint), swept volumes;
 // each for the colour layer alone and for colour + label mask.
+// - Swept_HullMeshing: Swept with the previous mesh construction (qhull over circumscribed
+//   sphere polytopes around every core point), for comparison in the same run.
 // Run with --benchmark_repetitions=5 and read the medians.
 #include <benchmark/benchmark.h>
 
@@ -103,10 +105,44 @@ void frame(benchmark::State& state, bool swept, bool moving, bool mask) {
 void BM_Static_Fixed(benchmark::State& s) { frame(s, false, false, s.range(0) != 0); }
 void BM_Static_Moving(benchmark::State& s) { frame(s, false, true, s.range(0) != 0); }
 void BM_Swept(benchmark::State& s) { frame(s, true, true, s.range(0) != 0); }
+void BM_Swept_HullMeshing(benchmark::State& s) {
+  useHullMeshing(true);
+  frame(s, true, true, s.range(0) != 0);
+  useHullMeshing(false);
+}
+
+// One swept volume's mesh alone (core points of the humanoid's swept volumes: a few tens), built
+// directly (arg 0) or by the previous qhull construction (arg 1); level 3.
+void BM_SweptMesh(benchmark::State& state) {
+  const Model& m = humanoid();
+  Checker checker(m);
+  const auto list = boxes(true);
+  std::vector<std::pair<std::vector<Vec3>, double>> volumes;
+  for (int k = 0; k < 8; ++k) {
+    const auto& [lo, hi] = list[static_cast<std::size_t>(k)];
+    const QueryResult& q = checker.query(lo, hi, QueryOptions{.type = QueryType::Distances});
+    for (const Volume& v : sceneVolumes(m, checker, bodyStatus(m, q)))
+      volumes.emplace_back(std::vector<Vec3>(v.points.begin(), v.points.end()), v.radius);
+  }
+  useHullMeshing(state.range(0) != 0);
+  std::size_t i = 0;
+  double points = 0, n = 0;
+  for (auto _ : state) {
+    const auto& [points_of, radius] = volumes[i++ % volumes.size()];
+    const Mesh mesh = buildSschMesh(points_of, radius, 3);
+    benchmark::DoNotOptimize(mesh.triangles.data());
+    points += static_cast<double>(points_of.size());
+    ++n;
+  }
+  useHullMeshing(false);
+  state.counters["core_points"] = points / n;
+}
+BENCHMARK(BM_SweptMesh)->ArgName("hull")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 BENCHMARK(BM_Static_Fixed)->ArgName("mask")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Static_Moving)->ArgName("mask")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Swept)->ArgName("mask")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_Swept_HullMeshing)->ArgName("mask")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 }  // namespace
 

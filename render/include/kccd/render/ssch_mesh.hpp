@@ -21,8 +21,9 @@ struct Mesh {
   /// Every edge once: its two vertices and the two triangles that share it.
   std::vector<std::array<std::uint32_t, 4>> edges;
   int level = 0;                                    ///< sphere tessellation level used
-  double mesh_radius = 0.0;                         ///< radius of the circumscribed sphere polytope
-  int hull_input = 0;                               ///< points passed to qhull (0: built directly)
+  double mesh_radius = 0.0;                         ///< radius of the circumscribed sphere polytope (every vertex is this far from the core hull)
+  bool direct = false;                              ///< built from the core hull (false: the qhull fallback)
+  int hull_input = 0;                               ///< points passed to qhull (the core hull; 0 for points, segments, flat sets)
 };
 
 /// The unit sphere polytope of a tessellation level (icosahedron subdivided `level` times,
@@ -43,13 +44,21 @@ const SpherePolytope& spherePolytope(int level);
 /// radius 0 are drawn as if their radius were this, so they stay visible and never look smaller.
 inline constexpr double kMinDrawRadius = 1e-3;
 
-/// A mesh containing the SSCH (points, radius): the convex hull of circumscribed sphere
-/// polytopes of radius max(radius, min_radius) around the core points. One point gives the
-/// sphere polytope itself and two points its sweep along the segment (built directly); more
-/// points go through qhull (only points that can be hull vertices of the Minkowski sum are
-/// passed). Works for flat and collinear sets. Throws std::invalid_argument for empty or
-/// non-finite input.
+/// A mesh containing the SSCH (points, radius): the Minkowski sum of the core points' convex
+/// hull P and the sphere polytope Q of radius max(radius, min_radius) scaled to contain the ball
+/// (turned by a fixed rotation), built directly from P's hull (tens of points) without a hull of
+/// all p_i + q_j: a patch triangle v + t for each triangle t of Q (v the vertex of P supporting
+/// its normal), a strip parallelogram e + g for each hull edge e of P and edge g of Q whose
+/// normal arcs cross, and each facet of P offset by the vertex of Q supporting its normal.
+/// Single points, collinear and flat sets (within 1e-9 (1 + extent), projected) and duplicate
+/// points are handled by the same construction; if rounding makes its pieces disagree it falls
+/// back to the hull of circumscribed sphere polytopes around the core points (qhull).
+/// Throws std::invalid_argument for empty or non-finite input.
 Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, double min_radius = kMinDrawRadius);
+
+/// Process-wide switch to the previous construction (the qhull hull of circumscribed sphere
+/// polytopes around the core points), for comparisons in benchmarks and tests.
+void useHullMeshing(bool on);
 
 /// Meshes keyed by the exact volume shape (the bytes of the points, radius, level and minimum radius): a volume
 /// that does not change (a static body, the same state) reuses its mesh; entries unused for a
