@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <random>
+#include <string>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -163,6 +165,38 @@ TEST(RenderContext, ReportsItsRenderer) {
   const auto ctx = GlContext::make();
   EXPECT_FALSE(ctx->renderer().empty());
   std::cout << "renderer: " << ctx->renderer() << "\n";
+  const char* chosen = std::getenv("KCCD_GL");
+  // Unset: EGL when this build has it (OSMesa only when EGL gives no context; not on CI machines).
+  const GlBackend expected = chosen != nullptr && std::string(chosen) == "osmesa" ? GlBackend::OsMesa
+                             : chosen == nullptr && !compiledIn(GlBackend::Egl) ? GlBackend::OsMesa
+                                                                                 : GlBackend::Egl;
+  EXPECT_EQ(ctx->backend(), expected) << toString(ctx->backend());
+  EXPECT_NE(ctx->renderer().find(expected == GlBackend::Egl ? "EGL" : "OSMesa"), std::string::npos);
+}
+
+TEST(RenderContext, UnknownOrMissingBackendIsAOneLineError) {
+  const char* saved = std::getenv("KCCD_GL");
+  const std::string restore = saved == nullptr ? "" : saved;
+  ::setenv("KCCD_GL", "vulkan", 1);
+  try {
+    (void)GlContext::make();
+    ADD_FAILURE() << "KCCD_GL=vulkan accepted";
+  } catch (const GlContextError& e) {
+    EXPECT_EQ(std::string(e.what()), "KCCD_GL=vulkan: unknown GL back end (use egl or osmesa)");
+  }
+  if (saved == nullptr) ::unsetenv("KCCD_GL"); else ::setenv("KCCD_GL", restore.c_str(), 1);
+  for (const GlBackend b : {GlBackend::Egl, GlBackend::OsMesa}) {
+    if (compiledIn(b)) {
+      EXPECT_EQ(GlContext::make(b)->backend(), b);
+    } else {
+      try {
+        (void)GlContext::make(b);
+        ADD_FAILURE() << toString(b) << " made without being compiled in";
+      } catch (const GlContextError& e) {
+        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+      }
+    }
+  }
 }
 
 }  // namespace
