@@ -624,27 +624,28 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
       cv::Mat unused;
       cv::convertMaps(mp.mapX(), mp.mapY(), mask_map_, unused, CV_16SC2, true);
     }
-    // One pass per row: the nearest pinhole pixel (0 outside the pinhole image), its label (the
-    // low byte of the float), and the pixels per label.
+    // The nearest pinhole pixel per output pixel (the floats' bits moved as they are, 0 outside the
+    // pinhole image), then one pass per row: the label (the low byte) and the pixels per label.
+    cv::Mat nearest(bits.rows, bits.cols, CV_8UC4, bits.data, bits.step);  // 4 bytes per pixel, moved as they are
+    if (mp.warps()) {
+      cv::Mat warped;
+      cv::remap(nearest, warped, mask_map_, cv::Mat(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+      nearest = warped;
+    }
     frame.mask.create(cam.height, cam.width, CV_8UC1);
     std::array<int, 256> counts{};
     std::mutex counts_mutex;
-    const bool warps = mp.warps();
     cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range& rows) {
       std::array<std::array<int, 256>, 4> local{};  // four histograms: fewer store-to-load stalls
-      const auto cols = static_cast<unsigned>(bits.cols), rows_in = static_cast<unsigned>(bits.rows);
-      const auto* base = bits.ptr<std::int32_t>();
-      const std::size_t step = bits.step1();
       for (int v = rows.start; v < rows.end; ++v) {
         uchar* out = frame.mask.ptr<uchar>(v);
-        const cv::Vec2s* map = warps ? mask_map_.ptr<cv::Vec2s>(v) : nullptr;
-        for (int u = 0; u < cam.width; ++u) {
-          const auto x = static_cast<unsigned>(warps ? map[u][0] : u), y = static_cast<unsigned>(warps ? map[u][1] : v);
-          const bool inside = x < cols && y < rows_in;
-          const int label = !inside ? 0 : fill_label >= 0 ? fill_label : (base[y * step + x] & 0xFF);
-          out[u] = static_cast<uchar>(label);
-          ++local[static_cast<std::size_t>(u & 3)][static_cast<std::size_t>(label)];
+        const auto* in = reinterpret_cast<const std::int32_t*>(nearest.ptr<uchar>(v));
+        if (fill_label < 0) {
+          for (int u = 0; u < cam.width; ++u) out[u] = static_cast<uchar>(in[u] & 0xFF);
+        } else {  // all bits 0: outside the pinhole image (the cleared label target is never 0)
+          for (int u = 0; u < cam.width; ++u) out[u] = in[u] != 0 ? static_cast<uchar>(fill_label) : uchar{0};
         }
+        for (int u = 0; u < cam.width; ++u) ++local[static_cast<std::size_t>(u & 3)][out[u]];
       }
       const std::lock_guard lock(counts_mutex);
       for (const auto& h : local)
