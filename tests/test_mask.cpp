@@ -105,6 +105,35 @@ TEST(RenderMask, NearestBodyWinsAndLabelsAreIndexPlusOne) {
   EXPECT_EQ(f.bgra.at<cv::Vec4b>(c.height - 1, c.width - 1)[3], 0);
 }
 
+// The labels come out of the colour pass (overlay look), or from a pass of their own (mask alone,
+// shaded look, multisampling): the same masks either way, in any order of frames.
+TEST(RenderMask, SameLabelsFromTheColourPassAndAlone) {
+  const Camera c = lookAt(Vec3(1.5, -1.0, 1.0), Vec3(0, 0, 0), 200, 150, 180, {-0.1, 0.01, 0, 0, 0});
+  const std::vector<Vec3> a = {Vec3(-0.2, 0, 0), Vec3(0.2, 0.1, 0)}, b = {Vec3(0.1, 0.1, 0.1)}, d = {Vec3(0, -0.3, 0.2)};
+  const Volume v[] = {{a, 0.15, VolumeStatus::Clear, "a"}, {b, 0.2, VolumeStatus::Colliding, "b"},
+                      {d, 0.1, VolumeStatus::WithinMargin, "d"}};
+  Renderer plain(c);
+  Renderer msaa(c, RenderOptions{.msaa_samples = 4});
+  const Frame together = plain.render(v, Style{}, true, true);
+  const Frame alone = plain.render(v, Style{}, false, true);
+  const Frame shaded = plain.render(v, Style{.shaded = true}, true, true);
+  const Frame again = plain.render(v, Style{}, true, true);
+  const Frame mask_first = msaa.render(v, Style{}, false, true);
+  const Frame multisampled = msaa.render(v, Style{}, true, true);
+  EXPECT_GT(together.pixels[0], 100);
+  EXPECT_GT(together.pixels[1], 100);
+  EXPECT_GT(together.pixels[2], 100);
+  for (const Frame* f : {&alone, &shaded, &again, &mask_first, &multisampled}) {
+    EXPECT_EQ(cv::countNonZero(f->mask != together.mask), 0);
+    EXPECT_EQ(f->pixels, together.pixels);
+  }
+  // The colour layer does not depend on whether a mask is drawn with it, nor on a mask drawn before.
+  const Frame colour_only = plain.render(v, Style{}, true, false);
+  EXPECT_EQ(cv::norm(colour_only.bgra, together.bgra, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(multisampled.bgra, msaa.render(v, Style{}, true, false).bgra, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::countNonZero(multisampled.bgra.reshape(1) > 0), 1000);
+}
+
 TEST(RenderMask, DegenerateVolumesAreVisible) {
   const Camera c = lookAt(Vec3(1.5, -1.0, 1.0), Vec3(0, 0, 0), 160, 120, 150, {-0.1, 0.01, 0, 0, 0});
   Renderer r(c);

@@ -487,6 +487,7 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   if (gl_->samples > 1) {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->ms_fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, gl_->resolve_fbo);
+    drawBuffers(true, false);  // a mask drawn alone before leaves the label attachment selected
     glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
   glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->resolve_fbo);
