@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -34,10 +33,10 @@ bool hasExtension(const char* list, const char* name) {
   return false;
 }
 
-// eglInitialize/eglTerminate count per display (EGL displays are per process): the display is
-// terminated when its last context goes.
+// EGL displays are per process and stay initialised until it exits: eglTerminate would unload
+// Mesa's driver under the other contexts' feet (and with it the code that owns its allocations),
+// and initialising an initialised display again does nothing.
 std::mutex display_mutex;
-std::map<EGLDisplay, int> display_users;
 
 class EglContext final : public GlContext {
  public:
@@ -78,7 +77,6 @@ class EglContext final : public GlContext {
       const std::lock_guard lock(display_mutex);
       EGLint major = 0, minor = 0;
       if (!eglInitialize(display_, &major, &minor)) throw GlContextError("EGL: " + where + ": " + eglError("eglInitialize"));
-      ++display_users[display_];
     }
     try {
       create(where);
@@ -123,11 +121,6 @@ class EglContext final : public GlContext {
       if (eglGetCurrentContext() == context_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
       eglDestroyContext(display_, context_);
       context_ = EGL_NO_CONTEXT;
-    }
-    const std::lock_guard lock(display_mutex);
-    if (--display_users[display_] == 0) {
-      display_users.erase(display_);
-      eglTerminate(display_);
     }
     display_ = EGL_NO_DISPLAY;
   }
