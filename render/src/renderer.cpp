@@ -625,28 +625,25 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
       cv::Mat unused;
       cv::convertMaps(mp.mapX(), mp.mapY(), mask_map_, unused, CV_16SC2, true);
     }
-    // The nearest pinhole pixel per output pixel (the floats' bits moved as they are, 0 outside the
-    // pinhole image), then one pass per row: the label (the low byte) and the pixels per label.
-    cv::Mat nearest(bits.rows, bits.cols, CV_8UC4, bits.data, bits.step);  // 4 bytes per pixel, moved as they are
+    // The labels (the low byte of each float: byte 0 on a little-endian machine), the nearest
+    // pinhole pixel per output pixel (0 outside the pinhole image), then the pixels per label.
+    cv::Mat pinhole_labels;
+    cv::extractChannel(cv::Mat(bits.rows, bits.cols, CV_8UC4, bits.data, bits.step), pinhole_labels,
+                       std::endian::native == std::endian::little ? 0 : 3);
+    if (fill_label >= 0) pinhole_labels.setTo(cv::Scalar::all(fill_label));
     if (mp.warps()) {
-      cv::Mat warped;
-      cv::remap(nearest, warped, mask_map_, cv::Mat(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar::all(0));
-      nearest = warped;
+      cv::remap(pinhole_labels, frame.mask, mask_map_, cv::Mat(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                cv::Scalar::all(0));
+    } else {
+      frame.mask = pinhole_labels;
     }
-    frame.mask.create(cam.height, cam.width, CV_8UC1);
     std::array<int, 256> counts{};
     std::mutex counts_mutex;
     cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range& rows) {
       std::array<std::array<int, 256>, 4> local{};  // four histograms: fewer store-to-load stalls
       for (int v = rows.start; v < rows.end; ++v) {
-        uchar* out = frame.mask.ptr<uchar>(v);
-        const auto* in = reinterpret_cast<const std::int32_t*>(nearest.ptr<uchar>(v));
-        if (fill_label < 0) {
-          for (int u = 0; u < cam.width; ++u) out[u] = static_cast<uchar>(in[u] & 0xFF);
-        } else {  // all bits 0: outside the pinhole image (the cleared label target is never 0)
-          for (int u = 0; u < cam.width; ++u) out[u] = in[u] != 0 ? static_cast<uchar>(fill_label) : uchar{0};
-        }
-        for (int u = 0; u < cam.width; ++u) ++local[static_cast<std::size_t>(u & 3)][out[u]];
+        const uchar* row = frame.mask.ptr<uchar>(v);
+        for (int u = 0; u < cam.width; ++u) ++local[static_cast<std::size_t>(u & 3)][row[u]];
       }
       const std::lock_guard lock(counts_mutex);
       for (const auto& h : local)
