@@ -3,7 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -106,6 +110,42 @@ TEST_F(RenderGolden, StaticFramesReuseBodyMeshes) {
   const int b4 = frame({0.1001, -0.3001, 0.9001}, false).meshes_built;
   EXPECT_EQ(b2, 0);
   EXPECT_GT(b4, 0);
+}
+
+// Both GL back ends draw the same pixels here (llvmpipe under EGL surfaceless and under OSMesa):
+// colour layers and masks bit for bit, static and swept.
+TEST(RenderBackends, EglAndOsMesaAreBitIdentical) {
+  if (!compiledIn(GlBackend::Egl) || !compiledIn(GlBackend::OsMesa)) GTEST_SKIP() << "this build has one GL back end";
+  const Model model = loadModel(kData + "/demo_arm.yaml");
+  const char* saved = std::getenv("KCCD_GL");
+  const std::string restore = saved == nullptr ? "" : saved;
+  std::vector<Frame> frames[2];
+  std::string names[2];
+  for (const int b : {0, 1}) {
+    ::setenv("KCCD_GL", b == 0 ? "egl" : "osmesa", 1);
+    Renderer r(goldenCamera());
+    names[b] = r.rendererString();
+    for (const auto& [lo, hi] : {std::pair<std::vector<double>, std::vector<double>>{{0.3, 0.4, 0.6}, {0.3, 0.4, 0.6}},
+                                 {{-0.5, 0.0, 0.0}, {0.5, 0.1, 0.2}}}) {
+      Checker checker(model);
+      const QueryResult& q = checker.query(lo, hi, QueryOptions{.type = QueryType::Distances});
+      const std::vector<Volume> volumes = sceneVolumes(model, checker, bodyStatus(model, q));
+      frames[b].push_back(r.render(volumes, Style{.labels = true}));
+      frames[b].push_back(r.render(volumes, Style{.shaded = true}, true, false));
+    }
+  }
+  if (saved == nullptr) ::unsetenv("KCCD_GL"); else ::setenv("KCCD_GL", restore.c_str(), 1);
+  EXPECT_NE(names[0].find("EGL"), std::string::npos) << names[0];
+  EXPECT_NE(names[1].find("OSMesa"), std::string::npos) << names[1];
+  ASSERT_EQ(frames[0].size(), frames[1].size());
+  for (std::size_t i = 0; i < frames[0].size(); ++i) {
+    const Frame &a = frames[0][i], &b = frames[1][i];
+    EXPECT_EQ(cv::norm(a.bgra, b.bgra, cv::NORM_INF), 0.0) << "colour " << i;
+    if (!a.mask.empty()) {
+      EXPECT_EQ(cv::norm(a.mask, b.mask, cv::NORM_INF), 0.0) << "mask " << i;
+    }
+    EXPECT_GT(cv::countNonZero(a.bgra.reshape(1) > 0), 1000) << i;
+  }
 }
 
 }  // namespace

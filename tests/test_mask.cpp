@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <random>
+#include <string>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -103,6 +105,35 @@ TEST(RenderMask, NearestBodyWinsAndLabelsAreIndexPlusOne) {
   EXPECT_EQ(f.bgra.at<cv::Vec4b>(c.height - 1, c.width - 1)[3], 0);
 }
 
+// The labels come out of the colour pass (overlay look), or from a pass of their own (mask alone,
+// shaded look, multisampling): the same masks either way, in any order of frames.
+TEST(RenderMask, SameLabelsFromTheColourPassAndAlone) {
+  const Camera c = lookAt(Vec3(1.5, -1.0, 1.0), Vec3(0, 0, 0), 200, 150, 180, {-0.1, 0.01, 0, 0, 0});
+  const std::vector<Vec3> a = {Vec3(-0.2, 0, 0), Vec3(0.2, 0.1, 0)}, b = {Vec3(0.1, 0.1, 0.1)}, d = {Vec3(0, -0.3, 0.2)};
+  const Volume v[] = {{a, 0.15, VolumeStatus::Clear, "a"}, {b, 0.2, VolumeStatus::Colliding, "b"},
+                      {d, 0.1, VolumeStatus::WithinMargin, "d"}};
+  Renderer plain(c);
+  Renderer msaa(c, RenderOptions{.msaa_samples = 4});
+  const Frame together = plain.render(v, Style{}, true, true);
+  const Frame alone = plain.render(v, Style{}, false, true);
+  const Frame shaded = plain.render(v, Style{.shaded = true}, true, true);
+  const Frame again = plain.render(v, Style{}, true, true);
+  const Frame mask_first = msaa.render(v, Style{}, false, true);
+  const Frame multisampled = msaa.render(v, Style{}, true, true);
+  EXPECT_GT(together.pixels[0], 100);
+  EXPECT_GT(together.pixels[1], 100);
+  EXPECT_GT(together.pixels[2], 100);
+  for (const Frame* f : {&alone, &shaded, &again, &mask_first, &multisampled}) {
+    EXPECT_EQ(cv::countNonZero(f->mask != together.mask), 0);
+    EXPECT_EQ(f->pixels, together.pixels);
+  }
+  // The colour layer does not depend on whether a mask is drawn with it, nor on a mask drawn before.
+  const Frame colour_only = plain.render(v, Style{}, true, false);
+  EXPECT_EQ(cv::norm(colour_only.bgra, together.bgra, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(multisampled.bgra, msaa.render(v, Style{}, true, false).bgra, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::countNonZero(multisampled.bgra.reshape(1) > 0), 1000);
+}
+
 TEST(RenderMask, DegenerateVolumesAreVisible) {
   const Camera c = lookAt(Vec3(1.5, -1.0, 1.0), Vec3(0, 0, 0), 160, 120, 150, {-0.1, 0.01, 0, 0, 0});
   Renderer r(c);
@@ -163,6 +194,38 @@ TEST(RenderContext, ReportsItsRenderer) {
   const auto ctx = GlContext::make();
   EXPECT_FALSE(ctx->renderer().empty());
   std::cout << "renderer: " << ctx->renderer() << "\n";
+  const char* chosen = std::getenv("KCCD_GL");
+  // Unset: EGL when this build has it (OSMesa only when EGL gives no context; not on CI machines).
+  const GlBackend expected = chosen != nullptr && std::string(chosen) == "osmesa" ? GlBackend::OsMesa
+                             : chosen == nullptr && !compiledIn(GlBackend::Egl) ? GlBackend::OsMesa
+                                                                                 : GlBackend::Egl;
+  EXPECT_EQ(ctx->backend(), expected) << toString(ctx->backend());
+  EXPECT_NE(ctx->renderer().find(expected == GlBackend::Egl ? "EGL" : "OSMesa"), std::string::npos);
+}
+
+TEST(RenderContext, UnknownOrMissingBackendIsAOneLineError) {
+  const char* saved = std::getenv("KCCD_GL");
+  const std::string restore = saved == nullptr ? "" : saved;
+  ::setenv("KCCD_GL", "vulkan", 1);
+  try {
+    (void)GlContext::make();
+    ADD_FAILURE() << "KCCD_GL=vulkan accepted";
+  } catch (const GlContextError& e) {
+    EXPECT_EQ(std::string(e.what()), "KCCD_GL=vulkan: unknown GL back end (use egl or osmesa)");
+  }
+  if (saved == nullptr) ::unsetenv("KCCD_GL"); else ::setenv("KCCD_GL", restore.c_str(), 1);
+  for (const GlBackend b : {GlBackend::Egl, GlBackend::OsMesa}) {
+    if (compiledIn(b)) {
+      EXPECT_EQ(GlContext::make(b)->backend(), b);
+    } else {
+      try {
+        (void)GlContext::make(b);
+        ADD_FAILURE() << toString(b) << " made without being compiled in";
+      } catch (const GlContextError& e) {
+        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -152,6 +152,8 @@ Runner addRender(CLI::App& app) {
   sub->footer("Colours: green clear, amber within the safety margin, red colliding.\n"
               "Volumes containing the camera fill the view; volumes behind the camera, farther than 1e6 m\n"
               "or not finite are not drawn and are listed (text: 'not drawn: reason'; JSON: not_drawn).\n"
+              "GL: KCCD_GL=egl (EGL surfaceless, the default) or KCCD_GL=osmesa; KCCD_EGL_DEVICE=N uses EGL device N\n"
+              "(e.g. a GPU); the renderer string (--json: renderer) names the one in use.\n"
               "Exit status: 0 written, 2 bad input, 3 unsafe query status or a non-finite volume (image still written).");
   return [args] { return runRender(*args); };
 }

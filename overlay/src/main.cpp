@@ -5,6 +5,7 @@
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
+#include "kccd/render/gl_context.hpp"
 
 namespace {
 
@@ -70,6 +71,8 @@ int main(int argc, char** argv) {
       if (sub->parsed()) return static_cast<int>(run());
   } catch (const kccd::InputError& e) {  // every reader's error and every option error (UsageError)
     return fail(Exit::BadInput, kccd::cli::oneLine(e.what()));
+  } catch (const kccd::render::GlContextError& e) {  // no GL context (KCCD_GL, EGL, OSMesa): not an input error
+    return fail(Exit::Internal, kccd::cli::oneLine(e.what()));
   } catch (const std::exception& e) {
     return fail(Exit::Internal, "internal error: " + kccd::cli::oneLine(e.what()));
   }

@@ -4,34 +4,26 @@
 #include <GL/gl.h>
 
 #include <array>
-#include <cstdio>
 
-#include "kccd/render/gl_context.hpp"
+#include "gl_backends.hpp"
 
 namespace kccd::render {
 namespace {
 
 class OsMesaContext final : public GlContext {
  public:
-  OsMesaContext() {
+  OsMesaContext() : GlContext(GlBackend::OsMesa) {
     const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_STENCIL_BITS, 0,
                            OSMESA_ACCUM_BITS, 0, OSMESA_PROFILE, OSMESA_COMPAT_PROFILE, 0};
     ctx_ = OSMesaCreateContextAttribs(attribs, nullptr);
     if (ctx_ == nullptr) ctx_ = OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, nullptr);
     if (ctx_ == nullptr) throw GlContextError("OSMesa: cannot create an off-screen GL context (OSMesaCreateContext failed)");
-    makeCurrent();
-    const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    const auto* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
-    if (renderer == nullptr || version == nullptr) {
+    try {
+      makeCurrent();
+      describe("OSMesa", "OSMesa");
+    } catch (...) {
       OSMesaDestroyContext(ctx_);
-      throw GlContextError(
-          "OSMesa: the context gives no GL_RENDERER string (is libGL linked ahead of libOSMesa?)");
-    }
-    renderer_ = std::string(renderer) + " / " + version;
-    int major = 0;
-    if (std::sscanf(version, "%d", &major) != 1 || major < 3) {
-      OSMesaDestroyContext(ctx_);
-      throw GlContextError("OSMesa: GL " + std::string(version) + " is too old (framebuffer objects need 3.0)");
+      throw;
     }
   }
   ~OsMesaContext() override { OSMesaDestroyContext(ctx_); }
@@ -48,6 +40,6 @@ class OsMesaContext final : public GlContext {
 
 }  // namespace
 
-std::unique_ptr<GlContext> GlContext::make() { return std::make_unique<OsMesaContext>(); }
+std::unique_ptr<GlContext> detail::makeOsMesaContext() { return std::make_unique<OsMesaContext>(); }
 
 }  // namespace kccd::render

@@ -6,10 +6,13 @@
 #include <GL/glext.h>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
@@ -50,15 +53,60 @@ cv::Scalar statusColour(VolumeStatus status) {
   return {255, 255, 255};
 }
 
-/// The framebuffers: a multisampled colour target resolved into a plain one, and a
-/// single-sampled colour + depth target for the mask.
+// Labels are drawn by a shader into a one-channel float target blended with GL_MIN: each fragment
+// writes its distance along the optical axis (camera z, > 0 in front of the near plane) with the
+// low 8 bits of the float replaced by the label. Positive floats order like their bit patterns, so
+// the minimum is the nearest surface (to 2^-15 of its depth: 0.1 mm at 3 m) and its low byte the
+// label, whatever the drawing order. The colour output is the fixed-function colour, so the
+// colour layer is the same as without labels, and both go out in one pass (two attachments).
+constexpr const char* kLabelVertexShader = R"(#version 330 compatibility
+out float camera_z;
+void main() {
+  gl_Position = ftransform();
+  gl_FrontColor = gl_Color;
+  camera_z = gl_Vertex.z;
+}
+)";
+constexpr const char* kLabelFragmentShader = R"(#version 330 compatibility
+in float camera_z;
+uniform uint label;
+layout(location = 0) out vec4 colour;
+layout(location = 1) out vec4 nearest;
+void main() {
+  colour = gl_Color;
+  nearest = vec4(uintBitsToFloat((floatBitsToUint(max(camera_z, 1e-30)) & 0xFFFFFF00u) | label), 0.0, 0.0, 0.0);
+}
+)";
+// The label target's clear value: farther than anything (2^126), label 0 (low byte zero).
+constexpr std::uint32_t kLabelClearBits = 0x7E800000u;
+
+/// The framebuffers: a multisampled colour target resolved into a plain one, with a second
+/// attachment for labels (drawn in the colour pass, or alone for a mask only), and a label target
+/// of its own when the mask uses another pinhole scale than the colour layer.
 struct Renderer::Gl {
   GLuint ms_fbo = 0, ms_colour = 0;
-  GLuint resolve_fbo = 0, resolve_colour = 0;
+  GLuint resolve_fbo = 0, resolve_colour = 0, resolve_labels = 0;
   GLuint ms_depth = 0, resolve_depth = 0;  // depth for the shaded (opaque) look
-  GLuint mask_fbo = 0, mask_colour = 0, mask_depth = 0;
+  GLuint mask_fbo = 0, mask_labels = 0;    // only with a separate mask scale
+  GLuint program = 0;
+  GLint label_location = -1;
   int samples = 0;
   int width = 0, height = 0;
+
+  static GLuint compile(GLenum type, const char* source) {
+    const GLuint shader = glCreateShader(type);
+    glShaderSource(shader, 1, &source, nullptr);
+    glCompileShader(shader);
+    GLint ok = 0;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+      char log[1024] = {};
+      glGetShaderInfoLog(shader, sizeof log, nullptr, log);
+      glDeleteShader(shader);
+      throw GlContextError(std::string("GL: label shader: ") + log);
+    }
+    return shader;
+  }
 
   static void check(GLuint fbo, const char* what) {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
@@ -93,6 +141,8 @@ struct Renderer::Gl {
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, resolve_colour);
     resolve_depth = renderbuffer(GL_DEPTH_COMPONENT24, 0, w, h);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, resolve_depth);
+    resolve_labels = renderbuffer(GL_R32F, 0, w, h);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, resolve_labels);
     check(resolve_fbo, "colour");
     if (samples > 1) {
       ms_colour = renderbuffer(GL_RGBA8, samples, w, h);
@@ -103,20 +153,41 @@ struct Renderer::Gl {
       glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth);
       check(ms_fbo, "multisample colour");
     }
-    mask_colour = renderbuffer(GL_RGBA8, 0, mw, mh);
-    mask_depth = renderbuffer(GL_DEPTH_COMPONENT24, 0, mw, mh);
-    glGenFramebuffers(1, &mask_fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, mask_fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, mask_colour);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, mask_depth);
-    check(mask_fbo, "mask");
+    if (mw != w || mh != h) {
+      mask_labels = renderbuffer(GL_R32F, 0, mw, mh);
+      glGenFramebuffers(1, &mask_fbo);
+      glBindFramebuffer(GL_FRAMEBUFFER, mask_fbo);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, mask_labels);
+      const GLenum buffers[] = {GL_NONE, GL_COLOR_ATTACHMENT1};
+      glDrawBuffers(2, buffers);
+      glReadBuffer(GL_COLOR_ATTACHMENT1);
+      check(mask_fbo, "mask");
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    const GLuint vs = compile(GL_VERTEX_SHADER, kLabelVertexShader);
+    const GLuint fs = compile(GL_FRAGMENT_SHADER, kLabelFragmentShader);
+    program = glCreateProgram();
+    glAttachShader(program, vs);
+    glAttachShader(program, fs);
+    glLinkProgram(program);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (!ok) {
+      char log[1024] = {};
+      glGetProgramInfoLog(program, sizeof log, nullptr, log);
+      glDeleteProgram(program);
+      throw GlContextError(std::string("GL: label shader: ") + log);
+    }
+    label_location = glGetUniformLocation(program, "label");
   }
   ~Gl() {
     const GLuint fbos[] = {ms_fbo, resolve_fbo, mask_fbo};
-    const GLuint rbs[] = {ms_colour, resolve_colour, mask_colour, mask_depth, ms_depth, resolve_depth};
+    const GLuint rbs[] = {ms_colour, resolve_colour, resolve_labels, mask_labels, ms_depth, resolve_depth};
     glDeleteFramebuffers(3, fbos);
     glDeleteRenderbuffers(6, rbs);
+    glDeleteProgram(program);
   }
 };
 
@@ -328,15 +399,42 @@ void drawTriangles(const Mesh& mesh, const std::vector<float>& vertices) {
   glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.triangles.size() * 3), GL_UNSIGNED_INT, mesh.triangles.data());
 }
 
+// Draw buffers of the bound framebuffer: the colour attachment, the label attachment, or both.
+void drawBuffers(bool colour, bool labels) {
+  const GLenum none = GL_NONE;
+  const GLenum buffers[] = {colour ? GLenum{GL_COLOR_ATTACHMENT0} : none, labels ? GLenum{GL_COLOR_ATTACHMENT1} : none};
+  glDrawBuffers(labels ? 2 : 1, buffers);
+}
+
+void clearLabels() {
+  const float far[4] = {std::bit_cast<float>(kLabelClearBits), 0, 0, 0};
+  glClearBufferfv(GL_COLOR, 1, far);  // draw buffer 1 = the label attachment
+}
+
+// Reads the label attachment of the bound framebuffer as the floats' bit patterns (CV_32S); the
+// label is the low byte (taken while warping, see Renderer::render).
+cv::Mat readLabels(int w, int h) {
+  cv::Mat bits(h, w, CV_32S);
+  glReadBuffer(GL_COLOR_ATTACHMENT1);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, w, h, GL_RED, GL_FLOAT, bits.data);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  return bits;
+}
+
 }  // namespace
 
-cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& style, double near, double far) {
+cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& style, double near, double far,
+                             cv::Mat* labels) {
   const int w = gl_->width, h = gl_->height;
+  const bool with_labels = labels != nullptr && gl_->samples <= 1 && !style.shaded;
   glBindFramebuffer(GL_FRAMEBUFFER, gl_->samples > 1 ? gl_->ms_fbo : gl_->resolve_fbo);
+  if (gl_->samples <= 1) drawBuffers(true, with_labels);
   setCamera(projection_, near, far);
   glClearColor(0, 0, 0, 0);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (with_labels) clearLabels();
   if (style.shaded) {
     std::vector<const Prepared*> all;
     for (const Prepared& p : bodies)
@@ -352,10 +450,20 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   for (const Prepared& p : bodies)
     if (p.mesh) order.push_back(&p);
   std::sort(order.begin(), order.end(), [](const Prepared* a, const Prepared* b) { return a->depth > b->depth; });
+  if (with_labels) {  // the labels of the nearest surfaces in the same pass (see kLabelFragmentShader)
+    glUseProgram(gl_->program);
+    glBlendEquationi(1, GL_MIN);
+  }
   for (const Prepared* p : order) {
     const cv::Scalar c = p->colour;  // BGR, drawn as GL's RGB (see the read-back)
     glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
+    if (with_labels) glUniform1ui(gl_->label_location, static_cast<GLuint>(p->index + 1));
     drawTriangles(*p->mesh, p->vertices);
+  }
+  if (with_labels) {
+    glUseProgram(0);
+    glBlendEquation(GL_FUNC_ADD);
+    drawBuffers(true, false);  // outlines and view fills: colour only
   }
   glLineWidth(static_cast<float>(style.outline_width * projection_.supersample()));
   glEnable(GL_LINE_SMOOTH);  // coverage in alpha, blended like the fill
@@ -379,6 +487,7 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   if (gl_->samples > 1) {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->ms_fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, gl_->resolve_fbo);
+    drawBuffers(true, false);  // a mask drawn alone before leaves the label attachment selected
     glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
   glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->resolve_fbo);
@@ -388,32 +497,33 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   // Colours are drawn with blue in GL's red channel, so the plain RGBA read (llvmpipe's fast
   // path, no swizzle) returns OpenCV's BGRA order.
   glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, image.data);
+  if (with_labels) *labels = readLabels(w, h);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return image;
 }
 
+// The labels alone (a mask without the colour layer, or with the shaded look or multisampling):
+// the label attachment of the colour target, or the mask's own target at its own scale.
 cv::Mat Renderer::drawMask(const std::vector<Prepared>& bodies, double near, double far) {
   const int w = gl_->mask_width, h = gl_->mask_height;
-  glBindFramebuffer(GL_FRAMEBUFFER, gl_->mask_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, gl_->mask_fbo != 0 ? gl_->mask_fbo : gl_->resolve_fbo);
+  drawBuffers(false, true);
   setCamera(maskProjection(), near, far);
-  // A volume containing the camera is the nearest everywhere.
-  const auto fill = std::find_if(bodies.begin(), bodies.end(), [](const Prepared& p) { return p.fills; });
-  glClearColor(fill == bodies.end() ? 0.0f : static_cast<float>(fill->index + 1) / 255.0f, 0, 0, 0);
-  glClearDepth(1.0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glDisable(GL_BLEND);
+  clearLabels();
+  glDisable(GL_DEPTH_TEST);
+  glEnable(GL_BLEND);
+  glBlendEquationi(1, GL_MIN);
+  glUseProgram(gl_->program);
   for (const Prepared& p : bodies) {
-    if (!p.mesh || fill != bodies.end()) continue;
-    glColor4ub(static_cast<GLubyte>(p.index + 1), 0, 0, 255);
+    if (!p.mesh) continue;
+    glUniform1ui(gl_->label_location, static_cast<GLuint>(p.index + 1));
     drawTriangles(*p.mesh, p.vertices);
   }
-  glDisable(GL_DEPTH_TEST);
-  cv::Mat mask(h, w, CV_8UC1);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glUseProgram(0);
+  glBlendEquation(GL_FUNC_ADD);
+  glDisable(GL_BLEND);
   glFinish();
-  glReadPixels(0, 0, w, h, GL_RED, GL_UNSIGNED_BYTE, mask.data);
+  cv::Mat mask = readLabels(w, h);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return mask;
 }
@@ -470,8 +580,11 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
   prepare(volumes, bodies, frame);
   tick("prepare");
   const Camera& cam = projection_.camera();
+  // The mask from the colour pass when it can (the overlay look at the colour pass's scale).
+  const bool same_pass = want_colour && want_mask && !style.shaded && gl_->samples <= 1 && !mask_projection_;
+  cv::Mat labels;
   if (want_colour) {
-    cv::Mat premultiplied = drawColour(bodies, style, frame.near, frame.far);
+    cv::Mat premultiplied = drawColour(bodies, style, frame.near, frame.far, same_pass ? &labels : nullptr);
     tick("colour+readback");
     if (projection_.warps()) {
       if (fixed_map_a_.empty())  // fixed-point maps: remap's fast path (1/32 px steps)
@@ -503,26 +616,42 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     tick("decorate");
   }
   if (want_mask) {
-    cv::Mat mask = drawMask(bodies, frame.near, frame.far);
+    const cv::Mat bits = same_pass ? labels : drawMask(bodies, frame.near, frame.far);
+    // A volume containing the camera is the nearest everywhere.
+    const auto fill = std::find_if(bodies.begin(), bodies.end(), [](const Prepared& p) { return p.fills; });
+    const int fill_label = fill != bodies.end() ? fill->index + 1 : -1;
     const Projection& mp = maskProjection();
-    if (mp.warps()) {
-      if (mask_map_.empty()) {  // nearest pinhole pixel per output pixel, as integers
-        cv::Mat unused;
-        cv::convertMaps(mp.mapX(), mp.mapY(), mask_map_, unused, CV_16SC2, true);
-      }
-      cv::Mat warped;
-      cv::remap(mask, warped, mask_map_, cv::Mat(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
-                cv::Scalar::all(0));
-      mask = warped;
+    if (mp.warps() && mask_map_.empty()) {  // nearest pinhole pixel per output pixel, as integers
+      cv::Mat unused;
+      cv::convertMaps(mp.mapX(), mp.mapY(), mask_map_, unused, CV_16SC2, true);
     }
-    frame.mask = mask;
+    // The labels (the low byte of each float: byte 0 on a little-endian machine), the nearest
+    // pinhole pixel per output pixel (0 outside the pinhole image), then the pixels per label.
+    cv::Mat pinhole_labels;
+    cv::extractChannel(cv::Mat(bits.rows, bits.cols, CV_8UC4, bits.data, bits.step), pinhole_labels,
+                       std::endian::native == std::endian::little ? 0 : 3);
+    if (fill_label >= 0) pinhole_labels.setTo(cv::Scalar::all(fill_label));
+    if (mp.warps()) {
+      cv::remap(pinhole_labels, frame.mask, mask_map_, cv::Mat(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                cv::Scalar::all(0));
+    } else {
+      frame.mask = pinhole_labels;
+    }
+    std::array<int, 256> counts{};
+    std::mutex counts_mutex;
+    cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range& rows) {
+      std::array<std::array<int, 256>, 4> local{};  // four histograms: fewer store-to-load stalls
+      for (int v = rows.start; v < rows.end; ++v) {
+        const uchar* row = frame.mask.ptr<uchar>(v);
+        for (int u = 0; u < cam.width; ++u) ++local[static_cast<std::size_t>(u & 3)][row[u]];
+      }
+      const std::lock_guard lock(counts_mutex);
+      for (const auto& h : local)
+        for (std::size_t k = 0; k < h.size(); ++k) counts[k] += h[k];
+    });
     tick("mask");
     frame.pixels.assign(volumes.size(), 0);
-    for (int v = 0; v < cam.height; ++v) {
-      const uchar* row = mask.ptr<uchar>(v);
-      for (int u = 0; u < cam.width; ++u)
-        if (row[u] != 0 && row[u] <= volumes.size()) ++frame.pixels[row[u] - 1];
-    }
+    for (std::size_t i = 0; i < volumes.size(); ++i) frame.pixels[i] = counts[i + 1];
   }
   if (profile) std::fprintf(stderr, "\n");
   return frame;

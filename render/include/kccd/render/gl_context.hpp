@@ -1,4 +1,5 @@
-// An off-screen OpenGL context behind a small interface: OSMesa today, EGL surfaceless later.
+// An off-screen OpenGL context behind a small interface, on one of two back ends: EGL
+// surfaceless (Mesa's EGL_MESA_platform_surfaceless, or an EGL device) and OSMesa.
 #pragma once
 
 #include <memory>
@@ -13,6 +14,16 @@ class GlContextError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The library a GlContext is made with.
+enum class GlBackend {
+  Egl,     ///< EGL without a window: Mesa's surfaceless platform, or an EGL device (KCCD_EGL_DEVICE)
+  OsMesa,  ///< Mesa's OSMesa (removed from Mesa 25.1 onward)
+};
+/// "egl" or "osmesa" (the values of KCCD_GL).
+const char* toString(GlBackend backend);
+/// Whether this build has the back end at all (its library was found at configure time).
+bool compiledIn(GlBackend backend);
+
 /// An off-screen GL context (compatibility profile, >= 3.0 with framebuffer objects) that is
 /// current on the creating thread. Drawing goes to framebuffer objects, never to a window.
 class GlContext {
@@ -23,16 +34,28 @@ class GlContext {
 
   /// Makes the context current on the calling thread (one context per thread).
   virtual void makeCurrent() = 0;
-  /// GL_RENDERER and GL_VERSION as reported at start-up, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) / 4.5 ...".
+  /// GL_RENDERER and GL_VERSION as reported at start-up and the back end, e.g.
+  /// "llvmpipe (LLVM 15.0.6, 256 bits) / 4.5 (Compatibility Profile) Mesa 22.3.6 / EGL surfaceless".
   const std::string& renderer() const { return renderer_; }
+  GlBackend backend() const { return backend_; }
 
-  /// Creates the default off-screen context (OSMesa) and checks that it works: a renderer
-  /// string, GL >= 3.0, framebuffer objects. Throws GlContextError with the reason otherwise.
+  /// Creates the off-screen context chosen by the environment variable KCCD_GL: "egl" or
+  /// "osmesa" (only that one, an error if it does not work); unset or empty: EGL, and OSMesa
+  /// when EGL gives no context. Checks that it works: a renderer string, GL >= 3.0, framebuffer
+  /// objects. Throws GlContextError with a one-line reason otherwise.
   static std::unique_ptr<GlContext> make();
+  /// Creates a context on the given back end (KCCD_GL is not read).
+  static std::unique_ptr<GlContext> make(GlBackend backend);
 
  protected:
-  GlContext() = default;
+  explicit GlContext(GlBackend backend) : backend_(backend) {}
+  /// Reads GL_RENDERER and GL_VERSION of the current context into renderer_ (with `suffix`
+  /// appended); throws GlContextError (prefixed with `who`) when missing or older than 3.0.
+  void describe(const std::string& who, const std::string& suffix);
   std::string renderer_;
+
+ private:
+  GlBackend backend_;
 };
 
 }  // namespace kccd::render

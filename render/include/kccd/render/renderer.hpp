@@ -68,9 +68,11 @@ struct Style {
 /// Renderer settings fixed at construction.
 struct RenderOptions {
   double supersample = 1.0;    ///< pinhole image scale (1..4); > 1 keeps thin slivers through the warp
-  /// Pinhole scale of the mask pass when the camera distorts: the warp samples the mask at
-  /// the nearest pinhole pixel, so a finer pinhole image keeps the label edges within 1/(2 s) px.
-  double mask_supersample = 2.0;
+  /// Pinhole scale of the mask when the camera distorts: the warp samples the mask at the nearest
+  /// pinhole pixel, so label edges are within 1/(2 s) px. At the colour pass's scale (the default)
+  /// the labels come out of the colour pass itself (a second attachment, no second pass); another
+  /// scale (e.g. 2 for ground truth) draws the labels in a pass of their own.
+  double mask_supersample = 1.0;
   /// Multisampling of the colour layer (0 or 1: off; at most 4 on llvmpipe). Off by default:
   /// on llvmpipe 4x MSAA costs ~5x the frame time, and the outline, drawn as smoothed lines on
   /// top of the fill edges, already gives anti-aliased silhouettes.
@@ -129,7 +131,8 @@ class Renderer {
   struct Gl;
   struct Prepared;
   void prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame);
-  cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style, double near, double far);
+  cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style, double near, double far,
+                     cv::Mat* labels = nullptr);
   cv::Mat drawMask(const std::vector<Prepared>& bodies, double near, double far);
   static void drawShaded(const std::vector<const Prepared*>& order, double ambient);
   void decorate(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility,
