@@ -3,6 +3,7 @@
 
 #include <atomic>
 #include <cstdlib>
+#include <limits>
 #include <new>
 #include <random>
 
@@ -40,7 +41,7 @@ TEST(NoAllocation, QueriesAllocateNothingOnceSetUp) {
   ASSERT_GT(g_allocations - before_probe, 0);
 
   std::mt19937_64 rng(123);
-  long queries = 0;
+  long queries = 0, exact_calls = 0;
   for (int i = 0; i < 300; ++i) {
     const Model m = testing::randomModel(rng, 6, 6);
     std::vector<double> lower, upper;
@@ -56,7 +57,10 @@ TEST(NoAllocation, QueriesAllocateNothingOnceSetUp) {
       o.n = 3;
       o.budget_us = (i % 3 == 0) ? 5.0 : 0.0;
       o.max_pairs = (i % 3 == 1) ? 2 : -1;
-      checker.query(lower, upper, o);
+      // The exact stage on flagged pairs (the default) or on every pair, display volumes or not.
+      o.exact_below = (i % 2 == 0) ? -1.0 : std::numeric_limits<double>::infinity();
+      o.tight_volumes = (i % 4) < 2;
+      exact_calls += checker.query(lower, upper, o).stats.exact_calls;
       checker.query(bad, upper, o);
       checker.query(shorter, shorter, o);
       queries += 3;
@@ -65,6 +69,7 @@ TEST(NoAllocation, QueriesAllocateNothingOnceSetUp) {
     ASSERT_EQ(g_allocations - start, 0) << "case " << i;
   }
   EXPECT_EQ(queries, 300 * 12);
+  EXPECT_GT(exact_calls, 1000);  // the exact stage ran, allocation-free
 }
 
 TEST(NoAllocation, StateAtAllocatesNothing) {
