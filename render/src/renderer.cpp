@@ -201,8 +201,13 @@ struct Renderer::Prepared {
   std::shared_ptr<const Mesh> mesh;
   std::vector<float> vertices;
   std::vector<std::uint32_t> outline;
+  // The silhouette edges as one closed loop, wound like the front faces (empty when they do not
+  // form a single simple loop).
+  std::vector<std::uint32_t> silhouette;
+  std::vector<std::uint32_t> fill;  // the silhouette polygon as triangles (see polygonTriangles)
   double depth = 0.0;
   bool fills = false;     // contains the camera: drawn as a full-view fill, no mesh
+  int level = 0;           // sphere tessellation level
   double clearance = 0.0;  // distance from the camera to the mesh (lower bound), when drawn
   double reach = 0.0;      // distance from the camera to the farthest point of the mesh
 };
@@ -246,6 +251,72 @@ Renderer::~Renderer() {
 
 const std::string& Renderer::rendererString() const { return context_->renderer(); }
 
+namespace {
+
+// The silhouette of a convex mesh seen from the camera: the edges between a front and a back
+// triangle, each directed as its front triangle runs along it, chained into one loop. Seen from
+// a camera in front of every vertex, the front triangles cover exactly the convex polygon this
+// loop bounds, so the polygon fills the same pixels with far fewer triangles. Leaves `loop`
+// empty when the edges do not chain into one simple loop (near-degenerate views).
+void silhouetteLoop(const Mesh& m, const std::vector<char>& front, const std::vector<std::uint32_t>& outline,
+                    std::vector<std::uint32_t>& loop) {
+  loop.clear();
+  const std::size_t n = outline.size() / 2;
+  if (n < 3) return;
+  // Directed edges from -> to, sorted by `from` for the walk.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> next;
+  next.reserve(n);
+  for (const auto& e : m.edges) {
+    if (front[e[2]] == front[e[3]]) continue;
+    const auto& t = m.triangles[front[e[2]] ? e[2] : e[3]];
+    const bool forward = (t[0] == e[0] && t[1] == e[1]) || (t[1] == e[0] && t[2] == e[1]) || (t[2] == e[0] && t[0] == e[1]);
+    next.emplace_back(forward ? e[0] : e[1], forward ? e[1] : e[0]);
+  }
+  std::sort(next.begin(), next.end());
+  for (std::size_t k = 1; k < next.size(); ++k)
+    if (next[k].first == next[k - 1].first) return;  // a vertex with two outgoing edges
+  const std::uint32_t start = next.front().first;
+  std::uint32_t at = start;
+  loop.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    loop.push_back(at);
+    const auto it = std::lower_bound(next.begin(), next.end(), std::make_pair(at, std::uint32_t{0}));
+    if (it == next.end() || it->first != at) {
+      loop.clear();
+      return;
+    }
+    at = it->second;
+    if (at == start && k + 1 != n) {  // closed early: more than one loop
+      loop.clear();
+      return;
+    }
+  }
+  if (at != start) loop.clear();
+}
+
+// A convex polygon (vertex indices in order) as triangles of about equal aspect: one triangle on
+// three vertices a third of the way round each other, and each remaining arc split in the middle.
+// The same pixels as a fan, but large triangles cover whole tiles of the rasteriser.
+void polygonTriangles(const std::vector<std::uint32_t>& loop, std::vector<std::uint32_t>& out) {
+  out.clear();
+  const std::size_t n = loop.size();
+  if (n < 3) return;
+  auto arc = [&](auto&& self, std::size_t a, std::size_t b) -> void {  // vertices a..b (b may be n: vertex 0)
+    if (b - a < 2) return;
+    const std::size_t m = (a + b) / 2;
+    out.insert(out.end(), {loop[a], loop[m], loop[b % n]});
+    self(self, a, m);
+    self(self, m, b);
+  };
+  const std::size_t i = n / 3, j = 2 * n / 3;
+  out.insert(out.end(), {loop[0], loop[i], loop[j]});
+  arc(arc, 0, i);
+  arc(arc, i, j);
+  arc(arc, j, n);
+}
+
+}  // namespace
+
 void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame) {
   cache_.nextFrame();
   const std::uint64_t built_before = cache_.built();
@@ -254,6 +325,8 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
   out.resize(volumes.size());
   frame.visibility.assign(volumes.size(), Visibility::Empty);
   std::vector<Vec3> cam_points;
+  std::vector<MeshRequest> requests;
+  std::vector<std::size_t> requested;  // the volume of each request
   const Vec3 origin = Vec3::Zero();
   for (std::size_t i = 0; i < volumes.size(); ++i) {
     const Volume& v = volumes[i];
@@ -265,6 +338,8 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     p.vertices.clear();
     p.outline.clear();
     p.fills = false;
+    p.silhouette.clear();
+    p.fill.clear();
     Visibility& visibility = frame.visibility[i];
     if (v.points.empty()) continue;
     // Tessellation fine enough that the circumscribed sphere polytope lies at most
@@ -317,35 +392,52 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
       visibility = Visibility::FillsView;
       continue;
     }
-    const std::uint64_t before = cache_.built();
-    try {
-      p.mesh = cache_.get(v.points, v.radius, level, options_.min_radius);
-    } catch (const std::exception&) {  // qhull on extreme coordinates
-      visibility = Visibility::NoMesh;
+    p.level = level;
+    requests.push_back(MeshRequest{v.points, v.radius, level, options_.min_radius});
+    requested.push_back(i);
+  }
+  // The meshes (those not cached built in parallel), then per volume in parallel: the vertices
+  // in camera coordinates, the silhouette edges and their loop.
+  const std::vector<MeshCache::Found> meshes = cache_.getAll(requests);
+  for (std::size_t k = 0; k < requested.size(); ++k) {
+    Prepared& p = out[requested[k]];
+    if (!meshes[k].mesh) {  // qhull on extreme coordinates
+      frame.visibility[requested[k]] = Visibility::NoMesh;
       continue;
     }
-    visibility = Visibility::Drawn;
-    if (cache_.built() != before) frame.hull_input += p.mesh->hull_input;
-    frame.max_level = std::max(frame.max_level, level);
-    const Mesh& m = *p.mesh;
-    p.vertices.resize(m.vertices.size() * 3);
-    for (std::size_t k = 0; k < m.vertices.size(); ++k) {
-      const Vec3 c = to_camera * m.vertices[k];
-      p.vertices[3 * k] = static_cast<float>(c.x());
-      p.vertices[3 * k + 1] = static_cast<float>(c.y());
-      p.vertices[3 * k + 2] = static_cast<float>(c.z());
-    }
-    // Silhouette edges: one neighbouring triangle faces the camera (at the origin), the other not.
-    std::vector<char> front(m.triangles.size());
-    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-      const Vec3 n = to_camera.linear() * m.normals[t];
-      const Vec3 a = to_camera * m.vertices[m.triangles[t][0]];
-      front[t] = n.dot(a) < 0.0;
-    }
-    for (const auto& e : m.edges)
-      if (front[e[2]] != front[e[3]]) p.outline.insert(p.outline.end(), {e[0], e[1]});
-    frame.triangles += static_cast<int>(m.triangles.size());
+    p.mesh = meshes[k].mesh;
+    frame.visibility[requested[k]] = Visibility::Drawn;
+    if (meshes[k].built) frame.hull_input += p.mesh->hull_input;
+    frame.max_level = std::max(frame.max_level, p.level);
+    frame.triangles += static_cast<int>(p.mesh->triangles.size());
   }
+  cv::parallel_for_(cv::Range(0, static_cast<int>(requested.size())), [&](const cv::Range& range) {
+    std::vector<char> front;
+    for (int k = range.start; k < range.end; ++k) {
+      Prepared& p = out[requested[static_cast<std::size_t>(k)]];
+      if (!p.mesh) continue;
+      const Mesh& m = *p.mesh;
+      const Pose to_camera = world_to_camera_ * volumes[static_cast<std::size_t>(p.index)].pose;
+      p.vertices.resize(m.vertices.size() * 3);
+      for (std::size_t j = 0; j < m.vertices.size(); ++j) {
+        const Vec3 c = to_camera * m.vertices[j];
+        p.vertices[3 * j] = static_cast<float>(c.x());
+        p.vertices[3 * j + 1] = static_cast<float>(c.y());
+        p.vertices[3 * j + 2] = static_cast<float>(c.z());
+      }
+      // Silhouette edges: one neighbouring triangle faces the camera (at the origin), the other not.
+      front.resize(m.triangles.size());
+      for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+        const Vec3 n = to_camera.linear() * m.normals[t];
+        const Vec3 a = to_camera * m.vertices[m.triangles[t][0]];
+        front[t] = n.dot(a) < 0.0;
+      }
+      for (const auto& e : m.edges)
+        if (front[e[2]] != front[e[3]]) p.outline.insert(p.outline.end(), {e[0], e[1]});
+      silhouetteLoop(m, front, p.outline, p.silhouette);
+      polygonTriangles(p.silhouette, p.fill);
+    }
+  });
   frame.meshes_built = static_cast<int>(cache_.built() - built_before);
   // Clipping planes that clip no drawn mesh: the near plane closer than the nearest mesh
   // anywhere in the view frustum, the far plane beyond the farthest one.
@@ -424,8 +516,8 @@ cv::Mat readLabels(int w, int h) {
 
 }  // namespace
 
-cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& style, double near, double far,
-                             cv::Mat* labels) {
+cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& style, Frame& frame, cv::Mat* labels) {
+  const double near = frame.near, far = frame.far;
   const int w = gl_->width, h = gl_->height;
   const bool with_labels = labels != nullptr && gl_->samples <= 1 && !style.shaded;
   glBindFramebuffer(GL_FRAMEBUFFER, gl_->samples > 1 ? gl_->ms_fbo : gl_->resolve_fbo);
@@ -450,6 +542,14 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   for (const Prepared& p : bodies)
     if (p.mesh) order.push_back(&p);
   std::sort(order.begin(), order.end(), [](const Prepared* a, const Prepared* b) { return a->depth > b->depth; });
+  // Whether the fill may be the silhouette polygon: a single loop whose vertices all lie beyond
+  // the near plane (then its projection is the convex outline of the front faces, unclipped).
+  auto polygonFill = [&](const Prepared& p) {
+    if (!options_.polygon_fill || p.fill.empty()) return false;
+    for (const std::uint32_t k : p.silhouette)
+      if (!(p.vertices[3 * k + 2] > near)) return false;
+    return true;
+  };
   if (with_labels) {  // the labels of the nearest surfaces in the same pass (see kLabelFragmentShader)
     glUseProgram(gl_->program);
     glBlendEquationi(1, GL_MIN);
@@ -457,8 +557,16 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   for (const Prepared* p : order) {
     const cv::Scalar c = p->colour;  // BGR, drawn as GL's RGB (see the read-back)
     glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
-    if (with_labels) glUniform1ui(gl_->label_location, static_cast<GLuint>(p->index + 1));
-    drawTriangles(*p->mesh, p->vertices);
+    if (with_labels) {
+      glUniform1ui(gl_->label_location, static_cast<GLuint>(p->index + 1));
+      drawTriangles(*p->mesh, p->vertices);
+    } else if (polygonFill(*p)) {
+      ++frame.polygon_fills;
+      glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(p->fill.size()), GL_UNSIGNED_INT, p->fill.data());
+    } else {
+      drawTriangles(*p->mesh, p->vertices);
+    }
   }
   if (with_labels) {
     glUseProgram(0);
@@ -584,7 +692,7 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
   const bool same_pass = want_colour && want_mask && !style.shaded && gl_->samples <= 1 && !mask_projection_;
   cv::Mat labels;
   if (want_colour) {
-    cv::Mat premultiplied = drawColour(bodies, style, frame.near, frame.far, same_pass ? &labels : nullptr);
+    cv::Mat premultiplied = drawColour(bodies, style, frame, same_pass ? &labels : nullptr);
     tick("colour+readback");
     if (projection_.warps()) {
       if (fixed_map_a_.empty())  // fixed-point maps: remap's fast path (1/32 px steps)

@@ -77,6 +77,13 @@ struct RenderOptions {
   /// on llvmpipe 4x MSAA costs ~5x the frame time, and the outline, drawn as smoothed lines on
   /// top of the fill edges, already gives anti-aliased silhouettes.
   int msaa_samples = 0;        ///< colour layer multisampling (0 or 1: off; at most 4 on llvmpipe)
+  /// Fill each volume's tint as the polygon its silhouette edges bound (a few tens of triangles)
+  /// instead of its front triangles (hundreds to thousands): the same pixels, since the
+  /// silhouette of a convex mesh seen from a camera in front of it bounds exactly the projection
+  /// of its front faces. Volumes whose silhouette is not one simple loop, that reach behind the
+  /// near plane, or whose labels are drawn in the same pass keep the triangles. Off: always the
+  /// triangles (for comparison).
+  bool polygon_fill = true;
   double tolerance_px = 0.5;   ///< largest outward error of the sphere tessellation, output pixels
   int max_level = 3;           ///< finest sphere tessellation (level 3: 642 vertices, 0.3 % outward)
   double min_radius = kMinDrawRadius;  ///< volumes thinner than this are drawn this thick (metres)
@@ -97,7 +104,8 @@ struct Frame {
   std::vector<Visibility> visibility;  ///< per volume
   double near = 0.0, far = 0.0;       ///< the clipping planes used
   int meshes_built = 0;   ///< meshes built in this frame (the others came from the cache)
-  int triangles = 0;      ///< triangles drawn per pass
+  int triangles = 0;      ///< triangles of the drawn meshes
+  int polygon_fills = 0;  ///< volumes whose tint was drawn as their silhouette polygon (RenderOptions::polygon_fill)
   int hull_input = 0;     ///< points passed to qhull for the meshes built in this frame
   int max_level = 0;      ///< finest sphere tessellation used
 };
@@ -131,8 +139,7 @@ class Renderer {
   struct Gl;
   struct Prepared;
   void prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame);
-  cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style, double near, double far,
-                     cv::Mat* labels = nullptr);
+  cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style, Frame& frame, cv::Mat* labels = nullptr);
   cv::Mat drawMask(const std::vector<Prepared>& bodies, double near, double far);
   static void drawShaded(const std::vector<const Prepared*>& order, double ambient);
   void decorate(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility,

@@ -60,6 +60,14 @@ Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, doubl
 /// polytopes around the core points), for comparisons in benchmarks and tests.
 void useHullMeshing(bool on);
 
+/// One SSCH to mesh (see buildSschMesh).
+struct MeshRequest {
+  std::span<const Vec3> points;
+  double radius = 0.0;
+  int level = 0;
+  double min_radius = kMinDrawRadius;
+};
+
 /// Meshes keyed by the exact volume shape (the bytes of the points, radius, level and minimum radius): a volume
 /// that does not change (a static body, the same state) reuses its mesh; entries unused for a
 /// while are dropped so a moving robot does not grow the cache.
@@ -69,6 +77,14 @@ class MeshCache {
   /// The mesh of the SSCH, built on first use.
   std::shared_ptr<const Mesh> get(std::span<const Vec3> points, double radius, int level,
                                   double min_radius = kMinDrawRadius);
+  /// A mesh from getAll: null when it could not be built (qhull failed on extreme coordinates).
+  struct Found {
+    std::shared_ptr<const Mesh> mesh;
+    bool built = false;  ///< built by this call (not from the cache)
+  };
+  /// The meshes of several SSCHs in order; those not cached are built in parallel
+  /// (cv::parallel_for_), equal requests once.
+  std::vector<Found> getAll(std::span<const MeshRequest> requests);
   /// Marks the start of a frame (entries unused for a few frames may then be evicted).
   void nextFrame() { ++frame_; }
   std::size_t size() const { return entries_.size(); }
@@ -80,6 +96,8 @@ class MeshCache {
     std::shared_ptr<const Mesh> mesh;
     std::uint64_t used = 0;
   };
+  static std::string key(const MeshRequest& r);
+  void makeRoom();
   std::size_t capacity_;
   std::uint64_t frame_ = 0, built_ = 0, reused_ = 0;
   std::unordered_map<std::string, Entry> entries_;
