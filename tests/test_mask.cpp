@@ -134,6 +134,45 @@ TEST(RenderMask, SameLabelsFromTheColourPassAndAlone) {
   EXPECT_GT(cv::countNonZero(multisampled.bgra.reshape(1) > 0), 1000);
 }
 
+// The mask's distortion warp (done on the GPU) is the nearest-pixel remap of the pinhole labels:
+// the same labels drawn through the undistorted pinhole camera and remapped on the CPU with
+// OpenCV's nearest-pixel map give the same mask, pixel for pixel, at both mask scales.
+TEST(RenderMask, WarpIsTheNearestPixelRemapOfThePinholeLabels) {
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 6; ++trial) {
+    const Camera c = randomCamera(rng, true, 300, 200);
+    std::vector<std::vector<Vec3>> cores(4);
+    std::vector<Volume> v;
+    for (std::size_t i = 0; i < cores.size(); ++i) {
+      cores[i] = {Vec3(0.5 * u(rng), 0.5 * u(rng), 0.5 * u(rng)), Vec3(0.5 * u(rng), 0.5 * u(rng), 0.5 * u(rng))};
+      v.push_back(Volume{cores[i], 0.05 + 0.1 * std::abs(u(rng)), VolumeStatus::Clear, ""});
+    }
+    for (const double scale : {1.0, 2.0}) {
+      // The finest tessellation for both (the level otherwise follows the output camera's focal length).
+      const RenderOptions options{.mask_supersample = scale, .tolerance_px = 0.0};
+      Renderer distorted(c, options);
+      const Projection& mp = distorted.maskProjection();
+      Camera pinhole = c;  // the pinhole image as a camera of its own: drawn without a warp
+      const Pinhole& ph = mp.pinhole();
+      pinhole.width = ph.width;
+      pinhole.height = ph.height;
+      pinhole.camera_matrix = cv::Matx33d(ph.fx, 0, ph.cx, 0, ph.fy, ph.cy, 0, 0, 1);
+      pinhole.distortion = {0, 0, 0, 0, 0};
+      Renderer plain(pinhole, RenderOptions{.tolerance_px = 0.0});
+      const Frame f = distorted.render(v, Style{}, false, true);
+      const Frame p = plain.render(v, Style{}, false, true);
+      ASSERT_EQ(f.near, p.near);
+      cv::Mat map, unused, expected;
+      cv::convertMaps(mp.mapX(), mp.mapY(), map, unused, CV_16SC2, true);
+      cv::remap(p.mask, expected, map, cv::Mat(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+      SCOPED_TRACE("trial " + std::to_string(trial) + ", mask scale " + std::to_string(scale));
+      EXPECT_GT(cv::countNonZero(expected), 500);
+      EXPECT_EQ(cv::countNonZero(f.mask != expected), 0);
+    }
+  }
+}
+
 TEST(RenderMask, DegenerateVolumesAreVisible) {
   const Camera c = lookAt(Vec3(1.5, -1.0, 1.0), Vec3(0, 0, 0), 160, 120, 150, {-0.1, 0.01, 0, 0, 0});
   Renderer r(c);
