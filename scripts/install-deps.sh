@@ -7,7 +7,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev
   libfcl-dev libqhull-dev
-  libcoin-dev inventor-data liburdfdom-dev
+  libcoin-dev inventor-data liburdfdom-dev libassimp-dev
   libosmesa6-dev libgl-dev libegl-dev libopengl-dev libegl-mesa0
   libopencv-dev libtinyxml2-dev libapriltag-dev
 )

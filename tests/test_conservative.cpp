@@ -42,9 +42,10 @@ struct Tally {
 };
 
 // Runs one case; returns false (with a message) on a violation.
-bool runCase(std::uint64_t seed, Tally& tally, std::string& why) {
+bool runCase(std::uint64_t seed, Tally& tally, std::string& why,
+             testing::MobileBase base = testing::MobileBase::None) {
   std::mt19937_64 rng(seed);
-  const Model m = testing::randomModel(rng);
+  const Model m = testing::randomModel(rng, 5, 4, base);
   std::vector<double> lower, upper;
   testing::randomBox(rng, m, lower, upper);
   Checker checker(m);
@@ -110,6 +111,32 @@ TEST(Conservative, BoundNeverExceedsSampledDistance) {
     EXPECT_EQ(tally.cases, cases);
     EXPECT_GT(tally.nontrivial, tally.pair_checks / 10);  // the test exercises separated pairs
     EXPECT_GT(tally.oracle_calls, tally.cases);           // and often needs the exact oracle
+  }
+}
+
+// Mobile bases as `kccd import` maps URDF planar and floating joints (a chain of prismatic,
+// prismatic and revolute joints in one plane; translation3d then rotation3d), at the root of
+// random trees: the same property.
+TEST(Conservative, MobileBasesFromUrdfJointsAreConservative) {
+  const long cases = envOr("KCCD_SOAK", 50000) / 10;
+  for (const testing::MobileBase base : {testing::MobileBase::Planar, testing::MobileBase::Floating}) {
+    Tally tally;
+    long failures = 0;
+    for (long i = 0; i < cases && failures < 5; ++i) {
+      const std::uint64_t seed = 0x6d6f62 + static_cast<std::uint64_t>(i);
+      std::string why;
+      if (!runCase(seed, tally, why, base)) {
+        ++failures;
+        ADD_FAILURE() << (base == testing::MobileBase::Planar ? "planar" : "floating") << " base, seed " << seed
+                      << ": " << why;
+      }
+    }
+    std::cout << "[ property ] " << (base == testing::MobileBase::Planar ? "planar" : "floating") << " bases: "
+              << tally.cases << " cases, " << tally.nontrivial << " pair samples with a positive bound, "
+              << tally.oracle_calls << " exact oracle calls; tightest true - bound = " << tally.worst_gap << " m\n";
+    EXPECT_EQ(failures, 0);
+    EXPECT_EQ(tally.cases, cases);
+    EXPECT_GT(tally.oracle_calls, tally.cases);
   }
 }
 

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "kccd/input_error.hpp"
+#include "kccd/kinematics.hpp"
 #include "kccd/model.hpp"
 #include "kccd/modelling/urdf_import.hpp"
 #include "support/reference_distance.hpp"
@@ -94,14 +95,6 @@ TEST(UrdfImport, ClearErrors) {
     return std::string("no error");
   };
   const std::string link = "<link name=\"a\"><collision><geometry><sphere radius=\"0.1\"/></geometry></collision></link>";
-  std::ofstream(dir / "floating.urdf") << "<robot name=\"r\">" << link
-                                       << "<link name=\"b\"/><joint name=\"free\" type=\"floating\"><parent link=\"a\"/>"
-                                          "<child link=\"b\"/></joint></robot>";
-  EXPECT_NE(message((dir / "floating.urdf").string()).find("joint free is floating: not supported"), std::string::npos);
-  std::ofstream(dir / "planar.urdf") << "<robot name=\"r\">" << link
-                                     << "<link name=\"b\"/><joint name=\"slide\" type=\"planar\"><parent link=\"a\"/>"
-                                        "<child link=\"b\"/><axis xyz=\"0 0 1\"/></joint></robot>";
-  EXPECT_NE(message((dir / "planar.urdf").string()).find("planar"), std::string::npos);
   std::ofstream(dir / "broken.urdf") << "<robot name=\"r\">\n<link name=\"a\">\n</robot>\n";
   EXPECT_NE(message((dir / "broken.urdf").string()).find("broken.urdf:"), std::string::npos);
   std::ofstream(dir / "package.urdf") << "<robot name=\"r\"><link name=\"a\"><collision><geometry>"
@@ -128,4 +121,81 @@ TEST(UrdfImport, ClearErrors) {
                                      "<origin xyz=\"2e6 0 0\"/></joint></robot>";
   const std::string far = message((dir / "far.urdf").string());
   EXPECT_EQ(far.rfind((dir / "far.urdf").string() + ": the imported model does not load: ", 0), 0u) << far;
+}
+
+// Mobile bases: a planar joint becomes prismatic x, prismatic y and revolute yaw in its plane, a
+// floating joint translation3d then rotation3d; the child link moves with the last of them, and
+// the chain places it as the URDF joint would.
+TEST(UrdfImport, MobileBasesBecomeJointChains) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "kccd_test_urdf";
+  std::filesystem::create_directories(dir);
+  const std::string box = "<collision><geometry><box size=\"0.2 0.2 0.2\"/></geometry></collision>";
+  std::ofstream(dir / "mobile.urdf")
+      << "<robot name=\"mobile\"><link name=\"floor\">" << box << "</link>"
+      << "<link name=\"cart\">" << box << "</link><link name=\"drone\">" << box << "</link>"
+      << "<link name=\"slider\">" << box << "</link>"
+      << "<joint name=\"base\" type=\"planar\"><parent link=\"floor\"/><child link=\"cart\"/>"
+         "<origin xyz=\"1 0 0.1\" rpy=\"0 0 0.3\"/><axis xyz=\"0 0 1\"/></joint>"
+      << "<joint name=\"fly\" type=\"floating\"><parent link=\"floor\"/><child link=\"drone\"/>"
+         "<origin xyz=\"0 2 1\"/></joint>"
+      << "<joint name=\"wall\" type=\"planar\"><parent link=\"cart\"/><child link=\"slider\"/>"
+         "<axis xyz=\"2 0 0\"/></joint></robot>";
+  km::ImportOptions opt;
+  opt.points = 4;
+  const Model m = kccd::parseModel(km::importUrdf((dir / "mobile.urdf").string(), opt), "imported");
+  ASSERT_EQ(m.joints.size(), 8u);
+  const kccd::Joint& x = m.joints[m.jointIndex("base_x")];
+  const kccd::Joint& y = m.joints[m.jointIndex("base_y")];
+  const kccd::Joint& yaw = m.joints[m.jointIndex("base_yaw")];
+  EXPECT_EQ(x.type, kccd::JointType::Prismatic);
+  EXPECT_EQ(y.type, kccd::JointType::Prismatic);
+  EXPECT_EQ(yaw.type, kccd::JointType::Revolute);
+  EXPECT_EQ(y.parent, m.jointIndex("base_x"));
+  EXPECT_EQ(yaw.parent, m.jointIndex("base_y"));
+  EXPECT_FALSE(yaw.limits);
+  EXPECT_EQ(m.bodies[m.bodyIndex("cart")].frame, m.jointIndex("base_yaw"));
+  EXPECT_EQ(m.joints[m.jointIndex("fly")].type, kccd::JointType::Translation3d);
+  EXPECT_EQ(m.joints[m.jointIndex("fly_rotation")].type, kccd::JointType::Rotation3d);
+  EXPECT_EQ(m.bodies[m.bodyIndex("drone")].frame, m.jointIndex("fly_rotation"));
+  // The tilted plane: two orthonormal axes normal to (1, 0, 0), the yaw about it.
+  const kccd::Joint& wx = m.joints[m.jointIndex("wall_x")];
+  const kccd::Joint& wy = m.joints[m.jointIndex("wall_y")];
+  const kccd::Joint& wyaw = m.joints[m.jointIndex("wall_yaw")];
+  EXPECT_NEAR(wx.axis.dot(Vec3::UnitX()), 0.0, 1e-12);
+  EXPECT_NEAR(wy.axis.dot(Vec3::UnitX()), 0.0, 1e-12);
+  EXPECT_NEAR(wx.axis.dot(wy.axis), 0.0, 1e-12);
+  EXPECT_NEAR((wyaw.axis - Vec3::UnitX()).norm(), 0.0, 1e-12);
+  EXPECT_EQ(wx.parent, m.jointIndex("base_yaw"));
+  // Placement: the cart at planar state (x, y, yaw) sits at origin * (x, y, 0) * Rz(yaw), the
+  // drone at its position and rotation vector.
+  std::vector<double> q(static_cast<std::size_t>(m.stateSize()), 0.0);
+  q[static_cast<std::size_t>(x.state_offset)] = 0.3;
+  q[static_cast<std::size_t>(y.state_offset)] = -0.2;
+  q[static_cast<std::size_t>(yaw.state_offset)] = 0.5;
+  const kccd::Joint& fly = m.joints[m.jointIndex("fly")];
+  const kccd::Joint& fly_rot = m.joints[m.jointIndex("fly_rotation")];
+  for (int k = 0; k < 3; ++k) q[static_cast<std::size_t>(fly.state_offset + k)] = 0.1 * (k + 1);
+  q[static_cast<std::size_t>(fly_rot.state_offset + 2)] = 0.7;
+  std::vector<kccd::Pose> poses(m.joints.size());
+  ASSERT_TRUE(kccd::framePoses(m, q, poses));
+  kccd::Pose expected = kccd::Pose::Identity();
+  expected.translation() = Vec3(1, 0, 0.1);
+  expected.linear() = Eigen::AngleAxisd(0.3, Vec3::UnitZ()).toRotationMatrix();
+  expected = expected * Eigen::Translation3d(0.3, -0.2, 0) * Eigen::AngleAxisd(0.5, Vec3::UnitZ());
+  EXPECT_NEAR((kccd::framePose(poses, m.jointIndex("base_yaw")).matrix() - expected.matrix()).norm(), 0, 1e-12);
+  kccd::Pose drone = kccd::Pose::Identity();
+  drone.translation() = Vec3(0.1, 2.2, 1.3);
+  drone.linear() = Eigen::AngleAxisd(0.7, Vec3::UnitZ()).toRotationMatrix();
+  EXPECT_NEAR((kccd::framePose(poses, m.jointIndex("fly_rotation")).matrix() - drone.matrix()).norm(), 0, 1e-12);
+  // A chain name taken by another URDF joint is an error, not a silent rename.
+  std::ofstream(dir / "clash.urdf")
+      << "<robot name=\"r\"><link name=\"a\">" << box << "</link><link name=\"b\"/><link name=\"c\"/>"
+      << "<joint name=\"base\" type=\"planar\"><parent link=\"a\"/><child link=\"b\"/><axis xyz=\"0 0 1\"/></joint>"
+      << "<joint name=\"base_yaw\" type=\"fixed\"><parent link=\"a\"/><child link=\"c\"/></joint></robot>";
+  try {
+    km::importUrdf((dir / "clash.urdf").string(), opt);
+    ADD_FAILURE() << "no error";
+  } catch (const kccd::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("base_yaw would repeat a joint name"), std::string::npos) << e.what();
+  }
 }

@@ -93,7 +93,8 @@ Runner addFit(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "fit",
       "Fits a conservative SSCH (K core points + radius) to one rigid part from an Open Inventor (.iv, ASCII or "
-      "binary), VRML 1/2 (.wrl) or STL file: every point of the part is inside, the volume is minimised");
+      "binary) or VRML 1/2 (.wrl) file (Coin3D), or a mesh: STL, OBJ, COLLADA (.dae), PLY, glTF (.glb, .gltf) and "
+      "the other formats Assimp reads; every point of the part is inside, the volume is minimised");
   sub->add_option("part", args->part_file, "CAD file of the part")->required();
   sub->add_option("--points,-k", args->points, "Number of core points K (1 ... 16)")->capture_default_str();
   sub->add_option("--part", args->part, "Fit only the node DEF'd with this name");
@@ -109,7 +110,9 @@ Runner addFit(CLI::App& app) {
   sub->add_flag("--quiet,-q", args->quiet, "No progress display");
   sub->footer(
       "Spheres, cylinders and cones are covered analytically (circumscribed, never Coin's inscribed "
-      "tessellation); the radius is recomputed exactly for the printed points.\n"
+      "tessellation); the radius is recomputed exactly for the printed points. Meshes: every node transform "
+      "applied; COLLADA's <unit meter> applied, its <up_axis> not (coordinates as written, as ROS tools place "
+      "them); --part picks a node by name.\n"
       "Exit status: 0 done, 2 bad input.");
   return [args] { return runFit(*args); };
 }

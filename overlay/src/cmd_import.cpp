@@ -53,7 +53,8 @@ Runner addImport(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "import",
       "Converts a URDF into a KCCD model: joints and origins mapped, each link's collision geometry (boxes, "
-      "cylinders, spheres analytically; meshes read with Coin3D) fitted with a conservative SSCH");
+      "cylinders, spheres analytically; meshes in any format Assimp reads: STL, OBJ, DAE, PLY, glTF, ...) fitted with "
+      "a conservative SSCH");
   sub->add_option("urdf", args->urdf, "URDF file")->required();
   sub->add_option("--srdf", args->srdf, "SRDF file: its disable_collisions become pairs: ignore");
   sub->add_option("--points,-k", args->points, "Core points per link (1 ... 16)")->capture_default_str();
@@ -64,8 +65,10 @@ Runner addImport(CLI::App& app) {
   sub->add_option("-o,--output", args->output, "Model file to write (default: standard output)");
   sub->add_flag("--quiet,-q", args->quiet, "No progress display");
   sub->footer(
-      "Joint kinds: fixed, revolute, continuous (revolute without limits), prismatic; floating and planar joints "
-      "are an error. Mimic joints are checked as independent joints (conservative).\n"
+      "Joint kinds: fixed, revolute, continuous (revolute without limits), prismatic; a floating joint J becomes "
+      "J (translation3d: x, y, z) and J_rotation (rotation3d: a rotation vector); a planar joint J becomes J_x, J_y "
+      "(prismatic along the plane) and J_yaw (revolute about its normal). Mimic joints are checked as independent "
+      "joints (conservative).\n"
       "Exit status: 0 done, 2 bad input.");
   return [args] { return runImport(*args); };
 }

@@ -1,5 +1,5 @@
-// libFuzzer target: kccd::modelling::readPart on arbitrary bytes (as .iv, .wrl or .stl by the
-// first byte). A result or the reader's one-line std::runtime_error is fine; a crash, any other
+// libFuzzer target: kccd::modelling::readPart on arbitrary bytes (as .iv, .wrl, or a mesh read
+// through Assimp: .stl, .obj, .dae, .ply, .glb, .gltf, chosen by the first byte). A result or the reader's one-line std::runtime_error is fine; a crash, any other
 // exception or a multi-line message is a finding.
 #include <cstddef>
 #include <cstdint>
@@ -18,11 +18,11 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
-  static const char* const extensions[] = {".iv", ".wrl", ".stl"};
+  static const char* const extensions[] = {".iv", ".wrl", ".stl", ".obj", ".dae", ".ply", ".glb", ".gltf"};
   const std::string path =
-      kccd::fuzz::writeInput("fuzz_part", std::string("input") + extensions[data[0] % 3], data + 1, size - 1);
+      kccd::fuzz::writeInput("fuzz_part", std::string("input") + extensions[data[0] % 8], data + 1, size - 1);
   try {
-    (void)kccd::modelling::readPart(path, {.merge = (data[0] & 4) != 0});
+    (void)kccd::modelling::readPart(path, {.merge = (data[0] & 8) != 0});
   } catch (const kccd::InputError& e) {
     kccd::fuzz::checkMessage(e.what(), path);
   }

@@ -18,13 +18,42 @@ Eigen::Matrix3d axisAngle(const Vec3& w) {
 
 }  // namespace
 
-Model randomModel(std::mt19937_64& rng, int max_joints, int max_bodies) {
+Model randomModel(std::mt19937_64& rng, int max_joints, int max_bodies, MobileBase base) {
   Model m;
   m.name = "random";
   const int budgets[] = {4, 8, 32};
   m.point_budget = budgets[uniformInt(rng, 0, 2)];
-  const int nj = uniformInt(rng, 1, max_joints);
-  for (int i = 0; i < nj; ++i) {
+  if (base != MobileBase::None) {
+    Pose origin = Pose::Identity();
+    origin.linear() = randomRotation(rng);
+    origin.translation() = Vec3(uniform(rng, -0.4, 0.4), uniform(rng, -0.4, 0.4), uniform(rng, -0.4, 0.4));
+    const Vec3 n = randomUnit(rng);
+    const Vec3 u = n.unitOrthogonal(), v = n.cross(u);
+    auto add = [&](const char* name, JointType type, const Vec3& axis) {
+      Joint j;
+      j.name = name;
+      j.parent = m.joints.empty() ? kWorld : static_cast<int>(m.joints.size()) - 1;
+      j.type = type;
+      j.origin = m.joints.empty() ? origin : Pose::Identity();
+      j.axis = axis;
+      const int mode = uniformInt(rng, 0, 4);
+      j.sweep = mode == 0 ? SweepMode::Exact : mode <= 2 ? SweepMode::Fast : SweepMode::Accurate;
+      if (type == JointType::Translation3d) j.error = uniform(rng, 0.0, 1.0) < 0.3 ? 0.0 : uniform(rng, 0.0, 0.05);
+      if (type == JointType::Rotation3d) j.error = uniform(rng, 0.0, 1.0) < 0.3 ? 0.0 : uniform(rng, 0.0, 0.4);
+      m.joints.push_back(j);
+    };
+    if (base == MobileBase::Planar) {
+      add("base_x", JointType::Prismatic, u);
+      add("base_y", JointType::Prismatic, v);
+      add("base_yaw", JointType::Revolute, n);
+    } else {
+      add("base", JointType::Translation3d, Vec3::UnitZ());
+      add("base_rotation", JointType::Rotation3d, Vec3::UnitZ());
+    }
+  }
+  const int first = static_cast<int>(m.joints.size());
+  const int nj = first + uniformInt(rng, 1, max_joints);
+  for (int i = first; i < nj; ++i) {
     Joint j;
     j.name = std::to_string(i);
     j.name.insert(0, 1, 'j');

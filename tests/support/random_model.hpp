@@ -9,8 +9,14 @@
 
 namespace kccd::testing {
 
-/// A random model: 1..max_joints joints of every type and sweep mode, 2..max_bodies bodies.
-Model randomModel(std::mt19937_64& rng, int max_joints = 5, int max_bodies = 4);
+/// A mobile base at the root of a random model, as `kccd import` maps URDF joints: planar
+/// (prismatic along u, prismatic along v, revolute about n = u x v, the last two at the first's
+/// origin) or floating (translation3d, then rotation3d at its origin).
+enum class MobileBase { None, Planar, Floating };
+
+/// A random model: 1..max_joints joints of every type and sweep mode, 2..max_bodies bodies; with a
+/// mobile base, its joints come first (random plane and origin) and the others may hang from it.
+Model randomModel(std::mt19937_64& rng, int max_joints = 5, int max_bodies = 4, MobileBase base = MobileBase::None);
 
 /// A random interval box for the model: widths from 0 through 1e-12 and tiny up to beyond 2*pi.
 /// Joints with `sweep: exact` get zero-width intervals.

@@ -61,6 +61,8 @@
 #include <Inventor/nodes/SoSphere.h>
 
 #include "kccd/modelling/part.hpp"
+#include "large_stack.hpp"
+#include "mesh_reader.hpp"
 
 namespace kccd::modelling {
 namespace {
@@ -68,10 +70,9 @@ namespace {
 std::mutex coin_mutex;  // Coin's database and error handlers are process-wide
 
 // Coin's reader and actions recurse once per nesting level. ASCII scenes are bounded before
-// Coin sees them; a binary file can only be bounded by its size, so Coin runs on a stack
-// large enough for the deepest binary file accepted (about 28 bytes per level, well under
-// 1 KiB of stack per level).
-constexpr std::size_t kCoinStackBytes = 256u << 20;
+// Coin sees them; a binary file can only be bounded by its size, so Coin runs on a large stack
+// (detail::onLargeStack: about 28 bytes of binary file per level, well under 1 KiB of stack
+// per level).
 
 void initCoin() {
   static bool done = false;
@@ -110,35 +111,6 @@ struct Messages {
     line = 0;
   }
 };
-
-// Runs `f` on a thread with a kCoinStackBytes stack; its exception is rethrown here.
-template <class F>
-void onLargeStack(F&& f) {
-  struct Job {
-    F* f;
-    std::exception_ptr error;
-  } job{&f, nullptr};
-  pthread_attr_t attr;
-  pthread_attr_init(&attr);
-  pthread_attr_setstacksize(&attr, kCoinStackBytes);
-  pthread_t thread;
-  const int created = pthread_create(
-      &thread, &attr,
-      [](void* data) -> void* {
-        auto* j = static_cast<Job*>(data);
-        try {
-          (*j->f)();
-        } catch (...) {
-          j->error = std::current_exception();
-        }
-        return nullptr;
-      },
-      &job);
-  pthread_attr_destroy(&attr);
-  if (created != 0) throw PartError("cannot start a reader thread (" + std::string(std::strerror(created)) + ")");
-  pthread_join(thread, nullptr);
-  if (job.error) std::rethrow_exception(job.error);
-}
 
 Eigen::Affine3d toEigen(const SbMatrix& m) {
   // Coin uses row vectors: p' = p * M.
@@ -397,42 +369,6 @@ std::string nodeLabel(SoNode* node, int index) {
   return label;
 }
 
-// STL, ASCII or binary: a list of triangles (binary when the size matches its triangle count).
-Part readStl(const std::string& data, const std::string& path, const Vec3& scale) {
-  Part part;
-  auto add = [&](const Vec3& v) { part.points.push_back(v.cwiseProduct(scale)); };
-  std::uint32_t count = 0;
-  if (data.size() >= 84) std::memcpy(&count, data.data() + 80, 4);
-  if (data.size() >= 84 && data.size() == 84 + 50ull * count) {
-    for (std::uint32_t t = 0; t < count; ++t) {
-      const char* rec = data.data() + 84 + 50ull * t + 12;  // skip the normal
-      for (int k = 0; k < 3; ++k) {
-        float xyz[3];
-        std::memcpy(xyz, rec + 12 * k, 12);
-        add(Vec3(xyz[0], xyz[1], xyz[2]));
-      }
-    }
-    part.triangles = static_cast<int>(count);
-  } else {
-    if (data.compare(0, 5, "solid") != 0)
-      throw PartError(path + ": not an STL file (neither ASCII 'solid' nor a binary triangle count)");
-    std::istringstream text(data);
-    std::string word;
-    int line_vertices = 0;
-    while (text >> word) {
-      if (word != "vertex") continue;
-      Vec3 v;
-      if (!(text >> v.x() >> v.y() >> v.z()))
-        throw PartError(path + ": malformed vertex after " + std::to_string(part.points.size()) +
-                                 " vertices");
-      add(v);
-      if (++line_vertices % 3 == 0) ++part.triangles;
-    }
-    if (line_vertices % 3 != 0) throw PartError(path + ": truncated facet (vertex count not a multiple of 3)");
-  }
-  return part;
-}
-
 // An ASCII Open Inventor or VRML text before Coin reads it: nesting of braces and brackets
 // (outside strings and comments) at most kMaxNesting, and no node that includes another file.
 void scanText(const std::string& data, const std::string& path) {
@@ -548,7 +484,7 @@ Part readScene(const std::string& data, const std::string& path, const ReadOptio
 
   std::lock_guard<std::mutex> lock(coin_mutex);
   Part result;
-  onLargeStack([&] {
+  detail::onLargeStack([&] {
     initCoin();
     // Coin keeps the handlers' data pointers: they must outlive the call.
     static Messages read_errors, other_errors;
@@ -723,8 +659,10 @@ Part readPart(const std::string& path, const ReadOptions& options) {
   std::string extension = std::filesystem::path(path).extension().string();
   for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
   const std::string data = readInputFile(path);
-  // Coin's STL reader fails on the second different STL file in a process: STL is read here.
-  Part part = extension == ".stl" ? readStl(data, name, options.scale) : readScene(data, name, options);
+  // Open Inventor and VRML (analytic primitives, scene graphs) through Coin3D; meshes (STL, OBJ,
+  // COLLADA, PLY, glTF, ...) through Assimp.
+  Part part = detail::readsAsMesh(extension) ? detail::readMesh(data, name, extension, options)
+                                             : readScene(data, name, options);
   if (part.triangles == 0 && part.primitives == 0)
     throw PartError(name + (options.part.empty() ? "" : " (part " + printable(options.part) + ")") +
                              ": no triangles or solid primitives (nothing to fit)");

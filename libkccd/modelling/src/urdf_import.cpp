@@ -316,6 +316,8 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
 
   std::ostringstream joints, bodies;
   std::set<std::string> link_names, body_names;
+  std::set<std::string> urdf_joint_names, joint_names;  // the URDF's; the model's
+  for (const auto& [name, joint] : urdf->joints_) urdf_joint_names.insert(name);
   std::map<std::string, std::string> frame_of;  // link -> KCCD frame name
   std::deque<urdf::LinkConstSharedPtr> queue{urdf->getRoot()};
   frame_of[urdf->getRoot()->name] = "world";
@@ -326,35 +328,63 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     order.push_back(link);
     link_names.insert(link->name);
     for (const urdf::JointSharedPtr& j : link->child_joints) {
-      const char* kind = nullptr;
-      switch (j->type) {
-        case urdf::Joint::REVOLUTE:
-        case urdf::Joint::CONTINUOUS: kind = "revolute"; break;
-        case urdf::Joint::PRISMATIC: kind = "prismatic"; break;
-        case urdf::Joint::FIXED: kind = "fixed"; break;
-        case urdf::Joint::FLOATING:
-          throw UrdfError(path + ": joint " + j->name +
-                                   " is floating: not supported (fixed, revolute, continuous, prismatic)");
-        case urdf::Joint::PLANAR:
-          throw UrdfError(path + ": joint " + j->name +
-                                   " is planar: not supported (fixed, revolute, continuous, prismatic)");
-        default: throw UrdfError(path + ": joint " + j->name + " has an unknown type");
-      }
       const urdf::Pose& o = j->parent_to_joint_origin_transform;
       double r, p, y;
       o.rotation.getRPY(r, p, y);
-      joints << "  - name: " << j->name << "\n"
-             << "    parent: " << frame_of.at(link->name) << "\n"
-             << "    type: " << kind << "\n"
-             << "    origin: {xyz: " << vec(o.position.x, o.position.y, o.position.z) << ", rpy: " << vec(r, p, y)
-             << "}\n";
-      if (j->type != urdf::Joint::FIXED) {
-        joints << "    axis: " << vec(j->axis.x, j->axis.y, j->axis.z) << "\n";
-        if (j->type != urdf::Joint::CONTINUOUS && j->limits)
-          joints << "    limits: [" << num(j->limits->lower) << ", " << num(j->limits->upper) << "]\n";
+      const std::string origin = "{xyz: " + vec(o.position.x, o.position.y, o.position.z) + ", rpy: " + vec(r, p, y) + "}";
+      // One KCCD joint, or a chain of them, in the URDF joint's place; the child link hangs
+      // from the last.
+      std::string parent = frame_of.at(link->name);
+      auto emit = [&](const std::string& name, const char* kind, const std::string& joint_origin, const Vec3* axis,
+                      const std::string& note) {
+        if ((name != j->name && urdf_joint_names.count(name) != 0) || !joint_names.insert(name).second)
+          throw UrdfError(path + ": joint " + j->name + ": its KCCD joint " + name + " would repeat a joint name");
+        joints << "  - name: " << name << "\n"
+               << "    parent: " << parent << "\n"
+               << "    type: " << kind << "\n"
+               << "    origin: " << joint_origin << "\n";
+        if (axis != nullptr) joints << "    axis: " << vec(axis->x(), axis->y(), axis->z()) << "\n";
+        if (!note.empty()) joints << "    # " << note << "\n";
+        parent = name;
+      };
+      const std::string zero = "{xyz: [0, 0, 0], rpy: [0, 0, 0]}";
+      const Vec3 axis(j->axis.x, j->axis.y, j->axis.z);
+      switch (j->type) {
+        case urdf::Joint::REVOLUTE:
+        case urdf::Joint::CONTINUOUS:
+        case urdf::Joint::PRISMATIC: {
+          emit(j->name, j->type == urdf::Joint::PRISMATIC ? "prismatic" : "revolute", origin, &axis, "");
+          if (j->type != urdf::Joint::CONTINUOUS && j->limits)
+            joints << "    limits: [" << num(j->limits->lower) << ", " << num(j->limits->upper) << "]\n";
+          break;
+        }
+        case urdf::Joint::FIXED: emit(j->name, "fixed", origin, nullptr, ""); break;
+        case urdf::Joint::FLOATING:
+          // A measured 6-DOF pose: position, then orientation as a rotation vector.
+          emit(j->name, "translation3d", origin, nullptr, "URDF floating joint " + j->name + ": position (x, y, z)");
+          emit(j->name + "_rotation", "rotation3d", zero, nullptr,
+               "URDF floating joint " + j->name + ": orientation (rotation vector)");
+          break;
+        case urdf::Joint::PLANAR: {
+          // Motion in the plane through the joint frame's origin normal to the axis: two
+          // prismatic joints along the plane's axes, then a revolute joint about the normal (the
+          // swept volume of an interval box is exactly these three sweeps in turn).
+          const double length = axis.norm();
+          if (!(length > 0.0) || !std::isfinite(length))
+            throw UrdfError(path + ": joint " + j->name + ": planar joint with a zero or non-finite axis");
+          const Vec3 n = axis / length;
+          const Vec3 pick = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+          const Vec3 u = (pick - pick.dot(n) * n).normalized(), v = n.cross(u);
+          const std::string what = "URDF planar joint " + j->name;
+          emit(j->name + "_x", "prismatic", origin, &u, what + ": first axis in the plane");
+          emit(j->name + "_y", "prismatic", zero, &v, what + ": second axis in the plane");
+          emit(j->name + "_yaw", "revolute", zero, &n, what + ": rotation about the plane's normal");
+          break;
+        }
+        default: throw UrdfError(path + ": joint " + j->name + " has an unknown type");
       }
       if (j->mimic) joints << "    # mimics " << j->mimic->joint_name << " in the URDF: checked as independent\n";
-      frame_of[j->child_link_name] = j->name;
+      frame_of[j->child_link_name] = parent;
       const urdf::LinkConstSharedPtr child = urdf->getLink(j->child_link_name);
       if (child) queue.push_back(child);
     }

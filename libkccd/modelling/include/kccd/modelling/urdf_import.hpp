@@ -25,8 +25,11 @@ struct ImportOptions {
 };
 
 /// Converts the URDF file at `path` into `kccd: 1` model text (checked by loading it back).
-/// Throws UrdfError with one line naming the file and the element on any problem:
-/// unreadable XML, unsupported joint kinds (floating, planar), unresolved or unreadable meshes.
+/// Joints map one to one, except: a floating joint J becomes J (translation3d) and J_rotation
+/// (rotation3d); a planar joint J becomes J_x and J_y (prismatic along two axes of the plane
+/// normal to its axis) and J_yaw (revolute about that axis). Throws UrdfError with one line
+/// naming the file and the element on any problem: unreadable XML, unresolved or unreadable
+/// meshes, a chain joint's name taken by another joint.
 std::string importUrdf(const std::string& path, const ImportOptions& options = {});
 
 }  // namespace kccd::modelling

@@ -1,0 +1,23 @@
+// Triangle meshes read through Assimp (OBJ, COLLADA, STL, PLY, glTF/GLB and the other formats
+// Assimp reads), for readPart.
+#pragma once
+
+#include <string>
+
+#include "kccd/modelling/part.hpp"
+
+namespace kccd::modelling::detail {
+
+/// Whether readPart reads a file with this extension (lower case, with the dot) through Assimp
+/// rather than Coin3D (Open Inventor and VRML stay on Coin3D).
+bool readsAsMesh(const std::string& extension);
+
+/// The triangles of the mesh file `data` (named `name` in messages, `extension` choosing the
+/// format), every node transform applied and then options.scale; options.part picks a node by
+/// name, several top-level nodes with triangles need options.merge. COLLADA: the `<unit meter>`
+/// scale is applied and `<up_axis>` is not (the file's coordinates are the link frame's, as ROS
+/// tools place them). Throws PartError with one line naming the file.
+Part readMesh(const std::string& data, const std::string& name, const std::string& extension,
+              const ReadOptions& options);
+
+}  // namespace kccd::modelling::detail
