@@ -1,6 +1,7 @@
-// libFuzzer target: kccd::modelling::readPart on arbitrary bytes (as .iv, .wrl, or a mesh read
-// through Assimp: .stl, .obj, .dae, .ply, .glb, .gltf, chosen by the first byte). A result or the reader's one-line std::runtime_error is fine; a crash, any other
-// exception or a multi-line message is a finding.
+// libFuzzer target: kccd::modelling::readPart on arbitrary bytes, as .iv or .wrl (Coin3D), .stl
+// (read directly), or .obj, .dae, .ply, .glb, .gltf (Assimp), chosen by the first byte. A result
+// or the reader's one-line std::runtime_error is fine; a crash, any other exception or a
+// multi-line message is a finding.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <string>
 #include <vector>
 
+#include <assimp/BaseImporter.h>
 #include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
@@ -100,6 +102,17 @@ Part readMesh(const std::string& data, const std::string& name, const std::strin
   // Assimp's parsers recurse per nesting level of the file (COLLADA and glTF nodes).
   onLargeStack([&] {
     Assimp::Importer importer;
+    // Only the readers that claim the extension may read the file: Assimp would otherwise try
+    // every format it knows on data that reader refuses (unregistered readers are ours to delete).
+    std::vector<Assimp::BaseImporter*> others;
+    for (std::size_t i = 0; i < importer.GetImporterCount(); ++i) {
+      Assimp::BaseImporter* reader = importer.GetImporter(i);
+      std::set<std::string> extensions;
+      reader->GetExtensionList(extensions);
+      if (extensions.count(extension.substr(1)) == 0) others.push_back(reader);
+    }
+    for (Assimp::BaseImporter* reader : others)
+      if (importer.UnregisterLoader(reader) == aiReturn_SUCCESS) delete reader;
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     // COLLADA: keep the file's axes (ROS tools place a mesh in the link frame as written);
     // Assimp still applies the <unit meter> scale to the root node.

@@ -1,5 +1,5 @@
-// Triangle meshes read through Assimp (OBJ, COLLADA, STL, PLY, glTF/GLB and the other formats
-// Assimp reads), for readPart.
+// Triangle meshes read through Assimp (OBJ, COLLADA, PLY, glTF/GLB and the other formats Assimp
+// reads), for readPart.
 #pragma once
 
 #include <string>
@@ -8,12 +8,12 @@
 
 namespace kccd::modelling::detail {
 
-/// Whether readPart reads a file with this extension (lower case, with the dot) through Assimp
-/// rather than Coin3D (Open Inventor and VRML stay on Coin3D).
+/// Whether Assimp reads files with this extension (lower case, with the dot); Open Inventor and
+/// VRML are left to Coin3D.
 bool readsAsMesh(const std::string& extension);
 
 /// The triangles of the mesh file `data` (named `name` in messages, `extension` choosing the
-/// format), every node transform applied and then options.scale; options.part picks a node by
+/// format: only Assimp's readers for it are tried), every node transform applied and then options.scale; options.part picks a node by
 /// name, several top-level nodes with triangles need options.merge. COLLADA: the `<unit meter>`
 /// scale is applied and `<up_axis>` is not (the file's coordinates are the link frame's, as ROS
 /// tools place them). Throws PartError with one line naming the file.
