@@ -345,4 +345,27 @@ TEST(Cli, ImportWritesALoadableModel) {
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(e.err.find("unknown package 'kccd_test'"), std::string::npos) << e.err;
   EXPECT_EQ(runKccd("import " + dir + "/two_link.urdf --package-path nonsense -q").code, 2);
+  // --pairs: the proofs of `kccd pairs` written into the ignore list, next to the SRDF's pairs.
+  const std::string proven = ::testing::TempDir() + "/" + std::to_string(getpid()) + "_proven.yaml";
+  const Outcome p = runKccd("import " + dir + "/two_link.urdf --srdf " + dir + "/two_link.srdf --package-path kccd_test=" +
+                            dir + " -k 4 --pairs -o " + proven);
+  ASSERT_EQ(p.code, 0) << p.err;
+  EXPECT_NE(p.err.find("pairs: "), std::string::npos) << p.err;
+  const Outcome again = runKccd("pairs " + proven + " --json");
+  ASSERT_EQ(again.code, 0) << again.err;
+  const nlohmann::json proofs = nlohmann::json::parse(again.out);
+  int ignored = 0;
+  for (const auto& pair : proofs["pairs"]) {
+    // Every pair proven never or always touching is now ignored; the SRDF's stay ignored.
+    if (pair["verdict"] == "never" || pair["verdict"] == "always_touching") {
+      EXPECT_FALSE(pair["checked"]) << pair;
+    }
+    ignored += pair["checked"] ? 0 : 1;
+  }
+  EXPECT_GE(ignored, 2);  // at least the SRDF's two pairs
+  const Outcome plain = runKccd("pairs " + out + " --json");
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  int ignored_plain = 0;
+  for (const auto& pair : nlohmann::json::parse(plain.out)["pairs"]) ignored_plain += pair["checked"] ? 0 : 1;
+  EXPECT_GE(ignored, ignored_plain);
 }

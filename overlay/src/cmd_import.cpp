@@ -6,7 +6,10 @@
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
+#include "kccd/model.hpp"
+#include "kccd/modelling/pair_proof.hpp"
 #include "kccd/modelling/urdf_import.hpp"
+#include "kccd/modelling/yaml_edit.hpp"
 
 namespace kccd::cli {
 namespace {
@@ -16,8 +19,35 @@ struct ImportArgs {
   int points = 8;
   double margin = 0.02;
   std::vector<std::string> packages;
-  bool quiet = false;
+  bool quiet = false, pairs = false;
+  int max_boxes = 2000;
 };
+
+// `--pairs`: the pairs `kccd pairs` proves never to come within the margin, or to touch at every
+// configuration, join the ignore list (with the SRDF's).
+std::string withProvenPairs(const std::string& text, const ImportArgs& args) {
+  const Model m = parseModel(text, args.urdf + " (imported)");
+  std::vector<modelling::PairReport> reports;
+  {
+    Progress progress("proving pairs", args.quiet);
+    reports = modelling::provePairs(m, {.max_boxes = args.max_boxes, .progress = [&](double f) { progress.update(f); }});
+  }
+  std::vector<std::array<std::string, 2>> ignore;
+  int never = 0, touching = 0, undecided = 0;
+  for (const auto& r : reports) {
+    never += r.verdict == modelling::Verdict::Never;
+    touching += r.verdict == modelling::Verdict::AlwaysTouching;
+    undecided += r.verdict == modelling::Verdict::Undecided;
+    if (!r.checked || r.verdict == modelling::Verdict::Never || r.verdict == modelling::Verdict::AlwaysTouching)
+      ignore.push_back({m.bodies[r.a].name, m.bodies[r.b].name});
+  }
+  if (!args.quiet)
+    std::cerr << "pairs: " << never << " never within the margin, " << touching << " always touching, " << undecided
+              << " undecided (of " << reports.size() << "); " << ignore.size() << " ignored\n";
+  std::string out = modelling::withIgnoreList(text, args.urdf + " (imported)", ignore);
+  (void)parseModel(out, args.urdf + " (imported)");
+  return out;
+}
 
 Exit runImport(const ImportArgs& args) {
   checkCorePoints(args.points);
@@ -37,6 +67,7 @@ Exit runImport(const ImportArgs& args) {
     opt.progress = [&](double f) { progress.update(f); };
     text = modelling::importUrdf(args.urdf, opt);
   }
+  if (args.pairs) text = withProvenPairs(text, args);
   if (args.output.empty() || args.output == "-") {
     std::cout << text;
   } else {
@@ -63,6 +94,12 @@ Runner addImport(CLI::App& app) {
       ->check(finiteIn(0.0, kMaxModelLength));
   sub->add_option("--package-path", args->packages, "Resolves package://NAME/... meshes: NAME=DIR (repeatable)");
   sub->add_option("-o,--output", args->output, "Model file to write (default: standard output)");
+  sub->add_flag("--pairs", args->pairs,
+                "Also prove which pairs never come within the margin inside the joint limits, or always touch, "
+                "and ignore them (as kccd pairs --write)");
+  sub->add_option("--max-boxes", args->max_boxes, "With --pairs: boxes per pair before a pair is undecided")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 10000000));
   sub->add_flag("--quiet,-q", args->quiet, "No progress display");
   sub->footer(
       "Joint kinds: fixed, revolute, continuous (revolute without limits), prismatic; a floating joint J becomes "
