@@ -173,6 +173,58 @@ TEST(RenderMask, WarpIsTheNearestPixelRemapOfThePinholeLabels) {
   }
 }
 
+// Appearance surfaces (Volume::surface): a triangle mesh drawn like the volume it bounds, both
+// sides, with the mask label it is given (0 hides what is behind it without a label).
+TEST(RenderMask, SurfacesDrawBothSidesWithTheirOwnLabels) {
+  const Camera c = lookAt(Vec3(2, 0.5, 0.8), Vec3(0, 0, 0), 240, 180, 220, {-0.05, 0, 0, 0, 0});
+  std::vector<Vec3> corners, soup;
+  for (int i = 0; i < 8; ++i) corners.emplace_back(i & 1 ? 0.2 : -0.2, i & 2 ? 0.2 : -0.2, i & 4 ? 0.2 : -0.2);
+  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) soup.insert(soup.end(), {corners[f[0]], corners[f[1]], corners[f[2]], corners[f[0]], corners[f[2]], corners[f[3]]});
+  const auto box = std::make_shared<const Mesh>(surfaceMesh(soup));
+  EXPECT_EQ(box->vertices.size(), 24u);  // each corner once per face: the creases stay sharp
+  EXPECT_EQ(box->triangles.size(), 12u);
+  Renderer r(c);
+  Volume surface;
+  surface.surface = box;
+  surface.mask_label = 7;
+  const Frame fs = r.render(std::span<const Volume>(&surface, 1), Style{.legend = false, .shaded = true}, true, true);
+  const Volume ssch{corners, 0.0, VolumeStatus::Clear, ""};
+  const Frame fv = r.render(std::span<const Volume>(&ssch, 1), Style{.shaded = true}, true, true);
+  const cv::Mat a = fs.mask > 0, b = fv.mask > 0;
+  EXPECT_EQ(cv::countNonZero(fs.mask == 7), cv::countNonZero(a));
+  EXPECT_EQ(fs.pixels[0], cv::countNonZero(a));
+  EXPECT_GT(fs.pixels[0], 2000);
+  // The SSCH of the same corners is drawn 1 mm thicker: the same silhouette within a pixel.
+  EXPECT_GE(static_cast<double>(cv::countNonZero(a & b)) / cv::countNonZero(a | b), 0.97);
+  EXPECT_EQ(fs.visibility[0], Visibility::Drawn);
+  // Shaded and opaque where it is drawn (inside its anti-aliased edge).
+  cv::Mat alpha, inside;
+  cv::extractChannel(fs.bgra, alpha, 3);
+  cv::erode(a, inside, cv::Mat::ones(3, 3, CV_8U));
+  EXPECT_GT(cv::countNonZero(inside), 1500);
+  EXPECT_EQ(cv::countNonZero((alpha == 255) & inside), cv::countNonZero(inside));
+
+  // One triangle turned away from the camera is drawn all the same.
+  std::vector<Vec3> back = {Vec3(0, -0.3, -0.3), Vec3(0, -0.3, 0.3), Vec3(0, 0.3, 0)};
+  std::vector<Vec3> front = {back[0], back[2], back[1]};
+  for (const auto* tri : {&back, &front}) {
+    Volume t;
+    t.surface = std::make_shared<const Mesh>(surfaceMesh(*tri));
+    const Frame f = r.render(std::span<const Volume>(&t, 1), Style{.shaded = true}, true, true);
+    EXPECT_GT(f.pixels[0], 500);
+  }
+  // Label 0 in front hides the volume behind it.
+  Volume wall;
+  wall.surface = std::make_shared<const Mesh>(surfaceMesh(std::vector<Vec3>{
+      Vec3(1, -1, -1), Vec3(1, 1, -1), Vec3(1, 1, 1), Vec3(1, -1, -1), Vec3(1, 1, 1), Vec3(1, -1, 1)}));
+  wall.mask_label = 0;
+  const Volume both[] = {ssch, wall};
+  const Frame hidden = r.render(both, Style{.shaded = true}, false, true);
+  EXPECT_EQ(hidden.pixels[0], 0);
+  EXPECT_LT(cv::countNonZero(hidden.mask), cv::countNonZero(b) / 10);
+}
+
 TEST(RenderMask, DegenerateVolumesAreVisible) {
   const Camera c = lookAt(Vec3(1.5, -1.0, 1.0), Vec3(0, 0, 0), 160, 120, 150, {-0.1, 0.01, 0, 0, 0});
   Renderer r(c);

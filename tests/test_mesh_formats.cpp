@@ -294,7 +294,11 @@ TEST(MeshFormats, UrdfMixingEveryFormatImports) {
   write("mix_box.glb", glbBox(size, Vec3(0.1, 0, 0)));
   write("mix_box.dae", daeBox(size * 1000, 0.001, "Y_UP", Vec3(0, 0, 0)));
   std::ostringstream urdf;
-  urdf << "<robot name=\"mix\">\n  <link name=\"base\"><collision><geometry><mesh filename=\"mix_box.obj\"/></geometry></collision></link>\n";
+  urdf << "<robot name=\"mix\">\n  <material name=\"orange\"><color rgba=\"1 0.5 0 1\"/></material>\n"
+       << "  <link name=\"base\"><collision><geometry><mesh filename=\"mix_box.obj\"/></geometry></collision>"
+       << "<visual><origin xyz=\"0 0 0.01\"/><geometry><mesh filename=\"mix_box.dae\" scale=\"2 2 2\"/></geometry>"
+       << "<material name=\"orange\"/></visual><visual><geometry><cylinder radius=\"0.1\" length=\"0.3\"/></geometry></visual>"
+       << "</link>\n";
   const char* files[] = {"mix_box.ply", "mix_box.stl", "mix_box.glb", "mix_box.dae"};
   std::string parent = "base";
   for (int i = 0; i < 4; ++i) {
@@ -310,6 +314,19 @@ TEST(MeshFormats, UrdfMixingEveryFormatImports) {
   options.points = 4;
   const kccd::Model m = kccd::parseModel(km::importUrdf(write("mix.urdf", urdf.str()), options), "imported");
   ASSERT_EQ(m.bodies.size(), 5u);
+  // The base link's two <visual>s: the DAE with its scale, origin and material colour, a cylinder.
+  ASSERT_EQ(m.visuals.size(), 2u);
+  EXPECT_EQ(m.visuals[0].shape, kccd::Visual::Shape::Mesh);
+  EXPECT_EQ(m.visuals[0].frame, kccd::kWorld);
+  EXPECT_TRUE(std::filesystem::path(m.visuals[0].mesh).is_absolute());
+  EXPECT_TRUE(std::filesystem::equivalent(m.visuals[0].mesh, scratch() / "mix_box.dae"));
+  EXPECT_EQ(m.visuals[0].scale, Vec3(2, 2, 2));
+  EXPECT_NEAR(m.visuals[0].origin.translation().z(), 0.01, 1e-12);
+  EXPECT_EQ(m.visuals[0].colour, (std::array<double, 4>{1, 0.5, 0, 1}));
+  EXPECT_EQ(m.visuals[1].shape, kccd::Visual::Shape::Cylinder);
+  EXPECT_EQ(m.visuals[1].size, Vec3(0.1, 0.1, 0.3));
+  options.visuals = false;
+  EXPECT_TRUE(kccd::parseModel(km::importUrdf((scratch() / "mix.urdf").string(), options), "imported").visuals.empty());
   auto contains = [&](const std::string& body, const std::vector<Vec3>& pts) {
     const kccd::Body& b = m.bodies[m.bodyIndex(body)];
     for (const Vec3& p : pts)

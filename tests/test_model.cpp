@@ -159,6 +159,63 @@ TEST(Model, EveryMistakeGetsOneClearMessage) {
   }
 }
 
+// visuals: appearance only, in a frame, one shape each; mesh paths relative to the model file.
+TEST(Model, VisualsLoadAndTheirMistakesPointAtTheLine) {
+  const std::string visuals = kGood + R"(visuals:
+  - frame: base
+    mesh: meshes/arm.dae
+    scale: [0.001, 0.001, 0.001]
+    origin: {xyz: [0, 0, 0.1], rpy: [0, 0, 0]}
+    colour: [1, 0.5, 0]
+  - frame: world
+    box: [1, 2, 0.1]
+  - frame: turn
+    cylinder: {radius: 0.05, length: 0.2}
+    colour: [0.2, 0.2, 0.2, 0.5]
+  - frame: world
+    sphere: 0.3
+  - frame: slide
+    mesh: /abs/tool.stl
+)";
+  const Model m = parseModel(visuals, "/models/cell/cell.yaml");
+  ASSERT_EQ(m.visuals.size(), 5u);
+  EXPECT_EQ(m.visuals[0].shape, Visual::Shape::Mesh);
+  EXPECT_EQ(m.visuals[0].frame, m.jointIndex("base"));
+  EXPECT_EQ(m.visuals[0].mesh, "/models/cell/meshes/arm.dae");
+  EXPECT_DOUBLE_EQ(m.visuals[0].scale.x(), 0.001);
+  EXPECT_DOUBLE_EQ(m.visuals[0].origin.translation().z(), 0.1);
+  EXPECT_EQ(m.visuals[0].colour, (std::array<double, 4>{1, 0.5, 0, 1}));
+  EXPECT_EQ(m.visuals[1].shape, Visual::Shape::Box);
+  EXPECT_EQ(m.visuals[1].frame, kWorld);
+  EXPECT_EQ(m.visuals[1].size, Vec3(1, 2, 0.1));
+  EXPECT_EQ(m.visuals[2].shape, Visual::Shape::Cylinder);
+  EXPECT_EQ(m.visuals[2].size, Vec3(0.05, 0.05, 0.2));
+  EXPECT_DOUBLE_EQ(m.visuals[2].colour[3], 0.5);
+  EXPECT_EQ(m.visuals[3].size, Vec3(0.3, 0.3, 0.3));
+  EXPECT_EQ(m.visuals[4].mesh, "/abs/tool.stl");
+  // Visuals change nothing that is checked.
+  EXPECT_EQ(m.pairs.size(), parseModel(kGood, "cell.yaml").pairs.size());
+  const int line = 44;  // the first visual's frame
+  auto error = [&](const std::string& from, const std::string& to) {
+    std::string text = visuals;
+    text.replace(text.find(from), from.size(), to);
+    return loadError(text);
+  };
+  auto expectIn = [](const std::string& message, const std::string& part) {
+    EXPECT_NE(message.find(part), std::string::npos) << message << " (expected '" << part << "')";
+  };
+  expectIn(error("frame: base\n    mesh", "frame: bse\n    mesh"), "cell.yaml:" + std::to_string(line) + ":");
+  expectIn(error("frame: base\n    mesh", "frame: bse\n    mesh"), "visuals[0].frame: unknown joint 'bse'");
+  expectIn(error("    box: [1, 2, 0.1]\n", "    box: [1, 2, 0.1]\n    sphere: 1\n"), "exactly one of mesh, box, cylinder, sphere");
+  expectIn(error("colour: [1, 0.5, 0]", "colour: [1, 1.5, 0]"), "visuals[0].colour[1]: must be in 0..1");
+  expectIn(error("box: [1, 2, 0.1]", "box: [1, 0, 0.1]"), "visuals[1].box[1]: must be > 0");
+  expectIn(error("    box: [1, 2, 0.1]\n", "    box: [1, 2, 0.1]\n    scale: [1, 1, 1]\n"), "a scale applies to meshes only");
+  expectIn(error("scale: [0.001, 0.001, 0.001]", "scale: [0.001, 0, 0.001]"), "factors must be non-zero");
+  expectIn(error("cylinder: {radius: 0.05, length: 0.2}", "cylinder: {radius: 0.05}"), "cylinder.length");
+  expectIn(error("sphere: 0.3", "sphere: 1e7"), "beyond the largest length");
+  expectIn(error("    sphere: 0.3\n", "    sphere: 0.3\n    texture: wood\n"), "unknown field");
+}
+
 TEST(Model, AxesOfAnyScaleNormalise) {
   for (const char* axis : {"[0, 0, 1e-150]", "[0, 0, 1e200]", "[1e-300, 0, 3e-300]", "[1.5e308, 0, 1.5e308]"}) {
     const Model m = parseModel(edit("axis: [0, 0, 2]", std::string("axis: ") + axis), "cell.yaml");

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "kccd/calib/camera.hpp"
@@ -252,6 +253,75 @@ TEST_F(Synth, NoCollisionOption) {
   EXPECT_TRUE(j["collision"]["frames"].empty());
   EXPECT_EQ(j["video"]["frames"], 20);
   for (const json& f : j["frames"]) EXPECT_GT(static_cast<double>(f["min_distance"]), 0.0);
+}
+
+// A model with visuals: the recording shows the visual meshes (an OBJ for the upper arm, boxes
+// and a cylinder), the masks label them with the body in their frame, and synth.json says so.
+TEST_F(Synth, DrawsTheModelsVisualGeometry) {
+  std::string model = kccd::testing::readText(kData + "/demo_arm.yaml");
+  {
+    std::ofstream obj(dir("upper_arm.obj"));
+    for (int i = 0; i < 8; ++i)
+      obj << "v " << (i & 1 ? 0.4 : 0.0) << " " << (i & 2 ? 0.04 : -0.04) << " " << (i & 4 ? 0.04 : -0.04) << "\n";
+    obj << "f 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\nf 1 2 6\nf 1 6 5\nf 3 7 8\nf 3 8 4\nf 1 5 7\nf 1 7 3\nf 2 4 8\nf 2 8 6\n";
+  }
+  model += "visuals:\n"
+           "  - frame: world\n    cylinder: {radius: 0.08, length: 0.35}\n    origin: {xyz: [0, 0, 0.175]}\n"
+           "  - frame: shoulder_pitch\n    mesh: upper_arm.obj\n    colour: [0.9, 0.4, 0.1]\n"
+           "  - frame: elbow\n    box: [0.4, 0.07, 0.07]\n    origin: {xyz: [0.2, 0, 0]}\n";
+  std::ofstream(dir("visual_arm.yaml")) << model;
+  const Outcome r = runKccd("synth " + dir("visual_arm.yaml") + " -o " + dir("v") +
+                            " --seconds 0.4 --fps 10 --seed 2 --no-collision -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = summary("v");
+  EXPECT_EQ(j["masks"]["appearance"], "visuals") << j["masks"].dump();
+  // Labels: body i + 1 of the first body in each visual's frame (pedestal 1, upper_arm 5, forearm 6).
+  std::vector<int> seen(256, 0);
+  for (int f = 0; f < 4; ++f) {
+    char name[64];
+    std::snprintf(name, sizeof name, "/masks/frame_%06d.png", f);
+    const cv::Mat mask = cv::imread(dir("v") + name, cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(mask.empty()) << name;
+    for (int y = 0; y < mask.rows; ++y)
+      for (int x = 0; x < mask.cols; ++x) ++seen[mask.at<uchar>(y, x)];
+  }
+  EXPECT_GT(seen[1], 0);
+  EXPECT_GT(seen[5], 0);
+  EXPECT_GT(seen[6], 0);
+  for (int label = 2; label < 256; ++label) {
+    if (label != 5 && label != 6) {
+      EXPECT_EQ(seen[label], 0) << label;  // no visual for the other bodies
+    }
+  }
+  // `kccd overlay --visuals` draws the same appearance over the recording: where the visuals'
+  // mask says the robot is, the overlay with --visuals differs from the one without.
+  const std::string common = "overlay " + dir("visual_arm.yaml") + " --camera " + dir("v") + "/camera_true.yaml --video " +
+                             dir("v") + "/video.mkv --states " + dir("v") + "/states.csv --time-offset 0.137 -q --plain";
+  const Outcome with = runKccd(common + " --visuals --png-dir " + dir("ov_with"));
+  ASSERT_EQ(with.code, 0) << with.err;
+  const Outcome without = runKccd(common + " --png-dir " + dir("ov_without"));
+  ASSERT_EQ(without.code, 0) << without.err;
+  const cv::Mat a = cv::imread(dir("ov_with") + "/frame_000000.png"), b = cv::imread(dir("ov_without") + "/frame_000000.png");
+  const cv::Mat robot = cv::imread(dir("v") + "/masks/frame_000000.png", cv::IMREAD_UNCHANGED) > 0;
+  ASSERT_FALSE(a.empty());
+  ASSERT_EQ(a.size(), robot.size());
+  cv::Mat diff, changed;
+  cv::absdiff(a, b, diff);
+  cv::cvtColor(diff, changed, cv::COLOR_BGR2GRAY);
+  changed = changed > 0;
+  EXPECT_GT(cv::countNonZero(changed & robot), cv::countNonZero(robot) / 2);
+  const Outcome none = runKccd("overlay " + kData + "/demo_arm.yaml --camera " + dir("v") + "/camera_true.yaml --video " +
+                               dir("v") + "/video.mkv --states " + dir("v") + "/states.csv -q --visuals --png-dir " + dir("ov_none"));
+  EXPECT_EQ(none.code, 2);
+  EXPECT_NE(none.err.find("has no visuals"), std::string::npos) << none.err;
+  // A visual mesh that cannot be read is one line naming the visual and the file.
+  std::ofstream(dir("broken_visual.yaml")) << kccd::testing::readText(kData + "/demo_arm.yaml")
+                                           << "visuals:\n  - frame: world\n    mesh: missing.obj\n";
+  const Outcome e = runKccd("synth " + dir("broken_visual.yaml") + " -o " + dir("w") + " --seconds 0.2 -q");
+  EXPECT_EQ(e.code, 2);
+  EXPECT_NE(e.err.find("visuals[0]: "), std::string::npos) << e.err;
+  EXPECT_NE(e.err.find("missing.obj"), std::string::npos) << e.err;
+  EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << e.err;
 }
 
 TEST_F(Synth, BadInputIsOneLineExitTwo) {

@@ -195,6 +195,73 @@ void parseBodies(const Reader& r, const YAML::Node& list, Model& m) {
   }
 }
 
+void parseVisuals(const Reader& r, const YAML::Node& list, Model& m, const std::string& source) {
+  if (!list.IsSequence()) r.fail(list, "visuals", "expected a list");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node n = list[i];
+    const std::string f = "visuals[" + std::to_string(i) + "]";
+    r.onlyKeys(n, f, {"frame", "mesh", "scale", "box", "cylinder", "sphere", "origin", "colour"});
+    Visual v;
+    const std::string frame = r.text(r.require(n, "frame", f, n), f + ".frame");
+    if (frame != "world") {
+      v.frame = m.jointIndex(frame);
+      if (v.frame < 0) r.fail(n["frame"], f + ".frame", "unknown joint '" + frame + "'");
+    }
+    int shapes = 0;
+    for (const char* key : {"mesh", "box", "cylinder", "sphere"}) shapes += n[key] ? 1 : 0;
+    if (shapes != 1) r.fail(n, f, "exactly one of mesh, box, cylinder, sphere");
+    auto positive = [&](const YAML::Node& node, const std::string& field) {
+      const double x = r.length(node, field);
+      if (!(x > 0.0)) r.fail(node, field, "must be > 0");
+      return x;
+    };
+    if (n["mesh"]) {
+      v.shape = Visual::Shape::Mesh;
+      const std::filesystem::path file = r.text(n["mesh"], f + ".mesh");
+      // Relative to the model file's folder when the model came from a file.
+      const std::filesystem::path folder = std::filesystem::path(source).parent_path();
+      v.mesh = (file.is_relative() ? folder / file : file).lexically_normal().string();
+      if (n["scale"]) {
+        v.scale = r.vec3(n["scale"], f + ".scale");
+        for (int k = 0; k < 3; ++k)
+          if (v.scale[k] == 0.0 || std::abs(v.scale[k]) > kMaxModelLength)
+            r.fail(n["scale"], f + ".scale", "factors must be non-zero and at most 1e6");
+      }
+    } else if (n["scale"]) {
+      r.fail(n["scale"], f + ".scale", "a scale applies to meshes only");
+    }
+    if (n["box"]) {
+      v.shape = Visual::Shape::Box;
+      const YAML::Node b = n["box"];
+      if (!b.IsSequence() || b.size() != 3) r.fail(b, f + ".box", "expected [x, y, z] sizes");
+      for (int k = 0; k < 3; ++k) v.size[k] = positive(b[k], f + ".box[" + std::to_string(k) + "]");
+    }
+    if (n["cylinder"]) {
+      v.shape = Visual::Shape::Cylinder;
+      const YAML::Node c = n["cylinder"];
+      r.onlyKeys(c, f + ".cylinder", {"radius", "length"});
+      const double radius = positive(r.require(c, "radius", f + ".cylinder", c), f + ".cylinder.radius");
+      v.size = Vec3(radius, radius, positive(r.require(c, "length", f + ".cylinder", c), f + ".cylinder.length"));
+    }
+    if (n["sphere"]) {
+      v.shape = Visual::Shape::Sphere;
+      const double radius = positive(n["sphere"], f + ".sphere");
+      v.size = Vec3(radius, radius, radius);
+    }
+    if (n["origin"]) v.origin = parseOrigin(r, n["origin"], f + ".origin");
+    if (n["colour"]) {
+      const YAML::Node c = n["colour"];
+      if (!c.IsSequence() || (c.size() != 3 && c.size() != 4)) r.fail(c, f + ".colour", "expected [r, g, b] or [r, g, b, a] in 0..1");
+      for (std::size_t k = 0; k < c.size(); ++k) {
+        const double x = r.number(c[k], f + ".colour[" + std::to_string(k) + "]");
+        if (x < 0.0 || x > 1.0) r.fail(c[k], f + ".colour[" + std::to_string(k) + "]", "must be in 0..1");
+        v.colour[k] = x;
+      }
+    }
+    m.visuals.push_back(std::move(v));
+  }
+}
+
 std::vector<std::array<int, 2>> parsePairList(const Reader& r, const YAML::Node& list, const Model& m,
                                               const std::string& field) {
   std::vector<std::array<int, 2>> out;
@@ -232,7 +299,7 @@ Model parseModel(const std::string& yaml_text, const std::string& source) {
                      ": YAML syntax error: " + e.msg);
   }
   if (!root.IsMap()) r.fail(root, "model", "expected a mapping with kccd, joints, bodies");
-  r.onlyKeys(root, "model", {"kccd", "name", "safety_margin", "point_budget", "joints", "bodies", "pairs"});
+  r.onlyKeys(root, "model", {"kccd", "name", "safety_margin", "point_budget", "joints", "bodies", "pairs", "visuals"});
   const YAML::Node version = r.require(root, "kccd", "model", root);
   if (!version.IsScalar() || version.Scalar() != "1")
     r.fail(version, "kccd", "unsupported format version '" + printable(version.Scalar()) + "' (this build reads 1)");
@@ -250,6 +317,7 @@ Model parseModel(const std::string& yaml_text, const std::string& source) {
   if (root["joints"]) parseJoints(r, root["joints"], m);
   parseBodies(r, r.require(root, "bodies", "model", root), m);
   if (m.bodies.empty()) r.fail(root["bodies"], "bodies", "a model needs at least one body");
+  if (root["visuals"]) parseVisuals(r, root["visuals"], m, source);
   bool check_all = true;
   std::vector<std::array<int, 2>> ignore, include;
   if (const YAML::Node pairs = root["pairs"]) {

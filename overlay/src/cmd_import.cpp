@@ -19,7 +19,7 @@ struct ImportArgs {
   int points = 8;
   double margin = 0.02;
   std::vector<std::string> packages;
-  bool quiet = false, pairs = false;
+  bool quiet = false, pairs = false, no_visuals = false;
   int max_boxes = 2000;
 };
 
@@ -55,6 +55,7 @@ Exit runImport(const ImportArgs& args) {
   opt.srdf = args.srdf;
   opt.points = args.points;
   opt.safety_margin = args.margin;
+  opt.visuals = !args.no_visuals;
   for (const std::string& p : args.packages) {
     const std::size_t eq = p.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == p.size())
@@ -94,6 +95,8 @@ Runner addImport(CLI::App& app) {
       ->check(finiteIn(0.0, kMaxModelLength));
   sub->add_option("--package-path", args->packages, "Resolves package://NAME/... meshes: NAME=DIR (repeatable)");
   sub->add_option("-o,--output", args->output, "Model file to write (default: standard output)");
+  sub->add_flag("--no-visuals", args->no_visuals,
+                "Leave out the links' <visual> geometry (written as visuals: for drawing; their mesh files must exist)");
   sub->add_flag("--pairs", args->pairs,
                 "Also prove which pairs never come within the margin inside the joint limits, or always touch, "
                 "and ignore them (as kccd pairs --write)");

@@ -34,6 +34,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "cli_args.hpp"
+#include "visuals.hpp"
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "contact_sheet.hpp"
@@ -57,7 +58,7 @@ struct OverlayArgs {
   std::string time_offset_text = "0";  // seconds, or auto:A:B
   double time_offset = 0.0, max_gap = 0.0, fps = 0.0;
   double latency = 0.01, deceleration = 5.0, max_acceleration = 0.0, position_error = 0.0, velocity_error = 0.0;
-  bool swept = false, plain = false, quiet = false, json = false;
+  bool swept = false, plain = false, quiet = false, json = false, visuals = false;
   int jobs = 0;  // 0: hardware threads
 };
 
@@ -184,6 +185,7 @@ struct Shared {
   std::vector<BrakingParams> braking;  // per state value (with --swept)
   render::RenderOptions render_options;
   std::optional<render::Projection> projection;  // made once, copied by every worker's Renderer
+  std::vector<LoadedVisual> visuals;              // with --visuals
 };
 
 // Queries, renders and composites frames; one per thread (its Renderer's GL context is current
@@ -257,6 +259,11 @@ class FrameWorker {
       if (!box_ok) status.assign(m.bodies.size(), render::VolumeStatus::Colliding);
       volumes = s_.args.swept && box_ok ? render::sceneVolumes(m, checker_, status)
                                         : render::staticSceneVolumes(m, checker_, q_, status);
+    }
+    if (!s_.visuals.empty() && rec.match != StateMatch::None) {
+      // The robot's appearance at the logged state, drawn with the volumes (its own colours).
+      std::vector<render::Volume> look = visualVolumes(m, s_.visuals, q_);
+      volumes.insert(volumes.begin(), std::make_move_iterator(look.begin()), std::make_move_iterator(look.end()));
     }
     const render::Frame layer = renderer_->render(volumes, style_, true, false);
     for (render::Visibility v : layer.visibility) rec.not_finite |= v == render::Visibility::NotFinite;
@@ -540,6 +547,12 @@ Exit runOverlay(OverlayArgs& a) {
   if (!a.frame_times.empty()) frame_times = frameTimes(a.frame_times);
 
   Shared shared{a, model, camera, log, max_gap, {}};
+  if (a.visuals) {
+    if (model.visuals.empty()) throw UsageError("--visuals: " + a.model + " has no visuals:");
+    if (model.visuals.size() + model.bodies.size() > 255)
+      throw UsageError("--visuals: " + a.model + ": more than 255 bodies and visuals to draw");
+    shared.visuals = loadVisuals(model);
+  }
   if (a.swept) {
     BrakingParams p;
     p.latency = a.latency;
@@ -915,6 +928,9 @@ Runner addOverlay(CLI::App& app) {
   sub->add_option("--position-error", a->position_error, "Braking: position measurement error bound")->capture_default_str()->check(finiteIn(0, 1e3));
   sub->add_option("--velocity-error", a->velocity_error, "Braking: velocity measurement error bound")->capture_default_str()->check(finiteIn(0, 1e6));
   sub->add_flag("--plain", a->plain, "Volumes only: no legend, no status line");
+  sub->add_flag("--visuals", a->visuals,
+                "Also draw the model's visual geometry (visuals:) at the logged state, tinted in its own colours: "
+                "where it misses the robot in the video, the camera, the log's clock or the model is off");
   sub->add_option("--codec", a->codec, "FourCC of the output video (default by extension)");
   sub->add_option("-j,--jobs", a->jobs, "Worker threads (each with its own GL context; default: hardware threads)")->check(CLI::Range(1, 256));
   sub->add_flag("--json", a->json, "Print the summary as JSON");

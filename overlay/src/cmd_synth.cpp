@@ -29,6 +29,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "cli_args.hpp"
+#include "visuals.hpp"
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
@@ -55,6 +56,7 @@ struct SynthArgs {
   int width = 1280, height = 720;
   std::uint64_t seed = 1;
   std::string codec = "ffv1";
+  std::string appearance = "auto";  // auto, volumes, visuals
   bool no_collision = false, force = false, quiet = false;
   bool size_given = false;  // --width or --height on the command line
 };
@@ -815,6 +817,13 @@ Exit runSynth(const SynthArgs& a) {
     }
     return v;
   };
+  // The robot's appearance: its visual meshes (the model's visuals:) or shrunken SSCHs.
+  const bool use_visuals = a.appearance == "visuals" || (a.appearance == "auto" && !m.visuals.empty());
+  if (use_visuals && m.visuals.empty()) throw UsageError("--appearance visuals: " + a.model + " has no visuals:");
+  const std::vector<LoadedVisual> visuals = use_visuals ? loadVisuals(m) : std::vector<LoadedVisual>{};
+  auto visibleAt = [&](std::span<const double> q) {
+    return use_visuals ? visualVolumes(m, visuals, q) : volumesAt(q, a.shrink);
+  };
   render::Style style;
   style.shaded = true;
   style.legend = false;
@@ -877,7 +886,7 @@ Exit runSynth(const SynthArgs& a) {
     }
     for (int i = 0; i < frames; ++i) {
       const auto r0 = Clock::now();
-      const std::vector<render::Volume> visible = volumesAt(states[i], a.shrink);
+      const std::vector<render::Volume> visible = visibleAt(states[i]);
       const render::Frame f = renderer->render(visible, style, true, true);
       cv::Mat frame = background.clone();
       render::compositeOver(frame, f.bgra);
@@ -928,6 +937,7 @@ Exit runSynth(const SynthArgs& a) {
   j["masks"] = {{"folder", "masks"},
                 {"pattern", "frame_%06d.png"},
                 {"labels", "0 background, i + 1 where body i's visible geometry is nearest (model order)"},
+                {"appearance", use_visuals ? "visuals" : "volumes"},
                 {"visible_radius_scale", a.shrink}};
   j["render"] = {{"supersample", ro.supersample}, {"mask_supersample", ro.mask_supersample}};
   j["room"] = {{"floor_z", room.floor_z}, {"wall_x", room.wall_x}, {"wall_y", room.wall_y}};
@@ -1043,6 +1053,11 @@ Runner addSynth(CLI::App& app) {
   sub->add_option("--visible-scale", a->shrink, "Radius of the visible geometry as a fraction of the SSCH radius")
       ->capture_default_str()
       ->check(finiteIn(0.1, 0.95));
+  sub->add_option("--appearance", a->appearance,
+                  "What the robot looks like: visuals (the model's visual meshes), volumes (its SSCHs shrunk by "
+                  "--visible-scale), auto (visuals when the model has them)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "volumes", "visuals"}));
   sub->add_option("--blur", a->blur, "Gaussian blur of every frame (sigma, px)")
       ->capture_default_str()
       ->check(finiteIn(0, 10));
@@ -1055,7 +1070,8 @@ Runner addSynth(CLI::App& app) {
   sub->footer(
       "Writes DIR/video.mkv (or .avi, .mp4), DIR/states.csv (time, every state value and its .vel),\n"
       "DIR/camera_true.yaml, DIR/intrinsics.yaml (no pose), DIR/tags.yaml, DIR/masks/frame_%06d.png (label\n"
-      "mask of the visible geometry: 0 background, i + 1 body i) and DIR/synth.json (the truth: camera,\n"
+      "mask of the visible geometry: 0 background, i + 1 body i; a visual counts for the first body in its\n"
+      "frame, 0 when there is none) and DIR/synth.json (the truth: camera,\n"
       "clock offset, rates, per-frame state and smallest distance, collision frames).\n"
       "Collision means a smallest distance bound <= 0 at the logged state of the frame.\n"
       "Exit status: 0 written, 2 bad input (or no trajectory found for this model and seed).");

@@ -210,6 +210,8 @@ struct Renderer::Prepared {
   int level = 0;           // sphere tessellation level
   double clearance = 0.0;  // distance from the camera to the mesh (lower bound), when drawn
   double reach = 0.0;      // distance from the camera to the farthest point of the mesh
+  bool surface = false;    // a Volume::surface: both sides drawn, no outline
+  int label = 0;           // mask label
 };
 
 Renderer::Renderer(const Camera& camera, const RenderOptions& options)
@@ -340,7 +342,14 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     p.fills = false;
     p.silhouette.clear();
     p.fill.clear();
+    p.surface = false;
+    p.label = v.mask_label >= 0 ? std::min(v.mask_label, 255) : static_cast<int>(i) + 1;
     Visibility& visibility = frame.visibility[i];
+    if (v.surface) {
+      prepareSurface(v, p, visibility);
+      if (visibility == Visibility::Drawn) frame.triangles += static_cast<int>(p.mesh->triangles.size());
+      continue;
+    }
     if (v.points.empty()) continue;
     // Tessellation fine enough that the circumscribed sphere polytope lies at most
     // tolerance_px outside the true surface, as seen from the closest point of the volume.
@@ -455,6 +464,49 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     if (p.mesh) frame.far = std::max(frame.far, 1.01 * p.reach);
 }
 
+// A surface (appearance mesh): its vertices in camera coordinates; how near it comes to the
+// camera bounded by the nearest vertex less the longest edge.
+void Renderer::prepareSurface(const Volume& v, Prepared& p, Visibility& visibility) {
+  const Mesh& m = *v.surface;
+  if (m.triangles.empty()) return;  // Empty
+  const Pose to_camera = world_to_camera_ * v.pose;
+  p.rotation = to_camera.linear();
+  p.vertices.resize(m.vertices.size() * 3);
+  Vec3 centre = Vec3::Zero();
+  double zmax = -1e300, nearest = 1e300, farthest = 0.0;
+  for (std::size_t k = 0; k < m.vertices.size(); ++k) {
+    const Vec3 c = to_camera * m.vertices[k];
+    if (!c.allFinite()) {
+      visibility = Visibility::NotFinite;
+      return;
+    }
+    p.vertices[3 * k] = static_cast<float>(c.x());
+    p.vertices[3 * k + 1] = static_cast<float>(c.y());
+    p.vertices[3 * k + 2] = static_cast<float>(c.z());
+    centre += c;
+    zmax = std::max(zmax, c.z());
+    nearest = std::min(nearest, c.norm());
+    farthest = std::max(farthest, c.norm());
+  }
+  double longest = 0.0;
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) longest = std::max(longest, (m.vertices[t[k]] - m.vertices[t[(k + 1) % 3]]).norm());
+  if (zmax <= 0.0) {
+    visibility = Visibility::BehindCamera;
+    return;
+  }
+  if (farthest * 1.01 > kMaxDrawDistance) {
+    visibility = Visibility::BeyondFar;
+    return;
+  }
+  p.depth = (centre / static_cast<double>(m.vertices.size())).norm();
+  p.reach = farthest;
+  p.clearance = std::max(nearest - longest, 1e-4);  // appearance only: a mesh reaching the camera is clipped
+  p.mesh = v.surface;
+  p.surface = true;
+  visibility = Visibility::Drawn;
+}
+
 namespace {
 
 void setCamera(const Projection& projection, double near, double far) {
@@ -558,8 +610,10 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
     const cv::Scalar c = p->colour;  // BGR, drawn as GL's RGB (see the read-back)
     glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
     if (with_labels) {
-      glUniform1ui(gl_->label_location, static_cast<GLuint>(p->index + 1));
+      glUniform1ui(gl_->label_location, static_cast<GLuint>(p->label));
+      if (p->surface) glDisable(GL_CULL_FACE);
       drawTriangles(*p->mesh, p->vertices);
+      glEnable(GL_CULL_FACE);
     } else if (polygonFill(*p)) {
       ++frame.polygon_fills;
       glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
@@ -624,8 +678,10 @@ cv::Mat Renderer::drawMask(const std::vector<Prepared>& bodies, double near, dou
   glUseProgram(gl_->program);
   for (const Prepared& p : bodies) {
     if (!p.mesh) continue;
-    glUniform1ui(gl_->label_location, static_cast<GLuint>(p.index + 1));
+    glUniform1ui(gl_->label_location, static_cast<GLuint>(p.label));
+    if (p.surface) glDisable(GL_CULL_FACE);
     drawTriangles(*p.mesh, p.vertices);
+    glEnable(GL_CULL_FACE);
   }
   glUseProgram(0);
   glBlendEquation(GL_FUNC_ADD);
@@ -655,10 +711,11 @@ void Renderer::drawShaded(const std::vector<const Prepared*>& order, double ambi
       for (const std::uint32_t k : m.triangles[t]) normals[k] += m.normals[t];
     colours.resize(m.vertices.size() * 4);
     for (std::size_t k = 0; k < m.vertices.size(); ++k) {
-      const Vec3 n = (p->rotation * normals[k]).normalized();
-      const double lambert = std::max(0.0, n.dot(to_light));
+      Vec3 n = (p->rotation * normals[k]).normalized();
       // A little rim darkening where the surface turns away from the camera (edges read as edges).
       const Vec3 view = -Vec3(p->vertices[3 * k], p->vertices[3 * k + 1], p->vertices[3 * k + 2]).normalized();
+      if (p->surface && n.dot(view) < 0.0) n = -n;  // both sides of a surface are lit
+      const double lambert = std::max(0.0, n.dot(to_light));
       const double facing = std::clamp(n.dot(view), 0.0, 1.0);
       const double shade = (ambient + (1.0 - ambient) * lambert) * (0.75 + 0.25 * std::sqrt(facing));
       for (int c = 0; c < 3; ++c) colours[4 * k + c] = static_cast<float>(std::min(1.0, p->colour[c] / 255.0 * shade));
@@ -666,7 +723,9 @@ void Renderer::drawShaded(const std::vector<const Prepared*>& order, double ambi
     }
     glColorPointer(4, GL_FLOAT, 0, colours.data());
     glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
+    if (p->surface) glDisable(GL_CULL_FACE);
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.triangles.size() * 3), GL_UNSIGNED_INT, m.triangles.data());
+    glEnable(GL_CULL_FACE);
   }
   glDisableClientState(GL_COLOR_ARRAY);
   glDisable(GL_DEPTH_TEST);
@@ -727,7 +786,7 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     const cv::Mat bits = same_pass ? labels : drawMask(bodies, frame.near, frame.far);
     // A volume containing the camera is the nearest everywhere.
     const auto fill = std::find_if(bodies.begin(), bodies.end(), [](const Prepared& p) { return p.fills; });
-    const int fill_label = fill != bodies.end() ? fill->index + 1 : -1;
+    const int fill_label = fill != bodies.end() ? fill->label : -1;
     const Projection& mp = maskProjection();
     if (mp.warps() && mask_map_.empty()) {  // nearest pinhole pixel per output pixel, as integers
       cv::Mat unused;
@@ -759,7 +818,7 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     });
     tick("mask");
     frame.pixels.assign(volumes.size(), 0);
-    for (std::size_t i = 0; i < volumes.size(); ++i) frame.pixels[i] = counts[i + 1];
+    for (std::size_t i = 0; i < volumes.size(); ++i) frame.pixels[i] = counts[static_cast<std::size_t>(bodies[i].label)];
   }
   if (profile) std::fprintf(stderr, "\n");
   return frame;
@@ -777,7 +836,7 @@ void Renderer::decorate(cv::Mat& bgra, std::span<const Volume> volumes, const st
   if (style.labels) {
     for (std::size_t i = 0; i < volumes.size(); ++i) {
       const Volume& v = volumes[i];
-      if (visibility[i] != Visibility::Drawn || v.label.empty()) continue;
+      if (visibility[i] != Visibility::Drawn || v.label.empty() || v.points.empty()) continue;
       Vec3 centre = Vec3::Zero();
       for (const Vec3& p : v.points) centre += p;
       centre = v.pose * (centre / static_cast<double>(v.points.size()));

@@ -568,6 +568,40 @@ Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, doubl
   return mesh;
 }
 
+Mesh surfaceMesh(std::span<const Vec3> triangle_points) {
+  if (triangle_points.size() % 3 != 0) throw std::invalid_argument("surfaceMesh: not whole triangles");
+  Mesh mesh;
+  // Equal points share a vertex (smooth shading) when their triangles' normals are within 40
+  // degrees of the first triangle that made the vertex; across sharper creases they do not (a
+  // box stays a box). Normals pointing the opposite way count as near (two-sided surfaces).
+  std::map<std::array<double, 3>, std::vector<std::uint32_t>> index;
+  std::vector<Vec3> first_normal;
+  const double crease = std::cos(40.0 * 3.141592653589793 / 180.0);
+  auto vertex = [&](const Vec3& p, const Vec3& n) {
+    if (!p.allFinite()) throw std::invalid_argument("surfaceMesh: non-finite point");
+    std::vector<std::uint32_t>& at = index[{p.x(), p.y(), p.z()}];
+    for (const std::uint32_t k : at)
+      if (std::abs(first_normal[k].dot(n)) >= crease) return k;
+    at.push_back(static_cast<std::uint32_t>(mesh.vertices.size()));
+    mesh.vertices.push_back(p);
+    first_normal.push_back(n);
+    return at.back();
+  };
+  for (std::size_t t = 0; t < triangle_points.size(); t += 3) {
+    const Vec3& a = triangle_points[t];
+    const Vec3 n = (triangle_points[t + 1] - a).cross(triangle_points[t + 2] - a);
+    if (!(n.norm() > 0.0) || !n.allFinite()) {
+      if (!a.allFinite() || !triangle_points[t + 1].allFinite() || !triangle_points[t + 2].allFinite())
+        throw std::invalid_argument("surfaceMesh: non-finite point");
+      continue;
+    }
+    const Vec3 u = n.normalized();
+    mesh.triangles.push_back({vertex(a, u), vertex(triangle_points[t + 1], u), vertex(triangle_points[t + 2], u)});
+    mesh.normals.push_back(u);
+  }
+  return mesh;
+}
+
 std::string MeshCache::key(const MeshRequest& r) {
   const std::size_t n = r.points.size() * sizeof(Vec3);
   std::string key(n + 2 * sizeof(double) + sizeof(int), '\0');

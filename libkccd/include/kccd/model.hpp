@@ -45,6 +45,19 @@ struct Body {
   double radius = 0.0;
 };
 
+/// How a link looks, for drawing only (never checked for collision): a mesh file or a
+/// primitive, placed in a frame, with a colour. `kccd import` writes them from URDF <visual>s.
+struct Visual {
+  enum class Shape : std::uint8_t { Mesh, Box, Cylinder, Sphere };
+  int frame = kWorld;
+  Shape shape = Shape::Mesh;
+  std::string mesh;                   ///< Mesh: the file (relative paths resolved against the model file's folder)
+  Vec3 scale = Vec3::Ones();          ///< Mesh: scale per axis, in the mesh's frame
+  Vec3 size = Vec3::Zero();           ///< Box: full sizes; Cylinder: radius, radius, length (along z); Sphere: radius in x
+  Pose origin = Pose::Identity();     ///< pose in the frame
+  std::array<double, 4> colour{0.7, 0.7, 0.7, 1.0};  ///< RGBA, 0..1
+};
+
 /// A checked body pair and the frame both are compared in (least common ancestor).
 struct BodyPair {
   int a = 0;
@@ -72,6 +85,7 @@ class Model {
   std::vector<Joint> joints;    ///< parents always precede children
   std::vector<Body> bodies;
   std::vector<BodyPair> pairs;
+  std::vector<Visual> visuals;  ///< appearance for drawing (optional)
 
   /// Number of state values.
   int stateSize() const { return state_size_; }

@@ -1,5 +1,6 @@
 #include "kccd/modelling/urdf_import.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -95,6 +96,69 @@ Part linkPart(const std::string& urdf_path, const urdf::Link& link, const Import
     }
   }
   return part;
+}
+
+// A YAML double-quoted string.
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (const char ch : text) {
+    const auto u = static_cast<unsigned char>(ch);
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (u < 0x20 || u == 0x7f) {
+      char buffer[5];
+      std::snprintf(buffer, sizeof buffer, "\\x%02x", u);
+      out += buffer;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
+// The link's <visual> elements as `visuals:` entries in `frame` (mesh files resolved like the
+// collision meshes, written as absolute paths; the material's colour when it has one).
+void writeVisuals(std::ostringstream& out, const std::string& urdf_path, const urdf::Link& link, const std::string& frame,
+                  const ImportOptions& options) {
+  for (const urdf::VisualSharedPtr& v : link.visual_array) {
+    if (!v || !v->geometry) continue;
+    const urdf::Pose& o = v->origin;
+    double r, p, y;
+    o.rotation.getRPY(r, p, y);
+    out << "  - frame: " << frame << "\n";
+    switch (v->geometry->type) {
+      case urdf::Geometry::SPHERE: out << "    sphere: " << num(static_cast<const urdf::Sphere&>(*v->geometry).radius) << "\n"; break;
+      case urdf::Geometry::BOX: {
+        const urdf::Vector3& d = static_cast<const urdf::Box&>(*v->geometry).dim;
+        out << "    box: " << vec(d.x, d.y, d.z) << "\n";
+        break;
+      }
+      case urdf::Geometry::CYLINDER: {
+        const auto& c = static_cast<const urdf::Cylinder&>(*v->geometry);
+        out << "    cylinder: {radius: " << num(c.radius) << ", length: " << num(c.length) << "}\n";
+        break;
+      }
+      case urdf::Geometry::MESH: {
+        const auto& mesh = static_cast<const urdf::Mesh&>(*v->geometry);
+        const std::string file = resolveMesh(urdf_path, link.name, mesh.filename, options);
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(file, ec))
+          throw UrdfError(urdf_path + ": link " + link.name + ": visual mesh " + printable(mesh.filename) + ": " +
+                          printable(file) + " is not a file (or import with --no-visuals)");
+        out << "    mesh: " << quoted(std::filesystem::absolute(file).lexically_normal().string()) << "\n";
+        if (mesh.scale.x != 1 || mesh.scale.y != 1 || mesh.scale.z != 1)
+          out << "    scale: " << vec(mesh.scale.x, mesh.scale.y, mesh.scale.z) << "\n";
+        break;
+      }
+    }
+    out << "    origin: {xyz: " << vec(o.position.x, o.position.y, o.position.z) << ", rpy: " << vec(r, p, y) << "}\n";
+    if (v->material) {
+      const urdf::Color& c = v->material->color;
+      auto unit = [](float x) { return num(std::clamp(static_cast<double>(x), 0.0, 1.0)); };
+      out << "    colour: [" << unit(c.r) << ", " << unit(c.g) << ", " << unit(c.b) << ", " << unit(c.a) << "]\n";
+    }
+  }
 }
 
 void loadXml(tinyxml2::XMLDocument& doc, const std::string& text, const std::string& path) {
@@ -409,6 +473,9 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     body_names.insert(link->name);
     ++fitted;
   }
+  std::ostringstream visuals;
+  if (options.visuals)
+    for (const auto& link : order) writeVisuals(visuals, path, *link, frame_of.at(link->name), options);
   std::vector<std::array<std::string, 2>> ignore;
   if (!options.srdf.empty()) ignore = readSrdf(srdf, options.srdf, link_names, body_names);
 
@@ -423,6 +490,7 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
   out << "joints:" << (jt.empty() ? " []\n" : "\n" + jt);
   out << "bodies:" << (bt.empty() ? " []\n" : "\n" + bt);
   out << "pairs:\n  check: all\n  ignore: " << flowPairs(ignore, 11) << "\n";
+  if (const std::string vt = visuals.str(); !vt.empty()) out << "visuals:   # appearance only, never checked\n" << vt;
   const std::string text = out.str();
   try {
     (void)parseModel(text, path + " (imported)");

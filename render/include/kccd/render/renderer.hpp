@@ -51,6 +51,13 @@ struct Volume {
   Pose pose = Pose::Identity();
   /// BGR fill colour overriding the status colour (used when colour[0] >= 0), e.g. for Style::shaded.
   cv::Scalar colour{-1, -1, -1, -1};
+  /// A triangle mesh drawn instead of the SSCH (appearance, e.g. a link's visual geometry; see
+  /// surfaceMesh): placed by `pose` like the points, both sides drawn, no outline. `points`
+  /// stays empty.
+  std::shared_ptr<const Mesh> surface;
+  /// The mask label of this volume (0..255; 0 hides what lies behind it without a label of its
+  /// own); -1: its index + 1. Frame::pixels[i] counts the pixels of volume i's label.
+  int mask_label = -1;
 };
 
 /// The look of the colour layer.
@@ -139,6 +146,7 @@ class Renderer {
   struct Gl;
   struct Prepared;
   void prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame);
+  void prepareSurface(const Volume& v, Prepared& p, Visibility& visibility);
   cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style, Frame& frame, cv::Mat* labels = nullptr);
   cv::Mat drawMask(const std::vector<Prepared>& bodies, double near, double far);
   static void drawShaded(const std::vector<const Prepared*>& order, double ambient);

@@ -56,6 +56,13 @@ inline constexpr double kMinDrawRadius = 1e-3;
 /// Throws std::invalid_argument for empty or non-finite input.
 Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, double min_radius = kMinDrawRadius);
 
+/// A drawable mesh from a triangle soup (three points per triangle, as modelling::readPart
+/// gives a mesh file's triangles): vertices shared where equal and the triangles' normals are
+/// within 40 degrees (smooth shading, sharp creases kept), normals as wound, no edges (drawn
+/// without outline). Throws std::invalid_argument for a count not a multiple of 3
+/// or non-finite points; degenerate triangles are dropped.
+Mesh surfaceMesh(std::span<const Vec3> triangle_points);
+
 /// Process-wide switch to the previous construction (the qhull hull of circumscribed sphere
 /// polytopes around the core points), for comparisons in benchmarks and tests.
 void useHullMeshing(bool on);

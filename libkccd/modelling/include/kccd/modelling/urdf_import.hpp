@@ -21,6 +21,7 @@ struct ImportOptions {
   int points = 8;                               ///< core points per fitted link (1 ... 16)
   double safety_margin = 0.02;                  ///< written into the model
   std::map<std::string, std::string> packages;  ///< package:// NAME -> directory
+  bool visuals = true;                          ///< write each link's <visual>s as `visuals:` (meshes must exist)
   std::function<void(double)> progress;
 };
 
