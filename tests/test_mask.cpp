@@ -214,6 +214,11 @@ TEST(RenderMask, SurfacesDrawBothSidesWithTheirOwnLabels) {
     const Frame f = r.render(std::span<const Volume>(&t, 1), Style{.shaded = true}, true, true);
     EXPECT_GT(f.pixels[0], 500);
   }
+  // In the tinted look the colour layer is the same with the mask drawn in the same pass or not.
+  const Frame tinted = r.render(std::span<const Volume>(&surface, 1), Style{}, true, true);
+  const Frame tinted_alone = r.render(std::span<const Volume>(&surface, 1), Style{}, true, false);
+  EXPECT_EQ(cv::norm(tinted.bgra, tinted_alone.bgra, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::countNonZero(tinted.mask == 7), 2000);
   // Label 0 in front hides the volume behind it.
   Volume wall;
   wall.surface = std::make_shared<const Mesh>(surfaceMesh(std::vector<Vec3>{

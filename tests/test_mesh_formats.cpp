@@ -12,8 +12,6 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
 #include <gtest/gtest.h>
 
 #include "kccd/input_error.hpp"
@@ -21,6 +19,7 @@
 #include "kccd/modelling/fit.hpp"
 #include "kccd/modelling/part.hpp"
 #include "kccd/modelling/urdf_import.hpp"
+#include "support/files.hpp"
 #include "support/reference_distance.hpp"
 
 namespace km = kccd::modelling;
@@ -28,16 +27,10 @@ using kccd::Vec3;
 
 namespace {
 
-std::filesystem::path scratch() {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("kccd_meshes_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+std::filesystem::path scratch() { return kccd::testing::scratchFolder("kccd_meshes"); }
 
-std::string write(const std::string& name, const std::string& bytes) {
-  const std::filesystem::path p = scratch() / name;
-  std::ofstream(p, std::ios::binary) << bytes;
-  return p.string();
+std::string write(const std::string& name, const std::string& text) {
+  return kccd::testing::writeScratch("kccd_meshes", name, text);
 }
 
 // The box [0, size.x] x [0, size.y] x [0, size.z]: corner i has bit k of i set for the far side on axis k.

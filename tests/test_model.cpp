@@ -159,6 +159,12 @@ TEST(Model, EveryMistakeGetsOneClearMessage) {
   }
 }
 
+std::string edit_text(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
+}
+
 // visuals: appearance only, in a frame, one shape each; mesh paths relative to the model file.
 TEST(Model, VisualsLoadAndTheirMistakesPointAtTheLine) {
   const std::string visuals = kGood + R"(visuals:
@@ -213,6 +219,9 @@ TEST(Model, VisualsLoadAndTheirMistakesPointAtTheLine) {
   expectIn(error("scale: [0.001, 0.001, 0.001]", "scale: [0.001, 0, 0.001]"), "factors must be non-zero");
   expectIn(error("cylinder: {radius: 0.05, length: 0.2}", "cylinder: {radius: 0.05}"), "cylinder.length");
   expectIn(error("sphere: 0.3", "sphere: 1e7"), "beyond the largest length");
+  expectIn(error("mesh: meshes/arm.dae", "mesh: package://robot/arm.dae"), "package:// paths are resolved by kccd import");
+  EXPECT_EQ(parseModel(edit_text(visuals, "mesh: /abs/tool.stl", "mesh: file:///abs/tool.stl"), "c.yaml").visuals[4].mesh,
+            "/abs/tool.stl");
   expectIn(error("    sphere: 0.3\n", "    sphere: 0.3\n    texture: wood\n"), "unknown field");
 }
 

@@ -21,17 +21,10 @@ namespace km = kccd::modelling;
 
 namespace {
 
-std::filesystem::path scratch() {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("kccd_inputs_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+std::filesystem::path scratch() { return kccd::testing::scratchFolder("kccd_inputs"); }
 
 std::string write(const std::string& name, const std::string& text) {
-  const std::filesystem::path p = scratch() / name;
-  std::ofstream(p, std::ios::binary) << text;
-  return p.string();
+  return kccd::testing::writeScratch("kccd_inputs", name, text);
 }
 
 template <class F>

@@ -314,6 +314,9 @@ TEST_F(Synth, DrawsTheModelsVisualGeometry) {
                                dir("v") + "/video.mkv --states " + dir("v") + "/states.csv -q --visuals --png-dir " + dir("ov_none"));
   EXPECT_EQ(none.code, 2);
   EXPECT_NE(none.err.find("has no visuals"), std::string::npos) << none.err;
+  const Outcome scale = runKccd("synth " + dir("visual_arm.yaml") + " -o " + dir("s") + " --seconds 0.2 --visible-scale 0.5 -q");
+  EXPECT_EQ(scale.code, 2);
+  EXPECT_NE(scale.err.find("--visible-scale"), std::string::npos) << scale.err;
   // A visual mesh that cannot be read is one line naming the visual and the file.
   std::ofstream(dir("broken_visual.yaml")) << kccd::testing::readText(kData + "/demo_arm.yaml")
                                            << "visuals:\n  - frame: world\n    mesh: missing.obj\n";

@@ -217,7 +217,11 @@ void parseVisuals(const Reader& r, const YAML::Node& list, Model& m, const std::
     };
     if (n["mesh"]) {
       v.shape = Visual::Shape::Mesh;
-      const std::filesystem::path file = r.text(n["mesh"], f + ".mesh");
+      std::string mesh = r.text(n["mesh"], f + ".mesh");
+      if (mesh.rfind("package://", 0) == 0)
+        r.fail(n["mesh"], f + ".mesh", "package:// paths are resolved by kccd import (--package-path); give a file path");
+      if (mesh.rfind("file://", 0) == 0) mesh.erase(0, 7);
+      const std::filesystem::path file = mesh;
       // Relative to the model file's folder when the model came from a file.
       const std::filesystem::path folder = std::filesystem::path(source).parent_path();
       v.mesh = (file.is_relative() ? folder / file : file).lexically_normal().string();

@@ -102,7 +102,8 @@ Runner addImport(CLI::App& app) {
                 "and ignore them (as kccd pairs --write)");
   sub->add_option("--max-boxes", args->max_boxes, "With --pairs: boxes per pair before a pair is undecided")
       ->capture_default_str()
-      ->check(CLI::Range(1, 10000000));
+      ->check(CLI::Range(1, 10000000))
+      ->needs("--pairs");
   sub->add_flag("--quiet,-q", args->quiet, "No progress display");
   sub->footer(
       "Joint kinds: fixed, revolute, continuous (revolute without limits), prismatic; a floating joint J becomes "

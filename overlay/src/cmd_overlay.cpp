@@ -260,13 +260,14 @@ class FrameWorker {
       volumes = s_.args.swept && box_ok ? render::sceneVolumes(m, checker_, status)
                                         : render::staticSceneVolumes(m, checker_, q_, status);
     }
+    const std::size_t checked = volumes.size();  // the volumes; the visuals come after them
     if (!s_.visuals.empty() && rec.match != StateMatch::None) {
       // The robot's appearance at the logged state, drawn with the volumes (its own colours).
       std::vector<render::Volume> look = visualVolumes(m, s_.visuals, q_);
-      volumes.insert(volumes.begin(), std::make_move_iterator(look.begin()), std::make_move_iterator(look.end()));
+      volumes.insert(volumes.end(), std::make_move_iterator(look.begin()), std::make_move_iterator(look.end()));
     }
     const render::Frame layer = renderer_->render(volumes, style_, true, false);
-    for (render::Visibility v : layer.visibility) rec.not_finite |= v == render::Visibility::NotFinite;
+    for (std::size_t i = 0; i < checked; ++i) rec.not_finite |= layer.visibility[i] == render::Visibility::NotFinite;
     if (rec.not_finite) rec.status = FrameStatus::Colliding;  // an overflowed volume is unsafe
     render::compositeOver(job.bgr, layer.bgra);
     if (!s_.args.plain) drawStatusLine(job.bgr, rec);

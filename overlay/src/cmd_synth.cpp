@@ -59,6 +59,7 @@ struct SynthArgs {
   std::string appearance = "auto";  // auto, volumes, visuals
   bool no_collision = false, force = false, quiet = false;
   bool size_given = false;  // --width or --height on the command line
+  bool shrink_given = false;  // --visible-scale on the command line
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -820,6 +821,9 @@ Exit runSynth(const SynthArgs& a) {
   // The robot's appearance: its visual meshes (the model's visuals:) or shrunken SSCHs.
   const bool use_visuals = a.appearance == "visuals" || (a.appearance == "auto" && !m.visuals.empty());
   if (use_visuals && m.visuals.empty()) throw UsageError("--appearance visuals: " + a.model + " has no visuals:");
+  if (use_visuals && m.visuals.size() > 255)
+    throw UsageError(a.model + ": " + std::to_string(m.visuals.size()) + " visuals: at most 255 can be drawn");
+  if (use_visuals && a.shrink_given) throw UsageError("--visible-scale: applies to --appearance volumes only");
   const std::vector<LoadedVisual> visuals = use_visuals ? loadVisuals(m) : std::vector<LoadedVisual>{};
   auto visibleAt = [&](std::span<const double> q) {
     return use_visuals ? visualVolumes(m, visuals, q) : volumesAt(q, a.shrink);
@@ -1050,7 +1054,8 @@ Runner addSynth(CLI::App& app) {
   sub->add_option("--time-offset", a->time_offset, "Log clock minus video clock (s; the log starts at log time 0)")
       ->capture_default_str()
       ->check(finiteIn(0, 10));
-  sub->add_option("--visible-scale", a->shrink, "Radius of the visible geometry as a fraction of the SSCH radius")
+  CLI::Option* shrink = sub->add_option("--visible-scale", a->shrink,
+                                         "Radius of the visible geometry as a fraction of the SSCH radius (--appearance volumes)")
       ->capture_default_str()
       ->check(finiteIn(0.1, 0.95));
   sub->add_option("--appearance", a->appearance,
@@ -1075,8 +1080,9 @@ Runner addSynth(CLI::App& app) {
       "clock offset, rates, per-frame state and smallest distance, collision frames).\n"
       "Collision means a smallest distance bound <= 0 at the logged state of the frame.\n"
       "Exit status: 0 written, 2 bad input (or no trajectory found for this model and seed).");
-  return [a, width, height] {
+  return [a, width, height, shrink] {
     a->size_given = width->count() > 0 || height->count() > 0;
+    a->shrink_given = shrink->count() > 0;
     return runSynth(*a);
   };
 }

@@ -1,6 +1,7 @@
 #include "visuals.hpp"
 
 #include <cmath>
+#include <utility>
 #include <numbers>
 #include <string>
 
@@ -61,6 +62,9 @@ std::vector<LoadedVisual> loadVisuals(const Model& model) {
       if (part.primitives > 0 || part.points.size() != 3 * static_cast<std::size_t>(part.triangles))
         throw UsageError(what + ": " + v.mesh + ": only triangle meshes are drawn (use box, cylinder or sphere for primitives)");
       soup = std::move(part.points);
+      // A mirroring scale turns the triangles inside out: wind them back.
+      if (v.scale.prod() < 0.0)
+        for (std::size_t t = 0; t + 2 < soup.size(); t += 3) std::swap(soup[t + 1], soup[t + 2]);
     } else {
       soup = primitive(v);
     }

@@ -464,8 +464,32 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     if (p.mesh) frame.far = std::max(frame.far, 1.01 * p.reach);
 }
 
-// A surface (appearance mesh): its vertices in camera coordinates; how near it comes to the
-// camera bounded by the nearest vertex less the longest edge.
+namespace {
+// Distance from the origin to the triangle abc (closest point by the triangle's Voronoi regions).
+double originToTriangle(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = -a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a.norm();
+  const Vec3 bp = -b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b.norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (a + d1 / (d1 - d3) * ab).norm();
+  const Vec3 cp = -c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c.norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (a + d2 / (d2 - d6) * ac).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b)).norm();
+  const double denom = va + vb + vc;
+  if (!(std::abs(denom) > 0.0)) return std::min({a.norm(), b.norm(), c.norm()});
+  return (a + (vb / denom) * ab + (vc / denom) * ac).norm();
+}
+}  // namespace
+
+// A surface (appearance mesh): its vertices in camera coordinates and how near it comes to the
+// camera (for the near plane).
 void Renderer::prepareSurface(const Volume& v, Prepared& p, Visibility& visibility) {
   const Mesh& m = *v.surface;
   if (m.triangles.empty()) return;  // Empty
@@ -488,9 +512,18 @@ void Renderer::prepareSurface(const Volume& v, Prepared& p, Visibility& visibili
     nearest = std::min(nearest, c.norm());
     farthest = std::max(farthest, c.norm());
   }
-  double longest = 0.0;
-  for (const auto& t : m.triangles)
-    for (int k = 0; k < 3; ++k) longest = std::max(longest, (m.vertices[t[k]] - m.vertices[t[(k + 1) % 3]]).norm());
+  // The nearest point of the surface: a triangle comes no nearer than its nearest vertex less
+  // its longest edge; only triangles that could beat the best distance so far are measured.
+  double clearance = nearest;
+  auto camera_point = [&](std::uint32_t k) {
+    return Vec3(p.vertices[3 * k], p.vertices[3 * k + 1], p.vertices[3 * k + 2]);
+  };
+  for (const auto& t : m.triangles) {
+    const Vec3 a = camera_point(t[0]), b = camera_point(t[1]), c = camera_point(t[2]);
+    const double edge = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    if (std::min({a.norm(), b.norm(), c.norm()}) - edge < clearance)
+      clearance = std::min(clearance, originToTriangle(a, b, c));
+  }
   if (zmax <= 0.0) {
     visibility = Visibility::BehindCamera;
     return;
@@ -501,7 +534,7 @@ void Renderer::prepareSurface(const Volume& v, Prepared& p, Visibility& visibili
   }
   p.depth = (centre / static_cast<double>(m.vertices.size())).norm();
   p.reach = farthest;
-  p.clearance = std::max(nearest - longest, 1e-4);  // appearance only: a mesh reaching the camera is clipped
+  p.clearance = std::max(0.999 * clearance, 1e-4);  // appearance only: a mesh reaching the camera is clipped
   p.mesh = v.surface;
   p.surface = true;
   visibility = Visibility::Drawn;
@@ -611,9 +644,7 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
     glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
     if (with_labels) {
       glUniform1ui(gl_->label_location, static_cast<GLuint>(p->label));
-      if (p->surface) glDisable(GL_CULL_FACE);
-      drawTriangles(*p->mesh, p->vertices);
-      glEnable(GL_CULL_FACE);
+      drawTriangles(*p->mesh, p->vertices);  // surfaces too as wound: the colour layer is the same without labels
     } else if (polygonFill(*p)) {
       ++frame.polygon_fills;
       glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());

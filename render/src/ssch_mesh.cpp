@@ -572,8 +572,8 @@ Mesh surfaceMesh(std::span<const Vec3> triangle_points) {
   if (triangle_points.size() % 3 != 0) throw std::invalid_argument("surfaceMesh: not whole triangles");
   Mesh mesh;
   // Equal points share a vertex (smooth shading) when their triangles' normals are within 40
-  // degrees of the first triangle that made the vertex; across sharper creases they do not (a
-  // box stays a box). Normals pointing the opposite way count as near (two-sided surfaces).
+  // degrees of the first triangle that made the vertex; across sharper creases (and between
+  // faces turned the opposite way) they do not: a box stays a box.
   std::map<std::array<double, 3>, std::vector<std::uint32_t>> index;
   std::vector<Vec3> first_normal;
   const double crease = std::cos(40.0 * 3.141592653589793 / 180.0);
@@ -581,7 +581,7 @@ Mesh surfaceMesh(std::span<const Vec3> triangle_points) {
     if (!p.allFinite()) throw std::invalid_argument("surfaceMesh: non-finite point");
     std::vector<std::uint32_t>& at = index[{p.x(), p.y(), p.z()}];
     for (const std::uint32_t k : at)
-      if (std::abs(first_normal[k].dot(n)) >= crease) return k;
+      if (first_normal[k].dot(n) >= crease) return k;
     at.push_back(static_cast<std::uint32_t>(mesh.vertices.size()));
     mesh.vertices.push_back(p);
     first_normal.push_back(n);

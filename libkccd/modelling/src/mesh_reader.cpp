@@ -13,6 +13,7 @@
 #include <assimp/scene.h>
 
 #include "large_stack.hpp"
+#include "part_messages.hpp"
 
 namespace kccd::modelling::detail {
 namespace {
@@ -26,11 +27,12 @@ Eigen::Affine3d toEigen(const aiMatrix4x4& m) {
   return t;
 }
 
-// Assimp's message on one line, printable, its name for the file read from memory replaced.
-std::string assimpMessage(const char* text, const std::string& extension) {
+// Assimp's message on one line, printable, the file's own path (already at the start of the
+// message) left out.
+std::string assimpMessage(const char* text, const std::string& path) {
   std::string s = text != nullptr ? text : "";
-  for (const std::string& magic : {"\"$$$___magic___$$$" + extension + "\"", "$$$___magic___$$$" + extension, std::string("$$$___magic___$$$")})
-    for (std::size_t at = s.find(magic); at != std::string::npos; at = s.find(magic)) s.replace(at, magic.size(), "this file");
+  for (const std::string& own : {"\"" + path + "\"", path})
+    for (std::size_t at = s.find(own); !own.empty() && at != std::string::npos; at = s.find(own)) s.replace(at, own.size(), "the file");
   for (char& c : s)
     if (c == '\n' || c == '\r' || c == '\t') c = ' ';
   while (!s.empty() && s.back() == ' ') s.pop_back();
@@ -95,7 +97,7 @@ bool readsAsMesh(const std::string& extension) {
   return known.find("*" + extension + ";") != std::string::npos || known.ends_with("*" + extension);
 }
 
-Part readMesh(const std::string& data, const std::string& name, const std::string& extension,
+Part readMesh(const std::string& data, const std::string& path, const std::string& name, const std::string& extension,
               const ReadOptions& options) {
   if (data.empty()) throw PartError(name + ": empty file");
   Part part;
@@ -118,10 +120,12 @@ Part readMesh(const std::string& data, const std::string& name, const std::strin
     // Assimp still applies the <unit meter> scale to the root node.
     importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
     const unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
-    const aiScene* scene = importer.ReadFileFromMemory(data.data(), data.size(), flags, extension.substr(1).c_str());
+    // From the file itself (its size and kind checked by the caller), so that files it names
+    // (a .gltf's buffers, an OBJ's materials) are looked up beside it.
+    const aiScene* scene = importer.ReadFile(path.c_str(), flags);
     if (scene == nullptr || scene->mRootNode == nullptr)
       throw PartError(name + ": not a readable " + printable(extension.substr(1)) + " mesh (" +
-                      assimpMessage(importer.GetErrorString(), extension) + ")");
+                      assimpMessage(importer.GetErrorString(), path) + ")");
     const aiNode& root = *scene->mRootNode;
     const Eigen::Affine3d identity = Eigen::Affine3d::Identity();
     if (!options.part.empty()) {
@@ -144,11 +148,7 @@ Part readMesh(const std::string& data, const std::string& name, const std::strin
     for (unsigned i = 0; i < root.mNumChildren; ++i)
       if (hasTriangles(*scene, *root.mChildren[i])) parts.push_back(label(*root.mChildren[i], i));
     if (parts.size() > 1 && !options.merge) {
-      std::string list;
-      for (std::size_t i = 0; i < parts.size() && i < 8; ++i) list += (i ? ", " : "") + parts[i];
-      if (parts.size() > 8) list += ", ...";
-      throw PartError(name + ": holds " + std::to_string(parts.size()) + " top-level parts (" + list +
-                      "); pick one with --part NAME, or --merge to fit them as one rigid body");
+      throw severalParts(name, parts);
     }
     collect(*scene, root, identity, options.scale, name, part);
   });

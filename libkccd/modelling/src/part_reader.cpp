@@ -62,6 +62,7 @@
 
 #include "kccd/modelling/part.hpp"
 #include "large_stack.hpp"
+#include "part_messages.hpp"
 #include "mesh_reader.hpp"
 
 namespace kccd::modelling {
@@ -620,11 +621,7 @@ Part readScene(const std::string& data, const std::string& path, const ReadOptio
         if (!probe.part.empty()) parts.push_back(nodeLabel(root->getChild(i), i));
       }
       if (parts.size() > 1 && !options.merge) {
-        std::string list;
-        for (std::size_t i = 0; i < parts.size() && i < 8; ++i) list += (i ? ", " : "") + parts[i];
-        if (parts.size() > 8) list += ", ...";
-        throw PartError(path + ": holds " + std::to_string(parts.size()) + " top-level parts (" + list +
-                                 "); pick one with --part NAME, or --merge to fit them as one rigid body");
+        throw detail::severalParts(path, parts);
       }
       run(c, top, nullptr);
     }
@@ -700,7 +697,7 @@ Part readPart(const std::string& path, const ReadOptions& options) {
   // STL directly; Open Inventor and VRML (analytic primitives, scene graphs) through Coin3D;
   // other meshes (OBJ, COLLADA, PLY, glTF, ...) through Assimp.
   Part part = extension == ".stl"                 ? readStl(data, name, options.scale)
-              : detail::readsAsMesh(extension) ? detail::readMesh(data, name, extension, options)
+              : detail::readsAsMesh(extension) ? detail::readMesh(data, path, name, extension, options)
                                                : readScene(data, name, options);
   if (part.triangles == 0 && part.primitives == 0)
     throw PartError(name + (options.part.empty() ? "" : " (part " + printable(options.part) + ")") +

@@ -141,7 +141,12 @@ void writeVisuals(std::ostringstream& out, const std::string& urdf_path, const u
       }
       case urdf::Geometry::MESH: {
         const auto& mesh = static_cast<const urdf::Mesh&>(*v->geometry);
-        const std::string file = resolveMesh(urdf_path, link.name, mesh.filename, options);
+        std::string file;
+        try {
+          file = resolveMesh(urdf_path, link.name, mesh.filename, options);
+        } catch (const UrdfError& e) {
+          throw UrdfError(std::string(e.what()) + " (a visual; or import with --no-visuals)");
+        }
         std::error_code ec;
         if (!std::filesystem::is_regular_file(file, ec))
           throw UrdfError(urdf_path + ": link " + link.name + ": visual mesh " + printable(mesh.filename) + ": " +
@@ -153,7 +158,9 @@ void writeVisuals(std::ostringstream& out, const std::string& urdf_path, const u
       }
     }
     out << "    origin: {xyz: " << vec(o.position.x, o.position.y, o.position.z) << ", rpy: " << vec(r, p, y) << "}\n";
-    if (v->material) {
+    // A material with a colour (urdfdom leaves a texture-only one black: not written).
+    if (v->material && !(v->material->color.r == 0 && v->material->color.g == 0 && v->material->color.b == 0 &&
+                         !v->material->texture_filename.empty())) {
       const urdf::Color& c = v->material->color;
       auto unit = [](float x) { return num(std::clamp(static_cast<double>(x), 0.0, 1.0)); };
       out << "    colour: [" << unit(c.r) << ", " << unit(c.g) << ", " << unit(c.b) << ", " << unit(c.a) << "]\n";
