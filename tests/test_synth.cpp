@@ -270,6 +270,12 @@ TEST_F(Synth, DrawsTheModelsVisualGeometry) {
            "  - frame: shoulder_pitch\n    mesh: upper_arm.obj\n    colour: [0.9, 0.4, 0.1]\n"
            "  - frame: elbow\n    box: [0.4, 0.07, 0.07]\n    origin: {xyz: [0.2, 0, 0]}\n";
   std::ofstream(dir("visual_arm.yaml")) << model;
+  const Outcome info = runKccd("info " + dir("visual_arm.yaml") + " --json");
+  ASSERT_EQ(info.code, 0) << info.err;
+  const json ij = json::parse(info.out);
+  EXPECT_EQ(ij["totals"]["visuals"], 3);
+  EXPECT_EQ(ij["visuals"][1]["shape"], "mesh");
+  EXPECT_EQ(fs::path(ij["visuals"][1]["mesh"].get<std::string>()).filename(), "upper_arm.obj");
   const Outcome r = runKccd("synth " + dir("visual_arm.yaml") + " -o " + dir("v") +
                             " --seconds 0.4 --fps 10 --seed 2 --no-collision -q");
   ASSERT_EQ(r.code, 0) << r.err;

@@ -1,4 +1,4 @@
-// `kccd info MODEL`: joints, state values, bodies, points and checked pairs.
+// `kccd info MODEL`: joints, state values, bodies, points, checked pairs and visuals.
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -10,6 +10,16 @@
 
 namespace kccd::cli {
 namespace {
+
+const char* shapeName(Visual::Shape shape) {
+  switch (shape) {
+    case Visual::Shape::Mesh: return "mesh";
+    case Visual::Shape::Box: return "box";
+    case Visual::Shape::Cylinder: return "cylinder";
+    case Visual::Shape::Sphere: return "sphere";
+  }
+  return "?";
+}
 
 struct InfoArgs {
   std::string model;
@@ -38,8 +48,14 @@ Exit runInfo(const InfoArgs& args) {
     j["pairs"] = nlohmann::json::array();
     for (const BodyPair& p : m.pairs)
       j["pairs"].push_back({{"a", m.bodies[p.a].name}, {"b", m.bodies[p.b].name}, {"frame", m.frameName(p.lca)}});
+    j["visuals"] = nlohmann::json::array();
+    for (const Visual& v : m.visuals) {
+      nlohmann::json o{{"frame", m.frameName(v.frame)}, {"shape", shapeName(v.shape)}};
+      if (v.shape == Visual::Shape::Mesh) o["mesh"] = v.mesh;
+      j["visuals"].push_back(o);
+    }
     j["totals"] = {{"joints", m.joints.size()}, {"dof", m.stateSize()}, {"bodies", m.bodies.size()}, {"points", points},
-                   {"pairs", m.pairs.size()}};
+                   {"pairs", m.pairs.size()}, {"visuals", m.visuals.size()}};
     std::cout << j.dump(2) << "\n";
     return Exit::Ok;
   }
@@ -62,6 +78,12 @@ Exit runInfo(const InfoArgs& args) {
   std::cout << "\nchecked pairs (compared in their common-ancestor frame):\n";
   for (const BodyPair& p : m.pairs)
     std::cout << "  " << m.bodies[p.a].name << " - " << m.bodies[p.b].name << "  [" << m.frameName(p.lca) << "]\n";
+  if (!m.visuals.empty()) {
+    std::cout << "\nvisuals (drawing only, never checked):\n";
+    for (const Visual& v : m.visuals)
+      std::cout << "  frame " << std::left << std::setw(16) << m.frameName(v.frame) << shapeName(v.shape)
+                << (v.shape == Visual::Shape::Mesh ? " " + v.mesh : std::string()) << "\n";
+  }
   return Exit::Ok;
 }
 
