@@ -355,17 +355,18 @@ TEST(Cli, ImportWritesALoadableModel) {
   ASSERT_EQ(again.code, 0) << again.err;
   const nlohmann::json proofs = nlohmann::json::parse(again.out);
   int ignored = 0;
-  for (const auto& pair : proofs["pairs"]) {
+  for (const auto& pair : proofs.at("pairs")) {
     // Every pair proven never or always touching is now ignored; the SRDF's stay ignored.
-    if (pair["verdict"] == "never" || pair["verdict"] == "always_touching") {
-      EXPECT_FALSE(pair["checked"]) << pair;
+    if (pair.at("verdict") == "never" || pair.at("verdict") == "always_touching") {
+      EXPECT_FALSE(pair.at("checked")) << pair;
     }
-    ignored += pair["checked"] ? 0 : 1;
+    ignored += pair.at("checked") ? 0 : 1;
   }
   EXPECT_GE(ignored, 2);  // at least the SRDF's two pairs
   const Outcome plain = runKccd("pairs " + out + " --json");
   ASSERT_EQ(plain.code, 0) << plain.err;
   int ignored_plain = 0;
-  for (const auto& pair : nlohmann::json::parse(plain.out)["pairs"]) ignored_plain += pair["checked"] ? 0 : 1;
+  const nlohmann::json plain_proofs = nlohmann::json::parse(plain.out);
+  for (const auto& pair : plain_proofs.at("pairs")) ignored_plain += pair.at("checked") ? 0 : 1;
   EXPECT_GE(ignored, ignored_plain);
 }

@@ -273,14 +273,15 @@ TEST_F(Synth, DrawsTheModelsVisualGeometry) {
   const Outcome info = runKccd("info " + dir("visual_arm.yaml") + " --json");
   ASSERT_EQ(info.code, 0) << info.err;
   const json ij = json::parse(info.out);
-  EXPECT_EQ(ij["totals"]["visuals"], 3);
-  EXPECT_EQ(ij["visuals"][1]["shape"], "mesh");
-  EXPECT_EQ(fs::path(ij["visuals"][1]["mesh"].get<std::string>()).filename(), "upper_arm.obj");
+  ASSERT_TRUE(ij.contains("visuals")) << info.out;
+  EXPECT_EQ(ij.at("totals").at("visuals"), 3);
+  EXPECT_EQ(ij.at("visuals").at(1).at("shape"), "mesh");
+  EXPECT_EQ(fs::path(ij.at("visuals").at(1).at("mesh").get<std::string>()).filename(), "upper_arm.obj");
   const Outcome r = runKccd("synth " + dir("visual_arm.yaml") + " -o " + dir("v") +
                             " --seconds 0.4 --fps 10 --seed 2 --no-collision -q");
   ASSERT_EQ(r.code, 0) << r.err;
   const json j = summary("v");
-  EXPECT_EQ(j["masks"]["appearance"], "visuals") << j["masks"].dump();
+  EXPECT_EQ(j.at("masks").at("appearance"), "visuals") << j.at("masks").dump();
   // Labels: body i + 1 of the first body in each visual's frame (pedestal 1, upper_arm 5, forearm 6).
   std::vector<int> seen(256, 0);
   for (int f = 0; f < 4; ++f) {
