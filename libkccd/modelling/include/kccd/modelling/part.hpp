@@ -51,8 +51,10 @@ struct ReadOptions {
   Eigen::Vector3d scale = Eigen::Vector3d::Ones();  ///< applied in the file's frame (URDF mesh scale)
 };
 
-/// Reads an Open Inventor (.iv, ASCII or binary), VRML 1/2 (.wrl) or STL file through Coin3D,
-/// all transforms applied. Throws PartError with a one-line message naming the file.
+/// Reads an Open Inventor (.iv, ASCII or binary) or VRML 1/2 (.wrl) file through Coin3D, an STL
+/// file (ASCII or binary) directly, or any other mesh file Assimp reads (OBJ, COLLADA with its
+/// unit and without its up-axis turn, PLY, glTF/GLB, ...; by extension), all transforms applied.
+/// Throws PartError with a one-line message naming the file.
 ///
 /// Refused with that error rather than read: anything but a regular file of at most
 /// kMaxInputBytes (binary Open Inventor: kMaxBinaryInventorBytes); ASCII scenes nested deeper than
