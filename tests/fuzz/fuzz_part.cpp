@@ -23,7 +23,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path =
       kccd::fuzz::writeInput("fuzz_part", std::string("input") + extensions[data[0] % 8], data + 1, size - 1);
   try {
-    (void)kccd::modelling::readPart(path, {.merge = (data[0] & 8) != 0});
+    kccd::modelling::ReadOptions options;
+    options.merge = (data[0] & 8) != 0;
+    options.mesh_time_limit_s = 4.0;  // an endless Assimp read ends well within libFuzzer's timeout
+    (void)kccd::modelling::readPart(path, options);
   } catch (const kccd::InputError& e) {
     kccd::fuzz::checkMessage(e.what(), path);
   }

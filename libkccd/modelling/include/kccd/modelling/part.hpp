@@ -2,6 +2,7 @@
 // whose convex hull contains every point of the part.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -49,6 +50,11 @@ struct ReadOptions {
   std::string part;    ///< name of a DEF'd node to read alone; empty: the whole file
   bool merge = false;  ///< accept several top-level parts as one rigid body
   Eigen::Vector3d scale = Eigen::Vector3d::Ones();  ///< applied in the file's frame (URDF mesh scale)
+  /// Meshes read through Assimp are read in a child process (Assimp's readers are not hardened
+  /// against malformed files): at most this long, and with at most this much memory beyond what
+  /// the process has (not enforced under AddressSanitizer). Exceeded: PartError.
+  double mesh_time_limit_s = 60.0;
+  std::size_t mesh_memory_limit_mb = 4096;
 };
 
 /// Reads an Open Inventor (.iv, ASCII or binary) or VRML 1/2 (.wrl) file through Coin3D, an STL
