@@ -32,14 +32,12 @@ std::string withProvenPairs(const std::string& text, const ImportArgs& args) {
     Progress progress("proving pairs", args.quiet);
     reports = modelling::provePairs(m, {.max_boxes = args.max_boxes, .progress = [&](double f) { progress.update(f); }});
   }
-  std::vector<std::array<std::string, 2>> ignore;
+  const std::vector<std::array<std::string, 2>> ignore = modelling::ignoreList(m, reports);
   int never = 0, touching = 0, undecided = 0;
   for (const auto& r : reports) {
     never += r.verdict == modelling::Verdict::Never;
     touching += r.verdict == modelling::Verdict::AlwaysTouching;
     undecided += r.verdict == modelling::Verdict::Undecided;
-    if (!r.checked || r.verdict == modelling::Verdict::Never || r.verdict == modelling::Verdict::AlwaysTouching)
-      ignore.push_back({m.bodies[r.a].name, m.bodies[r.b].name});
   }
   if (!args.quiet)
     std::cerr << "pairs: " << never << " never within the margin, " << touching << " always touching, " << undecided

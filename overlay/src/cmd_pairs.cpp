@@ -38,14 +38,7 @@ Exit runPairs(const PairsArgs& args) {
         m, {.margin = args.margin, .max_boxes = args.max_boxes, .progress = [&](double f) { progress.update(f); }});
   }
   const double margin = args.margin >= 0 ? args.margin : m.safety_margin;
-  std::vector<std::array<std::string, 2>> ignore;
-  for (const auto& r : reports)
-    if (r.verdict == modelling::Verdict::Never || r.verdict == modelling::Verdict::AlwaysTouching)
-      ignore.push_back({m.bodies[r.a].name, m.bodies[r.b].name});
-  // Pairs the model already ignores stay ignored.
-  for (const auto& r : reports)
-    if (!r.checked && r.verdict != modelling::Verdict::Never && r.verdict != modelling::Verdict::AlwaysTouching)
-      ignore.push_back({m.bodies[r.a].name, m.bodies[r.b].name});
+  const std::vector<std::array<std::string, 2>> ignore = modelling::ignoreList(m, reports);
 
   if (args.json) {
     nlohmann::json j;

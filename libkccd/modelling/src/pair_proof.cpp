@@ -223,4 +223,17 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
   return out;
 }
 
+std::vector<std::array<std::string, 2>> ignoreList(const Model& model, const std::vector<PairReport>& reports) {
+  const auto proven = [](const PairReport& r) {
+    return r.verdict == Verdict::Never || r.verdict == Verdict::AlwaysTouching;
+  };
+  std::vector<std::array<std::string, 2>> ignore;
+  for (const PairReport& r : reports)
+    if (proven(r)) ignore.push_back({model.bodies[r.a].name, model.bodies[r.b].name});
+  // Pairs the model already ignores stay ignored.
+  for (const PairReport& r : reports)
+    if (!r.checked && !proven(r)) ignore.push_back({model.bodies[r.a].name, model.bodies[r.b].name});
+  return ignore;
+}
+
 }  // namespace kccd::modelling

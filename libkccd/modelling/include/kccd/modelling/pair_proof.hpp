@@ -3,7 +3,9 @@
 // pairs always touch.
 #pragma once
 
+#include <array>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "kccd/model.hpp"
@@ -44,5 +46,9 @@ std::vector<std::array<double, 2>> jointRanges(const Model& model);
 
 /// Analyses every pair of bodies in different frames (checked or not).
 std::vector<PairReport> provePairs(const Model& model, const ProofOptions& options = {});
+
+/// The `pairs: ignore` list the proofs justify, as body-name pairs: first the pairs proven never
+/// within the margin or always touching, then those the model already ignores, each in report order.
+std::vector<std::array<std::string, 2>> ignoreList(const Model& model, const std::vector<PairReport>& reports);
 
 }  // namespace kccd::modelling
