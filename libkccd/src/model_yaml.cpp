@@ -117,6 +117,16 @@ SweepMode parseSweep(const Reader& r, const YAML::Node& n, const std::string& fi
   r.fail(n, field, "unknown sweep mode '" + t + "' (exact, fast, accurate)");
 }
 
+// The required `frame` of the entry `n` named `field` in messages: kWorld for "world", else a
+// joint defined earlier.
+int parseFrame(const Reader& r, const YAML::Node& n, const std::string& field, const Model& m) {
+  const std::string frame = r.text(r.require(n, "frame", field, n), field + ".frame");
+  if (frame == "world") return kWorld;
+  const int joint = m.jointIndex(frame);
+  if (joint < 0) r.fail(n["frame"], field + ".frame", "unknown joint '" + frame + "'");
+  return joint;
+}
+
 void parseJoints(const Reader& r, const YAML::Node& list, Model& m) {
   if (!list.IsSequence()) r.fail(list, "joints", "expected a list");
   for (std::size_t i = 0; i < list.size(); ++i) {
@@ -178,11 +188,7 @@ void parseBodies(const Reader& r, const YAML::Node& list, Model& m) {
     b.name = r.text(r.require(n, "name", f, n), f + ".name");
     const std::string fb = "body '" + b.name + "'";
     if (m.bodyIndex(b.name) >= 0) r.fail(n["name"], f + ".name", "duplicate body name '" + b.name + "'");
-    const std::string frame = r.text(r.require(n, "frame", fb, n), fb + ".frame");
-    if (frame != "world") {
-      b.frame = m.jointIndex(frame);
-      if (b.frame < 0) r.fail(n["frame"], fb + ".frame", "unknown joint '" + frame + "'");
-    }
+    b.frame = parseFrame(r, n, fb, m);
     const YAML::Node pts = r.require(n, "points", fb, n);
     if (!pts.IsSequence()) r.fail(pts, fb + ".points", "expected a list of [x, y, z]");
     if (pts.size() == 0) r.fail(pts, fb + ".points", "empty point list");
@@ -202,11 +208,7 @@ void parseVisuals(const Reader& r, const YAML::Node& list, Model& m, const std::
     const std::string f = "visuals[" + std::to_string(i) + "]";
     r.onlyKeys(n, f, {"frame", "mesh", "scale", "box", "cylinder", "sphere", "origin", "colour"});
     Visual v;
-    const std::string frame = r.text(r.require(n, "frame", f, n), f + ".frame");
-    if (frame != "world") {
-      v.frame = m.jointIndex(frame);
-      if (v.frame < 0) r.fail(n["frame"], f + ".frame", "unknown joint '" + frame + "'");
-    }
+    v.frame = parseFrame(r, n, f, m);
     int shapes = 0;
     for (const char* key : {"mesh", "box", "cylinder", "sphere"}) shapes += n[key] ? 1 : 0;
     if (shapes != 1) r.fail(n, f, "exactly one of mesh, box, cylinder, sphere");
