@@ -53,8 +53,12 @@ Eigen::Affine3d toEigen(const aiMatrix4x4& m) {
 // message) left out.
 std::string assimpMessage(const char* text, const std::string& path) {
   std::string s = text != nullptr ? text : "";
+  const std::string replacement = "the file";
+  // Each search resumes after the last replacement, so the text put in is never searched again.
   for (const std::string& own : {"\"" + path + "\"", path})
-    for (std::size_t at = s.find(own); !own.empty() && at != std::string::npos; at = s.find(own)) s.replace(at, own.size(), "the file");
+    for (std::size_t at = s.find(own); !own.empty() && at != std::string::npos;
+         at = s.find(own, at + replacement.size()))
+      s.replace(at, own.size(), replacement);
   for (char& c : s)
     if (c == '\n' || c == '\r' || c == '\t') c = ' ';
   while (!s.empty() && s.back() == ' ') s.pop_back();
