@@ -380,9 +380,10 @@ TEST(RenderMesh, PolygonFillCoversTheSamePixelsAsTheTriangles) {
       const VolumeStatus status = static_cast<VolumeStatus>(i % 3);
       scene.push_back(Volume{cores[static_cast<std::size_t>(i)], 0.02 + 0.2 * std::abs(u(rng)), status, ""});
     }
-    RenderOptions triangles;
+    RenderOptions triangles, silhouettes;
     triangles.polygon_fill = false;
-    Renderer with_polygons(c), with_triangles(c, triangles);
+    silhouettes.outline_from_core = false;  // the mesh's silhouette (outlines from the core: test_ssch_outline)
+    Renderer with_polygons(c, silhouettes), with_triangles(c, triangles);
     const Frame a = with_polygons.render(scene, Style{}, true, false);
     const Frame b = with_triangles.render(scene, Style{}, true, false);
     cv::Mat diff;

@@ -205,6 +205,11 @@ struct Renderer::Prepared {
   // form a single simple loop).
   std::vector<std::uint32_t> silhouette;
   std::vector<std::uint32_t> fill;  // the silhouette polygon as triangles (see polygonTriangles)
+  // The outline computed from the core (RenderOptions::outline_from_core): its corners in camera
+  // coordinates on a plane between the clipping planes, as lines and as triangles (empty: none).
+  std::vector<Eigen::Vector2d> outline_2d;  // normalised image coordinates
+  std::vector<float> outline_vertices;
+  std::vector<std::uint32_t> outline_lines, outline_fill;
   double depth = 0.0;
   bool fills = false;     // contains the camera: drawn as a full-view fill, no mesh
   int level = 0;           // sphere tessellation level
@@ -319,7 +324,8 @@ void polygonTriangles(const std::vector<std::uint32_t>& loop, std::vector<std::u
 
 }  // namespace
 
-void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame) {
+void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame, bool outlines,
+                       bool need_meshes) {
   cache_.nextFrame();
   const std::uint64_t built_before = cache_.built();
   const Camera& cam = projection_.camera();
@@ -342,6 +348,10 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     p.fills = false;
     p.silhouette.clear();
     p.fill.clear();
+    p.outline_2d.clear();
+    p.outline_vertices.clear();
+    p.outline_lines.clear();
+    p.outline_fill.clear();
     p.surface = false;
     p.label = v.mask_label >= 0 ? std::min(v.mask_label, 255) : static_cast<int>(i) + 1;
     Visibility& visibility = frame.visibility[i];
@@ -402,6 +412,18 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
       continue;
     }
     p.level = level;
+    // The outline straight from the core when the volume lies beyond the near plane; the mesh
+    // when a mask or the shaded look needs it, or the outline cannot be had.
+    if (outlines && sschOutline(cam_points, r, OutlineOptions{.focal_px = focal, .tolerance_px = options_.tolerance_px,
+                                                              .min_depth = options_.near},
+                                p.outline_2d) &&
+        p.outline_2d.size() >= 3) {  // (fewer corners: an image thinner than the tolerance, drawn from the mesh)
+      visibility = Visibility::Drawn;
+      ++frame.outlines;
+      if (!need_meshes) continue;
+    } else {
+      p.outline_2d.clear();
+    }
     requests.push_back(MeshRequest{v.points, v.radius, level, options_.min_radius});
     requested.push_back(i);
   }
@@ -411,7 +433,7 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
   for (std::size_t k = 0; k < requested.size(); ++k) {
     Prepared& p = out[requested[k]];
     if (!meshes[k].mesh) {  // qhull on extreme coordinates
-      frame.visibility[requested[k]] = Visibility::NoMesh;
+      if (p.outline_2d.empty()) frame.visibility[requested[k]] = Visibility::NoMesh;
       continue;
     }
     p.mesh = meshes[k].mesh;
@@ -458,10 +480,30 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     const double ty = std::max(ph.cy + 0.5, ph.height - ph.cy - 0.5) / ph.fy;
     const double corner = std::sqrt(1.0 + tx * tx + ty * ty);  // frustum corner at unit depth
     for (const Prepared& p : out)
-      if (p.mesh) frame.near = std::min(frame.near, 0.5 * p.clearance / corner);
+      if (p.mesh || !p.outline_2d.empty()) frame.near = std::min(frame.near, 0.5 * p.clearance / corner);
   }
   for (const Prepared& p : out)
-    if (p.mesh) frame.far = std::max(frame.far, 1.01 * p.reach);
+    if (p.mesh || !p.outline_2d.empty()) frame.far = std::max(frame.far, 1.01 * p.reach);
+  // Outlines on a plane between the clipping planes (drawn without depth test, so only their
+  // rays matter).
+  const double z = std::sqrt(frame.near * frame.far);
+  for (Prepared& p : out) {
+    if (p.outline_2d.empty()) continue;
+    const std::size_t n = p.outline_2d.size();
+    p.outline_vertices.resize(3 * n);
+    for (std::size_t k = 0; k < n; ++k) {
+      p.outline_vertices[3 * k] = static_cast<float>(p.outline_2d[k].x() * z);
+      p.outline_vertices[3 * k + 1] = static_cast<float>(p.outline_2d[k].y() * z);
+      p.outline_vertices[3 * k + 2] = static_cast<float>(z);
+    }
+    std::vector<std::uint32_t> loop(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      loop[k] = static_cast<std::uint32_t>(k);
+      p.outline_lines.insert(p.outline_lines.end(), {static_cast<std::uint32_t>(k), static_cast<std::uint32_t>((k + 1) % n)});
+    }
+    polygonTriangles(loop, p.outline_fill);
+    frame.triangles += static_cast<int>(p.outline_fill.size() / 3);
+  }
 }
 
 namespace {
@@ -625,7 +667,7 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   // Back to front; back faces culled, so each convex volume tints a pixel once.
   std::vector<const Prepared*> order;
   for (const Prepared& p : bodies)
-    if (p.mesh) order.push_back(&p);
+    if (p.mesh || !p.outline_2d.empty()) order.push_back(&p);
   std::sort(order.begin(), order.end(), [](const Prepared* a, const Prepared* b) { return a->depth > b->depth; });
   // Whether the fill may be the silhouette polygon: a single loop whose vertices all lie beyond
   // the near plane (then its projection is the convex outline of the front faces, unclipped).
@@ -635,17 +677,35 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
       if (!(p.vertices[3 * k + 2] > near)) return false;
     return true;
   };
-  if (with_labels) {  // the labels of the nearest surfaces in the same pass (see kLabelFragmentShader)
+  // Volumes drawn from the outline computed from their core; the others from their mesh.
+  auto outlined = [](const Prepared& p) { return !p.outline_2d.empty(); };
+  if (with_labels) {  // the labels of the nearest surfaces first (see kLabelFragmentShader), then the colour
+    drawBuffers(false, true);
     glUseProgram(gl_->program);
     glBlendEquationi(1, GL_MIN);
-  }
-  for (const Prepared* p : order) {
-    const cv::Scalar c = p->colour;  // BGR, drawn as GL's RGB (see the read-back)
-    glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
-    if (with_labels) {
+    for (const Prepared* p : order) {
+      if (!p->mesh) continue;
       glUniform1ui(gl_->label_location, static_cast<GLuint>(p->label));
       drawTriangles(*p->mesh, p->vertices);  // surfaces too as wound: the colour layer is the same without labels
-    } else if (polygonFill(*p)) {
+    }
+    glUseProgram(0);
+    glBlendEquation(GL_FUNC_ADD);
+    drawBuffers(true, false);
+  }
+  // The tints as premultiplied colours (the blend then multiplies nothing by the source alpha:
+  // ~15 % less fill time on llvmpipe than blending straight colours).
+  glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  for (const Prepared* p : order) {
+    const cv::Scalar c = p->colour;  // BGR, drawn as GL's RGB (see the read-back)
+    const double fa = style.fill_alpha;
+    glColor4d(fa * c[0] / 255.0, fa * c[1] / 255.0, fa * c[2] / 255.0, fa);
+    if (outlined(*p)) {
+      ++frame.polygon_fills;
+      glDisable(GL_CULL_FACE);  // the outline's winding is the image's, not the mesh's
+      glVertexPointer(3, GL_FLOAT, 0, p->outline_vertices.data());
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(p->outline_fill.size()), GL_UNSIGNED_INT, p->outline_fill.data());
+      glEnable(GL_CULL_FACE);
+    } else if (!p->surface && polygonFill(*p)) {
       ++frame.polygon_fills;
       glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
       glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(p->fill.size()), GL_UNSIGNED_INT, p->fill.data());
@@ -653,19 +713,17 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
       drawTriangles(*p->mesh, p->vertices);
     }
   }
-  if (with_labels) {
-    glUseProgram(0);
-    glBlendEquation(GL_FUNC_ADD);
-    drawBuffers(true, false);  // outlines and view fills: colour only
-  }
+  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);  // smoothed lines: coverage in alpha
   glLineWidth(static_cast<float>(style.outline_width * projection_.supersample()));
   glEnable(GL_LINE_SMOOTH);  // coverage in alpha, blended like the fill
   glHint(GL_LINE_SMOOTH_HINT, GL_NICEST);
   for (const Prepared* p : order) {
     const cv::Scalar c = p->colour * 0.7;
     glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
-    glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
-    glDrawElements(GL_LINES, static_cast<GLsizei>(p->outline.size()), GL_UNSIGNED_INT, p->outline.data());
+    const bool own = outlined(*p);
+    glVertexPointer(3, GL_FLOAT, 0, own ? p->outline_vertices.data() : p->vertices.data());
+    const std::vector<std::uint32_t>& lines = own ? p->outline_lines : p->outline;
+    glDrawElements(GL_LINES, static_cast<GLsizei>(lines.size()), GL_UNSIGNED_INT, lines.data());
   }
   glDisable(GL_LINE_SMOOTH);
   // Volumes containing the camera tint the whole view, in front of everything else.
@@ -775,7 +833,10 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     std::fprintf(stderr, "%s %.2f ms  ", what, std::chrono::duration<double, std::milli>(now - last).count());
     last = now;
   };
-  prepare(volumes, bodies, frame);
+  // Outlines from the cores for the tinted look's colour layer; meshes for the labels, the
+  // shaded look, and what the outlines cannot draw.
+  const bool outlines = want_colour && !style.shaded && options_.polygon_fill && options_.outline_from_core;
+  prepare(volumes, bodies, frame, outlines, want_mask || !outlines);
   tick("prepare");
   const Camera& cam = projection_.camera();
   // The mask from the colour pass when it can (the overlay look at the colour pass's scale).

@@ -13,6 +13,7 @@
 #include "kccd/render/projection.hpp"
 #include "kccd/render/gl_context.hpp"
 #include "kccd/render/ssch_mesh.hpp"
+#include "kccd/render/ssch_outline.hpp"
 
 namespace kccd::render {
 
@@ -91,6 +92,11 @@ struct RenderOptions {
   /// near plane, or whose labels are drawn in the same pass keep the triangles. Off: always the
   /// triangles (for comparison).
   bool polygon_fill = true;
+  /// In the tinted look, draw each volume's tint and outline from its outline computed straight
+  /// from the core points (see sschOutline: it contains the image and lies at most tolerance_px
+  /// outside), so a colour layer needs no mesh; meshes are built only for masks, the shaded look
+  /// and volumes reaching nearer than `near`. Needs polygon_fill. Off: from the mesh's silhouette.
+  bool outline_from_core = true;
   double tolerance_px = 0.5;   ///< largest outward error of the sphere tessellation, output pixels
   int max_level = 3;           ///< finest sphere tessellation (level 3: 642 vertices, 0.3 % outward)
   double min_radius = kMinDrawRadius;  ///< volumes thinner than this are drawn this thick (metres)
@@ -113,6 +119,7 @@ struct Frame {
   int meshes_built = 0;   ///< meshes built in this frame (the others came from the cache)
   int triangles = 0;      ///< triangles of the drawn meshes
   int polygon_fills = 0;  ///< volumes whose tint was drawn as their silhouette polygon (RenderOptions::polygon_fill)
+  int outlines = 0;       ///< of those, volumes drawn from their outline computed from the core (RenderOptions::outline_from_core)
   int hull_input = 0;     ///< points passed to qhull for the meshes built in this frame
   int max_level = 0;      ///< finest sphere tessellation used
 };
@@ -145,7 +152,7 @@ class Renderer {
  private:
   struct Gl;
   struct Prepared;
-  void prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame);
+  void prepare(std::span<const Volume> volumes, std::vector<Prepared>& out, Frame& frame, bool outlines, bool need_meshes);
   void prepareSurface(const Volume& v, Prepared& p, Visibility& visibility);
   cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style, Frame& frame, cv::Mat* labels = nullptr);
   cv::Mat drawMask(const std::vector<Prepared>& bodies, double near, double far);
