@@ -78,8 +78,8 @@ struct RenderOptions {
   double supersample = 1.0;    ///< pinhole image scale (1..4); > 1 keeps thin slivers through the warp
   /// Pinhole scale of the mask when the camera distorts: the warp samples the mask at the nearest
   /// pinhole pixel, so label edges are within 1/(2 s) px. At the colour pass's scale (the default)
-  /// the labels come out of the colour pass itself (a second attachment, no second pass); another
-  /// scale (e.g. 2 for ground truth) draws the labels in a pass of their own.
+  /// the labels go into a second attachment of the colour pass's framebuffer, drawn just before
+  /// the colour; another scale (e.g. 2 for ground truth) draws them into a framebuffer of its own.
   double mask_supersample = 1.0;
   /// Multisampling of the colour layer (0 or 1: off; at most 4 on llvmpipe). Off by default:
   /// on llvmpipe 4x MSAA costs ~5x the frame time, and the outline, drawn as smoothed lines on
@@ -156,6 +156,7 @@ class Renderer {
   void prepareSurface(const Volume& v, Prepared& p, Visibility& visibility);
   cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style, Frame& frame, cv::Mat* labels = nullptr);
   cv::Mat drawMask(const std::vector<Prepared>& bodies, double near, double far);
+  void drawLabelTriangles(const std::vector<Prepared>& bodies);
   static void drawShaded(const std::vector<const Prepared*>& order, double ambient);
   void decorate(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility,
                 const Style& style);
