@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
@@ -843,14 +844,6 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
   if (want_colour) {
     cv::Mat premultiplied = drawColour(bodies, style, frame, same_pass ? &labels : nullptr);
     tick("colour+readback");
-    if (projection_.warps()) {
-      if (fixed_map_a_.empty())  // fixed-point maps: remap's fast path (1/32 px steps)
-        cv::convertMaps(projection_.mapX(), projection_.mapY(), fixed_map_a_, fixed_map_b_, CV_16SC2);
-      cv::Mat warped;
-      cv::remap(premultiplied, warped, fixed_map_a_, fixed_map_b_, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-                cv::Scalar::all(0));
-      premultiplied = warped;
-    }
     // Straight alpha: colour / alpha, through a table.
     static const std::vector<uchar> unpremultiply = [] {
       std::vector<uchar> t(256 * 256);
@@ -858,16 +851,75 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
         for (int c = 0; c < 256; ++c) t[a * 256 + c] = static_cast<uchar>(std::min(255, (c * 255 + a / 2) / a));
       return t;
     }();
-    frame.bgra = premultiplied;
-    cv::parallel_for_(cv::Range(0, frame.bgra.rows), [&](const cv::Range& rows) {
-      for (int y = rows.start; y < rows.end; ++y) {
-        uchar* px = frame.bgra.ptr<uchar>(y);
-        for (int x = 0; x < frame.bgra.cols; ++x, px += 4) {
+    auto straighten = [&](cv::Mat rows) {
+      for (int y = 0; y < rows.rows; ++y) {
+        uchar* px = rows.ptr<uchar>(y);
+        for (int x = 0; x < rows.cols; ++x, px += 4) {
           const uchar* t = &unpremultiply[px[3] * 256];
           if (px[3] != 255 && px[3] != 0) px[0] = t[px[0]], px[1] = t[px[1]], px[2] = t[px[2]];
         }
       }
-    });
+    };
+    if (projection_.warps()) {
+      if (fixed_map_a_.empty()) {  // fixed-point maps: remap's fast path (1/32 px steps)
+        cv::convertMaps(projection_.mapX(), projection_.mapY(), fixed_map_a_, fixed_map_b_, CV_16SC2);
+        // The pinhole rows each output row's bilinear samples read (empty: none).
+        const cv::Mat& my = projection_.mapY();
+        source_rows_.assign(static_cast<std::size_t>(my.rows), {0, -1});
+        for (int y = 0; y < my.rows; ++y) {
+          float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+          for (int x = 0; x < my.cols; ++x) lo = std::min(lo, my.at<float>(y, x)), hi = std::max(hi, my.at<float>(y, x));
+          if (lo <= hi) source_rows_[static_cast<std::size_t>(y)] = {static_cast<int>(std::floor(lo)) - 1, static_cast<int>(std::floor(hi)) + 2};
+        }
+      }
+      // Pinhole rows with anything drawn (prefix counts), so output rows reading only empty rows
+      // are cleared instead of warped (what the warp would give them: all zero).
+      const int ph = premultiplied.rows;
+      std::vector<int> drawn(static_cast<std::size_t>(ph) + 1, 0);
+      cv::parallel_for_(cv::Range(0, ph), [&](const cv::Range& r) {
+        for (int y = r.start; y < r.end; ++y) {
+          const auto* row = premultiplied.ptr<std::uint32_t>(y);
+          std::uint32_t any = 0;
+          for (int x = 0; x < premultiplied.cols; ++x) any |= row[x];
+          drawn[static_cast<std::size_t>(y) + 1] = any != 0;
+        }
+      });
+      for (int y = 0; y < ph; ++y) drawn[static_cast<std::size_t>(y) + 1] += drawn[static_cast<std::size_t>(y)];
+      auto anyDrawn = [&](int lo, int hi) {
+        lo = std::clamp(lo, 0, ph);
+        hi = std::clamp(hi + 1, 0, ph);
+        return lo < hi && drawn[static_cast<std::size_t>(hi)] > drawn[static_cast<std::size_t>(lo)];
+      };
+      frame.bgra.create(fixed_map_a_.rows, fixed_map_a_.cols, CV_8UC4);
+      // Warp and straighten in blocks of rows, each while it is in cache.
+      constexpr int kBlock = 8;
+      cv::parallel_for_(cv::Range(0, (frame.bgra.rows + kBlock - 1) / kBlock), [&](const cv::Range& blocks) {
+        for (int b = blocks.start; b < blocks.end; ++b) {
+          const int y0 = b * kBlock, y1 = std::min(frame.bgra.rows, y0 + kBlock);
+          for (int y = y0; y < y1;) {  // runs of rows to warp or to clear
+            const auto [lo, hi] = source_rows_[static_cast<std::size_t>(y)];
+            const bool warp = anyDrawn(lo, hi);
+            int end = y + 1;
+            while (end < y1 && anyDrawn(source_rows_[static_cast<std::size_t>(end)].first,
+                                        source_rows_[static_cast<std::size_t>(end)].second) == warp)
+              ++end;
+            cv::Mat out = frame.bgra.rowRange(y, end);
+            if (warp) {
+              cv::remap(premultiplied, out, fixed_map_a_.rowRange(y, end), fixed_map_b_.rowRange(y, end),
+                        cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+              straighten(out);
+            } else {
+              out.setTo(cv::Scalar::all(0));
+            }
+            y = end;
+          }
+        }
+      });
+    } else {
+      frame.bgra = premultiplied;
+      cv::parallel_for_(cv::Range(0, frame.bgra.rows),
+                        [&](const cv::Range& rows) { straighten(frame.bgra.rowRange(rows.start, rows.end)); });
+    }
     tick("warp+unpremultiply");
     decorate(frame.bgra, volumes, frame.visibility, style);
     tick("decorate");
