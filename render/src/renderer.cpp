@@ -450,6 +450,7 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
         p.vertices[3 * j + 1] = static_cast<float>(c.y());
         p.vertices[3 * j + 2] = static_cast<float>(c.z());
       }
+      if (!p.outline_2d.empty()) continue;  // drawn from its outline: the mesh is for the labels only
       // Silhouette edges: one neighbouring triangle faces the camera (at the origin), the other not.
       front.resize(m.triangles.size());
       for (std::size_t t = 0; t < m.triangles.size(); ++t) {
