@@ -820,6 +820,64 @@ void Renderer::drawShaded(const std::vector<const Prepared*>& order, double ambi
   glDisable(GL_DEPTH_TEST);
 }
 
+namespace {
+
+// Per row of a warp's y map, the source rows its samples may read: the extremes' floors, widened
+// by a row each way for the fixed-point rounding and the bilinear neighbour (empty: first > second).
+std::vector<std::pair<int, int>> sourceRows(const cv::Mat& map_y) {
+  std::vector<std::pair<int, int>> rows(static_cast<std::size_t>(map_y.rows), {0, -1});
+  for (int y = 0; y < map_y.rows; ++y) {
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (int x = 0; x < map_y.cols; ++x) lo = std::min(lo, map_y.at<float>(y, x)), hi = std::max(hi, map_y.at<float>(y, x));
+    if (lo <= hi) rows[static_cast<std::size_t>(y)] = {static_cast<int>(std::floor(lo)) - 1, static_cast<int>(std::floor(hi)) + 2};
+  }
+  return rows;
+}
+
+// Which rows of an image hold a non-zero byte, as prefix counts (rows + 1 entries), to ask of
+// any range of rows whether something is drawn in it.
+struct DrawnRows {
+  std::vector<int> prefix;
+  explicit DrawnRows(const cv::Mat& image) : prefix(static_cast<std::size_t>(image.rows) + 1, 0) {
+    const std::size_t bytes = image.cols * image.elemSize();
+    cv::parallel_for_(cv::Range(0, image.rows), [&](const cv::Range& r) {
+      for (int y = r.start; y < r.end; ++y) {
+        const uchar* row = image.ptr<uchar>(y);
+        uchar any = 0;
+        for (std::size_t x = 0; x < bytes; ++x) any |= row[x];
+        prefix[static_cast<std::size_t>(y) + 1] = any != 0;
+      }
+    });
+    for (std::size_t y = 1; y < prefix.size(); ++y) prefix[y] += prefix[y - 1];
+  }
+  bool any(std::pair<int, int> rows) const {
+    const int n = static_cast<int>(prefix.size()) - 1;
+    const int lo = std::clamp(rows.first, 0, n), hi = std::clamp(rows.second + 1, 0, n);
+    return lo < hi && prefix[static_cast<std::size_t>(hi)] > prefix[static_cast<std::size_t>(lo)];
+  }
+};
+
+// Calls fn(first, end, drawn) in parallel for runs of output rows, in blocks of a few rows: each
+// run's rows either may read something drawn (drawn) or read only empty rows.
+template <class Fn>
+void forRowRuns(int rows, const std::vector<std::pair<int, int>>& source, const DrawnRows& drawn, Fn&& fn) {
+  constexpr int kBlock = 8;
+  cv::parallel_for_(cv::Range(0, (rows + kBlock - 1) / kBlock), [&](const cv::Range& blocks) {
+    for (int b = blocks.start; b < blocks.end; ++b) {
+      const int y1 = std::min(rows, (b + 1) * kBlock);
+      for (int y = b * kBlock; y < y1;) {
+        const bool any = drawn.any(source[static_cast<std::size_t>(y)]);
+        int end = y + 1;
+        while (end < y1 && drawn.any(source[static_cast<std::size_t>(end)]) == any) ++end;
+        fn(y, end, any);
+        y = end;
+      }
+    }
+  });
+}
+
+}  // namespace
+
 Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool want_colour, bool want_mask) {
   if (volumes.size() > 255) throw std::invalid_argument("Renderer: at most 255 volumes (8-bit mask labels)");
   context_->makeCurrent();
@@ -838,7 +896,6 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
   const bool outlines = want_colour && !style.shaded && options_.polygon_fill && options_.outline_from_core;
   prepare(volumes, bodies, frame, outlines, want_mask || !outlines);
   tick("prepare");
-  const Camera& cam = projection_.camera();
   // The mask from the colour pass when it can (the overlay look at the colour pass's scale).
   const bool same_pass = want_colour && want_mask && !style.shaded && gl_->samples <= 1 && !mask_projection_;
   cv::Mat labels;
@@ -864,57 +921,21 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     if (projection_.warps()) {
       if (fixed_map_a_.empty()) {  // fixed-point maps: remap's fast path (1/32 px steps)
         cv::convertMaps(projection_.mapX(), projection_.mapY(), fixed_map_a_, fixed_map_b_, CV_16SC2);
-        // The pinhole rows each output row's bilinear samples read (empty: none).
-        const cv::Mat& my = projection_.mapY();
-        source_rows_.assign(static_cast<std::size_t>(my.rows), {0, -1});
-        for (int y = 0; y < my.rows; ++y) {
-          float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-          for (int x = 0; x < my.cols; ++x) lo = std::min(lo, my.at<float>(y, x)), hi = std::max(hi, my.at<float>(y, x));
-          if (lo <= hi) source_rows_[static_cast<std::size_t>(y)] = {static_cast<int>(std::floor(lo)) - 1, static_cast<int>(std::floor(hi)) + 2};
-        }
+        source_rows_ = sourceRows(projection_.mapY());
       }
-      // Pinhole rows with anything drawn (prefix counts), so output rows reading only empty rows
-      // are cleared instead of warped (what the warp would give them: all zero).
-      const int ph = premultiplied.rows;
-      std::vector<int> drawn(static_cast<std::size_t>(ph) + 1, 0);
-      cv::parallel_for_(cv::Range(0, ph), [&](const cv::Range& r) {
-        for (int y = r.start; y < r.end; ++y) {
-          const auto* row = premultiplied.ptr<std::uint32_t>(y);
-          std::uint32_t any = 0;
-          for (int x = 0; x < premultiplied.cols; ++x) any |= row[x];
-          drawn[static_cast<std::size_t>(y) + 1] = any != 0;
-        }
-      });
-      for (int y = 0; y < ph; ++y) drawn[static_cast<std::size_t>(y) + 1] += drawn[static_cast<std::size_t>(y)];
-      auto anyDrawn = [&](int lo, int hi) {
-        lo = std::clamp(lo, 0, ph);
-        hi = std::clamp(hi + 1, 0, ph);
-        return lo < hi && drawn[static_cast<std::size_t>(hi)] > drawn[static_cast<std::size_t>(lo)];
-      };
+      // Warped and straightened in runs of rows, each while in cache; output rows whose warp
+      // reads only empty pinhole rows are cleared instead (what the warp would give them).
+      const DrawnRows drawn(premultiplied);
       frame.bgra.create(fixed_map_a_.rows, fixed_map_a_.cols, CV_8UC4);
-      // Warp and straighten in blocks of rows, each while it is in cache.
-      constexpr int kBlock = 8;
-      cv::parallel_for_(cv::Range(0, (frame.bgra.rows + kBlock - 1) / kBlock), [&](const cv::Range& blocks) {
-        for (int b = blocks.start; b < blocks.end; ++b) {
-          const int y0 = b * kBlock, y1 = std::min(frame.bgra.rows, y0 + kBlock);
-          for (int y = y0; y < y1;) {  // runs of rows to warp or to clear
-            const auto [lo, hi] = source_rows_[static_cast<std::size_t>(y)];
-            const bool warp = anyDrawn(lo, hi);
-            int end = y + 1;
-            while (end < y1 && anyDrawn(source_rows_[static_cast<std::size_t>(end)].first,
-                                        source_rows_[static_cast<std::size_t>(end)].second) == warp)
-              ++end;
-            cv::Mat out = frame.bgra.rowRange(y, end);
-            if (warp) {
-              cv::remap(premultiplied, out, fixed_map_a_.rowRange(y, end), fixed_map_b_.rowRange(y, end),
-                        cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
-              straighten(out);
-            } else {
-              out.setTo(cv::Scalar::all(0));
-            }
-            y = end;
-          }
+      forRowRuns(frame.bgra.rows, source_rows_, drawn, [&](int y, int end, bool any) {
+        cv::Mat out = frame.bgra.rowRange(y, end);
+        if (!any) {
+          out.setTo(cv::Scalar::all(0));
+          return;
         }
+        cv::remap(premultiplied, out, fixed_map_a_.rowRange(y, end), fixed_map_b_.rowRange(y, end), cv::INTER_LINEAR,
+                  cv::BORDER_CONSTANT, cv::Scalar::all(0));
+        straighten(out);
       });
     } else {
       frame.bgra = premultiplied;
@@ -934,28 +955,43 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     if (mp.warps() && mask_map_.empty()) {  // nearest pinhole pixel per output pixel, as integers
       cv::Mat unused;
       cv::convertMaps(mp.mapX(), mp.mapY(), mask_map_, unused, CV_16SC2, true);
+      mask_source_rows_ = sourceRows(mp.mapY());
     }
-    // The labels at the nearest pinhole pixel of each output pixel (0 outside the pinhole
-    // image), then the pixels per label.
     if (fill_label >= 0) pinhole_labels.setTo(cv::Scalar::all(fill_label));
-    if (mp.warps()) {
-      cv::remap(pinhole_labels, frame.mask, mask_map_, cv::Mat(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
-                cv::Scalar::all(0));
-    } else {
-      frame.mask = pinhole_labels;
-    }
+    // The labels at the nearest pinhole pixel of each output pixel (0 outside the pinhole image)
+    // and the pixels per label, in runs of rows (rows reading only unlabelled pinhole rows are
+    // cleared and counted as background).
     std::array<int, 256> counts{};
     std::mutex counts_mutex;
-    cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range& rows) {
+    auto count = [&](const cv::Mat& rows) {
       std::array<std::array<int, 256>, 4> local{};  // four histograms: fewer store-to-load stalls
-      for (int v = rows.start; v < rows.end; ++v) {
-        const uchar* row = frame.mask.ptr<uchar>(v);
-        for (int u = 0; u < cam.width; ++u) ++local[static_cast<std::size_t>(u & 3)][row[u]];
+      for (int v = 0; v < rows.rows; ++v) {
+        const uchar* row = rows.ptr<uchar>(v);
+        for (int u = 0; u < rows.cols; ++u) ++local[static_cast<std::size_t>(u & 3)][row[u]];
       }
       const std::lock_guard lock(counts_mutex);
       for (const auto& h : local)
         for (std::size_t k = 0; k < h.size(); ++k) counts[k] += h[k];
-    });
+    };
+    if (mp.warps()) {
+      const DrawnRows drawn(pinhole_labels);
+      frame.mask.create(mask_map_.rows, mask_map_.cols, CV_8UC1);
+      forRowRuns(frame.mask.rows, mask_source_rows_, drawn, [&](int y, int end, bool any) {
+        cv::Mat out = frame.mask.rowRange(y, end);
+        if (!any) {
+          out.setTo(cv::Scalar::all(0));
+          const std::lock_guard lock(counts_mutex);
+          counts[0] += out.rows * out.cols;
+          return;
+        }
+        cv::remap(pinhole_labels, out, mask_map_.rowRange(y, end), cv::Mat(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                  cv::Scalar::all(0));
+        count(out);
+      });
+    } else {
+      frame.mask = pinhole_labels;
+      cv::parallel_for_(cv::Range(0, frame.mask.rows), [&](const cv::Range& r) { count(frame.mask.rowRange(r.start, r.end)); });
+    }
     tick("mask");
     frame.pixels.assign(volumes.size(), 0);
     for (std::size_t i = 0; i < volumes.size(); ++i) frame.pixels[i] = counts[static_cast<std::size_t>(bodies[i].label)];

@@ -171,7 +171,7 @@ class Renderer {
   MeshCache cache_;
   Pose world_to_camera_;
   cv::Mat fixed_map_a_, fixed_map_b_, mask_map_;  // remap tables in fixed point
-  std::vector<std::pair<int, int>> source_rows_;   // per output row, the pinhole rows its warp reads
+  std::vector<std::pair<int, int>> source_rows_, mask_source_rows_;  // per output row, the pinhole rows its warp reads
   cv::Mat legend_;
   cv::Rect legend_box_;
   int legend_rows_ = 0;
