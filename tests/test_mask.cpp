@@ -134,6 +134,27 @@ TEST(RenderMask, SameLabelsFromTheColourPassAndAlone) {
   EXPECT_GT(cv::countNonZero(multisampled.bgra.reshape(1) > 0), 1000);
 }
 
+// A volume right next to the camera (outside the view) pulls the near plane in to a fraction of
+// a millimetre; the labels of two nearly coincident capsules 3 m away must not change (the label
+// pass's reversed float depth resolves ~1e-7 of the distance whatever the near plane; a
+// conventional depth buffer would resolve only ~1 mm there and mix the two labels up).
+TEST(RenderMask, LabelsDoNotDependOnTheNearPlane) {
+  const Camera c = lookAt(Vec3(3, 0, 0), Vec3(0, 0, 0), 320, 240, 300, {0, 0, 0, 0, 0});
+  const std::vector<Vec3> a = {Vec3(0, -0.5, 0), Vec3(0, 0.5, 0)};
+  const std::vector<Vec3> b = {Vec3(0.0002, -0.5, 0.002), Vec3(0.0002, 0.5, -0.002)};  // crossing a at 0.2 mm
+  const std::vector<Vec3> close = {Vec3(3 - 0.0005, 0.0025, 0)};  // 0.5 mm in front, 2.5 mm aside
+  const Volume pair[] = {{a, 0.1, VolumeStatus::Clear, "a"}, {b, 0.1, VolumeStatus::Colliding, "b"}};
+  const Volume with_close[] = {pair[0], pair[1], {close, 0.001, VolumeStatus::Clear, "close"}};
+  Renderer r(c);
+  const Frame plain = r.render(pair, Style{}, false, true);
+  const Frame near = r.render(with_close, Style{}, false, true);
+  EXPECT_LT(near.near, 1e-3);  // the close volume did pull the near plane in
+  EXPECT_EQ(near.pixels[2], 0);
+  EXPECT_GT(plain.pixels[0], 500);
+  EXPECT_GT(plain.pixels[1], 500);
+  EXPECT_EQ(cv::countNonZero(plain.mask != near.mask), 0);
+}
+
 // The mask's distortion warp (done on the GPU) is the nearest-pixel remap of the pinhole labels:
 // the same labels drawn through the undistorted pinhole camera and remapped on the CPU with
 // OpenCV's nearest-pixel map give the same mask, pixel for pixel, at both mask scales.

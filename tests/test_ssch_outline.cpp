@@ -7,6 +7,7 @@
 #include <cmath>
 #include <iostream>
 #include <random>
+#include <tuple>
 
 #include <opencv2/imgproc.hpp>
 
@@ -102,7 +103,9 @@ std::vector<Case> cases(std::mt19937_64& rng) {
   s.push_back({{Vec3(0.01, 0.02, 0.3), Vec3(-0.05, 0.0, 0.4)}, 0.2, "near the camera"});
   s.push_back({{Vec3(100, -50, 1e5), Vec3(130, -40, 1.0001e5)}, 10.0, "far away"});
   s.push_back({{Vec3(0, 0, 1e4), Vec3(1e3, 0, 1e4)}, 3e3, "huge"});
-  s.push_back({{Vec3(0.2, 0.1, 1.0)}, 0.99, "radius nearly its depth"});
+  s.push_back({{Vec3(0.2, 0.1, 1.0)}, 0.949, "radius nearly its depth"});
+  s.push_back({{Vec3(0.2, 0.1, 1.0)}, 0.99, "reaching nearer than min_depth"});
+  s.push_back({{Vec3(0.2, 0.1, 1.0), Vec3(3, 2, 40)}, 0.9, "near and far"});
   for (int i = 0; i < 40; ++i) {
     const Vec3 centre(3.0 * u(rng), 2.0 * u(rng), 1.5 + 4.0 * std::abs(u(rng)));
     Case k;
@@ -164,7 +167,7 @@ TEST(RenderOutline, ContainsTheImageAndIsWithinTolerance) {
           const Vec2& b = poly[(i + 1) % poly.size()];
           inside = std::min(inside, cross(a, b, x) / (b - a).norm());
         }
-        ASSERT_GE(inside * focal, -1e-6 * (1.0 + scale * focal)) << "rim point outside the outline";
+        ASSERT_GE(inside * focal, -1e-9 * (1.0 + scale * focal)) << "rim point outside the outline";
       }
       // Tightness: every corner within the tolerance of the hull of the rim points (which lies
       // inside the true image by less than a thousandth of a pixel here).
@@ -196,6 +199,33 @@ TEST(RenderOutline, RefusesWhatItCannotDraw) {
   EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(0, 0, 1)}, 0.5,
                            OutlineOptions{.focal_px = 1e9, .tolerance_px = 0.5, .max_vertices = 64}, poly));
   EXPECT_TRUE(sschOutline(std::vector<Vec3>{Vec3(0, 0, 1)}, 0.5, o, poly));
+  // Angles that stop splitting before a corner comes within tolerance (a sphere 1e-9 in front
+  // of the camera's plane): refused, not an endless refinement.
+  EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(1, 0, 0.5)}, 0.5 - 1e-9,
+                           OutlineOptions{.focal_px = 1000, .tolerance_px = 0.5, .min_depth = 0.0}, poly));
+}
+
+// Huge and tiny magnitudes in one core: every sphere counts (nothing lost to overflow or
+// underflow), the outline holds each centre's image and stays near it.
+TEST(RenderOutline, MixedMagnitudesKeepEverySphere) {
+  const OutlineOptions o{.focal_px = 1000, .tolerance_px = 0.5, .min_depth = 0.0};
+  std::vector<Vec2> poly;
+  for (const auto& [points, radius, far_image] :
+       {std::tuple{std::vector<Vec3>{Vec3(0, 0, 2), Vec3(1e200, 0, 1e200)}, 1.0, Vec2(1, 0)},
+        std::tuple{std::vector<Vec3>{Vec3(0, 0, 1), Vec3(1e-170, 0, 1e-170)}, 0.0, Vec2(1, 0)},
+        std::tuple{std::vector<Vec3>{Vec3(0, 0, 1e-160), Vec3(0, 5e-161, 1e-160)}, 0.0, Vec2(0, 0.5)},
+        std::tuple{std::vector<Vec3>{Vec3(0, 0, 3e150), Vec3(-3e150, 3e150, 3e150)}, 1e149, Vec2(-1, 1)}}) {
+    ASSERT_TRUE(sschOutline(points, radius, o, poly));
+    for (const Vec2& image : {Vec2(points[0].x() / points[0].z(), points[0].y() / points[0].z()), far_image}) {
+      bool inside = true;
+      for (std::size_t i = 0; i < poly.size() && poly.size() >= 3; ++i)
+        inside = inside && cross(poly[i], poly[(i + 1) % poly.size()], image) >= -1e-12;
+      EXPECT_TRUE(inside || polygonDistance(image, poly) < 1e-12) << image.transpose();
+    }
+    double reach = 0.0;
+    for (const Vec2& v : poly) reach = std::max(reach, v.norm());
+    EXPECT_LT(reach, 1.5 * std::max(1.0, far_image.norm()) + 0.5);
+  }
 }
 
 // The colour layer drawn from outlines covers the independent CPU silhouette (to one pixel of

@@ -54,21 +54,29 @@ cv::Scalar statusColour(VolumeStatus status) {
 }
 
 // Labels are drawn by a shader into a one-channel 8-bit target (label / 255, exact in unorm8),
-// depth-tested against a depth buffer of their own pass, so each pixel keeps the label of the
-// nearest surface whatever the drawing order. The colour output is unused (that draw buffer is
-// off), so the colour layer is drawn afterwards exactly as without labels.
+// depth-tested so each pixel keeps the label of the nearest surface whatever the drawing order.
+// The depth written is reversed, near / (camera z) in (0, 1] (GL_GREATER, cleared to 0): in the
+// float depth buffer it tells surfaces apart to ~1e-7 of their distance whatever the near plane
+// (which a volume next to the camera, even outside the view, pulls in close; a conventional
+// depth buffer would resolve ~6e-8 z^2 / near). The colour output is unused (that draw buffer
+// is off), so the colour layer is drawn afterwards exactly as without labels.
 constexpr const char* kLabelVertexShader = R"(#version 330 compatibility
+out float camera_z;
 void main() {
   gl_Position = ftransform();
+  camera_z = gl_Vertex.z;
 }
 )";
 constexpr const char* kLabelFragmentShader = R"(#version 330 compatibility
+in float camera_z;
 uniform uint label;
+uniform float near;
 layout(location = 0) out vec4 colour;
 layout(location = 1) out vec4 nearest;
 void main() {
   colour = vec4(0.0);
   nearest = vec4(float(label) / 255.0, 0.0, 0.0, 0.0);
+  gl_FragDepth = near / max(camera_z, near);
 }
 )";
 
@@ -81,7 +89,7 @@ struct Renderer::Gl {
   GLuint ms_depth = 0, resolve_depth = 0;  // depth for the shaded (opaque) look
   GLuint mask_fbo = 0, mask_labels = 0, mask_depth = 0;  // only with a separate mask scale
   GLuint program = 0;
-  GLint label_location = -1;
+  GLint label_location = -1, near_location = -1;
   int samples = 0;
   int width = 0, height = 0;
 
@@ -175,6 +183,7 @@ struct Renderer::Gl {
       throw GlContextError(std::string("GL: label shader: ") + log);
     }
     label_location = glGetUniformLocation(program, "label");
+    near_location = glGetUniformLocation(program, "near");
   }
   ~Gl() {
     const GLuint fbos[] = {ms_fbo, resolve_fbo, mask_fbo};
@@ -427,7 +436,7 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
   for (std::size_t k = 0; k < requested.size(); ++k) {
     Prepared& p = out[requested[k]];
     if (!meshes[k].mesh) {  // qhull on extreme coordinates
-      if (p.outline_2d.empty()) frame.visibility[requested[k]] = Visibility::NoMesh;
+      if (p.outline_2d.empty() || need_meshes) frame.visibility[requested[k]] = Visibility::NoMesh;  // (not in the mask)
       continue;
     }
     p.mesh = meshes[k].mesh;
@@ -620,9 +629,9 @@ void drawBuffers(bool colour, bool labels) {
   glDrawBuffers(labels ? 2 : 1, buffers);
 }
 
-// Clears the label attachment (draw buffer 1) to 0 and the depth buffer to the far plane.
+// Clears the label attachment (draw buffer 1) to 0 and the depth buffer to "infinitely far".
 void clearLabels() {
-  const float zero[4] = {0, 0, 0, 0}, far = 1.0f;
+  const float zero[4] = {0, 0, 0, 0}, far = 0.0f;  // reversed depth: 0 is infinitely far
   glClearBufferfv(GL_COLOR, 1, zero);
   glClearBufferfv(GL_DEPTH, 0, &far);
 }
@@ -677,7 +686,7 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   auto outlined = [](const Prepared& p) { return !p.outline_2d.empty(); };
   if (with_labels) {  // the labels of the nearest surfaces first (see kLabelFragmentShader), then the colour
     drawBuffers(false, true);
-    drawLabelTriangles(bodies);
+    drawLabelTriangles(bodies, near);
     drawBuffers(true, false);
     glEnable(GL_BLEND);
   }
@@ -743,15 +752,16 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
 }
 
 // The labels of the meshes into the label attachment of the bound framebuffer, depth-tested so
-// the nearest surface's label stays whatever the order (surfaces from both sides); leaves the
-// depth test and blending off.
-void Renderer::drawLabelTriangles(const std::vector<Prepared>& bodies) {
+// the nearest surface's label stays whatever the order (surfaces from both sides; reversed depth,
+// see kLabelFragmentShader); leaves the depth test and blending off.
+void Renderer::drawLabelTriangles(const std::vector<Prepared>& bodies, double near) {
   glDisable(GL_BLEND);
   glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
+  glDepthFunc(GL_GREATER);
   glDepthMask(GL_TRUE);
   glUseProgram(gl_->program);
-  // Front to back: farther fragments then fail the depth test before they are shaded or written.
+  glUniform1f(gl_->near_location, static_cast<float>(near));
+  // Front to back: farther fragments then fail the depth test and write nothing.
   std::vector<const Prepared*> order;
   for (const Prepared& p : bodies)
     if (p.mesh) order.push_back(&p);
@@ -763,6 +773,7 @@ void Renderer::drawLabelTriangles(const std::vector<Prepared>& bodies) {
     glEnable(GL_CULL_FACE);
   }
   glUseProgram(0);
+  glDepthFunc(GL_LESS);
   glDisable(GL_DEPTH_TEST);
 }
 
@@ -774,7 +785,7 @@ cv::Mat Renderer::drawMask(const std::vector<Prepared>& bodies, double near, dou
   drawBuffers(false, true);
   setCamera(maskProjection(), near, far);
   clearLabels();
-  drawLabelTriangles(bodies);
+  drawLabelTriangles(bodies, near);
   glFinish();
   cv::Mat mask = readLabels(w, h);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -824,11 +835,16 @@ namespace {
 
 // Per row of a warp's y map, the source rows its samples may read: the extremes' floors, widened
 // by a row each way for the fixed-point rounding and the bilinear neighbour (empty: first > second).
-std::vector<std::pair<int, int>> sourceRows(const cv::Mat& map_y) {
+// Samples above row -1 or below row `source_rows` (e.g. the far-off marks of pixels the lens
+// model cannot invert) read nothing (the constant border) and are left out.
+std::vector<std::pair<int, int>> sourceRows(const cv::Mat& map_y, int source_rows) {
   std::vector<std::pair<int, int>> rows(static_cast<std::size_t>(map_y.rows), {0, -1});
   for (int y = 0; y < map_y.rows; ++y) {
     float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-    for (int x = 0; x < map_y.cols; ++x) lo = std::min(lo, map_y.at<float>(y, x)), hi = std::max(hi, map_y.at<float>(y, x));
+    for (int x = 0; x < map_y.cols; ++x) {
+      const float v = map_y.at<float>(y, x);
+      if (v > -2.0f && v < static_cast<float>(source_rows) + 1.0f) lo = std::min(lo, v), hi = std::max(hi, v);
+    }
     if (lo <= hi) rows[static_cast<std::size_t>(y)] = {static_cast<int>(std::floor(lo)) - 1, static_cast<int>(std::floor(hi)) + 2};
   }
   return rows;
@@ -921,7 +937,7 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     if (projection_.warps()) {
       if (fixed_map_a_.empty()) {  // fixed-point maps: remap's fast path (1/32 px steps)
         cv::convertMaps(projection_.mapX(), projection_.mapY(), fixed_map_a_, fixed_map_b_, CV_16SC2);
-        source_rows_ = sourceRows(projection_.mapY());
+        source_rows_ = sourceRows(projection_.mapY(), projection_.pinhole().height);
       }
       // Warped and straightened in runs of rows, each while in cache; output rows whose warp
       // reads only empty pinhole rows are cleared instead (what the warp would give them).
@@ -955,7 +971,7 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     if (mp.warps() && mask_map_.empty()) {  // nearest pinhole pixel per output pixel, as integers
       cv::Mat unused;
       cv::convertMaps(mp.mapX(), mp.mapY(), mask_map_, unused, CV_16SC2, true);
-      mask_source_rows_ = sourceRows(mp.mapY());
+      mask_source_rows_ = sourceRows(mp.mapY(), mp.pinhole().height);
     }
     if (fill_label >= 0) pinhole_labels.setTo(cv::Scalar::all(fill_label));
     // The labels at the nearest pinhole pixel of each output pixel (0 outside the pinhole image)

@@ -89,9 +89,8 @@ struct RenderOptions {
   /// Fill each volume's tint as the polygon its silhouette edges bound (a few tens of triangles)
   /// instead of its front triangles (hundreds to thousands): the same pixels, since the
   /// silhouette of a convex mesh seen from a camera in front of it bounds exactly the projection
-  /// of its front faces. Volumes whose silhouette is not one simple loop, that reach behind the
-  /// near plane, or whose labels are drawn in the same pass keep the triangles. Off: always the
-  /// triangles (for comparison).
+  /// of its front faces. Volumes whose silhouette is not one simple loop or that reach behind the
+  /// near plane keep the triangles. Off: always the triangles (for comparison).
   bool polygon_fill = true;
   /// In the tinted look, draw each volume's tint and outline from its outline computed straight
   /// from the core points (see sschOutline: it contains the image and lies at most tolerance_px
@@ -118,7 +117,7 @@ struct Frame {
   std::vector<Visibility> visibility;  ///< per volume
   double near = 0.0, far = 0.0;       ///< the clipping planes used
   int meshes_built = 0;   ///< meshes built in this frame (the others came from the cache)
-  int triangles = 0;      ///< triangles of the drawn meshes
+  int triangles = 0;      ///< triangles drawn: meshes (colour or labels) and outline polygons
   int polygon_fills = 0;  ///< volumes whose tint was drawn as their silhouette polygon (RenderOptions::polygon_fill)
   int outlines = 0;       ///< of those, volumes drawn from their outline computed from the core (RenderOptions::outline_from_core)
   int hull_input = 0;     ///< points passed to qhull for the meshes built in this frame
@@ -157,7 +156,7 @@ class Renderer {
   void prepareSurface(const Volume& v, Prepared& p, Visibility& visibility);
   cv::Mat drawColour(const std::vector<Prepared>& bodies, const Style& style, Frame& frame, cv::Mat* labels = nullptr);
   cv::Mat drawMask(const std::vector<Prepared>& bodies, double near, double far);
-  void drawLabelTriangles(const std::vector<Prepared>& bodies);
+  void drawLabelTriangles(const std::vector<Prepared>& bodies, double near);
   static void drawShaded(const std::vector<const Prepared*>& order, double ambient);
   void decorate(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility,
                 const Style& style);
