@@ -213,6 +213,8 @@ struct Renderer::Prepared {
   std::vector<Eigen::Vector2d> outline_2d;  // normalised image coordinates
   std::vector<float> outline_vertices;
   std::vector<std::uint32_t> outline_lines, outline_fill;
+  bool outlined() const { return !outline_2d.empty(); }  // tint and outline from the core's outline
+  bool drawn() const { return mesh || outlined(); }      // in the images (else not drawn, or filling the view)
   double depth = 0.0;
   bool fills = false;     // contains the camera: drawn as a full-view fill, no mesh
   int level = 0;           // sphere tessellation level
@@ -436,7 +438,7 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
   for (std::size_t k = 0; k < requested.size(); ++k) {
     Prepared& p = out[requested[k]];
     if (!meshes[k].mesh) {  // qhull on extreme coordinates
-      if (p.outline_2d.empty() || need_meshes) frame.visibility[requested[k]] = Visibility::NoMesh;  // (not in the mask)
+      if (!p.outlined() || need_meshes) frame.visibility[requested[k]] = Visibility::NoMesh;  // (not in the mask)
       continue;
     }
     p.mesh = meshes[k].mesh;
@@ -459,7 +461,7 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
         p.vertices[3 * j + 1] = static_cast<float>(c.y());
         p.vertices[3 * j + 2] = static_cast<float>(c.z());
       }
-      if (!p.outline_2d.empty()) continue;  // drawn from its outline: the mesh is for the labels only
+      if (p.outlined()) continue;  // drawn from its outline: the mesh is for the labels only
       // Silhouette edges: one neighbouring triangle faces the camera (at the origin), the other not.
       front.resize(m.triangles.size());
       for (std::size_t t = 0; t < m.triangles.size(); ++t) {
@@ -484,15 +486,15 @@ void Renderer::prepare(std::span<const Volume> volumes, std::vector<Prepared>& o
     const double ty = std::max(ph.cy + 0.5, ph.height - ph.cy - 0.5) / ph.fy;
     const double corner = std::sqrt(1.0 + tx * tx + ty * ty);  // frustum corner at unit depth
     for (const Prepared& p : out)
-      if (p.mesh || !p.outline_2d.empty()) frame.near = std::min(frame.near, 0.5 * p.clearance / corner);
+      if (p.drawn()) frame.near = std::min(frame.near, 0.5 * p.clearance / corner);
   }
   for (const Prepared& p : out)
-    if (p.mesh || !p.outline_2d.empty()) frame.far = std::max(frame.far, 1.01 * p.reach);
+    if (p.drawn()) frame.far = std::max(frame.far, 1.01 * p.reach);
   // Outlines on a plane between the clipping planes (drawn without depth test, so only their
   // rays matter).
   const double z = std::sqrt(frame.near * frame.far);
   for (Prepared& p : out) {
-    if (p.outline_2d.empty()) continue;
+    if (!p.outlined()) continue;
     const std::size_t n = p.outline_2d.size();
     p.outline_vertices.resize(3 * n);
     for (std::size_t k = 0; k < n; ++k) {
@@ -672,7 +674,7 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   // Back to front; back faces culled, so each convex volume tints a pixel once.
   std::vector<const Prepared*> order;
   for (const Prepared& p : bodies)
-    if (p.mesh || !p.outline_2d.empty()) order.push_back(&p);
+    if (p.drawn()) order.push_back(&p);
   std::sort(order.begin(), order.end(), [](const Prepared* a, const Prepared* b) { return a->depth > b->depth; });
   // Whether the fill may be the silhouette polygon: a single loop whose vertices all lie beyond
   // the near plane (then its projection is the convex outline of the front faces, unclipped).
@@ -682,8 +684,6 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
       if (!(p.vertices[3 * k + 2] > near)) return false;
     return true;
   };
-  // Volumes drawn from the outline computed from their core; the others from their mesh.
-  auto outlined = [](const Prepared& p) { return !p.outline_2d.empty(); };
   if (with_labels) {  // the labels of the nearest surfaces first (see kLabelFragmentShader), then the colour
     drawBuffers(false, true);
     drawLabelTriangles(bodies, near);
@@ -697,7 +697,7 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
     const cv::Scalar c = p->colour;  // BGR, drawn as GL's RGB (see the read-back)
     const double fa = style.fill_alpha;
     glColor4d(fa * c[0] / 255.0, fa * c[1] / 255.0, fa * c[2] / 255.0, fa);
-    if (outlined(*p)) {
+    if (p->outlined()) {
       ++frame.polygon_fills;
       glDisable(GL_CULL_FACE);  // the outline's winding is the image's, not the mesh's
       glVertexPointer(3, GL_FLOAT, 0, p->outline_vertices.data());
@@ -718,7 +718,7 @@ cv::Mat Renderer::drawColour(const std::vector<Prepared>& bodies, const Style& s
   for (const Prepared* p : order) {
     const cv::Scalar c = p->colour * 0.7;
     glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
-    const bool own = outlined(*p);
+    const bool own = p->outlined();
     glVertexPointer(3, GL_FLOAT, 0, own ? p->outline_vertices.data() : p->vertices.data());
     const std::vector<std::uint32_t>& lines = own ? p->outline_lines : p->outline;
     glDrawElements(GL_LINES, static_cast<GLsizei>(lines.size()), GL_UNSIGNED_INT, lines.data());
@@ -873,19 +873,30 @@ struct DrawnRows {
   }
 };
 
-// Calls fn(first, end, drawn) in parallel for runs of output rows, in blocks of a few rows: each
-// run's rows either may read something drawn (drawn) or read only empty rows.
+// Warps `src` into `dst` (the maps' size, src's type; fixed-point maps, map_b may be empty) in
+// parallel runs of a few rows and calls after(rows, warped) on each run while it is in cache.
+// Output rows whose samples (`source`, from sourceRows) read only empty rows of `src` are cleared
+// instead of warped: what the warp would give them (zeros, the constant border).
 template <class Fn>
-void forRowRuns(int rows, const std::vector<std::pair<int, int>>& source, const DrawnRows& drawn, Fn&& fn) {
+void warpByRows(const cv::Mat& src, cv::Mat& dst, const cv::Mat& map_a, const cv::Mat& map_b, int interpolation,
+                const std::vector<std::pair<int, int>>& source, Fn&& after) {
+  const DrawnRows drawn(src);
+  dst.create(map_a.rows, map_a.cols, src.type());
   constexpr int kBlock = 8;
-  cv::parallel_for_(cv::Range(0, (rows + kBlock - 1) / kBlock), [&](const cv::Range& blocks) {
+  cv::parallel_for_(cv::Range(0, (dst.rows + kBlock - 1) / kBlock), [&](const cv::Range& blocks) {
     for (int b = blocks.start; b < blocks.end; ++b) {
-      const int y1 = std::min(rows, (b + 1) * kBlock);
+      const int y1 = std::min(dst.rows, (b + 1) * kBlock);
       for (int y = b * kBlock; y < y1;) {
         const bool any = drawn.any(source[static_cast<std::size_t>(y)]);
         int end = y + 1;
         while (end < y1 && drawn.any(source[static_cast<std::size_t>(end)]) == any) ++end;
-        fn(y, end, any);
+        cv::Mat out = dst.rowRange(y, end);
+        if (any)
+          cv::remap(src, out, map_a.rowRange(y, end), map_b.empty() ? cv::Mat() : map_b.rowRange(y, end), interpolation,
+                    cv::BORDER_CONSTANT, cv::Scalar::all(0));
+        else
+          out.setTo(cv::Scalar::all(0));
+        after(out, any);
         y = end;
       }
     }
@@ -939,20 +950,11 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
         cv::convertMaps(projection_.mapX(), projection_.mapY(), fixed_map_a_, fixed_map_b_, CV_16SC2);
         source_rows_ = sourceRows(projection_.mapY(), projection_.pinhole().height);
       }
-      // Warped and straightened in runs of rows, each while in cache; output rows whose warp
-      // reads only empty pinhole rows are cleared instead (what the warp would give them).
-      const DrawnRows drawn(premultiplied);
-      frame.bgra.create(fixed_map_a_.rows, fixed_map_a_.cols, CV_8UC4);
-      forRowRuns(frame.bgra.rows, source_rows_, drawn, [&](int y, int end, bool any) {
-        cv::Mat out = frame.bgra.rowRange(y, end);
-        if (!any) {
-          out.setTo(cv::Scalar::all(0));
-          return;
-        }
-        cv::remap(premultiplied, out, fixed_map_a_.rowRange(y, end), fixed_map_b_.rowRange(y, end), cv::INTER_LINEAR,
-                  cv::BORDER_CONSTANT, cv::Scalar::all(0));
-        straighten(out);
-      });
+      // Straightened run by run while in cache; rows the warp clears need nothing.
+      warpByRows(premultiplied, frame.bgra, fixed_map_a_, fixed_map_b_, cv::INTER_LINEAR, source_rows_,
+                 [&](const cv::Mat& rows, bool warped) {
+                   if (warped) straighten(rows);
+                 });
     } else {
       frame.bgra = premultiplied;
       cv::parallel_for_(cv::Range(0, frame.bgra.rows),
@@ -990,20 +992,15 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
         for (std::size_t k = 0; k < h.size(); ++k) counts[k] += h[k];
     };
     if (mp.warps()) {
-      const DrawnRows drawn(pinhole_labels);
-      frame.mask.create(mask_map_.rows, mask_map_.cols, CV_8UC1);
-      forRowRuns(frame.mask.rows, mask_source_rows_, drawn, [&](int y, int end, bool any) {
-        cv::Mat out = frame.mask.rowRange(y, end);
-        if (!any) {
-          out.setTo(cv::Scalar::all(0));
-          const std::lock_guard lock(counts_mutex);
-          counts[0] += out.rows * out.cols;
-          return;
-        }
-        cv::remap(pinhole_labels, out, mask_map_.rowRange(y, end), cv::Mat(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
-                  cv::Scalar::all(0));
-        count(out);
-      });
+      warpByRows(pinhole_labels, frame.mask, mask_map_, cv::Mat(), cv::INTER_NEAREST, mask_source_rows_,
+                 [&](const cv::Mat& rows, bool warped) {
+                   if (warped) {
+                     count(rows);
+                   } else {  // cleared: background
+                     const std::lock_guard lock(counts_mutex);
+                     counts[0] += rows.rows * rows.cols;
+                   }
+                 });
     } else {
       frame.mask = pinhole_labels;
       cv::parallel_for_(cv::Range(0, frame.mask.rows), [&](const cv::Range& r) { count(frame.mask.rowRange(r.start, r.end)); });
