@@ -58,16 +58,16 @@ TEST(YamlEdit, BlockAndFlowStyles) {
   EXPECT_EQ(m.bodies[1].radius, 0.25);
 
   // ignore lists: added to a file without a pairs section, replaced in one with it.
-  edited = km::withIgnoreList(edited, "block", {{{"a", "b"}}});
+  edited = km::withIgnoreList(edited, "block", {{"a", "b"}});
   m = kccd::parseModel(edited, "edited");
   EXPECT_TRUE(m.pairs.empty());
   edited = km::withIgnoreList(edited, "block", {});
   EXPECT_EQ(kccd::parseModel(edited, "edited").pairs.size(), 1u);
   const std::string flow = block + "pairs: {check: all}\n";
-  EXPECT_TRUE(kccd::parseModel(km::withIgnoreList(flow, "flow", {{{"b", "a"}}}), "f").pairs.empty());
+  EXPECT_TRUE(kccd::parseModel(km::withIgnoreList(flow, "flow", {{"b", "a"}}), "f").pairs.empty());
   const std::string nested = block + "pairs:\n  check: all   # every pair\n";
-  const std::string with = km::withIgnoreList(nested, "nested", {{{"a", "b"}}});
+  const std::string with = km::withIgnoreList(nested, "nested", {{"a", "b"}});
   EXPECT_TRUE(kccd::parseModel(with, "n").pairs.empty());
   EXPECT_NE(with.find("# every pair"), std::string::npos);
-  EXPECT_THROW(km::withIgnoreList(block, "block", {{{"a", "nobody"}}}), km::EditError);
+  EXPECT_THROW(km::withIgnoreList(block, "block", {{"a", "nobody"}}), km::EditError);
 }

@@ -8,7 +8,11 @@
 #include <gtest/gtest.h>
 
 #include "kccd/model.hpp"
+#include "kccd/checker.hpp"
 #include "kccd/modelling/pair_proof.hpp"
+#include "kccd/modelling/pair_survey.hpp"
+#include "kccd/modelling/urdf_import.hpp"
+#include "kccd/modelling/yaml_edit.hpp"
 #include "support/random_model.hpp"
 #include "support/reference_distance.hpp"
 
@@ -110,4 +114,227 @@ TEST(Pairs, DemoArm) {
   // The base column is far from the table whatever the joints do.
   EXPECT_EQ(find("table", "shoulder").verdict, km::Verdict::Never);
   EXPECT_EQ(find("post", "forearm").verdict, km::Verdict::Meets);
+}
+
+namespace {
+
+const km::PairReport& reportOf(const Model& m, const std::vector<km::PairReport>& reports, const std::string& a,
+                               const std::string& b) {
+  for (const auto& r : reports)
+    if ((m.bodies[r.a].name == a && m.bodies[r.b].name == b) || (m.bodies[r.a].name == b && m.bodies[r.b].name == a))
+      return r;
+  throw std::runtime_error(a + "-" + b + " not reported");
+}
+
+std::string reasonOf(const Model& m, const std::string& a, const std::string& b) {
+  for (const kccd::IgnoredPair& p : m.ignored)
+    if ((m.bodies[p.a].name == a && m.bodies[p.b].name == b) || (m.bodies[p.a].name == b && m.bodies[p.b].name == a))
+      return kccd::toString(p.reason);
+  return "checked";
+}
+
+Model gripperArm(bool keep_adjacent) {
+  km::ImportOptions opt;
+  opt.points = 4;
+  opt.keep_adjacent = keep_adjacent;
+  return kccd::parseModel(km::importUrdf(std::string(KCCD_TEST_DATA_DIR) + "/urdf/gripper_arm.urdf", opt), "gripper");
+}
+
+}  // namespace
+
+// A Panda-like arm: the hand on fixed joints under a link without geometry (rigid with the last
+// link), a camera bracket on a fixed joint, prismatic fingers. Import ignores rigid and adjacent
+// pairs with their reasons, and keeps every pair with a body on a link between the two.
+TEST(Pairs, RigidAndAdjacentPairsOfAGripperArm) {
+  const Model m = gripperArm(false);
+  EXPECT_EQ(reasonOf(m, "link3", "hand"), "rigid");      // fixed, fixed (flange has no geometry)
+  EXPECT_EQ(reasonOf(m, "link3", "camera"), "rigid");
+  EXPECT_EQ(reasonOf(m, "camera", "hand"), "rigid");     // siblings on fixed joints
+  EXPECT_EQ(reasonOf(m, "base", "link1"), "adjacent");
+  EXPECT_EQ(reasonOf(m, "link2", "link3"), "adjacent");
+  EXPECT_EQ(reasonOf(m, "hand", "left_finger"), "adjacent");   // one prismatic joint
+  EXPECT_EQ(reasonOf(m, "hand", "right_finger"), "adjacent");
+  EXPECT_EQ(reasonOf(m, "link2", "hand"), "checked");          // link3 lies between
+  EXPECT_EQ(reasonOf(m, "link3", "left_finger"), "checked");   // the hand lies between
+  EXPECT_EQ(reasonOf(m, "left_finger", "right_finger"), "checked");  // two moving joints
+  EXPECT_EQ(reasonOf(m, "base", "link2"), "checked");
+  EXPECT_EQ(m.ignored.size(), 8u);
+  EXPECT_EQ(m.pairs.size(), 28u - 8u);
+
+  const Model kept = gripperArm(true);
+  EXPECT_EQ(kept.ignored.size(), 3u);  // the rigid ones only
+  for (const kccd::IgnoredPair& p : kept.ignored) EXPECT_EQ(p.reason, kccd::IgnoreReason::Rigid);
+
+  // kccd pairs decides rigid pairs exactly: their one distance, never "meets".
+  const auto reports = km::provePairs(m);
+  std::vector<kccd::Pose> zero(m.joints.size());
+  kccd::testing::Sample s;
+  s.q.assign(m.stateSize(), 0.0);
+  s.translation_error.assign(m.joints.size(), Vec3::Zero());
+  s.rotation_error.assign(m.joints.size(), Eigen::Matrix3d::Identity());
+  s.error_first.assign(m.joints.size(), false);
+  const std::vector<kccd::Pose> poses = kccd::testing::jointPoses(m, s);
+  int rigid = 0;
+  for (const auto& r : reports) {
+    EXPECT_EQ(r.rigid, km::connection(m, r.a, r.b) == km::Connection::Rigid);
+    if (!r.rigid) continue;
+    ++rigid;
+    const double d = trueDistance(m, poses, r.a, r.b);
+    EXPECT_NE(r.verdict, km::Verdict::Meets);
+    EXPECT_EQ(r.verdict, d > m.safety_margin ? km::Verdict::Never : km::Verdict::AlwaysTouching);
+    EXPECT_NEAR(r.bound, d, 1e-9) << m.bodies[r.a].name << "-" << m.bodies[r.b].name;
+  }
+  EXPECT_EQ(rigid, 3);
+  EXPECT_EQ(reportOf(m, reports, "link3", "hand").verdict, km::Verdict::AlwaysTouching);
+  EXPECT_EQ(reportOf(m, reports, "link3", "camera").verdict, km::Verdict::Never);
+  EXPECT_EQ(reportOf(m, reports, "link1", "link2").verdict, km::Verdict::AlwaysTouching);  // shared axis point
+
+  // The ignore list: reasons from the proofs, adjacent pairs that meet ignored as adjacent.
+  const km::IgnorePlan plan = km::ignoreList(m, reports);
+  EXPECT_TRUE(plan.dropped.empty());
+  auto planned = [&](const std::string& a, const std::string& b) {
+    for (const auto& e : plan.ignore)
+      if ((e.a == a && e.b == b) || (e.a == b && e.b == a)) return std::string(kccd::toString(e.reason));
+    return std::string("checked");
+  };
+  EXPECT_EQ(planned("link3", "hand"), "rigid");
+  EXPECT_EQ(planned("hand", "left_finger"), "adjacent");
+  EXPECT_EQ(planned("link1", "link2"), "always_touching");
+  EXPECT_EQ(planned("left_finger", "right_finger"), reportOf(m, reports, "left_finger", "right_finger").verdict ==
+                                                            km::Verdict::Never
+                                                        ? "never"
+                                                        : "checked");
+  const km::IgnorePlan keep = km::ignoreList(m, reports, {.keep_adjacent = true});
+  for (const auto& e : keep.ignore) EXPECT_NE(e.reason, kccd::IgnoreReason::Adjacent);
+  EXPECT_EQ(keep.dropped.size(), 2u);  // the fingers' adjacent entries of the file: checked again
+}
+
+// Reasons are read, kept and written back; an entry whose proof no longer holds is dropped;
+// a reason that is not one of the words is one line naming the place.
+TEST(Pairs, IgnoreReasonsRoundTripAndStaleProofsAreDropped) {
+  const std::string text =
+      "kccd: 1\nsafety_margin: 0.01\njoints:\n"
+      "  - {name: j, parent: world, type: revolute, axis: [0, 0, 1], limits: [-1, 1]}\n"
+      "bodies:\n"
+      "  - {name: a, frame: world, points: [[0, 0, 0]], radius: 0.1}\n"
+      "  - {name: b, frame: j, points: [[0.5, 0, 0]], radius: 0.1}\n"
+      "  - {name: c, frame: j, points: [[-0.5, 0, 0]], radius: 0.1}\n"
+      "pairs:\n  ignore: [[a, b, never], [a, c, srdf]]\n";
+  const Model m = kccd::parseModel(text, "m.yaml");
+  ASSERT_EQ(m.ignored.size(), 2u);
+  EXPECT_EQ(m.ignored[0].reason, kccd::IgnoreReason::Never);
+  EXPECT_EQ(m.ignored[1].reason, kccd::IgnoreReason::Srdf);
+  EXPECT_TRUE(m.pairs.empty());
+  // a - b and a - c are 0.3 m apart at every angle: "never" stands; with a margin of 0.35 m it
+  // does not and the entry is dropped (adjacent pairs kept: a and b are adjacent), while the SRDF's stays.
+  const km::IgnorePlan plan = km::ignoreList(m, km::provePairs(m, {.margin = 0.35}), {.keep_adjacent = true});
+  ASSERT_EQ(plan.dropped.size(), 1u);
+  EXPECT_EQ(plan.dropped[0].reason, kccd::IgnoreReason::Never);
+  ASSERT_EQ(plan.ignore.size(), 1u);
+  EXPECT_EQ(plan.ignore[0].reason, kccd::IgnoreReason::Srdf);
+  const std::string written = km::withIgnoreList(text, "m.yaml", km::ignoreList(m, km::provePairs(m)).ignore);
+  EXPECT_NE(written.find("[a, b, never]"), std::string::npos) << written;
+  EXPECT_NE(written.find("[a, c, never]"), std::string::npos) << written;  // a proof outranks the SRDF
+  EXPECT_EQ(kccd::parseModel(written, "w").ignored.size(), 2u);
+  try {
+    (void)kccd::parseModel(text.substr(0, text.find("ignore:")) + "ignore: [[a, b, nearby]]\n", "bad.yaml");
+    ADD_FAILURE() << "an unknown reason was accepted";
+  } catch (const kccd::ModelError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("bad.yaml:10:", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("pairs.ignore[0].reason: unknown reason 'nearby'"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW((void)kccd::parseModel(text.substr(0, text.find("ignore:")) + "include: [[a, b, never]]\n", "b"),
+               kccd::ModelError);
+}
+
+// Ignoring pairs by rule takes them out of the checks and changes nothing else: every pair kept
+// gets the same bound, bit for bit, over random trees and boxes.
+TEST(Pairs, AnIgnoredPairNeverChangesTheBoundOfAPairKept) {
+  std::mt19937_64 rng(20261125);
+  int compared = 0, ignored = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const Model all = kccd::testing::randomModel(rng, 6, 5);
+    Model fewer = all;
+    std::vector<std::array<int, 2>> ignore;
+    for (const auto& e : km::structuralIgnores(all).ignore)
+      ignore.push_back({all.bodyIndex(e.a), all.bodyIndex(e.b)});
+    fewer.finalize(true, ignore, {});
+    ignored += static_cast<int>(all.pairs.size() - fewer.pairs.size());
+    kccd::Checker ca(all), cf(fewer);
+    std::vector<double> lower, upper;
+    for (int box = 0; box < 4; ++box) {
+      kccd::testing::randomBox(rng, all, lower, upper);
+      const kccd::QueryOptions q{.type = kccd::QueryType::Distances};
+      const kccd::QueryResult& ra = ca.query(lower, upper, q);
+      const kccd::QueryResult& rf = cf.query(lower, upper, q);
+      ASSERT_EQ(ra.status, rf.status);
+      for (const kccd::PairDistance& d : rf.pairs) {
+        const kccd::BodyPair& p = fewer.pairs[d.pair];
+        for (const kccd::PairDistance& e : ra.pairs)
+          if (all.pairs[e.pair].a == p.a && all.pairs[e.pair].b == p.b) {
+            ASSERT_EQ(d.distance, e.distance) << "trial " << trial << " pair " << p.a << "-" << p.b;
+            ++compared;
+          }
+      }
+    }
+  }
+  EXPECT_GT(ignored, 100);
+  EXPECT_GT(compared, 1000);
+}
+
+// The survey of a state log counts, per pair, the rows within the margin and the closest row,
+// against an independent distance at every row (forward kinematics and distances of the tests'
+// own reference code).
+TEST(PairSurvey, CountsAndClosestAgreeWithIndependentDistances) {
+  std::mt19937_64 rng(7);
+  int within = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    Model m = kccd::testing::randomModel(rng, 5, 4);
+    for (kccd::Joint& j : m.joints) j.error = 0.0;  // a recorded state is one configuration
+    m.safety_margin = std::uniform_real_distribution<double>(0.0, 0.3)(rng);
+    if (m.pairs.empty() || m.stateSize() == 0) continue;
+    kccd::StateLog log;
+    log.names = m.stateNames();
+    log.circular.assign(m.stateSize(), 0);
+    log.logged_velocity.assign(m.stateSize(), 0);
+    std::uniform_real_distribution<double> angle(-3.0, 3.0);
+    for (int row = 0; row < 50; ++row) {
+      log.times.push_back(0.01 * row);
+      for (int s = 0; s < m.stateSize(); ++s) log.values.push_back(0.3 * angle(rng));
+    }
+    const km::Survey survey = km::surveyStates(m, log, {.time_offset = 0.5});
+    ASSERT_EQ(survey.samples, 50u);
+    ASSERT_EQ(survey.pairs.size(), m.pairs.size());
+    std::vector<std::size_t> count(m.pairs.size(), 0);
+    std::vector<double> closest(m.pairs.size(), INFINITY), at(m.pairs.size(), 0.0);
+    std::size_t red = 0;
+    bool borderline = false;
+    for (int row = 0; row < 50; ++row) {
+      kccd::testing::Sample s;
+      s.q.assign(log.row(row).begin(), log.row(row).end());
+      s.translation_error.assign(m.joints.size(), Vec3::Zero());
+      s.rotation_error.assign(m.joints.size(), Eigen::Matrix3d::Identity());
+      s.error_first.assign(m.joints.size(), false);
+      const auto poses = kccd::testing::jointPoses(m, s);
+      bool any = false;
+      for (std::size_t p = 0; p < m.pairs.size(); ++p) {
+        const double d = trueDistance(m, poses, m.pairs[p].a, m.pairs[p].b);
+        borderline = borderline || std::abs(d - m.safety_margin) < 1e-7;
+        if (d <= m.safety_margin) ++count[p], any = true;
+        if (d < closest[p]) closest[p] = d, at[p] = log.times[row] - 0.5;
+      }
+      red += any;
+    }
+    if (borderline) continue;  // a row on the margin itself: either count is right
+    EXPECT_EQ(survey.samples_within, red) << "trial " << trial;
+    for (std::size_t p = 0; p < m.pairs.size(); ++p) {
+      const km::PairSurvey& s = survey.pairs[p];
+      EXPECT_EQ(s.within, count[p]) << "trial " << trial << " pair " << p;
+      EXPECT_LE(s.min_distance, std::max(0.0, closest[p]) + 1e-9);  // a lower bound
+      EXPECT_NEAR(s.min_distance, std::max(0.0, closest[p]), 1e-6) << "trial " << trial << " pair " << p;
+      within += static_cast<int>(s.within);
+    }
+  }
+  EXPECT_GT(within, 50);
 }

@@ -77,10 +77,16 @@ TEST(UrdfImport, TestRobot) {
 
   // SRDF: adjacent pairs ignored; a pair naming a link without geometry dropped.
   const std::string ignore = text.substr(text.find("ignore:"));
-  EXPECT_NE(ignore.find("[base, column]"), std::string::npos);
-  EXPECT_NE(ignore.find("[slider, tool]"), std::string::npos);
+  EXPECT_NE(ignore.find("[base, column, adjacent]"), std::string::npos);  // adjacent outranks the SRDF
+  EXPECT_NE(ignore.find("[slider, tool, adjacent]"), std::string::npos);
+  EXPECT_NE(ignore.find("[column, slider, adjacent]"), std::string::npos);
   EXPECT_EQ(ignore.find("marker"), std::string::npos);
-  EXPECT_EQ(m.pairs.size(), 4u);
+  EXPECT_EQ(m.pairs.size(), 3u);
+  opt.keep_adjacent = true;  // then the SRDF says why base - column and slider - tool are ignored
+  const std::string kept = km::importUrdf(dir + "/two_link.urdf", opt);
+  EXPECT_NE(kept.find("[base, column, srdf]"), std::string::npos) << kept;
+  EXPECT_NE(kept.find("[slider, tool, srdf]"), std::string::npos) << kept;
+  EXPECT_EQ(kccd::parseModel(kept, "kept").pairs.size(), 4u);
 }
 
 TEST(UrdfImport, ClearErrors) {

@@ -101,4 +101,26 @@ const char* toString(SweepMode mode) {
   return "?";
 }
 
+const char* toString(IgnoreReason reason) {
+  switch (reason) {
+    case IgnoreReason::User: return "user";
+    case IgnoreReason::Adjacent: return "adjacent";
+    case IgnoreReason::Rigid: return "rigid";
+    case IgnoreReason::Never: return "never";
+    case IgnoreReason::AlwaysTouching: return "always_touching";
+    case IgnoreReason::Srdf: return "srdf";
+  }
+  return "?";
+}
+
+bool parseIgnoreReason(const std::string& word, IgnoreReason& reason) {
+  for (IgnoreReason r : {IgnoreReason::User, IgnoreReason::Adjacent, IgnoreReason::Rigid, IgnoreReason::Never,
+                         IgnoreReason::AlwaysTouching, IgnoreReason::Srdf})
+    if (word == toString(r)) {
+      reason = r;
+      return true;
+    }
+  return false;
+}
+
 }  // namespace kccd

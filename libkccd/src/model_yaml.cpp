@@ -268,14 +268,18 @@ void parseVisuals(const Reader& r, const YAML::Node& list, Model& m, const std::
   }
 }
 
+// A list of [body, body] entries; with `reasons`, an entry may carry a third element, the
+// IgnoreReason word (stored in `reasons_out`).
 std::vector<std::array<int, 2>> parsePairList(const Reader& r, const YAML::Node& list, const Model& m,
-                                              const std::string& field) {
+                                              const std::string& field,
+                                              std::vector<IgnoredPair>* reasons_out = nullptr) {
   std::vector<std::array<int, 2>> out;
-  if (!list.IsSequence()) r.fail(list, field, "expected a list of [body, body]");
+  const char* shape = reasons_out ? "[body, body] or [body, body, reason]" : "[body, body]";
+  if (!list.IsSequence()) r.fail(list, field, std::string("expected a list of ") + shape);
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YAML::Node p = list[i];
     const std::string f = field + "[" + std::to_string(i) + "]";
-    if (!p.IsSequence() || p.size() != 2) r.fail(p, f, "expected [body, body]");
+    if (!p.IsSequence() || p.size() < 2 || p.size() > (reasons_out ? 3u : 2u)) r.fail(p, f, std::string("expected ") + shape);
     std::array<int, 2> ids{};
     for (int k = 0; k < 2; ++k) {
       const std::string name = r.text(p[k], f);
@@ -283,6 +287,16 @@ std::vector<std::array<int, 2>> parsePairList(const Reader& r, const YAML::Node&
       if (ids[k] < 0) r.fail(p[k], f, "unknown body '" + name + "'");
     }
     if (ids[0] == ids[1]) r.fail(p, f, "a body paired with itself");
+    if (reasons_out) {
+      IgnoredPair entry{ids[0], ids[1], IgnoreReason::User};
+      if (p.size() == 3) {
+        const std::string word = r.text(p[2], f + ".reason");
+        if (!parseIgnoreReason(word, entry.reason))
+          r.fail(p[2], f + ".reason",
+                 "unknown reason '" + printable(word, 40) + "' (user, adjacent, rigid, never, always_touching or srdf)");
+      }
+      reasons_out->push_back(entry);
+    }
     out.push_back(ids);
   }
   return out;
@@ -333,7 +347,7 @@ Model parseModel(const std::string& yaml_text, const std::string& source) {
       if (c != "all" && c != "none") r.fail(pairs["check"], "pairs.check", "expected 'all' or 'none', got '" + c + "'");
       check_all = c == "all";
     }
-    if (pairs["ignore"]) ignore = parsePairList(r, pairs["ignore"], m, "pairs.ignore");
+    if (pairs["ignore"]) ignore = parsePairList(r, pairs["ignore"], m, "pairs.ignore", &m.ignored);
     if (pairs["include"]) include = parsePairList(r, pairs["include"], m, "pairs.include");
   }
   try {

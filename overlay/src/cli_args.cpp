@@ -118,4 +118,14 @@ void checkCorePoints(int k) {
                      std::to_string(modelling::kMaxCorePoints) + " (got " + std::to_string(k) + ")");
 }
 
+std::vector<std::string> splitCommas(const std::string& text) {
+  std::vector<std::string> out;
+  for (std::size_t at = 0; at <= text.size() && !text.empty();) {
+    const std::size_t comma = std::min(text.find(',', at), text.size());
+    out.push_back(text.substr(at, comma - at));
+    at = comma + 1;
+  }
+  return out;
+}
+
 }  // namespace kccd::cli

@@ -28,6 +28,9 @@ CLI::Validator finiteIn(double lo, double hi);
 /// Parses "a,b,c" into numbers; `option` names the flag in error messages.
 std::vector<double> parseList(const std::string& text, const std::string& option);
 
+/// "a,b,c" split at every comma ("" gives no item, "a," gives "a" and ""): column lists.
+std::vector<std::string> splitCommas(const std::string& text);
+
 /// The interval box from `--state` (a single configuration) or `--lower`/`--upper`, each checked
 /// against the model's state size; `missing` is the message when neither is complete. With
 /// `finite`, NaN and infinite values are rejected too (else they reach the query as a status).

@@ -176,13 +176,7 @@ Gathered gather(const CalibArgs& a, const calib::Camera& cam, const std::optiona
   std::optional<StateLog> log;
   double max_gap = a.max_gap;
   if (!a.state_log.empty()) {
-    std::vector<std::string> ignore;
-    for (std::size_t at = 0; at <= a.ignore_columns.size() && !a.ignore_columns.empty();) {
-      const std::size_t comma = std::min(a.ignore_columns.find(',', at), a.ignore_columns.size());
-      ignore.push_back(a.ignore_columns.substr(at, comma - at));
-      at = comma + 1;
-    }
-    log = loadStateLog(a.state_log, *model, ignore);
+    log = loadStateLog(a.state_log, *model, splitCommas(a.ignore_columns));
     if (max_gap == 0.0) max_gap = 1.5 * log->medianPeriod();
   }
 

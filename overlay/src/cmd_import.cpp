@@ -19,7 +19,7 @@ struct ImportArgs {
   int points = 8;
   double margin = 0.02;
   std::vector<std::string> packages;
-  bool quiet = false, pairs = false, no_visuals = false;
+  bool quiet = false, pairs = false, no_visuals = false, keep_adjacent = false;
   int max_boxes = 2000;
 };
 
@@ -32,16 +32,20 @@ std::string withProvenPairs(const std::string& text, const ImportArgs& args) {
     Progress progress("proving pairs", args.quiet);
     reports = modelling::provePairs(m, {.max_boxes = args.max_boxes, .progress = [&](double f) { progress.update(f); }});
   }
-  const std::vector<std::array<std::string, 2>> ignore = modelling::ignoreList(m, reports);
-  int never = 0, touching = 0, undecided = 0;
+  const modelling::IgnorePlan plan = modelling::ignoreList(m, reports, {.keep_adjacent = args.keep_adjacent});
+  int never = 0, touching = 0, undecided = 0, rigid = 0, adjacent = 0;
   for (const auto& r : reports) {
-    never += r.verdict == modelling::Verdict::Never;
-    touching += r.verdict == modelling::Verdict::AlwaysTouching;
+    rigid += r.rigid;
+    adjacent += r.adjacent;
+    never += !r.rigid && r.verdict == modelling::Verdict::Never;
+    touching += !r.rigid && r.verdict == modelling::Verdict::AlwaysTouching;
     undecided += r.verdict == modelling::Verdict::Undecided;
   }
   if (!args.quiet)
-    std::cerr << "pairs: " << never << " never within the margin, " << touching << " always touching, " << undecided
-              << " undecided (of " << reports.size() << "); " << ignore.size() << " ignored\n";
+    std::cerr << "pairs: " << rigid << " rigid, " << adjacent << " adjacent" << (args.keep_adjacent ? " (kept)" : "")
+              << ", " << never << " never within the margin, " << touching << " always touching, " << undecided
+              << " undecided (of " << reports.size() << "); " << plan.ignore.size() << " ignored\n";
+  const auto& ignore = plan.ignore;
   std::string out = modelling::withIgnoreList(text, args.urdf + " (imported)", ignore);
   (void)parseModel(out, args.urdf + " (imported)");
   return out;
@@ -54,6 +58,7 @@ Exit runImport(const ImportArgs& args) {
   opt.points = args.points;
   opt.safety_margin = args.margin;
   opt.visuals = !args.no_visuals;
+  opt.keep_adjacent = args.keep_adjacent;
   for (const std::string& p : args.packages) {
     const std::size_t eq = p.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == p.size())
@@ -98,6 +103,8 @@ Runner addImport(CLI::App& app) {
   sub->add_flag("--pairs", args->pairs,
                 "Also prove which pairs never come within the margin inside the joint limits, or always touch, "
                 "and ignore them (as kccd pairs --write)");
+  sub->add_flag("--keep-adjacent", args->keep_adjacent,
+                "Check links joined by one moving joint (by default they are ignored, as MoveIt does: reason adjacent)");
   sub->add_option("--max-boxes", args->max_boxes, "With --pairs: boxes per pair before a pair is undecided")
       ->capture_default_str()
       ->check(CLI::Range(1, 10000000))
@@ -108,6 +115,10 @@ Runner addImport(CLI::App& app) {
       "J (translation3d: x, y, z) and J_rotation (rotation3d: a rotation vector); a planar joint J becomes J_x, J_y "
       "(prismatic along the plane) and J_yaw (revolute about its normal). Mimic joints are checked as independent "
       "joints (conservative).\n"
+      "Ignored pairs, each with its reason in pairs: ignore: links with only fixed joints between them (rigid: one "
+      "constant distance), links joined by one moving joint with no link with geometry between them (adjacent, "
+      "MoveIt's rule; --keep-adjacent checks them), the SRDF's disable_collisions (srdf), and with --pairs the pairs proven never "
+      "within the margin (never) or touching at every configuration (always_touching).\n"
       "Exit status: 0 done, 2 bad input.");
   return [args] { return runImport(*args); };
 }

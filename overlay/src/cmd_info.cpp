@@ -48,6 +48,9 @@ Exit runInfo(const InfoArgs& args) {
     j["pairs"] = nlohmann::json::array();
     for (const BodyPair& p : m.pairs)
       j["pairs"].push_back({{"a", m.bodies[p.a].name}, {"b", m.bodies[p.b].name}, {"frame", m.frameName(p.lca)}});
+    j["ignored"] = nlohmann::json::array();
+    for (const IgnoredPair& p : m.ignored)
+      j["ignored"].push_back({{"a", m.bodies[p.a].name}, {"b", m.bodies[p.b].name}, {"reason", toString(p.reason)}});
     j["visuals"] = nlohmann::json::array();
     for (const Visual& v : m.visuals) {
       nlohmann::json o{{"frame", m.frameName(v.frame)}, {"shape", shapeName(v.shape)}};
@@ -55,12 +58,12 @@ Exit runInfo(const InfoArgs& args) {
       j["visuals"].push_back(o);
     }
     j["totals"] = {{"joints", m.joints.size()}, {"dof", m.stateSize()}, {"bodies", m.bodies.size()}, {"points", points},
-                   {"pairs", m.pairs.size()}, {"visuals", m.visuals.size()}};
+                   {"pairs", m.pairs.size()}, {"ignored", m.ignored.size()}, {"visuals", m.visuals.size()}};
     std::cout << j.dump(2) << "\n";
     return Exit::Ok;
   }
   std::cout << "model " << m.name << ": " << m.joints.size() << " joints, " << m.stateSize() << " state values, "
-            << m.bodies.size() << " bodies, " << points << " points, " << m.pairs.size() << " checked pairs\n"
+            << m.bodies.size() << " bodies, " << points << " points, " << m.pairs.size() << " checked pairs, " << m.ignored.size() << " ignored\n"
             << "safety margin " << m.safety_margin << " m, point budget " << m.point_budget << "\n\njoints:\n";
   for (const Joint& jt : m.joints) {
     std::cout << "  " << std::left << std::setw(20) << jt.name << std::setw(14) << toString(jt.type) << "parent "
@@ -78,6 +81,12 @@ Exit runInfo(const InfoArgs& args) {
   std::cout << "\nchecked pairs (compared in their common-ancestor frame):\n";
   for (const BodyPair& p : m.pairs)
     std::cout << "  " << m.bodies[p.a].name << " - " << m.bodies[p.b].name << "  [" << m.frameName(p.lca) << "]\n";
+  if (!m.ignored.empty()) {
+    std::cout << "\nignored pairs (pairs: ignore) and why:\n";
+    for (const IgnoredPair& p : m.ignored)
+      std::cout << "  " << std::left << std::setw(42) << (m.bodies[p.a].name + " - " + m.bodies[p.b].name)
+                << toString(p.reason) << "\n";
+  }
   if (!m.visuals.empty()) {
     std::cout << "\nvisuals (drawing only, never checked):\n";
     for (const Visual& v : m.visuals)

@@ -65,6 +65,24 @@ struct BodyPair {
   int lca = kWorld;
 };
 
+/// Why a pair of bodies is left out of the checks, as its `pairs: ignore` entry says (the
+/// optional third element: `[a, b, adjacent]`; none means `user`).
+enum class IgnoreReason : std::uint8_t {
+  User,            ///< the file's author said so (no reason written)
+  Adjacent,        ///< one moving joint between them, no body on a link between (MoveIt's rule)
+  Rigid,           ///< only fixed joints between them: one constant distance
+  Never,           ///< proven never within the margin over the joint limits (kccd pairs)
+  AlwaysTouching,  ///< proven within the margin at every configuration (kccd pairs)
+  Srdf,            ///< an SRDF's disable_collisions
+};
+
+/// An ignored body pair and why it is ignored.
+struct IgnoredPair {
+  int a = 0;
+  int b = 0;
+  IgnoreReason reason = IgnoreReason::User;
+};
+
 /// A model file that cannot be loaded: the message names file, line and field.
 class ModelError : public InputError {
  public:
@@ -85,6 +103,7 @@ class Model {
   std::vector<Joint> joints;    ///< parents always precede children
   std::vector<Body> bodies;
   std::vector<BodyPair> pairs;
+  std::vector<IgnoredPair> ignored;  ///< the file's `pairs: ignore` entries, in file order
   std::vector<Visual> visuals;  ///< appearance for drawing (optional)
 
   /// Number of state values.
@@ -119,5 +138,8 @@ Model parseModel(const std::string& yaml_text, const std::string& source);
 
 const char* toString(JointType type);
 const char* toString(SweepMode mode);
+const char* toString(IgnoreReason reason);
+/// The reason named by `word` (toString's words), false when there is none.
+bool parseIgnoreReason(const std::string& word, IgnoreReason& reason);
 
 }  // namespace kccd

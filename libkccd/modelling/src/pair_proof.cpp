@@ -26,18 +26,24 @@ double distanceUpper(const SschView& a, const SschView& b) {
   return std::max(0.0, d.hull_upper - a.radius - b.radius);
 }
 
-// Adjacent through a revolute joint: points on its axis are fixed in both frames. If one of
-// them lies within the margin of both bodies, the bodies are within the margin at every angle.
-bool sharesAxisPoint(const Model& m, Checker& checker, int parent_body, int child_body, double margin) {
-  const Joint& j = m.joints[m.bodies[child_body].frame];
-  const SschView child = checker.sweptVolume(child_body, m.bodies[child_body].frame);
-  const SschView parent = checker.sweptVolume(parent_body, j.parent);
+// Adjacent through the revolute joint `g` (the one moving joint between the two bodies, above
+// the child body): points on its axis are fixed in both bodies' frames. If one of them lies within the margin of
+// both bodies, the bodies are within the margin at every angle. The child is taken in g's
+// frame, the parent body in the pair's common frame `lca` (only fixed joints lie between lca
+// and g's parent, so the axis has one place there).
+bool sharesAxisPoint(const Model& m, Checker& checker, int parent_body, int child_body, int g, int lca,
+                     double margin) {
+  const Joint& j = m.joints[g];
+  const SschView child = checker.sweptVolume(child_body, g);
+  const SschView parent = checker.sweptVolume(parent_body, lca);
   if (child.points.empty() || parent.points.empty()) return false;
+  Pose to_lca = j.origin;  // g's frame (at any angle, for points on its axis) in lca's frame
+  for (int f = j.parent; f != lca && f != kWorld; f = m.joints[f].parent) to_lca = m.joints[f].origin * to_lca;
   double extent = child.radius + parent.radius;
   for (const Vec3& p : child.points) extent = std::max(extent, p.norm() + child.radius);
   auto cost = [&](double t) {
     const Vec3 x = t * j.axis;
-    const Vec3 y = j.origin * x;
+    const Vec3 y = to_lca * x;
     return distanceUpper(SschView{std::span<const Vec3>(&x, 1), 0.0}, child) +
            distanceUpper(SschView{std::span<const Vec3>(&y, 1), 0.0}, parent);
   };
@@ -56,6 +62,41 @@ bool sharesAxisPoint(const Model& m, Checker& checker, int parent_body, int chil
   return best <= margin;
 }
 
+bool samePair(const IgnoreEntry& e, const std::string& a, const std::string& b) {
+  return (e.a == a && e.b == b) || (e.a == b && e.b == a);
+}
+
+// Appends (a, b, reason) unless the pair is listed already.
+void addOnce(std::vector<IgnoreEntry>& list, const std::string& a, const std::string& b, IgnoreReason reason) {
+  for (const IgnoreEntry& e : list)
+    if (samePair(e, a, b)) return;
+  list.push_back({a, b, reason});
+}
+
+// The model's own entries after `plan.ignore`'s: user and SRDF entries always, rigid and adjacent
+// ones while the rule still holds (adjacent ones only without keep_adjacent), proof entries
+// (never, always_touching) when `keep_proofs`; the rest go to `plan.dropped`.
+void carryModelEntries(const Model& m, const IgnoreOptions& options, bool keep_proofs, IgnorePlan& plan) {
+  for (const IgnoredPair& p : m.ignored) {
+    const std::string &a = m.bodies[p.a].name, &b = m.bodies[p.b].name;
+    bool keep = true;
+    switch (p.reason) {
+      case IgnoreReason::User:
+      case IgnoreReason::Srdf: break;
+      case IgnoreReason::Rigid: keep = connection(m, p.a, p.b) == Connection::Rigid; break;
+      case IgnoreReason::Adjacent: keep = !options.keep_adjacent && connection(m, p.a, p.b) == Connection::Adjacent; break;
+      case IgnoreReason::Never:
+      case IgnoreReason::AlwaysTouching: keep = keep_proofs; break;
+    }
+    bool listed = false;
+    for (const IgnoreEntry& e : plan.ignore) listed = listed || samePair(e, a, b);
+    if (keep || listed)
+      addOnce(plan.ignore, a, b, p.reason);
+    else
+      plan.dropped.push_back({a, b, p.reason});
+  }
+}
+
 }  // namespace
 
 const char* toString(Verdict v) {
@@ -67,6 +108,27 @@ const char* toString(Verdict v) {
     case Verdict::Unbounded: return "unbounded";
   }
   return "?";
+}
+
+Connection connection(const Model& m, int a, int b) {
+  const int fa = m.bodies[a].frame, fb = m.bodies[b].frame;
+  const int lca = m.commonAncestor(fa, fb);
+  // The links on the path between the two bodies' links, and the moving joints among its joints.
+  int moving = 0;
+  bool bare = true;  // every link strictly between the two carries no body
+  const auto carries = [&](int frame) {
+    for (const Body& body : m.bodies)
+      if (body.frame == frame) return true;
+    return false;
+  };
+  for (int start : {fa, fb})
+    for (int f = start; f != lca && f != kWorld; f = m.joints[f].parent) {
+      moving += m.joints[f].type != JointType::Fixed;
+      if (f != start && carries(f)) bare = false;
+    }
+  if (lca != fa && lca != fb && carries(lca)) bare = false;
+  if (moving == 0) return Connection::Rigid;
+  return moving == 1 && bare ? Connection::Adjacent : Connection::Distant;
 }
 
 std::vector<std::array<double, 2>> jointRanges(const Model& m) {
@@ -105,8 +167,9 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
         r.lca = m.commonAncestor(m.bodies[a].frame, m.bodies[b].frame);
         for (const BodyPair& p : model.pairs)
           if ((p.a == a && p.b == b) || (p.a == b && p.b == a)) r.checked = true;
-        const int fa = m.bodies[a].frame, fb = m.bodies[b].frame;
-        r.adjacent = (fb != kWorld && m.joints[fb].parent == fa) || (fa != kWorld && m.joints[fa].parent == fb);
+        const Connection c = connection(m, a, b);
+        r.adjacent = c == Connection::Adjacent;
+        r.rigid = c == Connection::Rigid;
         out.push_back(r);
       }
 
@@ -147,19 +210,23 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
       lower[s] = upper[s] = std::isnan(ranges[s][0]) ? 0.0 : 0.5 * ranges[s][0] + 0.5 * ranges[s][1];
     const QueryOptions qopt{.type = QueryType::Distances, .margin = margin};
 
-    if (r.adjacent) {
-      const int child = m.bodies[r.b].frame != kWorld && m.joints[m.bodies[r.b].frame].parent == m.bodies[r.a].frame
-                            ? r.b
-                            : r.a;
-      const int parent = child == r.b ? r.a : r.b;
-      const Joint& j = m.joints[m.bodies[child].frame];
+    if (r.rigid) {  // one configuration: its distance decides
       checker.query(lower, upper, qopt);
-      bool always = false;
-      if (j.type == JointType::Revolute)
-        always = sharesAxisPoint(m, checker, parent, child, margin);
-      else if (j.type == JointType::Fixed)
-        always = distanceUpper(checker.sweptVolume(r.a, r.lca), checker.sweptVolume(r.b, r.lca)) <= margin;
-      if (always) {
+      ++r.boxes;
+      const SschView va = checker.sweptVolume(r.a, r.lca), vb = checker.sweptVolume(r.b, r.lca);
+      const DistanceResult d = distance(va, vb);
+      r.bound = d.distance;
+      r.verdict = d.distance > margin && d.status != GjkStatus::InvalidInput ? Verdict::Never : Verdict::AlwaysTouching;
+      continue;
+    }
+    if (r.adjacent) {
+      // The one moving joint between them; the child body hangs below it.
+      int g = kWorld, child = r.a, parent = r.b;
+      for (int body : {r.a, r.b})
+        for (int f = m.bodies[body].frame; f != r.lca && f != kWorld; f = m.joints[f].parent)
+          if (m.joints[f].type != JointType::Fixed) g = f, child = body, parent = body == r.a ? r.b : r.a;
+      checker.query(lower, upper, qopt);
+      if (m.joints[g].type == JointType::Revolute && sharesAxisPoint(m, checker, parent, child, g, r.lca, margin)) {
         r.verdict = Verdict::AlwaysTouching;
         continue;
       }
@@ -223,17 +290,35 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
   return out;
 }
 
-std::vector<std::array<std::string, 2>> ignoreList(const Model& model, const std::vector<PairReport>& reports) {
-  const auto proven = [](const PairReport& r) {
-    return r.verdict == Verdict::Never || r.verdict == Verdict::AlwaysTouching;
-  };
-  std::vector<std::array<std::string, 2>> ignore;
+IgnorePlan structuralIgnores(const Model& m, const IgnoreOptions& options) {
+  IgnorePlan plan;
+  const int n = static_cast<int>(m.bodies.size());
+  for (const Connection want : {Connection::Rigid, Connection::Adjacent}) {
+    if (want == Connection::Adjacent && options.keep_adjacent) continue;
+    for (int a = 0; a < n; ++a)
+      for (int b = a + 1; b < n; ++b)
+        if (m.bodies[a].frame != m.bodies[b].frame && connection(m, a, b) == want)
+          addOnce(plan.ignore, m.bodies[a].name, m.bodies[b].name,
+                  want == Connection::Rigid ? IgnoreReason::Rigid : IgnoreReason::Adjacent);
+  }
+  carryModelEntries(m, options, true, plan);
+  return plan;
+}
+
+IgnorePlan ignoreList(const Model& m, const std::vector<PairReport>& reports, const IgnoreOptions& options) {
+  IgnorePlan plan;
+  const auto names = [&](const PairReport& r) { return std::pair(m.bodies[r.a].name, m.bodies[r.b].name); };
   for (const PairReport& r : reports)
-    if (proven(r)) ignore.push_back({model.bodies[r.a].name, model.bodies[r.b].name});
-  // Pairs the model already ignores stay ignored.
+    if (r.rigid) addOnce(plan.ignore, names(r).first, names(r).second, IgnoreReason::Rigid);
   for (const PairReport& r : reports)
-    if (!r.checked && !proven(r)) ignore.push_back({model.bodies[r.a].name, model.bodies[r.b].name});
-  return ignore;
+    if (r.verdict == Verdict::Never || r.verdict == Verdict::AlwaysTouching)
+      addOnce(plan.ignore, names(r).first, names(r).second,
+              r.verdict == Verdict::Never ? IgnoreReason::Never : IgnoreReason::AlwaysTouching);
+  if (!options.keep_adjacent)
+    for (const PairReport& r : reports)
+      if (r.adjacent) addOnce(plan.ignore, names(r).first, names(r).second, IgnoreReason::Adjacent);
+  carryModelEntries(m, options, false, plan);
+  return plan;
 }
 
 }  // namespace kccd::modelling

@@ -18,6 +18,7 @@
 
 #include "kccd/model.hpp"
 #include "kccd/modelling/fit.hpp"
+#include "kccd/modelling/pair_proof.hpp"
 #include "kccd/modelling/part.hpp"
 #include "kccd/modelling/yaml_edit.hpp"
 
@@ -336,12 +337,12 @@ int collisionLine(const tinyxml2::XMLDocument& doc, const std::string& name) {
   return 0;
 }
 
-std::vector<std::array<std::string, 2>> readSrdf(const tinyxml2::XMLDocument& doc, const std::string& path,
+std::vector<IgnoreEntry> readSrdf(const tinyxml2::XMLDocument& doc, const std::string& path,
                                                  const std::set<std::string>& links,
                                                  const std::set<std::string>& bodies) {
   const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
   if (!robot) throw UrdfError(path + ": not an SRDF file (no <robot> element)");
-  std::vector<std::array<std::string, 2>> out;
+  std::vector<IgnoreEntry> out;
   for (const tinyxml2::XMLElement* e = robot->FirstChildElement("disable_collisions"); e;
        e = e->NextSiblingElement("disable_collisions")) {
     const char* a = e->Attribute("link1");
@@ -353,7 +354,7 @@ std::vector<std::array<std::string, 2>> readSrdf(const tinyxml2::XMLDocument& do
       if (!links.count(l))
         throw UrdfError(path + ":" + std::to_string(e->GetLineNum()) + ": link '" + l +
                                  "' is not in the URDF");
-    if (bodies.count(a) && bodies.count(b) && std::string(a) != b) out.push_back({a, b});
+    if (bodies.count(a) && bodies.count(b) && std::string(a) != b) out.push_back({a, b, IgnoreReason::Srdf});
   }
   return out;
 }
@@ -483,27 +484,37 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
   std::ostringstream visuals;
   if (options.visuals)
     for (const auto& link : order) writeVisuals(visuals, path, *link, frame_of.at(link->name), options);
-  std::vector<std::array<std::string, 2>> ignore;
+  std::vector<IgnoreEntry> ignore;
   if (!options.srdf.empty()) ignore = readSrdf(srdf, options.srdf, link_names, body_names);
 
-  std::ostringstream out;
-  out << "# Imported from " << std::filesystem::path(path).filename().string()
-      << (options.srdf.empty() ? "" : " and " + std::filesystem::path(options.srdf).filename().string())
-      << " by kccd import (" << options.points << " core points per link)\n"
-      << "kccd: 1\n"
-      << "name: " << urdf->getName() << "\n"
-      << "safety_margin: " << num(options.safety_margin) << "\n";
-  const std::string jt = joints.str(), bt = bodies.str();
-  out << "joints:" << (jt.empty() ? " []\n" : "\n" + jt);
-  out << "bodies:" << (bt.empty() ? " []\n" : "\n" + bt);
-  out << "pairs:\n  check: all\n  ignore: " << flowPairs(ignore, 11) << "\n";
-  if (const std::string vt = visuals.str(); !vt.empty()) out << "visuals:   # appearance only, never checked\n" << vt;
-  const std::string text = out.str();
-  try {
-    (void)parseModel(text, path + " (imported)");
-  } catch (const ModelError& e) {
-    throw UrdfError(path + ": the imported model does not load: " + e.what());
-  }
+  const auto compose = [&] {
+    std::ostringstream out;
+    out << "# Imported from " << std::filesystem::path(path).filename().string()
+        << (options.srdf.empty() ? "" : " and " + std::filesystem::path(options.srdf).filename().string())
+        << " by kccd import (" << options.points << " core points per link)\n"
+        << "kccd: 1\n"
+        << "name: " << urdf->getName() << "\n"
+        << "safety_margin: " << num(options.safety_margin) << "\n";
+    const std::string jt = joints.str(), bt = bodies.str();
+    out << "joints:" << (jt.empty() ? " []\n" : "\n" + jt);
+    out << "bodies:" << (bt.empty() ? " []\n" : "\n" + bt);
+    out << "pairs:   # ignore [a, b, why]: rigid, adjacent (kccd pairs --help), srdf, never, always_touching\n"
+           "  check: all\n  ignore: "
+        << flowPairs(ignore, 11) << "\n";
+    if (const std::string vt = visuals.str(); !vt.empty()) out << "visuals:   # appearance only, never checked\n" << vt;
+    return out.str();
+  };
+  const auto load = [&](const std::string& text) {
+    try {
+      return parseModel(text, path + " (imported)");
+    } catch (const ModelError& e) {
+      throw UrdfError(path + ": the imported model does not load: " + e.what());
+    }
+  };
+  // Rigidly attached and adjacent links (MoveIt's rule), then the SRDF's pairs.
+  ignore = structuralIgnores(load(compose()), {.keep_adjacent = options.keep_adjacent}).ignore;
+  const std::string text = compose();
+  (void)load(text);
   if (options.progress) options.progress(1.0);
   return text;
 }

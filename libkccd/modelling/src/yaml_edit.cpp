@@ -148,11 +148,13 @@ std::string flowPoints(std::span<const Vec3> points) {
   return s + "]";
 }
 
-std::string flowPairs(const std::vector<std::array<std::string, 2>>& pairs, int indent) {
+std::string flowPairs(const std::vector<IgnoreEntry>& pairs, int indent) {
   std::string s = "[", line;
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     std::string item = "[";
-    item.append(quoted(pairs[i][0])).append(", ").append(quoted(pairs[i][1])).append("]");
+    item.append(quoted(pairs[i].a)).append(", ").append(quoted(pairs[i].b));
+    if (pairs[i].reason != IgnoreReason::User) item.append(", ").append(toString(pairs[i].reason));
+    item.append("]");
     if (i > 0) {
       s += ",";
       if (line.size() + item.size() > 90) {
@@ -196,7 +198,7 @@ std::string withBodyGeometry(const std::string& text, const std::string& source,
 }
 
 std::string withIgnoreList(const std::string& text, const std::string& source,
-                           const std::vector<std::array<std::string, 2>>& pairs) {
+                           const std::vector<IgnoreEntry>& pairs) {
   const YAML::Node root = load(text, source);
   std::string out;
   Found section;

@@ -1,6 +1,6 @@
 // Which body pairs can never come within the safety margin over the joint limits, proven with
-// the engine's own conservative sweeps (branch and bound on the joint box), and which adjacent
-// pairs always touch.
+// the engine's own conservative sweeps (branch and bound on the joint box), which adjacent
+// pairs always touch, which are rigidly attached, and the ignore list that follows.
 #pragma once
 
 #include <array>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "kccd/model.hpp"
+#include "kccd/modelling/yaml_edit.hpp"
 
 namespace kccd::modelling {
 
@@ -21,13 +22,25 @@ enum class Verdict {
 };
 const char* toString(Verdict verdict);
 
+/// How two bodies in different frames are joined, along the path of joints between them (a
+/// frame stands for the link it carries).
+enum class Connection {
+  Rigid,     ///< only fixed joints between them: one constant distance
+  Adjacent,  ///< one moving joint, and no body on a link between them (links without geometry
+             ///< merged, as MoveIt's adjacency rule does)
+  Distant,   ///< more than one moving joint, or a body in between
+};
+Connection connection(const Model& model, int body_a, int body_b);
+
 struct PairReport {
   int a = 0, b = 0;                 ///< body indices, a < b
   int lca = kWorld;
   Verdict verdict = Verdict::Undecided;
-  bool adjacent = false;            ///< one body's frame is the parent joint of the other's
+  bool adjacent = false;            ///< Connection::Adjacent
+  bool rigid = false;               ///< Connection::Rigid: decided exactly (Never or AlwaysTouching)
   bool checked = false;             ///< currently in Model::pairs
-  double bound = 0.0;               ///< Never: smallest lower bound over the covering boxes
+  double bound = 0.0;               ///< Never: smallest lower bound over the covering boxes; rigid: the
+                                    ///< constant distance (a lower bound, within 1e-9 relative)
   int boxes = 0;                    ///< boxes queried
   std::vector<double> witness;      ///< Meets: a state within the limits where they meet
   double witness_distance = 0.0;    ///< Meets: distance bound at the witness state
@@ -47,8 +60,24 @@ std::vector<std::array<double, 2>> jointRanges(const Model& model);
 /// Analyses every pair of bodies in different frames (checked or not).
 std::vector<PairReport> provePairs(const Model& model, const ProofOptions& options = {});
 
-/// The `pairs: ignore` list the proofs justify, as body-name pairs: first the pairs proven never
-/// within the margin or always touching, then those the model already ignores, each in report order.
-std::vector<std::array<std::string, 2>> ignoreList(const Model& model, const std::vector<PairReport>& reports);
+struct IgnoreOptions {
+  bool keep_adjacent = false;  ///< check adjacent pairs (MoveIt's rule not applied)
+};
+
+/// An ignore list and the model's entries it no longer carries.
+struct IgnorePlan {
+  std::vector<IgnoreEntry> ignore;   ///< the new `pairs: ignore` list, each entry with its reason
+  std::vector<IgnoreEntry> dropped;  ///< old entries whose reason no longer holds (checked again)
+};
+
+/// The `pairs: ignore` list without proofs: rigid pairs, adjacent pairs (unless keep_adjacent),
+/// then the model's own user and SRDF entries, and its proof entries (never, always_touching)
+/// as they are. Each pair once, in that order of reasons.
+IgnorePlan structuralIgnores(const Model& model, const IgnoreOptions& options = {});
+
+/// The `pairs: ignore` list the proofs justify: rigid pairs, pairs proven never within the margin
+/// or always touching, adjacent pairs (unless keep_adjacent), then the model's user and SRDF
+/// entries. A model entry whose reason is a proof or a rule that no longer holds is dropped.
+IgnorePlan ignoreList(const Model& model, const std::vector<PairReport>& reports, const IgnoreOptions& options = {});
 
 }  // namespace kccd::modelling

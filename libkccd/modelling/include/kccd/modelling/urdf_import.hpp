@@ -22,10 +22,14 @@ struct ImportOptions {
   double safety_margin = 0.02;                  ///< written into the model
   std::map<std::string, std::string> packages;  ///< package:// NAME -> directory
   bool visuals = true;                          ///< write each link's <visual>s as `visuals:` (meshes must exist)
+  bool keep_adjacent = false;                   ///< check adjacent links (else ignored: Connection::Adjacent)
   std::function<void(double)> progress;
 };
 
 /// Converts the URDF file at `path` into `kccd: 1` model text (checked by loading it back).
+/// `pairs: ignore` lists, each with its reason, the links joined only by fixed joints (rigid),
+/// those joined by one moving joint with no link with geometry between them (adjacent, unless
+/// keep_adjacent), then the SRDF's disable_collisions (srdf).
 /// Joints map one to one, except: a floating joint J becomes J (translation3d) and J_rotation
 /// (rotation3d); a planar joint J becomes J_x and J_y (prismatic along two axes of the plane
 /// normal to its axis) and J_yaw (revolute about that axis). Throws UrdfError with one line

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "kccd/input_error.hpp"
+#include "kccd/model.hpp"
 #include "kccd/ssch.hpp"
 
 namespace kccd::modelling {
@@ -19,6 +20,12 @@ class EditError : public InputError {
   using InputError::InputError;
 };
 
+/// One `pairs: ignore` entry as written: two body names and why (User: no reason written).
+struct IgnoreEntry {
+  std::string a, b;
+  IgnoreReason reason = IgnoreReason::User;
+};
+
 /// Replaces the `points` and `radius` of body `body` in model text (`source` names it in
 /// messages) with the given YAML texts and returns the edited text. Throws EditError
 /// when the body is missing or the edited model would not load.
@@ -26,14 +33,15 @@ std::string withBodyGeometry(const std::string& text, const std::string& source,
                              const std::string& points_yaml, const std::string& radius_yaml);
 /// Sets `pairs: ignore:` of model text to `pairs` (creating the keys if needed); same errors.
 std::string withIgnoreList(const std::string& text, const std::string& source,
-                           const std::vector<std::array<std::string, 2>>& pairs);
+                           const std::vector<IgnoreEntry>& pairs);
 /// A number as written into model files: 10 significant digits, rounded up when `up` (for radii,
 /// which must not shrink).
 std::string yamlNumber(double value, bool up = false);
 /// Points as a YAML flow list [[x, y, z], ...] with yamlNumber digits.
 std::string flowPoints(std::span<const Vec3> points);
 
-/// A YAML flow list of name pairs, wrapped to lines of about 100 characters after `indent`.
-std::string flowPairs(const std::vector<std::array<std::string, 2>>& pairs, int indent);
+/// A YAML flow list of ignore entries (`[a, b]`, or `[a, b, reason]` when the reason is not User),
+/// wrapped to lines of about 100 characters after `indent`.
+std::string flowPairs(const std::vector<IgnoreEntry>& pairs, int indent);
 
 }  // namespace kccd::modelling

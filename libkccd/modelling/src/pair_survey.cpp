@@ -1,0 +1,65 @@
+#include "kccd/modelling/pair_survey.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "kccd/checker.hpp"
+#include "kccd/distance.hpp"
+
+namespace kccd::modelling {
+
+Survey surveyStates(const Model& model, const StateLog& log, const SurveyOptions& options) {
+  Survey out;
+  out.margin = options.margin >= 0 ? options.margin : model.safety_margin;
+  // The surveyed model: the checked pairs, then (on request) the ignored ones, same frames.
+  Model m = model;
+  const std::size_t checked = m.pairs.size();
+  if (options.ignored_pairs)
+    for (const IgnoredPair& p : model.ignored) {
+      const int a = std::min(p.a, p.b), b = std::max(p.a, p.b);
+      bool listed = model.bodies[a].frame == model.bodies[b].frame;
+      for (const BodyPair& q : m.pairs) listed = listed || (q.a == a && q.b == b);
+      if (!listed) m.pairs.push_back({a, b, m.commonAncestor(m.bodies[a].frame, m.bodies[b].frame)});
+    }
+  for (std::size_t i = 0; i < m.pairs.size(); ++i) {
+    PairSurvey s;
+    s.a = m.pairs[i].a, s.b = m.pairs[i].b, s.lca = m.pairs[i].lca, s.checked = i < checked;
+    s.min_distance = INFINITY;
+    out.pairs.push_back(s);
+  }
+  Checker checker(m);
+  const QueryOptions q{.type = QueryType::Distances, .margin = out.margin};
+  const std::size_t rows = log.rows();
+  for (std::size_t row = 0; row < rows; ++row) {
+    if (options.progress && row % 256 == 0) options.progress(static_cast<double>(row) / rows);
+    const std::span<const double> state = log.row(row);
+    const double t = log.times[row] - options.time_offset;
+    const QueryResult& r = checker.query(state, state, q);
+    ++out.samples;
+    if (r.status != Status::Ok) {
+      ++out.unsafe, ++out.samples_within;
+      continue;
+    }
+    bool red = false;
+    for (const PairDistance& d : r.pairs) {
+      PairSurvey& s = out.pairs[d.pair];
+      if (d.distance < s.min_distance) s.min_distance = d.distance, s.min_time = t;
+      if (d.distance > out.margin) continue;
+      if (s.within++ == 0) s.first_within = t;
+      s.last_within = t;
+      red = red || s.checked;
+      if (d.distance <= 0.0) {
+        ++s.overlapping;
+        const Penetration p = penetration(checker.sweptVolume(s.a, s.lca), checker.sweptVolume(s.b, s.lca));
+        if (p.overlapping) s.max_penetration = std::max(s.max_penetration, p.depth);
+      }
+    }
+    out.samples_within += red;
+  }
+  for (PairSurvey& s : out.pairs)
+    if (!std::isfinite(s.min_distance)) s.min_distance = 0.0;  // no Ok sample
+  if (options.progress) options.progress(1.0);
+  return out;
+}
+
+}  // namespace kccd::modelling
