@@ -370,3 +370,96 @@ TEST(Cli, ImportWritesALoadableModel) {
   for (const auto& pair : plain_proofs.at("pairs")) ignored_plain += pair.at("checked") ? 0 : 1;
   EXPECT_GE(ignored, ignored_plain);
 }
+
+namespace {
+
+// A state log CSV with a header and the rows given (time first).
+std::string writeLog(const std::string& name, const std::string& header, const std::vector<std::string>& rows) {
+  const std::string path = ::testing::TempDir() + "/" + std::to_string(getpid()) + "_" + name;
+  std::ofstream f(path);
+  f << header << "\n";
+  for (const std::string& row : rows) f << row << "\n";
+  return path;
+}
+
+}  // namespace
+
+// A real robot out of the box: a Panda-like arm imported from its URDF (hand on fixed joints,
+// prismatic fingers) ignores its rigid and adjacent pairs with reasons, and a recording of it that
+// never touches anything (kccd synth's trajectory search, near-misses only) has no colliding
+// frame in kccd overlay; the survey of its log names the pair that comes within the margin.
+TEST(Cli, ImportedGripperArmRecordingHasNoCollidingFrame) {
+  const std::string dir = ::testing::TempDir() + "/" + std::to_string(getpid()) + "_gripper";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string model = dir + "/arm.yaml";
+  const Outcome imp =
+      runKccd("import " + std::string(KCCD_TEST_DATA_DIR) + "/urdf/gripper_arm.urdf -k 8 --pairs -q -o " + model);
+  ASSERT_EQ(imp.code, 0) << imp.err;
+  const auto info = nlohmann::json::parse(runKccd("info " + model + " --json").out);
+  std::map<std::string, std::string> reason;
+  for (const auto& p : info.at("ignored"))
+    reason[p.at("a").get<std::string>() + "-" + p.at("b").get<std::string>()] = p.at("reason");
+  EXPECT_EQ(reason["link3-hand"], "rigid");
+  EXPECT_EQ(reason["hand-left_finger"], "adjacent");
+  EXPECT_NE(reason["link2-hand"], "adjacent");  // link3 lies between: checked unless proven
+  const Outcome text = runKccd("info " + model);
+  EXPECT_NE(text.out.find("ignored pairs (pairs: ignore) and why:"), std::string::npos) << text.out;
+
+  const Outcome synth = runKccd("synth " + model + " -o " + dir + "/rec --seconds 4 --fps 10 --width 640 --height 480 "
+                                "--no-collision -q");
+  ASSERT_EQ(synth.code, 0) << synth.err;
+  const auto truth = nlohmann::json::parse(std::ifstream(dir + "/rec/synth.json"));
+  ASSERT_FALSE(truth.at("near_collision_frames").empty());  // it does come close
+  const Outcome ov = runKccd("overlay " + model + " --camera " + dir + "/rec/camera_true.yaml --video " + dir +
+                             "/rec/video.mkv --states " + dir + "/rec/states.csv --time-offset 0.137 -o " + dir +
+                             "/out.mkv --report " + dir + "/report.json -q");
+  ASSERT_EQ(ov.code, 0) << ov.err;
+  const auto report = nlohmann::json::parse(std::ifstream(dir + "/report.json"));
+  int colliding = 0, within = 0;
+  for (const auto& f : report.at("frames")) {
+    colliding += f.at("status") == "colliding";
+    within += f.at("status") == "within_margin";
+  }
+  EXPECT_EQ(colliding, 0);
+  EXPECT_GT(within, 0);
+
+  // The survey of the same log: the rows within the margin, the pair responsible, video times.
+  const Outcome sv = runKccd("pairs " + model + " --states " + dir + "/rec/states.csv --time-offset 0.137 --json -q");
+  ASSERT_EQ(sv.code, 0) << sv.err;
+  const auto survey = nlohmann::json::parse(sv.out);
+  EXPECT_GT(survey.at("samples_within").get<int>(), 0);
+  const auto& top = survey.at("pairs").at(0);
+  EXPECT_GT(top.at("within").get<int>(), 0);
+  EXPECT_EQ(top.at("overlapping"), 0);
+  EXPECT_GE(top.at("min_distance").get<double>(), 0.3 * 0.01);  // synth's near misses: about half the margin
+  EXPECT_LE(top.at("first_within").get<double>(), top.at("last_within").get<double>());
+  // --ignored also surveys the ignored pairs: the rigid hand overlaps link3 in every state.
+  const auto all = nlohmann::json::parse(
+      runKccd("pairs " + model + " --states " + dir + "/rec/states.csv --ignored --json -q").out);
+  bool rigid_seen = false;
+  for (const auto& p : all.at("pairs"))
+    if (p.at("a") == "link3" && p.at("b") == "hand") {
+      rigid_seen = true;
+      EXPECT_EQ(p.at("ignored"), "rigid");
+      EXPECT_EQ(p.at("within"), all.at("samples"));
+    }
+  EXPECT_TRUE(rigid_seen);
+  std::filesystem::remove_all(dir);
+}
+
+// Survey input errors: one line naming the log and place, exit 2; options that need --states.
+TEST(Cli, PairsSurveyBadInput) {
+  const std::string bad = writeLog("survey_bad.csv", "time,shoulder_yaw,shoulder_pitch,elbow", {"0,0,0,0", "0.1,0,x,0"});
+  const Outcome r = runKccd("pairs " + kDemo + " --states " + bad);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("survey_bad.csv:3:"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(runKccd("pairs " + kDemo + " --time-offset 1").code, 2);
+  EXPECT_EQ(runKccd("pairs " + kDemo + " --states " + bad + " --write").code, 2);
+  const std::string good = writeLog("survey_good.csv", "time,shoulder_yaw,shoulder_pitch,elbow",
+                                    {"0,-0.5,0,0", "0.1,0.5,0,0", "0.2,0,0,0"});
+  const Outcome ok = runKccd("pairs " + kDemo + " --states " + good + " --all");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_NE(ok.out.find("3 recorded states"), std::string::npos) << ok.out;
+}
