@@ -205,3 +205,30 @@ TEST(UrdfImport, MobileBasesBecomeJointChains) {
     EXPECT_NE(std::string(e.what()).find("base_yaw would repeat a joint name"), std::string::npos) << e.what();
   }
 }
+
+// --hulls: each body is its link's convex hull (the box's 8 corners, radius 0), the reference
+// bench_fit measures a fit's looseness against; a fitted body contains it.
+TEST(UrdfImport, HullBodiesAreTheLinksConvexHulls) {
+  const std::string dir = std::string(KCCD_TEST_DATA_DIR) + "/urdf";
+  km::ImportOptions opt;
+  opt.packages["kccd_test"] = dir;
+  opt.hulls = true;
+  const Model hull = kccd::parseModel(km::importUrdf(dir + "/two_link.urdf", opt), "hull");
+  const kccd::Body& base = hull.bodies[hull.bodyIndex("base")];
+  ASSERT_EQ(base.points.size(), 8u);
+  EXPECT_EQ(base.radius, 0.0);
+  for (const Vec3& p : base.points) {
+    EXPECT_NEAR(std::abs(p.x()), 0.2, 1e-12);
+    EXPECT_NEAR(std::abs(p.y()), 0.15, 1e-12);
+    EXPECT_TRUE(std::abs(p.z()) < 1e-12 || std::abs(p.z() - 0.1) < 1e-12) << p.transpose();
+  }
+  opt.hulls = false;
+  opt.points = 4;
+  const Model fitted = kccd::parseModel(km::importUrdf(dir + "/two_link.urdf", opt), "fitted");
+  for (const kccd::Body& b : hull.bodies) {
+    const kccd::Body& f = fitted.bodies[fitted.bodyIndex(b.name)];
+    for (const Vec3& p : b.points)
+      EXPECT_LE(static_cast<double>(kccd::testing::referencePointHullDistance(p, f.points)), f.radius + 1e-9)
+          << b.name << " " << p.transpose();
+  }
+}

@@ -19,7 +19,7 @@ struct ImportArgs {
   int points = 8;
   double margin = 0.02;
   std::vector<std::string> packages;
-  bool quiet = false, pairs = false, no_visuals = false, keep_adjacent = false;
+  bool quiet = false, pairs = false, no_visuals = false, keep_adjacent = false, hulls = false;
   int max_boxes = 2000;
 };
 
@@ -59,6 +59,7 @@ Exit runImport(const ImportArgs& args) {
   opt.safety_margin = args.margin;
   opt.visuals = !args.no_visuals;
   opt.keep_adjacent = args.keep_adjacent;
+  opt.hulls = args.hulls;
   for (const std::string& p : args.packages) {
     const std::size_t eq = p.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == p.size())
@@ -103,6 +104,10 @@ Runner addImport(CLI::App& app) {
   sub->add_flag("--pairs", args->pairs,
                 "Also prove which pairs never come within the margin inside the joint limits, or always touch, "
                 "and ignore them (as kccd pairs --write)");
+  sub->add_flag("--hulls", args->hulls,
+                "Bodies are the links' convex hulls (every hull vertex, no fit): a tight but slow reference model "
+                "to measure what a fit costs (kccd query on both)")
+      ->excludes(sub->get_option("--points"));
   sub->add_flag("--keep-adjacent", args->keep_adjacent,
                 "Check links joined by one moving joint (by default they are ignored, as MoveIt does: reason adjacent)");
   sub->add_option("--max-boxes", args->max_boxes, "With --pairs: boxes per pair before a pair is undecided")

@@ -17,6 +17,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include "kccd/model.hpp"
+#include "kccd/modelling/convex_hull.hpp"
 #include "kccd/modelling/fit.hpp"
 #include "kccd/modelling/pair_proof.hpp"
 #include "kccd/modelling/part.hpp"
@@ -472,12 +473,21 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     fo.points = options.points;
     if (options.progress)
       fo.progress = [&](double f) { options.progress((fitted + f) / std::max(1, with_geometry)); };
-    const FitResult fit_result = fit(part, fo);
     bodies << "  - name: " << link->name << "\n"
-           << "    frame: " << frame_of.at(link->name) << "\n"
-           << "    points: " << flowPoints(fit_result.points) << "\n"
-           << "    radius: " << yamlNumber(fit_result.radius, true) << "   # volume " << num(fit_result.volume)
-           << " m^3, hull " << num(fit_result.hull_volume) << " m^3\n";
+           << "    frame: " << frame_of.at(link->name) << "\n";
+    if (options.hulls) {  // the hull's vertices (balls sampled on their surface), no fit
+      const std::vector<Vec3> samples = part.samples();
+      std::vector<Vec3> vertices;
+      for (int i : convexHull(samples).vertices) vertices.push_back(samples[i]);
+      bodies << "    points: " << flowPoints(vertices) << "\n"
+             << "    radius: " << yamlNumber(part.coordinate_guard + 1e-9 * part.coordinate_guard, true)
+             << "   # the convex hull of the collision geometry\n";
+    } else {
+      const FitResult fit_result = fit(part, fo);
+      bodies << "    points: " << flowPoints(fit_result.points) << "\n"
+             << "    radius: " << yamlNumber(fit_result.radius, true) << "   # volume " << num(fit_result.volume)
+             << " m^3, hull " << num(fit_result.hull_volume) << " m^3\n";
+    }
     body_names.insert(link->name);
     ++fitted;
   }

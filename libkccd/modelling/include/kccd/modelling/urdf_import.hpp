@@ -22,6 +22,8 @@ struct ImportOptions {
   double safety_margin = 0.02;                  ///< written into the model
   std::map<std::string, std::string> packages;  ///< package:// NAME -> directory
   bool visuals = true;                          ///< write each link's <visual>s as `visuals:` (meshes must exist)
+  bool hulls = false;                           ///< bodies are the links' convex hulls (vertices, no fit): a
+                                                ///< tight, slow reference to measure what a fit costs
   bool keep_adjacent = false;                   ///< check adjacent links (else ignored: Connection::Adjacent)
   std::function<void(double)> progress;
 };
