@@ -163,6 +163,59 @@ std::vector<Vec3> farthestPoints(const std::vector<Vec3>& pool, const Vec3& cent
   return out;
 }
 
+// The hull's vertices moved inwards by r along their (angle-weighted) normals: each stays within
+// r of its vertex, so any core whose SSCH of radius r holds these points' hull covers the part.
+// On rounded parts the moved vertices gather (a cylinder's rim moved by its radius lands on its
+// axis), and a few of them describe the part: seeds for every scale of rounding.
+std::vector<std::vector<Vec3>> offsetClouds(const std::vector<Vec3>& points, const std::vector<double>& radii) {
+  std::vector<std::vector<Vec3>> out;
+  const ConvexHull h = convexHull(points);
+  if (h.dimension < 3) return out;
+  std::vector<Vec3> normal(points.size(), Vec3::Zero());
+  for (const auto& t : h.triangles) {
+    const Vec3 n = (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]);
+    if (!(n.norm() > 0.0)) continue;
+    for (int k = 0; k < 3; ++k) {  // weighted by the triangle's angle at the vertex
+      const Vec3 e1 = points[t[(k + 1) % 3]] - points[t[k]], e2 = points[t[(k + 2) % 3]] - points[t[k]];
+      const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
+      normal[t[k]] += angle * n.normalized();
+    }
+  }
+  for (const double r : radii) {
+    std::vector<Vec3> cloud;
+    for (int i : h.vertices)
+      if (normal[i].norm() > 0.0) cloud.push_back(points[i] - r * normal[i].normalized());
+    if (!cloud.empty()) out.push_back(std::move(cloud));
+  }
+  return out;
+}
+
+// k points of `cloud` (not empty) whose hull is as large as a greedy choice makes it: three
+// spread out, then each time the point that grows the hull most.
+std::vector<Vec3> greatestHull(const std::vector<Vec3>& all, int k) {
+  // Chosen among 48 points spread over the cloud (each step builds one hull per candidate).
+  Vec3 centre = Vec3::Zero();
+  for (const Vec3& p : all) centre += p;
+  const std::vector<Vec3> cloud =
+      all.size() > 48 ? farthestPoints(all, centre / static_cast<double>(all.size()), 48) : all;
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& p : cloud) mean += p;
+  std::vector<Vec3> out = farthestPoints(cloud, mean / static_cast<double>(cloud.size()), std::min(k, 3));
+  while (static_cast<int>(out.size()) < k) {
+    double best = -1.0;
+    std::size_t pick = 0;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      std::vector<Vec3> trial = out;
+      trial.push_back(cloud[i]);
+      const ConvexHull h = convexHull(trial);
+      const double size = h.dimension == 3 ? h.volume : h.dimension == 2 ? 1e-9 * h.area : 0.0;
+      if (size > best) best = size, pick = i;
+    }
+    out.push_back(cloud[pick]);
+  }
+  return out;
+}
+
 std::vector<Vec3> kMeans(const std::vector<Vec3>& pool, std::vector<Vec3> seeds) {
   for (int iter = 0; iter < 12; ++iter) {
     std::vector<Vec3> sum(seeds.size(), Vec3::Zero());
@@ -293,12 +346,38 @@ FitResult fit(const Part& part, const FitOptions& options) {
   for (const Sphere& b : c.balls) pool.push_back(b.center);
 
   std::vector<std::vector<Vec3>> extra_seeds(2);  // whole seeds, used as they are
+  // Offset hulls at rounding radii from 2 % to 45 % of the part's thinnest principal extent.
+  std::vector<std::vector<Vec3>> offsets;
+  if (!c.points.empty()) {
+    Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+    for (const Vec3& p : c.points) {
+      const Vec3 q = c.axes.transpose() * p;
+      lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+    }
+    const double thin = (hi - lo).minCoeff();
+    std::vector<double> radii;
+    for (double f : {0.02, 0.05, 0.1, 0.15, 0.22, 0.3, 0.45}) radii.push_back(f * thin);
+    offsets = offsetClouds(c.points, radii);
+  }
   auto optimise = [&](int k, const FitOptions& opt) {
     Objective f(c);
     std::vector<std::vector<Vec3>> seeds;
     const std::vector<Vec3> fps = farthestPoints(pool, c.center, k);
     seeds.push_back(fps);
     if (k > 1 && static_cast<int>(pool.size()) > k) seeds.push_back(kMeans(pool, fps));
+    // Seeds from the offset hulls (k of their points spread out, clustered, or spanning the
+    // largest hull), refined in addition to the others.
+    std::vector<std::vector<Vec3>> offset_seeds;
+    if (k >= 3)
+      for (const std::vector<Vec3>& cloud : offsets) {
+        if (static_cast<int>(cloud.size()) < k) continue;
+        Vec3 mean = Vec3::Zero();
+        for (const Vec3& p : cloud) mean += p;
+        const std::vector<Vec3> spread = farthestPoints(cloud, mean / static_cast<double>(cloud.size()), k);
+        offset_seeds.push_back(spread);
+        offset_seeds.push_back(kMeans(cloud, spread));
+        offset_seeds.push_back(greatestHull(cloud, k));
+      }
     if (k > 1) {
       // Corners of the principal box, flattened along its thinnest axes when k is small.
       Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
@@ -318,25 +397,40 @@ FitResult fit(const Part& part, const FitOptions& options) {
       seeds.push_back(seed);
     }
     // Every seed shrunk to its best scale; the three best are refined, the best result wins.
-    std::vector<std::pair<double, std::vector<Vec3>>> starts;
-    for (const auto& s : seeds) {
-      Vec3 mean = Vec3::Zero();
-      for (const Vec3& p : s) mean += p;
-      mean /= static_cast<double>(s.size());
-      double v = 0.0;
-      std::vector<Vec3> shrunk = bestShrink(s, mean, 1.5, f, v);
-      starts.emplace_back(v, std::move(shrunk));
-    }
+    // Every seed shrunk to its best scale; the three best of the first seeds and the two best
+    // offset seeds are refined (those with half the budget), the best result wins.
+    using Start = std::pair<double, std::vector<Vec3>>;
+    auto shrunk = [&](const std::vector<std::vector<Vec3>>& list) {
+      std::vector<Start> out;
+      for (const auto& s : list) {
+        Vec3 mean = Vec3::Zero();
+        for (const Vec3& p : s) mean += p;
+        mean /= static_cast<double>(s.size());
+        double v = 0.0;
+        std::vector<Vec3> scaled_seed = bestShrink(s, mean, 1.5, f, v);
+        out.emplace_back(v, std::move(scaled_seed));
+      }
+      return out;
+    };
+    std::vector<Start> starts = shrunk(seeds);
     for (const auto& s : extra_seeds)
       if (static_cast<int>(s.size()) == k) starts.emplace_back(f(s), s);
-    std::sort(starts.begin(), starts.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-    const int runs = std::min<int>(3, static_cast<int>(starts.size()));
+    const auto by_value = [](const Start& x, const Start& y) { return x.first < y.first; };
+    std::sort(starts.begin(), starts.end(), by_value);
+    starts.resize(std::min<std::size_t>(3, starts.size()));
+    const std::size_t first_offset = starts.size();
+    std::vector<Start> offset_starts = shrunk(offset_seeds);
+    std::sort(offset_starts.begin(), offset_starts.end(), by_value);
+    for (std::size_t i = 0; i < std::min<std::size_t>(2, offset_starts.size()); ++i) starts.push_back(offset_starts[i]);
+    const int runs = static_cast<int>(starts.size());
     FitOptions share = opt;  // each run gets the whole budget
     std::vector<Vec3> best;
     double best_value = INFINITY;
     for (int i = 0; i < runs; ++i) {
       if (opt.progress)
         share.progress = [&, i](double x) { opt.progress((i + x) / runs); };
+      // Offset seeds start close to a good shape: half the budget each.
+      share.max_evaluations = static_cast<std::size_t>(i) < first_offset ? opt.max_evaluations : opt.max_evaluations / 2;
       std::vector<Vec3> refined = patternSearch(starts[i].second, starts[i].first, c, f, share, rng);
       const double v = f(refined);
       if (v < best_value) best = std::move(refined), best_value = v;
