@@ -77,12 +77,12 @@ TEST(UrdfImport, TestRobot) {
 
   // SRDF: adjacent pairs ignored; a pair naming a link without geometry dropped.
   const std::string ignore = text.substr(text.find("ignore:"));
-  EXPECT_NE(ignore.find("[base, column, adjacent]"), std::string::npos);  // adjacent outranks the SRDF
-  EXPECT_NE(ignore.find("[slider, tool, adjacent]"), std::string::npos);
-  EXPECT_NE(ignore.find("[column, slider, adjacent]"), std::string::npos);
+  EXPECT_NE(ignore.find("[base, column, srdf]"), std::string::npos);  // the SRDF's word is kept
+  EXPECT_NE(ignore.find("[slider, tool, srdf]"), std::string::npos);
+  EXPECT_NE(ignore.find("[column, slider, adjacent]"), std::string::npos);  // and the rule adds this one
   EXPECT_EQ(ignore.find("marker"), std::string::npos);
   EXPECT_EQ(m.pairs.size(), 3u);
-  opt.keep_adjacent = true;  // then the SRDF says why base - column and slider - tool are ignored
+  opt.keep_adjacent = true;  // then only the SRDF's pairs are ignored
   const std::string kept = km::importUrdf(dir + "/two_link.urdf", opt);
   EXPECT_NE(kept.find("[base, column, srdf]"), std::string::npos) << kept;
   EXPECT_NE(kept.find("[slider, tool, srdf]"), std::string::npos) << kept;
@@ -222,10 +222,20 @@ TEST(UrdfImport, HullBodiesAreTheLinksConvexHulls) {
     EXPECT_NEAR(std::abs(p.y()), 0.15, 1e-12);
     EXPECT_TRUE(std::abs(p.z()) < 1e-12 || std::abs(p.z() - 0.1) < 1e-12) << p.transpose();
   }
+  // The slider's URDF sphere (radius 0.04 at x = 0.1) is inside its hull body.
+  const kccd::Body& slider = hull.bodies[hull.bodyIndex("slider")];
+  for (const Vec3& d : std::vector<Vec3>{Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ(), Vec3(1, 1, 1).normalized(),
+                                         Vec3(1, -2, 3).normalized()})
+    for (double sign : {1.0, -1.0})
+      EXPECT_LE(static_cast<double>(kccd::testing::referencePointHullDistance(Vec3(0.1, 0, 0) + sign * 0.04 * d,
+                                                                             slider.points)),
+                slider.radius + 1e-12)
+          << d.transpose();
   opt.hulls = false;
   opt.points = 4;
   const Model fitted = kccd::parseModel(km::importUrdf(dir + "/two_link.urdf", opt), "fitted");
   for (const kccd::Body& b : hull.bodies) {
+    if (b.name == "slider") continue;  // its sphere is a circumscribed polytope there, an exact ball in the fit
     const kccd::Body& f = fitted.bodies[fitted.bodyIndex(b.name)];
     for (const Vec3& p : b.points)
       EXPECT_LE(static_cast<double>(kccd::testing::referencePointHullDistance(p, f.points)), f.radius + 1e-9)

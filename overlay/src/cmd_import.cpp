@@ -32,7 +32,8 @@ std::string withProvenPairs(const std::string& text, const ImportArgs& args) {
     Progress progress("proving pairs", args.quiet);
     reports = modelling::provePairs(m, {.max_boxes = args.max_boxes, .progress = [&](double f) { progress.update(f); }});
   }
-  const modelling::IgnorePlan plan = modelling::ignoreList(m, reports, {.keep_adjacent = args.keep_adjacent});
+  const modelling::IgnorePlan plan =
+      modelling::ignoreList(m, reports, {.keep_adjacent = args.keep_adjacent, .world_is_link = true});
   int never = 0, touching = 0, undecided = 0, rigid = 0, adjacent = 0;
   for (const auto& r : reports) {
     rigid += r.rigid;

@@ -1,9 +1,12 @@
 // `kccd pairs MODEL`: proves which pairs can never come within the margin over the joint limits,
 // which are rigid or adjacent, and (with --states) surveys how close each pair comes in a recording.
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <random>
 
 #include "cli_args.hpp"
 #include "cli_files.hpp"
@@ -20,7 +23,8 @@ namespace {
 struct PairsArgs {
   std::string model, states, ignore_columns;
   double margin = -1.0, time_offset = 0.0;
-  int max_boxes = 2000;
+  int max_boxes = 2000, random = 0;
+  std::uint64_t seed = 1;
   bool write = false, json = false, quiet = false, all = false, keep_adjacent = false, ignored = false;
 };
 
@@ -31,17 +35,40 @@ void writeIgnoreList(const std::string& model, const std::string& proven_text,
            &proven_text);
 }
 
-// Why the pair is ignored now (its `pairs: ignore` reason), or "" when it is checked.
+// Why an unchecked pair is not checked: its `pairs: ignore` reason, or "not_included" (a model
+// with `check: none` that does not include it).
 std::string currentReason(const Model& m, int a, int b) {
   for (const IgnoredPair& p : m.ignored)
     if ((p.a == a && p.b == b) || (p.a == b && p.b == a)) return toString(p.reason);
-  return "";
+  return "not_included";
 }
 
 std::string pairName(const Model& m, int a, int b) { return m.bodies[a].name + " - " + m.bodies[b].name; }
 
+// `--random N`: N configurations drawn uniformly inside the joint limits (values without limits
+// at 0), numbered 0 ... N-1 in place of times.
+StateLog randomStates(const Model& m, int n, std::uint64_t seed) {
+  StateLog log;
+  log.names = m.stateNames();
+  log.circular.assign(m.stateSize(), 0);
+  log.logged_velocity.assign(m.stateSize(), 0);
+  const auto ranges = modelling::jointRanges(m);
+  std::mt19937_64 rng(seed);
+  for (int i = 0; i < n; ++i) {
+    log.times.push_back(i);
+    for (const auto& r : ranges)
+      log.values.push_back(std::isnan(r[0]) ? 0.0 : std::uniform_real_distribution<double>(r[0], r[1])(rng));
+  }
+  return log;
+}
+
 Exit runSurvey(const PairsArgs& args, const Model& m) {
-  const StateLog log = loadStateLog(args.states, m, splitCommas(args.ignore_columns));
+  const bool random = args.random > 0;
+  const StateLog log =
+      random ? randomStates(m, args.random, args.seed) : loadStateLog(args.states, m, splitCommas(args.ignore_columns));
+  const std::string source = random ? "random states inside the joint limits (seed " + std::to_string(args.seed) + ")"
+                                    : "recorded states from " + args.states;
+  const std::string when = random ? "sample" : "at (s)";
   modelling::Survey s;
   {
     Progress progress("surveying " + std::to_string(log.rows()) + " states", args.quiet || args.json);
@@ -59,14 +86,15 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
   });
   const double n = static_cast<double>(std::max<std::size_t>(1, s.samples));
   if (args.json) {
-    nlohmann::json j{{"margin", s.margin},         {"states", args.states},   {"time_offset", args.time_offset},
+    nlohmann::json j{{"margin", s.margin},         {"states", random ? nlohmann::json("random") : nlohmann::json(args.states)},
+                     {"time_offset", args.time_offset},
                      {"samples", s.samples},       {"samples_within", s.samples_within},
                      {"unsafe", s.unsafe},         {"pairs", nlohmann::json::array()}};
     for (const auto* p : order) {
       nlohmann::json o{{"a", m.bodies[p->a].name},  {"b", m.bodies[p->b].name}, {"frame", m.frameName(p->lca)},
                        {"checked", p->checked},     {"within", p->within},      {"fraction", p->within / n},
-                       {"overlapping", p->overlapping}, {"min_distance", p->min_distance},
-                       {"min_time", p->min_time}};
+                       {"overlapping", p->overlapping}, {"min_distance", number(p->min_distance)},
+                       {"min_time", number(p->min_time)}};
       if (!p->checked) o["ignored"] = currentReason(m, p->a, p->b);
       if (p->within > 0) o["first_within"] = p->first_within, o["last_within"] = p->last_within;
       if (p->overlapping > 0) o["max_penetration"] = p->max_penetration;
@@ -75,13 +103,12 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
     std::cout << j.dump(2) << "\n";
     return Exit::Ok;
   }
-  std::cout << "model " << m.name << ": " << s.samples << " recorded states from " << args.states << ", margin "
-            << s.margin << " m\n"
+  std::cout << "model " << m.name << ": " << s.samples << " " << source << ", margin " << s.margin << " m\n"
             << s.samples_within << " states (" << format(100.0 * s.samples_within / n, 3)
             << " %) have a checked pair within the margin" << (s.unsafe ? ", " + std::to_string(s.unsafe) + " unsafe" : "")
             << "\n";
   std::cout << std::left << std::setw(44) << "  pair" << std::setw(16) << "within margin" << std::setw(14)
-            << "closest (m)" << std::setw(12) << "at (s)" << "note\n";
+            << "closest (m)" << std::setw(12) << when << "note\n";
   int quiet_pairs = 0;
   for (const auto* p : order) {
     if (p->within == 0 && !args.all) {
@@ -94,12 +121,13 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
                                                        : "sometimes";
     if (p->overlapping) note += (note.empty() ? "" : "; ") + std::string("volumes overlap in ") +
                                 std::to_string(p->overlapping) + " states, up to " + format(p->max_penetration, 3) + " m";
-    if (p->within > 0)
+    if (p->within > 0 && !random)
       note += "; " + format(p->first_within, 6) + " ... " + format(p->last_within, 6) + " s";
     if (!p->checked) note = "(ignored: " + currentReason(m, p->a, p->b) + ") " + note;
     std::cout << "  " << std::left << std::setw(42) << pairName(m, p->a, p->b) << std::setw(16)
               << (std::to_string(p->within) + " (" + format(100.0 * f, 3) + " %)") << std::setw(14)
-              << format(p->min_distance, 4) << std::setw(12) << format(p->min_time, 6) << note << "\n";
+              << (std::isnan(p->min_distance) ? std::string("-") : format(p->min_distance, 4)) << std::setw(12)
+              << (std::isnan(p->min_time) ? std::string("-") : format(p->min_time, 6)) << note << "\n";
   }
   if (quiet_pairs > 0) std::cout << quiet_pairs << " pairs never within the margin (--all lists them)\n";
   std::cout << "A survey is evidence, not a proof: nothing is ignored from it. A pair within the margin in a run "
@@ -110,7 +138,9 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
 Exit runPairs(const PairsArgs& args) {
   std::string model_text;
   const Model m = loadOrExplain(args.model, &model_text);
-  if (!args.states.empty()) return runSurvey(args, m);
+  const bool survey = !args.states.empty() || args.random > 0;
+  if (args.ignored && !survey) throw UsageError("--ignored: needs --states or --random");
+  if (survey) return runSurvey(args, m);
   std::vector<modelling::PairReport> reports;
   {
     Progress progress("proving pairs", args.quiet || args.json);
@@ -154,8 +184,8 @@ Exit runPairs(const PairsArgs& args) {
     return Exit::Ok;
   }
   int counts[5] = {0, 0, 0, 0, 0}, rigid = 0, adjacent = 0;
-  for (const auto& r : reports) {
-    ++counts[static_cast<int>(r.verdict)];
+  for (const auto& r : reports) {  // rigid pairs counted as rigid only
+    if (!r.rigid) ++counts[static_cast<int>(r.verdict)];
     rigid += r.rigid;
     adjacent += r.adjacent;
   }
@@ -229,6 +259,12 @@ Runner addPairs(CLI::App& app) {
   auto* states = sub->add_option("--states", args->states,
                                  "Survey a state log (CSV) instead of proving: per checked pair, how many recorded "
                                  "states come within the margin, how close, when (nothing is written)");
+  auto* random = sub->add_option("--random", args->random,
+                                 "Survey N configurations drawn inside the joint limits instead of proving (MoveIt's "
+                                 "'often in collision' sampling; reported, nothing is written)")
+                     ->check(CLI::Range(1, 100000000))
+                     ->excludes(states);
+  sub->add_option("--seed", args->seed, "With --random: the seed of the draw")->capture_default_str()->needs(random);
   sub->add_option("--time-offset", args->time_offset,
                   "With --states: seconds added to the video time to get the log time (as kccd overlay); times are "
                   "reported as video times")
@@ -236,7 +272,7 @@ Runner addPairs(CLI::App& app) {
       ->needs(states);
   sub->add_option("--ignore-columns", args->ignore_columns, "With --states: comma-separated log columns to skip")
       ->needs(states);
-  sub->add_flag("--ignored", args->ignored, "With --states: also survey the pairs the model ignores")->needs(states);
+  sub->add_flag("--ignored", args->ignored, "With --states or --random: also survey the pairs the model ignores");
   sub->add_flag("--all", args->all, "Also list the pairs that meet (with --states: the pairs never within the margin)");
   sub->add_flag("--json", args->json, "Machine-readable output");
   sub->add_flag("--quiet,-q", args->quiet, "No progress display");
@@ -250,7 +286,10 @@ Runner addPairs(CLI::App& app) {
       "A proof holds while the joints stay inside their limits. Ignore entries whose reason no longer holds "
       "(a failed proof, a joint no longer fixed) are dropped by --write and listed.\n"
       "Exit status: 0 done, 2 bad input.");
-  states->excludes(sub->get_option("--write"));
+  for (const char* proof_only : {"--write", "--keep-adjacent", "--max-boxes"}) {  // not for a survey
+    states->excludes(sub->get_option(proof_only));
+    random->excludes(sub->get_option(proof_only));
+  }
   return [args] { return runPairs(*args); };
 }
 

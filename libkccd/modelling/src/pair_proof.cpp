@@ -26,19 +26,35 @@ double distanceUpper(const SschView& a, const SschView& b) {
   return std::max(0.0, d.hull_upper - a.radius - b.radius);
 }
 
+// The pose of `frame` in the frame of its ancestor `top` when only fixed joints lie between
+// (each joint's origin is then its whole motion).
+Pose fixedPose(const Model& m, int frame, int top) {
+  Pose pose = Pose::Identity();
+  for (int f = frame; f != top && f != kWorld; f = m.joints[f].parent) pose = m.joints[f].origin * pose;
+  return pose;
+}
+
+// A body's own points placed in an ancestor frame through fixed joints (its exact SSCH there:
+// no point budget, no radius growth).
+std::vector<Vec3> placed(const Model& m, int body, int top) {
+  const Pose pose = fixedPose(m, m.bodies[body].frame, top);
+  std::vector<Vec3> out;
+  for (const Vec3& p : m.bodies[body].points) out.push_back(pose * p);
+  return out;
+}
+
 // Adjacent through the revolute joint `g` (the one moving joint between the two bodies, above
-// the child body): points on its axis are fixed in both bodies' frames. If one of them lies within the margin of
-// both bodies, the bodies are within the margin at every angle. The child is taken in g's
-// frame, the parent body in the pair's common frame `lca` (only fixed joints lie between lca
-// and g's parent, so the axis has one place there).
-bool sharesAxisPoint(const Model& m, Checker& checker, int parent_body, int child_body, int g, int lca,
-                     double margin) {
+// the child body): points on its axis are fixed in both bodies' frames. If one of them lies
+// within the margin of both bodies, the bodies are within the margin at every angle. The child
+// is taken in g's frame, the parent body in the pair's common frame `lca` (only fixed joints lie
+// between either body and those frames, so both are exact).
+bool sharesAxisPoint(const Model& m, int parent_body, int child_body, int g, int lca, double margin) {
   const Joint& j = m.joints[g];
-  const SschView child = checker.sweptVolume(child_body, g);
-  const SschView parent = checker.sweptVolume(parent_body, lca);
+  const std::vector<Vec3> child_points = placed(m, child_body, g), parent_points = placed(m, parent_body, lca);
+  const SschView child{child_points, m.bodies[child_body].radius};
+  const SschView parent{parent_points, m.bodies[parent_body].radius};
   if (child.points.empty() || parent.points.empty()) return false;
-  Pose to_lca = j.origin;  // g's frame (at any angle, for points on its axis) in lca's frame
-  for (int f = j.parent; f != lca && f != kWorld; f = m.joints[f].parent) to_lca = m.joints[f].origin * to_lca;
+  const Pose to_lca = fixedPose(m, j.parent, lca) * j.origin;  // g's frame (on its axis: any angle)
   double extent = child.radius + parent.radius;
   for (const Vec3& p : child.points) extent = std::max(extent, p.norm() + child.radius);
   auto cost = [&](double t) {
@@ -73,9 +89,23 @@ void addOnce(std::vector<IgnoreEntry>& list, const std::string& a, const std::st
   list.push_back({a, b, reason});
 }
 
-// The model's own entries after `plan.ignore`'s: user and SRDF entries always, rigid and adjacent
-// ones while the rule still holds (adjacent ones only without keep_adjacent), proof entries
-// (never, always_touching) when `keep_proofs`; the rest go to `plan.dropped`.
+// Whether the adjacency rule may ignore the pair: adjacent, and a body in the world frame is a
+// link (a URDF's root) only when the options say so (otherwise it is an obstacle: a table, a post).
+bool adjacentByRule(const Model& m, int a, int b, const IgnoreOptions& options, bool world_is_link) {
+  if (options.keep_adjacent || connection(m, a, b) != Connection::Adjacent) return false;
+  return world_is_link || (m.bodies[a].frame != kWorld && m.bodies[b].frame != kWorld);
+}
+
+// The model's user and SRDF entries, which keep their reason whatever the rules say.
+void carryDecisions(const Model& m, IgnorePlan& plan) {
+  for (const IgnoredPair& p : m.ignored)
+    if (p.reason == IgnoreReason::User || p.reason == IgnoreReason::Srdf)
+      addOnce(plan.ignore, m.bodies[p.a].name, m.bodies[p.b].name, p.reason);
+}
+
+// The model's other entries after `plan.ignore`'s: rigid and adjacent ones while the rule still
+// holds (an adjacent entry in the file says its world body is a link), proof entries (never,
+// always_touching) when `keep_proofs`; the rest go to `plan.dropped`.
 void carryModelEntries(const Model& m, const IgnoreOptions& options, bool keep_proofs, IgnorePlan& plan) {
   for (const IgnoredPair& p : m.ignored) {
     const std::string &a = m.bodies[p.a].name, &b = m.bodies[p.b].name;
@@ -84,7 +114,7 @@ void carryModelEntries(const Model& m, const IgnoreOptions& options, bool keep_p
       case IgnoreReason::User:
       case IgnoreReason::Srdf: break;
       case IgnoreReason::Rigid: keep = connection(m, p.a, p.b) == Connection::Rigid; break;
-      case IgnoreReason::Adjacent: keep = !options.keep_adjacent && connection(m, p.a, p.b) == Connection::Adjacent; break;
+      case IgnoreReason::Adjacent: keep = adjacentByRule(m, p.a, p.b, options, true); break;
       case IgnoreReason::Never:
       case IgnoreReason::AlwaysTouching: keep = keep_proofs; break;
     }
@@ -210,11 +240,10 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
       lower[s] = upper[s] = std::isnan(ranges[s][0]) ? 0.0 : 0.5 * ranges[s][0] + 0.5 * ranges[s][1];
     const QueryOptions qopt{.type = QueryType::Distances, .margin = margin};
 
-    if (r.rigid) {  // one configuration: its distance decides
-      checker.query(lower, upper, qopt);
+    if (r.rigid) {  // one configuration: its distance (of the exact volumes) decides
       ++r.boxes;
-      const SschView va = checker.sweptVolume(r.a, r.lca), vb = checker.sweptVolume(r.b, r.lca);
-      const DistanceResult d = distance(va, vb);
+      const std::vector<Vec3> pa = placed(m, r.a, r.lca), pb = placed(m, r.b, r.lca);
+      const DistanceResult d = distance(SschView{pa, m.bodies[r.a].radius}, SschView{pb, m.bodies[r.b].radius});
       r.bound = d.distance;
       r.verdict = d.distance > margin && d.status != GjkStatus::InvalidInput ? Verdict::Never : Verdict::AlwaysTouching;
       continue;
@@ -225,8 +254,7 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
       for (int body : {r.a, r.b})
         for (int f = m.bodies[body].frame; f != r.lca && f != kWorld; f = m.joints[f].parent)
           if (m.joints[f].type != JointType::Fixed) g = f, child = body, parent = body == r.a ? r.b : r.a;
-      checker.query(lower, upper, qopt);
-      if (m.joints[g].type == JointType::Revolute && sharesAxisPoint(m, checker, parent, child, g, r.lca, margin)) {
+      if (m.joints[g].type == JointType::Revolute && sharesAxisPoint(m, parent, child, g, r.lca, margin)) {
         r.verdict = Verdict::AlwaysTouching;
         continue;
       }
@@ -292,21 +320,23 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
 
 IgnorePlan structuralIgnores(const Model& m, const IgnoreOptions& options) {
   IgnorePlan plan;
+  carryDecisions(m, plan);
   const int n = static_cast<int>(m.bodies.size());
-  for (const Connection want : {Connection::Rigid, Connection::Adjacent}) {
-    if (want == Connection::Adjacent && options.keep_adjacent) continue;
-    for (int a = 0; a < n; ++a)
-      for (int b = a + 1; b < n; ++b)
-        if (m.bodies[a].frame != m.bodies[b].frame && connection(m, a, b) == want)
-          addOnce(plan.ignore, m.bodies[a].name, m.bodies[b].name,
-                  want == Connection::Rigid ? IgnoreReason::Rigid : IgnoreReason::Adjacent);
-  }
+  for (int a = 0; a < n; ++a)
+    for (int b = a + 1; b < n; ++b)
+      if (m.bodies[a].frame != m.bodies[b].frame && connection(m, a, b) == Connection::Rigid)
+        addOnce(plan.ignore, m.bodies[a].name, m.bodies[b].name, IgnoreReason::Rigid);
+  for (int a = 0; a < n; ++a)
+    for (int b = a + 1; b < n; ++b)
+      if (m.bodies[a].frame != m.bodies[b].frame && adjacentByRule(m, a, b, options, options.world_is_link))
+        addOnce(plan.ignore, m.bodies[a].name, m.bodies[b].name, IgnoreReason::Adjacent);
   carryModelEntries(m, options, true, plan);
   return plan;
 }
 
 IgnorePlan ignoreList(const Model& m, const std::vector<PairReport>& reports, const IgnoreOptions& options) {
   IgnorePlan plan;
+  carryDecisions(m, plan);
   const auto names = [&](const PairReport& r) { return std::pair(m.bodies[r.a].name, m.bodies[r.b].name); };
   for (const PairReport& r : reports)
     if (r.rigid) addOnce(plan.ignore, names(r).first, names(r).second, IgnoreReason::Rigid);
@@ -314,9 +344,9 @@ IgnorePlan ignoreList(const Model& m, const std::vector<PairReport>& reports, co
     if (r.verdict == Verdict::Never || r.verdict == Verdict::AlwaysTouching)
       addOnce(plan.ignore, names(r).first, names(r).second,
               r.verdict == Verdict::Never ? IgnoreReason::Never : IgnoreReason::AlwaysTouching);
-  if (!options.keep_adjacent)
-    for (const PairReport& r : reports)
-      if (r.adjacent) addOnce(plan.ignore, names(r).first, names(r).second, IgnoreReason::Adjacent);
+  for (const PairReport& r : reports)
+    if (adjacentByRule(m, r.a, r.b, options, options.world_is_link))
+      addOnce(plan.ignore, names(r).first, names(r).second, IgnoreReason::Adjacent);
   carryModelEntries(m, options, false, plan);
   return plan;
 }

@@ -57,7 +57,7 @@ Survey surveyStates(const Model& model, const StateLog& log, const SurveyOptions
     out.samples_within += red;
   }
   for (PairSurvey& s : out.pairs)
-    if (!std::isfinite(s.min_distance)) s.min_distance = 0.0;  // no Ok sample
+    if (!std::isfinite(s.min_distance)) s.min_distance = s.min_time = std::nan("");  // no Ok sample
   if (options.progress) options.progress(1.0);
   return out;
 }

@@ -475,8 +475,10 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
       fo.progress = [&](double f) { options.progress((fitted + f) / std::max(1, with_geometry)); };
     bodies << "  - name: " << link->name << "\n"
            << "    frame: " << frame_of.at(link->name) << "\n";
-    if (options.hulls) {  // the hull's vertices (balls sampled on their surface), no fit
-      const std::vector<Vec3> samples = part.samples();
+    if (options.hulls) {  // the hull's vertices (balls by circumscribed polytopes), no fit
+      std::vector<Vec3> samples = part.points;
+      for (const Sphere& b : part.balls)
+        for (const Vec3& v : circumscribedUnitSphere()) samples.push_back(b.center + b.radius * v);
       std::vector<Vec3> vertices;
       for (int i : convexHull(samples).vertices) vertices.push_back(samples[i]);
       bodies << "    points: " << flowPoints(vertices) << "\n"
@@ -501,7 +503,9 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     std::ostringstream out;
     out << "# Imported from " << std::filesystem::path(path).filename().string()
         << (options.srdf.empty() ? "" : " and " + std::filesystem::path(options.srdf).filename().string())
-        << " by kccd import (" << options.points << " core points per link)\n"
+        << " by kccd import ("
+        << (options.hulls ? std::string("convex hulls, no fit") : std::to_string(options.points) + " core points per link")
+        << ")\n"
         << "kccd: 1\n"
         << "name: " << urdf->getName() << "\n"
         << "safety_margin: " << num(options.safety_margin) << "\n";
@@ -522,7 +526,7 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     }
   };
   // Rigidly attached and adjacent links (MoveIt's rule), then the SRDF's pairs.
-  ignore = structuralIgnores(load(compose()), {.keep_adjacent = options.keep_adjacent}).ignore;
+  ignore = structuralIgnores(load(compose()), {.keep_adjacent = options.keep_adjacent, .world_is_link = true}).ignore;
   const std::string text = compose();
   (void)load(text);
   if (options.progress) options.progress(1.0);

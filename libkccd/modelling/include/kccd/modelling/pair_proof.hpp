@@ -62,6 +62,10 @@ std::vector<PairReport> provePairs(const Model& model, const ProofOptions& optio
 
 struct IgnoreOptions {
   bool keep_adjacent = false;  ///< check adjacent pairs (MoveIt's rule not applied)
+  /// Bodies in the world frame are a link (a URDF's root link: kccd import), adjacent to the
+  /// bodies one moving joint away. Otherwise they are obstacles (a table, a post) and the rule
+  /// never ignores a pair with one of them; adjacent entries already in the file stay.
+  bool world_is_link = false;
 };
 
 /// An ignore list and the model's entries it no longer carries.
@@ -70,14 +74,14 @@ struct IgnorePlan {
   std::vector<IgnoreEntry> dropped;  ///< old entries whose reason no longer holds (checked again)
 };
 
-/// The `pairs: ignore` list without proofs: rigid pairs, adjacent pairs (unless keep_adjacent),
-/// then the model's own user and SRDF entries, and its proof entries (never, always_touching)
-/// as they are. Each pair once, in that order of reasons.
+/// The `pairs: ignore` list without proofs: the model's own user and SRDF entries (their reason
+/// kept), rigid pairs, adjacent pairs (unless keep_adjacent), then the model's proof entries
+/// (never, always_touching) as they are. Each pair once, in that order of reasons.
 IgnorePlan structuralIgnores(const Model& model, const IgnoreOptions& options = {});
 
-/// The `pairs: ignore` list the proofs justify: rigid pairs, pairs proven never within the margin
-/// or always touching, adjacent pairs (unless keep_adjacent), then the model's user and SRDF
-/// entries. A model entry whose reason is a proof or a rule that no longer holds is dropped.
+/// The `pairs: ignore` list the proofs justify: the model's user and SRDF entries, rigid pairs,
+/// pairs proven never within the margin or always touching, adjacent pairs (unless
+/// keep_adjacent). A model entry whose reason is a proof or a rule that no longer holds is dropped.
 IgnorePlan ignoreList(const Model& model, const std::vector<PairReport>& reports, const IgnoreOptions& options = {});
 
 }  // namespace kccd::modelling

@@ -19,8 +19,9 @@ struct PairSurvey {
   bool checked = true;              ///< in Model::pairs (false: an ignored pair, surveyed on request)
   std::size_t within = 0;           ///< samples with the distance <= margin
   std::size_t overlapping = 0;      ///< samples where the volumes overlap (distance 0)
-  double min_distance = 0.0;        ///< smallest distance over the samples (the engine's lower bound)
-  double min_time = 0.0;            ///< time of that sample (log time - time_offset)
+  double min_distance = 0.0;        ///< smallest distance over the samples (the engine's lower bound);
+                                    ///< NaN when no query ended Ok
+  double min_time = 0.0;            ///< time of that sample (log time - time_offset); NaN likewise
   double first_within = 0.0;        ///< first and last time within the margin (when within > 0)
   double last_within = 0.0;
   double max_penetration = 0.0;     ///< deepest overlap, libccd's MPR estimate (reporting only, not a bound)
