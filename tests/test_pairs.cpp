@@ -44,6 +44,16 @@ double trueDistance(const Model& m, const std::vector<kccd::Pose>& poses, int a,
 }
 
 
+// One configuration with no joint error realised: a recorded or drawn state.
+kccd::testing::Sample pointSample(const Model& m, std::vector<double> q) {
+  kccd::testing::Sample s;
+  s.q = std::move(q);
+  s.translation_error.assign(m.joints.size(), Vec3::Zero());
+  s.rotation_error.assign(m.joints.size(), Eigen::Matrix3d::Identity());
+  s.error_first.assign(m.joints.size(), false);
+  return s;
+}
+
 }  // namespace
 
 // A pair proven "never" must stay beyond the margin at every sampled configuration within the
@@ -158,11 +168,7 @@ TEST(Pairs, AlwaysTouchingThroughFixedJointsHoldsAtEveryAngle) {
     }
     ++touching;
     for (int k = 0; k <= 90; ++k) {
-      kccd::testing::Sample s;
-      s.q = {-std::numbers::pi + 2.0 * std::numbers::pi * k / 90.0};
-      s.translation_error.assign(m.joints.size(), Vec3::Zero());
-      s.rotation_error.assign(m.joints.size(), Eigen::Matrix3d::Identity());
-      s.error_first.assign(m.joints.size(), false);
+      const kccd::testing::Sample s = pointSample(m, {-std::numbers::pi + 2.0 * std::numbers::pi * k / 90.0});
       const double d = trueDistance(m, kccd::testing::jointPoses(m, s), 0, 1);
       ASSERT_LE(d, m.safety_margin + 1e-9) << "trial " << trial << " angle " << s.q[0];
     }
@@ -239,13 +245,8 @@ TEST(Pairs, RigidAndAdjacentPairsOfAGripperArm) {
 
   // kccd pairs decides rigid pairs exactly: their one distance, never "meets".
   const auto reports = km::provePairs(m);
-  std::vector<kccd::Pose> zero(m.joints.size());
-  kccd::testing::Sample s;
-  s.q.assign(m.stateSize(), 0.0);
-  s.translation_error.assign(m.joints.size(), Vec3::Zero());
-  s.rotation_error.assign(m.joints.size(), Eigen::Matrix3d::Identity());
-  s.error_first.assign(m.joints.size(), false);
-  const std::vector<kccd::Pose> poses = kccd::testing::jointPoses(m, s);
+  const std::vector<kccd::Pose> poses =
+      kccd::testing::jointPoses(m, pointSample(m, std::vector<double>(m.stateSize(), 0.0)));
   int rigid = 0;
   for (const auto& r : reports) {
     EXPECT_EQ(r.rigid, km::connection(m, r.a, r.b) == km::Connection::Rigid);
@@ -383,12 +384,8 @@ TEST(PairSurvey, CountsAndClosestAgreeWithIndependentDistances) {
     std::size_t red = 0;
     bool borderline = false;
     for (int row = 0; row < 50; ++row) {
-      kccd::testing::Sample s;
-      s.q.assign(log.row(row).begin(), log.row(row).end());
-      s.translation_error.assign(m.joints.size(), Vec3::Zero());
-      s.rotation_error.assign(m.joints.size(), Eigen::Matrix3d::Identity());
-      s.error_first.assign(m.joints.size(), false);
-      const auto poses = kccd::testing::jointPoses(m, s);
+      const auto poses =
+          kccd::testing::jointPoses(m, pointSample(m, std::vector<double>(log.row(row).begin(), log.row(row).end())));
       bool any = false;
       for (std::size_t p = 0; p < m.pairs.size(); ++p) {
         const double d = trueDistance(m, poses, m.pairs[p].a, m.pairs[p].b);
