@@ -453,7 +453,9 @@ TEST(Cli, ImportedGripperArmRecordingHasNoCollidingFrame) {
   EXPECT_EQ(drawn.at("samples"), 300);
   EXPECT_EQ(drawn.at("states"), "random");
   for (const auto& p : drawn.at("pairs"))
-    if (p.at("a") == "link3" && p.at("b") == "hand") EXPECT_EQ(p.at("within"), 300);  // rigid, touching
+    if (p.at("a") == "link3" && p.at("b") == "hand") {
+      EXPECT_EQ(p.at("within"), 300);  // rigid, touching
+    }
   EXPECT_EQ(runKccd("pairs " + model + " --random 300 --seed 4 --ignored --json -q").out, rnd.out);  // repeatable
   std::filesystem::remove_all(dir);
 }
