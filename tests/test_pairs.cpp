@@ -405,8 +405,9 @@ TEST(PairSurvey, CountsAndClosestAgreeWithIndependentDistances) {
       EXPECT_EQ(s.within, count[p]) << "trial " << trial << " pair " << p;
       EXPECT_LE(s.min_distance, std::max(0.0, closest[p]) + 1e-9);  // a lower bound
       EXPECT_NEAR(s.min_distance, std::max(0.0, closest[p]), 1e-6) << "trial " << trial << " pair " << p;
-      if (closest[p] > 1e-6 && second[p] - closest[p] > 1e-6)  // one closest row: its time, video clock
+      if (closest[p] > 1e-6 && second[p] - closest[p] > 1e-6) {  // one closest row: its time, video clock
         EXPECT_DOUBLE_EQ(s.min_time, at[p]) << "trial " << trial << " pair " << p;
+      }
       within += static_cast<int>(s.within);
     }
   }
