@@ -163,6 +163,13 @@ std::vector<Vec3> farthestPoints(const std::vector<Vec3>& pool, const Vec3& cent
   return out;
 }
 
+// The mean of a non-empty point set.
+Vec3 centroid(const std::vector<Vec3>& points) {
+  Vec3 sum = Vec3::Zero();
+  for (const Vec3& p : points) sum += p;
+  return sum / static_cast<double>(points.size());
+}
+
 // The hull's vertices moved inwards by r along their (angle-weighted) normals: each stays within
 // r of its vertex, so any core whose SSCH of radius r holds these points' hull covers the part.
 // On rounded parts the moved vertices gather (a cylinder's rim moved by its radius lands on its
@@ -194,13 +201,8 @@ std::vector<std::vector<Vec3>> offsetClouds(const std::vector<Vec3>& points, con
 // spread out, then each time the point that grows the hull most.
 std::vector<Vec3> greatestHull(const std::vector<Vec3>& all, int k) {
   // Chosen among 48 points spread over the cloud (each step builds one hull per candidate).
-  Vec3 centre = Vec3::Zero();
-  for (const Vec3& p : all) centre += p;
-  const std::vector<Vec3> cloud =
-      all.size() > 48 ? farthestPoints(all, centre / static_cast<double>(all.size()), 48) : all;
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& p : cloud) mean += p;
-  std::vector<Vec3> out = farthestPoints(cloud, mean / static_cast<double>(cloud.size()), std::min(k, 3));
+  const std::vector<Vec3> cloud = all.size() > 48 ? farthestPoints(all, centroid(all), 48) : all;
+  std::vector<Vec3> out = farthestPoints(cloud, centroid(cloud), std::min(k, 3));
   while (static_cast<int>(out.size()) < k) {
     double best = -1.0;
     std::size_t pick = 0;
@@ -294,9 +296,7 @@ std::vector<Vec3> patternSearch(std::vector<Vec3> core, double value, const Cons
     }
     // Collective moves: a single point rarely lowers the radius alone, but the whole set
     // scaled along one direction, or moved, often does.
-    Vec3 mean = Vec3::Zero();
-    for (const Vec3& p : core) mean += p;
-    mean /= static_cast<double>(core.size());
+    const Vec3 mean = centroid(core);
     const double rel = step / c.diameter * 2.0;
     auto collective = [&](const Eigen::Matrix3d& map, const Vec3& shift) {
       std::vector<Vec3> trial(core.size());
@@ -371,9 +371,7 @@ FitResult fit(const Part& part, const FitOptions& options) {
     if (k >= 3)
       for (const std::vector<Vec3>& cloud : offsets) {
         if (static_cast<int>(cloud.size()) < k) continue;
-        Vec3 mean = Vec3::Zero();
-        for (const Vec3& p : cloud) mean += p;
-        const std::vector<Vec3> spread = farthestPoints(cloud, mean / static_cast<double>(cloud.size()), k);
+        const std::vector<Vec3> spread = farthestPoints(cloud, centroid(cloud), k);
         offset_seeds.push_back(spread);
         offset_seeds.push_back(kMeans(cloud, spread));
         offset_seeds.push_back(greatestHull(cloud, k));
@@ -396,18 +394,14 @@ FitResult fit(const Part& part, const FitOptions& options) {
       while (static_cast<int>(seed.size()) < k) seed.push_back(seed[seed.size() % corners.size()]);
       seeds.push_back(seed);
     }
-    // Every seed shrunk to its best scale; the three best are refined, the best result wins.
     // Every seed shrunk to its best scale; the three best of the first seeds and the two best
     // offset seeds are refined (those with half the budget), the best result wins.
     using Start = std::pair<double, std::vector<Vec3>>;
     auto shrunk = [&](const std::vector<std::vector<Vec3>>& list) {
       std::vector<Start> out;
       for (const auto& s : list) {
-        Vec3 mean = Vec3::Zero();
-        for (const Vec3& p : s) mean += p;
-        mean /= static_cast<double>(s.size());
         double v = 0.0;
-        std::vector<Vec3> scaled_seed = bestShrink(s, mean, 1.5, f, v);
+        std::vector<Vec3> scaled_seed = bestShrink(s, centroid(s), 1.5, f, v);
         out.emplace_back(v, std::move(scaled_seed));
       }
       return out;

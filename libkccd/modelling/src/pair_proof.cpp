@@ -120,10 +120,7 @@ void carryModelEntries(const Model& m, const IgnoreOptions& options, bool keep_p
     }
     bool listed = false;
     for (const IgnoreEntry& e : plan.ignore) listed = listed || samePair(e, a, b);
-    if (keep || listed)
-      addOnce(plan.ignore, a, b, p.reason);
-    else
-      plan.dropped.push_back({a, b, p.reason});
+    if (!listed) (keep ? plan.ignore : plan.dropped).push_back({a, b, p.reason});
   }
 }
 
