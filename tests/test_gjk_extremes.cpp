@@ -1,4 +1,4 @@
-// The numerical extremes of ALGORITHMS.md section 8 for the distance routine.
+// The numerical extremes of docs/algorithms.md section 11 for the distance routine.
 #include <gtest/gtest.h>
 
 #include <cmath>

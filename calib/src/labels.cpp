@@ -1,4 +1,4 @@
-// The labels file (ARCHITECTURE.md section 5). Every error names the file, the line and column,
+// The labels file (docs/formats.md section 5). Every error names the file, the line and column,
 // and the field; loading stops at the first one.
 #include "kccd/calib/labels.hpp"
 

@@ -1,4 +1,4 @@
-// The tag layout file (ARCHITECTURE.md section 5). Every error names the file, the line and
+// The tag layout file (docs/formats.md section 4). Every error names the file, the line and
 // column, and the field; loading stops at the first one.
 #include "kccd/calib/tag_layout.hpp"
 

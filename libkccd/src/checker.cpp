@@ -489,7 +489,7 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
 }
 
 // Carries every stored bound over to this box: unchanged while the box stays inside the stored
-// one, otherwise lowered by the most the pair's points can have moved (ALGORITHMS.md 5).
+// one, otherwise lowered by the most the pair's points can have moved (docs/algorithms.md section 7).
 void Checker::carryBounds(Box box) noexcept {
   const int np = static_cast<int>(model_.pairs.size());
   for (int p = 0; p < np; ++p) {

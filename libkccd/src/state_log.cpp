@@ -1,4 +1,4 @@
-// The state log CSV dialect (ARCHITECTURE.md section 5) and the state at a time. Every error is
+// The state log CSV dialect (docs/formats.md section 6) and the state at a time. Every error is
 // one line naming the file, the line and, where one applies, the column; reading stops at the first.
 #include "kccd/state_log.hpp"
 

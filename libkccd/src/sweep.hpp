@@ -1,4 +1,4 @@
-// Conservative joint sweeps and the point budget (ALGORITHMS.md sections 1-2). Internal.
+// Conservative joint sweeps and the point budget (docs/algorithms.md sections 1-3). Internal.
 #pragma once
 
 #include <span>
@@ -28,7 +28,7 @@ int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span
 double rhoBound(const Vec3& axis, const Sphere& s) noexcept;
 
 /// The affine maps x -> lin x + off whose images of a point set cover a joint's motion over the
-/// box [lo, hi] and map into the parent frame (ALGORITHMS.md 2): chord ends (rigid), then for a
+/// box [lo, hi] and map into the parent frame (docs/algorithms.md section 6): chord ends (rigid), then for a
 /// revolute joint the tangent apexes (radial part scaled by 1 / cos(step / 2)). Covering with the
 /// first `chord_count` maps needs the radius to grow by `sagitta` times the distance from the
 /// axis; every cover adds `fixed_growth` plus `point_growth` times the distance from the joint

@@ -1,4 +1,4 @@
-// Braking intervals (ALGORITHMS.md section 6): where each joint can stop if braking starts now.
+// Braking intervals (docs/algorithms.md section 8): where each joint can stop if braking starts now.
 #pragma once
 
 #include <span>

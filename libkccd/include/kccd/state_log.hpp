@@ -1,4 +1,4 @@
-// State logs (ARCHITECTURE.md section 5): a CSV of a robot's state over time, read against a
+// State logs (docs/formats.md section 6): a CSV of a robot's state over time, read against a
 // model, and the state at any time (a sample, an interpolation between two samples, or none).
 #pragma once
 

@@ -1,5 +1,5 @@
 // The camera model: OpenCV intrinsics, lens distortion, pose and calibration quality, and the
-// camera file that holds them (ARCHITECTURE.md section 5). No GL: calibration, rendering and the
+// camera file that holds them (docs/formats.md section 3). No GL: calibration, rendering and the
 // overlay all use this one model.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Labelled points for calibrating a camera's pose (ARCHITECTURE.md section 5): a pixel and the
+// Labelled points for calibrating a camera's pose (docs/formats.md section 5): a pixel and the
 // world point it shows, either given directly or as a point fixed to a model body.
 #pragma once
 

@@ -1,5 +1,5 @@
 // The tag layout: where AprilTags (family tag36h11) are placed in the world, for calibrating a
-// camera's pose (ARCHITECTURE.md section 5), and the world points of a tag's corners.
+// camera's pose (docs/formats.md section 4), and the world points of a tag's corners.
 #pragma once
 
 #include <array>
