@@ -286,6 +286,7 @@ TEST(CalibLabels, EveryMistakeIsOneLineNamingThePlaceAndField) {
       {"labels:\n  - {name: a, pixel: [1, 2], body: [b], point: [0, 0, 0]}\n", "labels.yaml:2:36: label 'a'.body: expected a string"},
       {"labels:\n  - {name: '', pixel: [1, 2], world: [0, 0, 0]}\n", "labels.yaml:2:12: labels[0].name: must not be empty"},
       {"labels:\n  - {name: \"a\\tb\", pixel: [1, 2], world: [0, 0, 0]}\n", "labels.yaml:2:12: labels[0].name: contains a control character: 'a\\x09b'"},
+      {"labels:\n  - {name: a\xff" "b, pixel: [1, 2], world: [0, 0, 0]}\n", "labels.yaml:2:12: labels[0].name: is not UTF-8 text: 'a\\xffb'"},
       {"labels:\n  - {pixel: [1, 2], world: [0, 0, 0]}\n", "labels.yaml:2:5: labels[0].name: required field is missing"},
       {"labels:\n  - {name: a, pixel: [1, 2], world: [0, 0, 0], colour: red}\n", "labels.yaml:2:48: labels[0].colour: unknown field"},
       {"labels: []\n", "labels.yaml:1:9: labels: at least one label is needed"},

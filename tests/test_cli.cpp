@@ -191,6 +191,19 @@ TEST(Cli, FitJsonContractAndErrors) {
   e = runKccd("fit /nonexistent/part.iv");
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(e.err.find("/nonexistent/part.iv: cannot open the file"), std::string::npos) << e.err;
+  // --hull: no fit, the exact hull (a cylinder's rims as circumscribed polygons); no K with it.
+  const Outcome h = runKccd("fit " + kModels + "simple/cylinder.iv --hull --json");
+  ASSERT_EQ(h.code, 0) << h.err;
+  const auto jh = nlohmann::json::parse(h.out);
+  EXPECT_TRUE(jh["exact_hull"].get<bool>());
+  EXPECT_GT(jh["points"].size(), 16u);
+  EXPECT_EQ(jh["k"].get<std::size_t>(), jh["points"].size());
+  EXPECT_LT(jh["radius"].get<double>(), 1e-4);
+  EXPECT_NEAR(jh["volume_ratio"].get<double>(), 1.0, 1e-3);
+  EXPECT_FALSE(jh.contains("baselines"));
+  e = runKccd("fit " + kModels + "simple/cylinder.iv --hull -k 4");
+  EXPECT_EQ(e.code, 2);
+  EXPECT_NE(e.err.find("--points excludes --hull"), std::string::npos) << e.err;
 }
 
 // Every option error, whatever the parser finds, is one line starting "kccd: " and exit 2.

@@ -150,6 +150,10 @@ TEST(Model, EveryMistakeGetsOneClearMessage) {
       {"coordinate beyond the bound", edit("points: [[0, 0, 0], [1, 0, 0]]", "points: [[0, 0, 0], [1e7, 0, 0]]"),
        {"body 'arm'.points[1][0]", "largest length"}},
       {"control byte in a name", edit("name: tool", "name: \"to\\x1bol\""), {"control character", "to\\x1bol"}},
+      // A name must print as JSON (kccd info --json): bytes that are not UTF-8 are refused here.
+      {"not UTF-8 in a name", edit("name: tool", "name: to\xffol"), {"cell.yaml:", "is not UTF-8 text", "to\\xffol"}},
+      {"a surrogate in a name", edit("name: tool", "name: to\xed\xa0\x80l"), {"is not UTF-8 text"}},
+      {"an overlong form in a name", edit("name: tool", "name: to\xc0\xafl"), {"is not UTF-8 text"}},
   };
   for (const BadCase& c : cases) {
     const std::string msg = loadError(c.text);

@@ -21,6 +21,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "kccd/calib/camera.hpp"
+#include "kccd/overlay/staged_output.hpp"
 #include "kccd/render/composite.hpp"
 #include "support/golden.hpp"
 #include "support/run_program.hpp"
@@ -122,6 +123,10 @@ TEST_F(OverlayCli, EveryFrameWrittenAndReported) {
   const Outcome r = runKccd(base() + " -o " + out("out.mkv") + " --report " + out("report.json"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(readVideo(out("out.mkv")).size(), static_cast<std::size_t>(kFrames));
+  // Every output gets the permissions a plain create gives (the video as the report).
+  const fs::perms plain = static_cast<fs::perms>(kccd::overlay::plainCreateMode(false));
+  EXPECT_EQ(fs::status(out("out.mkv")).permissions(), plain);
+  EXPECT_EQ(fs::status(out("report.json")).permissions(), plain);
   const auto j = nlohmann::json::parse(readText(out("report.json")));
   EXPECT_EQ(j["frames_total"], kFrames);
   EXPECT_EQ(j["frames_written"], kFrames);
@@ -227,6 +232,7 @@ TEST_F(OverlayCli, PngDirWithFrames) {
   std::set<std::string> names;
   for (const auto& e : fs::directory_iterator(out("pngs"))) names.insert(e.path().filename().string());
   EXPECT_EQ(names, (std::set<std::string>{"frame_000002.png", "frame_000005.png", "frame_000008.png"}));
+  EXPECT_EQ(fs::status(out("pngs")).permissions(), static_cast<fs::perms>(kccd::overlay::plainCreateMode(true)));
   const auto j = nlohmann::json::parse(readText(out("report.json")));
   EXPECT_EQ(j["frames_total"], kFrames);  // every frame is still checked and reported
   EXPECT_EQ(j["frames_written"], 3);

@@ -215,6 +215,18 @@ TEST_F(Synth, CalibrationRecoversTheTrueCamera) {
   const Outcome r = runKccd("calib --intrinsics " + dir("a") + "/intrinsics.yaml --image " + frame + " --tags " +
                             dir("a") + "/tags.yaml -o " + solved + " -q");
   ASSERT_EQ(r.code, 0) << r.err << r.out;
+  {  // The same frame as an image sequence gives the same camera: one rule opens recordings.
+    cv::VideoCapture cap(dir("a") + "/video.mkv");
+    cv::Mat first;
+    ASSERT_TRUE(cap.read(first));
+    fs::create_directories(dir("seq"));
+    ASSERT_TRUE(cv::imwrite(dir("seq") + "/frame_000000.png", first));
+    const std::string from_sequence = dir("overlay_camera_seq.yaml");
+    const Outcome q = runKccd("calib --intrinsics " + dir("a") + "/intrinsics.yaml --video " + dir("seq") +
+                              "/frame_%06d.png --frame 0 --tags " + dir("a") + "/tags.yaml -o " + from_sequence + " -q");
+    ASSERT_EQ(q.code, 0) << q.err << q.out;
+    EXPECT_EQ(kccd::testing::readText(from_sequence), kccd::testing::readText(solved));
+  }
   const kccd::calib::Camera truth = kccd::calib::loadCamera(dir("a") + "/camera_true.yaml");
   const kccd::calib::Camera got = kccd::calib::loadCamera(solved);
   cv::Matx33d rt, rg;

@@ -82,6 +82,7 @@ class YamlReader {
     for (const char c : n.Scalar())
       if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F)
         fail(n, field, "contains a control character: '" + printable(n.Scalar(), 40) + "'");
+    if (!isUtf8(n.Scalar())) fail(n, field, "is not UTF-8 text: '" + printable(n.Scalar(), 40) + "'");
     return n.Scalar();
   }
 

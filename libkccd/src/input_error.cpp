@@ -1,5 +1,7 @@
 #include "kccd/input_error.hpp"
 
+#include <cstdio>
+
 namespace kccd {
 namespace {
 
@@ -15,10 +17,34 @@ std::size_t utf8Length(std::string_view s, std::size_t i) {
   if (i + n > s.size()) return 0;
   for (std::size_t k = 1; k < n; ++k)
     if ((byte(i + k) & 0xC0) != 0x80) return 0;
+  // No overlong forms, no surrogates (U+D800 ... U+DFFF), nothing above U+10FFFF.
+  const unsigned char second = byte(i + 1);
+  if ((c == 0xE0 && second < 0xA0) || (c == 0xED && second > 0x9F) || (c == 0xF0 && second < 0x90) ||
+      (c == 0xF4 && second > 0x8F))
+    return 0;
   return n;
 }
 
 }  // namespace
+
+std::string messageNumber(double value, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+  return buf;
+}
+
+bool isUtf8(std::string_view text) {
+  for (std::size_t i = 0; i < text.size();) {
+    if (static_cast<unsigned char>(text[i]) < 0x80) {
+      ++i;
+      continue;
+    }
+    const std::size_t n = utf8Length(text, i);
+    if (n == 0) return false;
+    i += n;
+  }
+  return true;
+}
 
 std::string printable(std::string_view text, std::size_t max_bytes) {
   static const char* hex = "0123456789abcdef";

@@ -1,4 +1,4 @@
-// The `kccd: 1` YAML model format (ARCHITECTURE.md section 3). Every error names the file, the
+// The `kccd: 1` YAML model format (docs/formats.md section 2). Every error names the file, the
 // line and column, and the field; loading stops at the first one.
 #include <yaml-cpp/yaml.h>
 
@@ -48,6 +48,7 @@ class Reader {
     if (n.Scalar().empty()) fail(n, field, "must not be empty");
     for (const char c : n.Scalar())
       if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F) fail(n, field, "contains a control character: '" + printable(n.Scalar()) + "'");
+    if (!isUtf8(n.Scalar())) fail(n, field, "is not UTF-8 text: '" + printable(n.Scalar()) + "'");
     return n.Scalar();
   }
 

@@ -14,6 +14,13 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// `value` as messages print it: printf's %g with `digits` significant digits ("0.137", "1e+300").
+std::string messageNumber(double value, int digits = 10);
+
+/// True when `text` is valid UTF-8: no stray or truncated sequences, overlong forms, surrogates or
+/// code points above U+10FFFF (what JSON output needs of every name it prints).
+bool isUtf8(std::string_view text);
+
 /// `text` made safe to quote in a one-line message: control bytes, DEL and bytes that are not
 /// UTF-8 become \xNN, and text longer than `max_bytes` is cut with "...".
 std::string printable(std::string_view text, std::size_t max_bytes = 80);

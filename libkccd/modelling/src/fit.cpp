@@ -331,6 +331,26 @@ double sschVolume(std::span<const Vec3> points, double radius) { return convexHu
 
 double coveringRadius(std::span<const Vec3> core, const Part& part) { return coverRadius(core, makeCover(part)); }
 
+FitResult exactHull(const Part& part) {
+  if (part.empty()) throw std::invalid_argument("the part has no geometry");
+  std::vector<Vec3> samples = part.points;
+  for (const Sphere& b : part.balls)
+    for (const Vec3& v : circumscribedUnitSphere()) samples.push_back(b.center + b.radius * v);
+  const ConvexHull h = convexHull(samples);
+  FitResult result;
+  Cover cover;  // the balls are inside their circumscribed polytopes: only vertices to cover
+  cover.guard = part.coordinate_guard;
+  for (int i : h.vertices) cover.vertices.push_back(samples[i]);
+  result.points = cover.vertices;
+  for (Vec3& p : result.points)  // as printed; the radius below covers the rounding
+    for (int i = 0; i < 3; ++i) p(i) = std::stod(yamlNumber(p(i)));
+  result.radius = coverRadius(result.points, cover);
+  result.volume = sschVolume(result.points, result.radius);
+  result.hull_volume = convexHull(part.samples()).volume;
+  result.hull_vertices = static_cast<int>(h.vertices.size());
+  return result;
+}
+
 FitResult fit(const Part& part, const FitOptions& options) {
   if (options.points < 1 || options.points > kMaxCorePoints)
     throw std::invalid_argument("the number of core points must be 1 ... " + std::to_string(kMaxCorePoints) +

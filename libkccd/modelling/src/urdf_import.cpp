@@ -476,14 +476,9 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     bodies << "  - name: " << link->name << "\n"
            << "    frame: " << frame_of.at(link->name) << "\n";
     if (options.hulls) {  // the hull's vertices (balls by circumscribed polytopes), no fit
-      std::vector<Vec3> samples = part.points;
-      for (const Sphere& b : part.balls)
-        for (const Vec3& v : circumscribedUnitSphere()) samples.push_back(b.center + b.radius * v);
-      std::vector<Vec3> vertices;
-      for (int i : convexHull(samples).vertices) vertices.push_back(samples[i]);
-      bodies << "    points: " << flowPoints(vertices) << "\n"
-             << "    radius: " << yamlNumber(part.coordinate_guard + 1e-9 * part.coordinate_guard, true)
-             << "   # the convex hull of the collision geometry\n";
+      const FitResult hull = exactHull(part);
+      bodies << "    points: " << flowPoints(hull.points) << "\n"
+             << "    radius: " << yamlNumber(hull.radius, true) << "   # the convex hull of the collision geometry\n";
     } else {
       const FitResult fit_result = fit(part, fo);
       bodies << "    points: " << flowPoints(fit_result.points) << "\n"

@@ -38,6 +38,12 @@ struct FitResult {
 /// Throws std::invalid_argument when K is out of range or the part is empty.
 FitResult fit(const Part& part, const FitOptions& options = {});
 
+/// No fit: the part's own convex hull as an SSCH, for links whose clearance matters more than
+/// query time. Core = every hull vertex (a ball by a polytope circumscribing it), rounded to 10
+/// significant digits, radius exactly covering the part for those points (the input's rounding
+/// guard and a few ulps). Throws std::invalid_argument when the part is empty.
+FitResult exactHull(const Part& part);
+
 /// The smallest radius r such that conv(core) ⊕ ball(r) contains the part (rounding covered).
 double coveringRadius(std::span<const Vec3> core, const Part& part);
 

@@ -9,7 +9,6 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "calib_drawing.hpp"
 #include "cli_args.hpp"
@@ -22,6 +21,7 @@
 #include "kccd/calib/tag_detect.hpp"
 #include "kccd/checker.hpp"
 #include "kccd/kinematics.hpp"
+#include "kccd/overlay/video_source.hpp"
 #include "kccd/render/renderer.hpp"
 #include "kccd/render/scene.hpp"
 #include "kccd/state_log.hpp"
@@ -106,28 +106,16 @@ std::string prefixed(const std::string& name, std::size_t frame, std::size_t fra
   return frames > 1 ? "f" + std::to_string(frame + 1) + "/" + name : name;
 }
 
-// Frames `wanted` (ascending after sorting) of a video, read in order (seeking is not reliable in
-// every codec); also the video's frame rate (0 when it does not say).
+// Frames `wanted` of a recording (a video file or an image sequence), read in order; also its
+// frame rate (0 when it does not say).
 std::vector<cv::Mat> readVideoFrames(const std::string& path, const std::vector<int>& wanted, double& fps) {
-  if (!std::filesystem::is_regular_file(path)) throw UsageError("--video " + path + ": no such file");
-  cv::VideoCapture capture;
-  try {
-    capture.open(path, cv::CAP_FFMPEG);
-  } catch (const cv::Exception&) {
-  }
-  if (!capture.isOpened()) throw UsageError("--video " + path + ": not a video OpenCV can read");
-  fps = capture.get(cv::CAP_PROP_FPS);
+  overlay::VideoSource video(path, "--video " + path);
+  fps = video.fps();
   const int last = *std::max_element(wanted.begin(), wanted.end());
   std::vector<cv::Mat> out(wanted.size());
   cv::Mat frame;
   for (int i = 0; i <= last; ++i) {
-    bool ok = false;
-    try {
-      ok = capture.read(frame);
-    } catch (const cv::Exception&) {
-      ok = false;
-    }
-    if (!ok || frame.empty())
+    if (!video.read(frame))
       throw UsageError("--frame " + std::to_string(last) + ": " + path + " has only " + std::to_string(i) + " readable frames");
     for (std::size_t k = 0; k < wanted.size(); ++k)
       if (wanted[k] == i) out[k] = frame.type() == CV_8UC3 ? frame.clone() : cv::Mat();
@@ -528,7 +516,9 @@ Runner addCalib(CLI::App& app) {
   auto a = std::make_shared<CalibArgs>();
   sub->add_option("--intrinsics", a->intrinsics, "Camera file with the intrinsics and lens distortion (its pose is ignored); required");
   sub->add_option("--image", a->images, "A frame from the fixed camera (repeat for several frames)")->allow_extra_args(false);
-  sub->add_option("--video", a->video, "A recording from the fixed camera: its frames given by --frame are the frames");
+  sub->add_option("--video", a->video,
+                  "A recording from the fixed camera (a video file or an image sequence such as frames/frame_%06d.png, "
+                  "as kccd overlay reads): its frames given by --frame are the frames");
   sub->add_option("--frame", a->video_frames, "Frame index in --video (from 0; repeat for several frames)")
       ->allow_extra_args(false)
       ->check(CLI::Range(0, 100000000));

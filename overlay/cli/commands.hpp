@@ -7,7 +7,7 @@
 
 namespace kccd::cli {
 
-/// The exit status of every subcommand (ARCHITECTURE.md section 5): turned into a number only in
+/// The exit status of every subcommand (docs/architecture.md section 6): turned into a number only in
 /// main, which also maps the exceptions (an InputError or UsageError is BadInput).
 enum class Exit : int {
   Ok = 0,           ///< done (also --help and --version)

@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "kccd/model.hpp"
+#include "kccd/overlay/staged_output.hpp"
 
 namespace kccd::cli {
 
@@ -15,10 +16,8 @@ namespace kccd::cli {
 /// also returns the file's text as it was read.
 Model loadOrExplain(const std::string& path, std::string* text = nullptr);
 
-/// Writes `text` to `path` through a new uniquely named file in the same folder and a rename:
-/// readers never see a partial file. A symbolic link stays a link (its target is replaced) and an
-/// existing file keeps its mode. Throws UsageError naming the path.
-void writeFileAtomically(const std::string& path, const std::string& text);
+/// Files are written through kccd::overlay's staged outputs (one temporary name, one rename).
+using overlay::writeFileAtomically;
 
 /// Checks an output path before any work: its extension (lower-cased) is `extension` and its folder
 /// exists. Throws UsageError "<option> <path>: ...".

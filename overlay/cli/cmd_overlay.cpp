@@ -42,6 +42,8 @@
 #include "kccd/braking.hpp"
 #include "kccd/checker.hpp"
 #include "kccd/frame_times.hpp"
+#include "kccd/overlay/time_offset.hpp"
+#include "kccd/overlay/video_source.hpp"
 #include "kccd/render/composite.hpp"
 #include "kccd/render/renderer.hpp"
 #include "kccd/render/scene.hpp"
@@ -317,69 +319,6 @@ class FrameWorker {
   std::vector<int> fixed_;
 };
 
-// ---------------------------------------------------------------------------------------------
-// Outputs written under temporary names and moved into place at the end.
-
-class PendingOutputs {
- public:
-  ~PendingOutputs() {
-    std::error_code ec;
-    if (!video_tmp_.empty()) fs::remove(video_tmp_, ec);
-    if (!png_tmp_.empty()) fs::remove_all(png_tmp_, ec);
-  }
-
-  // A unique name beside `path` with the same extension (the writer picks the container by it).
-  std::string reserveVideo(const std::string& path) {
-    const fs::path p(path);
-    const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
-    const std::string ext = p.extension().string();
-    std::string tmp = (dir / ("." + p.stem().string() + ".kccd-XXXXXX" + ext)).string();
-    const int fd = mkstemps(tmp.data(), static_cast<int>(ext.size()));
-    if (fd < 0) throw UsageError("-o " + path + ": cannot write in " + dir.string());
-    ::close(fd);
-    video_tmp_ = tmp;
-    video_ = path;
-    return tmp;
-  }
-
-  // A new folder beside `dir`; `dir` itself must not exist or be empty.
-  std::string reservePngDir(const std::string& dir) {
-    fs::path p = fs::path(dir);
-    if (p.filename().empty()) p = p.parent_path();
-    std::error_code ec;
-    if (fs::exists(p, ec)) {
-      if (!fs::is_directory(p, ec)) throw UsageError("--png-dir " + dir + ": exists and is not a folder");
-      if (!fs::is_empty(p, ec)) throw UsageError("--png-dir " + dir + ": the folder is not empty (kccd does not mix runs)");
-    }
-    const fs::path parent = p.parent_path().empty() ? fs::path(".") : p.parent_path();
-    if (!fs::is_directory(parent, ec)) throw UsageError("--png-dir " + dir + ": folder " + parent.string() + " does not exist");
-    std::string tmp = (parent / ("." + p.filename().string() + ".kccd-XXXXXX")).string();
-    if (mkdtemp(tmp.data()) == nullptr) throw UsageError("--png-dir " + dir + ": cannot create a folder in " + parent.string());
-    png_tmp_ = tmp;
-    png_dir_ = p.string();
-    return tmp;
-  }
-
-  // Moves every output into place.
-  void commit() {
-    std::error_code ec;
-    if (!video_tmp_.empty()) {
-      fs::rename(video_tmp_, video_, ec);
-      if (ec) throw UsageError("-o " + video_ + ": cannot move the finished video into place (" + ec.message() + ")");
-      video_tmp_.clear();
-    }
-    if (!png_tmp_.empty()) {
-      if (fs::exists(png_dir_)) fs::remove(png_dir_, ec);  // empty (checked before the run)
-      fs::rename(png_tmp_, png_dir_, ec);
-      if (ec) throw UsageError("--png-dir " + png_dir_ + ": cannot move the frames into place (" + ec.message() + ")");
-      png_tmp_.clear();
-    }
-  }
-
- private:
-  std::string video_, video_tmp_, png_dir_, png_tmp_;
-};
-
 int fourccFor(const std::string& output, const std::string& codec) {
   if (!codec.empty()) {
     if (codec.size() != 4) throw UsageError("--codec " + codec + ": a FourCC is 4 characters (e.g. mp4v, avc1, MJPG, FFV1)");
@@ -415,92 +354,6 @@ std::optional<AutoOffset> parseTimeOffset(const std::string& text, double& offse
   }
   if (!num(text, offset)) throw UsageError("--time-offset " + text + ": expected seconds (within 1e9) or auto:A:B");
   return std::nullopt;
-}
-
-// Finds the offset in [range.lo, range.hi] at which the image motion between consecutive frames
-// (mean absolute difference of downscaled grey frames) best follows the robot's motion in the log
-// between the same two instants (sum of the absolute changes of the state values): the largest
-// Pearson correlation on a grid of half the smaller of the frame and log periods. Throws
-// UsageError when too few frames have states or nothing correlates. Returns the offset and
-// writes the correlation to `score`.
-double findTimeOffset(const OverlayArgs& a, const StateLog& log, double max_gap, const std::vector<double>& frame_times,
-                      double fps, AutoOffset range, double& score) {
-  cv::VideoCapture cap;
-  try {
-    cap.open(a.video, a.video.find('%') != std::string::npos ? cv::CAP_IMAGES : cv::CAP_FFMPEG);
-  } catch (const cv::Exception&) {
-  }
-  if (!cap.isOpened()) throw UsageError("--video " + a.video + ": cannot open the video (not a video OpenCV reads, or missing)");
-  // Pair k: frames k and k + 1, their times and the image motion between them.
-  std::vector<double> t0, t1, motion;
-  cv::Mat frame, grey, small, previous;
-  double previous_time = 0.0;
-  for (std::size_t i = 0;; ++i) {
-    bool got = false;
-    try {
-      got = cap.read(frame);
-    } catch (const cv::Exception&) {
-      got = false;
-    }
-    if (!got || frame.empty()) break;  // the main pass reports a short or damaged video
-    const double t = !frame_times.empty() ? (i < frame_times.size() ? frame_times[i] : std::numeric_limits<double>::quiet_NaN())
-                                          : static_cast<double>(i) / fps;
-    if (frame.channels() == 3) cv::cvtColor(frame, grey, cv::COLOR_BGR2GRAY);
-    else if (frame.channels() == 4) cv::cvtColor(frame, grey, cv::COLOR_BGRA2GRAY);
-    else grey = frame;
-    cv::resize(grey, small, cv::Size(std::max(1, grey.cols / 8), std::max(1, grey.rows / 8)), 0, 0, cv::INTER_AREA);
-    small.convertTo(small, CV_32F);
-    if (!previous.empty() && previous.size() == small.size() && std::isfinite(t) && std::isfinite(previous_time)) {
-      t0.push_back(previous_time);
-      t1.push_back(t);
-      motion.push_back(cv::norm(small, previous, cv::NORM_L1) / static_cast<double>(small.total()));
-    }
-    std::swap(previous, small);
-    previous_time = t;
-  }
-  if (motion.size() < 10) throw UsageError("--time-offset auto: needs at least 11 frames, the video has " + std::to_string(motion.size() + 1));
-
-  double frame_period = (t1.back() - t0.front()) / static_cast<double>(motion.size());
-  double log_period = log.medianPeriod() > 0 ? log.medianPeriod() : frame_period;
-  const double step = 0.5 * std::min(frame_period, log_period);
-  const double steps = std::ceil((range.hi - range.lo) / step);
-  if (!(steps <= 200000)) throw UsageError("--time-offset auto: the range is more than 200000 steps of " + format(step, 3) + " s");
-  const std::size_t n = log.stateSize();
-  std::vector<double> qa(n), qb(n), speed(motion.size());
-  std::vector<std::uint8_t> has(motion.size());
-  double best = -2.0, best_offset = range.lo;
-  std::size_t best_pairs = 0;
-  for (long k = 0; k <= static_cast<long>(steps); ++k) {
-    const double offset = std::min(range.hi, range.lo + static_cast<double>(k) * step);
-    std::size_t m = 0;
-    double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
-    for (std::size_t p = 0; p < motion.size(); ++p) {
-      if (stateAt(log, t0[p] + offset, max_gap, qa) == StateMatch::None || stateAt(log, t1[p] + offset, max_gap, qb) == StateMatch::None)
-        continue;
-      double d = 0.0;
-      for (std::size_t v = 0; v < n; ++v) d += std::fabs(qb[v] - qa[v]);
-      const double x = motion[p];
-      sx += x, sy += d, sxx += x * x, syy += d * d, sxy += x * d;
-      ++m;
-    }
-    if (m < 10) continue;
-    const double mm = static_cast<double>(m);
-    const double cov = sxy - sx * sy / mm, vx = sxx - sx * sx / mm, vy = syy - sy * sy / mm;
-    if (!(vx > 0 && vy > 0)) continue;
-    const double r = cov / std::sqrt(vx * vy);
-    if (r > best) {
-      best = r;
-      best_offset = offset;
-      best_pairs = m;
-    }
-  }
-  if (best < 0.3)
-    throw UsageError("--time-offset auto:" + format(range.lo) + ":" + format(range.hi) +
-                     ": no offset in the range makes the video's motion follow the log's (best correlation " +
-                     (best > -2.0 ? format(best, 2) : std::string("none: too few frames with a state")) + "); give the offset");
-  (void)best_pairs;
-  score = best;
-  return best_offset;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -569,32 +422,28 @@ Exit runOverlay(OverlayArgs& a) {
     throw UsageError(a.camera + ": " + msg);
   }
 
-  cv::VideoCapture cap;
-  try {
-    cap.open(a.video, a.video.find('%') != std::string::npos ? cv::CAP_IMAGES : cv::CAP_FFMPEG);
-  } catch (const cv::Exception&) {
-  }
-  if (!cap.isOpened()) throw UsageError("--video " + a.video + ": cannot open the video (not a video OpenCV reads, or missing)");
-  double fps = a.fps > 0.0 ? a.fps : cap.get(cv::CAP_PROP_FPS);
+  overlay::VideoSource video(a.video, "--video " + a.video);
+  double fps = a.fps > 0.0 ? a.fps : video.fps();
   if (frame_times.empty() && !(fps > 0.0 && fps < 1e6))
     throw UsageError("--video " + a.video + ": the video gives no frame rate: give --fps or --frame-times");
-  double writer_fps = fps;
-  if (!(writer_fps > 0.0 && writer_fps < 1e6)) {  // from the frame times: the median step
-    std::vector<double> steps;
-    for (std::size_t i = 1; i < frame_times.size(); ++i)
-      if (std::isfinite(frame_times[i]) && std::isfinite(frame_times[i - 1])) steps.push_back(frame_times[i] - frame_times[i - 1]);
-    std::sort(steps.begin(), steps.end());
-    writer_fps = steps.empty() ? 25.0 : 1.0 / steps[steps.size() / 2];
+  const overlay::FrameClock clock(frame_times, fps);
+  const double writer_fps = clock.nominalFps();
+  if (auto_offset) {  // a first pass over the video
+    overlay::VideoSource first_pass(a.video, "--video " + a.video);
+    const overlay::TimeOffset found =
+        overlay::findTimeOffset(first_pass, clock, log, max_gap, auto_offset->lo, auto_offset->hi,
+                                "--time-offset auto:" + format(auto_offset->lo) + ":" + format(auto_offset->hi));
+    a.time_offset = found.offset;
+    auto_score = found.correlation;
   }
-  if (auto_offset) a.time_offset = findTimeOffset(a, log, max_gap, frame_times, fps, *auto_offset, auto_score);
-  const double declared_count = cap.get(cv::CAP_PROP_FRAME_COUNT);
-  const std::size_t expected =
-      declared_count > 0 && declared_count < 1e9 ? static_cast<std::size_t>(std::llround(declared_count)) : 0;
+  const std::size_t expected = video.declaredFrames();
 
-  PendingOutputs pending;
+  // Outputs under temporary names, moved into place only when every frame is done.
+  std::optional<overlay::StagedOutput> video_out, png_out;
   cv::VideoWriter writer;
   if (!a.output.empty()) {
-    const std::string tmp = pending.reserveVideo(a.output);
+    video_out.emplace(a.output, overlay::StagedOutput::Kind::File, "-o " + a.output);
+    const std::string tmp = video_out->path().string();
     const int fourcc = fourccFor(a.output, a.codec);
     bool ok = false;
     try {
@@ -605,7 +454,14 @@ Exit runOverlay(OverlayArgs& a) {
     if (!ok) throw UsageError("-o " + a.output + ": cannot open a video writer for this container and codec");
   }
   std::string png_tmp;
-  if (!a.png_dir.empty()) png_tmp = pending.reservePngDir(a.png_dir);
+  if (!a.png_dir.empty()) {
+    png_out.emplace(a.png_dir, overlay::StagedOutput::Kind::Folder, "--png-dir " + a.png_dir);
+    png_tmp = png_out->path().string();
+  }
+  const auto commit = [&] {
+    if (video_out) video_out->commit();
+    if (png_out) png_out->commit();
+  };
 
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
   const int jobs = a.jobs > 0 ? a.jobs : static_cast<int>(hw);
@@ -644,13 +500,7 @@ Exit runOverlay(OverlayArgs& a) {
             spare.pop_back();
           }
         }
-        bool got = false;
-        try {
-          got = cap.read(job.bgr);
-        } catch (const cv::Exception& e) {
-          throw UsageError("--video " + a.video + ": frame " + std::to_string(index) + " cannot be decoded (" + oneLine(e.what()) + ")");
-        }
-        if (!got || job.bgr.empty()) {
+        if (!video.read(job.bgr)) {
           if (index == 0) throw UsageError("--video " + a.video + ": no frame could be decoded");
           if (expected > 0 && index < expected)
             throw UsageError("--video " + a.video + ": the video ends after " + std::to_string(index) + " of the " +
@@ -671,13 +521,9 @@ Exit runOverlay(OverlayArgs& a) {
           else throw UsageError("--video " + a.video + ": frame " + std::to_string(index) + " is not an 8-bit colour image");
           job.bgr = converted;
         }
-        if (!frame_times.empty()) {
-          if (index >= frame_times.size() || !std::isfinite(frame_times[index]))
-            throw UsageError("--frame-times " + a.frame_times + ": no time for frame " + std::to_string(index));
-          job.record.time = frame_times[index];
-        } else {
-          job.record.time = static_cast<double>(index) / fps;
-        }
+        job.record.time = clock(index);
+        if (clock.fromFrameTimes() && !std::isfinite(job.record.time))
+          throw UsageError("--frame-times " + a.frame_times + ": no time for frame " + std::to_string(index));
         job.record.selected = selection.contains(index);
         std::lock_guard lock(mu);
         todo.push_back(std::move(job));
@@ -843,10 +689,10 @@ Exit runOverlay(OverlayArgs& a) {
     }
     nlohmann::json full = j;
     full["frames"] = std::move(frames);
-    pending.commit();
-    writeFileAtomically(a.report, full.dump(1) + "\n");
+    commit();
+    writeFileAtomically(a.report, full.dump(1) + "\n", "--report " + a.report);
   } else {
-    pending.commit();
+    commit();
   }
 
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();

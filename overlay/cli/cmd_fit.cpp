@@ -19,7 +19,7 @@ struct FitArgs {
   std::string part_file;
   int points = 8;
   std::string part, name, frame = "world", model, body;
-  bool merge = false, json = false, quiet = false;
+  bool merge = false, json = false, quiet = false, hull = false;
   int evaluations = 4000;
 };
 
@@ -30,7 +30,9 @@ Exit runFit(const FitArgs& args) {
   modelling::Part part;
   part = modelling::readPart(args.part_file, {.part = args.part, .merge = args.merge});
   modelling::FitResult r;
-  {
+  if (args.hull) {
+    r = modelling::exactHull(part);
+  } else {
     Progress progress("fitting " + std::filesystem::path(args.part_file).filename().string(), args.quiet || args.json);
     r = modelling::fit(part, {.points = args.points,
                               .max_evaluations = args.evaluations,
@@ -58,9 +60,11 @@ Exit runFit(const FitArgs& args) {
     j["volume"] = volume;
     j["hull_volume"] = hull;
     j["volume_ratio"] = number(ratio(volume));
-    j["baselines"] = {{"sphere_volume", r.sphere_volume}, {"sphere_ratio", number(ratio(r.sphere_volume))},
-                      {"capsule_volume", r.capsule_volume}, {"capsule_ratio", number(ratio(r.capsule_volume))}};
-    j["k"] = args.points;
+    if (!args.hull)
+      j["baselines"] = {{"sphere_volume", r.sphere_volume}, {"sphere_ratio", number(ratio(r.sphere_volume))},
+                        {"capsule_volume", r.capsule_volume}, {"capsule_ratio", number(ratio(r.capsule_volume))}};
+    j["k"] = static_cast<int>(r.points.size());
+    j["exact_hull"] = args.hull;
     j["triangles"] = part.triangles;
     j["primitives"] = part.primitives;
     j["hull_vertices"] = r.hull_vertices;
@@ -73,10 +77,12 @@ Exit runFit(const FitArgs& args) {
   std::ostringstream out;
   out << "# kccd fit " << args.part_file << ": " << part.triangles << " triangles, " << part.primitives
       << " analytic primitives, " << r.hull_vertices << " hull vertices, " << seconds << " s\n"
-      << "# K = " << args.points << ": volume " << format(volume, 6) << " = " << format(ratio(volume), 4)
-      << " x convex hull (" << format(hull, 6) << ")\n"
-      << "# baselines: bounding sphere (K = 1) " << format(ratio(r.sphere_volume), 4)
-      << " x hull, PCA capsule (K = 2) " << format(ratio(r.capsule_volume), 4) << " x hull\n";
+      << "# " << (args.hull ? "exact convex hull, " + std::to_string(r.points.size()) + " points" : "K = " + std::to_string(args.points))
+      << ": volume " << format(volume, 6) << " = " << format(ratio(volume), 4) << " x convex hull (" << format(hull, 6)
+      << ")\n";
+  if (!args.hull)
+    out << "# baselines: bounding sphere (K = 1) " << format(ratio(r.sphere_volume), 4) << " x hull, PCA capsule (K = 2) "
+        << format(ratio(r.capsule_volume), 4) << " x hull\n";
   if (!args.model.empty()) out << "# written into " << args.model << ", body " << args.body << "\n";
   out << "- name: " << body_name << "\n"
       << "  frame: " << args.frame << "\n"
@@ -96,16 +102,24 @@ Runner addFit(CLI::App& app) {
       "binary) or VRML 1/2 (.wrl) file (Coin3D), or a mesh: STL, OBJ, COLLADA (.dae), PLY, glTF (.glb, .gltf) and "
       "the other formats Assimp reads; every point of the part is inside, the volume is minimised");
   sub->add_option("part", args->part_file, "CAD file of the part")->required();
-  sub->add_option("--points,-k", args->points, "Number of core points K (1 ... 16)")->capture_default_str();
+  CLI::Option* points =
+      sub->add_option("--points,-k", args->points, "Number of core points K (1 ... 16)")->capture_default_str();
   sub->add_option("--part", args->part, "Fit only the node DEF'd with this name");
   sub->add_flag("--merge", args->merge, "Fit all top-level parts of the file as one rigid body");
   sub->add_option("--name", args->name, "Body name in the printed snippet (default: the file name)");
   sub->add_option("--frame", args->frame, "Frame in the printed snippet")->capture_default_str();
   sub->add_option("--model", args->model, "Write the result into this model file, in place (with --body)");
   sub->add_option("--body", args->body, "Body of --model whose points and radius are replaced");
-  sub->add_option("--evaluations", args->evaluations, "Optimiser budget per start (volume evaluations; three starts are refined)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 10000000));
+  CLI::Option* evaluations =
+      sub->add_option("--evaluations", args->evaluations,
+                      "Optimiser budget per start (volume evaluations; three starts are refined)")
+          ->capture_default_str()
+          ->check(CLI::Range(1, 10000000));
+  sub->add_flag("--hull", args->hull,
+                "No fit: the part's exact convex hull (every hull vertex a core point): no looseness, a query "
+                "costs more the more vertices (for the links of pairs that work close together)")
+      ->excludes(points)
+      ->excludes(evaluations);
   sub->add_flag("--json", args->json, "Machine-readable output");
   sub->add_flag("--quiet,-q", args->quiet, "No progress display");
   sub->footer(

@@ -551,17 +551,6 @@ std::string intrinsicsText(const calib::Camera& c) {
 // ---------------------------------------------------------------------------------------------
 // Output folder: built under a temporary name beside DIR, renamed into place at the end.
 
-struct TempDir {
-  std::string path;
-  bool keep = false;
-  ~TempDir() {
-    if (!keep && !path.empty()) {
-      std::error_code ec;
-      fs::remove_all(path, ec);
-    }
-  }
-};
-
 std::string fourccCodec(const std::string& codec, int& fourcc) {
   if (codec == "ffv1") return fourcc = cv::VideoWriter::fourcc('F', 'F', 'V', '1'), "video.mkv";
   if (codec == "mjpg") return fourcc = cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), "video.avi";
@@ -854,20 +843,14 @@ Exit runSynth(const SynthArgs& a) {
   const cv::Mat background = calib::renderTagSceneBgr(camera, layout, so);
   const auto t_bg = Clock::now();
 
-  // Output folder.
-  TempDir tmp;
-  {
-    std::string pattern = (parent / ("." + out.filename().string() + ".tmp-XXXXXX")).string();
-    if (!mkdtemp(pattern.data())) throw UsageError("-o " + a.output + ": cannot create a folder beside it");
-    tmp.path = pattern;
-    const mode_t mask = umask(0);  // mkdtemp makes it private; the result is an ordinary folder
-    umask(mask);
-    ::chmod(tmp.path.c_str(), 0777 & ~mask);
-  }
-  const std::string mask_dir = tmp.path + "/masks";
+  // Output folder, staged: an existing one is replaced only when the new one is complete.
+  overlay::StagedOutput staged(out, overlay::StagedOutput::Kind::Folder, "-o " + a.output,
+                               overlay::StagedOutput::Existing::ReplaceFolder);
+  const std::string dir = staged.path().string();
+  const std::string mask_dir = dir + "/masks";
   fs::create_directory(mask_dir);
   cv::VideoWriter video;
-  video.open(tmp.path + "/" + video_name, cv::CAP_FFMPEG, fourcc, a.fps, cv::Size(camera.width, camera.height), true);
+  video.open(dir + "/" + video_name, cv::CAP_FFMPEG, fourcc, a.fps, cv::Size(camera.width, camera.height), true);
   if (!video.isOpened()) throw UsageError("--codec " + a.codec + ": OpenCV cannot write this video here");
 
   double render_s = 0.0;
@@ -909,10 +892,10 @@ Exit runSynth(const SynthArgs& a) {
     throw std::runtime_error("synth: wrote " + std::to_string(written) + " of " + std::to_string(frames) + " frames");
 
   // Text outputs.
-  writeFileAtomically(tmp.path + "/states.csv", log_text);
-  writeFileAtomically(tmp.path + "/camera_true.yaml", calib::cameraText(camera));
-  writeFileAtomically(tmp.path + "/intrinsics.yaml", intrinsicsText(camera));
-  writeFileAtomically(tmp.path + "/tags.yaml", tagLayoutText(layout));
+  writeFileAtomically(dir + "/states.csv", log_text);
+  writeFileAtomically(dir + "/camera_true.yaml", calib::cameraText(camera));
+  writeFileAtomically(dir + "/intrinsics.yaml", intrinsicsText(camera));
+  writeFileAtomically(dir + "/tags.yaml", tagLayoutText(layout));
 
   const auto t_end = Clock::now();
   nlohmann::json j;
@@ -985,31 +968,9 @@ Exit runSynth(const SynthArgs& a) {
                    {"encode_video", 1e3 * writer_s[2] / frames},
                    {"masks", 1e3 * writer_s[3] / frames}}},
                  {"renderer", renderer->rendererString()}};
-  writeFileAtomically(tmp.path + "/synth.json", j.dump(1) + "\n");
+  writeFileAtomically(dir + "/synth.json", j.dump(1) + "\n");
 
-  // Into place.
-  if (fs::exists(out, ec)) {
-    if (fs::is_directory(out, ec) && fs::is_empty(out, ec)) {
-      fs::remove(out, ec);
-    } else {
-      std::string old = (parent / ("." + out.filename().string() + ".old-XXXXXX")).string();
-      if (!mkdtemp(old.data())) throw UsageError("-o " + a.output + ": cannot move the old folder aside");
-      fs::remove(old, ec);
-      if (std::rename(out.c_str(), old.c_str()) != 0)
-        throw UsageError("-o " + a.output + ": cannot move the old folder aside");
-      if (std::rename(tmp.path.c_str(), out.c_str()) != 0) {
-        std::rename(old.c_str(), out.c_str());
-        throw UsageError("-o " + a.output + ": cannot rename the new folder into place");
-      }
-      tmp.keep = true;
-      fs::remove_all(old, ec);
-    }
-  }
-  if (!tmp.keep) {
-    if (std::rename(tmp.path.c_str(), out.c_str()) != 0)
-      throw UsageError("-o " + a.output + ": cannot rename the new folder into place");
-    tmp.keep = true;
-  }
+  staged.commit();  // into place
   if (!a.quiet) {
     std::cout << "wrote " << a.output << ": " << frames << " frames " << camera.width << "x" << camera.height << " at "
               << a.fps << " fps (" << video_name << "), states.csv at " << a.log_rate << " Hz (log time = video time + "

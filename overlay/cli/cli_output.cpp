@@ -64,10 +64,6 @@ void Progress::finish() {
   if (shown_) std::cerr << "\r" << std::string(std::max(what_.size() + 40, shown_width_), ' ') << "\r" << std::flush;
 }
 
-std::string format(double value, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, value);
-  return buf;
-}
+std::string format(double value, int digits) { return messageNumber(value, digits); }
 
 }  // namespace kccd::cli
