@@ -9,7 +9,7 @@ packages=(
   libfcl-dev libqhull-dev
   libcoin-dev inventor-data liburdfdom-dev libassimp-dev
   libosmesa6-dev libgl-dev libegl-dev libopengl-dev libegl-mesa0
-  libopencv-dev libtinyxml2-dev libapriltag-dev
+  libopencv-dev libpng-dev libtinyxml2-dev libapriltag-dev
 )
 # --fuzz: also the compiler and runtime of the libFuzzer targets (scripts/fuzz.sh).
 [ "${1:-}" = "--fuzz" ] && packages+=(clang-14 libclang-rt-14-dev)

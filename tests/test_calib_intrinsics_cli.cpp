@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <sstream>
 #include <string>
@@ -62,6 +63,10 @@ TEST_F(IntrinsicsCli, BadInputIsOneLineNamingTheFile) {
   const std::string out = path("cam.yaml");
   {
     std::ofstream(path("text.png")) << "not an image\n";
+    // A PNG cut in the middle: libpng's own message, and nothing else on stderr.
+    std::ifstream in(a, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(path("cut.png"), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
   }
   struct Case {
     std::string args, expect;
@@ -69,6 +74,7 @@ TEST_F(IntrinsicsCli, BadInputIsOneLineNamingTheFile) {
       {"--image " + a + " " + b + " " + small + kGrid, small + ": image: 160x120 differs from " + a},
       {"--image " + a + " " + path("missing.png") + kGrid, path("missing.png") + ": image: no such file"},
       {"--image " + a + " " + path("text.png") + kGrid, path("text.png") + ": image: not an image"},
+      {"--image " + a + " " + path("cut.png") + kGrid, path("cut.png") + ": image: a damaged PNG ("},
       {"--image " + a + " " + dir_.string() + kGrid, dir_.string() + ": image: not a regular file"},
       {"--image " + a + " " + a + kGrid, a + ": image: given twice"},
       {"--image " + a + " --grid 6x4", "--grid needs --tag-size"},

@@ -1,6 +1,10 @@
 #include "kccd/calib/image_file.hpp"
 
+#include <png.h>
+
+#include <cstring>
 #include <filesystem>
+#include <memory>
 #include <system_error>
 
 #include <opencv2/imgcodecs.hpp>
@@ -10,9 +14,37 @@
 
 namespace kccd::calib {
 
+namespace {
+
+// A PNG that libpng cannot decode: its message (empty when it decodes). libpng's simplified API
+// keeps its messages to itself, where OpenCV's use of libpng prints them on stderr: a damaged PNG
+// is caught here first so that the user sees one line, and sees what is wrong with it.
+std::string pngProblem(std::span<const std::uint8_t> bytes) {
+  png_image image;
+  std::memset(&image, 0, sizeof image);
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_memory(&image, bytes.data(), bytes.size())) return image.message;
+  if (image.width > static_cast<png_uint_32>(kMaxImageSide) || image.height > static_cast<png_uint_32>(kMaxImageSide) ||
+      static_cast<long>(image.width) * image.height > kMaxImagePixels) {
+    png_image_free(&image);
+    return "";  // too large: decodeImage says so
+  }
+  image.format = PNG_FORMAT_GRAY;  // the smallest buffer: only the decoding is checked
+  std::unique_ptr<std::uint8_t[]> scratch(new std::uint8_t[PNG_IMAGE_SIZE(image)]);
+  if (!png_image_finish_read(&image, nullptr, scratch.get(), 0, nullptr)) return image.message;
+  return "";
+}
+
+}  // namespace
+
 cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& source, ImageColour colour) {
   const auto fail = [&](const std::string& problem) { throw ImageError(source + ": image: " + problem); };
   if (bytes.empty()) fail("empty file");
+  static constexpr std::uint8_t kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  if (bytes.size() >= 8 && std::memcmp(bytes.data(), kPngSignature, 8) == 0) {
+    const std::string problem = pngProblem(bytes);
+    if (!problem.empty()) fail("a damaged PNG (" + printable(problem) + ")");
+  }
   cv::Mat img;
   try {
     const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
