@@ -18,6 +18,7 @@
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/calib/intrinsics.hpp"
+#include "support/files.hpp"
 #include "support/run_program.hpp"
 #include "support/tag_scene.hpp"
 
@@ -64,8 +65,7 @@ TEST_F(IntrinsicsCli, BadInputIsOneLineNamingTheFile) {
   {
     std::ofstream(path("text.png")) << "not an image\n";
     // A PNG cut in the middle: libpng's own message, and nothing else on stderr.
-    std::ifstream in(a, std::ios::binary);
-    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string bytes = kccd::testing::readText(a);
     std::ofstream(path("cut.png"), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
   }
   struct Case {

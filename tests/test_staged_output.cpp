@@ -8,16 +8,17 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "kccd/overlay/staged_output.hpp"
+#include "support/files.hpp"
 
 namespace fs = std::filesystem;
 using kccd::overlay::OutputError;
 using kccd::overlay::StagedOutput;
+using kccd::testing::readText;
 
 namespace {
 
@@ -44,12 +45,6 @@ class StagedOutputTest : public ::testing::Test {
     for (const auto& n : names) out += n + " ";
     return out;
   }
-  static std::string read(const std::string& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
   static unsigned modeOf(const std::string& p) {
     struct stat st {};
     EXPECT_EQ(::stat(p.c_str(), &st), 0) << p;
@@ -73,7 +68,7 @@ TEST_F(StagedOutputTest, NewFilesAndFoldersGetWhatAPlainCreateGives) {
 
     const std::string report = path("report_" + std::to_string(mask) + ".json");
     kccd::overlay::writeFileAtomically(report, "{}\n");
-    EXPECT_EQ(read(report), "{}\n");
+    EXPECT_EQ(readText(report), "{}\n");
     EXPECT_EQ(modeOf(report), modeOf(plain_file)) << "umask " << mask;
 
     // A file a writer fills by its own name (a video), and a folder of frames.
@@ -86,7 +81,7 @@ TEST_F(StagedOutputTest, NewFilesAndFoldersGetWhatAPlainCreateGives) {
     std::ofstream(frames.path() / "frame_000000.png") << "png";
     frames.commit();
     EXPECT_EQ(modeOf(frames.target().string()), modeOf(plain_dir)) << "umask " << mask;
-    EXPECT_EQ(read(frames.target().string() + "/frame_000000.png"), "png");
+    EXPECT_EQ(readText(frames.target().string() + "/frame_000000.png"), "png");
   }
 }
 
@@ -108,10 +103,10 @@ TEST_F(StagedOutputTest, NothingUnderTheTargetNameBeforeCommitNothingLeftWithout
   {
     StagedOutput edit(path("model.yaml"), StagedOutput::Kind::File, "model.yaml");
     std::ofstream(edit.path()) << "new\n";
-    EXPECT_EQ(read(path("model.yaml")), "old\n");
+    EXPECT_EQ(readText(path("model.yaml")), "old\n");
     edit.commit();
   }
-  EXPECT_EQ(read(path("model.yaml")), "new\n");
+  EXPECT_EQ(readText(path("model.yaml")), "new\n");
   EXPECT_EQ(modeOf(path("model.yaml")), 0640u);
   EXPECT_EQ(listing(), "model.yaml ");
 }
@@ -122,7 +117,7 @@ TEST_F(StagedOutputTest, SymbolicLinksStayLinks) {
   fs::create_symlink("real/camera.yaml", path("camera.yaml"));
   kccd::overlay::writeFileAtomically(path("camera.yaml"), "b\n");
   EXPECT_TRUE(fs::is_symlink(path("camera.yaml")));
-  EXPECT_EQ(read(path("real/camera.yaml")), "b\n");
+  EXPECT_EQ(readText(path("real/camera.yaml")), "b\n");
 }
 
 TEST_F(StagedOutputTest, FoldersAreNotMixedUnlessReplaced) {
@@ -141,7 +136,7 @@ TEST_F(StagedOutputTest, FoldersAreNotMixedUnlessReplaced) {
     synth.commit();
   }
   EXPECT_FALSE(fs::exists(path("run/old.txt")));
-  EXPECT_EQ(read(path("run/new.txt")), "new");
+  EXPECT_EQ(readText(path("run/new.txt")), "new");
   EXPECT_EQ(listing(), "run ");  // the old folder moved aside is gone
   // An empty folder is simply taken.
   fs::create_directory(path("empty"));

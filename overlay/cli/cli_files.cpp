@@ -30,19 +30,19 @@ Model loadOrExplain(const std::string& path, std::string* text) {
 
 void editFile(const std::string& path, const std::function<std::string(const std::string&)>& edit,
               const std::string* expected) {
-  const std::filesystem::path target = path;  // a symbolic link: its target is locked and replaced
+  // A symbolic link: its target is locked (open and stat follow it) and replaced.
   // Lock the file, then make sure the name still refers to the locked file: a concurrent edit may
   // have renamed a new file into place while this one waited.
   int fd = -1;
   for (int attempt = 0;; ++attempt) {
-    fd = ::open(target.c_str(), O_RDONLY | O_CLOEXEC);
+    fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) throw UsageError(path + ": cannot read the file (" + std::strerror(errno) + ")");
     struct stat locked {}, named {};
     if (flock(fd, LOCK_EX) != 0 || fstat(fd, &locked) != 0) {
       ::close(fd);
       throw UsageError(path + ": cannot lock the file for editing (" + std::strerror(errno) + ")");
     }
-    if (::stat(target.c_str(), &named) == 0 && named.st_ino == locked.st_ino && named.st_dev == locked.st_dev) break;
+    if (::stat(path.c_str(), &named) == 0 && named.st_ino == locked.st_ino && named.st_dev == locked.st_dev) break;
     ::close(fd);
     if (attempt > 1000) throw UsageError(path + ": the file keeps being replaced; edit not done");
   }
@@ -62,7 +62,7 @@ void editFile(const std::string& path, const std::function<std::string(const std
   if (expected != nullptr && text != *expected)
     throw UsageError(path + ": the file changed while kccd worked on it; nothing written (run again)");
   const std::string edited = edit(text);  // an EditError names the file and place itself
-  writeFileAtomically(target, edited, path);  // keeps the file's mode
+  writeFileAtomically(path, edited);  // keeps the file's mode
 }
 
 void checkOutputPath(const std::string& path, const std::string& option, const std::string& extension) {

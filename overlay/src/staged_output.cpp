@@ -128,9 +128,10 @@ void StagedOutput::commit() {
 }
 
 void writeFileAtomically(const fs::path& path, const std::string& bytes, const std::string& label) {
-  StagedOutput out(path, StagedOutput::Kind::File, label.empty() ? path.string() : label);
+  const std::string shown = label.empty() ? path.string() : label;
+  StagedOutput out(path, StagedOutput::Kind::File, shown);
   const int fd = ::open(out.path().c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
-  if (fd < 0) throw OutputError((label.empty() ? path.string() : label) + ": cannot write (" + errnoText(errno) + ")");
+  if (fd < 0) throw OutputError(shown + ": cannot write (" + errnoText(errno) + ")");
   std::size_t done = 0;
   bool ok = true;
   while (ok && done < bytes.size()) {
@@ -141,7 +142,7 @@ void writeFileAtomically(const fs::path& path, const std::string& bytes, const s
   }
   const int err = errno;
   ::close(fd);
-  if (!ok) throw OutputError((label.empty() ? path.string() : label) + ": write failed (" + errnoText(err) + ")");
+  if (!ok) throw OutputError(shown + ": write failed (" + errnoText(err) + ")");
   out.commit();
 }
 
