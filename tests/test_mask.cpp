@@ -34,7 +34,7 @@ TEST(RenderCamera, TinyImagesRender) {
     c.camera_matrix(1, 2) = (h - 1) / 2.0;
     Renderer r(c);
     const std::vector<Vec3> ball = {Vec3(0, 0, 0)};
-    const Volume v[] = {{ball, 1.5, VolumeStatus::Clear, "ball"}};  // wider than the view
+    const Volume v[] = {{ball, 1.5, SafetyStatus::Clear, "ball"}};  // wider than the view
     const Frame f = r.render(v, Style{.labels = true, .legend = true});
     EXPECT_EQ(f.bgra.cols, w);
     EXPECT_EQ(f.bgra.rows, h);
@@ -57,7 +57,7 @@ TEST(RenderMask, MatchesIndependentCpuSilhouette) {
     const double radius = 0.15 + 0.1 * std::abs(u(rng));
     const cv::Mat cpu = cpuSilhouette(c, pts, radius);
     Renderer r(c);
-    const Volume v{pts, radius, VolumeStatus::Clear, ""};
+    const Volume v{pts, radius, SafetyStatus::Clear, ""};
     const Frame f = r.render(std::span<const Volume>(&v, 1), Style{}, false, true);
     const cv::Mat gl = f.mask > 0, ref = cpu > 0;
     const double inter = cv::countNonZero(gl & ref), uni = cv::countNonZero(gl | ref);
@@ -85,7 +85,7 @@ TEST(RenderMask, NearestBodyWinsAndLabelsAreIndexPlusOne) {
   Renderer r(c);
   const std::vector<Vec3> far = {Vec3(-0.3, 0, 0)}, near = {Vec3(0.3, 0.1, 0)};
   // The far one first in the list, so drawing order alone would let it win.
-  const Volume v[] = {{far, 0.25, VolumeStatus::Clear, "far"}, {near, 0.15, VolumeStatus::Colliding, "near"}};
+  const Volume v[] = {{far, 0.25, SafetyStatus::Clear, "far"}, {near, 0.15, SafetyStatus::Colliding, "near"}};
   const Frame f = r.render(v, Style{.legend = false}, true, true);
   const cv::Point centre_near(static_cast<int>(std::lround(r.projection().project(near[0]).x())),
                               static_cast<int>(std::lround(r.projection().project(near[0]).y())));
@@ -100,7 +100,7 @@ TEST(RenderMask, NearestBodyWinsAndLabelsAreIndexPlusOne) {
   ASSERT_EQ(f.mask.at<uchar>(far_only), 1);
   const cv::Vec4b px = f.bgra.at<cv::Vec4b>(far_only);
   EXPECT_NEAR(px[3], 0.35 * 255, 2);
-  const cv::Scalar green = statusColour(VolumeStatus::Clear);
+  const cv::Scalar green = statusColour(SafetyStatus::Clear);
   for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(px[ch], green[ch], 3) << ch;
   EXPECT_EQ(f.bgra.at<cv::Vec4b>(c.height - 1, c.width - 1)[3], 0);
 }
@@ -110,8 +110,8 @@ TEST(RenderMask, NearestBodyWinsAndLabelsAreIndexPlusOne) {
 TEST(RenderMask, SameLabelsFromTheColourPassAndAlone) {
   const Camera c = lookAt(Vec3(1.5, -1.0, 1.0), Vec3(0, 0, 0), 200, 150, 180, {-0.1, 0.01, 0, 0, 0});
   const std::vector<Vec3> a = {Vec3(-0.2, 0, 0), Vec3(0.2, 0.1, 0)}, b = {Vec3(0.1, 0.1, 0.1)}, d = {Vec3(0, -0.3, 0.2)};
-  const Volume v[] = {{a, 0.15, VolumeStatus::Clear, "a"}, {b, 0.2, VolumeStatus::Colliding, "b"},
-                      {d, 0.1, VolumeStatus::WithinMargin, "d"}};
+  const Volume v[] = {{a, 0.15, SafetyStatus::Clear, "a"}, {b, 0.2, SafetyStatus::Colliding, "b"},
+                      {d, 0.1, SafetyStatus::WithinMargin, "d"}};
   Renderer plain(c);
   Renderer msaa(c, RenderOptions{.msaa_samples = 4});
   const Frame together = plain.render(v, Style{}, true, true);
@@ -143,8 +143,8 @@ TEST(RenderMask, LabelsDoNotDependOnTheNearPlane) {
   const std::vector<Vec3> a = {Vec3(0, -0.5, 0), Vec3(0, 0.5, 0)};
   const std::vector<Vec3> b = {Vec3(0.0002, -0.5, 0.002), Vec3(0.0002, 0.5, -0.002)};  // crossing a at 0.2 mm
   const std::vector<Vec3> close = {Vec3(3 - 0.0005, 0.0025, 0)};  // 0.5 mm in front, 2.5 mm aside
-  const Volume pair[] = {{a, 0.1, VolumeStatus::Clear, "a"}, {b, 0.1, VolumeStatus::Colliding, "b"}};
-  const Volume with_close[] = {pair[0], pair[1], {close, 0.001, VolumeStatus::Clear, "close"}};
+  const Volume pair[] = {{a, 0.1, SafetyStatus::Clear, "a"}, {b, 0.1, SafetyStatus::Colliding, "b"}};
+  const Volume with_close[] = {pair[0], pair[1], {close, 0.001, SafetyStatus::Clear, "close"}};
   Renderer r(c);
   const Frame plain = r.render(pair, Style{}, false, true);
   const Frame near = r.render(with_close, Style{}, false, true);
@@ -167,7 +167,7 @@ TEST(RenderMask, WarpIsTheNearestPixelRemapOfThePinholeLabels) {
     std::vector<Volume> v;
     for (std::size_t i = 0; i < cores.size(); ++i) {
       cores[i] = {Vec3(0.5 * u(rng), 0.5 * u(rng), 0.5 * u(rng)), Vec3(0.5 * u(rng), 0.5 * u(rng), 0.5 * u(rng))};
-      v.push_back(Volume{cores[i], 0.05 + 0.1 * std::abs(u(rng)), VolumeStatus::Clear, ""});
+      v.push_back(Volume{cores[i], 0.05 + 0.1 * std::abs(u(rng)), SafetyStatus::Clear, ""});
     }
     for (const double scale : {1.0, 2.0}) {
       // The finest tessellation for both (the level otherwise follows the output camera's focal length).
@@ -210,7 +210,7 @@ TEST(RenderMask, SurfacesDrawBothSidesWithTheirOwnLabels) {
   surface.surface = box;
   surface.mask_label = 7;
   const Frame fs = r.render(std::span<const Volume>(&surface, 1), Style{.legend = false, .shaded = true}, true, true);
-  const Volume ssch{corners, 0.0, VolumeStatus::Clear, ""};
+  const Volume ssch{corners, 0.0, SafetyStatus::Clear, ""};
   const Frame fv = r.render(std::span<const Volume>(&ssch, 1), Style{.shaded = true}, true, true);
   const cv::Mat a = fs.mask > 0, b = fv.mask > 0;
   EXPECT_EQ(cv::countNonZero(fs.mask == 7), cv::countNonZero(a));
@@ -257,9 +257,9 @@ TEST(RenderMask, DegenerateVolumesAreVisible) {
   const std::vector<Vec3> square = {Vec3(-0.3, -0.3, 0), Vec3(0.3, -0.3, 0), Vec3(0.3, 0.3, 0), Vec3(-0.3, 0.3, 0)};
   const std::vector<Vec3> segment = {Vec3(-0.4, 0.4, 0.2), Vec3(0.4, 0.4, 0.2)};
   const std::vector<Vec3> point = {Vec3(0, 0, 0.5)};
-  const Volume v[] = {{square, 0.0, VolumeStatus::Clear, ""},
-                      {segment, 0.0, VolumeStatus::Clear, ""},
-                      {point, 0.05, VolumeStatus::Clear, ""}};
+  const Volume v[] = {{square, 0.0, SafetyStatus::Clear, ""},
+                      {segment, 0.0, SafetyStatus::Clear, ""},
+                      {point, 0.05, SafetyStatus::Clear, ""}};
   const Frame f = r.render(v, Style{}, true, true);
   EXPECT_GT(f.pixels[0], 500);  // a flat square seen at an angle
   EXPECT_GT(f.pixels[2], 20);    // a ball
@@ -274,9 +274,9 @@ TEST(RenderMask, VolumesThatCannotBeDrawnAreReported) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::vector<Vec3> behind = {Vec3(5, 0, 0)}, far = {Vec3(-2e7, 0, 0)}, bad = {Vec3(nan, 0, 0)},
                           distant = {Vec3(-500, 0, 0)}, off_axis = {Vec3(1.9999, -1e5, 0)};
-  const Volume v[] = {{behind, 0.5, VolumeStatus::Clear, "behind"},  {far, 1e3, VolumeStatus::Clear, "far"},
-                      {bad, 0.1, VolumeStatus::Clear, "bad"},        {distant, 30, VolumeStatus::Clear, "distant"},
-                      {off_axis, 0.01, VolumeStatus::Clear, "off axis"}};
+  const Volume v[] = {{behind, 0.5, SafetyStatus::Clear, "behind"},  {far, 1e3, SafetyStatus::Clear, "far"},
+                      {bad, 0.1, SafetyStatus::Clear, "bad"},        {distant, 30, SafetyStatus::Clear, "distant"},
+                      {off_axis, 0.01, SafetyStatus::Clear, "off axis"}};
   const Frame f = r.render(v, Style{.labels = true}, true, true);
   EXPECT_EQ(f.visibility[0], Visibility::BehindCamera);
   EXPECT_EQ(f.visibility[1], Visibility::BeyondFar);
@@ -289,7 +289,7 @@ TEST(RenderMask, VolumesThatCannotBeDrawnAreReported) {
   // 1 cm from the camera (closer than the default near plane, 5 cm): a ball of 2 cm radius
   // seen from 1 cm covers the whole view, not clipped away by the near plane.
   const std::vector<Vec3> close = {Vec3(1.97, 0, 0)};
-  const Volume u[] = {{close, 0.02, VolumeStatus::Clear, "close"}};
+  const Volume u[] = {{close, 0.02, SafetyStatus::Clear, "close"}};
   const Frame e = r.render(u, Style{}, true, true);
   EXPECT_EQ(e.visibility[0], Visibility::Drawn);
   EXPECT_LT(e.near, 0.01);
@@ -298,7 +298,7 @@ TEST(RenderMask, VolumesThatCannotBeDrawnAreReported) {
 
   // A volume containing the camera fills the view in the mask and tints the colour layer.
   const std::vector<Vec3> room = {Vec3(0, 0, 0)}, ball = {Vec3(0, 0, 0)};
-  const Volume w[] = {{ball, 0.3, VolumeStatus::Clear, "ball"}, {room, 5.0, VolumeStatus::Colliding, "room"}};
+  const Volume w[] = {{ball, 0.3, SafetyStatus::Clear, "ball"}, {room, 5.0, SafetyStatus::Colliding, "room"}};
   const Frame g = r.render(w, Style{.legend = false}, true, true);
   EXPECT_EQ(g.visibility[1], Visibility::FillsView);
   EXPECT_EQ(g.pixels[1], c.width * c.height);

@@ -114,7 +114,7 @@ TEST(RenderProjection, RasterisedEdgesMatchProjectPoints) {
     std::vector<Vec3> flat = quad;
     const Vec3 n = (quad[1] - quad[0]).cross(quad[2] - quad[0]).normalized();
     flat[3] -= n * n.dot(quad[3] - quad[0]);
-    const Volume v{flat, 0.0, VolumeStatus::Clear, ""};
+    const Volume v{flat, 0.0, SafetyStatus::Clear, ""};
     const Frame f = r.render(std::span<const Volume>(&v, 1), Style{}, false, true);
     std::vector<cv::Point2d> corners;
     for (const Vec3& p : flat) corners.push_back(cvProject(c, p));

@@ -377,7 +377,7 @@ TEST(RenderMesh, PolygonFillCoversTheSamePixelsAsTheTriangles) {
       cores.push_back(kccd::testing::randomCloud(rng, 1 + static_cast<int>(rng() % 12), centre, 0.1 + 0.4 * std::abs(u(rng))));
     }
     for (int i = 0; i < n; ++i) {
-      const VolumeStatus status = static_cast<VolumeStatus>(i % 3);
+      const SafetyStatus status = static_cast<SafetyStatus>(i % 3);
       scene.push_back(Volume{cores[static_cast<std::size_t>(i)], 0.02 + 0.2 * std::abs(u(rng)), status, ""});
     }
     RenderOptions triangles, silhouettes;

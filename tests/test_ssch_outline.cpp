@@ -244,7 +244,7 @@ TEST(RenderOutline, ColourLayerMatchesTheCpuSilhouette) {
     const double radius = 0.05 + 0.15 * std::abs(u(rng));
     const cv::Mat cpu = kccd::testing::cpuSilhouette(c, pts, radius) > 0;
     Renderer r(c);
-    const Volume v{pts, radius, VolumeStatus::Clear, ""};
+    const Volume v{pts, radius, SafetyStatus::Clear, ""};
     const Frame f = r.render(std::span<const Volume>(&v, 1), Style{.legend = false}, true, false);
     EXPECT_EQ(f.meshes_built, 0);
     outlines += f.outlines;
@@ -268,7 +268,7 @@ TEST(RenderOutline, ColourLayerMatchesTheCpuSilhouette) {
   const Camera c = kccd::testing::lookAt(Vec3(2, 0, 0), Vec3(0, 0, 0), 160, 120, 150, {-0.1, 0.01, 0, 0, 0});
   const std::vector<Vec3> close = {Vec3(1.97, 0.05, 0), Vec3(1.5, 0.1, 0)};  // 3 cm in front of the camera
   Renderer r(c);
-  const Volume v{close, 0.02, VolumeStatus::Clear, ""};
+  const Volume v{close, 0.02, SafetyStatus::Clear, ""};
   const Frame f = r.render(std::span<const Volume>(&v, 1), Style{.legend = false}, true, false);
   EXPECT_EQ(f.outlines, 0);
   EXPECT_EQ(f.meshes_built, 1);

@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
     kccd::Checker checker(model);
     const std::vector<double> state(model.stateSize(), 0.0);
     const kccd::QueryResult& result = checker.query(state, state, kccd::QueryOptions{.type = kccd::QueryType::Distances});
-    const std::vector<kccd::render::VolumeStatus> status = kccd::render::bodyStatus(model, result);  // the colours
+    const std::vector<kccd::SafetyStatus> status = kccd::render::bodyStatus(model, result);  // the colours
     kccd::render::Renderer renderer(camera);  // one off-screen GL context (EGL or OSMesa)
     const kccd::render::Frame frame =
         renderer.render(kccd::render::staticSceneVolumes(model, checker, state, status), {}, true, true);

@@ -233,7 +233,7 @@ cv::Mat volumesLayer(const Model& m, const calib::Camera& cam, std::span<const d
   Checker checker(m);
   const std::vector<double> s(state.begin(), state.end());
   const QueryResult& r = checker.query(s, s, QueryOptions{.type = QueryType::Distances});
-  const std::vector<render::VolumeStatus> status = render::bodyStatus(m, r);
+  const std::vector<SafetyStatus> status = render::bodyStatus(m, r);
   const std::vector<render::Volume> volumes = render::staticSceneVolumes(m, checker, s, status);
   try {
     render::Renderer renderer(cam);

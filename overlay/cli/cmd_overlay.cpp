@@ -216,7 +216,7 @@ class FrameWorker {
       // No state: only the bodies fixed in the world are known; they are drawn grey.
       for (int i : fixed_) {
         const Body& b = m.bodies[static_cast<std::size_t>(i)];
-        volumes.push_back(render::Volume{b.points, b.radius * (1.0 + 1e-9) + 1e-9, render::VolumeStatus::NoState, b.name});
+        volumes.push_back(render::Volume{b.points, b.radius * (1.0 + 1e-9) + 1e-9, SafetyStatus::NoState, b.name});
       }
     } else {
       rec.values.assign(q_.begin(), q_.end());
@@ -247,8 +247,8 @@ class FrameWorker {
       else
         rec.status = FrameStatus::Clear;
       if (!rec.selected) return;
-      std::vector<render::VolumeStatus> status = render::bodyStatus(m, r);
-      if (!box_ok) status.assign(m.bodies.size(), render::VolumeStatus::Colliding);
+      std::vector<SafetyStatus> status = render::bodyStatus(m, r);
+      if (!box_ok) status.assign(m.bodies.size(), SafetyStatus::Colliding);
       volumes = s_.args.swept && box_ok ? render::sceneVolumes(m, checker_, status)
                                         : render::staticSceneVolumes(m, checker_, q_, status);
     }
@@ -307,7 +307,7 @@ class FrameWorker {
     roi.convertTo(roi, -1, 0.35, 0);  // darkened background keeps the text readable on any frame
     const cv::Point at(box.x + pad, box.y + pad + size.height);
     const cv::Scalar colour = rec.status == FrameStatus::Clear ? cv::Scalar(255, 255, 255)
-                                                               : render::statusColour(static_cast<render::VolumeStatus>(rec.status));
+                                                               : render::statusColour(static_cast<SafetyStatus>(rec.status));
     cv::putText(bgr, text, at, font, scale, colour, thick, cv::LINE_AA);
   }
 

@@ -43,7 +43,7 @@ Exit runRender(const RenderArgs& args) {
   const Status status = r.status;
   const double margin = r.margin;
   const std::vector<double> nearest = render::bodyDistances(m, r);
-  const std::vector<render::VolumeStatus> body_status = render::bodyStatus(m, r);
+  const std::vector<SafetyStatus> body_status = render::bodyStatus(m, r);
   std::vector<render::Volume> volumes = box.point ? render::staticSceneVolumes(m, checker, lower, body_status)
                                                  : render::sceneVolumes(m, checker, body_status);
 
@@ -100,7 +100,7 @@ Exit runRender(const RenderArgs& args) {
         j["not_drawn"].push_back({{"body", m.bodies[i].name}, {"reason", render::toString(v)}});
     }
     for (std::size_t i = 0; i < m.bodies.size(); ++i)
-      j["bodies"].push_back({{"name", m.bodies[i].name}, {"label", i + 1}, {"status", render::toString(body_status[i])},
+      j["bodies"].push_back({{"name", m.bodies[i].name}, {"label", i + 1}, {"status", toString(body_status[i])},
                              {"min_distance", number(nearest[i])}, {"pixels", frame.pixels[i]}});
     j["stats"] = {{"frame_ms", frame_ms}, {"total_ms", total_ms}, {"triangles", frame.triangles},
                   {"meshes_built", frame.meshes_built}};
@@ -110,7 +110,7 @@ Exit runRender(const RenderArgs& args) {
               << camera.height << ", " << (swept ? "swept" : "static") << " volumes) in " << frame_ms << " ms\n"
               << "renderer " << renderer->rendererString() << "\n";
     for (std::size_t i = 0; i < m.bodies.size(); ++i)
-      std::cout << "  " << i + 1 << " " << m.bodies[i].name << ": " << render::toString(body_status[i]) << ", "
+      std::cout << "  " << i + 1 << " " << m.bodies[i].name << ": " << toString(body_status[i]) << ", "
                 << frame.pixels[i] << " px" << drawnNote(i) << "\n";
   }
   if (status != Status::Ok) {

@@ -95,7 +95,7 @@ std::vector<render::Volume> visualVolumes(const Model& model, std::span<const Lo
     volume.pose = framePose(poses, v.frame);
     volume.colour = v.colour;
     volume.mask_label = v.label;
-    volume.status = render::VolumeStatus::NoState;
+    volume.status = SafetyStatus::NoState;
     out.push_back(std::move(volume));
   }
   return out;

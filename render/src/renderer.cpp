@@ -20,16 +20,6 @@
 
 namespace kccd::render {
 
-const char* toString(VolumeStatus status) {
-  switch (status) {
-    case VolumeStatus::Clear: return "clear";
-    case VolumeStatus::WithinMargin: return "within_margin";
-    case VolumeStatus::Colliding: return "colliding";
-    case VolumeStatus::NoState: return "no_state";
-  }
-  return "?";
-}
-
 const char* toString(Visibility visibility) {
   switch (visibility) {
     case Visibility::Drawn: return "drawn";
@@ -43,12 +33,12 @@ const char* toString(Visibility visibility) {
   return "?";
 }
 
-cv::Scalar statusColour(VolumeStatus status) {
+cv::Scalar statusColour(SafetyStatus status) {
   switch (status) {
-    case VolumeStatus::Clear: return {60, 200, 40};
-    case VolumeStatus::WithinMargin: return {0, 180, 255};
-    case VolumeStatus::Colliding: return {40, 40, 230};
-    case VolumeStatus::NoState: return {160, 160, 160};
+    case SafetyStatus::Clear: return {60, 200, 40};
+    case SafetyStatus::WithinMargin: return {0, 180, 255};
+    case SafetyStatus::Colliding: return {40, 40, 230};
+    case SafetyStatus::NoState: return {160, 160, 160};
   }
   return {255, 255, 255};
 }
@@ -198,7 +188,7 @@ struct Renderer::Gl {
 /// uploaded), the silhouette edges seen from the camera, and its depth for sorting.
 struct Renderer::Prepared {
   int index = 0;
-  VolumeStatus status = VolumeStatus::NoState;
+  SafetyStatus status = SafetyStatus::NoState;
   cv::Scalar colour;      // fill colour (BGR)
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // volume frame -> camera
   std::shared_ptr<const Mesh> mesh;
@@ -1060,8 +1050,8 @@ cv::Mat Renderer::drawLegend(double scale, int thick) {
   };
   cv::Mat bgra;
   {
-    const VolumeStatus all[] = {VolumeStatus::Clear, VolumeStatus::WithinMargin, VolumeStatus::Colliding,
-                                VolumeStatus::NoState};
+    const SafetyStatus all[] = {SafetyStatus::Clear, SafetyStatus::WithinMargin, SafetyStatus::Colliding,
+                                SafetyStatus::NoState};
     const char* names[] = {"clear", "within margin", "colliding", "no state"};
     int baseline = 0;
     const cv::Size line = cv::getTextSize("within margin", font, scale, thick, &baseline);

@@ -16,34 +16,29 @@ std::vector<double> bodyDistances(const Model& model, const QueryResult& result)
   return nearest;
 }
 
-std::vector<VolumeStatus> bodyStatus(const Model& model, const QueryResult& result) {
-  std::vector<VolumeStatus> out(model.bodies.size(), VolumeStatus::Clear);
+std::vector<SafetyStatus> bodyStatus(const Model& model, const QueryResult& result) {
+  std::vector<SafetyStatus> out(model.bodies.size(), SafetyStatus::Clear);
   if (result.status != Status::Ok) {
-    out.assign(model.bodies.size(), VolumeStatus::Colliding);
+    out.assign(model.bodies.size(), SafetyStatus::Colliding);
     return out;
   }
   const std::vector<double> nearest = bodyDistances(model, result);
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    if (nearest[i] <= 0.0)
-      out[i] = VolumeStatus::Colliding;
-    else if (nearest[i] <= result.margin)
-      out[i] = VolumeStatus::WithinMargin;
-  }
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = safetyStatus(nearest[i], result.margin);
   return out;
 }
 
-std::vector<Volume> sceneVolumes(const Model& model, Checker& checker, const std::vector<VolumeStatus>& status) {
+std::vector<Volume> sceneVolumes(const Model& model, Checker& checker, const std::vector<SafetyStatus>& status) {
   std::vector<Volume> out;
   out.reserve(model.bodies.size());
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
     const SschView v = checker.sweptVolume(static_cast<int>(i), kWorld);
-    out.push_back(Volume{v.points, v.radius, status.empty() ? VolumeStatus::NoState : status[i], model.bodies[i].name});
+    out.push_back(Volume{v.points, v.radius, status.empty() ? SafetyStatus::NoState : status[i], model.bodies[i].name});
   }
   return out;
 }
 
 std::vector<Volume> staticSceneVolumes(const Model& model, Checker& checker, std::span<const double> state,
-                                       const std::vector<VolumeStatus>& status) {
+                                       const std::vector<SafetyStatus>& status) {
   std::vector<Volume> out = sceneVolumes(model, checker, status);
   std::vector<Pose> poses(model.joints.size());
   if (!framePoses(model, state, poses)) return out;  // the checker's (unsafe) volumes as they are

@@ -13,17 +13,15 @@
 
 #include "kccd/render/projection.hpp"
 #include "kccd/render/gl_context.hpp"
+#include "kccd/safety_status.hpp"
 #include "kccd/render/ssch_mesh.hpp"
 #include "kccd/render/ssch_outline.hpp"
 
 namespace kccd::render {
 
-/// How a volume is coloured: green clear, amber within the margin, red colliding (or an unsafe
-/// query status), grey when no state is known.
-enum class VolumeStatus : std::uint8_t { Clear, WithinMargin, Colliding, NoState };
-const char* toString(VolumeStatus status);
-/// The fill colour of a status as BGR (OpenCV order).
-cv::Scalar statusColour(VolumeStatus status);
+/// The fill colour of a status as BGR (OpenCV order): green clear, amber within the margin, red
+/// colliding (or an unsafe query status), grey when no state is known.
+cv::Scalar statusColour(SafetyStatus status);
 
 /// How a volume ended up in a frame. Only Drawn and FillsView volumes appear in the images.
 enum class Visibility : std::uint8_t {
@@ -48,7 +46,7 @@ inline constexpr double kMaxDrawDistance = 1e6;
 struct Volume {
   std::span<const Vec3> points;
   double radius = 0.0;
-  VolumeStatus status = VolumeStatus::NoState;
+  SafetyStatus status = SafetyStatus::NoState;
   std::string label;  ///< shown with Style::labels
   Pose pose = Pose::Identity();
   /// BGR fill colour overriding the status colour (used when colour[0] >= 0), e.g. for Style::shaded.
