@@ -1,4 +1,4 @@
-// Frame-times files (kccd/frame_times.hpp): the table, and one exact message per mistake.
+// Frame-times files (kccd/overlay/frame_times.hpp): the table, and one exact message per mistake.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -9,9 +9,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "kccd/frame_times.hpp"
+#include "kccd/overlay/frame_times.hpp"
 
-namespace kccd {
+namespace kccd::overlay {
 namespace {
 
 std::string errorOf(const std::string& text) {
@@ -72,4 +72,4 @@ TEST(FrameTimes, FilesAreRegularAndBounded) {
 }
 
 }  // namespace
-}  // namespace kccd
+}  // namespace kccd::overlay

@@ -29,7 +29,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "cli_args.hpp"
-#include "visuals.hpp"
+#include "kccd/render/visuals.hpp"
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
@@ -813,9 +813,9 @@ Exit runSynth(const SynthArgs& a) {
   if (use_visuals && m.visuals.size() > 255)
     throw UsageError(a.model + ": " + std::to_string(m.visuals.size()) + " visuals: at most 255 can be drawn");
   if (use_visuals && a.shrink_given) throw UsageError("--visible-scale: applies to --appearance volumes only");
-  const std::vector<LoadedVisual> visuals = use_visuals ? loadVisuals(m) : std::vector<LoadedVisual>{};
+  const std::vector<render::LoadedVisual> visuals = use_visuals ? render::loadVisuals(m) : std::vector<render::LoadedVisual>{};
   auto visibleAt = [&](std::span<const double> q) {
-    return use_visuals ? visualVolumes(m, visuals, q) : volumesAt(q, a.shrink);
+    return use_visuals ? render::visualVolumes(m, visuals, q) : volumesAt(q, a.shrink);
   };
   render::Style style;
   style.shaded = true;

@@ -4,8 +4,11 @@
 //   1. the plain transcode: decode -> encode, pipelined on two threads (the baseline),
 //   2. `kccd overlay` with static volumes,
 //   3. `kccd overlay --swept`,
-// and prints frames per second and the ratios. Usage:
+// and prints frames per second and the ratios. With --baseline OTHER_KCCD (e.g. the previous
+// build) the same two runs of that binary are timed in between, and the ratios to it printed.
+// Usage:
 //   bench_overlay KCCD_BINARY [--frames N] [--jobs J] [--dir WORKDIR] [--codec mp4v|MJPG|FFV1]
+//                 [--baseline OTHER_KCCD]
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -151,18 +154,20 @@ double runOverlay(const std::string& command) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::cerr << "usage: bench_overlay KCCD_BINARY [--frames N] [--jobs J] [--dir WORKDIR] [--codec mp4v|MJPG|FFV1]\n";
+    std::cerr << "usage: bench_overlay KCCD_BINARY [--frames N] [--jobs J] [--dir WORKDIR] [--codec mp4v|MJPG|FFV1] "
+                 "[--baseline OTHER_KCCD]\n";
     return 2;
   }
   const std::string kccd = argv[1];
   int frames = 150, jobs = 0;
-  std::string dir = (fs::temp_directory_path() / "kccd_bench_overlay").string(), codec = "mp4v";
+  std::string dir = (fs::temp_directory_path() / "kccd_bench_overlay").string(), codec = "mp4v", baseline;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
     if (k == "--frames") frames = std::stoi(v);
     else if (k == "--jobs") jobs = std::stoi(v);
     else if (k == "--dir") dir = v;
     else if (k == "--codec") codec = v;
+    else if (k == "--baseline") baseline = v;
   }
   try {
     fs::create_directories(dir);
@@ -176,9 +181,15 @@ int main(int argc, char** argv) {
 
     int plain_frames = 0;
     const double plain = transcode(video, dir + "/plain" + ext, codec, plain_frames);
-    const std::string base = kccd + " overlay " + model + " --camera " + camera + " --video " + video + " --states " + log +
+    const std::string args = " overlay " + model + " --camera " + camera + " --video " + video + " --states " + log +
                              " --quiet" + (jobs > 0 ? " --jobs " + std::to_string(jobs) : "");
+    const std::string base = kccd + args;
+    // With a baseline, its runs alternate with this build's (static, static, swept, swept), so a
+    // change in the machine's load falls on both.
+    const std::string other = baseline + args;
+    const double stat_base = baseline.empty() ? 0.0 : runOverlay(other + " -o " + dir + "/base_static" + ext + " --codec " + codec);
     const double stat = runOverlay(base + " -o " + dir + "/static" + ext + " --codec " + codec);
+    const double swept_base = baseline.empty() ? 0.0 : runOverlay(other + " --swept -o " + dir + "/base_swept" + ext + " --codec " + codec);
     const double swept = runOverlay(base + " --swept -o " + dir + "/swept" + ext + " --codec " + codec);
 
     const unsigned hw = std::thread::hardware_concurrency();
@@ -188,6 +199,12 @@ int main(int argc, char** argv) {
     std::printf("  plain transcode (decode + encode): %7.1f fps\n", f_plain);
     std::printf("  kccd overlay, static volumes:      %7.1f fps  (%.0f %% of the transcode)\n", f_static, 100 * f_static / f_plain);
     std::printf("  kccd overlay --swept:              %7.1f fps  (%.0f %% of the transcode)\n", f_swept, 100 * f_swept / f_plain);
+    if (!baseline.empty()) {
+      std::printf("  baseline %s, static volumes: %7.1f fps  (this build %.3f x as fast)\n", baseline.c_str(), frames / stat_base,
+                  stat_base / stat);
+      std::printf("  baseline %s, --swept:        %7.1f fps  (this build %.3f x as fast)\n", baseline.c_str(), frames / swept_base,
+                  swept_base / swept);
+    }
     std::printf("{\"frames\": %d, \"codec\": \"%s\", \"plain_fps\": %.2f, \"static_fps\": %.2f, \"swept_fps\": %.2f, "
                 "\"static_ratio\": %.3f, \"swept_ratio\": %.3f}\n",
                 frames, codec.c_str(), f_plain, f_static, f_swept, f_static / f_plain, f_swept / f_plain);

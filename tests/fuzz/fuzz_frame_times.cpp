@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "fuzz_support.hpp"
-#include "kccd/frame_times.hpp"
+#include "kccd/overlay/frame_times.hpp"
 #include "kccd/input_error.hpp"
 
 namespace {
@@ -37,11 +37,11 @@ void checkTimes(const std::vector<double>& times, std::size_t bytes) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = kccd::fuzz::writeInput("fuzz_frame_times", "times.csv", data, size);
   try {
-    const std::vector<double> times = kccd::loadFrameTimes(path);
+    const std::vector<double> times = kccd::overlay::loadFrameTimes(path);
     checkTimes(times, size);
     // The in-memory parser gives the same table.
     const std::string_view text(reinterpret_cast<const char*>(data), size);
-    check(kccd::parseFrameTimes(text, path) == times, "file and text agree");
+    check(kccd::overlay::parseFrameTimes(text, path) == times, "file and text agree");
   } catch (const kccd::InputError& e) {
     kccd::fuzz::checkMessage(e.what(), path);
   }

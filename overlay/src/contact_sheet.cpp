@@ -1,11 +1,11 @@
-#include "contact_sheet.hpp"
+#include "kccd/overlay/contact_sheet.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include <opencv2/imgproc.hpp>
 
-namespace kccd::cli {
+namespace kccd::overlay {
 
 ContactSheet::ContactSheet(std::size_t count, int tile_width) : count_(std::max<std::size_t>(1, count)), tile_width_(tile_width) {}
 
@@ -59,4 +59,4 @@ cv::Mat ContactSheet::compose() const {
   return sheet;
 }
 
-}  // namespace kccd::cli
+}  // namespace kccd::overlay

@@ -10,7 +10,7 @@
 
 #include "kccd/input_error.hpp"
 
-namespace kccd {
+namespace kccd::overlay {
 
 /// A frame-times file that cannot be used: one line, "file:line:col: problem" for a row and
 /// "file: problem" for the file itself.
@@ -30,4 +30,4 @@ inline constexpr long kMaxFrameNumber = 100000000;
 std::vector<double> loadFrameTimes(const std::string& path);
 std::vector<double> parseFrameTimes(std::string_view text, const std::string& name);
 
-}  // namespace kccd
+}  // namespace kccd::overlay

@@ -7,7 +7,7 @@
 
 #include <opencv2/core.hpp>
 
-namespace kccd::cli {
+namespace kccd::overlay {
 
 /// Collects small copies of frames as they stream past in order, keeping memory bounded: every
 /// stride-th frame (the stride doubles when 2 x `count` are held) plus the one with the lowest
@@ -36,4 +36,4 @@ class ContactSheet {
   bool has_critical_ = false;
 };
 
-}  // namespace kccd::cli
+}  // namespace kccd::overlay

@@ -1,4 +1,4 @@
-#include "kccd/frame_times.hpp"
+#include "kccd/overlay/frame_times.hpp"
 
 #include <cmath>
 #include <cstdlib>
@@ -7,7 +7,7 @@
 #include <iterator>
 #include <limits>
 
-namespace kccd {
+namespace kccd::overlay {
 namespace {
 
 // A field for a message: one printable line.
@@ -83,4 +83,4 @@ std::vector<double> loadFrameTimes(const std::string& path) {
   return parseFrameTimes(text, path);
 }
 
-}  // namespace kccd
+}  // namespace kccd::overlay

@@ -1,0 +1,87 @@
+// One video frame annotated: its time -> the logged state -> the library's query -> a safety status
+// -> the collision volumes rendered from the camera -> composited onto the frame.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <limits>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "kccd/braking.hpp"
+#include "kccd/checker.hpp"
+#include "kccd/render/projection.hpp"
+#include "kccd/render/renderer.hpp"
+#include "kccd/render/visuals.hpp"
+#include "kccd/safety_status.hpp"
+#include "kccd/state_log.hpp"
+
+namespace kccd::overlay {
+
+/// What a run says about one input frame.
+struct FrameRecord {
+  double time = 0.0;                  ///< on the video's clock (index / fps, or the frame-times file)
+  StateMatch match = StateMatch::None;  ///< how the state log gave the frame's state
+  SafetyStatus status = SafetyStatus::NoState;
+  Status query = Status::Ok;          ///< the query's own status
+  bool braking_failed = false;        ///< a non-finite position or velocity: no braking box (unsafe)
+  bool not_finite = false;            ///< a volume could not be drawn (overflow): unsafe
+  double min_distance = std::numeric_limits<double>::quiet_NaN();  ///< the bound, NaN without one
+  std::vector<std::array<int, 2>> pairs;  ///< body pairs within the margin (model body indices)
+  std::vector<double> values;             ///< the state used (empty without one)
+  bool selected = false;              ///< drawn (and handed to the sink)
+  bool written = false;               ///< handed to a sink that keeps frames
+  /// True when the frame's check cannot be trusted: treat the robot as unsafe.
+  bool unsafe() const { return query != Status::Ok || braking_failed || not_finite; }
+  /// The report's "query_status": "no_braking_box", "volume_not_finite" or the query's status word.
+  const char* queryStatusText() const;
+};
+
+/// How every frame of a run is checked and drawn.
+struct AnnotatorSettings {
+  double time_offset = 0.0;  ///< added to a frame's time to get the state log's time (s)
+  double max_gap = 0.0;      ///< no state when no two samples this close bracket the time (s)
+  bool swept = false;        ///< braking-interval swept volumes instead of the static ones
+  std::vector<BrakingParams> braking;  ///< per state value, with `swept`
+  bool plain = false;        ///< volumes only: no legend, no status line
+};
+
+/// What every annotator of a run reads; it must outlive them.
+struct AnnotatorScene {
+  const Model& model;
+  const StateLog& log;
+  const render::Projection& projection;  ///< made once per run, copied by each annotator's renderer
+  render::RenderOptions render_options;
+  std::span<const render::LoadedVisual> visuals;  ///< drawn at the logged state when not empty
+  AnnotatorSettings settings;
+};
+
+/// Checks and draws frames; one per thread, since its renderer's GL context is current on the
+/// thread that made it. Allocates per frame only for the drawing, never in the query.
+class FrameAnnotator {
+ public:
+  /// Makes the checker and the renderer (a GL context). Throws render::GlContextError.
+  explicit FrameAnnotator(const AnnotatorScene& scene);
+  ~FrameAnnotator();
+  FrameAnnotator(const FrameAnnotator&) = delete;
+  FrameAnnotator& operator=(const FrameAnnotator&) = delete;
+
+  /// Fills `record` from its time (state, query, status) and, when it is selected, composites
+  /// the volumes (and the status line unless plain) onto `bgr` (8-bit BGR, the camera's size).
+  void annotate(cv::Mat& bgr, FrameRecord& record);
+
+ private:
+  void drawStatusLine(cv::Mat& bgr, const FrameRecord& record) const;
+
+  const AnnotatorScene& scene_;
+  Checker checker_;
+  std::unique_ptr<render::Renderer> renderer_;
+  render::Style style_;
+  std::vector<double> q_, v_, lo_, hi_;
+  std::vector<int> fixed_;
+};
+
+}  // namespace kccd::overlay

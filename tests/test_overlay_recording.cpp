@@ -1,0 +1,245 @@
+// kccd::overlay::overlayRecording called as a library: every frame checked against a query run
+// here at a state interpolated here, the drawn frames handed on in order, the same answer with any
+// number of threads, bad recordings named on one line, and the video sink's staged outputs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "kccd/calib/camera.hpp"
+#include "kccd/checker.hpp"
+#include "kccd/overlay/overlay_recording.hpp"
+#include "kccd/overlay/video_sink.hpp"
+#include "kccd/overlay/video_source.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace kccd;
+
+const std::string kData = KCCD_DATA_DIR;
+constexpr int kW = 256, kH = 144, kFrames = 16;
+constexpr double kFps = 8.0;
+
+// The log: rows (time, three joint values); a gap between 0.75 and 1.5 s (median period 0.25 s,
+// so at most 0.375 s is bridged). At 0.5 s the arm points straight at the post.
+const std::vector<std::array<double, 4>> kRows = {
+    {0.0, -1.0, -0.5, 0.5}, {0.25, -0.8, -0.4, 0.4}, {0.5, 0.0, 0.0, 0.0}, {0.75, -0.6, -0.2, 0.2},
+    {1.5, -1.0, -0.6, 0.6}, {1.75, -1.2, -0.6, 0.6}, {2.0, -1.4, -0.6, 0.6}};
+
+// The state at time t by linear interpolation between the rows around it, if they are at most
+// `max_gap` apart (written here, independently of the library's state log).
+std::optional<std::vector<double>> stateHere(double t, double max_gap) {
+  for (std::size_t i = 0; i + 1 < kRows.size(); ++i) {
+    const auto &a = kRows[i], &b = kRows[i + 1];
+    if (t < a[0] - 1e-9 || t > b[0] + 1e-9) continue;
+    if (std::fabs(t - a[0]) < 1e-9) return std::vector<double>{a[1], a[2], a[3]};
+    if (std::fabs(t - b[0]) < 1e-9) return std::vector<double>{b[1], b[2], b[3]};
+    if (b[0] - a[0] > max_gap) return std::nullopt;
+    const double w = (t - a[0]) / (b[0] - a[0]);
+    return std::vector<double>{a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2]), a[3] + w * (b[3] - a[3])};
+  }
+  return std::nullopt;
+}
+
+cv::Mat inputFrame(int i) {
+  cv::Mat f(kH, kW, CV_8UC3);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) f.at<cv::Vec3b>(y, x) = cv::Vec3b(uchar((x + 5 * i) % 256), uchar(y % 256), uchar(30 + 9 * i));
+  return f;
+}
+
+// Keeps what it is handed.
+struct Keeper final : overlay::FrameSink {
+  void begin(double f, int w, int h) override {
+    ++begins;
+    fps = f;
+    size = cv::Size(w, h);
+  }
+  void write(std::size_t index, const cv::Mat& bgr) override {
+    indices.push_back(index);
+    frames.push_back(bgr.clone());
+  }
+  int begins = 0;
+  double fps = 0.0;
+  cv::Size size;
+  std::vector<std::size_t> indices;
+  std::vector<cv::Mat> frames;
+};
+
+class OverlayRecording : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(::testing::TempDir()) / ("kccd_overlay_recording_" + std::to_string(getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    camera_ = calib::loadCamera(kData + "/demo_camera.yaml");
+    const double s = static_cast<double>(kW) / camera_.width;
+    camera_.width = kW;
+    camera_.height = kH;
+    camera_.camera_matrix(0, 0) *= s;
+    camera_.camera_matrix(1, 1) *= s;
+    camera_.camera_matrix(0, 2) = (camera_.camera_matrix(0, 2) + 0.5) * s - 0.5;
+    camera_.camera_matrix(1, 2) = (camera_.camera_matrix(1, 2) + 0.5) * s - 0.5;
+    video_ = (dir_ / "in.mkv").string();
+    cv::VideoWriter vw(video_, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), kFps, cv::Size(kW, kH), true);
+    ASSERT_TRUE(vw.isOpened());
+    for (int i = 0; i < kFrames; ++i) vw.write(inputFrame(i));
+    std::string csv = "time,shoulder_yaw,shoulder_pitch,elbow\n";
+    for (const auto& r : kRows) csv += std::to_string(r[0]) + "," + std::to_string(r[1]) + "," + std::to_string(r[2]) + "," + std::to_string(r[3]) + "\n";
+    log_.emplace(parseStateLog(csv, "log.csv", model_));
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  overlay::OverlayReport run(overlay::FrameSink* sink, overlay::OverlayOptions o = {}, const std::string& video = "") {
+    const overlay::OverlayInputs in{model_, camera_, *log_, video.empty() ? video_ : video, {}, "--video in.mkv", "cam.yaml", ""};
+    return overlay::overlayRecording(in, o, sink);
+  }
+  fs::path dir_;
+  Model model_ = loadModel(kData + "/demo_arm.yaml");
+  calib::Camera camera_;
+  std::optional<StateLog> log_;
+  std::string video_;
+};
+
+TEST_F(OverlayRecording, EveryFrameCarriesTheQueryAtItsLoggedState) {
+  overlay::OverlayOptions o;
+  o.frames = overlay::parseFrameRange("1:15:2");
+  o.jobs = 2;
+  o.contact_frames = 4;
+  Keeper keep;
+  const overlay::OverlayReport r = run(&keep, o);
+  ASSERT_EQ(r.frames.size(), static_cast<std::size_t>(kFrames));
+  EXPECT_EQ(keep.begins, 1);
+  EXPECT_DOUBLE_EQ(keep.fps, kFps);
+  EXPECT_EQ(keep.size, cv::Size(kW, kH));
+  EXPECT_EQ(keep.indices, (std::vector<std::size_t>{1, 3, 5, 7, 9, 11, 13}));
+  EXPECT_EQ(r.written, keep.indices.size());
+  EXPECT_DOUBLE_EQ(r.max_gap, 0.375);
+  Checker checker(model_);
+  std::size_t colliding = 0, none = 0;
+  for (int i = 0; i < kFrames; ++i) {
+    const overlay::FrameRecord& f = r.frames[static_cast<std::size_t>(i)];
+    EXPECT_DOUBLE_EQ(f.time, i / kFps);
+    EXPECT_EQ(f.selected, i % 2 == 1 && i < 15) << i;
+    const std::optional<std::vector<double>> q = stateHere(i / kFps, 0.375);
+    if (!q) {
+      EXPECT_EQ(f.status, SafetyStatus::NoState) << i;
+      EXPECT_TRUE(f.values.empty());
+      ++none;
+      continue;
+    }
+    ASSERT_EQ(f.values.size(), 3u) << i;
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(f.values[k], (*q)[k], 1e-9) << i;
+    const QueryResult& res = checker.query(*q, *q, QueryOptions{.type = QueryType::Distances, .tight_volumes = true});
+    ASSERT_EQ(res.status, Status::Ok);
+    EXPECT_EQ(f.status, safetyStatus(res)) << i;
+    EXPECT_NEAR(f.min_distance, res.min_distance, 1e-9) << i;
+    colliding += f.status == SafetyStatus::Colliding;
+  }
+  EXPECT_GE(colliding, 1u);  // the arm at the post (t = 0.5 s)
+  EXPECT_GE(none, 4u);       // the gap in the log
+  EXPECT_EQ(r.no_state, none);
+  EXPECT_EQ(r.colliding, colliding);
+  EXPECT_EQ(r.clear + r.within_margin + r.colliding + r.no_state, r.frames.size());
+  EXPECT_FALSE(r.firstUnsafe().has_value());
+  // Drawn frames carry the volumes: they differ from the input frame; the sheet shows 4 of them.
+  for (std::size_t k = 0; k < keep.frames.size(); ++k)
+    EXPECT_GT(cv::norm(keep.frames[k], inputFrame(static_cast<int>(keep.indices[k])), cv::NORM_L1), 0.0);
+  EXPECT_FALSE(r.contact_sheet.empty());
+  const nlohmann::json j = overlay::reportJson(r, model_, true);
+  EXPECT_EQ(j.at("frames_total"), kFrames);
+  EXPECT_EQ(j.at("frames").size(), static_cast<std::size_t>(kFrames));
+  EXPECT_EQ(j.at("frames")[4].at("status"), toString(r.frames[4].status));
+  EXPECT_EQ(j.at("frames")[7].at("written"), true);
+  EXPECT_FALSE(overlay::reportJson(r, model_, false).contains("frames"));
+}
+
+TEST_F(OverlayRecording, TheAnswerDoesNotDependOnTheNumberOfThreads) {
+  overlay::OverlayOptions o;
+  o.swept = true;
+  o.braking.latency = 0.02;
+  o.braking.deceleration = 4.0;
+  std::vector<overlay::OverlayReport> reports;
+  std::vector<Keeper> keeps(2);
+  for (int jobs : {1, 3}) {
+    o.jobs = jobs;
+    reports.push_back(run(&keeps[reports.size()], o));
+  }
+  ASSERT_EQ(keeps[0].frames.size(), static_cast<std::size_t>(kFrames));
+  ASSERT_EQ(keeps[1].frames.size(), keeps[0].frames.size());
+  for (std::size_t i = 0; i < keeps[0].frames.size(); ++i) {
+    EXPECT_EQ(cv::norm(keeps[0].frames[i], keeps[1].frames[i], cv::NORM_INF), 0.0) << i;
+    EXPECT_EQ(reports[0].frames[i].status, reports[1].frames[i].status) << i;
+    EXPECT_TRUE(reports[0].frames[i].min_distance == reports[1].frames[i].min_distance ||
+                (std::isnan(reports[0].frames[i].min_distance) && std::isnan(reports[1].frames[i].min_distance)));
+  }
+}
+
+TEST_F(OverlayRecording, ARecordingOfAnotherSizeIsOneLineNamingIt) {
+  const std::string small = (dir_ / "small.mkv").string();
+  {
+    cv::VideoWriter vw(small, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), kFps, cv::Size(64, 36), true);
+    for (int i = 0; i < 3; ++i) vw.write(cv::Mat(36, 64, CV_8UC3, cv::Scalar(i, 2 * i, 3 * i)));
+  }
+  try {
+    run(nullptr, {}, small);
+    FAIL() << "no error";
+  } catch (const overlay::VideoError& e) {
+    EXPECT_EQ(std::string(e.what()), "--video in.mkv: frame 0 is 64x36 but cam.yaml is calibrated for 256x144");
+  }
+  EXPECT_THROW(run(nullptr, {}, (dir_ / "missing.mkv").string()), overlay::VideoError);
+}
+
+TEST_F(OverlayRecording, FrameRangesAreSlicesAndMistakesNameTheOption) {
+  const overlay::FrameRange r = overlay::parseFrameRange("2:9:3");
+  std::vector<std::size_t> in;
+  for (std::size_t i = 0; i < 12; ++i)
+    if (r.contains(i)) in.push_back(i);
+  EXPECT_EQ(in, (std::vector<std::size_t>{2, 5, 8}));
+  EXPECT_TRUE(overlay::parseFrameRange("").contains(123456));
+  EXPECT_TRUE(overlay::parseFrameRange("7").contains(7));
+  EXPECT_FALSE(overlay::parseFrameRange("7").contains(8));
+  for (const char* bad : {"5:5", "1:2:0", "a", "1:2:3:4", "-1"}) {
+    try {
+      overlay::parseFrameRange(bad, "--frames");
+      ADD_FAILURE() << bad;
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(std::string("--frames ") + bad + ": expected FIRST", 0), 0u) << e.what();
+    }
+  }
+}
+
+TEST_F(OverlayRecording, TheVideoSinkShowsItsOutputsOnlyWhenCommitted) {
+  const std::string video = (dir_ / "out.mkv").string(), pngs = (dir_ / "frames").string();
+  {
+    overlay::VideoSink sink({.video = video, .png_dir = pngs});
+    sink.begin(kFps, kW, kH);
+    sink.write(3, inputFrame(3));
+    EXPECT_THROW(sink.write(4, cv::Mat(10, 10, CV_8UC3)), std::logic_error);
+  }  // not committed: nothing left
+  EXPECT_FALSE(fs::exists(video));
+  EXPECT_FALSE(fs::exists(pngs));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);  // in.mkv
+  overlay::VideoSink sink({.video = video, .png_dir = pngs});
+  sink.begin(kFps, kW, kH);
+  for (int i : {2, 5}) sink.write(static_cast<std::size_t>(i), inputFrame(i));
+  sink.commit();
+  EXPECT_EQ(cv::norm(cv::imread(pngs + "/frame_000005.png"), inputFrame(5), cv::NORM_INF), 0.0);
+  EXPECT_TRUE(fs::exists(pngs + "/frame_000002.png"));
+  overlay::VideoSource back(video);
+  cv::Mat f;
+  int n = 0;
+  while (back.read(f)) EXPECT_EQ(cv::norm(f, inputFrame(n++ == 0 ? 2 : 5), cv::NORM_INF), 0.0);  // FFV1: lossless
+  EXPECT_EQ(n, 2);
+}
+
+}  // namespace
