@@ -208,6 +208,36 @@ TEST(Queries, ReusesBoundsWhenTheBoxShrinks) {
   for (std::size_t k = 0; k < r.pairs.size(); ++k) EXPECT_EQ(r.pairs[k].distance, f.pairs[k].distance);
 }
 
+// After reset() a checker answers exactly as a new one, whatever it answered before (the overlay
+// resets per frame so that its report does not depend on which thread had which frame).
+TEST(Queries, AfterResetTheAnswerIsANewCheckersBitForBit) {
+  std::mt19937_64 rng(83);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Model m = testing::randomModel(rng, 5, 6);
+    Checker used(m);
+    std::vector<double> lower, upper;
+    for (int k = 0; k < 4; ++k) {  // a history of other boxes warms the table and the GJK starts
+      testing::randomBox(rng, m, lower, upper);
+      used.query(lower, upper, options(QueryType::Distances));
+    }
+    testing::randomBox(rng, m, lower, upper);
+    for (QueryType type : {QueryType::Distances, QueryType::Closest, QueryType::Collision}) {
+      used.reset();
+      const QueryResult& r = used.query(lower, upper, options(type));
+      Checker fresh(m);
+      const QueryResult& f = fresh.query(lower, upper, options(type));
+      ASSERT_EQ(r.status, f.status);
+      EXPECT_EQ(r.min_distance, f.min_distance) << trial;
+      ASSERT_EQ(r.pairs.size(), f.pairs.size());
+      for (std::size_t k = 0; k < r.pairs.size(); ++k) {
+        EXPECT_EQ(r.pairs[k].pair, f.pairs[k].pair);
+        EXPECT_EQ(r.pairs[k].distance, f.pairs[k].distance) << trial << " " << k;
+        EXPECT_EQ(r.pairs[k].witness_a, f.pairs[k].witness_a);
+      }
+    }
+  }
+}
+
 TEST(Queries, BadStateInputIsAnUnsafeStatus) {
   const Model m = testing::randomModel(*std::make_unique<std::mt19937_64>(5), 3, 3);
   const int n = m.stateSize();

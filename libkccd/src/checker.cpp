@@ -166,7 +166,9 @@ void Checker::computeReach() {
 }
 
 void Checker::reset() noexcept {
-  for (Entry& e : table_) e.valid = false;
+  // Everything a query carries to the next, the GJK warm-start directions included: after a
+  // reset the answer is bit for bit a new Checker's, whatever this one answered before.
+  for (Entry& e : table_) e = Entry{};
 }
 
 bool Checker::validate(std::span<const double> lower, std::span<const double> upper) noexcept {

@@ -34,7 +34,8 @@ class Checker {
   const QueryResult& query(std::span<const double> lower, std::span<const double> upper,
                            const QueryOptions& options = {}) noexcept;
 
-  /// Forgets every stored bound (the next query recomputes from scratch).
+  /// Forgets every stored bound and warm start: the next query's answer is exactly a new
+  /// Checker's (bit for bit), whatever was asked before.
   void reset() noexcept;
 
   const Model& model() const { return model_; }
