@@ -1,13 +1,14 @@
-// The tag scene renderer (kccd/calib/tag_scene.hpp) under the names the image tests use.
+// The tag scene renderer (kccd/overlay/tag_scene.hpp, the room of `kccd synth`) under the names the
+// image tests use.
 #pragma once
 
-#include "kccd/calib/tag_scene.hpp"
+#include "kccd/overlay/tag_scene.hpp"
 
 namespace kccd::testing {
 
-using calib::distortNormalised;
-using calib::projectTagCorners;
-using calib::renderTagScene;
-using calib::TagSceneOptions;
+using overlay::distortNormalised;
+using overlay::projectTagCorners;
+using overlay::renderTagScene;
+using overlay::TagSceneOptions;
 
 }  // namespace kccd::testing
