@@ -2,21 +2,27 @@
 // on synthetic views of a known distorted camera, outlier views, and every way it refuses.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <random>
 #include <string>
-#include <unistd.h>
 
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
 
+#include "kccd/calib/board_views.hpp"
+#include "kccd/calib/image_file.hpp"
 #include "kccd/calib/intrinsics.hpp"
+#include "support/tag_scene.hpp"
 
 namespace {
 
 using namespace kccd;
 using namespace kccd::calib;
+using kccd::testing::renderTagScene;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -182,6 +188,73 @@ TEST(CalibIntrinsics, TheIntrinsicsFileWritesAndReads) {
   EXPECT_EQ(c.distortion.size(), 5u);
   EXPECT_EQ(c.rvec, cv::Vec3d(0, 0, 0));
   EXPECT_NEAR(*c.reprojection_rms_px, r.rms_px, 1e-12);
+}
+
+// The camera file of a solve: what loadCamera reads, then OpenCV's two extra fields.
+TEST(CalibIntrinsics, TheCameraFileTextCarriesOpenCVsFields) {
+  std::mt19937_64 rng(7);
+  const IntrinsicsResult r =
+      calibrateIntrinsics(tiltedViews(trueCamera(), Board::grid(grid()), 8, 0.2, rng), cv::Size(960, 720));
+  ASSERT_EQ(r.status, IntrinsicsStatus::Solved) << r.message;
+  const std::string text = intrinsicsCameraText(r);
+  EXPECT_EQ(text.rfind(cameraText(r.camera), 0), 0u) << text;
+  char rms[64];
+  std::snprintf(rms, sizeof rms, "%.17g", r.rms_px);
+  EXPECT_NE(text.find("\navg_reprojection_error: " + std::string(rms) + "\nnr_of_frames: 8\n"), std::string::npos)
+      << text;
+  const std::string path =
+      (std::filesystem::path(::testing::TempDir()) / ("kccd_intr_text_" + std::to_string(getpid()) + ".yaml")).string();
+  std::ofstream(path) << text;
+  const Camera c = loadCamera(path);
+  std::filesystem::remove(path);
+  EXPECT_EQ(c.camera_matrix, r.camera.camera_matrix);
+  EXPECT_EQ(c.distortion, r.camera.distortion);
+}
+
+// Board views from image files: each image's board corners where the camera sees them, the tags
+// it shows that the board lacks, and an image of another size named.
+TEST(CalibBoardViews, CornersOfRenderedImagesAndTheirSize) {
+  const Board board = Board::grid(TagGrid{.cols = 4, .rows = 3, .tag_size = 0.04, .spacing = 0.01, .first_id = 0});
+  const Board smaller = Board::grid(TagGrid{.cols = 4, .rows = 2, .tag_size = 0.04, .spacing = 0.01, .first_id = 0});
+  const std::filesystem::path dir =
+      std::filesystem::path(::testing::TempDir()) / ("kccd_board_views_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  std::vector<std::string> images;
+  std::vector<Camera> cameras;
+  for (int i = 0; i < 2; ++i) {
+    Camera c = trueCamera();
+    boardPose(board, 25, 90.0 * i, 10, cv::Vec3d(0.01 * i, 0, 0.45), c.rvec, c.tvec);
+    images.push_back((dir / ("view" + std::to_string(i) + ".png")).string());
+    ASSERT_TRUE(cv::imwrite(images.back(), renderTagScene(c, board.layout)));
+    cameras.push_back(c);
+  }
+  std::vector<double> progress;
+  const BoardViews v = detectBoardViews(images, smaller, [&](double f) { progress.push_back(f); });
+  EXPECT_EQ(progress, (std::vector<double>{0.5, 1.0}));
+  EXPECT_EQ(v.image_size, cv::Size(960, 720));
+  ASSERT_EQ(v.views.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(v.views[i].name, images[i]);
+    EXPECT_EQ(v.tags[i], 8);  // the 4 x 2 board's tags; the third row's are not on it
+    EXPECT_EQ(v.unknown_ids[i], (std::vector<int>{8, 9, 10, 11}));
+    ASSERT_EQ(v.views[i].points.size(), 32u);
+    for (const Correspondence& p : v.views[i].points) {
+      std::vector<cv::Point2d> q;
+      cv::projectPoints(std::vector<cv::Point3d>{p.world}, cameras[i].rvec, cameras[i].tvec, cameras[i].camera_matrix,
+                        cameras[i].distortion, q);
+      EXPECT_LT(cv::norm(p.pixel - q[0]), 0.5) << p.name;
+    }
+  }
+  ASSERT_TRUE(cv::imwrite((dir / "small.png").string(), cv::Mat(240, 320, CV_8UC1, cv::Scalar(128))));
+  images.push_back((dir / "small.png").string());
+  try {
+    (void)detectBoardViews(images, board);
+    ADD_FAILURE() << "an image of another size was accepted";
+  } catch (const ImageError& e) {
+    EXPECT_EQ(std::string(e.what()), images[2] + ": image: 320x240 differs from " + images[0] +
+                                         " (960x720): all images must come from one camera at one resolution");
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(CalibIntrinsics, FixedK3AndRationalModels) {

@@ -413,3 +413,91 @@ TEST(PairSurvey, CountsAndClosestAgreeWithIndependentDistances) {
   }
   EXPECT_GT(within, 50);
 }
+
+// `--random N`: N states inside the joint ranges, one per time 0 ... N-1, the same for the same seed.
+TEST(PairSurvey, RandomStatesStayInsideTheLimits) {
+  const Model m = kccd::loadModel(std::string(KCCD_DATA_DIR) + "/demo_arm.yaml");
+  const kccd::StateLog log = km::randomStates(m, 200, 7);
+  ASSERT_EQ(log.rows(), 200u);
+  EXPECT_EQ(log.names, m.stateNames());
+  const auto ranges = km::jointRanges(m);
+  std::vector<double> lo(ranges.size(), INFINITY), hi(ranges.size(), -INFINITY);
+  for (std::size_t row = 0; row < log.rows(); ++row) {
+    EXPECT_EQ(log.times[row], static_cast<double>(row));
+    for (std::size_t k = 0; k < ranges.size(); ++k) {
+      const double v = log.row(row)[k];
+      EXPECT_GE(v, ranges[k][0]);
+      EXPECT_LE(v, ranges[k][1]);
+      lo[k] = std::min(lo[k], v), hi[k] = std::max(hi[k], v);
+    }
+  }
+  for (std::size_t k = 0; k < ranges.size(); ++k)  // spread over the range, not stuck at a value
+    EXPECT_GT(hi[k] - lo[k], 0.8 * (ranges[k][1] - ranges[k][0])) << k;
+  EXPECT_EQ(km::randomStates(m, 200, 7).values, log.values);
+  EXPECT_NE(km::randomStates(m, 200, 8).values, log.values);
+}
+
+// A survey's pairs by concern: most often within the margin, then the closest, ties in survey order.
+TEST(PairSurvey, ByConcernOrdersByCountThenDistance) {
+  km::Survey s;
+  const std::pair<std::size_t, double> pairs[] = {{0, 0.5}, {3, 0.2}, {3, 0.1}, {0, 0.05}, {3, 0.1}};
+  for (const auto& [within, distance] : pairs) {
+    km::PairSurvey p;
+    p.within = within;
+    p.min_distance = distance;
+    s.pairs.push_back(p);
+  }
+  const std::vector<const km::PairSurvey*> order = km::byConcern(s);
+  const std::vector<const km::PairSurvey*> expected{&s.pairs[2], &s.pairs[4], &s.pairs[1], &s.pairs[3], &s.pairs[0]};
+  EXPECT_EQ(order, expected);
+}
+
+// What `kccd pairs` says of each pair, from the library: the reason it is ignored now and after
+// the plan, the verdict in words, and the counts.
+TEST(Pairs, ReasonsNotesAndCountsOfAGripperArm) {
+  const Model m = gripperArm(false);
+  const auto reports = km::provePairs(m);
+  const km::IgnorePlan plan = km::ignoreList(m, reports);
+  for (const auto& r : reports) {
+    const std::string a = m.bodies[r.a].name, b = m.bodies[r.b].name;
+    if (!r.checked) {
+      EXPECT_EQ(km::currentIgnoreReason(m, r.a, r.b), reasonOf(m, a, b)) << a << "-" << b;
+    }
+    EXPECT_EQ(km::currentIgnoreReason(m, r.a, r.b), km::currentIgnoreReason(m, r.b, r.a));
+    const std::string planned = km::plannedIgnoreReason(plan, m, r.a, r.b);
+    bool listed = false;
+    for (const auto& e : plan.ignore)
+      if ((e.a == a && e.b == b) || (e.a == b && e.b == a)) {
+        listed = true;
+        EXPECT_EQ(planned, kccd::toString(e.reason)) << a << "-" << b;
+      }
+    EXPECT_EQ(planned.empty(), !listed) << a << "-" << b;
+  }
+  EXPECT_EQ(km::plannedIgnoreReason(plan, m, reportOf(m, reports, "link3", "hand").a,
+                                    reportOf(m, reports, "link3", "hand").b),
+            "rigid");
+  EXPECT_EQ(
+      km::currentIgnoreReason(m, reportOf(m, reports, "link2", "hand").a, reportOf(m, reports, "link2", "hand").b),
+      "not_included");  // checked: in no ignore entry
+
+  const km::VerdictCounts c = km::countVerdicts(reports);
+  EXPECT_EQ(c.rigid, 3);
+  EXPECT_EQ(c.never + c.always_touching + c.meets + c.undecided + c.unbounded + c.rigid,
+            static_cast<int>(reports.size()));
+  int adjacent = 0, never = 0;
+  for (const auto& r : reports) adjacent += r.adjacent, never += !r.rigid && r.verdict == km::Verdict::Never;
+  EXPECT_EQ(c.adjacent, adjacent);
+  EXPECT_EQ(c.never, never);
+
+  const km::PairReport& rigid = reportOf(m, reports, "link3", "camera");
+  EXPECT_EQ(km::verdictNote(rigid),
+            "rigid (only fixed joints between them): a constant distance, never within the margin: ignore");
+  km::PairReport proven = rigid;
+  proven.rigid = false;
+  proven.boxes = 12;
+  EXPECT_EQ(km::verdictNote(proven), "proven in 12 boxes: safe to ignore");
+  proven.verdict = km::Verdict::Undecided;
+  EXPECT_EQ(km::verdictNote(proven), "no proof within 12 boxes: keep");
+  EXPECT_EQ(km::verdictNote(reportOf(m, reports, "link3", "hand")),
+            "rigid (only fixed joints between them): a constant distance, always within the margin: ignore");
+}

@@ -13,6 +13,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "kccd/calib/pose.hpp"
+#include "kccd/calib/pose_difference.hpp"
 #include "support/cameras.hpp"
 
 namespace {
@@ -412,6 +413,30 @@ TEST(CalibPose, BadInputThrows) {
   Camera no_focal = s.truth;
   no_focal.camera_matrix(0, 0) = 0;
   EXPECT_THROW(solvePose(no_focal, s.points), CameraError);
+}
+
+// How far apart two poses are: a known turn about the camera centre and a known shift, down to
+// angles where the trace alone loses its digits; the centre is -R^T t.
+TEST(CalibPose, PoseDifferenceOfAKnownTurnAndShift) {
+  const Camera a = lookAt(Vec3(2.0, -1.5, 1.3), Vec3(0.3, 0.1, 0.5), 1280, 720, 1000, {});
+  const cv::Vec3d centre = cameraCentre(a);
+  EXPECT_LT(cv::norm(centre - cv::Vec3d(2.0, -1.5, 1.3)), 1e-12);
+  for (double angle_deg : {0.0, 1e-7, 0.5, 30.0, 179.0}) {
+    cv::Matx33d ra, turn;
+    cv::Rodrigues(a.rvec, ra);
+    cv::Rodrigues(cv::Vec3d(0.6, 0.0, 0.8) * (angle_deg * CV_PI / 180.0), turn);
+    Camera b = a;
+    const cv::Matx33d rb = turn * ra;
+    cv::Rodrigues(rb, b.rvec);
+    const cv::Vec3d moved = centre + cv::Vec3d(0.006, -0.008, 0.0);
+    b.tvec = -(rb * moved);
+    const PoseDifference d = poseDifference(a, b);
+    EXPECT_NEAR(d.rotation_deg, angle_deg, 1e-9 + 1e-9 * angle_deg) << angle_deg;
+    EXPECT_NEAR(d.position_m, 0.01, 1e-12) << angle_deg;
+    EXPECT_NEAR(poseDifference(b, a).rotation_deg, angle_deg, 1e-9 + 1e-9 * angle_deg) << angle_deg;
+  }
+  EXPECT_EQ(poseDifference(a, a).rotation_deg, 0.0);
+  EXPECT_EQ(poseDifference(a, a).position_m, 0.0);
 }
 
 }  // namespace

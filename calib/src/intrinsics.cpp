@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <unordered_set>
 
 #include <opencv2/calib3d.hpp>
@@ -427,6 +428,16 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
                    ", cx " + num(cam.camera_matrix(0, 2), 5) + " +- " + num(result.sigmas.cx, 2) + ", cy " +
                    num(cam.camera_matrix(1, 2), 5) + " +- " + num(result.sigmas.cy, 2) + " px";
   return result;
+}
+
+std::string intrinsicsCameraText(const IntrinsicsResult& result) {
+  std::string text = cameraText(result.camera);
+  if (!text.empty() && text.back() != '\n') text += '\n';
+  std::ostringstream extra;
+  extra.precision(17);
+  extra << "avg_reprojection_error: " << result.rms_px << "\n";
+  extra << "nr_of_frames: " << result.used.size() << "\n";
+  return text + extra.str();
 }
 
 }  // namespace kccd::calib

@@ -7,7 +7,6 @@
 #include <iostream>
 #include <memory>
 #include <regex>
-#include <sstream>
 
 #include <unistd.h>
 
@@ -16,7 +15,7 @@
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
-#include "kccd/calib/image_file.hpp"
+#include "kccd/calib/board_views.hpp"
 #include "kccd/calib/intrinsics.hpp"
 
 namespace kccd::cli {
@@ -67,24 +66,9 @@ calib::Board boardFrom(const IntrinsicsArgs& args) {
   }
 }
 
-// One image as 8-bit grey; every failure names the file.
-cv::Mat readImage(const std::string& path) { return calib::readImageFile(path, calib::ImageColour::Grey); }
-
 bool sameFile(const std::string& a, const std::string& b) {
   std::error_code ec;
   return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec);
-}
-
-// The camera file text: cameraText's layout (what loadCamera reads), plus the fields OpenCV's
-// calibration sample writes.
-std::string cameraFileText(const calib::Camera& camera, const calib::IntrinsicsResult& r) {
-  std::string text = calib::cameraText(camera);
-  if (!text.empty() && text.back() != '\n') text += '\n';
-  std::ostringstream extra;
-  extra.precision(17);
-  extra << "avg_reprojection_error: " << r.rms_px << "\n";
-  extra << "nr_of_frames: " << r.used.size() << "\n";
-  return text + extra.str();
 }
 
 Exit runIntrinsics(const IntrinsicsArgs& args) {
@@ -105,36 +89,22 @@ Exit runIntrinsics(const IntrinsicsArgs& args) {
         throw UsageError(args.images[i] + ": image: given twice (--image " + std::to_string(j + 1) + " and " + std::to_string(i + 1) + ")");
 
   // ---- detect the tags of every image
-  std::vector<calib::IntrinsicsView> views;
-  std::vector<int> tags_seen;
-  std::vector<std::vector<int>> unknown;
-  cv::Size size;
+  calib::BoardViews seen;
   {
     Progress progress("detecting tags", args.quiet || args.json);
-    for (std::size_t i = 0; i < args.images.size(); ++i) {
-      const std::string& path = args.images[i];
-      const cv::Mat gray = readImage(path);
-      if (i == 0) size = gray.size();
-      else if (gray.size() != size)
-        throw UsageError(path + ": image: " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows) + " differs from " +
-                         args.images[0] + " (" + std::to_string(size.width) + "x" + std::to_string(size.height) +
-                         "): all images must come from one camera at one resolution");
-      const std::vector<calib::TagDetection> detections = calib::detectTags(gray);
-      const calib::TagCorrespondences tc = calib::tagCorrespondences(detections, board.layout, path);
-      views.push_back({path, tc.points});
-      tags_seen.push_back(static_cast<int>(tc.points.size() / 4));
-      unknown.push_back(tc.unknown_ids);
-      progress.update(static_cast<double>(i + 1) / static_cast<double>(args.images.size()));
-    }
+    seen = calib::detectBoardViews(args.images, board, [&](double f) { progress.update(f); });
   }
+  const cv::Size size = seen.image_size;
+  const std::vector<int>& tags_seen = seen.tags;
+  const std::vector<std::vector<int>>& unknown = seen.unknown_ids;
 
   // ---- solve
   calib::IntrinsicsOptions options;
   options.fix_k3 = args.fix_k3;
   options.rational = args.rational;
-  const calib::IntrinsicsResult r = calib::calibrateIntrinsics(views, size, options);
+  const calib::IntrinsicsResult r = calib::calibrateIntrinsics(seen.views, size, options);
   const bool solved = r.status == calib::IntrinsicsStatus::Solved;
-  if (solved) writeFileAtomically(args.output, cameraFileText(r.camera, r));
+  if (solved) writeFileAtomically(args.output, calib::intrinsicsCameraText(r));
 
   const cv::Matx33d& k = r.camera.camera_matrix;
   if (args.json) {

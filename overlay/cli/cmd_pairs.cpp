@@ -6,7 +6,6 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
-#include <random>
 
 #include "cli_args.hpp"
 #include "cli_files.hpp"
@@ -35,37 +34,12 @@ void writeIgnoreList(const std::string& model, const std::string& proven_text,
            &proven_text);
 }
 
-// Why an unchecked pair is not checked: its `pairs: ignore` reason, or "not_included" (a model
-// with `check: none` that does not include it).
-std::string currentReason(const Model& m, int a, int b) {
-  for (const IgnoredPair& p : m.ignored)
-    if ((p.a == a && p.b == b) || (p.a == b && p.b == a)) return toString(p.reason);
-  return "not_included";
-}
-
 std::string pairName(const Model& m, int a, int b) { return m.bodies[a].name + " - " + m.bodies[b].name; }
-
-// `--random N`: N configurations drawn uniformly inside the joint limits (values without limits
-// at 0), numbered 0 ... N-1 in place of times.
-StateLog randomStates(const Model& m, int n, std::uint64_t seed) {
-  StateLog log;
-  log.names = m.stateNames();
-  log.circular.assign(m.stateSize(), 0);
-  log.logged_velocity.assign(m.stateSize(), 0);
-  const auto ranges = modelling::jointRanges(m);
-  std::mt19937_64 rng(seed);
-  for (int i = 0; i < n; ++i) {
-    log.times.push_back(i);
-    for (const auto& r : ranges)
-      log.values.push_back(std::isnan(r[0]) ? 0.0 : std::uniform_real_distribution<double>(r[0], r[1])(rng));
-  }
-  return log;
-}
 
 Exit runSurvey(const PairsArgs& args, const Model& m) {
   const bool random = args.random > 0;
-  const StateLog log =
-      random ? randomStates(m, args.random, args.seed) : loadStateLog(args.states, m, splitCommas(args.ignore_columns));
+  const StateLog log = random ? modelling::randomStates(m, args.random, args.seed)
+                              : loadStateLog(args.states, m, splitCommas(args.ignore_columns));
   const std::string source = random ? "random states inside the joint limits (seed " + std::to_string(args.seed) + ")"
                                     : "recorded states from " + args.states;
   const std::string when = random ? "sample" : "at (s)";
@@ -78,12 +52,7 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
                                  .ignored_pairs = args.ignored,
                                  .progress = [&](double f) { progress.update(f); }});
   }
-  // Most often within the margin first, then the closest.
-  std::vector<const modelling::PairSurvey*> order;
-  for (const auto& p : s.pairs) order.push_back(&p);
-  std::stable_sort(order.begin(), order.end(), [](const auto* x, const auto* y) {
-    return x->within != y->within ? x->within > y->within : x->min_distance < y->min_distance;
-  });
+  const std::vector<const modelling::PairSurvey*> order = modelling::byConcern(s);
   const double n = static_cast<double>(std::max<std::size_t>(1, s.samples));
   if (args.json) {
     nlohmann::json j{{"margin", s.margin},         {"states", random ? nlohmann::json("random") : nlohmann::json(args.states)},
@@ -95,7 +64,7 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
                        {"checked", p->checked},     {"within", p->within},      {"fraction", p->within / n},
                        {"overlapping", p->overlapping}, {"min_distance", number(p->min_distance)},
                        {"min_time", number(p->min_time)}};
-      if (!p->checked) o["ignored"] = currentReason(m, p->a, p->b);
+      if (!p->checked) o["ignored"] = modelling::currentIgnoreReason(m, p->a, p->b);
       if (p->within > 0) o["first_within"] = p->first_within, o["last_within"] = p->last_within;
       if (p->overlapping > 0) o["max_penetration"] = p->max_penetration;
       j["pairs"].push_back(o);
@@ -123,7 +92,7 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
                                 std::to_string(p->overlapping) + " states, up to " + format(p->max_penetration, 3) + " m";
     if (p->within > 0 && !random)
       note += "; " + format(p->first_within, 6) + " ... " + format(p->last_within, 6) + " s";
-    if (!p->checked) note = "(ignored: " + currentReason(m, p->a, p->b) + ") " + note;
+    if (!p->checked) note = "(ignored: " + modelling::currentIgnoreReason(m, p->a, p->b) + ") " + note;
     std::cout << "  " << std::left << std::setw(42) << pairName(m, p->a, p->b) << std::setw(16)
               << (std::to_string(p->within) + " (" + format(100.0 * f, 3) + " %)") << std::setw(14)
               << (std::isnan(p->min_distance) ? std::string("-") : format(p->min_distance, 4)) << std::setw(12)
@@ -149,13 +118,6 @@ Exit runPairs(const PairsArgs& args) {
   }
   const double margin = args.margin >= 0 ? args.margin : m.safety_margin;
   const modelling::IgnorePlan plan = modelling::ignoreList(m, reports, {.keep_adjacent = args.keep_adjacent});
-  // The reason each pair would be ignored for after --write ("" when it would be checked).
-  auto planned = [&](const modelling::PairReport& r) -> std::string {
-    for (const auto& e : plan.ignore)
-      if ((e.a == m.bodies[r.a].name && e.b == m.bodies[r.b].name) || (e.a == m.bodies[r.b].name && e.b == m.bodies[r.a].name))
-        return toString(e.reason);
-    return "";
-  };
 
   if (args.json) {
     nlohmann::json j;
@@ -165,8 +127,9 @@ Exit runPairs(const PairsArgs& args) {
       nlohmann::json o{{"a", m.bodies[r.a].name}, {"b", m.bodies[r.b].name}, {"frame", m.frameName(r.lca)},
                        {"verdict", toString(r.verdict)}, {"adjacent", r.adjacent}, {"rigid", r.rigid},
                        {"checked", r.checked}, {"boxes", r.boxes}};
-      if (!r.checked) o["ignored"] = currentReason(m, r.a, r.b);
-      if (const std::string why = planned(r); !why.empty()) o["ignore_reason"] = why;
+      if (!r.checked) o["ignored"] = modelling::currentIgnoreReason(m, r.a, r.b);
+      if (const std::string why = modelling::plannedIgnoreReason(plan, m, r.a, r.b); !why.empty())
+        o["ignore_reason"] = why;
       if (r.verdict == modelling::Verdict::Never || r.rigid) o["bound"] = number(r.bound);
       if (r.verdict == modelling::Verdict::Meets) {
         o["witness_state"] = r.witness;
@@ -183,47 +146,30 @@ Exit runPairs(const PairsArgs& args) {
     std::cout << j.dump(2) << "\n";
     return Exit::Ok;
   }
-  int counts[5] = {0, 0, 0, 0, 0}, rigid = 0, adjacent = 0;
-  for (const auto& r : reports) {  // rigid pairs counted as rigid only
-    if (!r.rigid) ++counts[static_cast<int>(r.verdict)];
-    rigid += r.rigid;
-    adjacent += r.adjacent;
-  }
+  const modelling::VerdictCounts counts = modelling::countVerdicts(reports);
   std::cout << "model " << m.name << ": " << reports.size() << " body pairs in different frames, margin " << margin
             << " m, over the joint limits\n";
   std::cout << std::left << std::setw(44) << "  pair" << std::setw(17) << "verdict" << std::setw(12) << "bound (m)"
             << "note\n";
   for (const auto& r : reports) {
-    const std::string why = planned(r);
+    const std::string why = modelling::plannedIgnoreReason(plan, m, r.a, r.b);
     // Pairs that meet and stay checked are the normal case: listed with --all only.
     if (r.verdict == modelling::Verdict::Meets && why.empty() && !args.all) continue;
-    std::string note;
-    if (r.rigid) {
-      note = std::string("rigid (only fixed joints between them): a constant distance, ") +
-             (r.verdict == modelling::Verdict::Never ? "never within the margin" : "always within the margin") + ": ignore";
-    } else {
-      switch (r.verdict) {
-        case modelling::Verdict::Never: note = "proven in " + std::to_string(r.boxes) + " boxes: safe to ignore"; break;
-        case modelling::Verdict::AlwaysTouching: note = "adjacent, touch at every configuration: ignore"; break;
-        case modelling::Verdict::Meets:
-          note = "within the margin at a state inside the limits";
-          break;
-        case modelling::Verdict::Undecided: note = "no proof within " + std::to_string(r.boxes) + " boxes: keep"; break;
-        case modelling::Verdict::Unbounded: note = "a joint without limits moves them: keep"; break;
-      }
-      if (r.adjacent && why == "adjacent") note += "; adjacent (one moving joint): ignored as MoveIt does";
-      else if (r.adjacent && args.keep_adjacent) note += "; adjacent, kept (--keep-adjacent)";
-    }
-    if (!r.checked) note += " (ignored now: " + currentReason(m, r.a, r.b) + ")";
+    std::string note = modelling::verdictNote(r);
+    if (!r.rigid && r.adjacent && why == "adjacent")
+      note += "; adjacent (one moving joint): ignored as MoveIt does";
+    else if (!r.rigid && r.adjacent && args.keep_adjacent)
+      note += "; adjacent, kept (--keep-adjacent)";
+    if (!r.checked) note += " (ignored now: " + modelling::currentIgnoreReason(m, r.a, r.b) + ")";
     std::cout << "  " << std::left << std::setw(42) << pairName(m, r.a, r.b) << std::setw(17)
               << (r.rigid ? std::string("rigid") : std::string(toString(r.verdict))) << std::setw(12)
               << (r.verdict == modelling::Verdict::Never || r.rigid ? format(r.bound, 4) : std::string("-")) << note
               << "\n";
   }
-  std::cout << rigid << " rigid, " << adjacent << " adjacent" << (args.keep_adjacent ? " (kept)" : "") << "; "
-            << counts[0] << " never, " << counts[1] << " always touching, " << counts[2] << " meet, " << counts[3]
-            << " undecided, " << counts[4] << " unbounded" << (args.all ? "" : " (pairs that meet: --all lists them)")
-            << "\n";
+  std::cout << counts.rigid << " rigid, " << counts.adjacent << " adjacent" << (args.keep_adjacent ? " (kept)" : "")
+            << "; " << counts.never << " never, " << counts.always_touching << " always touching, " << counts.meets
+            << " meet, " << counts.undecided << " undecided, " << counts.unbounded << " unbounded"
+            << (args.all ? "" : " (pairs that meet: --all lists them)") << "\n";
   for (const auto& e : plan.dropped)
     std::cout << "no longer ignored: " << e.a << " - " << e.b << " (was " << toString(e.reason)
               << ", which no longer holds)\n";

@@ -28,6 +28,8 @@ Runner addRender(CLI::App& app);
 Runner addCalib(CLI::App& app);
 Runner addSynth(CLI::App& app);
 Runner addOverlay(CLI::App& app);
+/// `sheet`, registered on the `calib` subcommand app.
+Runner addCalibSheet(CLI::App& calib);
 /// `intrinsics`, registered on the `calib` subcommand app.
 Runner addCalibIntrinsics(CLI::App& calib);
 

@@ -348,4 +348,64 @@ IgnorePlan ignoreList(const Model& m, const std::vector<PairReport>& reports, co
   return plan;
 }
 
+std::string currentIgnoreReason(const Model& model, int a, int b) {
+  for (const IgnoredPair& p : model.ignored)
+    if ((p.a == a && p.b == b) || (p.a == b && p.b == a)) return toString(p.reason);
+  return "not_included";
+}
+
+std::string plannedIgnoreReason(const IgnorePlan& plan, const Model& model, int a, int b) {
+  const std::string& na = model.bodies[a].name;
+  const std::string& nb = model.bodies[b].name;
+  for (const IgnoreEntry& e : plan.ignore)
+    if ((e.a == na && e.b == nb) || (e.a == nb && e.b == na)) return toString(e.reason);
+  return "";
+}
+
+std::string verdictNote(const PairReport& r) {
+  if (r.rigid)
+    return std::string("rigid (only fixed joints between them): a constant distance, ") +
+           (r.verdict == Verdict::Never ? "never within the margin" : "always within the margin") + ": ignore";
+  switch (r.verdict) {
+    case Verdict::Never:
+      return "proven in " + std::to_string(r.boxes) + " boxes: safe to ignore";
+    case Verdict::AlwaysTouching:
+      return "adjacent, touch at every configuration: ignore";
+    case Verdict::Meets:
+      return "within the margin at a state inside the limits";
+    case Verdict::Undecided:
+      return "no proof within " + std::to_string(r.boxes) + " boxes: keep";
+    case Verdict::Unbounded:
+      return "a joint without limits moves them: keep";
+  }
+  return "";
+}
+
+VerdictCounts countVerdicts(const std::vector<PairReport>& reports) {
+  VerdictCounts c;
+  for (const PairReport& r : reports) {
+    c.rigid += r.rigid;
+    c.adjacent += r.adjacent;
+    if (r.rigid) continue;
+    switch (r.verdict) {
+      case Verdict::Never:
+        ++c.never;
+        break;
+      case Verdict::AlwaysTouching:
+        ++c.always_touching;
+        break;
+      case Verdict::Meets:
+        ++c.meets;
+        break;
+      case Verdict::Undecided:
+        ++c.undecided;
+        break;
+      case Verdict::Unbounded:
+        ++c.unbounded;
+        break;
+    }
+  }
+  return c;
+}
+
 }  // namespace kccd::modelling

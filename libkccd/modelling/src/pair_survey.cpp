@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "kccd/checker.hpp"
 #include "kccd/distance.hpp"
+#include "kccd/modelling/pair_proof.hpp"
 
 namespace kccd::modelling {
 
@@ -60,6 +62,30 @@ Survey surveyStates(const Model& model, const StateLog& log, const SurveyOptions
     if (!std::isfinite(s.min_distance)) s.min_distance = s.min_time = std::nan("");  // no Ok sample
   if (options.progress) options.progress(1.0);
   return out;
+}
+
+StateLog randomStates(const Model& model, int count, std::uint64_t seed) {
+  StateLog log;
+  log.names = model.stateNames();
+  log.circular.assign(model.stateSize(), 0);
+  log.logged_velocity.assign(model.stateSize(), 0);
+  const auto ranges = jointRanges(model);
+  std::mt19937_64 rng(seed);
+  for (int i = 0; i < count; ++i) {
+    log.times.push_back(i);
+    for (const auto& r : ranges)
+      log.values.push_back(std::isnan(r[0]) ? 0.0 : std::uniform_real_distribution<double>(r[0], r[1])(rng));
+  }
+  return log;
+}
+
+std::vector<const PairSurvey*> byConcern(const Survey& survey) {
+  std::vector<const PairSurvey*> order;
+  for (const PairSurvey& p : survey.pairs) order.push_back(&p);
+  std::stable_sort(order.begin(), order.end(), [](const PairSurvey* x, const PairSurvey* y) {
+    return x->within != y->within ? x->within > y->within : x->min_distance < y->min_distance;
+  });
+  return order;
 }
 
 }  // namespace kccd::modelling

@@ -125,4 +125,8 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
 /// Name of a status ("solved", "too few views", ...).
 const char* toString(IntrinsicsStatus status);
 
+/// The camera file of a solved result: cameraText's layout (what loadCamera reads) followed by the
+/// fields OpenCV's calibration sample writes (avg_reprojection_error, nr_of_frames).
+std::string intrinsicsCameraText(const IntrinsicsResult& result);
+
 }  // namespace kccd::calib

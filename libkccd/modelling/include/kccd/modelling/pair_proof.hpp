@@ -84,4 +84,23 @@ IgnorePlan structuralIgnores(const Model& model, const IgnoreOptions& options = 
 /// keep_adjacent). A model entry whose reason is a proof or a rule that no longer holds is dropped.
 IgnorePlan ignoreList(const Model& model, const std::vector<PairReport>& reports, const IgnoreOptions& options = {});
 
+/// Why the model does not check the pair of bodies `a`, `b` now: its `pairs: ignore` reason
+/// (toString), or "not_included" when a model with `check: none` does not include it.
+std::string currentIgnoreReason(const Model& model, int a, int b);
+
+/// The reason `plan` ignores the pair of bodies `a`, `b` for (toString), or "" when it checks it.
+std::string plannedIgnoreReason(const IgnorePlan& plan, const Model& model, int a, int b);
+
+/// What a pair's verdict says about ignoring it, in words ("proven in 12 boxes: safe to ignore").
+std::string verdictNote(const PairReport& report);
+
+/// How many pairs have each verdict (rigid pairs counted as rigid only), and how many are rigid or
+/// adjacent.
+struct VerdictCounts {
+  int never = 0, always_touching = 0, meets = 0, undecided = 0, unbounded = 0;
+  int rigid = 0, adjacent = 0;
+};
+/// The counts of `reports`.
+VerdictCounts countVerdicts(const std::vector<PairReport>& reports);
+
 }  // namespace kccd::modelling

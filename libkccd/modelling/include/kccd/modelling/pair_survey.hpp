@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -45,5 +46,13 @@ struct Survey {
 /// Queries every row of `log` (recorded for `model`) as a point state, distances of every
 /// checked pair (and ignored ones on request), exact within the margin.
 Survey surveyStates(const Model& model, const StateLog& log, const SurveyOptions& options = {});
+
+/// `count` states drawn uniformly inside the joint ranges (jointRanges; values without a range at
+/// 0) by a generator seeded with `seed`, at times 0, 1, ..., count - 1: MoveIt's "often in
+/// collision" sampling. The same seed gives the same states.
+StateLog randomStates(const Model& model, int count, std::uint64_t seed);
+
+/// The survey's pairs by concern: most often within the margin first, then the closest (stable).
+std::vector<const PairSurvey*> byConcern(const Survey& survey);
 
 }  // namespace kccd::modelling

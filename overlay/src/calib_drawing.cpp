@@ -1,4 +1,4 @@
-#include "calib_drawing.hpp"
+#include "kccd/overlay/calib_drawing.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,10 +7,10 @@
 
 #include "kccd/render/composite.hpp"
 
-namespace kccd::cli {
+namespace kccd::overlay {
 namespace {
 
-const cv::Scalar kInlier(60, 200, 60);     // BGR
+const cv::Scalar kInlier(60, 200, 60);  // BGR
 const cv::Scalar kRejected(40, 40, 230);
 const cv::Scalar kProjected(230, 200, 40);
 const cv::Scalar kVector(0, 220, 255);
@@ -30,7 +30,8 @@ struct Ink {
 };
 
 cv::Point at(const cv::Point2d& p) {
-  return {static_cast<int>(std::lround(std::clamp(p.x, -1e6, 1e6))), static_cast<int>(std::lround(std::clamp(p.y, -1e6, 1e6)))};
+  return {static_cast<int>(std::lround(std::clamp(p.x, -1e6, 1e6))),
+          static_cast<int>(std::lround(std::clamp(p.y, -1e6, 1e6)))};
 }
 
 bool finite(const cv::Point2d& p) { return std::isfinite(p.x) && std::isfinite(p.y); }
@@ -76,7 +77,8 @@ cv::Mat drawCheck(const cv::Mat& frame, cv::Size size, const cv::Mat& volumes, c
       std::snprintf(buf, sizeof buf, "%.1f px", p.residual_px);
       s += (s.empty() ? "" : ": ") + std::string(std::isfinite(p.residual_px) ? buf : "behind camera");
     }
-    if (!s.empty()) text(img, s, at(p.pixel + cv::Point2d(ink.radius + 2, -ink.radius - 2)), ink, p.inlier ? kInlier : kRejected);
+    if (!s.empty())
+      text(img, s, at(p.pixel + cv::Point2d(ink.radius + 2, -ink.radius - 2)), ink, p.inlier ? kInlier : kRejected);
   }
   // The headline band at the bottom (the volumes' legend is at the top left).
   const int line_h = static_cast<int>(std::lround(30 * ink.font)) + 4;
@@ -85,18 +87,17 @@ cv::Mat drawCheck(const cv::Mat& frame, cv::Size size, const cv::Mat& volumes, c
     cv::Mat strip = img.rowRange(img.rows - band, img.rows);
     strip.convertTo(strip, -1, 0.35, 0);
     for (std::size_t i = 0; i < headline.size(); ++i)
-      text(img, headline[i], {8, img.rows - band + line_h * static_cast<int>(i + 1) - 2}, ink, cv::Scalar(255, 255, 255));
+      text(img, headline[i], {8, img.rows - band + line_h * static_cast<int>(i + 1) - 2}, ink,
+           cv::Scalar(255, 255, 255));
   }
   return img;
 }
 
-cv::Mat drawSheet(const cv::Mat& frame, const std::vector<calib::TagDetection>& tags, const std::vector<bool>& known,
-                  const std::vector<SheetPoint>& candidates, const std::vector<SheetPoint>& model_points) {
+cv::Mat drawSheet(const cv::Mat& frame, const LabellingCandidates& candidates) {
   cv::Mat img = frame.clone();
   const Ink ink(img.size());
-  for (std::size_t t = 0; t < tags.size(); ++t) {
-    const calib::TagDetection& d = tags[t];
-    const cv::Scalar colour = t < known.size() && known[t] ? kInlier : kUnknownTag;
+  for (const TagCandidate& d : candidates.tags) {
+    const cv::Scalar colour = d.placed ? kInlier : kUnknownTag;
     cv::Point2d centre(0, 0);
     for (std::size_t k = 0; k < 4; ++k) {
       cv::line(img, at(d.corners[k]), at(d.corners[(k + 1) % 4]), colour, ink.thick, cv::LINE_AA);
@@ -110,40 +111,15 @@ cv::Mat drawSheet(const cv::Mat& frame, const std::vector<calib::TagDetection>& 
     }
     text(img, "id " + std::to_string(d.id), at(centre + cv::Point2d(-ink.radius * 3, ink.radius)), ink, colour);
   }
-  for (const SheetPoint& p : candidates) {
+  for (const CornerCandidate& p : candidates.corners) {
     cv::circle(img, at(p.pixel), ink.radius, kCandidate, ink.thick, cv::LINE_AA);
     text(img, p.name, at(p.pixel + cv::Point2d(ink.radius + 2, -ink.radius - 2)), ink, kCandidate);
   }
-  for (const SheetPoint& p : model_points) {
+  for (const ModelPointCandidate& p : candidates.model_points) {
     cross(img, p.pixel, ink.radius, kModel, ink.thick);
     text(img, p.name, at(p.pixel + cv::Point2d(ink.radius + 2, ink.radius * 3)), ink, kModel);
   }
   return img;
 }
 
-std::vector<cv::Point2d> candidateCorners(const cv::Mat& gray, const std::vector<calib::TagDetection>& tags, int count) {
-  std::vector<cv::Point2f> found;
-  const double spacing = std::max(12.0, gray.cols / 50.0);
-  cv::goodFeaturesToTrack(gray, found, std::max(1, count * 3), 0.02, spacing);
-  if (!found.empty())
-    cv::cornerSubPix(gray, found, cv::Size(5, 5), cv::Size(-1, -1),
-                     cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 0.01));
-  std::vector<cv::Point2d> out;
-  for (const cv::Point2f& f : found) {
-    if (static_cast<int>(out.size()) >= count) break;
-    bool near_tag = false;
-    for (const calib::TagDetection& d : tags) {
-      std::vector<cv::Point2f> quad;
-      cv::Point2d c(0, 0);
-      for (const cv::Point2d& p : d.corners) c += p * 0.25;
-      // The quad grown by 15 % around its centre: tag corners and the code inside are left out.
-      for (const cv::Point2d& p : d.corners) quad.emplace_back(c + 1.15 * (p - c));
-      near_tag = near_tag || cv::pointPolygonTest(quad, f, false) >= 0;
-    }
-    // OpenCV's corner coordinates already use pixel centres at integers.
-    if (!near_tag) out.emplace_back(f.x, f.y);
-  }
-  return out;
-}
-
-}  // namespace kccd::cli
+}  // namespace kccd::overlay
