@@ -5,7 +5,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "cli_args.hpp"
 #include "kccd/render/composite.hpp"
+#include "kccd/render/model_view.hpp"
 
 namespace kccd::cli {
 namespace {
@@ -52,6 +54,22 @@ cv::Mat canvas(const cv::Mat& frame, cv::Size size) {
 }
 
 }  // namespace
+
+cv::Mat checkVolumes(const Model& model, const calib::Camera& camera, std::span<const double> state,
+                     const std::string& camera_name, std::string& renderer_name) {
+  try {
+    render::ModelView view(model, camera);
+    render::ModelViewRequest request;
+    request.state = state;
+    request.tight_volumes = false;
+    request.mask = false;
+    request.style.labels = model.bodies.size() <= 12;  // names of many bodies only cover each other
+    renderer_name = view.renderer().rendererString();
+    return view.draw(request).images.bgra;
+  } catch (const calib::CameraError& e) {
+    throw UsageError(camera_name + ": " + e.what());
+  }
+}
 
 cv::Mat drawCheck(const cv::Mat& frame, cv::Size size, const cv::Mat& volumes, const std::vector<CheckPoint>& points,
                   const std::vector<std::string>& headline, double magnify) {

@@ -2,12 +2,15 @@
 // sheet that helps them pick points.
 #pragma once
 
+#include <span>
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
+#include "kccd/calib/camera.hpp"
 #include "kccd/calib/tag_detect.hpp"
+#include "kccd/model.hpp"
 
 namespace kccd::cli {
 
@@ -19,6 +22,13 @@ struct CheckPoint {
   bool inlier = true;
   std::string label;      ///< written next to it (empty: not written; rejected points always are)
 };
+
+/// The volumes of `model` at `state` as the solved `camera` sees them, for the check image: a
+/// BGRA layer coloured by a query at the state, with body names when there are at most 12 bodies
+/// (more only cover each other); `renderer_name` gets the GL renderer's name. A camera the
+/// renderer cannot draw is a UsageError naming `camera_name`.
+cv::Mat checkVolumes(const Model& model, const calib::Camera& camera, std::span<const double> state,
+                     const std::string& camera_name, std::string& renderer_name);
 
 /// The check image: `frame` (BGR, or a grey canvas when empty) with the solved volumes layer
 /// (`volumes`, BGRA, may be empty) composited, then every point: a circle where it was seen, a

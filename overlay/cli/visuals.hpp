@@ -1,33 +1,10 @@
-// A model's visual geometry (Model::visuals) as drawable meshes: mesh files read once, primitives
-// tessellated, placed per configuration.
+// Moved to kccd/render/visuals.hpp (namespace kccd::render); kept for the commands that include it here.
 #pragma once
 
-#include <memory>
-#include <span>
-#include <vector>
-
-#include "kccd/model.hpp"
-#include "kccd/render/renderer.hpp"
+#include "kccd/render/visuals.hpp"
 
 namespace kccd::cli {
-
-/// One visual ready to draw: its mesh in its frame (origin and scale applied), colour (BGR, 0..255)
-/// and the mask label of the first body in the same frame (0 when the frame has none).
-struct LoadedVisual {
-  int frame = kWorld;
-  std::shared_ptr<const render::Mesh> mesh;
-  cv::Scalar colour;
-  int label = 0;
-};
-
-/// Reads every mesh file of the model's visuals (through modelling::readPart, so the same formats
-/// and errors as `kccd fit`) and tessellates boxes, cylinders and spheres. Throws UsageError with
-/// one line naming the visual and the file.
-std::vector<LoadedVisual> loadVisuals(const Model& model);
-
-/// The visuals placed at a configuration (frame poses from kccd::framePoses); an empty list when
-/// the state is not a valid configuration.
-std::vector<render::Volume> visualVolumes(const Model& model, std::span<const LoadedVisual> visuals,
-                                          std::span<const double> state);
-
+using render::LoadedVisual;
+using render::loadVisuals;
+using render::visualVolumes;
 }  // namespace kccd::cli

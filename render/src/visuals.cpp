@@ -1,17 +1,16 @@
-#include "visuals.hpp"
+#include "kccd/render/visuals.hpp"
 
 #include <cmath>
 #include <utility>
 #include <numbers>
 #include <string>
 
-#include "cli_args.hpp"
 #include "kccd/input_error.hpp"
 #include "kccd/kinematics.hpp"
 #include "kccd/modelling/part.hpp"
 #include "kccd/render/ssch_mesh.hpp"
 
-namespace kccd::cli {
+namespace kccd::render {
 namespace {
 
 void addQuad(std::vector<Vec3>& soup, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
@@ -37,7 +36,7 @@ std::vector<Vec3> primitive(const Visual& v) {
       soup.insert(soup.end(), {top, p0 + top, p1 + top, -top, p1 - top, p0 - top});
     }
   } else {
-    const render::SpherePolytope& s = render::spherePolytope(3);
+    const SpherePolytope& s = spherePolytope(3);
     for (const auto& t : s.triangles)
       for (const std::uint32_t k : t) soup.push_back(v.size.x() * s.vertices[k]);
   }
@@ -57,10 +56,10 @@ std::vector<LoadedVisual> loadVisuals(const Model& model) {
       try {
         part = modelling::readPart(v.mesh, {.merge = true, .scale = v.scale});
       } catch (const InputError& e) {
-        throw UsageError(what + ": " + e.what());
+        throw VisualError(what + ": " + e.what());
       }
       if (part.primitives > 0 || part.points.size() != 3 * static_cast<std::size_t>(part.triangles))
-        throw UsageError(what + ": " + v.mesh + ": only triangle meshes are drawn (use box, cylinder or sphere for primitives)");
+        throw VisualError(what + ": " + v.mesh + ": only triangle meshes are drawn (use box, cylinder or sphere for primitives)");
       soup = std::move(part.points);
       // A mirroring scale turns the triangles inside out: wind them back.
       if (v.scale.prod() < 0.0)
@@ -71,7 +70,7 @@ std::vector<LoadedVisual> loadVisuals(const Model& model) {
     for (Vec3& p : soup) p = v.origin * p;
     LoadedVisual lv;
     lv.frame = v.frame;
-    lv.mesh = std::make_shared<const render::Mesh>(render::surfaceMesh(soup));
+    lv.mesh = std::make_shared<const Mesh>(surfaceMesh(soup));
     lv.colour = cv::Scalar(255 * v.colour[2], 255 * v.colour[1], 255 * v.colour[0]);
     for (std::size_t b = 0; b < model.bodies.size(); ++b)
       if (model.bodies[b].frame == v.frame) {
@@ -83,14 +82,14 @@ std::vector<LoadedVisual> loadVisuals(const Model& model) {
   return out;
 }
 
-std::vector<render::Volume> visualVolumes(const Model& model, std::span<const LoadedVisual> visuals,
+std::vector<Volume> visualVolumes(const Model& model, std::span<const LoadedVisual> visuals,
                                           std::span<const double> state) {
   std::vector<Pose> poses(model.joints.size());
   if (!framePoses(model, state, poses)) return {};
-  std::vector<render::Volume> out;
+  std::vector<Volume> out;
   out.reserve(visuals.size());
   for (const LoadedVisual& v : visuals) {
-    render::Volume volume;
+    Volume volume;
     volume.surface = v.mesh;
     volume.pose = framePose(poses, v.frame);
     volume.colour = v.colour;
@@ -101,4 +100,4 @@ std::vector<render::Volume> visualVolumes(const Model& model, std::span<const Lo
   return out;
 }
 
-}  // namespace kccd::cli
+}  // namespace kccd::render
