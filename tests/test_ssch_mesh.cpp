@@ -13,6 +13,7 @@
 #include "kccd/distance.hpp"
 #include "kccd/render/projection.hpp"
 #include "kccd/render/renderer.hpp"
+#include "kccd/render/mesh_cache.hpp"
 #include "kccd/render/ssch_mesh.hpp"
 #include "support/cameras.hpp"
 #include "support/random_shapes.hpp"
@@ -292,9 +293,7 @@ TEST(RenderMesh, DirectAgreesWithHullConstruction) {
     std::vector<Vec3> pts;
     for (int k = 0; k < 3 + c; ++k) pts.emplace_back(u(rng), u(rng), u(rng));
     const Mesh direct = buildSschMesh(pts, 0.1, 3);
-    useHullMeshing(true);
-    const Mesh hull = buildSschMesh(pts, 0.1, 3);
-    useHullMeshing(false);
+    const Mesh hull = buildSschMesh(pts, 0.1, 3, kMinDrawRadius, SschMeshing::Hull);
     EXPECT_TRUE(direct.direct);
     EXPECT_FALSE(hull.direct);
     EXPECT_NEAR(volume(direct), volume(hull), 2e-3 * volume(hull));
@@ -323,6 +322,27 @@ TEST(RenderMesh, CacheReusesUnchangedShapes) {
   EXPECT_NE(cache.get(b, 0.1, 2).get(), m1.get());
   EXPECT_NE(cache.get(a, 0.1000001, 2).get(), m1.get());
   EXPECT_EQ(cache.built(), 3u);
+}
+
+// The construction is a setting of each cache: two caches side by side build the same shapes
+// their own way (the qhull construction never gives a direct mesh).
+TEST(RenderMesh, CacheBuildsWithItsOwnConstruction) {
+  const std::vector<Vec3> pts = {Vec3(0, 0, 0), Vec3(0.3, 0, 0), Vec3(0, 0.2, 0), Vec3(0.1, 0.1, 0.25)};
+  MeshCache direct;
+  MeshCache hull(MeshCache::kDefaultCapacity, SschMeshing::Hull);
+  EXPECT_EQ(direct.meshing(), SschMeshing::Direct);
+  EXPECT_EQ(hull.meshing(), SschMeshing::Hull);
+  const auto a = direct.get(pts, 0.05, 3);
+  const auto b = hull.get(pts, 0.05, 3);
+  const MeshRequest request{pts, 0.05, 3};
+  const auto c = hull.getAll(std::span<const MeshRequest>(&request, 1));
+  EXPECT_TRUE(a->direct);
+  EXPECT_FALSE(b->direct);
+  EXPECT_EQ(c[0].mesh.get(), b.get());  // cached by shape
+  const Mesh expected = buildSschMesh(pts, 0.05, 3, kMinDrawRadius, SschMeshing::Hull);
+  EXPECT_EQ(b->vertices, expected.vertices);
+  EXPECT_EQ(b->triangles, expected.triangles);
+  EXPECT_EQ(buildSschMesh(pts, 0.05, 3).vertices, a->vertices);
 }
 
 TEST(RenderMesh, CacheBuildsBatchesInParallelLikeOneByOne) {

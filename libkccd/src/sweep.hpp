@@ -4,6 +4,7 @@
 #include <span>
 
 #include "kccd/model.hpp"
+#include "kccd/ssch.hpp"
 
 namespace kccd::detail {
 

@@ -12,9 +12,7 @@
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
-#include "kccd/checker.hpp"
-#include "kccd/render/renderer.hpp"
-#include "kccd/render/scene.hpp"
+#include "kccd/render/model_view.hpp"
 
 namespace kccd::cli {
 namespace {
@@ -38,32 +36,36 @@ Exit runRender(const RenderArgs& args) {
   const std::vector<double>& upper = box.upper;
   if (m.bodies.size() > 255) throw UsageError(args.model + ": more than 255 bodies do not fit an 8-bit mask");
 
-  Checker checker(m);
-  const QueryResult& r = checker.query(lower, upper, QueryOptions{.type = QueryType::Distances, .tight_volumes = true});
-  const Status status = r.status;
-  const double margin = r.margin;
-  const std::vector<double> nearest = render::bodyDistances(m, r);
-  const std::vector<SafetyStatus> body_status = render::bodyStatus(m, r);
-  std::vector<render::Volume> volumes = box.point ? render::staticSceneVolumes(m, checker, lower, body_status)
-                                                 : render::sceneVolumes(m, checker, body_status);
-
   render::RenderOptions options;
   options.supersample = args.supersample;
-  std::unique_ptr<render::Renderer> renderer;
+  std::unique_ptr<render::ModelView> view;
   try {
-    renderer = std::make_unique<render::Renderer>(camera, options);
+    view = std::make_unique<render::ModelView>(m, camera, options);
   } catch (const calib::CameraError& e) {
     // Messages of the projection name the camera as "camera: field: problem".
     std::string msg = e.what();
     if (msg.rfind("camera: ", 0) == 0) msg = msg.substr(8);
     throw UsageError(args.camera + ": " + msg);
   }
-  render::Style style;
-  style.labels = args.labels;
-  style.legend = !args.no_legend;
+  render::ModelViewRequest request;
+  if (box.point) {
+    request.state = lower;  // static volumes at the configuration
+  } else {
+    request.lower = lower;  // swept volumes over the box
+    request.upper = upper;
+  }
+  request.colour = !args.mask;
+  request.mask = true;  // also for the pixels per body
+  request.style.labels = args.labels;
+  request.style.legend = !args.no_legend;
   const auto t1 = std::chrono::steady_clock::now();
-  const render::Frame frame = renderer->render(volumes, style, !args.mask, true);
+  const render::ModelFrame drawn = view->draw(request);  // the query and the images
   const auto t2 = std::chrono::steady_clock::now();
+  const render::Frame& frame = drawn.images;
+  const Status status = drawn.query->status;
+  const double margin = drawn.query->margin;
+  const std::vector<double>& nearest = drawn.distances;
+  const std::vector<SafetyStatus>& body_status = drawn.status;
   writePngAtomically(args.output, args.mask ? frame.mask : frame.bgra, "-o");
 
   const double total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -84,7 +86,7 @@ Exit runRender(const RenderArgs& args) {
     j["output"] = args.output;
     j["kind"] = args.mask ? "mask" : "rgba";
     j["volumes"] = swept ? "swept" : "static";
-    j["renderer"] = renderer->rendererString();
+    j["renderer"] = view->renderer().rendererString();
     j["width"] = camera.width;
     j["height"] = camera.height;
     j["distortion"] = camera.distorted();
@@ -108,7 +110,7 @@ Exit runRender(const RenderArgs& args) {
   } else {
     std::cout << "wrote " << args.output << " (" << (args.mask ? "label mask" : "RGBA") << ", " << camera.width << "x"
               << camera.height << ", " << (swept ? "swept" : "static") << " volumes) in " << frame_ms << " ms\n"
-              << "renderer " << renderer->rendererString() << "\n";
+              << "renderer " << view->renderer().rendererString() << "\n";
     for (std::size_t i = 0; i < m.bodies.size(); ++i)
       std::cout << "  " << i + 1 << " " << m.bodies[i].name << ": " << toString(body_status[i]) << ", "
                 << frame.pixels[i] << " px" << drawnNote(i) << "\n";

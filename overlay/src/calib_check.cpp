@@ -8,8 +8,7 @@
 
 #include "kccd/checker.hpp"
 #include "kccd/overlay/calib_drawing.hpp"
-#include "kccd/render/renderer.hpp"
-#include "kccd/render/scene.hpp"
+#include "kccd/render/model_view.hpp"
 
 namespace kccd::overlay {
 namespace {
@@ -17,17 +16,15 @@ namespace {
 // The volumes of the model at `state` as a BGRA layer seen by the solved camera.
 cv::Mat volumesLayer(const Model& m, const calib::Camera& cam, std::span<const double> state,
                      const std::string& camera_name, std::string& renderer_name) {
-  Checker checker(m);
-  const std::vector<double> s(state.begin(), state.end());
-  const QueryResult& r = checker.query(s, s, QueryOptions{.type = QueryType::Distances});
-  const std::vector<SafetyStatus> status = render::bodyStatus(m, r);
-  const std::vector<render::Volume> volumes = render::staticSceneVolumes(m, checker, s, status);
   try {
-    render::Renderer renderer(cam);
-    render::Style style;
-    style.labels = m.bodies.size() <= 12;  // names of many bodies only cover each other
-    renderer_name = renderer.rendererString();
-    return renderer.render(volumes, style, true, false).bgra;
+    render::ModelView view(m, cam);
+    render::ModelViewRequest request;
+    request.state = state;
+    request.tight_volumes = false;
+    request.mask = false;
+    request.style.labels = m.bodies.size() <= 12;  // names of many bodies only cover each other
+    renderer_name = view.renderer().rendererString();
+    return view.draw(request).images.bgra;
   } catch (const calib::CameraError& e) {
     throw calib::CameraError(camera_name + ": " + e.what());
   }

@@ -1,20 +1,18 @@
 #include "kccd/render/ssch_mesh.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <cstring>
 #include <map>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
-#include <string_view>
 
 #include <Eigen/Geometry>
-#include <opencv2/core/utility.hpp>
 
 #include "kccd/hull/qhull.hpp"
 #include "kccd/hull/sphere_polytope.hpp"
+#include "kccd/ssch.hpp"
+#include "mesh_edges.hpp"
 
 namespace kccd::render {
 namespace {
@@ -42,26 +40,6 @@ SpherePolytope makeSphere(int level) {
   s.scale = hull::circumscribedScale(ico);
   s.cone_chord = 2.0 * std::sin(max_angle / 2.0) * (1.0 + 1e-9) + 1e-12;
   return s;
-}
-
-// Fills Mesh::edges from the triangles (sorted half-edges, paired up).
-void buildEdges(Mesh& mesh) {
-  std::vector<std::array<std::uint32_t, 3>> half;  // low vertex, high vertex, triangle
-  half.reserve(mesh.triangles.size() * 3);
-  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const auto [lo, hi] = std::minmax(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3]);
-      half.push_back({lo, hi, t});
-    }
-  std::sort(half.begin(), half.end());
-  mesh.edges.clear();
-  mesh.edges.reserve(half.size() / 2);
-  for (std::size_t i = 0; i < half.size();) {
-    std::size_t j = i + 1;
-    while (j < half.size() && half[j][0] == half[i][0] && half[j][1] == half[i][1]) ++j;
-    mesh.edges.push_back({half[i][0], half[i][1], half[i][2], half[j - 1][2]});
-    i = j;
-  }
 }
 
 // The sphere polytope of radius r around a, swept along the segment to b: faces whose normal
@@ -151,7 +129,7 @@ Mesh hullMesh(std::span<const Vec3> points, double radius, int level, double min
     Mesh mesh = segmentMesh(sphere, points[0], points.back(), big_r);
     mesh.level = level;
     mesh.mesh_radius = big_r;
-    buildEdges(mesh);
+    detail::buildEdges(mesh);
     return mesh;
   }
 
@@ -215,52 +193,8 @@ Mesh hullMesh(std::span<const Vec3> points, double radius, int level, double min
   if (code != 0 || mesh.triangles.empty())
     throw std::runtime_error("buildSschMesh: qhull failed (code " + std::to_string(code) + ")");
 
-  buildEdges(mesh);
+  detail::buildEdges(mesh);
   return mesh;
-}
-
-// Fills Mesh::edges and checks that the triangles close up: every edge is shared by exactly two
-// triangles that run along it in opposite directions, and V - E + F = 2. Linear time: the
-// half-edges are bucketed by their lower vertex and paired within each (small) bucket.
-bool closeUp(Mesh& mesh) {
-  const std::size_t nv = mesh.vertices.size();
-  std::vector<std::uint32_t> start(nv + 1, 0);
-  for (const auto& tri : mesh.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
-      if (a == b) return false;
-      ++start[std::min(a, b) + 1];
-    }
-  for (std::size_t i = 0; i < nv; ++i) start[i + 1] += start[i];
-  struct Half {
-    std::uint32_t hi, triangle;
-    bool forward;
-  };
-  std::vector<Half> half(start[nv]);
-  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
-      half[fill[std::min(a, b)]++] = Half{std::max(a, b), t, a < b};
-    }
-  mesh.edges.clear();
-  mesh.edges.reserve(half.size() / 2);
-  for (std::uint32_t lo = 0; lo < nv; ++lo) {
-    const std::uint32_t begin = start[lo], end = start[lo + 1];
-    for (std::uint32_t i = begin; i < end; ++i) {
-      if (half[i].hi == UINT32_MAX) continue;  // already paired
-      std::uint32_t match = UINT32_MAX;
-      for (std::uint32_t j = i + 1; j < end; ++j)
-        if (half[j].hi == half[i].hi) {
-          if (match != UINT32_MAX || half[j].forward == half[i].forward) return false;
-          match = j;
-        }
-      if (match == UINT32_MAX) return false;
-      mesh.edges.push_back({lo, half[i].hi, half[i].triangle, half[match].triangle});
-      half[match].hi = UINT32_MAX;
-    }
-  }
-  return static_cast<long>(nv) - static_cast<long>(mesh.edges.size()) + static_cast<long>(mesh.triangles.size()) == 2;
 }
 
 // The sphere polytope of a level turned by a fixed rotation, so that its face normals and the
@@ -530,21 +464,17 @@ std::optional<Mesh> directMesh(const CoreHull& core, const TurnedSphere& q, doub
     for (std::size_t k = 1; k + 1 < loop.size(); ++k)
       triangle(vertex(loop[0], u), vertex(loop[k], u), vertex(loop[k + 1], u), n);
   }
-  if (!closeUp(mesh)) return std::nullopt;
+  if (!detail::closeUp(mesh)) return std::nullopt;
   return mesh;
 }
 
-std::atomic<bool> g_hull_meshing{false};
-
 }  // namespace
 
-void useHullMeshing(bool on) { g_hull_meshing = on; }
-
-Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, double min_radius) {
+Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, double min_radius, SschMeshing meshing) {
   if (points.empty()) throw std::invalid_argument("buildSschMesh: no core points");
   if (!allFinite(points) || !std::isfinite(radius) || radius < 0.0 || !(min_radius > 0.0))
     throw std::invalid_argument("buildSschMesh: non-finite point or bad radius");
-  if (g_hull_meshing) return hullMesh(points, radius, level, min_radius);
+  if (meshing == SschMeshing::Hull) return hullMesh(points, radius, level, min_radius);
   double extent = 0.0;
   for (const Vec3& p : points) extent = std::max(extent, p.cwiseAbs().maxCoeff());
   // Guard for the float conversion of vertices when drawing (a micrometre at 1 m), as before;
@@ -566,114 +496,6 @@ Mesh buildSschMesh(std::span<const Vec3> points, double radius, int level, doubl
   Mesh mesh = hullMesh(points, radius, level, min_radius);
   mesh.hull_input += qhull_points;
   return mesh;
-}
-
-Mesh surfaceMesh(std::span<const Vec3> triangle_points) {
-  if (triangle_points.size() % 3 != 0) throw std::invalid_argument("surfaceMesh: not whole triangles");
-  Mesh mesh;
-  // Equal points share a vertex (smooth shading) when their triangles' normals are within 40
-  // degrees of the first triangle that made the vertex; across sharper creases (and between
-  // faces turned the opposite way) they do not: a box stays a box.
-  std::map<std::array<double, 3>, std::vector<std::uint32_t>> index;
-  std::vector<Vec3> first_normal;
-  const double crease = std::cos(40.0 * 3.141592653589793 / 180.0);
-  auto vertex = [&](const Vec3& p, const Vec3& n) {
-    if (!p.allFinite()) throw std::invalid_argument("surfaceMesh: non-finite point");
-    std::vector<std::uint32_t>& at = index[{p.x(), p.y(), p.z()}];
-    for (const std::uint32_t k : at)
-      if (first_normal[k].dot(n) >= crease) return k;
-    at.push_back(static_cast<std::uint32_t>(mesh.vertices.size()));
-    mesh.vertices.push_back(p);
-    first_normal.push_back(n);
-    return at.back();
-  };
-  for (std::size_t t = 0; t < triangle_points.size(); t += 3) {
-    const Vec3& a = triangle_points[t];
-    const Vec3 n = (triangle_points[t + 1] - a).cross(triangle_points[t + 2] - a);
-    if (!(n.norm() > 0.0) || !n.allFinite()) {
-      if (!a.allFinite() || !triangle_points[t + 1].allFinite() || !triangle_points[t + 2].allFinite())
-        throw std::invalid_argument("surfaceMesh: non-finite point");
-      continue;
-    }
-    const Vec3 u = n.normalized();
-    mesh.triangles.push_back({vertex(a, u), vertex(triangle_points[t + 1], u), vertex(triangle_points[t + 2], u)});
-    mesh.normals.push_back(u);
-  }
-  return mesh;
-}
-
-std::string MeshCache::key(const MeshRequest& r) {
-  const std::size_t n = r.points.size() * sizeof(Vec3);
-  std::string key(n + 2 * sizeof(double) + sizeof(int), '\0');
-  std::memcpy(key.data(), r.points.data(), n);
-  std::memcpy(key.data() + n, &r.radius, sizeof(double));
-  std::memcpy(key.data() + n + sizeof(double), &r.level, sizeof(int));
-  std::memcpy(key.data() + n + sizeof(double) + sizeof(int), &r.min_radius, sizeof(double));
-  return key;
-}
-
-void MeshCache::makeRoom() {
-  if (entries_.size() < capacity_) return;
-  std::erase_if(entries_, [&](const auto& e) { return e.second.used + 2 < frame_; });
-  if (entries_.size() >= capacity_) entries_.clear();
-}
-
-std::shared_ptr<const Mesh> MeshCache::get(std::span<const Vec3> points, double radius, int level,
-                                           double min_radius) {
-  const MeshRequest request{points, radius, level, min_radius};
-  std::string k = key(request);
-  auto it = entries_.find(k);
-  if (it != entries_.end()) {
-    it->second.used = frame_;
-    ++reused_;
-    return it->second.mesh;
-  }
-  makeRoom();
-  auto mesh = std::make_shared<const Mesh>(buildSschMesh(points, radius, level, min_radius));
-  ++built_;
-  entries_.emplace(std::move(k), Entry{mesh, frame_});
-  return mesh;
-}
-
-std::vector<MeshCache::Found> MeshCache::getAll(std::span<const MeshRequest> requests) {
-  std::vector<Found> out(requests.size());
-  std::vector<std::string> keys(requests.size());
-  std::vector<std::size_t> missing;  // requests to build, first of each key
-  std::unordered_map<std::string_view, std::size_t> first;
-  for (std::size_t i = 0; i < requests.size(); ++i) {
-    keys[i] = key(requests[i]);
-    const auto it = entries_.find(keys[i]);
-    if (it != entries_.end()) {
-      it->second.used = frame_;
-      ++reused_;
-      out[i].mesh = it->second.mesh;
-    } else if (first.emplace(keys[i], i).second) {
-      missing.push_back(i);
-    }
-  }
-  cv::parallel_for_(cv::Range(0, static_cast<int>(missing.size())), [&](const cv::Range& range) {
-    for (int k = range.start; k < range.end; ++k) {
-      const MeshRequest& r = requests[missing[static_cast<std::size_t>(k)]];
-      try {
-        out[missing[static_cast<std::size_t>(k)]].mesh =
-            std::make_shared<const Mesh>(buildSschMesh(r.points, r.radius, r.level, r.min_radius));
-      } catch (const std::exception&) {  // qhull on extreme coordinates: no mesh
-      }
-    }
-  });
-  for (const std::size_t i : missing) {
-    if (!out[i].mesh) continue;
-    out[i].built = true;
-    ++built_;
-    makeRoom();
-    entries_.emplace(keys[i], Entry{out[i].mesh, frame_});
-  }
-  for (std::size_t i = 0; i < requests.size(); ++i)
-    if (!out[i].mesh) {
-      const auto it = first.find(keys[i]);
-      if (it != first.end() && it->second != i) out[i].mesh = out[it->second].mesh;  // a repeated request
-    }
-  return out;
 }
 
 }  // namespace kccd::render

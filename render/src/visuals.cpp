@@ -56,10 +56,10 @@ std::vector<LoadedVisual> loadVisuals(const Model& model) {
       try {
         part = modelling::readPart(v.mesh, {.merge = true, .scale = v.scale});
       } catch (const InputError& e) {
-        throw InputError(what + ": " + e.what());
+        throw VisualError(what + ": " + e.what());
       }
       if (part.primitives > 0 || part.points.size() != 3 * static_cast<std::size_t>(part.triangles))
-        throw InputError(what + ": " + v.mesh + ": only triangle meshes are drawn (use box, cylinder or sphere for primitives)");
+        throw VisualError(what + ": " + v.mesh + ": only triangle meshes are drawn (use box, cylinder or sphere for primitives)");
       soup = std::move(part.points);
       // A mirroring scale turns the triangles inside out: wind them back.
       if (v.scale.prod() < 0.0)

@@ -69,14 +69,21 @@ RenderOptions benchOptions() {
   return o;
 }
 
-Renderer& renderer() {
-  static Renderer r(benchCamera(), benchOptions());
-  return r;
+// One renderer per mesh construction, made on first use.
+Renderer& renderer(SschMeshing meshing) {
+  static Renderer direct(benchCamera(), benchOptions());
+  if (meshing == SschMeshing::Direct) return direct;
+  static Renderer hull(benchCamera(), [] {
+    RenderOptions o = benchOptions();
+    o.meshing = SschMeshing::Hull;
+    return o;
+  }());
+  return hull;
 }
 
-void frame(benchmark::State& state, bool swept, bool moving, bool mask) {
+void frame(benchmark::State& state, bool swept, bool moving, bool mask, SschMeshing meshing = SschMeshing::Direct) {
   const Model& m = humanoid();
-  Renderer& r = renderer();
+  Renderer& r = renderer(meshing);
   Checker checker(m);
   static const auto static_list = boxes(false), swept_list = boxes(true);
   const auto& list = swept ? swept_list : static_list;
@@ -105,11 +112,7 @@ void frame(benchmark::State& state, bool swept, bool moving, bool mask) {
 void BM_Static_Fixed(benchmark::State& s) { frame(s, false, false, s.range(0) != 0); }
 void BM_Static_Moving(benchmark::State& s) { frame(s, false, true, s.range(0) != 0); }
 void BM_Swept(benchmark::State& s) { frame(s, true, true, s.range(0) != 0); }
-void BM_Swept_HullMeshing(benchmark::State& s) {
-  useHullMeshing(true);
-  frame(s, true, true, s.range(0) != 0);
-  useHullMeshing(false);
-}
+void BM_Swept_HullMeshing(benchmark::State& s) { frame(s, true, true, s.range(0) != 0, SschMeshing::Hull); }
 
 // One swept volume's mesh alone (core points of the humanoid's swept volumes: a few tens), built
 // directly (arg 0) or by the previous qhull construction (arg 1); level 3.
@@ -124,17 +127,16 @@ void BM_SweptMesh(benchmark::State& state) {
     for (const Volume& v : sceneVolumes(m, checker, bodyStatus(m, q)))
       volumes.emplace_back(std::vector<Vec3>(v.points.begin(), v.points.end()), v.radius);
   }
-  useHullMeshing(state.range(0) != 0);
+  const SschMeshing meshing = state.range(0) != 0 ? SschMeshing::Hull : SschMeshing::Direct;
   std::size_t i = 0;
   double points = 0, n = 0;
   for (auto _ : state) {
     const auto& [points_of, radius] = volumes[i++ % volumes.size()];
-    const Mesh mesh = buildSschMesh(points_of, radius, 3);
+    const Mesh mesh = buildSschMesh(points_of, radius, 3, kMinDrawRadius, meshing);
     benchmark::DoNotOptimize(mesh.triangles.data());
     points += static_cast<double>(points_of.size());
     ++n;
   }
-  useHullMeshing(false);
   state.counters["core_points"] = points / n;
 }
 BENCHMARK(BM_SweptMesh)->ArgName("hull")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);

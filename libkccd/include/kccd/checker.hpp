@@ -9,6 +9,7 @@
 
 #include "kccd/model.hpp"
 #include "kccd/query.hpp"
+#include "kccd/ssch.hpp"
 
 namespace kccd::detail {
 struct JointMaps;

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "kccd/input_error.hpp"
-#include "kccd/ssch.hpp"
+#include "kccd/types.hpp"
 
 namespace kccd {
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <span>
 
-#include "kccd/ssch.hpp"
+#include "kccd/types.hpp"
 
 namespace kccd {
 

@@ -4,13 +4,9 @@
 #include <span>
 #include <vector>
 
-#include <Eigen/Core>
-#include <Eigen/Geometry>
+#include "kccd/types.hpp"
 
 namespace kccd {
-
-using Vec3 = Eigen::Vector3d;
-using Pose = Eigen::Isometry3d;
 
 /// A non-owning view of an SSCH: the set of points within `radius` of conv(points).
 /// This is what the distance routines take; it never allocates.

@@ -13,7 +13,7 @@
 #include <opencv2/core.hpp>
 
 #include "kccd/input_error.hpp"
-#include "kccd/ssch.hpp"
+#include "kccd/types.hpp"
 
 namespace kccd::calib {
 

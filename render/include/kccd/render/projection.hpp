@@ -8,7 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "kccd/calib/camera.hpp"
-#include "kccd/ssch.hpp"
+#include "kccd/types.hpp"
 
 namespace kccd::render {
 

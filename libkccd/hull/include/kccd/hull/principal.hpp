@@ -5,7 +5,7 @@
 
 #include <Eigen/Core>
 
-#include "kccd/ssch.hpp"
+#include "kccd/types.hpp"
 
 namespace kccd::hull {
 

@@ -4,7 +4,7 @@
 #include <span>
 #include <vector>
 
-#include "kccd/ssch.hpp"
+#include "kccd/types.hpp"
 
 namespace kccd::hull {
 

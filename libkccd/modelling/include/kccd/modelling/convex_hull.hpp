@@ -6,7 +6,7 @@
 #include <span>
 #include <vector>
 
-#include "kccd/ssch.hpp"
+#include "kccd/types.hpp"
 
 namespace kccd::modelling {
 

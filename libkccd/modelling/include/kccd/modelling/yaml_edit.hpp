@@ -10,7 +10,7 @@
 
 #include "kccd/input_error.hpp"
 #include "kccd/model.hpp"
-#include "kccd/ssch.hpp"
+#include "kccd/types.hpp"
 
 namespace kccd::modelling {
 

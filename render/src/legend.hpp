@@ -1,0 +1,34 @@
+// The text on the colour layer (internal): body names at the projected volume centres and the
+// colour legend of the statuses in the top-left corner.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "kccd/render/projection.hpp"
+#include "kccd/render/render_types.hpp"
+
+namespace kccd::render::detail {
+
+/// Draws names and the legend on camera images of one projection (which must outlive it); the
+/// legend is drawn once per image height and copied afterwards.
+class Legend {
+ public:
+  /// For volumes seen through `projection`; names of centres nearer than `near` are not drawn.
+  Legend(const Projection& projection, double near);
+  /// Draws on `bgra` (the straight-alpha camera image) what `style` asks: the names of the drawn
+  /// volumes (Style::labels) and the legend (Style::legend).
+  void draw(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility, const Style& style);
+
+ private:
+  const Projection& projection_;
+  Pose world_to_camera_;
+  double near_;
+  cv::Mat legend_;
+  cv::Rect legend_box_;
+  int legend_rows_ = 0;
+};
+
+}  // namespace kccd::render::detail

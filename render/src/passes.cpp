@@ -1,0 +1,255 @@
+#include "passes.hpp"
+
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+namespace kccd::render::detail {
+namespace {
+
+void setCamera(const Projection& projection, double near, double far) {
+  const std::array<float, 16> m = projection.glMatrix(near, far);
+  glViewport(0, 0, projection.pinhole().width, projection.pinhole().height);
+  glMatrixMode(GL_PROJECTION);
+  glLoadMatrixf(m.data());
+  glMatrixMode(GL_MODELVIEW);
+  glLoadIdentity();
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glFrontFace(GL_CW);  // the projection keeps image rows top-down, which mirrors the winding
+  glEnableClientState(GL_VERTEX_ARRAY);
+}
+
+// Draws a quad over the whole viewport (the camera matrices are restored afterwards).
+void fillViewport() {
+  glMatrixMode(GL_PROJECTION);
+  glPushMatrix();
+  glLoadIdentity();
+  glMatrixMode(GL_MODELVIEW);
+  glDisable(GL_CULL_FACE);
+  const float quad[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+  glVertexPointer(3, GL_FLOAT, 0, quad);
+  glDrawArrays(GL_TRIANGLE_FAN, 0, 4);
+  glEnable(GL_CULL_FACE);
+  glMatrixMode(GL_PROJECTION);
+  glPopMatrix();
+  glMatrixMode(GL_MODELVIEW);
+}
+
+void drawTriangles(const Mesh& mesh, const std::vector<float>& vertices) {
+  glVertexPointer(3, GL_FLOAT, 0, vertices.data());
+  glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.triangles.size() * 3), GL_UNSIGNED_INT, mesh.triangles.data());
+}
+
+// Draw buffers of the bound framebuffer: the colour attachment, the label attachment, or both.
+void drawBuffers(bool colour, bool labels) {
+  const GLenum none = GL_NONE;
+  const GLenum buffers[] = {colour ? GLenum{GL_COLOR_ATTACHMENT0} : none, labels ? GLenum{GL_COLOR_ATTACHMENT1} : none};
+  glDrawBuffers(labels ? 2 : 1, buffers);
+}
+
+// Clears the label attachment (draw buffer 1) to 0 and the depth buffer to "infinitely far".
+void clearLabels() {
+  const float zero[4] = {0, 0, 0, 0}, far = 0.0f;  // reversed depth: 0 is infinitely far
+  glClearBufferfv(GL_COLOR, 1, zero);
+  glClearBufferfv(GL_DEPTH, 0, &far);
+}
+
+// Reads the label attachment of the bound framebuffer (CV_8UC1).
+cv::Mat readLabels(int w, int h) {
+  cv::Mat labels(h, w, CV_8UC1);
+  glReadBuffer(GL_COLOR_ATTACHMENT1);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, w, h, GL_RED, GL_UNSIGNED_BYTE, labels.data);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  return labels;
+}
+
+// The labels of the meshes into the label attachment of the bound framebuffer, depth-tested so
+// the nearest surface's label stays whatever the order (surfaces from both sides; reversed depth,
+// see the label shader in gl_targets.cpp); leaves the depth test and blending off.
+void drawLabelTriangles(const GlTargets& gl, const std::vector<PreparedVolume>& bodies, double near) {
+  glDisable(GL_BLEND);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_TRUE);
+  glUseProgram(gl.program);
+  glUniform1f(gl.near_location, static_cast<float>(near));
+  // Front to back: farther fragments then fail the depth test and write nothing.
+  std::vector<const PreparedVolume*> order;
+  for (const PreparedVolume& p : bodies)
+    if (p.mesh) order.push_back(&p);
+  std::sort(order.begin(), order.end(), [](const PreparedVolume* a, const PreparedVolume* b) { return a->depth < b->depth; });
+  for (const PreparedVolume* p : order) {
+    glUniform1ui(gl.label_location, static_cast<GLuint>(p->label));
+    if (p->surface) glDisable(GL_CULL_FACE);
+    drawTriangles(*p->mesh, p->vertices);
+    glEnable(GL_CULL_FACE);
+  }
+  glUseProgram(0);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_DEPTH_TEST);
+}
+
+// Opaque volumes, depth-tested, each vertex lit by Lambert's law with the normal averaged over its
+// triangles (smooth shading of the tessellated surface).
+void drawShaded(const std::vector<const PreparedVolume*>& order, double ambient) {
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_BLEND);
+  glShadeModel(GL_SMOOTH);
+  glEnableClientState(GL_COLOR_ARRAY);
+  // Light from the camera's upper left (camera frame: x right, y down, z forward), towards the scene.
+  const Vec3 to_light = Vec3(-0.45, -0.6, -1.0).normalized();
+  std::vector<Vec3> normals;
+  std::vector<float> colours;
+  for (const PreparedVolume* p : order) {
+    const Mesh& m = *p->mesh;
+    normals.assign(m.vertices.size(), Vec3::Zero());
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+      for (const std::uint32_t k : m.triangles[t]) normals[k] += m.normals[t];
+    colours.resize(m.vertices.size() * 4);
+    for (std::size_t k = 0; k < m.vertices.size(); ++k) {
+      Vec3 n = (p->rotation * normals[k]).normalized();
+      // A little rim darkening where the surface turns away from the camera (edges read as edges).
+      const Vec3 view = -Vec3(p->vertices[3 * k], p->vertices[3 * k + 1], p->vertices[3 * k + 2]).normalized();
+      if (p->surface && n.dot(view) < 0.0) n = -n;  // both sides of a surface are lit
+      const double lambert = std::max(0.0, n.dot(to_light));
+      const double facing = std::clamp(n.dot(view), 0.0, 1.0);
+      const double shade = (ambient + (1.0 - ambient) * lambert) * (0.75 + 0.25 * std::sqrt(facing));
+      for (int c = 0; c < 3; ++c) colours[4 * k + c] = static_cast<float>(std::min(1.0, p->colour[c] / 255.0 * shade));
+      colours[4 * k + 3] = 1.0f;
+    }
+    glColorPointer(4, GL_FLOAT, 0, colours.data());
+    glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
+    if (p->surface) glDisable(GL_CULL_FACE);
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.triangles.size() * 3), GL_UNSIGNED_INT, m.triangles.data());
+    glEnable(GL_CULL_FACE);
+  }
+  glDisableClientState(GL_COLOR_ARRAY);
+  glDisable(GL_DEPTH_TEST);
+}
+
+}  // namespace
+
+cv::Mat drawColour(GlTargets& gl, const Projection& projection, const RenderOptions& options,
+                   const std::vector<PreparedVolume>& bodies, const Style& style, Frame& frame, cv::Mat* labels) {
+  const double near = frame.near, far = frame.far;
+  const int w = gl.width, h = gl.height;
+  const bool with_labels = labels != nullptr && gl.samples <= 1 && !style.shaded;
+  glBindFramebuffer(GL_FRAMEBUFFER, gl.samples > 1 ? gl.ms_fbo : gl.resolve_fbo);
+  if (gl.samples <= 1) drawBuffers(true, with_labels);
+  setCamera(projection, near, far);
+  glClearColor(0, 0, 0, 0);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (with_labels) clearLabels();
+  if (style.shaded) {
+    std::vector<const PreparedVolume*> all;
+    for (const PreparedVolume& p : bodies)
+      if (p.mesh) all.push_back(&p);
+    drawShaded(all, style.ambient);
+  } else {
+  glDisable(GL_DEPTH_TEST);
+  glEnable(GL_BLEND);
+  // Premultiplied result on a transparent clear; converted to straight alpha after read-back.
+  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  // Back to front; back faces culled, so each convex volume tints a pixel once.
+  std::vector<const PreparedVolume*> order;
+  for (const PreparedVolume& p : bodies)
+    if (p.drawn()) order.push_back(&p);
+  std::sort(order.begin(), order.end(), [](const PreparedVolume* a, const PreparedVolume* b) { return a->depth > b->depth; });
+  // Whether the fill may be the silhouette polygon: a single loop whose vertices all lie beyond
+  // the near plane (then its projection is the convex outline of the front faces, unclipped).
+  auto polygonFill = [&](const PreparedVolume& p) {
+    if (!options.polygon_fill || p.fill.empty()) return false;
+    for (const std::uint32_t k : p.silhouette)
+      if (!(p.vertices[3 * k + 2] > near)) return false;
+    return true;
+  };
+  if (with_labels) {  // the labels of the nearest surfaces first (see kLabelFragmentShader), then the colour
+    drawBuffers(false, true);
+    drawLabelTriangles(gl, bodies, near);
+    drawBuffers(true, false);
+    glEnable(GL_BLEND);
+  }
+  // The tints as premultiplied colours (the blend then multiplies nothing by the source alpha:
+  // ~15 % less fill time on llvmpipe than blending straight colours).
+  glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  for (const PreparedVolume* p : order) {
+    const cv::Scalar c = p->colour;  // BGR, drawn as GL's RGB (see the read-back)
+    const double fa = style.fill_alpha;
+    glColor4d(fa * c[0] / 255.0, fa * c[1] / 255.0, fa * c[2] / 255.0, fa);
+    if (p->outlined()) {
+      ++frame.polygon_fills;
+      glDisable(GL_CULL_FACE);  // the outline's winding is the image's, not the mesh's
+      glVertexPointer(3, GL_FLOAT, 0, p->outline_vertices.data());
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(p->outline_fill.size()), GL_UNSIGNED_INT, p->outline_fill.data());
+      glEnable(GL_CULL_FACE);
+    } else if (!p->surface && polygonFill(*p)) {
+      ++frame.polygon_fills;
+      glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(p->fill.size()), GL_UNSIGNED_INT, p->fill.data());
+    } else {
+      drawTriangles(*p->mesh, p->vertices);
+    }
+  }
+  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);  // smoothed lines: coverage in alpha
+  glLineWidth(static_cast<float>(style.outline_width * projection.supersample()));
+  glEnable(GL_LINE_SMOOTH);  // coverage in alpha, blended like the fill
+  glHint(GL_LINE_SMOOTH_HINT, GL_NICEST);
+  for (const PreparedVolume* p : order) {
+    const cv::Scalar c = p->colour * 0.7;
+    glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
+    const bool own = p->outlined();
+    glVertexPointer(3, GL_FLOAT, 0, own ? p->outline_vertices.data() : p->vertices.data());
+    const std::vector<std::uint32_t>& lines = own ? p->outline_lines : p->outline;
+    glDrawElements(GL_LINES, static_cast<GLsizei>(lines.size()), GL_UNSIGNED_INT, lines.data());
+  }
+  glDisable(GL_LINE_SMOOTH);
+  // Volumes containing the camera tint the whole view, in front of everything else.
+  for (const PreparedVolume& p : bodies)
+    if (p.fills) {
+      const cv::Scalar c = p.colour;
+      glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
+      fillViewport();
+    }
+  glDisable(GL_BLEND);
+  }
+  if (gl.samples > 1) {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, gl.ms_fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, gl.resolve_fbo);
+    drawBuffers(true, false);  // a mask drawn alone before leaves the label attachment selected
+    glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, gl.resolve_fbo);
+  cv::Mat image(h, w, CV_8UC4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glFinish();
+  // Colours are drawn with blue in GL's red channel, so the plain RGBA read (llvmpipe's fast
+  // path, no swizzle) returns OpenCV's BGRA order.
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, image.data);
+  if (with_labels) *labels = readLabels(w, h);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  return image;
+}
+
+cv::Mat drawMask(GlTargets& gl, const Projection& mask_projection, const std::vector<PreparedVolume>& bodies,
+                 double near, double far) {
+  const int w = gl.mask_width, h = gl.mask_height;
+  glBindFramebuffer(GL_FRAMEBUFFER, gl.mask_fbo != 0 ? gl.mask_fbo : gl.resolve_fbo);
+  drawBuffers(false, true);
+  setCamera(mask_projection, near, far);
+  clearLabels();
+  drawLabelTriangles(gl, bodies, near);
+  glFinish();
+  cv::Mat mask = readLabels(w, h);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  return mask;
+}
+
+}  // namespace kccd::render::detail

@@ -1,0 +1,158 @@
+#include "warp.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <mutex>
+
+#include <opencv2/imgproc.hpp>
+
+namespace kccd::render::detail {
+namespace {
+
+// Per row of a warp's y map, the source rows its samples may read: the extremes' floors, widened
+// by a row each way for the fixed-point rounding and the bilinear neighbour (empty: first > second).
+// Samples above row -1 or below row `source_rows` (e.g. the far-off marks of pixels the lens
+// model cannot invert) read nothing (the constant border) and are left out.
+std::vector<std::pair<int, int>> sourceRows(const cv::Mat& map_y, int source_rows) {
+  std::vector<std::pair<int, int>> rows(static_cast<std::size_t>(map_y.rows), {0, -1});
+  for (int y = 0; y < map_y.rows; ++y) {
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (int x = 0; x < map_y.cols; ++x) {
+      const float v = map_y.at<float>(y, x);
+      if (v > -2.0f && v < static_cast<float>(source_rows) + 1.0f) lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+    if (lo <= hi) rows[static_cast<std::size_t>(y)] = {static_cast<int>(std::floor(lo)) - 1, static_cast<int>(std::floor(hi)) + 2};
+  }
+  return rows;
+}
+
+// Which rows of an image hold a non-zero byte, as prefix counts (rows + 1 entries), to ask of
+// any range of rows whether something is drawn in it.
+struct DrawnRows {
+  std::vector<int> prefix;
+  explicit DrawnRows(const cv::Mat& image) : prefix(static_cast<std::size_t>(image.rows) + 1, 0) {
+    const std::size_t bytes = image.cols * image.elemSize();
+    cv::parallel_for_(cv::Range(0, image.rows), [&](const cv::Range& r) {
+      for (int y = r.start; y < r.end; ++y) {
+        const uchar* row = image.ptr<uchar>(y);
+        uchar any = 0;
+        for (std::size_t x = 0; x < bytes; ++x) any |= row[x];
+        prefix[static_cast<std::size_t>(y) + 1] = any != 0;
+      }
+    });
+    for (std::size_t y = 1; y < prefix.size(); ++y) prefix[y] += prefix[y - 1];
+  }
+  bool any(std::pair<int, int> rows) const {
+    const int n = static_cast<int>(prefix.size()) - 1;
+    const int lo = std::clamp(rows.first, 0, n), hi = std::clamp(rows.second + 1, 0, n);
+    return lo < hi && prefix[static_cast<std::size_t>(hi)] > prefix[static_cast<std::size_t>(lo)];
+  }
+};
+
+// Warps `src` into `dst` (the maps' size, src's type; fixed-point maps, map_b may be empty) in
+// parallel runs of a few rows and calls after(rows, warped) on each run while it is in cache.
+// Output rows whose samples (`source`, from sourceRows) read only empty rows of `src` are cleared
+// instead of warped: what the warp would give them (zeros, the constant border).
+template <class Fn>
+void warpByRows(const cv::Mat& src, cv::Mat& dst, const cv::Mat& map_a, const cv::Mat& map_b, int interpolation,
+                const std::vector<std::pair<int, int>>& source, Fn&& after) {
+  const DrawnRows drawn(src);
+  dst.create(map_a.rows, map_a.cols, src.type());
+  constexpr int kBlock = 8;
+  cv::parallel_for_(cv::Range(0, (dst.rows + kBlock - 1) / kBlock), [&](const cv::Range& blocks) {
+    for (int b = blocks.start; b < blocks.end; ++b) {
+      const int y1 = std::min(dst.rows, (b + 1) * kBlock);
+      for (int y = b * kBlock; y < y1;) {
+        const bool any = drawn.any(source[static_cast<std::size_t>(y)]);
+        int end = y + 1;
+        while (end < y1 && drawn.any(source[static_cast<std::size_t>(end)]) == any) ++end;
+        cv::Mat out = dst.rowRange(y, end);
+        if (any)
+          cv::remap(src, out, map_a.rowRange(y, end), map_b.empty() ? cv::Mat() : map_b.rowRange(y, end), interpolation,
+                    cv::BORDER_CONSTANT, cv::Scalar::all(0));
+        else
+          out.setTo(cv::Scalar::all(0));
+        after(out, any);
+        y = end;
+      }
+    }
+  });
+}
+
+// Straight alpha: colour / alpha, through a table, for every pixel of `rows` (CV_8UC4).
+void straighten(cv::Mat rows) {
+  static const std::vector<uchar> unpremultiply = [] {
+    std::vector<uchar> t(256 * 256);
+    for (int a = 1; a < 256; ++a)
+      for (int c = 0; c < 256; ++c) t[a * 256 + c] = static_cast<uchar>(std::min(255, (c * 255 + a / 2) / a));
+    return t;
+  }();
+  for (int y = 0; y < rows.rows; ++y) {
+    uchar* px = rows.ptr<uchar>(y);
+    for (int x = 0; x < rows.cols; ++x, px += 4) {
+      const uchar* t = &unpremultiply[px[3] * 256];
+      if (px[3] != 255 && px[3] != 0) px[0] = t[px[0]], px[1] = t[px[1]], px[2] = t[px[2]];
+    }
+  }
+}
+
+}  // namespace
+
+cv::Mat ColourWarp::apply(const cv::Mat& premultiplied) {
+  cv::Mat out;
+  if (projection_.warps()) {
+    if (map_a_.empty()) {  // fixed-point maps: remap's fast path (1/32 px steps)
+      cv::convertMaps(projection_.mapX(), projection_.mapY(), map_a_, map_b_, CV_16SC2);
+      source_rows_ = sourceRows(projection_.mapY(), projection_.pinhole().height);
+    }
+    // Straightened run by run while in cache; rows the warp clears need nothing.
+    warpByRows(premultiplied, out, map_a_, map_b_, cv::INTER_LINEAR, source_rows_, [&](const cv::Mat& rows, bool warped) {
+      if (warped) straighten(rows);
+    });
+  } else {
+    out = premultiplied;
+    cv::parallel_for_(cv::Range(0, out.rows), [&](const cv::Range& rows) { straighten(out.rowRange(rows.start, rows.end)); });
+  }
+  return out;
+}
+
+cv::Mat LabelWarp::apply(const cv::Mat& pinhole_labels, std::array<int, 256>& counts) {
+  if (projection_.warps() && map_.empty()) {  // nearest pinhole pixel per output pixel, as integers
+    cv::Mat unused;
+    cv::convertMaps(projection_.mapX(), projection_.mapY(), map_, unused, CV_16SC2, true);
+    source_rows_ = sourceRows(projection_.mapY(), projection_.pinhole().height);
+  }
+  // The labels at the nearest pinhole pixel of each output pixel (0 outside the pinhole image)
+  // and the pixels per label, in runs of rows (rows reading only unlabelled pinhole rows are
+  // cleared and counted as background).
+  counts.fill(0);
+  std::mutex counts_mutex;
+  auto count = [&](const cv::Mat& rows) {
+    std::array<std::array<int, 256>, 4> local{};  // four histograms: fewer store-to-load stalls
+    for (int v = 0; v < rows.rows; ++v) {
+      const uchar* row = rows.ptr<uchar>(v);
+      for (int u = 0; u < rows.cols; ++u) ++local[static_cast<std::size_t>(u & 3)][row[u]];
+    }
+    const std::lock_guard lock(counts_mutex);
+    for (const auto& h : local)
+      for (std::size_t k = 0; k < h.size(); ++k) counts[k] += h[k];
+  };
+  cv::Mat out;
+  if (projection_.warps()) {
+    warpByRows(pinhole_labels, out, map_, cv::Mat(), cv::INTER_NEAREST, source_rows_, [&](const cv::Mat& rows, bool warped) {
+      if (warped) {
+        count(rows);
+      } else {  // cleared: background
+        const std::lock_guard lock(counts_mutex);
+        counts[0] += rows.rows * rows.cols;
+      }
+    });
+  } else {
+    out = pinhole_labels;
+    cv::parallel_for_(cv::Range(0, out.rows), [&](const cv::Range& r) { count(out.rowRange(r.start, r.end)); });
+  }
+  return out;
+}
+
+}  // namespace kccd::render::detail

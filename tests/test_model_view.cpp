@@ -1,0 +1,239 @@
+// The model as the camera sees it (kccd/render/model_view.hpp) and the model's visual geometry
+// (kccd/render/visuals.hpp): the same images as the steps it joins (query, scene volumes,
+// renderer) taken one by one, each kind of request, and visuals placed at the state.
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "kccd/calib/camera.hpp"
+#include "kccd/checker.hpp"
+#include "kccd/render/model_view.hpp"
+#include "kccd/render/scene.hpp"
+#include "kccd/render/visuals.hpp"
+
+namespace {
+
+using namespace kccd;
+using namespace kccd::render;
+
+const std::string kData = KCCD_DATA_DIR;
+
+// The sample camera at a quarter of its size (320 x 180), as the golden images use it.
+calib::Camera smallCamera() {
+  calib::Camera c = calib::loadCamera(kData + "/demo_camera.yaml");
+  c.width = 320;
+  c.height = 180;
+  c.camera_matrix(0, 0) /= 4;
+  c.camera_matrix(1, 1) /= 4;
+  c.camera_matrix(0, 2) = (c.camera_matrix(0, 2) + 0.5) / 4 - 0.5;
+  c.camera_matrix(1, 2) = (c.camera_matrix(1, 2) + 0.5) / 4 - 0.5;
+  return c;
+}
+
+bool sameImage(const cv::Mat& a, const cv::Mat& b) {
+  return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+}
+
+class ModelViewTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { model_ = new Model(loadModel(kData + "/demo_arm.yaml")); }
+  static void TearDownTestSuite() { delete model_; }
+  static Model* model_;
+};
+Model* ModelViewTest::model_ = nullptr;
+
+TEST_F(ModelViewTest, StateDrawsWhatTheStepsDraw) {
+  const Model& m = *model_;
+  const std::vector<double> q = {0.3, 0.4, 0.6};
+  ModelView view(m, smallCamera());
+  ModelViewRequest request;
+  request.state = q;
+  request.style.labels = true;
+  const ModelFrame f = view.draw(request);
+
+  Checker checker(m);
+  const QueryResult& r = checker.query(q, q, QueryOptions{.type = QueryType::Distances, .tight_volumes = true});
+  Renderer renderer(smallCamera());
+  const Frame expected =
+      renderer.render(staticSceneVolumes(m, checker, q, bodyStatus(m, r)), Style{.labels = true}, true, true);
+  ASSERT_TRUE(f.query.has_value());
+  EXPECT_EQ(f.query->status, Status::Ok);
+  EXPECT_EQ(f.query->min_distance, r.min_distance);
+  EXPECT_EQ(f.status, bodyStatus(m, r));
+  EXPECT_EQ(f.distances, bodyDistances(m, r));
+  EXPECT_EQ(f.first_visual, m.bodies.size());
+  EXPECT_TRUE(sameImage(f.images.bgra, expected.bgra));
+  EXPECT_TRUE(sameImage(f.images.mask, expected.mask));
+  EXPECT_EQ(f.images.pixels, expected.pixels);
+  EXPECT_EQ(f.images.visibility, expected.visibility);
+  EXPECT_GT(cv::countNonZero(f.images.mask), 1000);
+}
+
+TEST_F(ModelViewTest, BoxDrawsTheSweptVolumes) {
+  const Model& m = *model_;
+  const std::vector<double> lo = {-0.5, 0.0, 0.0}, hi = {0.5, 0.1, 0.2};
+  ModelView view(m, smallCamera());
+  ModelViewRequest request;
+  request.lower = lo;
+  request.upper = hi;
+  request.colour = false;
+  const ModelFrame f = view.draw(request);
+  EXPECT_TRUE(f.images.bgra.empty());
+
+  Checker checker(m);
+  const QueryResult& r = checker.query(lo, hi, QueryOptions{.type = QueryType::Distances, .tight_volumes = true});
+  Renderer renderer(smallCamera());
+  const Frame expected = renderer.render(sceneVolumes(m, checker, bodyStatus(m, r)), Style{}, false, true);
+  EXPECT_TRUE(sameImage(f.images.mask, expected.mask));
+  EXPECT_EQ(f.images.pixels, expected.pixels);
+  EXPECT_EQ(f.status, bodyStatus(m, r));
+  // A swept box covers more than the static volumes at one of its corners.
+  request = ModelViewRequest{};
+  request.state = lo;
+  request.colour = false;
+  EXPECT_GT(cv::countNonZero(f.images.mask), cv::countNonZero(view.draw(request).images.mask));
+}
+
+TEST_F(ModelViewTest, WithoutAStateOnlyTheFixedBodiesAreDrawnGrey) {
+  const Model& m = *model_;
+  ModelView view(m, smallCamera());
+  const ModelFrame f = view.draw(ModelViewRequest{});
+  EXPECT_FALSE(f.query.has_value());
+  EXPECT_TRUE(f.distances.empty());
+  ASSERT_EQ(f.images.visibility.size(), m.bodies.size());
+  for (std::size_t i = 0; i < m.bodies.size(); ++i) {
+    EXPECT_EQ(f.status[i], SafetyStatus::NoState);
+    if (m.bodies[i].frame == kWorld) {
+      EXPECT_EQ(f.images.visibility[i], Visibility::Drawn) << m.bodies[i].name;
+      EXPECT_GT(f.images.pixels[i], 0) << m.bodies[i].name;
+    } else {
+      EXPECT_EQ(f.images.visibility[i], Visibility::Empty) << m.bodies[i].name;
+      EXPECT_EQ(f.images.pixels[i], 0) << m.bodies[i].name;
+    }
+  }
+}
+
+TEST_F(ModelViewTest, GivenStatusesAndColoursColourTheVolumes) {
+  const Model& m = *model_;
+  const std::vector<double> q = {0.3, 0.4, 0.6};
+  ModelView view(m, smallCamera());
+  const std::vector<SafetyStatus> colliding(m.bodies.size(), SafetyStatus::Colliding);
+  ModelViewRequest request;
+  request.state = q;
+  request.status = colliding;
+  request.style.legend = false;
+  const ModelFrame f = view.draw(request);
+  EXPECT_EQ(f.status, colliding);
+  ASSERT_TRUE(f.query.has_value());
+  EXPECT_EQ(f.query->status, Status::Ok);  // the query still ran
+
+  Checker checker(m);
+  checker.query(q, q, QueryOptions{.type = QueryType::Distances, .tight_volumes = true});
+  Renderer renderer(smallCamera());
+  const Frame expected = renderer.render(staticSceneVolumes(m, checker, q, colliding), Style{.legend = false}, true, true);
+  EXPECT_TRUE(sameImage(f.images.bgra, expected.bgra));
+
+  // One colour for every body, thinner volumes: fewer pixels, and the volumes' pixels in that hue.
+  const std::vector<cv::Scalar> blue(m.bodies.size(), cv::Scalar(255, 0, 0));
+  request.colours = blue;
+  request.radius_scale = 0.5;
+  request.style.fill_alpha = 1.0;
+  const ModelFrame thin = view.draw(request);
+  EXPECT_LT(cv::countNonZero(thin.images.mask), cv::countNonZero(f.images.mask));
+  int blue_pixels = 0, other = 0;
+  for (int y = 0; y < thin.images.bgra.rows; ++y)
+    for (int x = 0; x < thin.images.bgra.cols; ++x) {
+      const cv::Vec4b px = thin.images.bgra.at<cv::Vec4b>(y, x);
+      if (px[3] != 255) continue;  // outlines are darker, edges translucent
+      (px[0] > 200 && px[1] < 60 && px[2] < 60 ? blue_pixels : other) += 1;
+    }
+  EXPECT_GT(blue_pixels, 500);
+  EXPECT_GT(blue_pixels, 4 * other);
+
+  request.status = std::span<const SafetyStatus>(colliding.data(), 2);
+  EXPECT_THROW(view.draw(request), std::invalid_argument);
+}
+
+TEST_F(ModelViewTest, VisualsArePlacedAtTheState) {
+  Model m = *model_;
+  const int upper_arm = 4;
+  ASSERT_EQ(m.bodies[upper_arm].name, "upper_arm");
+  Visual box;
+  box.frame = m.bodies[upper_arm].frame;
+  box.shape = Visual::Shape::Box;
+  box.size = Vec3(0.3, 0.06, 0.06);  // inside the upper arm's volume (segment 0..0.4 m along x, radius 0.055 m)
+  box.origin = Pose(Eigen::Translation3d(0.2, 0, 0));
+  box.colour = {0.0, 0.0, 1.0, 1.0};  // blue (RGBA)
+  m.visuals.push_back(box);
+  const std::vector<LoadedVisual> visuals = loadVisuals(m);
+  ASSERT_EQ(visuals.size(), 1u);
+  EXPECT_EQ(visuals[0].label, upper_arm + 1);  // the mask label of the body in its frame
+  EXPECT_EQ(visuals[0].colour, cv::Scalar(255, 0, 0));  // BGR
+  ASSERT_TRUE(visuals[0].mesh);
+  EXPECT_EQ(visuals[0].mesh->triangles.size(), 12u);
+
+  ModelView view(m, smallCamera(), RenderOptions{}, visuals);
+  const std::vector<double> q = {0.3, 0.4, 0.6};
+  ModelViewRequest request;
+  request.state = q;
+  request.volumes = false;
+  request.visuals = true;
+  request.colour = false;
+  const ModelFrame f = view.draw(request);
+  EXPECT_EQ(f.first_visual, 0u);
+  ASSERT_EQ(f.images.visibility.size(), 1u);
+  EXPECT_EQ(f.images.visibility[0], Visibility::Drawn);
+  const int pixels = f.images.pixels[0];
+  EXPECT_GT(pixels, 50);
+  EXPECT_EQ(cv::countNonZero(f.images.mask == upper_arm + 1), pixels);
+  EXPECT_EQ(cv::countNonZero(f.images.mask), pixels);
+  // The box lies inside the upper arm's volume: within the volumes' pixels.
+  request.volumes = true;
+  const ModelFrame both = view.draw(request);
+  EXPECT_EQ(both.first_visual, m.bodies.size());
+  ASSERT_EQ(both.images.visibility.size(), m.bodies.size() + 1);
+  request.visuals = false;
+  const cv::Mat volumes = view.draw(request).images.mask != 0;
+  EXPECT_EQ(cv::countNonZero((f.images.mask != 0) & ~volumes), 0);
+  EXPECT_EQ(cv::countNonZero(both.images.mask != 0), cv::countNonZero(volumes));
+  request.visuals = true;
+  // Another state moves the box with its frame.
+  const std::vector<double> q2 = {-0.6, 0.4, 0.6};
+  request.state = q2;
+  request.volumes = false;
+  const ModelFrame moved = view.draw(request);
+  EXPECT_GT(cv::countNonZero(moved.images.mask != f.images.mask), pixels / 2);
+  // Without a state, no visuals.
+  request.state = {};
+  EXPECT_EQ(view.draw(request).images.visibility.size(), 0u);
+}
+
+TEST(RenderVisuals, AMeshFileThatCannotBeReadNamesTheVisual) {
+  Model m = loadModel(kData + "/demo_arm.yaml");
+  Visual v;
+  v.shape = Visual::Shape::Mesh;
+  v.mesh = "/nonexistent/kccd_part.stl";
+  m.visuals.push_back(v);
+  try {
+    loadVisuals(m);
+    FAIL() << "no error";
+  } catch (const VisualError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("visuals[0]: ", 0), 0u) << what;
+    EXPECT_NE(what.find("kccd_part.stl"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+  // An invalid state places nothing.
+  const std::vector<double> wrong = {0.1};
+  m.visuals[0].shape = Visual::Shape::Sphere;
+  m.visuals[0].size = Vec3(0.1, 0.1, 0.1);
+  EXPECT_TRUE(visualVolumes(m, loadVisuals(m), wrong).empty());
+  EXPECT_EQ(visualVolumes(m, loadVisuals(m), std::vector<double>{0.1, 0.2, 0.3}).size(), 1u);
+}
+
+}  // namespace
