@@ -52,11 +52,8 @@ Exit runRender(const RenderArgs& args) {
   std::unique_ptr<render::Renderer> renderer;
   try {
     renderer = std::make_unique<render::Renderer>(camera, options);
-  } catch (const calib::CameraError& e) {
-    // Messages of the projection name the camera as "camera: field: problem".
-    std::string msg = e.what();
-    if (msg.rfind("camera: ", 0) == 0) msg = msg.substr(8);
-    throw UsageError(args.camera + ": " + msg);
+  } catch (const calib::CameraError& e) {  // the projection calls the camera "camera": name its file
+    throw UsageError(e.messageFrom(args.camera));
   }
   render::Style style;
   style.labels = args.labels;
