@@ -281,6 +281,58 @@ TEST(CalibCamera, BoundsWhatTheRendererCanDraw) {
 }
 
 // The pose quality figures calibration writes travel through the file; absent means unknown.
+// The CameraError of loading `text` from a file named `name`, with its location as data.
+CameraError cameraError(const std::string& name, const std::string& text) {
+  try {
+    loadCamera(writeTemp(name, text));
+  } catch (const CameraError& e) {
+    return e;
+  }
+  ADD_FAILURE() << name << " loaded";
+  return CameraError("none");
+}
+
+TEST(CalibCamera, ErrorsCarryTheirLocationAsData) {
+  const std::string path = ::testing::TempDir() + "/kccd_cam_where.yaml";
+  const CameraError field = cameraError("kccd_cam_where.yaml", cameraText("image_width", "image_width: -5\n"));
+  EXPECT_EQ(field.location().source, path);
+  EXPECT_EQ(field.location().line, 0u);  // OpenCV's nodes have no place
+  EXPECT_EQ(field.location().field, "image_width");
+  EXPECT_EQ(field.problem(), "-5 is not in 1..8192");
+  EXPECT_EQ(std::string(field.what()), path + ": image_width: -5 is not in 1..8192");
+  // The text checks know the line; the YAML pre-check the line and the column.
+  const CameraError header = cameraError("kccd_cam_where.yaml", "image_width: 320\n");
+  EXPECT_EQ(header.location().line, 1u);
+  EXPECT_EQ(header.location().column, 0u);
+  EXPECT_EQ(header.location().field, "header");
+  const CameraError dup = cameraError("kccd_cam_where.yaml", cameraText() + "image_width: 640\n");
+  EXPECT_GT(dup.location().line, 2u);
+  EXPECT_EQ(dup.location().column, 1u);
+  EXPECT_EQ(dup.location().field, "image_width");
+  // The file itself: field "file".
+  const CameraError missing = [] {
+    try {
+      loadCamera("/nonexistent/cam.yaml");
+    } catch (const CameraError& e) {
+      return e;
+    }
+    return CameraError("none");
+  }();
+  EXPECT_EQ(missing.location().source, "/nonexistent/cam.yaml");
+  EXPECT_EQ(missing.location().field, "file");
+  EXPECT_EQ(missing.problem(), "cannot open the camera file (no such file)");
+  // validate() names what it is given: a caller shows its own name for it from the data.
+  Camera bad = loadCamera(kData + "/demo_camera.yaml");
+  bad.width = 0;
+  try {
+    bad.validate("camera");
+    ADD_FAILURE();
+  } catch (const CameraError& e) {
+    EXPECT_STREQ(e.what(), "camera: image_width: not in 1..8192");
+    EXPECT_EQ(e.messageFrom("studio.yaml"), "studio.yaml: image_width: not in 1..8192");
+  }
+}
+
 TEST(CalibCamera, QualityFiguresRoundTrip) {
   std::mt19937_64 rng(7);
   Camera c = randomCamera(rng, true);

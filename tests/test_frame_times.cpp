@@ -71,5 +71,18 @@ TEST(FrameTimes, FilesAreRegularAndBounded) {
   std::filesystem::remove_all(dir);
 }
 
+// The frame-times reader fills the error's location as data (line, column, field), as every table reader does.
+TEST(FrameTimesFile, ErrorsCarryLineColumnAndField) {
+  try {
+    (void)parseFrameTimes("frame,time\n0,0\n1,x\n", "t.csv");
+    ADD_FAILURE();
+  } catch (const FrameTimesError& e) {
+    EXPECT_STREQ(e.what(), "t.csv:3:3: column 'time': not a finite number: 'x'");
+    EXPECT_EQ(e.location().line, 3u);
+    EXPECT_EQ(e.location().column, 3u);
+    EXPECT_EQ(e.location().field, "column 'time'");
+  }
+}
+
 }  // namespace
 }  // namespace kccd::overlay

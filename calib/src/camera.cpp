@@ -4,13 +4,13 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
-#include <sstream>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
+#include "kccd/file_reader.hpp"
+#include "kccd/format_number.hpp"
 #include "kccd/yaml_document.hpp"
-#include "yaml_input.hpp"
 
 namespace kccd::calib {
 namespace {
@@ -19,22 +19,20 @@ constexpr int kDistortionSizes[] = {4, 5, 8, 12, 14};
 constexpr int kMaxMatrixSide = 16;  // rows, cols of a matrix in a camera file
 
 [[noreturn]] void fail(const std::string& source, const std::string& field, const std::string& problem) {
-  throw CameraError(source + ": " + field + ": " + problem);
+  throw CameraError(InputLocation{source, 0, 0, field}, problem);
 }
 
 [[noreturn]] void failAt(const std::string& source, std::size_t line, const std::string& field,
                          const std::string& problem) {
-  throw CameraError(source + ":" + std::to_string(line) + ": " + field + ": " + problem);
+  throw CameraError(InputLocation{source, line, 0, field}, problem);
 }
 
 // The whole file (a bounded regular file, never blocking on a FIFO or device), errors as CameraError.
 std::string readCameraFile(const std::string& path) {
   try {
-    return detail::readInputFile(path, kMaxCameraFileBytes, "camera file");
-  } catch (const CameraError&) {
-    throw;
-  } catch (const InputError& e) {
-    throw CameraError(e.what());
+    return readRegularFile(path, kMaxCameraFileBytes, "camera file");
+  } catch (const FileError& e) {
+    throw CameraError(e.location(), e.problem());
   }
 }
 
@@ -78,7 +76,7 @@ void checkCameraText(const std::string& text, const std::string& path) {
   try {
     checkYamlDocument(yaml, path);
   } catch (const InputError& e) {
-    throw CameraError(e.what());
+    throw CameraError(e.location(), e.problem());
   }
 }
 
@@ -163,12 +161,6 @@ cv::Vec3d readVec3(const cv::FileStorage& fs, const std::string& source, const c
   return {m.at<double>(0), m.at<double>(1), m.at<double>(2)};
 }
 
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 }  // namespace
 
 // Normalised coordinates of the pixel centres `pixels` (n x 1, CV_64FC2) through the inverse of
@@ -228,25 +220,29 @@ void Camera::validate(const std::string& source) const {
   if (k(1, 0) != 0.0 || k(2, 0) != 0.0 || k(2, 1) != 0.0 || k(2, 2) != 1.0)
     fail(source, "camera_matrix", "must have the form [fx 0 cx; 0 fy cy; 0 0 1]");
   if (k(0, 0) < 1.0 || k(0, 0) > kMaxFocal || k(1, 1) < 1.0 || k(1, 1) > kMaxFocal)
-    fail(source, "camera_matrix", "focal lengths fx " + num(k(0, 0)) + ", fy " + num(k(1, 1)) + " must be in 1.." + num(kMaxFocal) + " px");
+    fail(source, "camera_matrix",
+         "focal lengths fx " + formatNumber(k(0, 0), 6) + ", fy " + formatNumber(k(1, 1), 6) + " must be in 1.." +
+             formatNumber(kMaxFocal, 6) + " px");
   if (k(0, 2) < -width || k(0, 2) > 2.0 * width || k(1, 2) < -height || k(1, 2) > 2.0 * height)
-    fail(source, "camera_matrix", "principal point (" + num(k(0, 2)) + ", " + num(k(1, 2)) +
-                                      ") must lie within one image size of the image (cx in -width..2 width, cy in -height..2 height)");
+    fail(source, "camera_matrix",
+         "principal point (" + formatNumber(k(0, 2), 6) + ", " + formatNumber(k(1, 2), 6) +
+             ") must lie within one image size of the image (cx in -width..2 width, cy in -height..2 height)");
   if (!std::count(std::begin(kDistortionSizes), std::end(kDistortionSizes), static_cast<int>(distortion.size())))
     fail(source, "distortion_coefficients", "needs 4, 5, 8, 12 or 14 values, has " + std::to_string(distortion.size()));
   for (std::size_t i = 0; i < distortion.size(); ++i) {
     if (!std::isfinite(distortion[i])) fail(source, "distortion_coefficients", "non-finite value");
     const double bound = i >= 12 ? 1.0 : kMaxDistortion;  // tilt angles tx, ty in radians
     if (std::abs(distortion[i]) > bound)
-      fail(source, "distortion_coefficients", "coefficient " + std::to_string(i) + " = " + num(distortion[i]) + " is out of range (|k|, |p|, |s| <= " +
-                                                  num(kMaxDistortion) + ", tilt |tx|, |ty| <= 1 rad)");
+      fail(source, "distortion_coefficients",
+           "coefficient " + std::to_string(i) + " = " + formatNumber(distortion[i], 6) +
+               " is out of range (|k|, |p|, |s| <= " + formatNumber(kMaxDistortion, 6) + ", tilt |tx|, |ty| <= 1 rad)");
   }
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(rvec[i])) fail(source, "rvec", "non-finite value");
     if (!std::isfinite(tvec[i])) fail(source, "tvec", "non-finite value");
   }
   if (cv::norm(rvec) > 100.0) fail(source, "rvec", "longer than 100 (its length is the rotation angle in radians)");
-  if (cv::norm(tvec) > kMaxTranslation) fail(source, "tvec", "farther than " + num(kMaxTranslation) + " m");
+  if (cv::norm(tvec) > kMaxTranslation) fail(source, "tvec", "farther than " + formatNumber(kMaxTranslation, 6) + " m");
   if (!distorted()) return;
   // The renderer inverts the distortion model at every pixel and draws a pinhole image widened
   // to cover the distorted frame: the border decides both (cheap: 2 (w + h) pixels).
@@ -260,7 +256,8 @@ void Camera::validate(const std::string& source) const {
   for (std::size_t i = 0; i < border.size(); ++i) {
     if (!valid[i])
       fail(source, "distortion_coefficients",
-           "the lens model cannot be inverted at image pixel (" + num(border[i][0]) + ", " + num(border[i][1]) +
+           "the lens model cannot be inverted at image pixel (" + formatNumber(border[i][0], 6) + ", " +
+               formatNumber(border[i][1], 6) +
                ") within one image size of extra field: distortion too strong for this image");
     const cv::Vec2d p = normal.at<cv::Vec2d>(static_cast<int>(i));
     xmin = std::min(xmin, p[0]), xmax = std::max(xmax, p[0]);
@@ -269,8 +266,8 @@ void Camera::validate(const std::string& source) const {
   const double w = (xmax - xmin) * k(0, 0) + 5, h = (ymax - ymin) * k(1, 1) + 5;
   if (w > kMaxPinholeSide || h > kMaxPinholeSide)
     fail(source, "distortion_coefficients",
-         "the undistorted image covering this lens would need " + num(std::ceil(w)) + "x" + num(std::ceil(h)) +
-             " pixels, more than " + std::to_string(kMaxPinholeSide) + " a side");
+         "the undistorted image covering this lens would need " + formatNumber(std::ceil(w), 6) + "x" +
+             formatNumber(std::ceil(h), 6) + " pixels, more than " + std::to_string(kMaxPinholeSide) + " a side");
 }
 
 Camera loadCamera(const std::string& path, CameraPose pose) {

@@ -3,14 +3,12 @@
 #include <png.h>
 
 #include <cstring>
-#include <filesystem>
 #include <memory>
-#include <system_error>
 
 #include <opencv2/imgcodecs.hpp>
 
 #include "kccd/calib/camera.hpp"
-#include "yaml_input.hpp"
+#include "kccd/file_reader.hpp"
 
 namespace kccd::calib {
 
@@ -38,7 +36,9 @@ std::string pngProblem(std::span<const std::uint8_t> bytes) {
 }  // namespace
 
 cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& source, ImageColour colour) {
-  const auto fail = [&](const std::string& problem) { throw ImageError(source + ": image: " + problem); };
+  const auto fail = [&](const std::string& problem) {
+    throw ImageError(InputLocation{source, 0, 0, "image"}, problem);
+  };
   if (bytes.empty()) fail("empty file");
   static constexpr std::uint8_t kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   if (bytes.size() >= 8 && std::memcmp(bytes.data(), kPngSignature, 8) == 0) {
@@ -62,18 +62,20 @@ cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& sour
 }
 
 cv::Mat readImageFile(const std::string& path, ImageColour colour) {
-  std::error_code ec;
-  const std::filesystem::file_status st = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(st)) throw ImageError(path + ": image: no such file");
-  if (!std::filesystem::is_regular_file(st)) throw ImageError(path + ": image: not a regular file");
   std::string bytes;
   try {
-    bytes = detail::readInputFile(path, kMaxImageFileBytes, "image");
-  } catch (const InputError& e) {  // "path: file: problem"
-    std::string msg = e.what();
-    const std::size_t at = msg.find(": file: ", path.size());
-    if (at != std::string::npos) msg.replace(at, 8, ": image: ");
-    throw ImageError(msg);
+    bytes = readRegularFile(path, kMaxImageFileBytes, "image");
+  } catch (const FileError& e) {  // said as "path: image: problem"
+    const InputLocation where{path, 0, 0, "image"};
+    switch (e.kind()) {
+      case FileProblem::Missing:
+        throw ImageError(where, "no such file");
+      case FileProblem::Directory:
+      case FileProblem::NotRegular:
+        throw ImageError(where, "not a regular file");
+      default:
+        throw ImageError(where, e.problem());
+    }
   }
   return decodeImage({reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()}, path, colour);
 }

@@ -8,17 +8,13 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "kccd/format_number.hpp"
+
 namespace kccd::calib {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kPlaneTolerance = 1e-3;  // of the board's extent
-
-std::string num(double v, int digits = 3) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
 
 std::string plural(std::size_t n, const char* word) {
   return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
@@ -114,15 +110,15 @@ const char* const kAddViews =
 
 Board Board::grid(const TagGrid& g) {
   const auto fail = [](const std::string& field, const std::string& problem) {
-    throw InputError("grid: " + field + ": " + problem);
+    throw InputError(InputLocation{"grid", 0, 0, field}, problem);
   };
   if (g.cols < 1 || g.cols > kMaxTagId + 1) fail("cols", std::to_string(g.cols) + " is not in 1.." + std::to_string(kMaxTagId + 1));
   if (g.rows < 1 || g.rows > kMaxTagId + 1) fail("rows", std::to_string(g.rows) + " is not in 1.." + std::to_string(kMaxTagId + 1));
   if (g.cols * g.rows < 2) fail("size", "a board needs at least 2 tags (a view needs 8 corners)");
   if (!std::isfinite(g.tag_size) || !(g.tag_size > 0) || g.tag_size > kMaxTagSize)
-    fail("tag size", num(g.tag_size) + " m is not in (0, " + num(kMaxTagSize) + "]");
+    fail("tag size", formatNumber(g.tag_size, 3) + " m is not in (0, " + formatNumber(kMaxTagSize, 3) + "]");
   if (!std::isfinite(g.spacing) || g.spacing < 0 || g.spacing > kMaxTagSize)
-    fail("spacing", num(g.spacing) + " m is not in [0, " + num(kMaxTagSize) + "]");
+    fail("spacing", formatNumber(g.spacing, 3) + " m is not in [0, " + formatNumber(kMaxTagSize, 3) + "]");
   if (g.first_id < 0 || g.first_id > kMaxTagId) fail("first id", std::to_string(g.first_id) + " is not in 0.." + std::to_string(kMaxTagId));
   const int last = g.first_id + g.cols * g.rows - 1;
   if (last > kMaxTagId)
@@ -151,8 +147,9 @@ Board Board::fromLayout(const TagLayout& layout, const std::string& source) {
   Plane plane = fitPlane(corners);
   if (plane.max_offset > kPlaneTolerance * plane.extent) {
     const Tag& t = layout.tags[plane.worst / 4];
-    throw TagLayoutError(source + ": tags: tag " + std::to_string(t.id) + " is " + num(plane.max_offset) +
-                         " m off the plane of the other tags: a calibration board must be flat (all tags in one plane)");
+    throw TagLayoutError(
+        source + ": tags: tag " + std::to_string(t.id) + " is " + formatNumber(plane.max_offset, 3) +
+        " m off the plane of the other tags: a calibration board must be flat (all tags in one plane)");
   }
   const Vec3 z0 = layout.tags.front().pose().linear().col(2);
   for (const Tag& t : layout.tags) {
@@ -259,8 +256,9 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
   const Plane plane = fitPlane(all);
   if (plane.max_offset > kPlaneTolerance * plane.extent) {
     result.status = IntrinsicsStatus::NotPlanar;
-    result.message = "the board points lie up to " + num(plane.max_offset) + " m off one plane (board extent " +
-                     num(plane.extent) + " m): intrinsics need a flat board with all tags in one plane";
+    result.message = "the board points lie up to " + formatNumber(plane.max_offset, 3) +
+                     " m off one plane (board extent " + formatNumber(plane.extent, 3) +
+                     " m): intrinsics need a flat board with all tags in one plane";
     reject_unused();
     return result;
   }
@@ -305,10 +303,11 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
   }
   const auto fronto = [&](double largest) {
     result.status = IntrinsicsStatus::FrontoParallel;
-    result.message = "every view sees the board nearly face-on (largest tilt " + num(largest, 2) + " deg, at least " +
-                     num(options.min_tilt_deg, 3) +
-                     " needed): tilt the board 20-45 deg towards the camera about different axes (left/right and up/down) in "
-                     "several views";
+    result.message =
+        "every view sees the board nearly face-on (largest tilt " + formatNumber(largest, 2) + " deg, at least " +
+        formatNumber(options.min_tilt_deg, 3) +
+        " needed): tilt the board 20-45 deg towards the camera about different axes (left/right and up/down) in "
+        "several views";
     reject_unused();
     return result;
   };
@@ -349,13 +348,15 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
     if (in.size() <= need) {
       for (std::size_t i : in) result.views[i].used = true;
       result.status = IntrinsicsStatus::IllConditioned;
-      result.message = "view " + printable(w.name) + " does not fit the others (RMS " + num(w.rms_px) + " px, median " +
-                       num(med) + " px) and no view can be spared: retake it or " + kAddViews;
+      result.message = "view " + printable(w.name) + " does not fit the others (RMS " + formatNumber(w.rms_px, 3) +
+                       " px, median " + formatNumber(med, 3) + " px) and no view can be spared: retake it or " +
+                       kAddViews;
       reject_unused();
       return result;
     }
-    result.views[in[worst]].note =
-        "outlier: RMS " + num(w.rms_px) + " px, more than " + num(limit) + " px (the other views' median " + num(med) + " px)";
+    result.views[in[worst]].note = "outlier: RMS " + formatNumber(w.rms_px, 3) + " px, more than " +
+                                   formatNumber(limit, 3) + " px (the other views' median " + formatNumber(med, 3) +
+                                   " px)";
     in.erase(in.begin() + static_cast<std::ptrdiff_t>(worst));
   }
   for (std::size_t i : in) result.views[i].used = true;
@@ -402,7 +403,8 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
   std::string weak;
   const auto known = [&](const char* name, double sigma, double value) {
     if (!std::isfinite(sigma)) return std::string(name) + " is not determined by these views";
-    return std::string(name) + " " + num(value, 5) + " is known only to +-" + num(sigma * scale) + " px";
+    return std::string(name) + " " + formatNumber(value, 5) + " is known only to +-" + formatNumber(sigma * scale, 3) +
+           " px";
   };
   if (!(result.sigmas.fx * scale <= options.max_focal_sigma_ratio * fx)) weak = known("fx", result.sigmas.fx, fx);
   else if (!(result.sigmas.fy * scale <= options.max_focal_sigma_ratio * fy)) weak = known("fy", result.sigmas.fy, fy);
@@ -412,7 +414,8 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
     weak = known("cy", result.sigmas.cy, cam.camera_matrix(1, 2));
   if (!weak.empty()) {
     result.status = IntrinsicsStatus::IllConditioned;
-    result.message = weak + " (at " + num(std::max(rms, options.noise_floor_px), 2) + " px noise): " + kAddViews;
+    result.message =
+        weak + " (at " + formatNumber(std::max(rms, options.noise_floor_px), 2) + " px noise): " + kAddViews;
     return result;
   }
   try {
@@ -423,10 +426,12 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
     return result;
   }
   result.status = IntrinsicsStatus::Solved;
-  result.message = "solved from " + std::to_string(in.size()) + " of " + plural(n, "view") + ": RMS " + num(rms) + " px, fx " +
-                   num(fx, 6) + " +- " + num(result.sigmas.fx, 2) + ", fy " + num(fy, 6) + " +- " + num(result.sigmas.fy, 2) +
-                   ", cx " + num(cam.camera_matrix(0, 2), 5) + " +- " + num(result.sigmas.cx, 2) + ", cy " +
-                   num(cam.camera_matrix(1, 2), 5) + " +- " + num(result.sigmas.cy, 2) + " px";
+  result.message = "solved from " + std::to_string(in.size()) + " of " + plural(n, "view") + ": RMS " +
+                   formatNumber(rms, 3) + " px, fx " + formatNumber(fx, 6) + " +- " +
+                   formatNumber(result.sigmas.fx, 2) + ", fy " + formatNumber(fy, 6) + " +- " +
+                   formatNumber(result.sigmas.fy, 2) + ", cx " + formatNumber(cam.camera_matrix(0, 2), 5) + " +- " +
+                   formatNumber(result.sigmas.cx, 2) + ", cy " + formatNumber(cam.camera_matrix(1, 2), 5) + " +- " +
+                   formatNumber(result.sigmas.cy, 2) + " px";
   return result;
 }
 

@@ -4,8 +4,9 @@
 
 #include <map>
 
+#include "kccd/file_reader.hpp"
 #include "kccd/kinematics.hpp"
-#include "yaml_input.hpp"
+#include "kccd/yaml_reader.hpp"
 
 namespace kccd::calib {
 
@@ -16,7 +17,7 @@ const Label* Labels::find(const std::string& name) const {
 }
 
 Labels parseLabels(const std::string& yaml_text, const std::string& source) {
-  const detail::YamlReader<LabelsError> r(source);
+  const YamlReader r(source, 40);
   try {
     const YAML::Node root = r.load(yaml_text);
     if (!root.IsMap()) r.fail(root, "labels", "expected a mapping with labels: [...]");
@@ -65,17 +66,19 @@ Labels parseLabels(const std::string& yaml_text, const std::string& source) {
     return out;
   } catch (const LabelsError&) {
     throw;
+  } catch (const InputError& e) {
+    throw LabelsError(e.location(), e.problem());
   } catch (const YAML::Exception& e) {
-    throw LabelsError(source + ": yaml: " + printable(e.what(), 100));
+    throw LabelsError(InputLocation{source, 0, 0, "yaml"}, printable(e.what(), 100));
   }
 }
 
 Labels loadLabels(const std::string& path) {
   std::string text;
   try {
-    text = detail::readInputFile(path, kMaxLabelsBytes, "labels file");
-  } catch (const InputError& e) {
-    throw LabelsError(e.what());
+    text = readRegularFile(path, kMaxLabelsBytes, "labels file");
+  } catch (const FileError& e) {
+    throw LabelsError(e.location(), e.problem());
   }
   return parseLabels(text, path);
 }

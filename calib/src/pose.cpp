@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <random>
 #include <unordered_set>
 
 #include <opencv2/calib3d.hpp>
+
+#include "kccd/format_number.hpp"
 
 namespace kccd::calib {
 namespace {
@@ -16,12 +17,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr std::size_t kMaxTriples = 2000;  // P3P samples; fewer triples than this are all tried
 constexpr std::size_t kMinTriples = 200;   // sampled triples tried before the adaptive stop
-
-std::string num(double v, int digits = 3) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
 
 // Singular values (descending, RMS-scaled) and the direction of the smallest of centred points.
 struct Spread {
@@ -156,7 +151,7 @@ std::string rejectedText(const std::vector<Correspondence>& pts, const std::vect
       break;
     }
     s += (shown++ ? ", " : "") + printable(pts[i].name, 40) + " (" +
-         (std::isfinite(res[i]) ? num(res[i]) + " px" : std::string("behind the camera")) + ")";
+         (std::isfinite(res[i]) ? formatNumber(res[i], 3) + " px" : std::string("behind the camera")) + ")";
   }
   return s;
 }
@@ -328,8 +323,8 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   const auto tooFewInliers = [&](int count, const std::vector<double>& res, const std::vector<char>& in) {
     result.status = PoseStatus::TooFewInliers;
     result.message = "only " + std::to_string(count) + " of " + std::to_string(n) +
-                     " points agree on one pose within " + num(options.ransac_threshold_px) + " px, at least " +
-                     std::to_string(need) + " needed: check the labels or add points";
+                     " points agree on one pose within " + formatNumber(options.ransac_threshold_px, 3) +
+                     " px, at least " + std::to_string(need) + " needed: check the labels or add points";
     if (!res.empty()) {
       fillResiduals(res, in);
       result.message += " (outside: " + rejectedText(points, res, in) + ")";
@@ -417,7 +412,8 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   cv::Mat w, u, vt;
   cv::SVD::compute(jtj, w, u, vt);
   const bool cond_ok = w.at<double>(5) > 1e-12 * w.at<double>(0);
-  const std::string at_noise = " at " + num(std::max(std::sqrt(sigma2), options.noise_floor_px)) + " px noise";
+  const std::string at_noise =
+      " at " + formatNumber(std::max(std::sqrt(sigma2), options.noise_floor_px), 3) + " px noise";
   if (!cond_ok) {
     result.status = PoseStatus::PoorGeometry;
     result.message =
@@ -459,8 +455,9 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
     }
   if (rot_gate > options.max_rotation_sigma_deg || pos_gate > options.max_position_sigma_ratio * distance) {
     result.status = PoseStatus::PoorGeometry;
-    result.message = "the points span only " + num(extent) + " deg of the view at " + num(distance) +
-                     " m: the pose is uncertain to " + num(rot_gate) + " deg and " + num(pos_gate) + " m" + at_noise +
+    result.message = "the points span only " + formatNumber(extent, 3) + " deg of the view at " +
+                     formatNumber(distance, 3) + " m: the pose is uncertain to " + formatNumber(rot_gate, 3) +
+                     " deg and " + formatNumber(pos_gate, 3) + " m" + at_noise +
                      "; add points spread wider (or closer to the camera)" + rejected;
     return result;
   }
@@ -488,8 +485,9 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
       const double e2 = sumSquares(pixelResiduals(cam, r2, t2, wi, pi));
       if ((e2 - sse_in) / gate2 < options.min_mirror_separation) {
         result.status = PoseStatus::PoorGeometry;
-        result.message = "a mirrored pose " + num(ang) + " deg away fits these nearly planar points almost as well" +
-                         at_noise + ": add points off their plane or spread wider across the view" + rejected;
+        result.message = "a mirrored pose " + formatNumber(ang, 3) +
+                         " deg away fits these nearly planar points almost as well" + at_noise +
+                         ": add points off their plane or spread wider across the view" + rejected;
         return result;
       }
     }
@@ -502,8 +500,9 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   result.camera.rotation_sigma_deg = rot_sigma;
   result.camera.position_sigma_m = pos_sigma;
   result.covariance = cov;
-  result.message = "solved with " + std::to_string(k) + " of " + std::to_string(n) + " points: RMS " + num(rms) +
-                   " px, rotation +-" + num(rot_sigma) + " deg, position +-" + num(pos_sigma) + " m" + rejected;
+  result.message = "solved with " + std::to_string(k) + " of " + std::to_string(n) + " points: RMS " +
+                   formatNumber(rms, 3) + " px, rotation +-" + formatNumber(rot_sigma, 3) + " deg, position +-" +
+                   formatNumber(pos_sigma, 3) + " m" + rejected;
   return result;
 }
 

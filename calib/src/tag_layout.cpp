@@ -4,8 +4,9 @@
 
 #include <cmath>
 
+#include "kccd/file_reader.hpp"
 #include "kccd/rotation.hpp"
-#include "yaml_input.hpp"
+#include "kccd/yaml_reader.hpp"
 
 namespace kccd::calib {
 
@@ -35,7 +36,7 @@ const Tag* TagLayout::find(int id) const {
 }
 
 TagLayout parseTagLayout(const std::string& yaml_text, const std::string& source) {
-  const detail::YamlReader<TagLayoutError> r(source);
+  const YamlReader r(source, 40);
   try {
     const YAML::Node root = r.load(yaml_text);
     if (!root.IsMap()) r.fail(root, "layout", "expected a mapping with tags: [...]");
@@ -70,17 +71,19 @@ TagLayout parseTagLayout(const std::string& yaml_text, const std::string& source
     return layout;
   } catch (const TagLayoutError&) {
     throw;
+  } catch (const InputError& e) {
+    throw TagLayoutError(e.location(), e.problem());
   } catch (const YAML::Exception& e) {
-    throw TagLayoutError(source + ": yaml: " + printable(e.what(), 100));
+    throw TagLayoutError(InputLocation{source, 0, 0, "yaml"}, printable(e.what(), 100));
   }
 }
 
 TagLayout loadTagLayout(const std::string& path) {
   std::string text;
   try {
-    text = detail::readInputFile(path, kMaxTagLayoutBytes, "tag layout");
-  } catch (const InputError& e) {
-    throw TagLayoutError(e.what());
+    text = readRegularFile(path, kMaxTagLayoutBytes, "tag layout");
+  } catch (const FileError& e) {
+    throw TagLayoutError(e.location(), e.problem());
   }
   return parseTagLayout(text, path);
 }

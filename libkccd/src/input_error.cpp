@@ -1,6 +1,6 @@
 #include "kccd/input_error.hpp"
 
-#include <cstdio>
+#include <utility>
 
 namespace kccd {
 namespace {
@@ -25,12 +25,34 @@ std::size_t utf8Length(std::string_view s, std::size_t i) {
   return n;
 }
 
+// A message: the location's text, then the problem.
+std::string joined(const std::string& where, const std::string& problem) {
+  return where.empty() ? problem : where + ": " + problem;
+}
+
 }  // namespace
 
-std::string messageNumber(double value, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, value);
-  return buf;
+std::string InputLocation::text() const {
+  std::string out = source;
+  if (line > 0) {
+    out.append(1, ':').append(std::to_string(line));
+    if (column > 0) out.append(1, ':').append(std::to_string(column));
+  }
+  if (!field.empty()) out.append(out.empty() ? "" : ": ").append(field);
+  return out;
+}
+
+InputError::InputError(const std::string& message)
+    : std::runtime_error(message), data_(std::make_shared<const Data>(Data{{}, message})) {}
+
+InputError::InputError(InputLocation where, const std::string& problem)
+    : std::runtime_error(joined(where.text(), problem)),
+      data_(std::make_shared<const Data>(Data{std::move(where), problem})) {}
+
+std::string InputError::messageFrom(std::string_view source) const {
+  InputLocation where = location();
+  where.source = source;
+  return joined(where.text(), problem());
 }
 
 bool isUtf8(std::string_view text) {

@@ -4,65 +4,19 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <set>
-#include <sstream>
 
+#include "kccd/file_reader.hpp"
 #include "kccd/model.hpp"
 #include "kccd/rotation.hpp"
-#include "kccd/yaml_document.hpp"
+#include "kccd/yaml_reader.hpp"
 
 namespace kccd {
 namespace {
 
-class Reader {
+// The model's own checks of a node, on top of the YAML reader's.
+class Reader : public YamlReader {
  public:
-  explicit Reader(std::string source) : source_(std::move(source)) {}
-
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& field, const std::string& what) const {
-    std::ostringstream msg;
-    msg << source_;
-    if (node.IsDefined() && node.Mark().line >= 0)
-      msg << ':' << node.Mark().line + 1 << ':' << node.Mark().column + 1;
-    msg << ": " << field << ": " << what;
-    throw ModelError(msg.str());
-  }
-
-  void onlyKeys(const YAML::Node& map, const std::string& field, std::initializer_list<const char*> keys) const {
-    if (!map.IsMap()) fail(map, field, "expected a mapping");
-    for (const auto& kv : map) {
-      const std::string k = kv.first.Scalar();
-      if (std::none_of(keys.begin(), keys.end(), [&](const char* allowed) { return k == allowed; }))
-        fail(kv.first, field + "." + printable(k, 40), "unknown field");
-    }
-  }
-
-  YAML::Node require(const YAML::Node& map, const char* key, const std::string& field, const YAML::Node& where) const {
-    YAML::Node n = map[key];
-    if (!n.IsDefined() || n.IsNull()) fail(where, field + "." + key, "required field is missing");
-    return n;
-  }
-
-  std::string text(const YAML::Node& n, const std::string& field) const {
-    if (!n.IsScalar()) fail(n, field, "expected a string");
-    if (n.Scalar().empty()) fail(n, field, "must not be empty");
-    for (const char c : n.Scalar())
-      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F) fail(n, field, "contains a control character: '" + printable(n.Scalar()) + "'");
-    if (!isUtf8(n.Scalar())) fail(n, field, "is not UTF-8 text: '" + printable(n.Scalar()) + "'");
-    return n.Scalar();
-  }
-
-  double number(const YAML::Node& n, const std::string& field) const {
-    if (!n.IsScalar()) fail(n, field, "expected a number");
-    double v = 0.0;
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      fail(n, field, "expected a number, got '" + printable(n.Scalar()) + "'");
-    }
-    if (!std::isfinite(v)) fail(n, field, "must be finite");
-    return v;
-  }
+  using YamlReader::YamlReader;
 
   // A length in metres: finite and within kMaxModelLength.
   double length(const YAML::Node& n, const std::string& field) const {
@@ -72,21 +26,12 @@ class Reader {
   }
 
   Vec3 point(const YAML::Node& n, const std::string& field) const {
-    const Vec3 v = vec3(n, field);
+    const Vec3 v = vec<3>(n, field);
     for (int k = 0; k < 3; ++k)
       if (std::abs(v[k]) > kMaxModelLength)
         fail(n[k], field + "[" + std::to_string(k) + "]", "beyond the largest length a model may give (1e6 m)");
     return v;
   }
-
-  Vec3 vec3(const YAML::Node& n, const std::string& field) const {
-    if (!n.IsSequence()) fail(n, field, "expected a list of 3 numbers");
-    if (n.size() != 3) fail(n, field, "expected 3 numbers, got " + std::to_string(n.size()));
-    return {number(n[0], field + "[0]"), number(n[1], field + "[1]"), number(n[2], field + "[2]")};
-  }
-
- private:
-  std::string source_;
 };
 
 Pose parseOrigin(const Reader& r, const YAML::Node& n, const std::string& field) {
@@ -94,7 +39,7 @@ Pose parseOrigin(const Reader& r, const YAML::Node& n, const std::string& field)
   Pose pose = Pose::Identity();
   if (n["xyz"]) pose.translation() = r.point(n["xyz"], field + ".xyz");
   if (n["rpy"]) {
-    const Vec3 rpy = r.vec3(n["rpy"], field + ".rpy");
+    const Vec3 rpy = r.vec<3>(n["rpy"], field + ".rpy");
     pose.linear() = rotationFromRpy(rpy);
   }
   return pose;
@@ -121,7 +66,7 @@ SweepMode parseSweep(const Reader& r, const YAML::Node& n, const std::string& fi
 // The required `frame` of the entry `n` named `field` in messages: kWorld for "world", else a
 // joint defined earlier.
 int parseFrame(const Reader& r, const YAML::Node& n, const std::string& field, const Model& m) {
-  const std::string frame = r.text(r.require(n, "frame", field, n), field + ".frame");
+  const std::string frame = r.text(r.require(n, "frame", field), field + ".frame");
   if (frame == "world") return kWorld;
   const int joint = m.jointIndex(frame);
   if (joint < 0) r.fail(n["frame"], field + ".frame", "unknown joint '" + frame + "'");
@@ -135,21 +80,21 @@ void parseJoints(const Reader& r, const YAML::Node& list, Model& m) {
     const std::string f = "joints[" + std::to_string(i) + "]";
     r.onlyKeys(n, f, {"name", "parent", "type", "origin", "axis", "sweep", "limits", "error"});
     Joint j;
-    j.name = r.text(r.require(n, "name", f, n), f + ".name");
+    j.name = r.text(r.require(n, "name", f), f + ".name");
     const std::string fn = "joint '" + j.name + "'";
     if (j.name == "world") r.fail(n["name"], f + ".name", "'world' is reserved");
     if (m.jointIndex(j.name) >= 0) r.fail(n["name"], f + ".name", "duplicate joint name '" + j.name + "'");
-    const std::string parent = r.text(r.require(n, "parent", fn, n), fn + ".parent");
+    const std::string parent = r.text(r.require(n, "parent", fn), fn + ".parent");
     if (parent != "world") {
       j.parent = m.jointIndex(parent);
       if (j.parent < 0) r.fail(n["parent"], fn + ".parent", "'" + parent + "' is not a joint defined earlier");
     }
-    j.type = parseType(r, r.require(n, "type", fn, n), fn + ".type");
+    j.type = parseType(r, r.require(n, "type", fn), fn + ".type");
     if (n["origin"]) j.origin = parseOrigin(r, n["origin"], fn + ".origin");
     const bool one_dof = j.type == JointType::Revolute || j.type == JointType::Prismatic;
     if (one_dof) {
-      const YAML::Node axis = r.require(n, "axis", fn, n);
-      const Vec3 a = r.vec3(axis, fn + ".axis");
+      const YAML::Node axis = r.require(n, "axis", fn);
+      const Vec3 a = r.vec<3>(axis, fn + ".axis");
       // Scaled by its largest component first, so tiny and huge components normalise alike.
       const double scale = a.cwiseAbs().maxCoeff();
       if (!(scale > 0.0)) r.fail(axis, fn + ".axis", "zero axis");
@@ -186,16 +131,16 @@ void parseBodies(const Reader& r, const YAML::Node& list, Model& m) {
     const std::string f = "bodies[" + std::to_string(i) + "]";
     r.onlyKeys(n, f, {"name", "frame", "points", "radius"});
     Body b;
-    b.name = r.text(r.require(n, "name", f, n), f + ".name");
+    b.name = r.text(r.require(n, "name", f), f + ".name");
     const std::string fb = "body '" + b.name + "'";
     if (m.bodyIndex(b.name) >= 0) r.fail(n["name"], f + ".name", "duplicate body name '" + b.name + "'");
     b.frame = parseFrame(r, n, fb, m);
-    const YAML::Node pts = r.require(n, "points", fb, n);
+    const YAML::Node pts = r.require(n, "points", fb);
     if (!pts.IsSequence()) r.fail(pts, fb + ".points", "expected a list of [x, y, z]");
     if (pts.size() == 0) r.fail(pts, fb + ".points", "empty point list");
     for (std::size_t k = 0; k < pts.size(); ++k)
       b.points.push_back(r.point(pts[k], fb + ".points[" + std::to_string(k) + "]"));
-    const YAML::Node rad = r.require(n, "radius", fb, n);
+    const YAML::Node rad = r.require(n, "radius", fb);
     b.radius = r.length(rad, fb + ".radius");
     if (b.radius < 0.0) r.fail(rad, fb + ".radius", "negative radius");
     m.bodies.push_back(std::move(b));
@@ -229,7 +174,7 @@ void parseVisuals(const Reader& r, const YAML::Node& list, Model& m, const std::
       const std::filesystem::path folder = std::filesystem::path(source).parent_path();
       v.mesh = (file.is_relative() ? folder / file : file).lexically_normal().string();
       if (n["scale"]) {
-        v.scale = r.vec3(n["scale"], f + ".scale");
+        v.scale = r.vec<3>(n["scale"], f + ".scale");
         for (int k = 0; k < 3; ++k)
           if (v.scale[k] == 0.0 || std::abs(v.scale[k]) > kMaxModelLength)
             r.fail(n["scale"], f + ".scale", "factors must be non-zero and at most 1e6");
@@ -247,8 +192,8 @@ void parseVisuals(const Reader& r, const YAML::Node& list, Model& m, const std::
       v.shape = Visual::Shape::Cylinder;
       const YAML::Node c = n["cylinder"];
       r.onlyKeys(c, f + ".cylinder", {"radius", "length"});
-      const double radius = positive(r.require(c, "radius", f + ".cylinder", c), f + ".cylinder.radius");
-      v.size = Vec3(radius, radius, positive(r.require(c, "length", f + ".cylinder", c), f + ".cylinder.length"));
+      const double radius = positive(r.require(c, "radius", f + ".cylinder"), f + ".cylinder.radius");
+      v.size = Vec3(radius, radius, positive(r.require(c, "length", f + ".cylinder"), f + ".cylinder.length"));
     }
     if (n["sphere"]) {
       v.shape = Visual::Shape::Sphere;
@@ -303,25 +248,13 @@ std::vector<std::array<int, 2>> parsePairList(const Reader& r, const YAML::Node&
   return out;
 }
 
-}  // namespace
-
-Model parseModel(const std::string& yaml_text, const std::string& source) {
+// The model in `yaml_text`; every failure an InputError (parseModel makes it a ModelError).
+Model parse(const std::string& yaml_text, const std::string& source) {
   const Reader r(source);
-  try {
-    checkYamlDocument(yaml_text, source);  // one document, unique keys, bounded nesting
-  } catch (const InputError& e) {
-    throw ModelError(e.what());
-  }
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::ParserException& e) {
-    throw ModelError(source + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                     ": YAML syntax error: " + e.msg);
-  }
+  const YAML::Node root = r.load(yaml_text);  // one document, unique keys, bounded nesting
   if (!root.IsMap()) r.fail(root, "model", "expected a mapping with kccd, joints, bodies");
   r.onlyKeys(root, "model", {"kccd", "name", "safety_margin", "point_budget", "joints", "bodies", "pairs", "visuals"});
-  const YAML::Node version = r.require(root, "kccd", "model", root);
+  const YAML::Node version = r.require(root, "kccd", "model");
   if (!version.IsScalar() || version.Scalar() != "1")
     r.fail(version, "kccd", "unsupported format version '" + printable(version.Scalar()) + "' (this build reads 1)");
   Model m;
@@ -336,7 +269,7 @@ Model parseModel(const std::string& yaml_text, const std::string& source) {
     m.point_budget = static_cast<int>(b);
   }
   if (root["joints"]) parseJoints(r, root["joints"], m);
-  parseBodies(r, r.require(root, "bodies", "model", root), m);
+  parseBodies(r, r.require(root, "bodies", "model"), m);
   if (m.bodies.empty()) r.fail(root["bodies"], "bodies", "a model needs at least one body");
   if (root["visuals"]) parseVisuals(r, root["visuals"], m, source);
   bool check_all = true;
@@ -359,19 +292,39 @@ Model parseModel(const std::string& yaml_text, const std::string& source) {
   return m;
 }
 
+}  // namespace
+
+Model parseModel(const std::string& yaml_text, const std::string& source) {
+  try {
+    return parse(yaml_text, source);
+  } catch (const ModelError&) {
+    throw;
+  } catch (const InputError& e) {
+    throw ModelError(e.location(), e.problem());
+  }
+}
+
 std::string readModelText(const std::string& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(status)) throw ModelError(path + ": cannot open the model file (no such file)");
-  if (!std::filesystem::is_regular_file(status)) throw ModelError(path + ": not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ModelError(path + ": cannot open the model file");
   constexpr std::size_t kMaxBytes = YamlLimits{}.max_bytes;
-  if (std::filesystem::file_size(path, ec) > kMaxBytes)
-    throw ModelError(path + ": larger than " + std::to_string(kMaxBytes >> 20) + " MiB");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
+  try {
+    return readRegularFile(path, kMaxBytes, "model file");
+  } catch (const FileError& e) {
+    const InputLocation where{path, 0, 0, {}};
+    switch (e.kind()) {
+      case FileProblem::Missing:
+        throw ModelError(where, "cannot open the model file (no such file)");
+      case FileProblem::Directory:
+      case FileProblem::NotRegular:
+        throw ModelError(where, "not a regular file");
+      case FileProblem::CannotOpen:
+        throw ModelError(where, "cannot open the model file");
+      case FileProblem::TooLarge:
+        throw ModelError(where, "larger than " + std::to_string(kMaxBytes >> 20) + " MiB");
+      case FileProblem::CannotRead:
+        break;
+    }
+    throw ModelError(where, "cannot read the model file (" + e.systemReason() + ")");
+  }
 }
 
 Model loadModel(const std::string& path) { return parseModel(readModelText(path), path); }

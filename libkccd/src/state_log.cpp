@@ -2,12 +2,7 @@
 // one line naming the file, the line and, where one applies, the column; reading stops at the first.
 #include "kccd/state_log.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -16,6 +11,9 @@
 #include <system_error>
 #include <unordered_map>
 #include <unordered_set>
+
+#include "kccd/file_reader.hpp"
+#include "kccd/format_number.hpp"
 
 namespace kccd {
 namespace {
@@ -34,13 +32,8 @@ class Parser {
   explicit Parser(const std::string& source) : source_(printable(source, 1024)) {}
 
   [[noreturn]] void fail(std::size_t line, std::size_t col, std::string_view column, const std::string& problem) const {
-    std::string msg = source_;
-    msg.append(1, ':').append(std::to_string(line));
-    if (col != kNoColumn) msg.append(1, ':').append(std::to_string(col));
-    msg += ": ";
-    if (!column.empty()) msg.append("column '").append(printable(column, 60)).append("': ");
-    msg += problem;
-    throw StateLogError(msg);
+    const std::string field = column.empty() ? std::string() : "column '" + printable(column, 60) + "'";
+    throw StateLogError(InputLocation{source_, line, col, field}, problem);
   }
 
   // A number field: a C-locale decimal, finite, of magnitude at most kMaxStateLogMagnitude.
@@ -101,12 +94,6 @@ class Parser {
 
   std::string source_;
 };
-
-std::string shortest(double v) {
-  char buffer[32];
-  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, v);
-  return ec == std::errc() ? std::string(buffer, end) : std::string("?");
-}
 
 // The lines of the text, one at a time, with the checks every line shares.
 class Lines {
@@ -277,7 +264,7 @@ StateLog parseStateLog(std::string_view text, const std::string& source, const M
           case Column::Kind::Time:
             if (row > 0 && !(v > log.times[row - 1]))
               parser.fail(at, start + 1, c.name,
-                          shortest(v) + " is not after the previous row's " + shortest(log.times[row - 1]) +
+                          shortestNumber(v) + " is not after the previous row's " + shortestNumber(log.times[row - 1]) +
                               " (time must increase strictly)");
             log.times[row] = v;
             break;
@@ -294,40 +281,26 @@ StateLog parseStateLog(std::string_view text, const std::string& source, const M
 }
 
 StateLog loadStateLog(const std::string& path, const Model& model, std::span<const std::string> ignore_columns) {
-  const std::string name = printable(path, 1024);
-  const auto fail = [&](const std::string& problem) { throw StateLogError(name + ": " + problem); };
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) {
-    const int err = errno;
-    fail(std::string("cannot open the state log (") + (err == ENOENT ? "no such file" : std::strerror(err)) + ")");
-  }
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) fail(std::string("cannot read the state log (") + std::strerror(errno) + ")");
-  if (S_ISDIR(st.st_mode)) fail("a directory, not a state log file");
-  if (!S_ISREG(st.st_mode)) fail("not a regular file (a device, FIFO or socket)");
-  const std::string too_large = "larger than " + std::to_string(kMaxStateLogBytes >> 20) + " MiB";
-  if (static_cast<std::uintmax_t>(st.st_size) > kMaxStateLogBytes) fail(too_large);
-  std::string text(static_cast<std::size_t>(st.st_size), '\0');
-  std::size_t used = 0;
-  for (;;) {
-    if (used == text.size()) {
-      if (text.size() > kMaxStateLogBytes) fail(too_large);
-      text.resize(text.size() + 65536);  // the file grew after fstat
+  std::string text;
+  try {
+    text = readRegularFile(path, kMaxStateLogBytes, "state log");
+  } catch (const FileError& e) {
+    const InputLocation where{printable(path, 1024), 0, 0, {}};
+    switch (e.kind()) {
+      case FileProblem::Missing:
+      case FileProblem::CannotOpen:
+        throw StateLogError(where, "cannot open the state log (" + e.systemReason() + ")");
+      case FileProblem::Directory:
+        throw StateLogError(where, "a directory, not a state log file");
+      case FileProblem::NotRegular:
+        throw StateLogError(where, "not a regular file (a device, FIFO or socket)");
+      case FileProblem::TooLarge:
+        throw StateLogError(where, "larger than " + std::to_string(kMaxStateLogBytes >> 20) + " MiB");
+      case FileProblem::CannotRead:
+        break;
     }
-    const ssize_t got = ::read(fd, text.data() + used, text.size() - used);
-    if (got < 0) {
-      if (errno == EINTR) continue;
-      fail(std::string("cannot read the state log (") + std::strerror(errno) + ")");
-    }
-    if (got == 0) break;
-    used += static_cast<std::size_t>(got);
+    throw StateLogError(where, "cannot read the state log (" + e.systemReason() + ")");
   }
-  if (used > kMaxStateLogBytes) fail(too_large);
-  text.resize(used);
   return parseStateLog(text, path, model, ignore_columns);
 }
 

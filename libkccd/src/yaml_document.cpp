@@ -14,6 +14,16 @@
 namespace kccd {
 namespace {
 
+// The place of `mark` in `source` (no line when the mark has none).
+InputLocation at(const std::string& source, const YAML::Mark& mark, std::string field) {
+  InputLocation where{source, 0, 0, std::move(field)};
+  if (mark.line >= 0) {
+    where.line = static_cast<std::size_t>(mark.line) + 1;
+    where.column = static_cast<std::size_t>(mark.column) + 1;
+  }
+  return where;
+}
+
 class Checker final : public YAML::EventHandler {
  public:
   Checker(const std::string& source, const YamlLimits& limits) : source_(source), limits_(limits) {}
@@ -46,11 +56,7 @@ class Checker final : public YAML::EventHandler {
   };
 
   [[noreturn]] void fail(const YAML::Mark& mark, const std::string& field, const std::string& problem) const {
-    std::ostringstream msg;
-    msg << source_;
-    if (mark.line >= 0) msg << ':' << mark.line + 1 << ':' << mark.column + 1;
-    msg << ": " << (field.empty() ? std::string("document") : field) << ": " << problem;
-    throw InputError(msg.str());
+    throw InputError(at(source_, mark, field.empty() ? std::string("document") : field), problem);
   }
 
   std::string path() const {
@@ -119,7 +125,7 @@ class Checker final : public YAML::EventHandler {
 
 void checkYamlDocument(std::string_view text, const std::string& source, const YamlLimits& limits) {
   if (text.size() > limits.max_bytes)
-    throw InputError(source + ": file: larger than " + std::to_string(limits.max_bytes >> 20) + " MiB");
+    throw InputError({source, 0, 0, "file"}, "larger than " + std::to_string(limits.max_bytes >> 20) + " MiB");
   std::istringstream in{std::string(text)};
   Checker checker(source, limits);
   try {
@@ -127,11 +133,7 @@ void checkYamlDocument(std::string_view text, const std::string& source, const Y
     while (parser.HandleNextDocument(checker)) {
     }
   } catch (const YAML::Exception& e) {
-    std::ostringstream msg;
-    msg << source;
-    if (e.mark.line >= 0) msg << ':' << e.mark.line + 1 << ':' << e.mark.column + 1;
-    msg << ": YAML syntax error: " << printable(e.msg, 120);
-    throw InputError(msg.str());
+    throw InputError(at(source, e.mark, {}), "YAML syntax error: " + printable(e.msg, 120));
   }
 }
 

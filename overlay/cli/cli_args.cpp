@@ -18,7 +18,7 @@ std::string optionMessage(const std::string& text) {
   std::size_t last = 0;
   for (; it != std::sregex_iterator(); ++it) {
     out += text.substr(last, it->position() - last);
-    out += format(std::strtod(it->str().c_str(), nullptr), 6);
+    out += formatNumber(std::strtod(it->str().c_str(), nullptr), 6);
     last = it->position() + it->length();
   }
   out += text.substr(last);
@@ -45,10 +45,11 @@ CLI::Validator finiteIn(double lo, double hi) {
         const double v = std::strtod(begin, &end);
         if (text.empty() || end != begin + text.size()) return "'" + printable(text, 40) + "' is not a number";
         if (!std::isfinite(v)) return "must be a finite number, got '" + printable(text, 40) + "'";
-        if (v < lo || v > hi) return "must be in [" + format(lo, 6) + ", " + format(hi, 6) + "], got " + format(v, 6);
+        if (v < lo || v > hi)
+          return "must be in [" + formatNumber(lo, 6) + ", " + formatNumber(hi, 6) + "], got " + formatNumber(v, 6);
         return std::string();
       },
-      "NUMBER in [" + format(lo, 6) + ", " + format(hi, 6) + "]");
+      "NUMBER in [" + formatNumber(lo, 6) + ", " + formatNumber(hi, 6) + "]");
 }
 
 std::vector<double> parseList(const std::string& text, const std::string& option) {

@@ -64,6 +64,4 @@ void Progress::finish() {
   if (shown_) std::cerr << "\r" << std::string(std::max(what_.size() + 40, shown_width_), ' ') << "\r" << std::flush;
 }
 
-std::string format(double value, int digits) { return messageNumber(value, digits); }
-
 }  // namespace kccd::cli

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "kccd/format_number.hpp"
 #include "kccd/ssch.hpp"
 
 namespace kccd::cli {
@@ -35,7 +36,7 @@ class Progress {
   std::size_t shown_width_ = 0;
 };
 
-/// Prints a number with `digits` significant digits (nearest).
-std::string format(double value, int digits = 10);
+/// kccd::formatNumber under the name the commands knew it by (`digits` significant digits).
+inline std::string format(double value, int digits = 10) { return formatNumber(value, digits); }
 
 }  // namespace kccd::cli

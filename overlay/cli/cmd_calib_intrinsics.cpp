@@ -2,7 +2,6 @@
 // --spacing D) -o CAMERA.yaml`: camera intrinsics from several images of a planar AprilTag board.
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -17,6 +16,7 @@
 #include "commands.hpp"
 #include "kccd/calib/board_views.hpp"
 #include "kccd/calib/intrinsics.hpp"
+#include "kccd/format_number.hpp"
 
 namespace kccd::cli {
 namespace {
@@ -33,12 +33,6 @@ struct IntrinsicsArgs {
   CLI::Option* spacing_opt = nullptr;
   CLI::Option* first_id_opt = nullptr;
 };
-
-std::string num(double v, int digits = 4) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
 
 calib::Board boardFrom(const IntrinsicsArgs& args) {
   const bool grid_options = !args.grid.empty() || args.tag_size_opt->count() || args.spacing_opt->count() || args.first_id_opt->count();
@@ -62,7 +56,7 @@ calib::Board boardFrom(const IntrinsicsArgs& args) {
   try {
     return calib::Board::grid(g);
   } catch (const InputError& e) {
-    throw UsageError("--grid " + args.grid + ": " + std::string(e.what()).substr(6));  // drop "grid: "
+    throw UsageError(e.messageFrom("--grid " + args.grid));  // the error names its source "grid"
   }
 }
 
@@ -142,20 +136,22 @@ Exit runIntrinsics(const IntrinsicsArgs& args) {
     for (std::size_t i = 0; i < r.views.size(); ++i) {
       const auto& v = r.views[i];
       std::cout << "  " << v.name << ": " << tags_seen[i] << " board tag" << (tags_seen[i] == 1 ? "" : "s");
-      if (std::isfinite(v.tilt_deg)) std::cout << ", tilt " << num(v.tilt_deg, 3) << " deg";
-      if (std::isfinite(v.rms_px)) std::cout << ", RMS " << num(v.rms_px, 3) << " px";
+      if (std::isfinite(v.tilt_deg)) std::cout << ", tilt " << formatNumber(v.tilt_deg, 3) << " deg";
+      if (std::isfinite(v.rms_px)) std::cout << ", RMS " << formatNumber(v.rms_px, 3) << " px";
       if (!unknown[i].empty()) std::cout << ", " << unknown[i].size() << " tag(s) not on the board";
       if (!v.note.empty()) std::cout << " - left out: " << v.note;
       std::cout << "\n";
     }
     if (solved) {
-      std::cout << "wrote " << args.output << ": " << size.width << "x" << size.height << ", fx " << num(k(0, 0), 7) << " +- "
-                << num(r.sigmas.fx, 2) << ", fy " << num(k(1, 1), 7) << " +- " << num(r.sigmas.fy, 2) << ", cx "
-                << num(k(0, 2), 6) << " +- " << num(r.sigmas.cx, 2) << ", cy " << num(k(1, 2), 6) << " +- "
-                << num(r.sigmas.cy, 2) << " px\n"
+      std::cout << "wrote " << args.output << ": " << size.width << "x" << size.height << ", fx "
+                << formatNumber(k(0, 0), 7) << " +- " << formatNumber(r.sigmas.fx, 2) << ", fy "
+                << formatNumber(k(1, 1), 7) << " +- " << formatNumber(r.sigmas.fy, 2) << ", cx "
+                << formatNumber(k(0, 2), 6) << " +- " << formatNumber(r.sigmas.cx, 2) << ", cy "
+                << formatNumber(k(1, 2), 6) << " +- " << formatNumber(r.sigmas.cy, 2) << " px\n"
                 << "distortion";
-      for (double d : r.camera.distortion) std::cout << " " << num(d, 5);
-      std::cout << "\nRMS " << num(r.rms_px, 3) << " px from " << r.used.size() << " of " << r.views.size() << " images\n";
+      for (double d : r.camera.distortion) std::cout << " " << formatNumber(d, 5);
+      std::cout << "\nRMS " << formatNumber(r.rms_px, 3) << " px from " << r.used.size() << " of " << r.views.size()
+                << " images\n";
     }
   }
   if (!solved) {

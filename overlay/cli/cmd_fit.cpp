@@ -77,12 +77,14 @@ Exit runFit(const FitArgs& args) {
   std::ostringstream out;
   out << "# kccd fit " << args.part_file << ": " << part.triangles << " triangles, " << part.primitives
       << " analytic primitives, " << r.hull_vertices << " hull vertices, " << seconds << " s\n"
-      << "# " << (args.hull ? "exact convex hull, " + std::to_string(r.points.size()) + " points" : "K = " + std::to_string(args.points))
-      << ": volume " << format(volume, 6) << " = " << format(ratio(volume), 4) << " x convex hull (" << format(hull, 6)
-      << ")\n";
+      << "# "
+      << (args.hull ? "exact convex hull, " + std::to_string(r.points.size()) + " points"
+                    : "K = " + std::to_string(args.points))
+      << ": volume " << formatNumber(volume, 6) << " = " << formatNumber(ratio(volume), 4) << " x convex hull ("
+      << formatNumber(hull, 6) << ")\n";
   if (!args.hull)
-    out << "# baselines: bounding sphere (K = 1) " << format(ratio(r.sphere_volume), 4) << " x hull, PCA capsule (K = 2) "
-        << format(ratio(r.capsule_volume), 4) << " x hull\n";
+    out << "# baselines: bounding sphere (K = 1) " << formatNumber(ratio(r.sphere_volume), 4)
+        << " x hull, PCA capsule (K = 2) " << formatNumber(ratio(r.capsule_volume), 4) << " x hull\n";
   if (!args.model.empty()) out << "# written into " << args.model << ", body " << args.body << "\n";
   out << "- name: " << body_name << "\n"
       << "  frame: " << args.frame << "\n"

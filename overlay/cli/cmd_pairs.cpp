@@ -73,9 +73,9 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
     return Exit::Ok;
   }
   std::cout << "model " << m.name << ": " << s.samples << " " << source << ", margin " << s.margin << " m\n"
-            << s.samples_within << " states (" << format(100.0 * s.samples_within / n, 3)
-            << " %) have a checked pair within the margin" << (s.unsafe ? ", " + std::to_string(s.unsafe) + " unsafe" : "")
-            << "\n";
+            << s.samples_within << " states (" << formatNumber(100.0 * s.samples_within / n, 3)
+            << " %) have a checked pair within the margin"
+            << (s.unsafe ? ", " + std::to_string(s.unsafe) + " unsafe" : "") << "\n";
   std::cout << std::left << std::setw(44) << "  pair" << std::setw(16) << "within margin" << std::setw(14)
             << "closest (m)" << std::setw(12) << when << "note\n";
   int quiet_pairs = 0;
@@ -88,15 +88,16 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
     std::string note = p->within == 0 ? "" : f >= 0.95 ? "always or nearly: adjacent, or a fit too loose?"
                                           : f >= 0.5   ? "often"
                                                        : "sometimes";
-    if (p->overlapping) note += (note.empty() ? "" : "; ") + std::string("volumes overlap in ") +
-                                std::to_string(p->overlapping) + " states, up to " + format(p->max_penetration, 3) + " m";
+    if (p->overlapping)
+      note += (note.empty() ? "" : "; ") + std::string("volumes overlap in ") + std::to_string(p->overlapping) +
+              " states, up to " + formatNumber(p->max_penetration, 3) + " m";
     if (p->within > 0 && !random)
-      note += "; " + format(p->first_within, 6) + " ... " + format(p->last_within, 6) + " s";
+      note += "; " + formatNumber(p->first_within, 6) + " ... " + formatNumber(p->last_within, 6) + " s";
     if (!p->checked) note = "(ignored: " + modelling::currentIgnoreReason(m, p->a, p->b) + ") " + note;
     std::cout << "  " << std::left << std::setw(42) << pairName(m, p->a, p->b) << std::setw(16)
-              << (std::to_string(p->within) + " (" + format(100.0 * f, 3) + " %)") << std::setw(14)
-              << (std::isnan(p->min_distance) ? std::string("-") : format(p->min_distance, 4)) << std::setw(12)
-              << (std::isnan(p->min_time) ? std::string("-") : format(p->min_time, 6)) << note << "\n";
+              << (std::to_string(p->within) + " (" + formatNumber(100.0 * f, 3) + " %)") << std::setw(14)
+              << (std::isnan(p->min_distance) ? std::string("-") : formatNumber(p->min_distance, 4)) << std::setw(12)
+              << (std::isnan(p->min_time) ? std::string("-") : formatNumber(p->min_time, 6)) << note << "\n";
   }
   if (quiet_pairs > 0) std::cout << quiet_pairs << " pairs never within the margin (--all lists them)\n";
   std::cout << "A survey is evidence, not a proof: nothing is ignored from it. A pair within the margin in a run "
@@ -163,8 +164,8 @@ Exit runPairs(const PairsArgs& args) {
     if (!r.checked) note += " (ignored now: " + modelling::currentIgnoreReason(m, r.a, r.b) + ")";
     std::cout << "  " << std::left << std::setw(42) << pairName(m, r.a, r.b) << std::setw(17)
               << (r.rigid ? std::string("rigid") : std::string(toString(r.verdict))) << std::setw(12)
-              << (r.verdict == modelling::Verdict::Never || r.rigid ? format(r.bound, 4) : std::string("-")) << note
-              << "\n";
+              << (r.verdict == modelling::Verdict::Never || r.rigid ? formatNumber(r.bound, 4) : std::string("-"))
+              << note << "\n";
   }
   std::cout << counts.rigid << " rigid, " << counts.adjacent << " adjacent" << (args.keep_adjacent ? " (kept)" : "")
             << "; " << counts.never << " never, " << counts.always_touching << " always touching, " << counts.meets

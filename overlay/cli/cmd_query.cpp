@@ -82,7 +82,7 @@ void printExplain(const Model& m, const std::vector<PairExplanation>& explained,
               << m.bodies[static_cast<std::size_t>(p.b)].name << ": bound " << e.bound << " m, found "
               << e.closest.distance << " m: " << toString(e.verdict) << "\n    at";
     for (std::size_t i = 0; i < e.closest.state.size(); ++i)
-      std::cout << (i == 0 ? " " : ", ") << m.stateNames()[i] << " = " << format(e.closest.state[i]);
+      std::cout << (i == 0 ? " " : ", ") << m.stateNames()[i] << " = " << formatNumber(e.closest.state[i], 10);
     std::cout << "\n";
   }
 }

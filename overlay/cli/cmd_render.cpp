@@ -41,11 +41,8 @@ Exit runRender(const RenderArgs& args) {
   std::unique_ptr<render::ModelView> view;
   try {
     view = std::make_unique<render::ModelView>(m, camera, options);
-  } catch (const calib::CameraError& e) {
-    // Messages of the projection name the camera as "camera: field: problem".
-    std::string msg = e.what();
-    if (msg.rfind("camera: ", 0) == 0) msg = msg.substr(8);
-    throw UsageError(args.camera + ": " + msg);
+  } catch (const calib::CameraError& e) {  // the projection calls the camera "camera": name its file
+    throw UsageError(e.messageFrom(args.camera));
   }
   render::ModelViewRequest request;
   if (box.point) {

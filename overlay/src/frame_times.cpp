@@ -2,10 +2,9 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <limits>
+
+#include "kccd/file_reader.hpp"
 
 namespace kccd::overlay {
 namespace {
@@ -22,6 +21,9 @@ std::string shown(std::string_view text) {
 
 std::vector<double> parseFrameTimes(std::string_view text, const std::string& name) {
   const std::string file = printable(name, 400);
+  const auto fail = [&](long line, std::size_t column, const char* field, const std::string& problem) {
+    throw FrameTimesError(InputLocation{file, static_cast<std::size_t>(line), column, field}, problem);
+  };
   std::vector<double> times;
   long line_no = 0, last_frame = -1;
   double last_time = -std::numeric_limits<double>::infinity();
@@ -34,52 +36,60 @@ std::vector<double> parseFrameTimes(std::string_view text, const std::string& na
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line_no == 1) {
       if (line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);
-      if (line != "frame,time") throw FrameTimesError(file + ":1:1: the header must be 'frame,time' (found '" + shown(line) + "')");
+      if (line != "frame,time") fail(1, 1, "", "the header must be 'frame,time' (found '" + shown(line) + "')");
       continue;
     }
-    const std::string where = file + ":" + std::to_string(line_no) + ":";
     if (line.empty()) {
       if (at >= text.size()) break;  // a final empty line
-      throw FrameTimesError(where + "1: empty line");
+      fail(line_no, 1, "", "empty line");
     }
     const std::size_t comma = line.find(',');
     if (comma == std::string_view::npos || line.find(',', comma + 1) != std::string_view::npos)
-      throw FrameTimesError(where + "1: expected two fields: frame,time");
+      fail(line_no, 1, "", "expected two fields: frame,time");
     const std::string_view f = line.substr(0, comma), t = line.substr(comma + 1);
     if (f.empty() || f.size() > 12 || f.find_first_not_of("0123456789") != std::string_view::npos)
-      throw FrameTimesError(where + "1: column 'frame': not a frame number: '" + shown(f) + "'");
+      fail(line_no, 1, "column 'frame'", "not a frame number: '" + shown(f) + "'");
     const long frame = std::strtol(std::string(f).c_str(), nullptr, 10);
     const std::string tstr(t);
     char* end = nullptr;
     const double time = std::strtod(tstr.c_str(), &end);
-    const std::string tcol = std::to_string(comma + 2);
+    const std::size_t tcol = comma + 2;
     if (tstr.empty() || end != tstr.c_str() + tstr.size() || !std::isfinite(time) || std::fabs(time) > 1e300)
-      throw FrameTimesError(where + tcol + ": column 'time': not a finite number: '" + shown(t) + "'");
+      fail(line_no, tcol, "column 'time'", "not a finite number: '" + shown(t) + "'");
     if (frame != last_frame + 1)
-      throw FrameTimesError(where + "1: column 'frame': expected frame " + std::to_string(last_frame + 1) + ", found " +
-                            std::to_string(frame) + " (one row per frame, from 0, in order)");
-    if (!(time > last_time)) throw FrameTimesError(where + tcol + ": column 'time': times must increase strictly");
-    if (frame > kMaxFrameNumber) throw FrameTimesError(where + "1: column 'frame': frame number too large");
+      fail(line_no, 1, "column 'frame'",
+           "expected frame " + std::to_string(last_frame + 1) + ", found " + std::to_string(frame) +
+               " (one row per frame, from 0, in order)");
+    if (!(time > last_time)) fail(line_no, tcol, "column 'time'", "times must increase strictly");
+    if (frame > kMaxFrameNumber) fail(line_no, 1, "column 'frame'", "frame number too large");
     last_frame = frame;
     last_time = time;
     times.push_back(time);
   }
-  if (times.empty()) throw FrameTimesError(file + ": no rows");
+  if (times.empty()) throw FrameTimesError(InputLocation{file, 0, 0, {}}, "no rows");
   return times;
 }
 
 std::vector<double> loadFrameTimes(const std::string& path) {
-  namespace fs = std::filesystem;
-  const std::string file = printable(path, 400);
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) throw FrameTimesError(file + ": no such file");
-  if (!fs::is_regular_file(st)) throw FrameTimesError(file + ": not a regular file");
-  if (fs::file_size(path, ec) > kMaxFrameTimesBytes) throw FrameTimesError(file + ": larger than 1 GiB");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FrameTimesError(file + ": cannot read the file");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw FrameTimesError(file + ": cannot read the file");
+  std::string text;
+  try {
+    text = readRegularFile(path, kMaxFrameTimesBytes, "frame-times file");
+  } catch (const FileError& e) {
+    const InputLocation where{printable(path, 400), 0, 0, {}};
+    switch (e.kind()) {
+      case FileProblem::Missing:
+        throw FrameTimesError(where, "no such file");
+      case FileProblem::Directory:
+      case FileProblem::NotRegular:
+        throw FrameTimesError(where, "not a regular file");
+      case FileProblem::TooLarge:
+        throw FrameTimesError(where, "larger than 1 GiB");
+      case FileProblem::CannotOpen:
+      case FileProblem::CannotRead:
+        break;
+    }
+    throw FrameTimesError(where, "cannot read the file");
+  }
   return parseFrameTimes(text, path);
 }
 

@@ -33,13 +33,6 @@ struct FrameJob {
   FrameRecord record;
 };
 
-// The camera reader's "camera: ..." with the name the caller gave the camera file.
-[[noreturn]] void throwCameraError(const calib::CameraError& e, const std::string& label) {
-  std::string msg = e.what();
-  if (msg.rfind("camera: ", 0) == 0) msg = msg.substr(8);
-  throw InputError(label + ": " + msg);
-}
-
 }  // namespace
 
 bool FrameRange::contains(std::size_t i) const {
@@ -122,7 +115,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   try {
     projection.emplace(camera, render_options.supersample);
   } catch (const calib::CameraError& e) {
-    throwCameraError(e, camera_label);
+    throw InputError(e.messageFrom(camera_label));
   }
 
   VideoSource video(in.video, video_label);
@@ -228,7 +221,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
         try {
           annotator.emplace(scene);
         } catch (const calib::CameraError& e) {
-          throwCameraError(e, camera_label);
+          throw InputError(e.messageFrom(camera_label));
         }
         for (;;) {
           FrameJob job;

@@ -110,9 +110,7 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
   try {
     painter.emplace(m, scene.camera);
   } catch (const calib::CameraError& e) {
-    std::string msg = e.what();
-    if (msg.rfind("camera: ", 0) == 0) msg = msg.substr(8);
-    throw SynthError((o.camera.empty() ? std::string("camera") : o.camera) + ": " + msg);
+    throw SynthError(e.messageFrom(o.camera.empty() ? std::string("camera") : o.camera));
   }
   std::vector<render::LoadedVisual> visuals = appearanceOf(o, m);
   const bool use_visuals = !visuals.empty();

@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "kccd/format_number.hpp"
 #include "kccd/overlay/video_source.hpp"
 
 namespace kccd::overlay {
@@ -68,7 +69,7 @@ TimeOffset findTimeOffset(VideoSource& video, const FrameClock& clock, const Sta
   const double step = 0.5 * std::min(frame_period, log_period);
   const double steps = std::ceil((hi - lo) / step);
   if (!(steps <= 200000))
-    throw TimeOffsetError(label + ": the range is more than 200000 steps of " + messageNumber(step, 3) + " s");
+    throw TimeOffsetError(label + ": the range is more than 200000 steps of " + formatNumber(step, 3) + " s");
   const std::size_t n = log.stateSize();
   std::vector<double> qa(n), qb(n);
   TimeOffset best{lo, -2.0, 0};
@@ -94,8 +95,9 @@ TimeOffset findTimeOffset(VideoSource& video, const FrameClock& clock, const Sta
     if (r > best.correlation) best = {offset, r, m};
   }
   if (best.correlation < 0.3)
-    throw TimeOffsetError(label + ": no offset in the range makes the video's motion follow the log's (best correlation " +
-                          (best.correlation > -2.0 ? messageNumber(best.correlation, 2)
+    throw TimeOffsetError(label +
+                          ": no offset in the range makes the video's motion follow the log's (best correlation " +
+                          (best.correlation > -2.0 ? formatNumber(best.correlation, 2)
                                                    : std::string("none: too few frames with a state")) +
                           "); give the offset");
   return best;

@@ -11,7 +11,8 @@ Projection::Projection(const Camera& camera, double supersample)
     : camera_(camera), supersample_(supersample) {
   camera_.validate("camera");
   world_to_camera_ = camera.worldToCamera();
-  if (!(supersample >= 1.0 && supersample <= 4.0)) throw CameraError("camera: supersample: must be in 1..4");
+  if (!(supersample >= 1.0 && supersample <= 4.0))
+    throw CameraError(InputLocation{"camera", 0, 0, "supersample"}, "must be in 1..4");
   const double s = supersample;
   const double fx = camera.camera_matrix(0, 0), fy = camera.camera_matrix(1, 1);
   const double cx = camera.camera_matrix(0, 2), cy = camera.camera_matrix(1, 2);
@@ -58,7 +59,9 @@ Projection::Projection(const Camera& camera, double supersample)
       xmin = std::min(xmin, p[0]), xmax = std::max(xmax, p[0]);
       ymin = std::min(ymin, p[1]), ymax = std::max(ymax, p[1]);
     }
-  if (xmin > xmax) throw CameraError("camera: distortion_coefficients: the lens model cannot be inverted anywhere in the image");
+  if (xmin > xmax)
+    throw CameraError(InputLocation{"camera", 0, 0, "distortion_coefficients"},
+                      "the lens model cannot be inverted anywhere in the image");
   const double pad = 2.0;
   pinhole_.cx = -xmin * pinhole_.fx + pad;
   pinhole_.cy = -ymin * pinhole_.fy + pad;

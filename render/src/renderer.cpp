@@ -33,10 +33,10 @@ Renderer::Renderer(const Projection& projection, const RenderOptions& options)
   auto fits = [&](const Projection& p) { return p.pinhole().width <= max_w && p.pinhole().height <= max_h; };
   if (!fits(projection_)) {
     std::ostringstream msg;
-    msg << "camera: image_width: the " << camera.width << "x" << camera.height << " image is drawn as a "
+    msg << "the " << camera.width << "x" << camera.height << " image is drawn as a "
         << projection_.pinhole().width << "x" << projection_.pinhole().height << " pinhole image (supersample "
         << options.supersample << "), more than this GL allows (" << max_w << "x" << max_h << "): use a smaller supersample";
-    throw CameraError(msg.str());
+    throw CameraError(InputLocation{"camera", 0, 0, "image_width"}, msg.str());
   }
   if (camera.distorted() && options.mask_supersample != options.supersample) {
     auto mask = std::make_unique<Projection>(camera, options.mask_supersample);

@@ -2,20 +2,54 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 
+#include "kccd/format_number.hpp"
+
 namespace kccd {
 
-/// Input that cannot be used. The message is one line: "file[:line[:column]]: field: problem".
-class InputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
+/// Where in an input a problem lies. Every part may be unknown (empty, or 0).
+struct InputLocation {
+  std::string source;      ///< the input as messages show it: a file name, or an option such as "--video x"
+  std::size_t line = 0;    ///< 1-based line; 0 when unknown
+  std::size_t column = 0;  ///< 1-based column; 0 when unknown (or no line is known)
+  std::string field;       ///< the field as messages name it ("joints[2].axis", "column 'time'", "file")
+
+  /// "source[:line[:column]][: field]", the start of a message (empty when nothing is known).
+  std::string text() const;
 };
 
-/// `value` as messages print it: printf's %g with `digits` significant digits ("0.137", "1e+300").
-std::string messageNumber(double value, int digits = 10);
+/// Input that cannot be used. The message is one line: "file[:line[:column]]: field: problem";
+/// the location and the problem are kept as data beside it.
+class InputError : public std::runtime_error {
+ public:
+  /// An error whose message is `message` as given: the location is unknown, the problem is the message.
+  explicit InputError(const std::string& message);
+  explicit InputError(const char* message) : InputError(std::string(message)) {}
+  /// An error at `where`: the message is where.text() and `problem` joined by ": ".
+  InputError(InputLocation where, const std::string& problem);
+
+  /// Where the problem lies (as given to the constructor).
+  const InputLocation& location() const noexcept { return data_->location; }
+  /// The message without its location.
+  const std::string& problem() const noexcept { return data_->problem; }
+  /// The same message with `source` shown as its source, e.g. a camera file's name where the
+  /// error says "camera" (an error without a location gets `source` in front).
+  std::string messageFrom(std::string_view source) const;
+
+ private:
+  struct Data {
+    InputLocation location;
+    std::string problem;
+  };
+  std::shared_ptr<const Data> data_;  // shared: copying an exception must not throw
+};
+
+/// `value` as messages print it: printf's %g with `digits` significant digits (formatNumber).
+inline std::string messageNumber(double value, int digits = 10) { return formatNumber(value, digits); }
 
 /// True when `text` is valid UTF-8: no stray or truncated sequences, overlong forms, surrogates or
 /// code points above U+10FFFF (what JSON output needs of every name it prints).

@@ -1,23 +1,17 @@
 // Reading a rigid part with Coin3D: triangles of every shape in world (file) coordinates, and
 // spheres, cylinders and cones covered analytically instead of by Coin's inscribed tessellation.
 #include <cctype>
-#include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
-#include <sstream>
-#include <cmath>
 #include <filesystem>
 #include <mutex>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
-
-#include <fcntl.h>
-#include <pthread.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <Inventor/SbMatrix.h>
 #include <Inventor/SoDB.h>
@@ -60,10 +54,12 @@
 #include <Inventor/nodes/SoShape.h>
 #include <Inventor/nodes/SoSphere.h>
 
+#include "kccd/file_reader.hpp"
+#include "kccd/format_number.hpp"
 #include "kccd/modelling/part.hpp"
 #include "large_stack.hpp"
-#include "part_messages.hpp"
 #include "mesh_reader.hpp"
+#include "part_messages.hpp"
 
 namespace kccd::modelling {
 namespace {
@@ -123,12 +119,6 @@ Eigen::Affine3d toEigen(const SbMatrix& m) {
   return t;
 }
 
-std::string number(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.9g", v);
-  return buffer;
-}
-
 // "Sphere" or "Sphere 'name'" (the DEF name), for messages.
 std::string nodeName(const SoNode* node) {
   std::string label = node->getTypeId().getName().getString();
@@ -155,8 +145,8 @@ void triangle(void* data, SoCallbackAction* action, const SoPrimitiveVertex* v1,
 
 // A size of an analytic primitive: finite and not negative (zero is a degenerate but exact shape).
 std::string checkSize(const char* field, double v) {
-  if (!std::isfinite(v)) return std::string(field) + ": " + number(v) + " is not finite";
-  if (v < 0) return std::string(field) + ": " + number(v) + " is negative";
+  if (!std::isfinite(v)) return std::string(field) + ": " + formatNumber(v, 9) + " is not finite";
+  if (v < 0) return std::string(field) + ": " + formatNumber(v, 9) + " is negative";
   return {};
 }
 
@@ -326,7 +316,7 @@ SoCallbackAction::Response shape(void* data, SoCallbackAction* action, const SoN
       } else {
         const SbVec4f& p = coords->get4(i);
         if (!(p[3] > 0))
-          problem = "control point " + std::to_string(i) + ": weight " + number(p[3]) + " is not positive";
+          problem = "control point " + std::to_string(i) + ": weight " + formatNumber(p[3], 9) + " is not positive";
         else
           c->part.points.push_back(m * (Vec3(p[0], p[1], p[2]) / p[3]));
       }
@@ -649,48 +639,33 @@ std::string printable(std::string_view text) {
 }
 
 std::string readInputFile(const std::string& path, std::uintmax_t max_bytes) {
-  const std::string name = printable(path);
-  // Non-blocking: opening a FIFO must not wait for a writer (it is refused below).
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) throw InputError(name + ": cannot open the file (" + std::strerror(errno) + ")");
-  struct Close {
-    int fd;
-    ~Close() { ::close(fd); }
-  } close_fd{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) throw InputError(name + ": cannot open the file (" + std::strerror(errno) + ")");
-  if (S_ISDIR(st.st_mode)) throw InputError(name + ": is a directory, not a file");
-  if (!S_ISREG(st.st_mode)) throw InputError(name + ": not a regular file (a device, FIFO or socket)");
-  auto too_large = [&](std::uintmax_t size) {
-    return InputError(name + ": " + std::to_string(size) + " bytes is more than the limit of " +
-                              std::to_string(max_bytes >> 20) + " MiB");
-  };
-  if (static_cast<std::uintmax_t>(st.st_size) > max_bytes) throw too_large(static_cast<std::uintmax_t>(st.st_size));
-  std::string data(static_cast<std::size_t>(st.st_size), '\0');
-  std::size_t used = 0;
-  for (;;) {
-    if (used == data.size()) {
-      if (data.size() > max_bytes) throw too_large(data.size());
-      data.resize(data.size() + 65536);  // the file grew after fstat
+  try {
+    return readRegularFile(path, max_bytes);
+  } catch (const FileError& e) {
+    const InputLocation where{printable(path), 0, 0, {}};
+    switch (e.kind()) {
+      case FileProblem::Missing:
+      case FileProblem::CannotOpen:
+        throw InputError(where, "cannot open the file (" + std::string(std::strerror(e.systemError())) + ")");
+      case FileProblem::Directory:
+        throw InputError(where, "is a directory, not a file");
+      case FileProblem::NotRegular:
+        throw InputError(where, "not a regular file (a device, FIFO or socket)");
+      case FileProblem::TooLarge:
+        throw InputError(where, std::to_string(e.size()) + " bytes is more than the limit of " +
+                                    std::to_string(max_bytes >> 20) + " MiB");
+      case FileProblem::CannotRead:
+        break;
     }
-    const ssize_t n = ::read(fd, data.data() + used, data.size() - used);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      throw InputError(name + ": cannot read the file (" + std::strerror(errno) + ")");
-    }
-    if (n == 0) break;
-    used += static_cast<std::size_t>(n);
+    throw InputError(where, "cannot read the file (" + std::string(std::strerror(e.systemError())) + ")");
   }
-  data.resize(used);
-  if (data.size() > max_bytes) throw too_large(data.size());
-  return data;
 }
 
 Part readPart(const std::string& path, const ReadOptions& options) {
   const std::string name = printable(path);
   if (!options.scale.allFinite() || (options.scale.array() == 0.0).any())
-    throw PartError(name + ": scale " + number(options.scale.x()) + " " + number(options.scale.y()) + " " +
-                             number(options.scale.z()) + ": factors must be finite and non-zero");
+    throw PartError(name + ": scale " + formatNumber(options.scale.x(), 9) + " " + formatNumber(options.scale.y(), 9) +
+                    " " + formatNumber(options.scale.z(), 9) + ": factors must be finite and non-zero");
   std::string extension = std::filesystem::path(path).extension().string();
   for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
   const std::string data = readInputFile(path);

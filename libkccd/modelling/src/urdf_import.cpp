@@ -26,11 +26,9 @@
 namespace kccd::modelling {
 namespace {
 
-std::string num(double v) { return yamlNumber(v); }
-
 std::string vec(double x, double y, double z) {
   std::string s = "[";
-  s.append(num(x)).append(", ").append(num(y)).append(", ").append(num(z)).append("]");
+  s.append(yamlNumber(x)).append(", ").append(yamlNumber(y)).append(", ").append(yamlNumber(z)).append("]");
   return s;
 }
 
@@ -130,7 +128,9 @@ void writeVisuals(std::ostringstream& out, const std::string& urdf_path, const u
     o.rotation.getRPY(r, p, y);
     out << "  - frame: " << frame << "\n";
     switch (v->geometry->type) {
-      case urdf::Geometry::SPHERE: out << "    sphere: " << num(static_cast<const urdf::Sphere&>(*v->geometry).radius) << "\n"; break;
+      case urdf::Geometry::SPHERE:
+        out << "    sphere: " << yamlNumber(static_cast<const urdf::Sphere&>(*v->geometry).radius) << "\n";
+        break;
       case urdf::Geometry::BOX: {
         const urdf::Vector3& d = static_cast<const urdf::Box&>(*v->geometry).dim;
         out << "    box: " << vec(d.x, d.y, d.z) << "\n";
@@ -138,7 +138,7 @@ void writeVisuals(std::ostringstream& out, const std::string& urdf_path, const u
       }
       case urdf::Geometry::CYLINDER: {
         const auto& c = static_cast<const urdf::Cylinder&>(*v->geometry);
-        out << "    cylinder: {radius: " << num(c.radius) << ", length: " << num(c.length) << "}\n";
+        out << "    cylinder: {radius: " << yamlNumber(c.radius) << ", length: " << yamlNumber(c.length) << "}\n";
         break;
       }
       case urdf::Geometry::MESH: {
@@ -164,7 +164,7 @@ void writeVisuals(std::ostringstream& out, const std::string& urdf_path, const u
     if (v->material && !(v->material->color.r == 0 && v->material->color.g == 0 && v->material->color.b == 0 &&
                          !v->material->texture_filename.empty())) {
       const urdf::Color& c = v->material->color;
-      auto unit = [](float x) { return num(std::clamp(static_cast<double>(x), 0.0, 1.0)); };
+      auto unit = [](float x) { return yamlNumber(std::clamp(static_cast<double>(x), 0.0, 1.0)); };
       out << "    colour: [" << unit(c.r) << ", " << unit(c.g) << ", " << unit(c.b) << ", " << unit(c.a) << "]\n";
     }
   }
@@ -264,8 +264,7 @@ void checkOrigin(const Place& at, const tinyxml2::XMLElement* parent) {
 
 void nonNegative(const Place& at, const tinyxml2::XMLElement* e, const char* attribute, const std::vector<double>& v) {
   for (const double x : v)
-    if (x < 0)
-      throw at.error(e, std::string(e->Name()) + " " + attribute + ": " + num(x) + " is negative");
+    if (x < 0) throw at.error(e, std::string(e->Name()) + " " + attribute + ": " + yamlNumber(x) + " is negative");
 }
 
 // Every <collision> of every link checked as the fit reads it; returns the number per link.
@@ -428,7 +427,7 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
         case urdf::Joint::PRISMATIC: {
           emit(j->name, j->type == urdf::Joint::PRISMATIC ? "prismatic" : "revolute", origin, &axis, "");
           if (j->type != urdf::Joint::CONTINUOUS && j->limits)
-            joints << "    limits: [" << num(j->limits->lower) << ", " << num(j->limits->upper) << "]\n";
+            joints << "    limits: [" << yamlNumber(j->limits->lower) << ", " << yamlNumber(j->limits->upper) << "]\n";
           break;
         }
         case urdf::Joint::FIXED: emit(j->name, "fixed", origin, nullptr, ""); break;
@@ -482,8 +481,8 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     } else {
       const FitResult fit_result = fit(part, fo);
       bodies << "    points: " << flowPoints(fit_result.points) << "\n"
-             << "    radius: " << yamlNumber(fit_result.radius, true) << "   # volume " << num(fit_result.volume)
-             << " m^3, hull " << num(fit_result.hull_volume) << " m^3\n";
+             << "    radius: " << yamlNumber(fit_result.radius, true) << "   # volume " << yamlNumber(fit_result.volume)
+             << " m^3, hull " << yamlNumber(fit_result.hull_volume) << " m^3\n";
     }
     body_names.insert(link->name);
     ++fitted;
@@ -499,11 +498,12 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     out << "# Imported from " << std::filesystem::path(path).filename().string()
         << (options.srdf.empty() ? "" : " and " + std::filesystem::path(options.srdf).filename().string())
         << " by kccd import ("
-        << (options.hulls ? std::string("convex hulls, no fit") : std::to_string(options.points) + " core points per link")
+        << (options.hulls ? std::string("convex hulls, no fit")
+                          : std::to_string(options.points) + " core points per link")
         << ")\n"
         << "kccd: 1\n"
         << "name: " << urdf->getName() << "\n"
-        << "safety_margin: " << num(options.safety_margin) << "\n";
+        << "safety_margin: " << yamlNumber(options.safety_margin) << "\n";
     const std::string jt = joints.str(), bt = bodies.str();
     out << "joints:" << (jt.empty() ? " []\n" : "\n" + jt);
     out << "bodies:" << (bt.empty() ? " []\n" : "\n" + bt);

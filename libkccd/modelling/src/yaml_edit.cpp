@@ -1,11 +1,11 @@
 #include "kccd/modelling/yaml_edit.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
 
+#include "kccd/format_number.hpp"
 #include "kccd/model.hpp"
 
 namespace kccd::modelling {
@@ -128,11 +128,7 @@ void check(const std::string& text, const std::string& source) {
 }  // namespace
 
 std::string yamlNumber(double value, bool up) {
-  char buf[40];
-  auto print = [&](double v) {
-    std::snprintf(buf, sizeof buf, "%.10g", v == 0.0 ? 0.0 : v);
-    return std::string(buf);
-  };
+  const auto print = [](double v) { return formatNumber(v == 0.0 ? 0.0 : v, 10); };  // no "-0"
   std::string s = print(value);
   for (int i = 1; up && std::stod(s) < value && i < 64; ++i) s = print(value + std::abs(value) * 1e-10 * i);
   return s;
