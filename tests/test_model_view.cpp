@@ -74,6 +74,32 @@ TEST_F(ModelViewTest, StateDrawsWhatTheStepsDraw) {
   EXPECT_GT(cv::countNonZero(f.images.mask), 1000);
 }
 
+// Neither colour nor mask asked: the query and the statuses alone (the overlay's frames outside
+// --frames), the same answer as a drawn request's, and no images.
+TEST_F(ModelViewTest, NoImageAskedIsTheQueryAlone) {
+  const Model& m = *model_;
+  const std::vector<double> lo = {0.2, 0.3, 0.5}, hi = {0.4, 0.5, 0.7};
+  ModelView view(m, smallCamera());
+  ModelViewRequest request;
+  request.state = lo;
+  request.lower = lo;
+  request.upper = hi;
+  const ModelFrame drawn = view.draw(request);
+  request.colour = false;
+  request.mask = false;
+  const ModelFrame counted = view.draw(request);
+  ASSERT_TRUE(drawn.query.has_value());
+  ASSERT_TRUE(counted.query.has_value());
+  EXPECT_EQ(counted.query->status, drawn.query->status);
+  EXPECT_EQ(counted.query->min_distance, drawn.query->min_distance);
+  EXPECT_EQ(counted.status, drawn.status);
+  EXPECT_EQ(counted.distances, drawn.distances);
+  EXPECT_TRUE(counted.images.bgra.empty());
+  EXPECT_TRUE(counted.images.mask.empty());
+  EXPECT_TRUE(counted.images.visibility.empty());
+  EXPECT_FALSE(drawn.images.bgra.empty());
+}
+
 TEST_F(ModelViewTest, BoxDrawsTheSweptVolumes) {
   const Model& m = *model_;
   const std::vector<double> lo = {-0.5, 0.0, 0.0}, hi = {0.5, 0.1, 0.2};

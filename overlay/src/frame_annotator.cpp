@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <iterator>
 #include <sstream>
 #include <string>
 
@@ -11,7 +10,6 @@
 
 #include "kccd/input_error.hpp"
 #include "kccd/render/composite.hpp"
-#include "kccd/render/scene.hpp"
 
 namespace kccd::overlay {
 
@@ -21,17 +19,13 @@ const char* FrameRecord::queryStatusText() const {
 
 FrameAnnotator::FrameAnnotator(const AnnotatorScene& scene)
     : scene_(scene),
-      checker_(scene.model),
+      view_(scene.model, scene.projection, scene.render_options,
+            std::vector<render::LoadedVisual>(scene.visuals.begin(), scene.visuals.end())),
       q_(scene.model.stateSize()),
       v_(scene.model.stateSize()),
       lo_(scene.model.stateSize()),
-      hi_(scene.model.stateSize()) {
-  renderer_ = std::make_unique<render::Renderer>(scene.projection, scene.render_options);
-  style_.labels = false;
-  style_.legend = !scene.settings.plain;
-  for (std::size_t i = 0; i < scene.model.bodies.size(); ++i)
-    if (scene.model.bodies[i].frame == kWorld) fixed_.push_back(static_cast<int>(i));
-}
+      hi_(scene.model.stateSize()),
+      all_colliding_(scene.model.bodies.size(), SafetyStatus::Colliding) {}
 
 FrameAnnotator::~FrameAnnotator() = default;
 
@@ -40,51 +34,47 @@ void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
   const AnnotatorSettings& set = scene_.settings;
   const double t = rec.time + set.time_offset;
   rec.match = set.swept ? stateAt(scene_.log, t, set.max_gap, q_, v_) : stateAt(scene_.log, t, set.max_gap, q_);
-  std::vector<render::Volume> volumes;
+  render::ModelViewRequest request;
+  request.tight_volumes = true;
+  request.visuals = true;    // when the scene has visuals and a state is known: the robot's look at it
+  request.mask = false;
+  request.colour = rec.selected;  // not selected: the query alone
+  request.style.labels = false;
+  request.style.legend = !set.plain;
+  bool box_ok = true;
   if (rec.match == StateMatch::None) {
+    // No state: only the bodies fixed in the world are known; they are drawn grey.
     rec.status = SafetyStatus::NoState;
     if (!rec.selected) return;
-    // No state: only the bodies fixed in the world are known; they are drawn grey.
-    for (int i : fixed_) {
-      const Body& b = m.bodies[static_cast<std::size_t>(i)];
-      volumes.push_back(render::Volume{b.points, b.radius * (1.0 + 1e-9) + 1e-9, SafetyStatus::NoState, b.name});
-    }
   } else {
     rec.values.assign(q_.begin(), q_.end());
-    bool box_ok = true;
+    request.state = q_;
     if (set.swept) {
       box_ok = brakingIntervals(m, q_, v_, set.braking, lo_, hi_);
-      if (!box_ok) {
+      if (box_ok) {
+        request.lower = lo_;
+        request.upper = hi_;
+      } else {
+        // No braking box: the static volumes at the state, all coloured colliding.
         rec.braking_failed = true;
-        lo_ = q_;
-        hi_ = q_;
+        request.status = all_colliding_;
       }
-    } else {
-      lo_ = q_;
-      hi_ = q_;
     }
-    // From scratch every frame: the answer does not depend on which annotator had which frame.
-    checker_.reset();
-    const QueryResult& r = checker_.query(lo_, hi_, QueryOptions{.type = QueryType::Distances, .tight_volumes = true});
+  }
+  // The view queries from scratch every frame: the answer does not depend on which annotator had which frame.
+  const render::ModelFrame drawn = view_.draw(request);
+  if (drawn.query) {
+    const QueryResult& r = *drawn.query;
     rec.query = r.status;
     // A bound only for the box the run is about: none for an unsafe status or a missing braking box.
     if (r.status == Status::Ok && box_ok) rec.min_distance = r.min_distance;
     for (const PairDistance& pd : r.pairs)
       if (pd.distance <= r.margin) rec.pairs.push_back({m.pairs[pd.pair].a, m.pairs[pd.pair].b});
     rec.status = box_ok ? safetyStatus(r) : SafetyStatus::Colliding;
-    if (!rec.selected) return;
-    std::vector<SafetyStatus> status = render::bodyStatus(m, r);
-    if (!box_ok) status.assign(m.bodies.size(), SafetyStatus::Colliding);
-    volumes = set.swept && box_ok ? render::sceneVolumes(m, checker_, status) : render::staticSceneVolumes(m, checker_, q_, status);
   }
-  const std::size_t checked = volumes.size();  // the volumes; the visuals come after them
-  if (!scene_.visuals.empty() && rec.match != StateMatch::None) {
-    // The robot's appearance at the logged state, drawn with the volumes (its own colours).
-    std::vector<render::Volume> look = render::visualVolumes(m, scene_.visuals, q_);
-    volumes.insert(volumes.end(), std::make_move_iterator(look.begin()), std::make_move_iterator(look.end()));
-  }
-  const render::Frame layer = renderer_->render(volumes, style_, true, false);
-  for (std::size_t i = 0; i < checked; ++i) rec.not_finite |= layer.visibility[i] == render::Visibility::NotFinite;
+  if (!rec.selected) return;
+  const render::Frame& layer = drawn.images;
+  for (std::size_t i = 0; i < drawn.first_visual; ++i) rec.not_finite |= layer.visibility[i] == render::Visibility::NotFinite;
   if (rec.not_finite) rec.status = SafetyStatus::Colliding;  // an overflowed volume is unsafe
   render::compositeOver(bgr, layer.bgra);
   if (!set.plain) drawStatusLine(bgr, rec);

@@ -41,40 +41,42 @@ cv::Scalar bodyColour(const Model& m, std::size_t i) {
   return palette[i % 4];
 }
 
-FramePainter::FramePainter(const Model& m, const calib::Camera& camera) : model_(m), checker_(m) {
+FramePainter::FramePainter(const Model& m, const calib::Camera& camera) : model_(m), camera_(camera) {
   options_.supersample = 2.0;
   options_.mask_supersample = 2.0;
-  renderer_ = std::make_unique<render::Renderer>(camera, options_);
-  style_.shaded = true;
-  style_.legend = false;
+  view_ = std::make_unique<render::ModelView>(m, camera, options_);
+  for (std::size_t b = 0; b < m.bodies.size(); ++b) colours_.push_back(bodyColour(m, b));
 }
 
 void FramePainter::setAppearance(std::vector<render::LoadedVisual> visuals, double volume_scale) {
-  visuals_ = std::move(visuals);
+  use_visuals_ = !visuals.empty();
   scale_ = volume_scale;
+  view_.reset();  // one GL context at a time
+  view_ = std::make_unique<render::ModelView>(model_, camera_, options_, std::move(visuals));
 }
-
-std::vector<render::Volume> FramePainter::volumesAt(std::span<const double> q, double scale) {
-  checker_.query(q, q, QueryOptions{.type = QueryType::Distances});
-  std::vector<render::Volume> v = render::staticSceneVolumes(model_, checker_, q, {});
-  for (std::size_t b = 0; b < v.size(); ++b) {
-    v[b].radius *= scale;
-    v[b].colour = bodyColour(model_, b);
-  }
-  return v;
-}
-
-std::vector<render::Volume> FramePainter::fullVolumes(std::span<const double> q) { return volumesAt(q, 1.0); }
 
 render::Frame FramePainter::robot(std::span<const double> q) {
-  const std::vector<render::Volume> visible =
-      visuals_.empty() ? volumesAt(q, scale_) : render::visualVolumes(model_, visuals_, q);
-  return renderer_->render(visible, style_, true, true);
+  render::ModelViewRequest request;
+  request.state = q;
+  request.tight_volumes = false;
+  request.volumes = !use_visuals_;  // the visuals, or the volumes at the visible scale
+  request.visuals = use_visuals_;
+  request.radius_scale = scale_;
+  request.colours = colours_;
+  request.style.shaded = true;
+  request.style.legend = false;
+  return view_->draw(request).images;
 }
 
 cv::Mat FramePainter::fullMask(std::span<const double> q) {
-  const std::vector<render::Volume> full = fullVolumes(q);
-  return renderer_->render(full, style_, false, true).mask;
+  render::ModelViewRequest request;
+  request.state = q;
+  request.tight_volumes = false;
+  request.colour = false;
+  request.colours = colours_;
+  request.style.shaded = true;
+  request.style.legend = false;
+  return view_->draw(request).images.mask;
 }
 
 cv::Mat FramePainter::draw(const cv::Mat& background, std::span<const double> q, cv::Mat& mask) {

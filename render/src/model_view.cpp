@@ -25,12 +25,13 @@ ModelFrame ModelView::draw(const ModelViewRequest& request) {
     throw std::invalid_argument("ModelView: " + std::to_string(request.colours.size()) + " colours for " +
                                 std::to_string(n) + " bodies");
   ModelFrame out;
+  const bool drawn = request.colour || request.mask;  // else the query and the statuses alone
   std::vector<Volume> volumes;
   const bool box = !request.lower.empty() || !request.upper.empty();
   if (request.state.empty() && !box) {
     // No state: only the bodies fixed in the world are known; they are drawn grey.
     out.status.assign(n, SafetyStatus::NoState);
-    if (request.volumes) {
+    if (request.volumes && drawn) {
       volumes.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
         const Body& b = model_.bodies[i];
@@ -52,10 +53,11 @@ ModelFrame ModelView::draw(const ModelViewRequest& request) {
     out.distances = bodyDistances(model_, r);
     out.status = request.status.empty() ? bodyStatus(model_, r)
                                         : std::vector<SafetyStatus>(request.status.begin(), request.status.end());
-    if (request.volumes)
+    if (request.volumes && drawn)
       volumes = box ? sceneVolumes(model_, checker_, out.status)
                     : staticSceneVolumes(model_, checker_, request.state, out.status);
   }
+  if (!drawn) return out;
   for (std::size_t i = 0; i < volumes.size(); ++i) {
     if (request.radius_scale != 1.0) volumes[i].radius *= request.radius_scale;
     if (!request.colours.empty()) volumes[i].colour = request.colours[i];

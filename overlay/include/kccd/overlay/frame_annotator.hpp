@@ -13,8 +13,8 @@
 
 #include "kccd/braking.hpp"
 #include "kccd/checker.hpp"
+#include "kccd/render/model_view.hpp"
 #include "kccd/render/projection.hpp"
-#include "kccd/render/renderer.hpp"
 #include "kccd/render/visuals.hpp"
 #include "kccd/safety_status.hpp"
 #include "kccd/state_log.hpp"
@@ -63,7 +63,7 @@ struct AnnotatorScene {
 /// thread that made it. Allocates per frame only for the drawing, never in the query.
 class FrameAnnotator {
  public:
-  /// Makes the checker and the renderer (a GL context). Throws render::GlContextError.
+  /// Makes its model view (checker, renderer with its GL context, visuals). Throws render::GlContextError.
   explicit FrameAnnotator(const AnnotatorScene& scene);
   ~FrameAnnotator();
   FrameAnnotator(const FrameAnnotator&) = delete;
@@ -77,11 +77,9 @@ class FrameAnnotator {
   void drawStatusLine(cv::Mat& bgr, const FrameRecord& record) const;
 
   const AnnotatorScene& scene_;
-  Checker checker_;
-  std::unique_ptr<render::Renderer> renderer_;
-  render::Style style_;
+  render::ModelView view_;
   std::vector<double> q_, v_, lo_, hi_;
-  std::vector<int> fixed_;
+  std::vector<SafetyStatus> all_colliding_;
 };
 
 }  // namespace kccd::overlay

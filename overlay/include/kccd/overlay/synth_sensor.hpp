@@ -14,9 +14,8 @@
 #include <opencv2/core.hpp>
 
 #include "kccd/calib/camera.hpp"
-#include "kccd/checker.hpp"
 #include "kccd/model.hpp"
-#include "kccd/render/renderer.hpp"
+#include "kccd/render/model_view.hpp"
 #include "kccd/render/visuals.hpp"
 
 namespace cv {
@@ -47,8 +46,6 @@ class FramePainter {
   /// What the robot looks like: `visuals` when not empty, else the volumes at `volume_scale`.
   void setAppearance(std::vector<render::LoadedVisual> visuals, double volume_scale);
 
-  /// Every body's SSCH at full radius (the volumes the library checks) at state q.
-  std::vector<render::Volume> fullVolumes(std::span<const double> q);
   /// The visible geometry at q, rendered with its label mask (0 background, i + 1 body i).
   render::Frame robot(std::span<const double> q);
   /// Label mask of the full volumes at q (no colour image).
@@ -57,16 +54,15 @@ class FramePainter {
   cv::Mat draw(const cv::Mat& background, std::span<const double> q, cv::Mat& mask);
 
   const render::RenderOptions& renderOptions() const { return options_; }
-  std::string rendererString() const { return renderer_->rendererString(); }
+  std::string rendererString() const { return view_->renderer().rendererString(); }
 
  private:
-  std::vector<render::Volume> volumesAt(std::span<const double> q, double scale);
   const Model& model_;
+  calib::Camera camera_;
   render::RenderOptions options_;
-  std::unique_ptr<render::Renderer> renderer_;
-  Checker checker_;
-  render::Style style_;
-  std::vector<render::LoadedVisual> visuals_;
+  std::unique_ptr<render::ModelView> view_;
+  std::vector<cv::Scalar> colours_;  // per body, bodyColour
+  bool use_visuals_ = false;
   double scale_ = 1.0;
 };
 

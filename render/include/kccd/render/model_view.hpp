@@ -41,7 +41,7 @@ struct ModelViewRequest {
   bool volumes = true;        ///< draw the bodies' volumes
   bool visuals = false;       ///< draw the loaded visuals too (after the volumes), when a state is given
   bool colour = true;         ///< make the colour layer (Frame::bgra)
-  bool mask = true;           ///< make the label mask (Frame::mask, Frame::pixels)
+  bool mask = true;           ///< make the label mask (Frame::mask, Frame::pixels); neither: query only, no images
   Style style;                ///< the colour layer's look: labels, legend, shaded, ...
 };
 
