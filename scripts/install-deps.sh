@@ -5,7 +5,7 @@ packages=(
   g++ cmake ninja-build pkg-config
   libeigen3-dev libccd-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  nlohmann-json3-dev
+  nlohmann-json3-dev libcpp-httplib-dev
   libfcl-dev libqhull-dev
   libcoin-dev inventor-data liburdfdom-dev libassimp-dev
   libosmesa6-dev libgl-dev libegl-dev libopengl-dev libegl-mesa0
@@ -13,12 +13,30 @@ packages=(
 )
 # --fuzz: also the compiler and runtime of the libFuzzer targets (scripts/fuzz.sh).
 [ "${1:-}" = "--fuzz" ] && packages+=(clang-14 libclang-rt-14-dev)
+# --tests: also what the labelling page's tests run: Debian's chromium, node and npm (below), and
+# npm's playwright-core in tests/e2e (scripts/test.sh).
+tests=0
+[ "${1:-}" = "--tests" ] && tests=1 && packages+=(chromium)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# Node and npm for the labelling page's tests (node --test, and playwright-core from npm): Debian's
+# packages unless a node with npm is already installed.
+if [ $tests = 1 ]; then
+  command -v node >/dev/null 2>&1 || missing+=(nodejs)
+  command -v npm >/dev/null 2>&1 || missing+=(npm)
+fi
+root=$(cd "$(dirname "$0")/.." && pwd)
+e2e() {  # the browser test's driver, from npm (the browser itself is Debian's chromium)
+  [ $tests = 1 ] || return 0
+  [ -d "$root/tests/e2e/node_modules/playwright-core" ] && return 0
+  echo "install-deps: npm ci in tests/e2e (playwright-core)"
+  (cd "$root/tests/e2e" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+}
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages present"
+  e2e
   exit 0
 fi
 echo "install-deps: installing ${missing[*]}"
@@ -28,3 +46,4 @@ export DEBIAN_FRONTEND=noninteractive
 "${sudo_cmd[@]}" apt-get update -qq
 "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 echo "install-deps: done"
+e2e

@@ -7,7 +7,7 @@
 # Environment: KCCD_JOBS (default 2), KCCD_SOAK=N for a long property-test soak.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
+bash scripts/install-deps.sh --tests
 jobs=${KCCD_JOBS:-2}
 release=1 sanitize=1 fuzz=1
 for arg in "$@"; do

@@ -86,4 +86,9 @@ void writePngAtomically(const std::string& path, const cv::Mat& image, const std
   writeFileAtomically(path, std::string(png.begin(), png.end()), option + " " + path);
 }
 
+bool sameFile(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  return std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec) && std::filesystem::equivalent(a, b, ec);
+}
+
 }  // namespace kccd::cli

@@ -23,6 +23,9 @@ using overlay::writeFileAtomically;
 /// exists. Throws UsageError "<option> <path>: ...".
 void checkOutputPath(const std::string& path, const std::string& option, const std::string& extension);
 
+/// Whether two paths name one existing file (a link, another spelling).
+bool sameFile(const std::string& a, const std::string& b);
+
 /// Encodes `image` as PNG in memory and writes it with writeFileAtomically. Throws UsageError
 /// "<option> <path>: ..." when it cannot be encoded or written.
 void writePngAtomically(const std::string& path, const cv::Mat& image, const std::string& option);

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 
+#include "calib_frames.hpp"
 #include "cli_args.hpp"
 #include "cli_files.hpp"
 #include "cli_output.hpp"
@@ -20,13 +21,9 @@
 namespace kccd::cli {
 namespace {
 
-struct CalibArgs {
+struct CalibArgs : FrameOptions {
   std::string intrinsics, tags, model, output, check, truth;
-  std::vector<std::string> images, labels, states;
-  std::string state_log, ignore_columns, video;
-  std::vector<double> times;
-  std::vector<int> video_frames;
-  double max_gap = 0.0;  // 0: 1.5 x the log's median period
+  std::vector<std::string> labels;
   double threshold = 8.0, magnify = 20.0;
   int min_inliers = 6;
   bool json = false, quiet = false;
@@ -44,69 +41,21 @@ void checkBodyLabels(const calib::Labels& labels, const std::optional<Model>& mo
   }
 }
 
-// The gathering inputs the options describe: the pictures (--image, or --frame of --video), the
-// labels, each frame's state (--state, or --states at --time) and the tag layout.
+// The gathering inputs the options describe: the frames (calib_frames.hpp), the labels and the
+// tag layout.
 overlay::GatherInputs gatherInputs(const CalibArgs& a, const calib::Camera& cam, const std::optional<Model>& model) {
-  std::vector<std::string> picture_names = a.images;
-  std::vector<cv::Mat> video_pictures;
-  std::vector<double> times = a.times;
-  if (!a.video.empty()) {
-    if (!a.images.empty()) throw UsageError("--video: give --image files or --video with --frame, not both");
-    if (a.video_frames.empty()) throw UsageError("--video: say which frames with --frame N (repeat for several)");
-    overlay::RecordingFrames recording = overlay::readRecordingFrames(a.video, a.video_frames, "--video " + a.video);
-    video_pictures = std::move(recording.frames);
-    for (int f : a.video_frames) picture_names.push_back(a.video + "#" + std::to_string(f));
-    if (!a.state_log.empty() && times.empty()) {
-      if (!(recording.fps > 0.0))
-        throw UsageError("--video " + a.video + ": no frame rate: give each frame's time with --time");
-      for (int f : a.video_frames) times.push_back(f / recording.fps);
-    }
-  } else if (!a.video_frames.empty()) {
-    throw UsageError("--frame: needs --video");
-  }
-  const std::size_t n = picture_names.empty() ? a.labels.size() : picture_names.size();
-  if (n == 0) throw UsageError("give --image FRAME (with --tags and/or --labels) or --labels LABELS (see kccd calib --help)");
-  if (!picture_names.empty() && !a.labels.empty() && a.labels.size() != picture_names.size())
-    throw UsageError("--labels: given " + std::to_string(a.labels.size()) + " times for " + std::to_string(picture_names.size()) +
-                     " images: give one labels file per --image, in the same order");
-  if (!a.tags.empty() && picture_names.empty()) throw UsageError("--tags: needs --image (tags are detected in the images)");
-  if (!picture_names.empty() && a.tags.empty() && a.labels.empty())
-    throw UsageError("--image: give --tags LAYOUT and/or --labels LABELS to say what the image shows");
-  if (!a.states.empty() && a.states.size() != 1 && a.states.size() != n)
-    throw UsageError("--state: given " + std::to_string(a.states.size()) + " times for " + std::to_string(n) +
-                     " frames: give it once (all frames) or once per frame");
-  if (!a.states.empty() && !model) throw UsageError("--state: needs --model");
-  if (!a.state_log.empty() && !model) throw UsageError("--states: needs --model");
-  if (!a.state_log.empty() && !a.states.empty()) throw UsageError("--state and --states: give one of them");
-  if (a.state_log.empty() != times.empty())
-    throw UsageError(a.state_log.empty() ? "--time: needs --states LOG.csv" : "--states: give each frame's time with --time");
-  if (!times.empty() && times.size() != n)
-    throw UsageError("--time: given " + std::to_string(times.size()) + " times for " + std::to_string(n) + " frames: give one per frame");
-  std::optional<StateLog> log;
-  double max_gap = a.max_gap;
-  if (!a.state_log.empty()) {
-    log = loadStateLog(a.state_log, *model, splitCommas(a.ignore_columns));
-    if (max_gap == 0.0) max_gap = 1.5 * log->medianPeriod();
-  }
-
+  const GivenFrames given = givenFrames(a, a.labels.size(), !a.tags.empty(), model);
   overlay::GatherInputs in;
   in.camera = cam;
   in.camera_name = a.intrinsics;
   in.model = model ? &*model : nullptr;
   if (!a.tags.empty()) in.tags = calib::loadTagLayout(a.tags);
-  in.frames.resize(n);
-  for (std::size_t f = 0; f < n; ++f) {
+  in.frames.resize(given.count);
+  for (std::size_t f = 0; f < given.count; ++f) {
     overlay::CalibFrame& fr = in.frames[f];
-    if (!a.states.empty()) {
-      fr.state = parseStateBox(*model, a.states[a.states.size() == 1 ? 0 : f], "", "", "", true).lower;
-    } else if (log) {
-      fr.state.emplace(static_cast<std::size_t>(model->stateSize()), 0.0);
-      if (stateAt(*log, times[f], max_gap, *fr.state) == StateMatch::None)
-        throw UsageError("--time " + format(times[f]) + ": " + a.state_log + " has no sample within --max-gap " + format(max_gap) +
-                         " s of it (the log covers " + format(log->times.front()) + " ... " + format(log->times.back()) + " s)");
-    }
-    if (!picture_names.empty()) fr.image = picture_names[f];
-    if (!video_pictures.empty()) fr.bgr = video_pictures[f];
+    fr.state = given.states[f];
+    if (!given.names.empty()) fr.image = given.names[f];
+    if (!given.pictures.empty()) fr.bgr = given.pictures[f];
     if (!a.labels.empty()) {
       fr.labels = calib::loadLabels(a.labels[f]);
       checkBodyLabels(*fr.labels, model, fr.state.has_value());
@@ -236,10 +185,13 @@ Runner addCalib(CLI::App& app) {
   CLI::App* sheet_sub = sub->get_subcommand("sheet");
   const Runner intrinsics = addCalibIntrinsics(*sub);
   CLI::App* intrinsics_sub = sub->get_subcommand("intrinsics");
+  const Runner label = addCalibLabel(*sub);
+  CLI::App* label_sub = sub->get_subcommand("label");
 
-  return [a, sheet, sheet_sub, intrinsics, intrinsics_sub]() -> Exit {
+  return [a, sheet, sheet_sub, intrinsics, intrinsics_sub, label, label_sub]() -> Exit {
     if (sheet_sub->parsed()) return sheet();
     if (intrinsics_sub->parsed()) return intrinsics();
+    if (label_sub->parsed()) return label();
     if (a->intrinsics.empty()) throw UsageError("calib: --intrinsics CAMERA.yaml is required (see kccd calib --help)");
     if (a->output.empty()) throw UsageError("calib: -o CAMERA.yaml is required (see kccd calib --help)");
     return runCalib(*a);

@@ -60,11 +60,6 @@ calib::Board boardFrom(const IntrinsicsArgs& args) {
   }
 }
 
-bool sameFile(const std::string& a, const std::string& b) {
-  std::error_code ec;
-  return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec);
-}
-
 Exit runIntrinsics(const IntrinsicsArgs& args) {
   const calib::Board board = boardFrom(args);
   if (args.images.empty()) throw UsageError("give the images: --image A.png B.png ... (at least 3 views of the board)");

@@ -30,6 +30,8 @@ Runner addSynth(CLI::App& app);
 Runner addOverlay(CLI::App& app);
 /// `sheet`, registered on the `calib` subcommand app.
 Runner addCalibSheet(CLI::App& calib);
+/// `kccd calib label`: the labelling page (cmd_calib_label.cpp).
+Runner addCalibLabel(CLI::App& calib);
 /// `intrinsics`, registered on the `calib` subcommand app.
 Runner addCalibIntrinsics(CLI::App& calib);
 

@@ -1,0 +1,38 @@
+// The frames of a calibration as the command line gives them: pictures (--image files, or --frame
+// of --video) and each frame's state (--state, or --states at --time). Shared by `kccd calib` and
+// `kccd calib label`, so both read the same options the same way.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "kccd/model.hpp"
+
+namespace kccd::cli {
+
+/// The options that say which frames and which states.
+struct FrameOptions {
+  std::vector<std::string> images, states;
+  std::string state_log, ignore_columns, video;
+  std::vector<double> times;
+  std::vector<int> video_frames;
+  double max_gap = 0.0;  ///< 0: 1.5 x the log's median period
+};
+
+/// The frames the options give, in order.
+struct GivenFrames {
+  std::vector<std::string> names;   ///< the image files, or "VIDEO#N"; empty: labels only
+  std::vector<cv::Mat> pictures;    ///< the decoded frames of --video; empty: read `names` as image files
+  std::vector<std::optional<std::vector<double>>> states;  ///< one per frame
+  std::size_t count = 0;            ///< frames (pictures, or labels files when there are none)
+};
+
+/// Checks the options against each other (`labels` labels files and `tags` a tag layout given)
+/// and reads the recording's frames and the state log. Throws UsageError, or the readers' errors.
+GivenFrames givenFrames(const FrameOptions& o, std::size_t labels, bool tags, const std::optional<Model>& model);
+
+}  // namespace kccd::cli

@@ -1,0 +1,116 @@
+// End to end in a real browser: `kccd calib label` serves the page, Debian's chromium (driven by
+// playwright-core, headless) labels the demo's points as an operator would (a world point typed
+// in, a body point found by search, then a click on the frame), saves, and the residual table the
+// page shows must match `kccd calib --json` on the saved file. A screenshot is kept.
+//   node label_page.mjs KCCD DATA_DIR OUT_DIR
+// Exit 0 passed, 1 failed (also when no browser can start: never skipped).
+import { spawn, execFileSync } from "node:child_process";
+import { mkdirSync, rmSync, existsSync, readFileSync } from "node:fs";
+import { join } from "node:path";
+import { createInterface } from "node:readline";
+import { chromium } from "playwright-core";
+
+const [kccd, data, out] = process.argv.slice(2);
+if (!out) {
+  console.error("usage: node label_page.mjs KCCD DATA_DIR OUT_DIR");
+  process.exit(1);
+}
+rmSync(out, { recursive: true, force: true });
+mkdirSync(out, { recursive: true });
+const fail = (why) => {
+  console.error(`label_page: ${why}`);
+  process.exitCode = 1;
+};
+
+// The frame: the demo arm rendered at the labels' state (what the camera sees, on grey).
+const frame = join(out, "frame.png");
+execFileSync(kccd, ["render", join(data, "demo_arm.yaml"), "--camera", join(data, "demo_camera.yaml"), "--state", "0.3,0.4,0.6",
+  "--no-legend", "-o", frame]);
+const labels = join(out, "labels.yaml");
+const camera = join(out, "camera.yaml");
+const server = spawn(kccd, ["calib", "label", "--intrinsics", join(data, "demo_camera.yaml"), "--image", frame, "--labels", labels,
+  "--model", join(data, "demo_arm.yaml"), "--state", "0.3,0.4,0.6", "-o", camera, "-q"], { stdio: ["ignore", "pipe", "inherit"] });
+const url = await new Promise((resolve, reject) => {
+  createInterface({ input: server.stdout }).once("line", resolve);
+  server.once("exit", (code) => reject(new Error(`kccd calib label exited with ${code} before printing its URL`)));
+});
+if (!/^http:\/\/127\.0\.0\.1:\d+\/$/.test(url)) fail(`first line is not the URL: ${url}`);
+
+// The demo's labels (data/demo_labels.yaml): world points typed in; the shoulder's core point
+// through the target search.
+const wanted = [
+  { name: "pedestal_0", pixel: [548.6, 444.3], world: [0, 0, 0] },
+  { name: "pedestal_1", pixel: [545.4, 354.0], world: [0, 0, 0.25] },
+  { name: "table_0", pixel: [527.3, 539.1], world: [0.45, -0.4, 0.1] },
+  { name: "table_1", pixel: [704.6, 656.5], world: [0.95, -0.4, 0.1] },
+  { name: "table_2", pixel: [963.9, 495.6], world: [0.95, 0.4, 0.1] },
+  { name: "table_3", pixel: [788.9, 420.4], world: [0.45, 0.4, 0.1] },
+  { name: "post_0", pixel: [718.1, 538.7], world: [0.6, 0, 0] },
+];
+
+let browser;
+try {
+  browser = await chromium.launch({ executablePath: "/usr/bin/chromium", headless: true,
+    args: ["--no-sandbox", "--disable-background-networking", "--disable-gpu"] });
+  // bypassCSP: the page's policy forbids eval, which Playwright's waitForFunction uses.
+  const context = await browser.newContext({ viewport: { width: 1600, height: 900 }, bypassCSP: true });
+  const page = await context.newPage();
+  const errors = [];
+  page.on("pageerror", (e) => errors.push(e.message));
+  await page.goto(url);
+  await page.waitForSelector("body[data-ready='1']", { timeout: 20000 });
+  const settle = () => page.waitForFunction(() => !window.kccdPage.pending(), null, { timeout: 20000 });
+  for (const w of wanted) {
+    await page.click("#worldform summary").catch(() => {});
+    await page.evaluate(() => (document.getElementById("worldform").open = true));
+    await page.fill("#wname", w.name);
+    await page.fill("#wx", String(w.world[0]));
+    await page.fill("#wy", String(w.world[1]));
+    await page.fill("#wz", String(w.world[2]));
+    await page.click("#wuse");
+    const [x, y] = await page.evaluate((p) => window.kccdPage.clientOf(p), w.pixel);
+    await page.mouse.click(x, y);
+    await settle();
+  }
+  await page.fill("#search", "shoulder point 0");
+  await page.press("#search", "Enter");
+  const [sx, sy] = await page.evaluate(() => window.kccdPage.clientOf([544.4, 316.6]));
+  await page.mouse.click(sx, sy);
+  await settle();
+  await page.keyboard.press("Control+s");
+  await page.waitForFunction(() => document.getElementById("message").textContent.startsWith("saved"), null, { timeout: 20000 });
+  await page.screenshot({ path: join(out, "label_page.png") });
+
+  // The page's residual table against kccd calib --json on the saved file.
+  const table = await page.$$eval("#labels tbody tr", (rows) => rows.map((r) => [r.cells[1].textContent, r.cells[3].textContent]));
+  if (table.length !== wanted.length + 1) fail(`the table has ${table.length} rows, expected ${wanted.length + 1}`);
+  if (!existsSync(labels)) fail("Save wrote no labels file");
+  let cli = null;
+  try {
+    cli = JSON.parse(execFileSync(kccd, ["calib", "--intrinsics", join(data, "demo_camera.yaml"), "--labels", labels, "--model",
+      join(data, "demo_arm.yaml"), "--state", "0.3,0.4,0.6", "-o", join(out, "cli_camera.yaml"), "--json"]).toString());
+  } catch (e) {
+    cli = JSON.parse(e.stdout.toString());  // not solvable is exit 4, with its JSON
+  }
+  for (const [name, shown] of table) {
+    const r = cli.residuals.find((x) => x.name === name);
+    if (!r) fail(`${name}: not in kccd calib's residuals`);
+    else if (shown !== (r.px === null ? "behind" : Number(r.px).toFixed(2))) fail(`${name}: the page shows ${shown} px, kccd calib ${r.px}`);
+  }
+  const solve = await page.evaluate(() => window.kccdPage.solve());
+  if (solve.status !== cli.status) fail(`page status ${solve.status}, kccd calib ${cli.status}`);
+  if (cli.status === "solved" && !existsSync(camera)) fail("solved, but Save wrote no camera file");
+  if (cli.status === "solved" && readFileSync(camera, "utf8") !== readFileSync(join(out, "cli_camera.yaml"), "utf8"))
+    fail("the page's camera file differs from kccd calib's on the same labels");
+  if (errors.length) fail(`errors in the page: ${errors.join("; ")}`);
+  console.log(`label_page: ${table.length} labels placed in ${url}, status ${cli.status}, rms ${cli.reprojection_rms_px} px; ` +
+    `screenshot ${join(out, "label_page.png")}`);
+  await page.click("#quit");
+} catch (e) {
+  fail(e.stack || String(e));
+} finally {
+  if (browser) await browser.close();
+  setTimeout(() => server.kill("SIGTERM"), 500);
+}
+const code = server.exitCode !== null ? server.exitCode : await new Promise((resolve) => server.once("exit", (c) => resolve(c)));
+if (code !== 0) fail(`kccd calib label exited with ${code}`);
