@@ -1,7 +1,8 @@
 // `kccd calib label`'s server driven over HTTP on 127.0.0.1 (any free port): the session, a labels
 // round trip that gives kccd calib's pose, a misclick rejected by name, a bad document refused with
 // the labels reader's own message, the refusals of a local server (Host, Origin, content type,
-// size), and a save that writes exactly the files named and nothing else.
+// size), a save that writes exactly the files named and nothing else, the body under a point from
+// the drawn volumes, and the autosave.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -249,13 +250,92 @@ TEST_F(LabelServerTest, ForeignHostsOriginsFormsAndHugeBodiesAreRefused) {
   EXPECT_EQ(client_->Get("/api/session", {{"Host", "attacker.example:" + port}})->status, 421);
   EXPECT_EQ(client_->Get("/", {{"Host", "localhost:" + port}})->status, 200);
   EXPECT_EQ(putLabels(doc, {{"Origin", "http://attacker.example"}})->status, 403);
-  EXPECT_EQ(putLabels(doc, {{"Origin", "http://127.0.0.1:" + port}})->status, 200);
   EXPECT_EQ(client_->Put("/api/labels", doc.dump(), "text/plain")->status, 415);
   EXPECT_EQ(client_->Post("/api/save", "labels=x", "application/x-www-form-urlencoded")->status, 415);
   EXPECT_EQ(client_->Put("/api/labels", std::string(2 << 20, ' '), "application/json")->status, 413);
   EXPECT_EQ(client_->Get("/../../etc/passwd")->status, 404);
-  EXPECT_FALSE(fs::exists(labels_ + ".bak"));
+  EXPECT_FALSE(fs::exists(labels_ + ".bak")) << "nothing refused was autosaved";
+  EXPECT_EQ(getJson("/api/session")["revision"], 0);
+  EXPECT_EQ(putLabels(doc, {{"Origin", "http://127.0.0.1:" + port}})->status, 200);
 }
+
+// A point placed on the drawn volumes: the body there, and its points nearest in the image first.
+// Each model point's own pixel either shows its body (then it is listed first, 0 px away) or a
+// body nearer the camera hiding it; most are not hidden.
+TEST_F(LabelServerTest, TheVolumesPickTheBodyUnderAPoint) {
+  start();
+  const nlohmann::json s = getJson("/api/session");
+  ASSERT_EQ(s["solve"]["status"], "solved");
+  std::set<std::string> bodies;
+  for (const nlohmann::json& b : s["bodies"]) bodies.insert(b["name"].get<std::string>());
+  int own = 0, total = 0;
+  for (const nlohmann::json& m : s["candidates"]["model_points"]) {
+    const double u = m["pixel"][0], v = m["pixel"][1];
+    if (!(u >= 0 && v >= 0 && u <= 1279 && v <= 719)) continue;
+    ++total;
+    const nlohmann::json r = getJson("/api/pick?frame=0&x=" + std::to_string(u) + "&y=" + std::to_string(v));
+    ASSERT_TRUE(r["body"].is_string()) << m.dump() << " lies inside its own volume, so some volume is drawn there";
+    EXPECT_TRUE(bodies.count(r["body"].get<std::string>()));
+    ASSERT_FALSE(r["points"].empty());
+    double last = 0;
+    for (const nlohmann::json& p : r["points"]) {
+      EXPECT_EQ(p["body"], r["body"]);
+      EXPECT_GE(p["distance_px"].get<double>(), last);
+      last = p["distance_px"];
+    }
+    if (r["body"] == m["body"]) {
+      ++own;
+      EXPECT_LT(r["points"][0]["distance_px"].get<double>(), 1e-3);
+    }
+  }
+  ASSERT_GE(total, 4);
+  EXPECT_GE(own * 2, total) << own << " of " << total << " model points show their own body";
+
+  // Where the overlay layer is transparent no volume is drawn: no body.
+  const auto layer = client_->Get("/overlay/0.png");
+  const cv::Mat rgba = cv::imdecode(std::vector<unsigned char>(layer->body.begin(), layer->body.end()), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(rgba.at<cv::Vec4b>(0, 0)[3], 0);
+  EXPECT_TRUE(getJson("/api/pick?frame=0&x=0&y=0")["body"].is_null());
+  EXPECT_TRUE(getJson("/api/pick?frame=0&x=-5&y=3e8")["body"].is_null());
+  for (const char* bad : {"/api/pick?frame=0&x=abc&y=1", "/api/pick?frame=0&x=nan&y=1", "/api/pick?frame=0&x=1",
+                          "/api/pick?frame=0&x=1e999&y=1"})
+    EXPECT_EQ(client_->Get(bad)->status, 400) << bad;
+  EXPECT_EQ(client_->Get("/api/pick?frame=3&x=1&y=1")->status, 404);
+}
+
+// Every accepted edit is autosaved to LABELS.yaml.bak; a session started later offers it back while
+// it is newer than the labels file; a save makes the .bak the version before again.
+TEST_F(LabelServerTest, EditsAreAutosavedAndOfferedAgain) {
+  const std::string original = readText(labels_);
+  start();
+  nlohmann::json doc = getJson("/api/session")["labels"];
+  doc["labels"][0]["pixel"][0] = doc["labels"][0]["pixel"][0].get<double>() + 1.25;
+  ASSERT_EQ(putLabels(doc)->status, 200);
+  EXPECT_EQ(readText(labels_), original) << "the labels file is written by save only";
+  EXPECT_EQ(readText(labels_ + ".bak"), labelsYaml(doc, labels_));
+  stopServer();
+  session_.reset();
+
+  start();  // the page was closed without saving
+  nlohmann::json s = getJson("/api/session");
+  ASSERT_TRUE(s["frames"][0]["recovered"].is_object());
+  EXPECT_EQ(s["frames"][0]["recovered"]["file"], labels_ + ".bak");
+  EXPECT_EQ(s["frames"][0]["recovered"]["labels"], doc);
+  EXPECT_EQ(s["labels"], labelsJson(calib::parseLabels(original, labels_))) << "the labels file is what loads";
+  ASSERT_EQ(putLabels(doc)->status, 200);  // restored
+  EXPECT_TRUE(getJson("/api/session")["frames"][0]["recovered"].is_null());
+  ASSERT_EQ(client_->Post("/api/save", "{}", "application/json")->status, 200);
+  EXPECT_EQ(readText(labels_), labelsYaml(doc, labels_));
+  EXPECT_EQ(readText(labels_ + ".bak"), original);
+  stopServer();
+  session_.reset();
+
+  start();  // saved: nothing to offer, and the saved file loads back exactly as it was sent
+  const nlohmann::json again = getJson("/api/session");
+  EXPECT_TRUE(again["frames"][0]["recovered"].is_null());
+  EXPECT_EQ(again["labels"], doc);
+}
+
 
 // The page itself: built in, with a content security policy that allows nothing from elsewhere.
 TEST_F(LabelServerTest, ThePageIsServedFromTheProgram) {
@@ -294,6 +374,7 @@ TEST_F(LabelServerTest, NewAndBadLabelsFiles) {
   const auto saved = client_->Post("/api/save", "{}", "application/json");
   EXPECT_EQ(nlohmann::json::parse(saved->body)["labels"], nlohmann::json::array());
   EXPECT_FALSE(fs::exists(labels_)) << "nothing labelled: no file written";
+  EXPECT_TRUE(getJson("/api/pick?frame=0&x=640&y=360")["body"].is_null()) << "not solved: no volumes drawn";
   stopServer();
   session_.reset();
   std::ofstream(labels_) << "labels: [{name: a, pixel: [1, 2]}]\n";

@@ -103,6 +103,12 @@ Exit runLabel(LabelArgs a) {
     for (const std::string& l : a.labels) std::cerr << " " << l;
     std::cerr << (a.output.empty() ? "" : "; camera to " + a.output) << ". Ctrl+C or Quit in the page ends it.\n";
   }
+  const nlohmann::json frames = session.session()["frames"];
+  for (const nlohmann::json& f : frames)
+    if (f["recovered"].is_object())
+      std::cerr << "kccd calib label: " << f["recovered"]["file"].get<std::string>() << " holds "
+                << f["recovered"]["labels"]["labels"].size() << " label(s) autosaved after " << f["labels_file"].get<std::string>()
+                << " was saved; the page offers to restore them\n";
   if (a.open && !a.no_browser) {
     const std::string command = "xdg-open '" + server.url() + "' >/dev/null 2>&1 &";
     if (std::system(command.c_str()) != 0) std::cerr << "kccd: could not open a browser: open " << server.url() << " yourself\n";
@@ -111,7 +117,7 @@ Exit runLabel(LabelArgs a) {
   pthread_kill(waiter.native_handle(), SIGUSR1);  // ended by Quit: wake the waiter
   waiter.join();
   if (session.dirty())
-    std::cerr << "kccd calib label: edits since the last save were not written (the page's Save writes them)\n";
+    std::cerr << "kccd calib label: edits since the last save are only in the autosave (LABELS.yaml.bak); the next session offers them\n";
   return Exit::Ok;
 }
 

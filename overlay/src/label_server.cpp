@@ -1,6 +1,8 @@
 #include "kccd/overlay/label_server.hpp"
 
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <mutex>
 #include <set>
@@ -32,13 +34,14 @@ void sendPng(httplib::Response& res, const std::vector<unsigned char>& png, bool
   res.set_content(reinterpret_cast<const char*>(png.data()), png.size(), "image/png");
 }
 
-// The index in a path's first match, or -1 when it is not a small whole number.
-long frameIndex(const httplib::Request& req) {
-  if (req.matches.size() < 2) return -1;
-  const std::string s = req.matches[1];
-  if (s.empty() || s.size() > 6) return -1;
+// A small whole number, or -1 when `s` is not one.
+long parseIndex(const std::string& s) {
+  if (s.empty() || s.size() > 6 || s.find_first_not_of("0123456789") != std::string::npos) return -1;
   return std::stol(s);
 }
+
+// The index in a path's first match, or -1 when it is not a small whole number.
+long frameIndex(const httplib::Request& req) { return req.matches.size() < 2 ? -1 : parseIndex(req.matches[1]); }
 
 }  // namespace
 
@@ -142,6 +145,21 @@ struct LabelServer::Impl {
       } catch (const InputError& e) {
         sendError(res, 400, e.what());
       }
+    });
+    server.Get("/api/pick", [this](const httplib::Request& req, httplib::Response& res) {
+      double at[2] = {0, 0};
+      const char* names[2] = {"x", "y"};
+      for (int k = 0; k < 2; ++k) {
+        const std::string v = req.get_param_value(names[k]);
+        char* end = nullptr;
+        at[k] = v.empty() || v.size() > 32 ? NAN : std::strtod(v.c_str(), &end);
+        if (!std::isfinite(at[k]) || end != v.c_str() + v.size())
+          return sendError(res, 400, std::string(names[k]) + ": expected a pixel coordinate, got '" + v.substr(0, 32) + "'");
+      }
+      const long i = req.has_param("frame") ? parseIndex(req.get_param_value("frame")) : 0;
+      const std::lock_guard<std::mutex> lock(mutex);
+      if (i < 0 || static_cast<std::size_t>(i) >= session.frameCount()) return sendError(res, 404, "no such frame");
+      sendJson(res, 200, session.pick(static_cast<std::size_t>(i), at[0], at[1]));
     });
     server.Post("/api/save", [this](const httplib::Request&, httplib::Response& res) {
       const std::lock_guard<std::mutex> lock(mutex);

@@ -1,5 +1,7 @@
 #include "kccd/overlay/label_session.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <stdexcept>
 #include <utility>
@@ -23,8 +25,10 @@ struct LabelSession::Frame {
   std::optional<calib::Labels> labels;  // parsed; none while the document is empty
   std::vector<unsigned char> png;       // the picture
   nlohmann::json candidates;            // tags and corners (model points: per request)
-  int overlay_revision = -1;            // the revision overlay_png was drawn at
+  int overlay_revision = -1;            // the revision overlay_png and mask were drawn at
   std::vector<unsigned char> overlay_png;
+  cv::Mat mask;                         // body i + 1 where body i's volume is nearest; empty: none drawn
+  std::optional<nlohmann::json> recovered;  // the autosave found at the start, newer than the labels file
 };
 
 namespace {
@@ -51,6 +55,25 @@ nlohmann::json candidatesJson(const LabellingCandidates& c) {
   return {{"tags", std::move(tags)}, {"corners", std::move(corners)}, {"model_points", std::move(models)}};
 }
 
+// The autosave PATH.bak as a labels document when it is newer than PATH (or PATH is missing) and
+// says something else: edits a session made and nobody saved. None when it cannot be read: a
+// backup that is not labels is not offered.
+std::optional<nlohmann::json> newerAutosave(const std::string& path) {
+  namespace fs = std::filesystem;
+  const std::string bak = path + ".bak";
+  std::error_code ec;
+  if (path.empty() || !fs::is_regular_file(bak, ec)) return std::nullopt;
+  const bool has_labels = fs::exists(path, ec);
+  if (has_labels && !(fs::last_write_time(bak, ec) > fs::last_write_time(path, ec))) return std::nullopt;
+  try {
+    const calib::Labels recovered = calib::loadLabels(bak);
+    if (has_labels && labelsJson(calib::loadLabels(path)) == labelsJson(recovered)) return std::nullopt;
+    return labelsJson(recovered);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
 std::vector<unsigned char> encodePng(const cv::Mat& image) {
   std::vector<unsigned char> bytes;
   if (!cv::imencode(".png", image, bytes)) throw std::runtime_error("PNG encoding failed");
@@ -72,6 +95,7 @@ LabelSession::LabelSession(LabelSessionInputs inputs) : in_(std::move(inputs)) {
     } else {
       s.document = nlohmann::json{{"labels", nlohmann::json::array()}};
     }
+    s.recovered = newerAutosave(f.labels_path);
     s.png = encodePng(f.bgr);
     CandidateInputs c;
     c.image = f.name;
@@ -133,17 +157,7 @@ nlohmann::json LabelSession::session() const {
   for (std::size_t i = 0; i < in_.frames.size(); ++i) {
     const LabelFrame& f = in_.frames[i];
     nlohmann::json candidates = frames_[i].candidates;
-    if (solved_ && in_.model && f.state) {
-      // The model's core points where the current estimate projects them.
-      CandidateInputs c;
-      c.image = f.name;
-      c.corners = 0;
-      c.camera = *solved_;
-      c.camera_name = in_.intrinsics_name;
-      c.model = in_.model;
-      c.state = *f.state;
-      candidates["model_points"] = candidatesJson(labellingCandidates(f.bgr, c))["model_points"];
-    }
+    if (solved_ && in_.model && f.state) candidates["model_points"] = modelPoints(i);
     frames.push_back({{"index", i},
                       {"name", f.name},
                       {"image", "/frame/" + std::to_string(i) + ".png"},
@@ -152,7 +166,9 @@ nlohmann::json LabelSession::session() const {
                       {"state", f.state ? nlohmann::json(*f.state) : nlohmann::json(nullptr)},
                       {"labels_file", f.labels_path},
                       {"labels", frames_[i].document},
-                      {"candidates", std::move(candidates)}});
+                      {"candidates", std::move(candidates)},
+                      {"recovered", frames_[i].recovered ? nlohmann::json{{"file", f.labels_path + ".bak"}, {"labels", *frames_[i].recovered}}
+                                                         : nlohmann::json(nullptr)}});
   }
   nlohmann::json bodies = nlohmann::json::array();
   if (in_.model) {
@@ -202,7 +218,47 @@ nlohmann::json LabelSession::putLabels(std::size_t frame, const nlohmann::json& 
   }
   f.document = labelsJson(f.labels ? *f.labels : calib::Labels{});
   dirty_ = true;
+  f.recovered.reset();  // an autosave offered at the start is replaced by this one
+  const std::string& path = in_.frames[frame].labels_path;
+  if (f.labels && !path.empty()) writeFileAtomically(path + ".bak", labelsYaml(f.document, path));
   return solve_json_;
+}
+
+nlohmann::json LabelSession::modelPoints(std::size_t frame) const {
+  const LabelFrame& f = in_.frames.at(frame);
+  if (!solved_ || !in_.model || !f.state) return nlohmann::json::array();
+  // The model's core points where the current estimate projects them.
+  CandidateInputs c;
+  c.image = f.name;
+  c.corners = 0;
+  c.camera = *solved_;
+  c.camera_name = in_.intrinsics_name;
+  c.model = in_.model;
+  c.state = *f.state;
+  return candidatesJson(labellingCandidates(f.bgr, c))["model_points"];
+}
+
+nlohmann::json LabelSession::pick(std::size_t frame, double u, double v) {
+  overlayPng(frame);  // draws this revision's mask when it is not drawn yet
+  const Frame& f = frames_.at(frame);
+  nlohmann::json out{{"body", nullptr}, {"points", nlohmann::json::array()}, {"revision", revision_}};
+  if (f.mask.empty() || !(std::abs(u) < 1e9) || !(std::abs(v) < 1e9)) return out;
+  const long x = std::lround(u), y = std::lround(v);  // pixel centres at integers
+  if (x < 0 || y < 0 || x >= f.mask.cols || y >= f.mask.rows) return out;
+  const std::size_t label = f.mask.at<std::uint8_t>(static_cast<int>(y), static_cast<int>(x));
+  if (label == 0 || label > in_.model->bodies.size()) return out;
+  const std::string& body = in_.model->bodies[label - 1].name;
+  out["body"] = body;
+  std::vector<std::pair<double, nlohmann::json>> near;
+  for (nlohmann::json& p : modelPoints(frame)) {
+    if (p["body"] != body) continue;
+    const double d = std::hypot(p["pixel"][0].get<double>() - u, p["pixel"][1].get<double>() - v);
+    p["distance_px"] = d;
+    near.emplace_back(d, std::move(p));
+  }
+  std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (auto& [d, p] : near) out["points"].push_back(std::move(p));
+  return out;
 }
 
 const std::vector<unsigned char>& LabelSession::framePng(std::size_t frame) const { return frames_.at(frame).png; }
@@ -217,12 +273,15 @@ const std::vector<unsigned char>& LabelSession::overlayPng(std::size_t frame) {
     render::ModelViewRequest request;
     request.state = *in.state;
     request.tight_volumes = false;
-    request.mask = false;
+    request.mask = true;  // which body is where: pick()
     request.style.labels = in_.model->bodies.size() <= 12;
     request.style.legend = false;
-    layer = view.draw(request).images.bgra;
+    render::ModelFrame drawn = view.draw(request);
+    layer = std::move(drawn.images.bgra);
+    f.mask = std::move(drawn.images.mask);
   } else {
     layer = cv::Mat(in.bgr.rows, in.bgr.cols, CV_8UC4, cv::Scalar(0, 0, 0, 0));
+    f.mask = cv::Mat();
   }
   f.overlay_png = encodePng(layer);
   f.overlay_revision = revision_;

@@ -31,6 +31,8 @@ const state = {
   space: false,
   revision: 0,
   preview: null,
+  pick: null,        // GET /api/pick's answer for the pending point
+  refreshMs: [],     // per edit, the time until its solve and volumes were shown
 };
 
 const doc = () => state.preview || state.stacks[state.frame].current;  // preview: a label being dragged
@@ -206,15 +208,33 @@ function drawLoupe() {
 function renderTargets() {
   const list = $("targets");
   list.replaceChildren();
-  for (const t of L.searchTargets(state.targets, $("search").value).slice(0, 200)) {
+  const shown = offeredTargets();
+  $("picked").textContent = state.pick && state.pick.body ? `on the volumes: ${state.pick.body}, its points nearest first` : "";
+  for (const t of shown.slice(0, 200)) {
     const li = document.createElement("li");
     li.textContent = t.text;
     li.title = t.kind === "world" ? `world ${t.world.join(", ")}` : `${t.body} ${t.point.join(", ")}`;
     li.setAttribute("role", "option");
-    if (state.target && state.target.name === t.name) li.className = "chosen";
+    li.className = [state.target && state.target.name === t.name ? "chosen" : "", t.picked ? "picked" : ""].join(" ").trim();
     li.onclick = () => chooseTarget(t);
     list.appendChild(li);
   }
+}
+
+// The targets offered: the search's matches, the body under the placed point first.
+const offeredTargets = () => L.searchTargets(L.pickedFirst(state.targets, state.pick), $("search").value);
+
+// Which body the volumes show where the point was placed, and its points nearest first.
+async function pickAt(pixel) {
+  state.pick = null;
+  try {
+    const [x, y] = pixel;
+    const pick = await api("GET", `/api/pick?frame=${state.frame}&x=${x}&y=${y}`);
+    if (state.pending === pixel) state.pick = pick;  // still the point placed
+  } catch (e) {
+    message(e.message, true);
+  }
+  renderTargets();
 }
 
 function chooseTarget(t) {
@@ -224,8 +244,10 @@ function chooseTarget(t) {
     state.selected = label.name;
     edit(L.addLabel(doc(), label));
     state.pending = null;
+    state.pick = null;
     $("pending").hidden = true;
     state.target = null;
+    $("search").value = "";  // the search found this label's target; the next starts afresh
   }
   renderTargets();
   draw();
@@ -310,6 +332,7 @@ async function resolve() {
     return;
   }
   $("stale").hidden = false;
+  const started = performance.now();
   const frame = state.frame;
   inflight = api("PUT", `/api/labels?frame=${frame}`, L.enabledOnly(doc(), state.disabled[frame]));
   try {
@@ -317,6 +340,7 @@ async function resolve() {
     state.revision = state.solve.revision;
     message("");
     await refreshOverlay(frame);
+    state.refreshMs.push(performance.now() - started);  // edit to solve and volumes shown
   } catch (e) {
     message(e.message, true);
   } finally {
@@ -435,6 +459,7 @@ canvas.addEventListener("pointerup", (e) => {
       $("pending").hidden = false;
       $("search").focus();
       draw();
+      pickAt(pixel);
     }
   } else if (d.mode === "move" && d.moved) {
     state.preview = null;
@@ -455,8 +480,8 @@ canvas.addEventListener("pointerleave", () => {
 });
 
 window.addEventListener("keydown", (e) => {
-  if (e.target.tagName === "INPUT" && e.key !== "Escape") return;
   const ctrl = e.ctrlKey || e.metaKey;
+  if (e.target.tagName === "INPUT" && e.key !== "Escape" && !(ctrl && e.key === "s")) return;
   if (ctrl && (e.key === "z" || e.key === "Z")) {
     e.preventDefault();
     if (e.shiftKey) redo();
@@ -469,6 +494,9 @@ window.addEventListener("keydown", (e) => {
     save();
   } else if (e.key === "Escape") {
     state.pending = null;
+    state.pick = null;
+    renderTargets();
+    canvas.focus();
     state.selected = null;
     $("pending").hidden = true;
     renderLabels();
@@ -511,7 +539,7 @@ window.addEventListener("resize", resize);
 $("search").addEventListener("input", renderTargets);
 $("search").addEventListener("keydown", (e) => {
   if (e.key === "Enter") {
-    const first = L.searchTargets(state.targets, $("search").value)[0];
+    const first = offeredTargets()[0];
     if (first) chooseTarget(first);
   }
 });
@@ -539,6 +567,8 @@ $("frame").onchange = async () => {
   state.frame = Number($("frame").value);
   state.selected = null;
   state.pending = null;
+  state.pick = null;
+  showRecovered();
   fit();
   await refreshOverlay(state.frame);
   renderLabels();
@@ -550,6 +580,21 @@ for (const th of $("labels").tHead.rows[0].cells)
       state.sort = { key: th.dataset.sort, dir: state.sort.key === th.dataset.sort ? -state.sort.dir : 1 };
       renderLabels();
     };
+
+// An autosave newer than the labels file (edits a session made and nobody saved): offered as an
+// edit that can be undone.
+function showRecovered() {
+  const r = state.session.frames[state.frame].recovered;
+  $("recovered").hidden = !r;
+  if (r) $("recovered-text").textContent = `${r.file} holds ${r.labels.labels.length} label(s) autosaved after the labels file was last saved.`;
+}
+$("restore").onclick = () => {
+  const f = state.session.frames[state.frame];
+  if (!f.recovered) return;
+  edit(f.recovered.labels);
+  f.recovered = null;
+  showRecovered();
+};
 
 // ---- start
 
@@ -575,6 +620,7 @@ async function start() {
     renderTargets();
     renderSolve();
     renderLabels();
+    showRecovered();
     await refreshOverlay(0);
     draw();
     document.body.dataset.ready = "1";  // for tests
@@ -587,6 +633,7 @@ async function start() {
       },
       solve: () => state.solve,
       pending: () => inflight !== null || again,
+      refreshMs: () => [...state.refreshMs],
     };
   } catch (e) {
     message(e.message, true);

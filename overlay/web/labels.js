@@ -84,3 +84,19 @@ export function searchTargets(targets, query) {
   const words = query.toLowerCase().split(/\s+/).filter(Boolean);
   return targets.filter((t) => words.every((w) => `${t.name} ${t.text}`.toLowerCase().includes(w)));
 }
+
+/** The targets in the order a click on the volumes suggests: the picked body's points nearest
+ *  first (from GET /api/pick: {body, points: [{name, distance_px}]}), each saying how far, then
+ *  the rest as they were. No body picked: `targets` unchanged. */
+export function pickedFirst(targets, pick) {
+  if (!pick || !pick.body) return targets;
+  const byName = new Map(targets.map((t) => [t.name, t]));
+  const first = [];
+  for (const p of pick.points || []) {
+    const t = byName.get(p.name);
+    if (!t) continue;
+    first.push({ ...t, text: `${t.text} · ${Number(p.distance_px).toFixed(1)} px`, picked: true });
+    byName.delete(p.name);
+  }
+  return [...first, ...targets.filter((t) => byName.has(t.name))];
+}

@@ -1,7 +1,8 @@
 // End to end in a real browser: `kccd calib label` serves the page, Debian's chromium (driven by
 // playwright-core, headless) labels the demo's points as an operator would (a world point typed
-// in, a body point found by search, then a click on the frame), saves, and the residual table the
-// page shows must match `kccd calib --json` on the saved file. A screenshot is kept.
+// in, a body point found by search, then a click on the frame), a click on the drawn volumes offers
+// that body's nearest point first, saves, and the residual table the page shows must match
+// `kccd calib --json` on the saved file. A screenshot is kept.
 //   node label_page.mjs KCCD DATA_DIR OUT_DIR
 // Exit 0 passed, 1 failed (also when no browser can start: never skipped).
 import { spawn, execFileSync } from "node:child_process";
@@ -77,6 +78,27 @@ try {
   const [sx, sy] = await page.evaluate(() => window.kccdPage.clientOf([544.4, 316.6]));
   await page.mouse.click(sx, sy);
   await settle();
+  // A point placed on the drawn volumes offers the body there first, its nearest point first.
+  const probe = await page.evaluate(async () => {
+    const s = await (await fetch("/api/session")).json();
+    for (const m of s.candidates.model_points) {
+      // Away from the labels placed: a click there would select the label.
+      if (s.labels.labels.some((l) => Math.hypot(l.pixel[0] - m.pixel[0], l.pixel[1] - m.pixel[1]) < 30)) continue;
+      const p = await (await fetch(`/api/pick?x=${m.pixel[0]}&y=${m.pixel[1]}`)).json();
+      if (p.body === m.body) return m;
+    }
+    return null;
+  });
+  if (!probe) fail("no model point shows its own body in the drawn volumes");
+  else {
+    const [px, py] = await page.evaluate((p) => window.kccdPage.clientOf(p), probe.pixel);
+    await page.mouse.click(px, py);
+    await page.waitForFunction(() => document.getElementById("picked").textContent !== "", null, { timeout: 20000 });
+    const first = await page.$eval("#targets li", (li) => li.textContent);
+    if (!first.startsWith(`${probe.body} point ${probe.point} `)) fail(`clicked on ${probe.name}'s volume; the first target offered is '${first}'`);
+    await page.keyboard.press("Escape");
+  }
+
   await page.keyboard.press("Control+s");
   await page.waitForFunction(() => document.getElementById("message").textContent.startsWith("saved"), null, { timeout: 20000 });
   await page.screenshot({ path: join(out, "label_page.png") });
@@ -103,6 +125,9 @@ try {
   if (cli.status === "solved" && readFileSync(camera, "utf8") !== readFileSync(join(out, "cli_camera.yaml"), "utf8"))
     fail("the page's camera file differs from kccd calib's on the same labels");
   if (errors.length) fail(`errors in the page: ${errors.join("; ")}`);
+  const ms = (await page.evaluate(() => window.kccdPage.refreshMs())).sort((a, b) => a - b);
+  if (!ms.length) fail("no edit was solved");
+  console.log(`label_page: edit -> solve and volumes shown: median ${ms[ms.length >> 1].toFixed(0)} ms, max ${ms[ms.length - 1].toFixed(0)} ms over ${ms.length} edits`);
   console.log(`label_page: ${table.length} labels placed in ${url}, status ${cli.status}, rms ${cli.reprojection_rms_px} px; ` +
     `screenshot ${join(out, "label_page.png")}`);
   await page.click("#quit");

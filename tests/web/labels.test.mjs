@@ -47,3 +47,16 @@ test("search matches every word, in names and descriptions", () => {
   assert.deepEqual(L.searchTargets(targets, "FOREARM").map((t) => t.name), ["forearm.0", "forearm.1"]);
   assert.equal(L.searchTargets(targets, "").length, targets.length);
 });
+
+test("a pick puts the body's points first, nearest first, and keeps every target once", () => {
+  const targets = L.targetsOf(session);
+  const pick = { body: "forearm", points: [{ name: "forearm.1", distance_px: 2.5 }, { name: "forearm.0", distance_px: 40 }] };
+  const ordered = L.pickedFirst(targets, pick);
+  assert.deepEqual(ordered.slice(0, 2).map((t) => t.name), ["forearm.1", "forearm.0"]);
+  assert.ok(ordered[0].picked && ordered[0].text.endsWith("· 2.5 px"));
+  assert.equal(ordered.length, targets.length);
+  assert.deepEqual(new Set(ordered.map((t) => t.name)), new Set(targets.map((t) => t.name)));
+  assert.deepEqual(ordered[0].point, [0.3, 0, 0], "the target itself is unchanged");
+  assert.equal(L.pickedFirst(targets, { body: null, points: [] }), targets);
+  assert.equal(L.pickedFirst(targets, null), targets);
+});

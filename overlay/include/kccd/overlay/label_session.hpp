@@ -25,7 +25,7 @@ struct LabelFrame {
   std::string name;                          ///< names the picture (an image file, or "video.mkv#12")
   cv::Mat bgr;                               ///< the picture, 8-bit BGR, the camera's size
   std::optional<std::vector<double>> state;  ///< the robot's state in it (places body labels, draws the volumes)
-  std::string labels_path;                   ///< its labels file: read when it exists, the only file save() writes for it
+  std::string labels_path;                   ///< its labels file: read when it exists; with PATH.bak the only files written for it
 };
 
 /// What a session is made of.
@@ -71,6 +71,9 @@ class LabelSession {
   /// Replaces frame `frame`'s labels document and solves again; returns solve(). A document that
   /// cannot be used throws calib::LabelsError or CalibInputError with the message `kccd calib`
   /// prints for the same labels saved, and nothing changes. std::out_of_range for a bad frame.
+  /// An accepted document with labels is autosaved to the frame's LABELS.yaml.bak (which then
+  /// holds the unsaved edits; after save() it holds the version before). A session started where
+  /// LABELS.yaml.bak is newer than LABELS.yaml and differs offers it as frames[i].recovered.
   nlohmann::json putLabels(std::size_t frame, const nlohmann::json& document);
 
   /// Frame `frame`'s picture as PNG bytes. std::out_of_range for a bad frame.
@@ -80,6 +83,12 @@ class LabelSession {
   /// of the frame's size, transparent where there are none (not solved, no model or no state).
   /// Drawn once per revision. Throws render::GlContextError when no GL context can be made.
   const std::vector<unsigned char>& overlayPng(std::size_t frame);
+
+  /// What the volumes show at stored pixel (u, v) of frame `frame` at the current estimate:
+  /// `{"body": name or null, "points": [that body's model points, nearest in the image first, each
+  /// with "distance_px"], "revision"}`. The body is null where no volume is drawn there, or none
+  /// is drawn (not solved, no model or no state). std::out_of_range for a bad frame.
+  nlohmann::json pick(std::size_t frame, double u, double v);
 
   /// Writes every frame's labels (frames without labels are left alone), each file under a
   /// temporary name then renamed, its previous version kept as PATH.bak, and the camera file when
@@ -93,6 +102,7 @@ class LabelSession {
  private:
   struct Frame;
   void resolve();
+  nlohmann::json modelPoints(std::size_t frame) const;
   LabelSessionInputs in_;
   std::vector<Frame> frames_;
   nlohmann::json solve_json_;
