@@ -20,7 +20,7 @@ while [ $# -gt 0 ]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_model fuzz_states fuzz_frame_times fuzz_camera fuzz_tags fuzz_labels fuzz_labels_json fuzz_frame fuzz_video fuzz_part fuzz_urdf)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_model fuzz_states fuzz_frame_times fuzz_camera fuzz_tags fuzz_labels fuzz_labels_json fuzz_golden_manifest fuzz_frame fuzz_video fuzz_part fuzz_urdf)
 bash scripts/install-deps.sh --fuzz
 CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DKCCD_BUILD_FUZZERS=ON -DKCCD_BUILD_TESTS=OFF -DKCCD_BUILD_BENCHMARKS=OFF >/dev/null
@@ -37,6 +37,7 @@ ci_runs() {  # inputs per target in --ci mode (about 15 s each on this project's
     fuzz_tags) echo 140000 ;;
     fuzz_labels) echo 130000 ;;
     fuzz_labels_json) echo 100000 ;;
+    fuzz_golden_manifest) echo 100000 ;;
     fuzz_part) echo 30000 ;;
     fuzz_urdf) echo 4000 ;;
   esac
@@ -51,6 +52,7 @@ seeds() {  # extra seed files from data/ per target
     fuzz_tags) ;;
     fuzz_labels) ;;
     fuzz_labels_json) ;;
+    fuzz_golden_manifest) ;;
     fuzz_frame) ;;
     fuzz_video) ;;
     fuzz_part) ls data/parts/* ;;

@@ -5,7 +5,7 @@ packages=(
   g++ cmake ninja-build pkg-config
   libeigen3-dev libccd-dev libyaml-cpp-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  nlohmann-json3-dev libcpp-httplib-dev
+  nlohmann-json3-dev libcpp-httplib-dev libssl-dev
   libfcl-dev libqhull-dev
   libcoin-dev inventor-data liburdfdom-dev libassimp-dev
   libosmesa6-dev libgl-dev libegl-dev libopengl-dev libegl-mesa0

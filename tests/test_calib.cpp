@@ -51,6 +51,11 @@ TEST(CalibCamera, RoundTripsThroughSave) {
   EXPECT_EQ(d.distortion, c.distortion);
   EXPECT_EQ(d.rvec, c.rvec);
   EXPECT_EQ(d.tvec, c.tvec);
+  // A camera without coefficients (OpenCV: no distortion) is saved as five zeros.
+  Camera pinhole = c;
+  pinhole.distortion.clear();
+  saveCamera(pinhole, path);
+  EXPECT_EQ(loadCamera(path).distortion, std::vector<double>(5, 0.0));
 }
 
 TEST(CalibCamera, OpenCvCalibrationOutputWithoutAPoseLoadsAsIntrinsics) {

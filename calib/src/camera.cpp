@@ -318,7 +318,10 @@ std::string cameraText(const Camera& camera) {
   cv::FileStorage fs(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   fs << "image_width" << camera.width << "image_height" << camera.height;
   fs << "camera_matrix" << cv::Mat(camera.camera_matrix);
-  fs << "distortion_coefficients" << cv::Mat(camera.distortion).reshape(1, 1);
+  // No coefficients means none (OpenCV's reading of an empty list): written as five zeros, which
+  // the reader accepts and which project the same.
+  const std::vector<double> distortion = camera.distortion.empty() ? std::vector<double>(5, 0.0) : camera.distortion;
+  fs << "distortion_coefficients" << cv::Mat(distortion).reshape(1, 1);
   fs << "rvec" << cv::Mat(camera.rvec) << "tvec" << cv::Mat(camera.tvec);
   if (camera.reprojection_rms_px) fs << "reprojection_rms_px" << *camera.reprojection_rms_px;
   if (camera.rotation_sigma_deg) fs << "rotation_sigma_deg" << *camera.rotation_sigma_deg;
