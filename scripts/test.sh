@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Builds KCCD and runs the whole test suite: a Release build, then the same tests under
-# AddressSanitizer + UndefinedBehaviorSanitizer, then every libFuzzer target briefly. Options:
+# AddressSanitizer + UndefinedBehaviorSanitizer, then every libFuzzer target briefly. The
+# sanitizer build is -O1 -g1 (the reports' stacks keep files and lines; with GCC 12 the heaviest
+# file compiles in 30 s instead of 61 s at -O2 -g), and its statistical tests draw fewer cases
+# (tests/support/sanitized.hpp). Options:
 #   --no-sanitize   skip the sanitizer build
 #   --sanitize-only run only the sanitizer build
 #   --no-fuzz       skip the fuzz targets (scripts/fuzz.sh)
@@ -32,7 +35,8 @@ if [ $sanitize -eq 1 ]; then
   echo "== ASan + UBSan build and tests"
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
-    run build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKCCD_SANITIZE=ON -DKCCD_BUILD_BENCHMARKS=OFF
+    run build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKCCD_SANITIZE=ON -DKCCD_BUILD_BENCHMARKS=OFF \
+    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
 fi
 if [ $fuzz -eq 1 ]; then
   echo "== libFuzzer targets (a fixed seed and number of inputs each)"

@@ -16,6 +16,7 @@
 #include <apriltag/tag36h11.h>
 #include <opencv2/calib3d.hpp>
 
+#include "support/sanitized.hpp"
 #include "kccd/calib/pose.hpp"
 #include "kccd/calib/tag_detect.hpp"
 #include "support/cameras.hpp"
@@ -333,10 +334,10 @@ RandomView randomView(std::mt19937_64& rng, int width, int height) {
   }
 }
 
-// The whole pipeline on frames of >= 100 random cameras: detectTags -> tagCorrespondences ->
+// The whole pipeline on frames of 100 random cameras (30 under the sanitizers): detectTags -> tagCorrespondences ->
 // solvePose. Blur 0.5-1.0 px, noise 2 grey levels, background texture and clutter.
 TEST(CalibImages, PoseOfRandomCamerasFromRenderedFrames) {
-  constexpr int kCameras = 100;
+  constexpr int kCameras = kccd::testing::casesFor(100, 30);  // 30 under the sanitizers
   std::mt19937_64 rng(20261123);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::vector<double> rot, pos, rms, rot_ratio, pos_ratio;  // errors, and errors over the reported sigmas

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <random>
 
+#include "support/sanitized.hpp"
 #include "kccd/checker.hpp"
 #include "support/random_model.hpp"
 #include "support/reference_distance.hpp"
@@ -90,7 +91,8 @@ bool runCase(std::uint64_t seed, Tally& tally, std::string& why,
 
 TEST(Conservative, BoundNeverExceedsSampledDistance) {
   const long single = envOr("KCCD_SEED", -1);
-  const long cases = single >= 0 ? 1 : envOr("KCCD_SOAK", 50000);
+  // 50,000 cases (15,000 under the sanitizers); KCCD_SOAK=N for a long soak.
+  const long cases = single >= 0 ? 1 : envOr("KCCD_SOAK", kccd::testing::casesFor(50000, 15000));
   const std::uint64_t base = 0x6b636364;  // "kccd"
   Tally tally;
   long failures = 0;
