@@ -94,7 +94,7 @@ Exit runRun(const GoldenArgs& a) {
                 << (r.cause.empty() ? "" : " -- likely cause: " + r.cause) << "\n";
   }
   std::cout << goldenSummaryLine(run) << "; report " << (fs::path(a.out) / "report.html").string() << "\n";
-  return unsafe ? Exit::Unsafe : failed ? Exit::Internal : Exit::Ok;  // 1: a case failed or its golden is missing
+  return unsafe ? Exit::Unsafe : failed ? Exit::CheckFailed : Exit::Ok;
 }
 
 Exit runUpdate(const GoldenArgs& a) {

@@ -12,6 +12,7 @@ namespace kccd::cli {
 enum class Exit : int {
   Ok = 0,           ///< done (also --help and --version)
   Internal = 1,     ///< a bug: an exception that is not about the input
+  CheckFailed = 1,  ///< `kccd golden run`: a case failed or its golden is missing (as pytest and JUnit runners say it)
   BadInput = 2,     ///< bad input or option: one line naming the file and place
   Unsafe = 3,       ///< an unsafe query status (query, render, overlay)
   NotSolvable = 4,  ///< calibration could not solve (degenerate, too few inliers)
