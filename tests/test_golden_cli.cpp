@@ -21,6 +21,7 @@
 
 #include "kccd/calib/camera.hpp"
 #include "support/cameras.hpp"
+#include "support/files.hpp"
 #include "support/run_program.hpp"
 
 namespace {
@@ -30,10 +31,7 @@ using kccd::testing::Outcome;
 const std::string kData = KCCD_DATA_DIR;
 const std::string kCli = KCCD_CLI;
 
-std::string readText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+std::string readText(const fs::path& p) { return kccd::testing::readText(p.string()); }
 
 void writeText(const fs::path& p, const std::string& s) { std::ofstream(p, std::ios::binary) << s; }
 

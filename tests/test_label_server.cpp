@@ -22,6 +22,7 @@
 #include "kccd/overlay/calib_solve.hpp"
 #include "kccd/overlay/label_server.hpp"
 #include "kccd/overlay/labels_document.hpp"
+#include "support/files.hpp"
 
 // Last: the OpenSSL headers it pulls in define names that clash with Eigen's when they come first.
 #include <httplib.h>
@@ -39,10 +40,7 @@ std::set<std::string> filesIn(const fs::path& dir) {
   return out;
 }
 
-std::string readText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+std::string readText(const fs::path& p) { return kccd::testing::readText(p.string()); }
 
 class LabelServerTest : public ::testing::Test {
  protected:

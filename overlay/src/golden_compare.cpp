@@ -172,9 +172,7 @@ cv::Mat falseColour(const cv::Mat& mask) {
   return out;
 }
 
-namespace {
-
-cv::Mat asBgr(const cv::Mat& image, bool mask) {
+cv::Mat picture(const cv::Mat& image, bool mask) {
   if (mask) return falseColour(image);
   cv::Mat out;
   if (image.channels() == 1) cv::cvtColor(image, out, cv::COLOR_GRAY2BGR);
@@ -191,12 +189,10 @@ cv::Mat asBgr(const cv::Mat& image, bool mask) {
   return out;
 }
 
-}  // namespace
-
 cv::Mat diffPicture(const cv::Mat& expected, const cv::Mat& actual, const Comparison& comparison, bool masks) {
-  if (comparison.changed.empty()) return asBgr(actual, masks);
+  if (comparison.changed.empty()) return picture(actual, masks);
   cv::Mat grey, out;
-  cv::cvtColor(asBgr(expected, masks), grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(picture(expected, masks), grey, cv::COLOR_BGR2GRAY);
   grey = grey / 3 + 40;
   cv::cvtColor(grey, out, cv::COLOR_GRAY2BGR);
   out.setTo(cv::Scalar(40, 40, 255), comparison.changed);

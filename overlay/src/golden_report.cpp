@@ -63,15 +63,9 @@ Evidence evidenceOf(const OutputResult& o, const GoldenImage& img) {
   e.diff = deterministicPng(diff);
   if (!o.comparison.largest_cluster.empty()) {
     // Expected | actual | diff around the largest cluster, 8x, side by side.
-    const cv::Mat shown_e = mask ? falseColour(o.expected) : o.expected;
-    const cv::Mat shown_a = mask ? falseColour(img.image) : img.image;
     std::vector<cv::Mat> parts;
-    for (const cv::Mat* m : {&shown_e, &shown_a, &diff}) {
-      cv::Mat bgr = *m;
-      if (bgr.channels() == 4) bgr = diffPicture(*m, *m, Comparison{}, false);  // over the checkerboard
-      else if (bgr.channels() == 1) cv::merge(std::vector<cv::Mat>{bgr, bgr, bgr}, bgr);
-      parts.push_back(magnifiedCrop(bgr, o.comparison.largest_cluster));
-    }
+    for (const cv::Mat& shown : {picture(o.expected, mask), picture(img.image, mask), diff})
+      parts.push_back(magnifiedCrop(shown, o.comparison.largest_cluster));
     if (parts[0].size() == parts[1].size() && parts[1].size() == parts[2].size()) {
       const cv::Mat gap(parts[0].rows, 6, CV_8UC3, cv::Scalar(255, 255, 255));
       cv::Mat row;

@@ -126,9 +126,9 @@ struct LabelServer::Impl {
       std::size_t frame = 0;
       if (req.has_param("frame")) {
         const std::string f = req.get_param_value("frame");
-        if (f.empty() || f.size() > 6 || f.find_first_not_of("0123456789") != std::string::npos)
-          return sendError(res, 400, "frame: expected a frame index, got '" + f + "'");
-        frame = std::stoul(f);
+        const long i = parseIndex(f);
+        if (i < 0) return sendError(res, 400, "frame: expected a frame index, got '" + f + "'");
+        frame = static_cast<std::size_t>(i);
       }
       nlohmann::json document;
       try {

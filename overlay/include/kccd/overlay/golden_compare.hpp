@@ -69,4 +69,8 @@ cv::Mat magnifiedCrop(const cv::Mat& image, const cv::Rect& box, int scale = 8);
 /// A mask shown in false colour (BGR): each label its own colour, background black.
 cv::Mat falseColour(const cv::Mat& mask);
 
+/// An image as a person sees it, BGR: a mask (`mask`) in false colour, an image with alpha over a
+/// checkerboard so that transparency shows, grey as grey.
+cv::Mat picture(const cv::Mat& image, bool mask);
+
 }  // namespace kccd::overlay
