@@ -2,8 +2,9 @@
 // box and one recorded frame: update then run passes, a second update is byte-identical, reports
 // and JUnit are written; each real change fails naming the case, the output and the likely cause
 // (the camera's cx + 1 px, the thin post moved 1 px across and along, a body removed, the safety
-// margin, a re-encoded video); run never writes goldens; update --only failed touches only the
-// failing case; approve gives the bytes update gives; a bad manifest is one line with its place.
+// margin, a re-encoded video, a URDF edit re-imported); run never writes goldens; update --only
+// failed touches only the failing case; approve gives the bytes update gives; a bad manifest is one
+// line with its place; `supersample` draws finer masks, their edge bound in the sidecar.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -266,6 +267,8 @@ TEST_F(GoldenCli, MistakesAreOneLineWithThePlace) {
        "case 'a'.outputs: overlay needs a recorded frame"},
       {"kccd_golden: 1\ndefaults: {model: nothing.yaml, camera: front.yaml}\ncases:\n  - {id: a, state: [0, 0, 0]}\n", "nothing.yaml"},
       {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml}\ncases:\n  - {id: ../x, state: [0, 0, 0]}\n", "is not a folder name"},
+      {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml, supersample: 5}\ncases:\n  - {id: a, state: [0, 0, 0]}\n",
+       ":2:64: defaults.supersample: must be in 1..4"},
   };
   for (const Case& c : cases) {
     writeText(dir_ / "bad.yaml", c.manifest);
@@ -277,6 +280,81 @@ TEST_F(GoldenCli, MistakesAreOneLineWithThePlace) {
   }
   EXPECT_EQ(golden("run " + manifest() + " --case nothing*").code, 2);
   EXPECT_EQ(golden("update " + manifest() + " --only some").code, 2);
+}
+
+// The integrator's own flow for a URDF robot: the model imported from the URDF, goldens made; the
+// same URDF imported again is no change (the import is deterministic and masks are matched by body
+// name); a 5 mm change of one link's collision cylinder, re-imported, fails naming the model.
+TEST_F(GoldenCli, AUrdfEditReimportedFails) {
+  const fs::path urdf = dir_ / "urdf";
+  fs::copy(fs::path(KCCD_TEST_DATA_DIR) / "urdf", urdf, fs::copy_options::recursive);
+  const std::string original = readText(urdf / "two_link.urdf");
+  auto import = [&] {
+    const Outcome o = kccd::testing::runProgram(kCli + " import " + (urdf / "two_link.urdf").string() + " --srdf " +
+                                                (urdf / "two_link.srdf").string() + " --package-path kccd_test=" + urdf.string() +
+                                                " -k 4 -q -o " + (dir_ / "cell.yaml").string());
+    ASSERT_EQ(o.code, 0) << o.err;
+  };
+  import();
+  kccd::calib::saveCamera(kccd::testing::lookAt({1.4, -1.1, 0.7}, {0.05, 0.0, 0.3}, 320, 240, 320, {-0.06, 0.01, 0, 0, 0}),
+                          (dir_ / "cell_cam.yaml").string());
+  writeText(dir_ / "cell_golden.yaml", R"(kccd_golden: 1
+goldens: cell_goldens/
+defaults: {model: cell.yaml, camera: cell_cam.yaml, outputs: [mask, colour]}
+cases:
+  - {id: home, state: [0, 0.05, 0]}
+  - {id: turned, state: [0.8, 0.12, 1.0]}
+)");
+  const std::string m = (dir_ / "cell_golden.yaml").string();
+  ASSERT_EQ(golden("update " + m + " -q").code, 0);
+  const auto goldens = tree(dir_ / "cell_goldens");
+  import();
+  Outcome o = golden("run " + m + " --out " + out() + " -q");
+  EXPECT_EQ(o.code, 0) << "the same URDF imported again: " << o.out;
+
+  writeText(urdf / "two_link.urdf", replaced(original, R"(<cylinder radius="0.05" length="0.5"/>)", R"(<cylinder radius="0.055" length="0.5"/>)"));
+  import();
+  o = golden("run " + m + " --out " + out() + " -q");
+  EXPECT_EQ(o.code, 1) << o.out;
+  EXPECT_NE(o.out.find("home: mask failed"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("turned: mask failed"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("likely cause: the model changed (cell.yaml)"), std::string::npos) << o.out;
+  EXPECT_EQ(tree(dir_ / "cell_goldens"), goldens);
+}
+
+// `supersample` draws the case's images finer: the sidecar records it and the mask's edge bound
+// (render::Frame::mask_edge_px), which at 3 is under half a pixel where at 1 it is about one; the
+// two masks differ only along the edges.
+TEST_F(GoldenCli, SupersampleDrawsFinerMasks) {
+  writeText(dir_ / "fine.yaml", R"(kccd_golden: 1
+defaults: {model: robot.yaml, camera: front.yaml, outputs: [mask]}
+cases:
+  - {id: plain, state: [0.3, 0.4, 0.6]}
+  - {id: fine, state: [0.3, 0.4, 0.6], supersample: 3}
+)");
+  const std::string m = (dir_ / "fine.yaml").string();
+  ASSERT_EQ(golden("update " + m + " -q").code, 0);
+  EXPECT_EQ(golden("run " + m + " --out " + out() + " -q").code, 0);
+  const nlohmann::json plain = nlohmann::json::parse(readText(dir_ / "goldens/plain/golden.json"));
+  const nlohmann::json fine = nlohmann::json::parse(readText(dir_ / "goldens/fine/golden.json"));
+  EXPECT_EQ(plain["options"]["supersample"], 1.0);
+  EXPECT_EQ(fine["options"]["supersample"], 3.0);
+  const double edge_plain = plain["outputs"]["mask"]["edge_px"], edge_fine = fine["outputs"]["mask"]["edge_px"];
+  std::printf("mask edge bound: %.3f px at supersample 1, %.3f px at 3\n", edge_plain, edge_fine);
+  EXPECT_GT(edge_plain, 0.7);  // the front camera distorts: the nearest pinhole sample alone is up to 0.71 px
+  EXPECT_LE(edge_fine, 0.5);
+  const cv::Mat a = cv::imread((dir_ / "goldens/plain/mask.png").string(), cv::IMREAD_UNCHANGED);
+  const cv::Mat b = cv::imread((dir_ / "goldens/fine/mask.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(a.size(), cv::Size(320, 240));
+  ASSERT_EQ(b.size(), a.size());
+  cv::Mat edges;  // pixels next to a label change in the finer mask
+  cv::Mat grown, shrunk;
+  cv::dilate(b, grown, cv::Mat::ones(3, 3, CV_8U));
+  cv::erode(b, shrunk, cv::Mat::ones(3, 3, CV_8U));
+  edges = grown != shrunk;
+  const int differing = cv::countNonZero(a != b);
+  EXPECT_GT(differing, 0);
+  EXPECT_EQ(cv::countNonZero((a != b) & ~edges), 0) << "the masks differ only along edges";
 }
 
 TEST_F(GoldenCli, ListShowsMissingAndUnusedGoldens) {

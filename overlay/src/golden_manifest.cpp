@@ -26,6 +26,7 @@ bool validId(const std::string& id) {
 struct Shared {
   std::string model, camera, states, video;
   double time_offset = 0.0;
+  double supersample = 1.0;
   std::vector<GoldenOutput> outputs{GoldenOutput::Mask, GoldenOutput::Colour};
   MaskTolerance mask;
   ColourTolerance colour, overlay;
@@ -48,8 +49,8 @@ class ManifestReader {
     m.goldens = root["goldens"] ? resolve(r_.text(root["goldens"], "goldens")) : resolve("goldens");
     Shared defaults;
     if (const YAML::Node d = root["defaults"]) {
-      if (!d.IsMap()) r_.fail(d, "defaults", "expected a mapping of model, camera, outputs, compare, states, video, time_offset");
-      r_.onlyKeys(d, "defaults", {"model", "camera", "outputs", "compare", "states", "video", "time_offset"});
+      if (!d.IsMap()) r_.fail(d, "defaults", "expected a mapping of model, camera, outputs, compare, states, video, time_offset, supersample");
+      r_.onlyKeys(d, "defaults", {"model", "camera", "outputs", "compare", "states", "video", "time_offset", "supersample"});
       shared(d, "defaults", "defaults", defaults);
     }
     const YAML::Node cases = r_.require(root, "cases", "manifest");
@@ -122,6 +123,10 @@ class ManifestReader {
     if (n["states"]) s.states = resolve(r_.text(n["states"], field + ".states"));
     if (n["video"]) s.video = resolve(r_.text(n["video"], field + ".video"));
     if (n["time_offset"]) s.time_offset = r_.bounded(n["time_offset"], field + ".time_offset", 1e6, "1e6 s");
+    if (const YAML::Node ss = n["supersample"]) {
+      s.supersample = r_.number(ss, field + ".supersample");
+      if (!(s.supersample >= 1.0 && s.supersample <= 4.0)) r_.fail(ss, field + ".supersample", "must be in 1..4");
+    }
     if (const YAML::Node o = n["outputs"]) {
       if (!o.IsSequence() || o.size() == 0) r_.fail(o, field + ".outputs", "expected a list of mask, colour, overlay");
       s.outputs.clear();
@@ -144,7 +149,7 @@ class ManifestReader {
   GoldenCase readCase(const YAML::Node& n, std::size_t i, const Shared& defaults, std::map<std::string, std::size_t>& ids) const {
     std::string f = "cases[" + std::to_string(i) + "]";
     if (!n.IsMap()) r_.fail(n, f, "expected a mapping with id and state, lower/upper or video/frame");
-    r_.onlyKeys(n, f, {"id", "model", "camera", "outputs", "compare", "state", "lower", "upper", "video", "frame", "states", "time_offset"});
+    r_.onlyKeys(n, f, {"id", "model", "camera", "outputs", "compare", "state", "lower", "upper", "video", "frame", "states", "time_offset", "supersample"});
     GoldenCase c;
     c.where = r_.where(n);
     const YAML::Node id = r_.require(n, "id", f);
@@ -161,6 +166,7 @@ class ManifestReader {
     c.camera = s.camera;
     c.outputs = s.outputs;
     c.time_offset = s.time_offset;
+    c.supersample = s.supersample;
     c.mask = s.mask;
     c.colour = s.colour;
     c.overlay = s.overlay;

@@ -1,8 +1,11 @@
 #include "kccd/overlay/golden_render.hpp"
 
+#include <cmath>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <stdexcept>
+#include <tuple>
 
 #include <openssl/evp.h>
 #include <opencv2/imgcodecs.hpp>
@@ -66,7 +69,7 @@ struct GoldenRenderer::Impl {
   std::map<std::pair<std::string, std::string>, std::unique_ptr<StateLog>> logs;  // (log, model)
   std::map<std::size_t, LoadedFrame> frames;                                     // per frame case
   std::map<std::string, std::string> hashes;                                     // path -> sha256
-  std::map<std::pair<std::string, std::string>, std::unique_ptr<render::ModelView>> views;
+  std::map<std::tuple<std::string, std::string, double>, std::unique_ptr<render::ModelView>> views;
   std::string renderer;
 
   const std::string& hash(const std::string& path) {
@@ -80,10 +83,12 @@ struct GoldenRenderer::Impl {
   }
 
   render::ModelView& view(const GoldenCase& c) {
-    auto& v = views[{c.model, c.camera}];
+    auto& v = views[{c.model, c.camera, c.supersample}];
     if (!v) {
       try {
-        v = std::make_unique<render::ModelView>(*models.at(c.model), cameras.at(c.camera));
+        render::RenderOptions options;
+        options.supersample = options.mask_supersample = c.supersample;
+        v = std::make_unique<render::ModelView>(*models.at(c.model), cameras.at(c.camera), options);
       } catch (const calib::CameraError& e) {
         throw InputError(e.messageFrom(c.camera));
       }
@@ -153,11 +158,13 @@ GoldenRendering GoldenRenderer::render(std::size_t index) {
     inputs["states"] = {{"file", relativeTo(c.states, s.manifest.folder)}, {"sha256", s.hash(c.states)}};
     inputs["video"] = {{"file", relativeTo(c.video, s.manifest.folder)}, {"frame", c.frame}, {"time_offset", c.time_offset}};
     inputs["video_frame"] = {{"sha256", f.pixels_sha256}};
-    const render::Projection projection(s.cameras.at(c.camera));
+    const render::Projection projection(s.cameras.at(c.camera), c.supersample);
     AnnotatorSettings settings;
     settings.time_offset = c.time_offset;
     settings.max_gap = 1.5 * log.medianPeriod();
-    const AnnotatorScene scene{m, log, projection, render::RenderOptions{}, {}, settings};
+    render::RenderOptions options;
+    options.supersample = options.mask_supersample = c.supersample;
+    const AnnotatorScene scene{m, log, projection, options, {}, settings};
     FrameAnnotator annotator(scene);
     FrameRecord record;
     record.time = f.time;
@@ -215,6 +222,9 @@ GoldenRendering GoldenRenderer::render(std::size_t index) {
       nlohmann::json labels = nlohmann::json::object();
       for (std::size_t k = 0; k < g.labels.size(); ++k) labels[std::to_string(k + 1)] = g.labels[k];
       entry["labels"] = labels;
+      // How far from its centre a pixel's label may come from (null: no bound, a volume at the camera).
+      const double edge = drawn->images.mask_edge_px;
+      entry["edge_px"] = std::isfinite(edge) ? nlohmann::json(std::round(edge * 1e4) / 1e4) : nlohmann::json(nullptr);
     }
     outputs[goldenOutputName(o)] = entry;
     out.images.push_back(std::move(g));
@@ -223,7 +233,7 @@ GoldenRendering GoldenRenderer::render(std::size_t index) {
                  {"case", c.id},
                  {"kccd_version", kccdVersion()},
                  {"renderer", s.renderer},
-                 {"options", {{"supersample", 1.0}, {"tight_volumes", true}, {"legend", false}}},
+                 {"options", {{"supersample", c.supersample}, {"tight_volumes", true}, {"legend", false}}},
                  {"inputs", inputs},
                  {"outputs", outputs}};
   return out;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include <opencv2/core/utility.hpp>
@@ -129,6 +130,11 @@ PreparedFrame FramePreparer::prepare(std::span<const Volume> volumes, const Prep
   const std::uint64_t built_before = cache_.built();
   const Camera& cam = colour_.camera();
   const double focal = std::max(cam.camera_matrix(0, 0), cam.camera_matrix(1, 1));
+  // Camera pixels per metre across the line of sight at depth 1, at most; and the tessellation's
+  // tolerance, finer for a mask drawn finer.
+  const double px_per_metre = focal * mask_.obliquity() * mask_.stretch() * mask_.supersample();
+  const double tolerance = needs.mask ? options_.tolerance_px / mask_.supersample() : options_.tolerance_px;
+  const int max_level = needs.mask ? std::max(options_.max_level, options_.mask_max_level) : options_.max_level;
   out.resize(volumes.size());
   frame.visibility.assign(volumes.size(), Visibility::Empty);
   std::vector<Vec3> cam_points;
@@ -192,15 +198,17 @@ PreparedFrame FramePreparer::prepare(std::span<const Volume> volumes, const Prep
       continue;
     }
     zmin -= r;
-    int level = options_.max_level;
-    if (zmin > options_.near) {
-      const double r_px = focal * r / zmin;
-      for (int l = 1; l < options_.max_level; ++l)
-        if ((spherePolytope(l).scale - 1.0) * r_px <= options_.tolerance_px) {
+    // The radius in camera pixels where it is largest: nearest, at the image's most oblique
+    // direction, through the lens's largest stretch.
+    int level = max_level;
+    const double r_px = zmin > 0.0 ? px_per_metre * r / zmin : std::numeric_limits<double>::infinity();
+    if (zmin > options_.near)
+      for (int l = 1; l < max_level; ++l)
+        if ((spherePolytope(l).scale - 1.0) * r_px <= tolerance) {
           level = l;
           break;
         }
-    }
+    p.mesh_error_px = (spherePolytope(level).scale - 1.0) * r_px;
     // How near the mesh comes to the camera: the volume's distance less the tessellation's
     // outward error. A volume (nearly) containing the camera covers the whole view.
     const DistanceResult d = distance(SschView{cam_points, r}, SschView{std::span<const Vec3>(&origin, 1), 0.0});

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <opencv2/calib3d.hpp>
 
@@ -25,6 +26,10 @@ Projection::Projection(const Camera& camera, double supersample)
     pinhole_.width = static_cast<int>(std::lround(s * camera.width));
     pinhole_.height = static_cast<int>(std::lround(s * camera.height));
     warps_ = s != 1.0;
+    stretch_ = 1.0 / s;
+    for (const double x : {(-0.5 - cx) / fx, (camera.width - 0.5 - cx) / fx})
+      for (const double y : {(-0.5 - cy) / fy, (camera.height - 0.5 - cy) / fy})
+        obliquity_ = std::max(obliquity_, std::sqrt(1.0 + x * x + y * y));
     if (warps_) {
       map_x_.create(camera.height, camera.width, CV_32F);
       map_y_.create(camera.height, camera.width, CV_32F);
@@ -68,6 +73,27 @@ Projection::Projection(const Camera& camera, double supersample)
   pinhole_.width = static_cast<int>(std::ceil((xmax - xmin) * pinhole_.fx + 2 * pad)) + 1;
   pinhole_.height = static_cast<int>(std::ceil((ymax - ymin) * pinhole_.fy + 2 * pad)) + 1;
   warps_ = true;
+  // The Jacobian of the camera -> pinhole map from each pixel to its right and lower neighbours
+  // (left and upper on the last column and row): its smallest singular value is the least a camera
+  // pixel spans in pinhole pixels, the inverse of the most a pinhole pixel spans in the camera.
+  const int w = camera.width, h = camera.height;
+  double least = 1e300;
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const int i = v * w + u;
+      if (!valid[i]) continue;
+      const cv::Vec2d p = normal.at<cv::Vec2d>(i);
+      obliquity_ = std::max(obliquity_, std::sqrt(1.0 + p[0] * p[0] + p[1] * p[1]));
+      const int iu = u + 1 < w ? i + 1 : i - 1, iv = v + 1 < h ? i + w : i - w;
+      if (w < 2 || h < 2 || !valid[iu] || !valid[iv]) continue;
+      const double su = u + 1 < w ? 1.0 : -1.0, sv = v + 1 < h ? 1.0 : -1.0;
+      const cv::Vec2d du = (normal.at<cv::Vec2d>(iu) - p) * su, dv = (normal.at<cv::Vec2d>(iv) - p) * sv;
+      const double a = du[0] * pinhole_.fx, b = dv[0] * pinhole_.fx, c = du[1] * pinhole_.fy, d = dv[1] * pinhole_.fy;
+      const double t = a * a + b * b + c * c + d * d, det = a * d - b * c;
+      const double largest = std::sqrt(0.5 * (t + std::sqrt(std::max(0.0, t * t - 4.0 * det * det))));
+      least = std::min(least, largest > 0.0 ? std::abs(det) / largest : 0.0);
+    }
+  stretch_ = least >= 1e300 ? 1.0 / s : least > 0.0 ? 1.0 / least : std::numeric_limits<double>::infinity();
   map_x_.create(camera.height, camera.width, CV_32F);
   map_y_.create(camera.height, camera.width, CV_32F);
   for (int v = 0, i = 0; v < camera.height; ++v)

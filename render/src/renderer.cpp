@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -74,7 +75,7 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
   // Outlines from the cores for the tinted look's colour layer; meshes for the labels, the
   // shaded look, and what the outlines cannot draw.
   const bool outlines = want_colour && !style.shaded && options_.polygon_fill && options_.outline_from_core;
-  PreparedFrame prepared = preparer_->prepare(volumes, PrepareNeeds{.outlines = outlines, .meshes = want_mask || !outlines});
+  PreparedFrame prepared = preparer_->prepare(volumes, PrepareNeeds{.outlines = outlines, .meshes = want_mask || !outlines, .mask = want_mask});
   const std::vector<PreparedVolume>& bodies = prepared.volumes;
   Frame frame = std::move(prepared.frame);
   tick("prepare");
@@ -98,6 +99,13 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     std::array<int, 256> counts{};
     frame.mask = label_warp_->apply(pinhole_labels, counts);
     tick("mask");
+    // Each label from the nearest pinhole sample (through a warp) of a mesh drawn a little outside.
+    const Projection& mp = maskProjection();
+    frame.mask_edge_px = mp.warps() ? std::sqrt(0.5) * mp.stretch() : 0.0;
+    double mesh_error = 0.0;
+    for (const PreparedVolume& p : bodies)
+      if (p.mesh && !p.surface) mesh_error = std::max(mesh_error, p.mesh_error_px);
+    frame.mask_edge_px += mesh_error;
     frame.pixels.assign(volumes.size(), 0);
     for (std::size_t i = 0; i < volumes.size(); ++i) frame.pixels[i] = counts[static_cast<std::size_t>(bodies[i].label)];
   }

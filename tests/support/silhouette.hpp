@@ -17,8 +17,10 @@ namespace kccd::testing {
 // the radius centred on a dense set of points of the core hull (vertices, edges, triangles),
 // each ball's rim sampled densely, projected, and its convex outline filled at 7x resolution
 // (pixel (x, y) is the 7x pixel (7x + 3, 7y + 3)), so the fill follows pixel centres to ~0.1 px.
-inline cv::Mat cpuSilhouette(const calib::Camera& c, const std::vector<Vec3>& pts, double radius) {
-  const int k = 7;
+// This is the 7x image itself (kSilhouetteScale); cpuSilhouette below samples it at pixel centres.
+constexpr int kSilhouetteScale = 7;
+inline cv::Mat cpuSilhouetteFine(const calib::Camera& c, const std::vector<Vec3>& pts, double radius) {
+  const int k = kSilhouetteScale;
   cv::Mat big = cv::Mat::zeros(c.height * k, c.width * k, CV_8UC1);
   std::vector<Vec3> centres = pts;
   const double step = radius / 6.0;
@@ -54,6 +56,13 @@ inline cv::Mat cpuSilhouette(const calib::Camera& c, const std::vector<Vec3>& pt
     cv::convexHull(fixed, hull);
     cv::fillConvexPoly(big, hull, cv::Scalar(1), cv::LINE_8, 8);
   }
+  return big;
+}
+
+// The silhouette at pixel centres (1 inside, 0 outside).
+inline cv::Mat cpuSilhouette(const calib::Camera& c, const std::vector<Vec3>& pts, double radius) {
+  const int k = kSilhouetteScale;
+  const cv::Mat big = cpuSilhouetteFine(c, pts, radius);
   cv::Mat out(c.height, c.width, CV_8UC1);
   for (int y = 0; y < c.height; ++y)
     for (int x = 0; x < c.width; ++x) out.at<uchar>(y, x) = big.at<uchar>(y * k + k / 2, x * k + k / 2);

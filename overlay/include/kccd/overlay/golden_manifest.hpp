@@ -34,6 +34,9 @@ struct GoldenCase {
   std::string video, states;         ///< a recorded frame composited, its state from the log
   std::int64_t frame = -1;
   double time_offset = 0.0;          ///< added to the frame's time to get the log's time (s)
+  /// Pinhole scale (1..4) of the mask and colour images: finer masks follow the volumes' edges
+  /// closer (render::Frame::mask_edge_px).
+  double supersample = 1.0;
   MaskTolerance mask;
   ColourTolerance colour, overlay;
   ToleranceSource tolerance_source;

@@ -43,6 +43,9 @@ struct PreparedVolume {
   double depth = 0.0;                                       ///< distance from the camera to its centre (drawing order)
   bool fills = false;                                       ///< contains the camera: drawn as a full-view fill, no mesh
   int level = 0;                                            ///< sphere tessellation level
+  /// How far, at most, its mesh shows outside the true volume in the camera image, camera pixels
+  /// (0 for surfaces, infinite when the volume reaches the camera's plane).
+  double mesh_error_px = 0.0;
   double clearance = 0.0;                                   ///< distance from the camera to the mesh (lower bound), when drawn
   double reach = 0.0;                                       ///< distance from the camera to the farthest point of the mesh
   bool surface = false;                                     ///< a Volume::surface: both sides drawn, no outline
@@ -58,6 +61,8 @@ struct PreparedVolume {
 struct PrepareNeeds {
   bool outlines = true;  ///< outlines from the cores where they can be had (the tinted colour layer)
   bool meshes = true;    ///< meshes also for outlined volumes (the mask, the shaded look)
+  /// A mask is drawn: meshes fine enough for the mask's scale (tolerance_px / mask supersample).
+  bool mask = false;
 };
 
 /// A prepared frame: per volume what to draw, and the frame's visibility, clipping planes and

@@ -51,12 +51,20 @@ class Projection {
   /// Where the drawn image shows a world point in the camera image: pinholePixel, then the
   /// camera's distortion model (what the warp inverts). Equals cv::projectPoints to ~1e-3 px.
   Eigen::Vector2d project(const Vec3& world) const;
+  /// The most one pinhole pixel spans in the camera image, in camera pixels: the largest singular
+  /// value of the pinhole -> camera map's Jacobian over the image (1 / supersample without
+  /// distortion). A label taken at the nearest pinhole pixel lies within sqrt(2)/2 of this.
+  double stretch() const { return stretch_; }
+  /// The largest sqrt(1 + x^2 + y^2) over the image's normalised coordinates (x, y): a point at
+  /// depth z moved by d metres moves at most f d sqrt(1 + x^2 + y^2) / z pinhole pixels at scale 1.
+  double obliquity() const { return obliquity_; }
 
  private:
   Camera camera_;
   double supersample_ = 1.0;
   Pinhole pinhole_;
   bool warps_ = false;
+  double stretch_ = 1.0, obliquity_ = 1.0;
   cv::Mat map_x_, map_y_;
   Pose world_to_camera_;
 };

@@ -73,8 +73,10 @@ struct Style {
 /// Renderer settings fixed at construction.
 struct RenderOptions {
   double supersample = 1.0;    ///< pinhole image scale (1..4); > 1 keeps thin slivers through the warp
-  /// Pinhole scale of the mask when the camera distorts: the warp samples the mask at the nearest
-  /// pinhole pixel, so label edges are within 1/(2 s) px. At the colour pass's scale (the default)
+  /// Pinhole scale of the mask when the camera distorts: the warp takes each label from the
+  /// nearest pinhole pixel, which lies within sqrt(2)/2 pinhole pixels of the exact point, and the
+  /// meshes for a mask are tessellated to tolerance_px / s (Frame::mask_edge_px is the bound that
+  /// results: about 1 px at 1, under 0.5 px at 3 for a mild lens). At the colour pass's scale (the default)
   /// the labels go into a second attachment of the colour pass's framebuffer, drawn just before
   /// the colour; another scale (e.g. 2 for ground truth) draws them into a framebuffer of its own.
   double mask_supersample = 1.0;
@@ -95,6 +97,7 @@ struct RenderOptions {
   bool outline_from_core = true;
   double tolerance_px = 0.5;   ///< largest outward error of the sphere tessellation, output pixels
   int max_level = 3;           ///< finest sphere tessellation (level 3: 642 vertices, 0.3 % outward)
+  int mask_max_level = 4;      ///< finest tessellation when a mask is drawn (level 4: 2562 vertices, 0.08 % outward)
   double min_radius = kMinDrawRadius;  ///< volumes thinner than this are drawn this thick (metres)
   /// Clipping planes, metres along the optical axis. Per frame, the near plane moves closer
   /// when a volume comes nearer to the camera than this, and the far plane moves out to the
@@ -120,6 +123,11 @@ struct Frame {
   int outlines = 0;       ///< of those, volumes drawn from their outline computed from the core (RenderOptions::outline_from_core)
   int hull_input = 0;     ///< points passed to qhull for the meshes built in this frame
   int max_level = 0;      ///< finest sphere tessellation used
+  /// With a mask: how far from its centre, at most, the point lies whose label a mask pixel shows,
+  /// camera pixels (the nearest pinhole sample through the warp, plus the meshes' outward error).
+  /// Each label's region thus lies within this of the exact pixel-centre labels of the volumes as
+  /// drawn; infinite when a volume reaches the camera's plane.
+  double mask_edge_px = 0.0;
 };
 
 }  // namespace kccd::render
