@@ -69,7 +69,7 @@ TEST(Cli, QueryExactStageChoices) {
   // A wide swing of the demo arm: the exact stage tightens every pair it refines, never loosens.
   const std::string box = "query " + kDemo + " --lower -0.6,0.1,0.2 --upper 0.6,0.5,0.8 --type distances --json";
   std::map<std::string, nlohmann::json> runs;
-  for (const char* exact : {"off", "margin", "all", "0.25"}) {
+  for (const char* exact : {"off", "margin", "band", "all", "0.25"}) {
     const Outcome r = runKccd(box + " --exact " + exact);
     ASSERT_EQ(r.code, 0) << exact << ": " << r.err;
     runs[exact] = nlohmann::json::parse(r.out);
@@ -81,19 +81,25 @@ TEST(Cli, QueryExactStageChoices) {
   for (std::size_t k = 0; k < runs["off"]["pairs"].size(); ++k) {
     const double off = runs["off"]["pairs"][k]["distance"], all = runs["all"]["pairs"][k]["distance"];
     const double margin = runs["margin"]["pairs"][k]["distance"], quarter = runs["0.25"]["pairs"][k]["distance"];
+    const double band = runs["band"]["pairs"][k]["distance"];
     EXPECT_GE(all, off);
     EXPECT_GE(margin, off);
     EXPECT_GE(quarter, margin - 1e-12);
+    EXPECT_GE(band, margin);  // the band refines more pairs: never looser
     tighter += all > off + 1e-6;
   }
   EXPECT_GT(tighter, 0);
-  // The default is the margin.
+  // The default is the band (0.2 m above the margin for distance queries), which here refines
+  // pairs the margin alone leaves to the point volumes.
   const auto plain = nlohmann::json::parse(runKccd(box).out);
-  EXPECT_EQ(plain["pairs"], runs["margin"]["pairs"]);
+  EXPECT_EQ(plain["pairs"], runs["band"]["pairs"]);
+  EXPECT_GT(runs["band"]["stats"]["exact_calls"].get<int>(), runs["margin"]["stats"]["exact_calls"].get<int>());
+  const auto narrow_band = nlohmann::json::parse(runKccd(box + " --exact-band 0").out);
+  EXPECT_EQ(narrow_band["pairs"], runs["margin"]["pairs"]);
   for (const char* bad : {"sometimes", "-1", "nan", "2e6"}) {
     const Outcome r = runKccd(box + " --exact " + bad, true);
     EXPECT_EQ(r.code, 2) << bad;
-    EXPECT_NE(r.out.find("--exact: expected margin, all, off or a distance"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--exact: expected band, margin, all, off or a distance"), std::string::npos) << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
   }
 }

@@ -52,9 +52,12 @@ bool runCase(std::uint64_t seed, Tally& tally, std::string& why,
   Checker checker(m);
   QueryOptions opt;
   opt.type = QueryType::Distances;
-  // Every third case refines every pair by the exact stage, every third none.
+  // Every third case refines every pair by the exact stage (those clear of the margin to
+  // kExactDistanceTolerance), every third the default (the margin plus a band of 0.2 m or of 5 m:
+  // every pair of most trees), every third none.
   opt.exact_below = seed % 3 == 0 ? std::numeric_limits<double>::infinity() : seed % 3 == 1 ? -1.0 : -std::numeric_limits<double>::infinity();
   opt.tight_volumes = (seed / 3) % 2 == 0;  // the display volumes are bounds too
+  opt.exact_band = (seed / 6) % 2 == 0 ? 0.2 : 5.0;
   const QueryResult& r = checker.query(lower, upper, opt);
   if (r.status != Status::Ok) {
     why = std::string("status ") + toString(r.status);

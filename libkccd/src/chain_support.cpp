@@ -91,7 +91,8 @@ double chainExtent(const ChainView& chain) noexcept {
   return top.center.norm() + top.radius;
 }
 
-SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work, int max_nodes, long* nodes) noexcept {
+SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work, int max_nodes, double tolerance,
+                        long* nodes) noexcept {
   const int depth = static_cast<int>(chain.levels.size());
   const double dn = dir.norm();
   const Vec3 d = dn > 0.0 ? Vec3(dir / dn) : Vec3::UnitX();
@@ -107,7 +108,7 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work
   // Branches whose bound exceeds the best leaf by at most this are not explored: near-ties are
   // common (directions where several maps give almost the same value), and the slack they leave
   // costs the distance bound at most this much per support.
-  const double tolerance = kSupportTolerance * chainExtent(chain);
+  if (!(tolerance >= 0.0)) tolerance = kSupportTolerance * chainExtent(chain);
 
   auto leaf = [&](const Vec3& row, double offset) {
     int arg = 0;

@@ -67,10 +67,11 @@ int chainStackSize(int levels) noexcept;
 /// the slack by which the true support value may exceed its value along dir / |dir| (0 when the
 /// search completed, up to rounding). The search stops after `max_nodes` nodes with a valid slack.
 /// A warm `work` starts from its last best leaf (successive GJK directions differ little), which
-/// prunes most of the tree at once; `work` is left warm. `nodes` (if not null) accumulates the
-/// nodes visited.
+/// prunes most of the tree at once; `work` is left warm. Branches that cannot beat the best leaf by
+/// more than `tolerance` (metres; negative: 1e-5 of the chain's extent) are not explored, their
+/// excess counted in the slack. `nodes` (if not null) accumulates the nodes visited.
 SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work, int max_nodes,
-                        long* nodes = nullptr) noexcept;
+                        double tolerance = -1.0, long* nodes = nullptr) noexcept;
 
 /// A bound on |x| for every core point x of the chain (for rounding guards).
 double chainExtent(const ChainView& chain) noexcept;

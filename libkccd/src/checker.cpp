@@ -20,6 +20,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Nodes one support search of the exact stage may visit (bounds its time; a search stopped early
 // still gives a valid bound).
 constexpr int kExactNodes = 2048;
+// The apex chains are searched for a distance only when they can lift the bound by more than this.
+constexpr double kExactDistanceGain = 2e-3;
 // With QueryOptions::tight_volumes, a sweep whose radius growth exceeds this fraction of the swept
 // sphere's radius also tries the other cover (chords for every point, reduced to the budget).
 constexpr double kCoarseCover = 0.02;
@@ -339,6 +341,9 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
   const double stop_below =
       result_.type == QueryType::Collision || exact_below_ <= result_.margin ? result_.margin : -kInf;
   double chord_upper = kInf;  // upper bound on the distance of the chord chains' cores
+  // A pair already clear of the margin is refined for its distance only: supports to within
+  // kExactDistanceTolerance (their slack counted in the bound) and GJK to a relative 1e-3.
+  const bool for_distance = bound > result_.margin;
   for (int variant = 0; variant < 2; ++variant) {
     if (bound > stop_above) break;
     detail::ChainView ca, cb;
@@ -349,6 +354,9 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
     // The apex chains hold the chord chains' cores (chord ends are among their maps) with smaller
     // radii: when the chord cores are proven close enough, the apex chains are within the margin too.
     if (variant == 1 && chord_upper - ca.radius - cb.radius <= stop_below) break;
+    // Nor can they lift a distance above that: refined for its distance, a pair whose bound is
+    // already within the tolerance of it keeps the chord chains' bound.
+    if (variant == 1 && for_distance && chord_upper - ca.radius - cb.radius <= bound + kExactDistanceGain) break;
     detail::SetsInfo info;
     info.scale_a = detail::chainExtent(ca);
     info.scale_b = detail::chainExtent(cb);
@@ -357,14 +365,16 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
     // One work area per side (each keeps its chain's last best leaf); the stack is shared.
     detail::ChainWork work_a{chain_stack_.data(), chain_choice_.data(), chain_best_.data()};
     detail::ChainWork work_b{chain_stack_.data(), chain_choice_.data(), chain_best_.data() + max_levels};
-    auto support_a = [&](const Vec3& dir) { return detail::chainSupport(ca, dir, work_a, kExactNodes); };
-    auto support_b = [&](const Vec3& dir) { return detail::chainSupport(cb, dir, work_b, kExactNodes); };
+    const double tolerance = for_distance ? kExactDistanceTolerance : -1.0;
+    auto support_a = [&](const Vec3& dir) { return detail::chainSupport(ca, dir, work_a, kExactNodes, tolerance); };
+    auto support_b = [&](const Vec3& dir) { return detail::chainSupport(cb, dir, work_b, kExactNodes, tolerance); };
     GjkOptions opt;
     opt.stop_above = stop_above;
     opt.stop_below = stop_below;
     opt.warm_start = &e.direction;
     opt.max_iterations = 64;
     opt.relative_tolerance = 1e-9;
+    if (for_distance) opt.relative_tolerance = 1e-3;
     const DistanceResult d = detail::gjkDistance(support_a, support_b, ca.radius, cb.radius, info, opt);
     ++result_.stats.exact_calls;
     if (d.status == GjkStatus::InvalidInput || !std::isfinite(d.distance)) return false;
@@ -449,9 +459,11 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   result_.margin = options.margin >= 0.0 ? options.margin : model_.safety_margin;
   const double margin = result_.margin;
   tight_volumes_ = options.tight_volumes;
+  const double band = options.exact_band > 0.0 ? options.exact_band : 0.0;  // (NaN: none)
   exact_below_ = std::isnan(options.exact_below) || options.exact_below == -kInf ? -kInf
-                 : options.exact_below < 0.0                                  ? margin
-                                                                              : options.exact_below;
+                 : options.exact_below >= 0.0                                 ? options.exact_below
+                 : options.type == QueryType::Collision                       ? margin
+                                                                              : margin + band;
   if (!validate(lower, upper)) {
     result_.collision = true;
     result_.min_distance = 0.0;

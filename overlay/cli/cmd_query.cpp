@@ -22,14 +22,17 @@ struct QueryArgs {
   int n = 1;
   double margin = -1.0;
   double budget_us = 0.0;
-  std::string exact = "margin";
+  std::string exact = "band";
+  double exact_band = 0.2;
   bool json = false;
   bool explain = false;
 };
 
-// --exact: which pairs the exact stage refines (QueryOptions::exact_below).
-double parseExact(const std::string& e) {
-  if (e == "margin") return -1.0;
+// --exact: which pairs the exact stage refines (QueryOptions::exact_below); `margin` is the
+// query's margin (the model's unless --margin).
+double parseExact(const std::string& e, double margin) {
+  if (e == "band") return -1.0;
+  if (e == "margin") return margin;
   if (e == "all") return std::numeric_limits<double>::infinity();
   if (e == "off") return -std::numeric_limits<double>::infinity();
   try {
@@ -38,7 +41,7 @@ double parseExact(const std::string& e) {
     if (used == e.size() && std::isfinite(d) && d >= 0.0 && d <= kMaxModelLength) return d;
   } catch (const std::exception&) {
   }
-  throw UsageError("--exact: expected margin, all, off or a distance from 0 to 1e6 m, got '" + printable(e) + "'");
+  throw UsageError("--exact: expected band, margin, all, off or a distance from 0 to 1e6 m, got '" + printable(e) + "'");
 }
 
 QueryType parseType(const std::string& t) {
@@ -101,7 +104,8 @@ Exit runQuery(const QueryArgs& args) {
   opt.n = args.n;
   opt.margin = args.margin;
   opt.budget_us = args.budget_us;
-  opt.exact_below = parseExact(args.exact);
+  opt.exact_below = parseExact(args.exact, args.margin >= 0.0 ? args.margin : m.safety_margin);
+  opt.exact_band = args.exact_band;
   const QueryResult& r = checker.query(lower, upper, opt);
   const bool explain = args.explain && r.status == Status::Ok;
   const std::vector<PairExplanation> explained =
@@ -174,9 +178,14 @@ Runner addQuery(CLI::App& app) {
       ->check(finiteIn(0.0, kMaxBudgetUs));
   sub->add_option("--exact", args->exact,
                   "Which pairs the exact stage refines (swept volumes with no point budget, tight, slower): "
-                  "margin (every pair whose bound is within the margin: decides every verdict), all (every pair: "
-                  "tight distances), off (point volumes only), or a distance in metres")
+                  "band (collision: every pair whose bound is within the margin, which decides every verdict; "
+                  "closest, nclosest, distances: also every pair within --exact-band above it, for tight distances), "
+                  "margin (only the verdicts), all (every pair), off (point volumes only), or a distance in metres")
       ->capture_default_str();
+  sub->add_option("--exact-band", args->exact_band,
+                  "With --exact band: how far above the margin (metres) a distance query's pairs are refined")
+      ->capture_default_str()
+      ->check(finiteIn(0.0, kMaxModelLength));
   sub->add_flag("--json", args->json, "Machine-readable output");
   sub->add_flag("--explain", args->explain,
                 "For every pair whose bound is <= the margin, search the box for its closest configuration and "

@@ -11,8 +11,16 @@
 // are distances at configurations inside the box), and how often and by how much they differ is
 // reported. Every found configuration is re-measured by the exact Checker: its lower bound there
 // must not exceed the found distance (else the run fails: the search would be wrong).
+// Bodies behind a 3-DOF joint with error bounds (the cell's mock-up pose) are searched over the box
+// widened by the error bounds (searchBoxOf), so found distances are ones the true cell can have.
 // Then, per setting:
-//   looseness   = found - bound (mm), over near pairs (found < kNear, found > 0): median and p90;
+//   distances time, also over the verdict-only distances query (exact stage at the margin) timed
+//                 interleaved on the same boxes;
+//   looseness in band = found - bound (mm) over every pair whose bound is within kBand of the margin
+//                 (whatever was found): p50 / p90 / max, and p90 / max by the number of swept
+//                 joints between the two bodies (0-2, 3-5, 6-8, 9-11, 12+);
+//   near-pair looseness = found - bound (mm), over pairs found near (found < kNear, found > 0):
+//                 median and p90 (leaves out pairs found far whose bound is low);
 //   false alarm = a box where some pair's bound <= margin while no found distance is <= margin
 //                 (% of all boxes, and of the truly clear ones); per pair: a pair clear of the
 //                 margin (found > margin; unsearched pairs count as clear) whose bound is <= margin,
@@ -30,7 +38,7 @@
 //
 // Usage: bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]
 //                    [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]
-//                    [--exact margin|all|off]
+//                    [--exact default|margin|all|off|METRES]
 //                    [--markdown F] [--csv F] [--plot F.png]
 // Exit status: 0 done, 1 error, 2 bad option, 3 a bound violation, 4 a found distance below the
 // exact bound at its own configuration (a wrong search).
@@ -64,6 +72,11 @@ using namespace kccd;
 using Clock = std::chrono::steady_clock;
 constexpr double kDeg = 3.141592653589793 / 180.0;
 constexpr double kNear = 0.3;  // m: pairs closer than this count as near
+constexpr double kBand = 0.2;  // m above the margin: the pairs whose looseness is reported
+// Chain-length bins of the looseness table: swept joints between the two bodies.
+constexpr int kChainBins = 5;
+constexpr const char* kChainBinNames[kChainBins] = {"0-2", "3-5", "6-8", "9-11", "12+"};
+int chainBin(int joints) { return std::min(joints / 3, kChainBins - 1); }
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -71,8 +84,10 @@ using bench::Oracle;
 using bench::Options;
 using bench::parseOptions;
 
-// The measured queries' exact stage (--exact), the same for every setting.
+// The measured queries' exact stage (--exact), the same for every setting; kExactAtMargin is
+// resolved to the model's margin.
 double g_exact_below = -1.0;
+double exactBelow(const Model& m) { return g_exact_below == bench::kExactAtMargin ? m.safety_margin : g_exact_below; }
 
 [[noreturn]] void fail(const std::string& message) {
   std::fprintf(stderr, "bench_trade: %s\n", message.c_str());
@@ -177,14 +192,15 @@ std::vector<Setting> makeSettings(const Model& base, const std::vector<int>& bud
 }
 
 // The cold time of one query (table reset before each run): the fastest of `repeats` runs, in us.
-double coldTime(Checker& checker, const Box& box, bool at_centre, QueryType type, int repeats) {
+// `exact_below` as QueryOptions::exact_below.
+double coldTime(Checker& checker, const Box& box, bool at_centre, QueryType type, int repeats, double exact_below) {
   const std::vector<double>& lo = at_centre ? box.centre : box.lower;
   const std::vector<double>& hi = at_centre ? box.centre : box.upper;
   double best = kInf;
   for (int r = 0; r < repeats; ++r) {
     checker.reset();
     const auto t0 = Clock::now();
-    const QueryResult& res = checker.query(lo, hi, {.type = type, .exact_below = g_exact_below});
+    const QueryResult& res = checker.query(lo, hi, {.type = type, .exact_below = exact_below});
     const double us = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
     if (res.status != Status::Ok) fail(std::string("unexpected query status ") + toString(res.status));
     best = std::min(best, us);
@@ -196,7 +212,7 @@ double coldTime(Checker& checker, const Box& box, bool at_centre, QueryType type
 std::vector<double> distancesBounds(Checker& checker, const Box& box, bool at_centre) {
   checker.reset();
   const QueryResult& r = checker.query(at_centre ? box.centre : box.lower, at_centre ? box.centre : box.upper,
-                                       {.type = QueryType::Distances, .exact_below = g_exact_below});
+                                       {.type = QueryType::Distances, .exact_below = exactBelow(checker.model())});
   std::vector<double> out(checker.model().pairs.size(), 0.0);
   for (const PairDistance& p : r.pairs) out[static_cast<std::size_t>(p.pair)] = p.distance;
   return out;
@@ -207,6 +223,7 @@ std::vector<double> distancesBounds(Checker& checker, const Box& box, bool at_ce
 
 struct Timing {
   double distances_us = 0.0, collision_us = 0.0;
+  double verdict_us = 0.0;  // the distances query refining only verdicts (exact stage at the margin)
 };
 
 struct BoxRecord {
@@ -223,13 +240,17 @@ void measureBox(std::vector<Setting>& settings, Checker& exact, const Box& box, 
   // Settings interleaved per box, so that load on the shared machine hits them alike.
   for (Setting& s : settings) {
     Timing t;
-    t.distances_us = coldTime(*s.checker, box, false, QueryType::Distances, repeats);
-    t.collision_us = coldTime(*s.checker, box, false, QueryType::Collision, repeats);
+    const double below = exactBelow(*s.model), margin = s.model->safety_margin;
+    t.distances_us = coldTime(*s.checker, box, false, QueryType::Distances, repeats, below);
+    t.collision_us = coldTime(*s.checker, box, false, QueryType::Collision, repeats, below);
+    t.verdict_us = coldTime(*s.checker, box, false, QueryType::Distances, repeats, margin);
     rec.times.push_back(t);
     rec.bounds.push_back(distancesBounds(*s.checker, box, false));
   }
-  rec.point.distances_us = coldTime(exact, box, true, QueryType::Distances, repeats);
-  rec.point.collision_us = coldTime(exact, box, true, QueryType::Collision, repeats);
+  const double below = exactBelow(exact.model());
+  rec.point.distances_us = coldTime(exact, box, true, QueryType::Distances, repeats, below);
+  rec.point.collision_us = coldTime(exact, box, true, QueryType::Collision, repeats, below);
+  rec.point.verdict_us = rec.point.distances_us;
   rec.point_bounds = distancesBounds(exact, box, true);
 }
 
@@ -286,9 +307,28 @@ double exactBoundAt(Checker& exact, int pair, const std::vector<double>& state) 
   return kInf;
 }
 
+// The box the searches explore: `box`, and for a 3-DOF joint with an error bound e (translation3d:
+// metres, rotation3d: radians) each of its values widened by e / sqrt(3), so that the search also
+// varies the pose within its error bounds. Every configuration in it is one the error bounds
+// allow (a translation within e, and, exp being 1-Lipschitz on SO(3), a rotation within e of one
+// in the box), so a distance found in it is a distance the true cell can have.
+Box searchBoxOf(const Model& m, const Box& box) {
+  Box out = box;
+  for (const Joint& j : m.joints) {
+    if (!(j.error > 0.0) || j.dof != 3) continue;
+    for (int k = 0; k < 3; ++k) {
+      const auto s = static_cast<std::size_t>(j.state_offset + k);
+      out.lower[s] -= j.error / std::sqrt(3.0);
+      out.upper[s] += j.error / std::sqrt(3.0);
+    }
+  }
+  return out;
+}
+
 // Searches every pair whose best bound over all settings is below kNear (the others cannot be near).
-void searchBox(const Model& nominal, kccd::bench::BoxSearch& own, Checker& exact, const Options& o, const Box& box,
+void searchBox(const Model& nominal, kccd::bench::BoxSearch& own, Checker& exact, const Options& o, const Box& given,
                std::uint64_t seed, BoxRecord& rec, SearchCheck& check, long& evaluations) {
+  const Box box = searchBoxOf(nominal, given);
   const std::size_t pairs = nominal.pairs.size();
   rec.found.assign(pairs, kInf);
   rec.centre_distance.assign(pairs, kInf);
@@ -299,7 +339,7 @@ void searchBox(const Model& nominal, kccd::bench::BoxSearch& own, Checker& exact
     const int pair = static_cast<int>(p);
     const Found f = closestInBox(nominal, own, o, pair, box, seed * 1000003 + p, check, evaluations);
     rec.found[p] = f.distance;
-    rec.centre_distance[p] = own.distanceAt(pair, box.centre);
+    rec.centre_distance[p] = own.distanceAt(pair, given.centre);
     if (f.distance <= nominal.safety_margin) rec.within = true;
 
     const double at_found = exactBoundAt(exact, pair, f.state);
@@ -328,7 +368,14 @@ struct Row {
   double distances_us = kNaN, distances_clear_us = kNaN, distances_within_us = kNaN;  // medians
   double clear_med = kNaN, clear_p90 = kNaN, within_med = kNaN, within_p90 = kNaN;
   double ratio = kNaN;  // collision on truly clear boxes / point-state collision on the same boxes
-  double loose_med = kNaN, loose_p90 = kNaN;
+  double loose_med = kNaN, loose_p90 = kNaN;  // near pairs (found < kNear)
+  // Pairs whose bound is within kBand of the margin: overall, and per chain-length bin.
+  double band_med = kNaN, band_p90 = kNaN, band_max = kNaN;
+  long band_pairs = 0;
+  double bin_p90[kChainBins] = {kNaN, kNaN, kNaN, kNaN, kNaN}, bin_max[kChainBins] = {kNaN, kNaN, kNaN, kNaN, kNaN};
+  long bin_pairs[kChainBins] = {0, 0, 0, 0, 0};
+  double verdict_us = kNaN;        // median verdict-only distances query
+  double over_verdict = kNaN;      // median distances / median verdict-only distances
   double alarm_boxes_pct = kNaN, alarm_clear_pct = kNaN, alarm_pairs_pct = kNaN;
   long far_alarms = 0;  // pairs with found >= kNear (not near) whose bound is within the margin
   long violations = 0;
@@ -351,9 +398,10 @@ struct SetSummary {
 };
 
 // Statistics of one setting's bounds and times over all boxes (`point`: the point-state query).
-Row summarise(const std::vector<BoxRecord>& recs, double margin, int setting, bool point,
-              std::vector<Violation>& violations) {
-  std::vector<double> dist_us, dist_clear_us, dist_within_us, clear_us, within_us, point_clear_us, loose;
+Row summarise(const std::vector<BoxRecord>& recs, double margin, const std::vector<int>& chain_joints, int setting,
+              bool point, std::vector<Violation>& violations) {
+  std::vector<double> dist_us, dist_clear_us, dist_within_us, clear_us, within_us, point_clear_us, loose, verdict_us;
+  std::vector<double> band, bins[kChainBins];
   long alarms = 0, clear_boxes = 0, pair_alarms = 0, clear_pairs = 0;
   Row row;
   for (std::size_t i = 0; i < recs.size(); ++i) {
@@ -362,6 +410,7 @@ Row summarise(const std::vector<BoxRecord>& recs, double margin, int setting, bo
     const std::vector<double>& bounds = point ? r.point_bounds : r.bounds[static_cast<std::size_t>(setting)];
     const std::vector<double>& truth = point ? r.centre_distance : r.found;
     dist_us.push_back(t.distances_us);
+    verdict_us.push_back(t.verdict_us);
     (r.within ? dist_within_us : dist_clear_us).push_back(t.distances_us);
     (r.within ? within_us : clear_us).push_back(t.collision_us);
     if (!r.within) point_clear_us.push_back(r.point.collision_us);
@@ -379,6 +428,11 @@ Row summarise(const std::vector<BoxRecord>& recs, double margin, int setting, bo
         violations.push_back({static_cast<int>(i), point ? -1 : setting, static_cast<int>(p), bounds[p], truth[p]});
       }
       if (truth[p] < kNear && truth[p] > 0.0) loose.push_back(1000.0 * (truth[p] - bounds[p]));
+      if (bounds[p] <= margin + kBand) {  // every pair the bound puts within the band, whatever was found
+        const double l = 1000.0 * (truth[p] - bounds[p]);
+        band.push_back(l);
+        bins[chainBin(chain_joints[p])].push_back(l);
+      }
     }
     if (!r.within) {
       ++clear_boxes;
@@ -395,12 +449,38 @@ Row summarise(const std::vector<BoxRecord>& recs, double margin, int setting, bo
   row.ratio = row.clear_med / quantile(point_clear_us, 0.5);
   row.loose_med = quantile(loose, 0.5);
   row.loose_p90 = quantile(loose, 0.9);
+  row.band_med = quantile(band, 0.5);
+  row.band_p90 = quantile(band, 0.9);
+  row.band_max = quantile(band, 1.0);
+  row.band_pairs = static_cast<long>(band.size());
+  for (int b = 0; b < kChainBins; ++b) {
+    row.bin_p90[b] = quantile(bins[b], 0.9);
+    row.bin_max[b] = quantile(bins[b], 1.0);
+    row.bin_pairs[b] = static_cast<long>(bins[b].size());
+  }
+  row.verdict_us = quantile(verdict_us, 0.5);
+  row.over_verdict = row.distances_us / row.verdict_us;
   if (!point) {
     row.alarm_boxes_pct = 100.0 * static_cast<double>(alarms) / static_cast<double>(recs.size());
     if (clear_boxes > 0) row.alarm_clear_pct = 100.0 * static_cast<double>(alarms) / static_cast<double>(clear_boxes);
     if (clear_pairs > 0) row.alarm_pairs_pct = 100.0 * static_cast<double>(pair_alarms) / static_cast<double>(clear_pairs);
   }
   return row;
+}
+
+// Per pair, the swept (non-fixed) joints between its two bodies: from each body's frame up to,
+// not including, their least common ancestor.
+std::vector<int> chainJoints(const Model& m) {
+  std::vector<int> out;
+  for (const BodyPair& p : m.pairs) {
+    int n = 0;
+    for (const int body : {p.a, p.b})
+      for (int f = m.bodies[static_cast<std::size_t>(body)].frame; f != p.lca && f != kWorld;
+           f = m.joints[static_cast<std::size_t>(f)].parent)
+        n += m.joints[static_cast<std::size_t>(f)].type != JointType::Fixed ? 1 : 0;
+    out.push_back(n);
+  }
+  return out;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -433,13 +513,14 @@ SetSummary runSet(const std::string& scene, const BoxSet& set, int set_index, co
     (r.within ? sum.within : sum.clear) += 1;
     for (double f : r.found) sum.near_pairs += f < kNear ? 1 : 0;
   }
+  const std::vector<int> chain_joints = chainJoints(base);
   for (std::size_t s = 0; s < settings.size(); ++s) {
-    Row row = summarise(recs, base.safety_margin, static_cast<int>(s), false, sum.violations);
+    Row row = summarise(recs, base.safety_margin, chain_joints, static_cast<int>(s), false, sum.violations);
     row.mode = toString(settings[s].mode);
     row.budget = settings[s].budget;
     sum.rows.push_back(row);
   }
-  Row point = summarise(recs, base.safety_margin, -1, true, sum.violations);
+  Row point = summarise(recs, base.safety_margin, chain_joints, -1, true, sum.violations);
   point.mode = "point state (centre)";
   point.budget = base.point_budget;
   sum.rows.push_back(point);
@@ -479,30 +560,59 @@ std::string markdownTable(const SetSummary& s, double margin) {
        << s.check.own_lower << " times, library lower " << s.check.library_lower << " times, largest difference "
        << num(s.check.max_difference_mm, "%.3f") << " mm";
   md << ".\n\n"
-     << "| mode | budget | distances µs | collision µs clear (med / p90) | collision µs within (med / p90) "
-        "| clear / point state | looseness mm (med / p90) | false alarms % boxes (of clear) | false alarms % pairs "
-        "| flagged pairs found >= 0.3 m |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|\n";
-  for (const Row& r : s.rows)
-    md << "| " << r.mode << " | " << r.budget << " | " << num(r.distances_us) << " | " << num(r.clear_med) << " / "
+     << "| mode | budget | distances µs | / verdict-only | collision µs clear (med / p90) | collision µs within (med / p90) "
+        "| clear / point state | looseness mm in band (p50 / p90 / max) | near-pair looseness mm (med / p90) "
+        "| false alarms % boxes (of clear) | false alarms % pairs | flagged pairs found >= 0.3 m |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Row& r : s.rows) {
+    const bool point = r.mode.rfind("point", 0) == 0;
+    md << "| " << r.mode << " | " << r.budget << " | " << num(r.distances_us) << " | "
+       << (point ? std::string("-") : num(r.over_verdict, "%.2f")) << " | " << num(r.clear_med) << " / "
        << num(r.clear_p90) << " | " << num(r.within_med) << " / " << num(r.within_p90) << " | "
-       << num(r.ratio, "%.2f") << " | " << num(r.loose_med) << " / " << num(r.loose_p90) << " | "
+       << num(r.ratio, "%.2f") << " | " << num(r.band_med) << " / " << num(r.band_p90) << " / " << num(r.band_max) << " | "
+       << num(r.loose_med) << " / " << num(r.loose_p90) << " | "
        << num(r.alarm_boxes_pct) << " (" << num(r.alarm_clear_pct) << ") | " << num(r.alarm_pairs_pct, "%.2f") << " | "
-       << (r.mode.rfind("point", 0) == 0 ? std::string("-") : std::to_string(r.far_alarms)) << " |\n";
+       << (point ? std::string("-") : std::to_string(r.far_alarms)) << " |\n";
+  }
+  md << "\nLooseness in band by swept joints between the two bodies, p90 / max mm (pair-boxes):\n\n| mode | budget |";
+  for (const char* b : kChainBinNames) md << " " << b << " |";
+  md << "\n|---|---|";
+  for (int b = 0; b < kChainBins; ++b) md << "---|";
+  md << "\n";
+  for (const Row& r : s.rows) {
+    if (r.mode.rfind("point", 0) == 0) continue;
+    md << "| " << r.mode << " | " << r.budget << " |";
+    for (int b = 0; b < kChainBins; ++b)
+      md << " " << (r.bin_pairs[b] > 0 ? num(r.bin_p90[b]) + " / " + num(r.bin_max[b]) + " (" + std::to_string(r.bin_pairs[b]) + ")" : std::string("-")) << " |";
+    md << "\n";
+  }
   md << "\n";
   return md.str();
 }
 
+std::string exactName(double below) {
+  if (below == kInf) return "every pair (--exact all)";
+  if (below == -kInf) return "off (--exact off)";
+  if (below == bench::kExactAtMargin) return "pairs within the margin (--exact margin)";
+  if (below < 0.0) return "the library's default: collision queries pairs within the margin, distance queries pairs within " +
+                          num(kBand, "%g") + " m of it (QueryOptions::exact_band)";
+  return "pairs within " + num(below, "%g") + " m (--exact " + num(below, "%g") + ")";
+}
+
 std::string markdownNotes(const Options& o) {
   std::ostringstream md;
-  md << "Exact stage: "
-     << (o.exact_below == kInf ? "every pair (--exact all)" : o.exact_below == -kInf ? "off (--exact off)" : "pairs within the margin (--exact margin, the default)")
-     << ". Cold queries (table reset before each; the same box repeated, so CPU caches are warm), the fastest of "
+  md << "Exact stage: " << exactName(o.exact_below)
+     << ". \"/ verdict-only\": the median distances query over the median distances query whose exact stage "
+        "refines only the pairs within the margin (the verdicts), measured interleaved on the same boxes. "
+        "Looseness in band: found distance minus bound over every pair whose bound is within "
+     << num(kBand, "%g") << " m of the margin (found by the searches; whatever it is), overall and by the number "
+        "of swept joints between the two bodies. For bodies behind a joint with error bounds (the cell's mock-up "
+        "pose) the searches also vary the pose within them, so a found distance is one the cell can have. Cold queries (table reset before each; the same box repeated, so CPU caches are warm), the fastest of "
      << o.repeats << " runs per box, median / p90 over the boxes (nearest rank). "
         "\"clear\"/\"within\": boxes whose closest found configuration is beyond / within the margin. "
         "\"clear / point state\": median collision query on the truly clear boxes over the median exact "
-        "collision query at the same boxes' centres. Looseness: found distance minus bound over near pairs "
-        "(found < 0.3 m, not touching); for the point-state row, the nominal distance at the centre minus "
+        "collision query at the same boxes' centres. Near-pair looseness: found distance minus bound over pairs "
+        "found near (found < 0.3 m, not touching; leaves out pairs found far whose bound is low); for the point-state row, the nominal distance at the centre minus "
         "the exact bound there (the cost of joint error bounds). False alarms: boxes where some bound is "
         "within the margin but no found distance is, as % of all boxes (and of the truly clear ones); "
         "pairs: % of all checked pairs (of all boxes) that are clear of the margin and flagged within it "
@@ -516,9 +626,13 @@ std::string csvText(const std::vector<SetSummary>& sets) {
        "distances_clear_us_median,distances_within_us_median,"
        "collision_clear_us_median,collision_clear_us_p90,collision_within_us_median,collision_within_us_p90,"
        "clear_over_point_state,looseness_mm_median,looseness_mm_p90,false_alarm_boxes_pct,"
-       "false_alarm_clear_boxes_pct,false_alarm_pairs_pct,false_alarm_far_pairs,violations\n";
+       "false_alarm_clear_boxes_pct,false_alarm_pairs_pct,false_alarm_far_pairs,violations,"
+       "verdict_only_distances_us_median,distances_over_verdict_only,band_pairs,band_looseness_mm_p50,"
+       "band_looseness_mm_p90,band_looseness_mm_max";
+  for (const char* b : kChainBinNames) c << ",band_p90_mm_joints_" << b << ",band_max_mm_joints_" << b << ",band_pairs_joints_" << b;
+  c << "\n";
   for (const SetSummary& s : sets)
-    for (const Row& r : s.rows)
+    for (const Row& r : s.rows) {
       c << s.scene << "," << s.set << "," << (r.mode.rfind("point", 0) == 0 ? "point_state" : r.mode) << ","
         << r.budget << "," << s.boxes << "," << s.clear << "," << s.within << "," << s.near_pairs << ","
         << csvNum(r.distances_us, "%.3f") << "," << csvNum(r.distances_clear_us, "%.3f") << ","
@@ -526,8 +640,13 @@ std::string csvText(const std::vector<SetSummary>& sets) {
         << csvNum(r.within_med, "%.3f") << "," << csvNum(r.within_p90, "%.3f") << "," << csvNum(r.ratio, "%.4f") << ","
         << csvNum(r.loose_med, "%.4f") << "," << csvNum(r.loose_p90, "%.4f") << "," << csvNum(r.alarm_boxes_pct, "%.2f")
         << "," << csvNum(r.alarm_clear_pct, "%.2f") << "," << csvNum(r.alarm_pairs_pct, "%.2f") << ","
-        << (r.mode.rfind("point", 0) == 0 ? std::string() : std::to_string(r.far_alarms)) << "," << r.violations
-        << "\n";
+        << (r.mode.rfind("point", 0) == 0 ? std::string() : std::to_string(r.far_alarms)) << "," << r.violations << ","
+        << csvNum(r.verdict_us, "%.3f") << "," << csvNum(r.over_verdict, "%.4f") << "," << r.band_pairs << ","
+        << csvNum(r.band_med, "%.4f") << "," << csvNum(r.band_p90, "%.4f") << "," << csvNum(r.band_max, "%.4f");
+      for (int b = 0; b < kChainBins; ++b)
+        c << "," << csvNum(r.bin_p90[b], "%.4f") << "," << csvNum(r.bin_max[b], "%.4f") << "," << r.bin_pairs[b];
+      c << "\n";
+    }
   return c.str();
 }
 
@@ -563,7 +682,7 @@ void writePlot(const std::string& path, const std::vector<SetSummary>& sets, int
     for (const Row& r : s.rows) {
       if (r.mode.rfind("point", 0) == 0) continue;
       if (cell.series.empty() || cell.series.back().label != r.mode) cell.series.push_back({r.mode, {}});
-      cell.series.back().points.push_back({r.budget, r.distances_us, r.loose_p90, r.alarm_boxes_pct});
+      cell.series.back().points.push_back({r.budget, r.distances_us, r.band_p90, r.alarm_boxes_pct});
     }
     cells.push_back(std::move(cell));
   }

@@ -41,7 +41,7 @@ Options parseOptions(int argc, char** argv) {
     if (a == "--help") {
       std::printf("bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]\n"
                   "            [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]\n"
-                  "            [--exact margin|all|off] [--markdown F] [--csv F] [--plot F.png]\n");
+                  "            [--exact default|margin|all|off|METRES] [--markdown F] [--csv F] [--plot F.png]\n");
       std::exit(0);
     }
     if (a == "--quick") {
@@ -75,11 +75,15 @@ Options parseOptions(int argc, char** argv) {
         usageError("--oracle: expected own, library or both, got '" + v + "'");
       }
     } else if (a == "--exact") {
-      if (v == "margin") o.exact_below = -1.0;
+      if (v == "default") o.exact_below = -1.0;
+      else if (v == "margin") o.exact_below = kExactAtMargin;
       else if (v == "all") o.exact_below = kInf;
       else if (v == "off") o.exact_below = -kInf;
       else {
-        usageError("--exact: expected margin, all or off, got '" + v + "'");
+        char* end = nullptr;
+        const double x = std::strtod(v.c_str(), &end);
+        if (v.empty() || *end != '\0' || !(x >= 0.0)) usageError("--exact: expected default, margin, all, off or a distance in metres, got '" + v + "'");
+        o.exact_below = x;
       }
     } else if (a == "--markdown") {
       o.markdown = v;

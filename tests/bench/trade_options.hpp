@@ -10,6 +10,9 @@ namespace kccd::bench {
 /// Which search finds each pair's closest configuration: this program's own, the library's, or both.
 enum class Oracle { Own, Library, Both };
 
+/// The --exact margin setting (resolved to each model's margin).
+inline constexpr double kExactAtMargin = -2.0;
+
 /// bench_trade's options (see its --help).
 struct Options {
   int boxes = 256;  ///< per box set
@@ -19,7 +22,10 @@ struct Options {
   std::uint64_t seed = 1;
   int search_effort = 1;  ///< multiplies the own search's samples, starts and steps
   Oracle oracle = Oracle::Both;
-  double exact_below = -1.0;  ///< QueryOptions::exact_below of the measured queries
+  /// QueryOptions::exact_below of the measured queries: -1 the library's default (the margin for
+  /// collision queries, the margin plus QueryOptions::exact_band for distance queries);
+  /// kExactAtMargin the model's margin; +inf every pair; -inf off; else metres.
+  double exact_below = -1.0;
   std::string markdown, csv, plot;
 };
 

@@ -125,7 +125,7 @@ void drawCell(cv::Mat& img, cv::Rect cell, const TradeCell& c) {
   const Axes bottom{{left, ybottom, width, cell.y + cell.height - 62 - ybottom}, lx0, lx1, 0.0, atop};
 
   text(img, c.title, {cell.x + cell.width / 2, cell.y + 24}, 0.55, kBlack, true);
-  drawFrame(img, top, "looseness p90 (mm)", false);
+  drawFrame(img, top, "looseness p90 in band (mm)", false);
   drawFrame(img, bottom, "false alarms (% boxes)", true);
   text(img, "distances query time, cold median (us, log scale)",
        {left + width / 2, bottom.area.y + bottom.area.height + 38}, 0.45, kBlack, true);

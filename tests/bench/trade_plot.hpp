@@ -1,6 +1,7 @@
 // The speed/accuracy plot of bench_trade (OpenCV, PNG): one cell per scene and box set, each with
-// two panels over the same x axis (distances query time, log scale): looseness p90 above, the
-// false-alarm rate below; one line per sweep mode through its point budgets.
+// two panels over the same x axis (distances query time, log scale): looseness p90 over the pairs
+// whose bound is within the band above the margin above, the false-alarm rate below; one line per
+// sweep mode through its point budgets.
 #pragma once
 
 #include <string>

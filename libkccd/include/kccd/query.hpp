@@ -32,6 +32,12 @@ const char* toString(QueryType type);
 /// The largest time budget a query honours (about 11.6 days, in microseconds); larger is unlimited.
 inline constexpr double kMaxBudgetUs = 1e12;
 
+/// How exactly the exact stage refines a pair already clear of the margin (metres): each support
+/// of its search within this (the slack counted in the bound) and its distance to a relative 1e-3,
+/// so its bound lies at most 2 kExactDistanceTolerance + 1e-3 of the distance below the search's
+/// exact value. A verdict (a pair within the margin) is always searched exactly.
+inline constexpr double kExactDistanceTolerance = 1e-3;
+
 /// What a query asks and how long it may take.
 struct QueryOptions {
   QueryType type = QueryType::Collision;
@@ -41,9 +47,15 @@ struct QueryOptions {
   int max_pairs = -1;      ///< work budget: recompute at most this many pairs; < 0: unlimited
   /// The exact stage (swept volumes without a point budget, searched by branch and bound) refines
   /// a pair whose point-volume bound is at most this and at most what the query still needs to
-  /// know. Negative (default): the margin, so every verdict is decided by the exact stage; +inf:
-  /// every pair of a Distances query (tightest, slowest); -inf or NaN: never (point volumes only).
+  /// know. Negative (default): the margin for a Collision query, so every verdict is decided by the
+  /// exact stage, and the margin plus exact_band for the distance queries (Closest, NClosest,
+  /// Distances), so near pairs get tight distances too; +inf: every pair (tightest, slowest);
+  /// -inf or NaN: never (point volumes only).
   double exact_below = -1.0;
+  /// With the default exact_below: how far above the margin (metres) a distance query's pairs are
+  /// refined. A pair already clear of the margin is refined for its distance only, to within
+  /// about a millimetre (kExactDistanceTolerance), which costs a fraction of a verdict's search.
+  double exact_band = 0.2;
   /// Point volumes for display: where a sweep's budget forces a coarse cover, also try chords for
   /// every point reduced to the budget by hull distance, and keep the tighter. Slower; the
   /// verdicts do not change (the exact stage decides them).
