@@ -373,8 +373,7 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
     opt.stop_below = stop_below;
     opt.warm_start = &e.direction;
     opt.max_iterations = 64;
-    opt.relative_tolerance = 1e-9;
-    if (for_distance) opt.relative_tolerance = 1e-3;
+    opt.relative_tolerance = for_distance ? 1e-3 : 1e-9;
     const DistanceResult d = detail::gjkDistance(support_a, support_b, ca.radius, cb.radius, info, opt);
     ++result_.stats.exact_calls;
     if (d.status == GjkStatus::InvalidInput || !std::isfinite(d.distance)) return false;

@@ -43,6 +43,13 @@ struct LoadedFrame {
   std::string pixels_sha256;
 };
 
+// The renderer's options of a case: its images, mask included, at the case's pinhole scale.
+render::RenderOptions renderOptions(const GoldenCase& c) {
+  render::RenderOptions options;
+  options.supersample = options.mask_supersample = c.supersample;
+  return options;
+}
+
 }  // namespace
 
 std::string sha256Hex(std::span<const unsigned char> bytes) {
@@ -86,9 +93,7 @@ struct GoldenRenderer::Impl {
     auto& v = views[{c.model, c.camera, c.supersample}];
     if (!v) {
       try {
-        render::RenderOptions options;
-        options.supersample = options.mask_supersample = c.supersample;
-        v = std::make_unique<render::ModelView>(*models.at(c.model), cameras.at(c.camera), options);
+        v = std::make_unique<render::ModelView>(*models.at(c.model), cameras.at(c.camera), renderOptions(c));
       } catch (const calib::CameraError& e) {
         throw InputError(e.messageFrom(c.camera));
       }
@@ -162,9 +167,7 @@ GoldenRendering GoldenRenderer::render(std::size_t index) {
     AnnotatorSettings settings;
     settings.time_offset = c.time_offset;
     settings.max_gap = 1.5 * log.medianPeriod();
-    render::RenderOptions options;
-    options.supersample = options.mask_supersample = c.supersample;
-    const AnnotatorScene scene{m, log, projection, options, {}, settings};
+    const AnnotatorScene scene{m, log, projection, renderOptions(c), {}, settings};
     FrameAnnotator annotator(scene);
     FrameRecord record;
     record.time = f.time;
