@@ -311,6 +311,40 @@ TEST(Queries, RevoluteSweepBoundIsTightForASpinningPoint) {
   }
 }
 
+TEST(Queries, Translation3dBoxBoundIsExactInTheExactStage) {
+  // A ball behind a translation3d joint with an error bound, its box wide along x, y and z, and a
+  // point obstacle straight ahead along x. The motion's reach towards the obstacle is the box's
+  // half-width plus the error, not the box's half-diagonal: the exact stage covers the box by its
+  // corners (exact) and adds the error ball.
+  Model m;
+  Joint j;
+  j.name = "pose";
+  j.type = JointType::Translation3d;
+  j.error = 0.01;
+  m.joints.push_back(j);
+  m.bodies.push_back({"obstacle", kWorld, {Vec3(1.0, 0, 0)}, 0.0});
+  m.bodies.push_back({"ball", 0, {Vec3(0, 0, 0)}, 0.1});
+  m.finalize(true, {}, {});
+  Checker c(m);
+  const std::vector<double> lo{-0.05, -0.05, -0.05}, hi{0.05, 0.05, 0.05};
+  // True smallest distance: from x = 0.05 + 0.01 (error towards the obstacle), radius 0.1.
+  const double truth = 1.0 - 0.06 - 0.1;
+  const double point = c.query(lo, hi, options(QueryType::Distances)).pairs[0].distance;
+  EXPECT_LE(point, truth + 1e-12);  // the point volumes: the ball around the box, conservative
+  QueryOptions exact = options(QueryType::Distances);
+  exact.exact_below = std::numeric_limits<double>::infinity();
+  c.reset();
+  const double e = c.query(lo, hi, exact).pairs[0].distance;
+  EXPECT_LE(e, truth + 1e-12);
+  EXPECT_GT(e, truth - 1e-9);
+  // The half-diagonal would lose (sqrt(3) - 1) 0.05 = 37 mm; the point volumes still do.
+  EXPECT_LT(point, truth - 0.03);
+  // Zero width on some axes: fewer corners, still exact.
+  const std::vector<double> lo2{0.0, -0.05, 0.0}, hi2{0.05, 0.05, 0.0};
+  c.reset();
+  EXPECT_NEAR(c.query(lo2, hi2, exact).pairs[0].distance, truth, 1e-9);
+}
+
 TEST(Braking, StoppingDistanceAndIntervals) {
   BrakingParams p;
   p.latency = 0.01;

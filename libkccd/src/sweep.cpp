@@ -389,10 +389,23 @@ JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi) noex
       m.offset_norm += std::max(std::abs(lo[0]), std::abs(hi[0]));
       break;
     case JointType::Translation3d: {
-      const Box3 box = box3(joint, lo, hi);
-      add(rot, rot * box.centre + t, 1.0);
-      m.fixed_growth = box.reach;
-      m.offset_norm += box.centre.norm();
+      // The box's corners (one per distinct corner, at most 8: the Minkowski sum with the box is
+      // the hull of the translates by its corners, exact) and the error ball as growth.
+      double corner_norm = 0.0;
+      for (int k = 0; k < 8; ++k) {
+        bool repeat = false;
+        Vec3 corner;
+        for (int i = 0; i < 3; ++i) {
+          const bool high = (k >> i) & 1;
+          repeat = repeat || (high && !(hi[i] > lo[i]));
+          corner[i] = high ? hi[i] : lo[i];
+        }
+        if (repeat) continue;
+        add(rot, rot * corner + t, 1.0);
+        corner_norm = std::max(corner_norm, corner.norm());
+      }
+      m.fixed_growth = joint.error > 0.0 ? roundedUp(joint.error, 2) : 0.0;
+      m.offset_norm += corner_norm;
       break;
     }
     case JointType::Rotation3d: {
