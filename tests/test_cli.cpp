@@ -96,6 +96,16 @@ TEST(Cli, QueryExactStageChoices) {
   EXPECT_GT(runs["band"]["stats"]["exact_calls"].get<int>(), runs["margin"]["stats"]["exact_calls"].get<int>());
   const auto narrow_band = nlohmann::json::parse(runKccd(box + " --exact-band 0").out);
   EXPECT_EQ(narrow_band["pairs"], runs["margin"]["pairs"]);
+  // Splitting (on by default) only ever raises a bound; 0 turns it off.
+  const auto unsplit = nlohmann::json::parse(runKccd(box + " --exact-splits 0").out);
+  EXPECT_EQ(unsplit["stats"]["split_pairs"], 0);
+  for (std::size_t k = 0; k < unsplit["pairs"].size(); ++k)
+    EXPECT_GE(runs["band"]["pairs"][k]["distance"].get<double>(), unsplit["pairs"][k]["distance"].get<double>());
+  for (const char* bad : {"-1", "33", "two"}) {
+    const Outcome r = runKccd(box + " --exact-splits " + bad, true);
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_NE(r.out.find("--exact-splits"), std::string::npos) << r.out;
+  }
   for (const char* bad : {"sometimes", "-1", "nan", "2e6"}) {
     const Outcome r = runKccd(box + " --exact " + bad, true);
     EXPECT_EQ(r.code, 2) << bad;

@@ -38,7 +38,7 @@ double sphereLowerBound(const std::vector<Eigen::Vector3d>& a, double ra, const 
 }
 
 struct Tally {
-  long cases = 0, pair_checks = 0, nontrivial = 0, oracle_calls = 0;
+  long cases = 0, pair_checks = 0, nontrivial = 0, oracle_calls = 0, split_pairs = 0;
   double worst_gap = -1.0;  // smallest (true - bound) seen over nontrivial checks
 };
 
@@ -58,7 +58,9 @@ bool runCase(std::uint64_t seed, Tally& tally, std::string& why,
   opt.exact_below = seed % 3 == 0 ? std::numeric_limits<double>::infinity() : seed % 3 == 1 ? -1.0 : -std::numeric_limits<double>::infinity();
   opt.tight_volumes = (seed / 3) % 2 == 0;  // the display volumes are bounds too
   opt.exact_band = (seed / 6) % 2 == 0 ? 0.2 : 5.0;
+  opt.exact_splits = (seed / 12) % 3 == 0 ? 0 : (seed / 12) % 3 == 1 ? 8 : kMaxExactSplits;  // box splitting
   const QueryResult& r = checker.query(lower, upper, opt);
+  tally.split_pairs += r.stats.split_pairs;
   if (r.status != Status::Ok) {
     why = std::string("status ") + toString(r.status);
     return false;
@@ -110,12 +112,14 @@ TEST(Conservative, BoundNeverExceedsSampledDistance) {
   }
   std::cout << "[ property ] " << tally.cases << " cases, " << tally.pair_checks << " pair samples, "
             << tally.nontrivial << " with a positive bound, " << tally.oracle_calls
-            << " exact oracle calls; tightest margin true - bound = " << tally.worst_gap << " m\n";
+            << " exact oracle calls, " << tally.split_pairs << " pairs split; tightest margin true - bound = "
+            << tally.worst_gap << " m\n";
   EXPECT_EQ(failures, 0);
   if (single < 0) {
     EXPECT_EQ(tally.cases, cases);
     EXPECT_GT(tally.nontrivial, tally.pair_checks / 10);  // the test exercises separated pairs
     EXPECT_GT(tally.oracle_calls, tally.cases);           // and often needs the exact oracle
+    EXPECT_GT(tally.split_pairs, tally.cases / 100);      // and splits boxes
   }
 }
 
@@ -138,7 +142,8 @@ TEST(Conservative, MobileBasesFromUrdfJointsAreConservative) {
     }
     std::cout << "[ property ] " << (base == testing::MobileBase::Planar ? "planar" : "floating") << " bases: "
               << tally.cases << " cases, " << tally.nontrivial << " pair samples with a positive bound, "
-              << tally.oracle_calls << " exact oracle calls; tightest true - bound = " << tally.worst_gap << " m\n";
+              << tally.oracle_calls << " exact oracle calls, " << tally.split_pairs
+              << " pairs split; tightest true - bound = " << tally.worst_gap << " m\n";
     EXPECT_EQ(failures, 0);
     EXPECT_EQ(tally.cases, cases);
     EXPECT_GT(tally.oracle_calls, tally.cases);

@@ -2,12 +2,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <limits>
 #include <random>
 
 #include "kccd/braking.hpp"
 #include "kccd/checker.hpp"
+#include "kccd/explain.hpp"
 #include "support/random_model.hpp"
+#include "support/sanitized.hpp"
 
 namespace kccd {
 namespace {
@@ -123,7 +126,7 @@ TEST(Queries, KnobsAreMonotone) {
       if (j.sweep != SweepMode::Exact) j.sweep = mode;
     return m;
   };
-  long compared = 0, tighter = 0, budget_checks = 0;
+  long compared = 0, tighter = 0, budget_checks = 0, split_pairs = 0;
   for (int i = 0; i < 1500; ++i) {
     const Model base = testing::randomModel(rng, 6, 5);
     if (base.pairs.empty()) continue;
@@ -141,6 +144,8 @@ TEST(Queries, KnobsAreMonotone) {
         const QueryResult& ra = ca.query(lower, upper, o);
         ASSERT_EQ(rf.status, Status::Ok);
         ASSERT_EQ(ra.status, Status::Ok);
+        EXPECT_EQ(rf.stats.split_pairs, 0);  // splitting is accurate's
+        split_pairs += ra.stats.split_pairs;
         if (!rf.collision) {
           EXPECT_FALSE(ra.collision) << "case " << i;
         }
@@ -189,7 +194,8 @@ TEST(Queries, KnobsAreMonotone) {
     }
   }
   EXPECT_GT(compared, 1000);
-  EXPECT_GT(tighter, compared / 100);  // apexes do tighten bounds
+  EXPECT_GT(tighter, compared / 100);  // apexes (and accurate's box splitting) do tighten bounds
+  EXPECT_GT(split_pairs, 0);
   EXPECT_GT(budget_checks, 1000);
 }
 
@@ -309,6 +315,107 @@ TEST(Queries, RevoluteSweepBoundIsTightForASpinningPoint) {
     EXPECT_GE(e, d);
     EXPECT_GT(e, mode == SweepMode::Accurate ? 0.5 - 1e-9 : 0.5 - sagitta - 1e-9);
   }
+}
+
+TEST(Queries, SplittingTightensAWideBodyOnAWideArc) {
+  // A flat plate (a segment 0.8 m wide, 0.5 m from the axis, across the radius) turning +-10
+  // degrees about z, and a point obstacle between it and the axis at x = 0.35. Closed forms: the
+  // plate's line is 0.5 - 0.35 cos(q) from the obstacle, smallest at q = 0: 0.15 m. The convex
+  // hull of the sweep holds the chord between the plate's ends at -10 and +10 degrees, at x =
+  // 0.5 cos 10 - 0.4 sin 10 = 0.4229: a bound of about 0.073 m at best. Eight sub-boxes of 2.5
+  // degrees lose at most 0.5 - (0.5 cos 1.25 - 0.4 sin 1.25) = 8.9 mm.
+  Model m;
+  Joint j;
+  j.name = "j";
+  j.type = JointType::Revolute;
+  j.axis = Vec3::UnitZ();
+  m.joints.push_back(j);
+  m.bodies.push_back({"obstacle", kWorld, {Vec3(0.35, 0, 0)}, 0.0});
+  m.bodies.push_back({"plate", 0, {Vec3(0.5, -0.4, 0), Vec3(0.5, 0.4, 0)}, 0.0});
+  m.safety_margin = 0.0;
+  m.finalize(true, {}, {});
+  const double truth = 0.15, deg = 3.141592653589793 / 180.0;
+  const std::vector<double> lo{-10 * deg}, hi{10 * deg};
+  const double hull = 0.5 * std::cos(10 * deg) - 0.4 * std::sin(10 * deg) - 0.35;
+  const double piece = 0.5 - (0.5 * std::cos(1.25 * deg) - 0.4 * std::sin(1.25 * deg));
+  for (SweepMode mode : {SweepMode::Fast, SweepMode::Accurate}) {
+    m.joints[0].sweep = mode;
+    Checker c(m);
+    QueryOptions o = options(QueryType::Distances);
+    o.exact_splits = 0;
+    const QueryResult& unsplit = c.query(lo, hi, o);
+    const double whole = unsplit.pairs[0].distance;
+    EXPECT_LE(whole, hull + 1e-9);
+    EXPECT_EQ(unsplit.stats.split_pairs, 0);
+    c.reset();
+    const QueryResult& split = c.query(lo, hi, options(QueryType::Distances));  // 8 sub-boxes
+    if (mode == SweepMode::Fast) {  // splitting is part of accurate's refinement
+      EXPECT_EQ(split.stats.split_pairs, 0);
+      EXPECT_EQ(split.pairs[0].distance, whole);
+      continue;
+    }
+    EXPECT_EQ(split.stats.split_pairs, 1);
+    EXPECT_LE(split.pairs[0].distance, truth);
+    EXPECT_GT(split.pairs[0].distance, truth - piece - kExactDistanceTolerance - 1e-3 * truth);
+    const double d = split.pairs[0].distance;
+    // The same bound from the other distance queries; collision queries never split.
+    c.reset();
+    EXPECT_EQ(c.query(lo, hi, options(QueryType::NClosest, 1)).pairs[0].distance, d);
+    c.reset();
+    EXPECT_EQ(c.query(lo, hi, options(QueryType::Collision)).stats.split_pairs, 0);
+    // Fewer sub-boxes, looser; never above the truth.
+    for (int splits : {2, 4, 32}) {
+      o.exact_splits = splits;
+      c.reset();
+      const double s = c.query(lo, hi, o).pairs[0].distance;
+      EXPECT_LE(s, truth) << splits;
+      if (splits < 8) EXPECT_LT(s, d) << splits;
+      if (splits > 8) EXPECT_GT(s, d) << splits;
+    }
+    // The band caps what a split may reach: with a band of 0.1 m the bound stays within it.
+    o.exact_splits = 8;
+    o.exact_band = 0.1;
+    c.reset();
+    EXPECT_LE(c.query(lo, hi, o).pairs[0].distance, 0.1);
+  }
+}
+
+TEST(Queries, SplitBoundsStayBelowTheSearchedMinimum) {
+  // Random trees and boxes, distance queries splitting up to 32 sub-boxes per pair with every pair
+  // in the band: each bound must lie below the smallest distance kccd::closestConfiguration finds
+  // in the box (a configuration of the box: an upper bound on the true minimum; its own search,
+  // no exact stage and no splitting). The split pairs must be tighter than unsplit ones.
+  std::mt19937_64 rng(77);
+  long split = 0, compared = 0, tighter = 0;
+  for (int i = 0; i < testing::casesFor(2000, 400); ++i) {
+    const Model m = testing::randomModel(rng, 5, 4);
+    if (m.pairs.empty()) continue;
+    std::vector<double> lower, upper;
+    testing::randomBox(rng, m, lower, upper);
+    QueryOptions o = options(QueryType::Distances);
+    o.exact_band = 5.0;
+    o.exact_splits = kMaxExactSplits;
+    Checker c(m), plain(m);
+    const QueryResult& r = c.query(lower, upper, o);
+    ASSERT_EQ(r.status, Status::Ok);
+    split += r.stats.split_pairs;
+    o.exact_splits = 0;
+    const QueryResult& u = plain.query(lower, upper, o);
+    for (std::size_t k = 0; k < r.pairs.size(); ++k) {
+      const double bound = r.pairs[k].distance;
+      EXPECT_GE(bound, u.pairs[k].distance - 1e-12) << "case " << i << " pair " << k;
+      tighter += bound > u.pairs[k].distance + 1e-6;
+      if (!(bound > 0.0) || bound == u.pairs[k].distance) continue;
+      const ClosestConfiguration found = closestConfiguration(m, static_cast<int>(k), lower, upper, {.starts = 4});
+      ++compared;
+      EXPECT_LE(bound, found.distance + 1e-9) << "case " << i << " pair " << k;
+    }
+  }
+  std::cout << "[ property ] " << split << " pairs split, " << compared << " searched, " << tighter
+            << " tighter than unsplit\n";
+  EXPECT_GT(split, 10);
+  EXPECT_GT(compared, 10);
+  EXPECT_GT(tighter, 10);
 }
 
 TEST(Queries, Translation3dBoxBoundIsExactInTheExactStage) {

@@ -10,6 +10,7 @@
 #include "bounding_sphere.hpp"
 #include "chain_support.hpp"
 #include "kccd/distance.hpp"
+#include "kccd/kinematics.hpp"
 #include "rounding.hpp"
 #include "sweep.hpp"
 
@@ -64,6 +65,14 @@ Checker::Checker(const Model& model) : model_(model) {
     base_box_.push_back(0.5 * (hi - lo) + Vec3::Constant(detail::roundingGuard(lo.cwiseAbs().maxCoeff() + hi.cwiseAbs().maxCoeff(), 4)));
   }
   chain_stack_.resize(detail::chainStackSize(max_levels));
+  split_box_.assign(2 * static_cast<std::size_t>(kMaxExactSplits) * static_cast<std::size_t>(ns), 0.0);
+  split_extent_.assign(2 * static_cast<std::size_t>(std::max(max_levels, 1)), 0.0);
+  centre_.assign(ns, 0.0);
+  std::size_t most_points = 1;
+  for (const Body& body : model.bodies) most_points = std::max(most_points, body.points.size());
+  centre_points_.assign(2 * most_points, Vec3::Zero());
+  split_grad_.assign(ns, 0.0);
+  split_frames_.assign(2 * static_cast<std::size_t>(std::max(max_levels, 1)), Pose::Identity());
   chain_choice_.assign(std::max(max_levels, 1), 0);
   chain_best_.assign(2 * static_cast<std::size_t>(std::max(max_levels, 1)), 0);
 }
@@ -256,14 +265,14 @@ SschView Checker::view(const Volume& v) const noexcept {
 const Sphere* Checker::sphere(int body, int level, Box box) noexcept {
   const int idx = level_begin_[body] + level;
   Volume& v = volumes_[idx];
-  if (level == 0 || v.sphere_stamp == cycle_) return &v.swept_sphere;
+  if (level == 0 || v.sphere_stamp == geo_cycle_) return &v.swept_sphere;
   const Sphere* below = sphere(body, level - 1, box);
   if (below == nullptr) return nullptr;
   const Joint& joint = model_.joints[path_[idx - 1]];
   v.swept_sphere = detail::sweepSphere(joint, box.lower.data() + joint.state_offset,
                                        box.upper.data() + joint.state_offset, *below);
   if (!v.swept_sphere.center.allFinite() || !std::isfinite(v.swept_sphere.radius)) return nullptr;
-  v.sphere_stamp = cycle_;
+  v.sphere_stamp = geo_cycle_;
   return &v.swept_sphere;
 }
 
@@ -278,10 +287,10 @@ SschView Checker::sweptVolume(int body, int frame) noexcept {
 }
 
 const detail::JointMaps* Checker::jointMaps(int joint, Box box) noexcept {
-  if (joint_maps_stamp_[joint] != cycle_) {
+  if (joint_maps_stamp_[joint] != geo_cycle_) {
     const Joint& j = model_.joints[joint];
     joint_maps_[joint] = detail::jointMaps(j, box.lower.data() + j.state_offset, box.upper.data() + j.state_offset);
-    joint_maps_stamp_[joint] = cycle_;
+    joint_maps_stamp_[joint] = geo_cycle_;
   }
   return &joint_maps_[joint];
 }
@@ -296,7 +305,7 @@ bool Checker::chain(int body, int level, int variant, Box box, detail::ChainView
   bool tangent = false;
   for (int l = 1; l <= level; ++l) {
     const int idx = begin + l;
-    if (chain_stamp_[variant][idx] != cycle_) {
+    if (chain_stamp_[variant][idx] != geo_cycle_) {
       const int joint = path_[idx - 1];
       const Sphere& below = l == 1 ? base_sphere_[body] : levels[idx - 1].core;
       const bool apexes = variant == 1 && model_.joints[joint].sweep == SweepMode::Accurate;
@@ -315,7 +324,7 @@ bool Checker::chain(int body, int level, int variant, Box box, detail::ChainView
       if (!levels[idx].core.center.allFinite() || !std::isfinite(levels[idx].core.radius) ||
           !std::isfinite(chain_radius_[variant][idx]))
         return false;
-      chain_stamp_[variant][idx] = cycle_;
+      chain_stamp_[variant][idx] = geo_cycle_;
     }
     radius = chain_radius_[variant][idx];
     tangent = chain_tangent_[variant][idx] != 0;
@@ -427,7 +436,12 @@ double Checker::refresh(int p, double stop_above, Box box) noexcept {
       e.witness_a = d.witness_a;
       e.witness_b = d.witness_b;
       e.gjk = true;
-      if (bound <= std::min(stop_above, exact_below_) && !exactStage(p, stop_above, box, bound)) return fail();
+      if (bound <= std::min(stop_above, exact_below_)) {
+        if (!exactStage(p, stop_above, box, bound)) return fail();
+        if (splits_ > 1 && bound > result_.margin && bound <= std::min(stop_above, exact_below_) &&
+            !splitPair(p, box, bound))
+          return fail();
+      }
     }
   }
   e.valid = true;
@@ -438,6 +452,169 @@ double Checker::refresh(int p, double stop_above, Box box) noexcept {
     box_[2 * k + 1] = box.upper[reach_state_[k]];
   }
   return bound;
+}
+
+// Splits the box of pair p, refined for its distance with the bound `bound`, when the bound lies
+// more than kSplitGap below an upper bound on the pair's true smallest distance (its distance at
+// two configurations of the box: the centre, and the corner the gradient there points to). The sub-boxes: splits_ of them, made
+// by halving level by level each sub-box's state value that moves the pair's points farthest over
+// its interval (width times the extent of the volume below its joint, from the whole box's swept
+// spheres; metres for translations): a choice from the geometry only, the same in every sweep
+// mode. Each sub-box is refined by the exact stage from `bound` (which holds for every part); the
+// pair's bound becomes the smallest over the sub-boxes, which cover the box, up to exact_below_.
+// Stops early when a sub-box gains nothing. The exact stage runs under stamps of its own (geo_cycle_), and a fresh
+// stamp is left for the box, so the spheres, joint maps and chains are recomputed for it when
+// next needed; the point volumes (cycle_) are not touched.
+bool Checker::splitPair(int p, Box box, double& bound) noexcept {
+  const BodyPair& pair = model_.pairs[p];
+  Entry& e = table_[p];
+  const auto nsz = static_cast<std::size_t>(model_.stateSize());
+  const int side_level[2] = {pair_level_[2 * p], pair_level_[2 * p + 1]};
+  const int side_body[2] = {pair.a, pair.b};
+  const int max_levels = static_cast<int>(split_extent_.size() / 2);
+  // Splitting is part of accurate's refinement: pairs moved by fast joints only are left as they are.
+  bool accurate = false;
+  for (int s = 0; s < 2; ++s)
+    for (int l = 1; l <= side_level[s]; ++l)
+      accurate = accurate ||
+                 model_.joints[static_cast<std::size_t>(path_[level_begin_[side_body[s]] + l - 1])].sweep == SweepMode::Accurate;
+  if (!accurate) return true;
+  // An upper bound on the true smallest distance: the nominal distance (no error bounds) at the
+  // box centre and at the corner the distance's gradient there points away from, both
+  // configurations of the box. No split can gain more than it lies above the bound.
+  std::fill(split_grad_.begin(), split_grad_.end(), 0.0);
+  for (std::size_t k = 0; k < nsz; ++k) centre_[k] = box.lower[k] + 0.5 * (box.upper[k] - box.lower[k]);
+  double upper = posedDistance(p, centre_.data(), split_grad_.data());
+  if (!(upper - bound > kSplitGap)) return true;
+  for (std::size_t k = 0; k < nsz; ++k)
+    if (split_grad_[k] != 0.0) centre_[k] = split_grad_[k] > 0.0 ? box.lower[k] : box.upper[k];
+  upper = std::min(upper, posedDistance(p, centre_.data(), nullptr));
+  if (!(upper - bound > kSplitGap)) return true;
+  for (int s = 0; s < 2; ++s)
+    for (int l = 1; l <= side_level[s]; ++l) {
+      const Sphere* below = sphere(side_body[s], l - 1, box);
+      if (below == nullptr) return false;
+      split_extent_[static_cast<std::size_t>(s * max_levels + l - 1)] = below->center.norm() + below->radius;
+    }
+  const Vec3 witness_a = e.witness_a, witness_b = e.witness_b, direction = e.direction;
+  const bool gjk = e.gjk;
+  auto restore = [&]() {
+    e.witness_a = witness_a;
+    e.witness_b = witness_b;
+    e.direction = direction;
+    e.gjk = gjk;
+    geo_cycle_ = ++stamps_;
+  };
+  ++result_.stats.split_pairs;
+  auto lo = [&](int leaf) { return split_box_.data() + 2 * static_cast<std::size_t>(leaf) * nsz; };
+  auto hi = [&](int leaf) { return lo(leaf) + nsz; };
+  std::copy(box.lower.begin(), box.lower.end(), lo(0));
+  std::copy(box.upper.begin(), box.upper.end(), hi(0));
+  int leaves = 1;
+  for (; leaves < splits_; leaves *= 2)
+    for (int leaf = 0; leaf < leaves; ++leaf) {
+      int arg = -1;
+      double move = 0.0;
+      for (int s = 0; s < 2; ++s)
+        for (int l = 1; l <= side_level[s]; ++l) {
+          const Joint& j = model_.joints[static_cast<std::size_t>(path_[level_begin_[side_body[s]] + l - 1])];
+          const double extent = split_extent_[static_cast<std::size_t>(s * max_levels + l - 1)];
+          const bool turns = j.type == JointType::Revolute || j.type == JointType::Rotation3d;
+          for (int k = 0; k < j.dof; ++k) {
+            const int st = j.state_offset + k;
+            const double m = (hi(leaf)[st] - lo(leaf)[st]) * (turns ? extent : 1.0);
+            if (m > move) {
+              move = m;
+              arg = st;
+            }
+          }
+        }
+      const int other = leaves + leaf;
+      std::copy(lo(leaf), lo(leaf) + 2 * nsz, lo(other));
+      if (arg < 0) continue;  // nothing moves: the copy covers the same box
+      const double mid = lo(leaf)[arg] + 0.5 * (hi(leaf)[arg] - lo(leaf)[arg]);
+      hi(leaf)[arg] = mid;
+      lo(other)[arg] = mid;
+    }
+  double split = kInf;
+  Vec3 best_a = witness_a, best_b = witness_b;
+  for (int leaf = 0; leaf < leaves && split > bound; ++leaf) {
+    geo_cycle_ = ++stamps_;
+    double b = bound;
+    e.witness_a = witness_a;
+    e.witness_b = witness_b;
+    if (!exactStage(p, kInf, Box{std::span<const double>(lo(leaf), nsz), std::span<const double>(hi(leaf), nsz)}, b))
+      return false;
+    if (b < split) {
+      split = b;
+      best_a = e.witness_a;
+      best_b = e.witness_b;
+    }
+  }
+  restore();
+  // Up to the top of the band: what a distance query asks to be tight. (A bound above it could
+  // exceed what another sweep mode reports for the same pair when its point volumes already put
+  // the pair above the band: the modes would no longer be monotone.)
+  split = std::min(split, exact_below_);
+  if (split > bound && split < kInf) {
+    bound = split;
+    e.witness_a = best_a;
+    e.witness_b = best_b;
+  }
+  return true;
+}
+
+// The nominal distance of pair p at configuration q (error bounds not applied): its two bodies
+// posed in the pair's common-ancestor frame, an upper bound from GJK (the hulls' upper distance
+// less the radii). With `grad`, adds to it the distance's derivative along each state value of the
+// pair's joints (the witness points moved by each joint's motion, along the separating
+// direction). Used to choose whether to split; +inf when GJK fails.
+double Checker::posedDistance(int p, const double* q, double* grad) noexcept {
+  const BodyPair& pair = model_.pairs[p];
+  const int side_level[2] = {pair_level_[2 * p], pair_level_[2 * p + 1]};
+  const int side_body[2] = {pair.a, pair.b};
+  const int max_levels = static_cast<int>(split_extent_.size() / 2);
+  SschView posed[2];
+  for (int s = 0; s < 2; ++s) {
+    Pose above = Pose::Identity();  // from the frame below level l's motion to the common frame
+    for (int l = side_level[s]; l >= 1; --l) {
+      const Joint& j = model_.joints[static_cast<std::size_t>(path_[level_begin_[side_body[s]] + l - 1])];
+      const Pose frame = above * j.origin;
+      split_frames_[static_cast<std::size_t>(s * max_levels + l - 1)] = frame;
+      above = frame * jointMotion(j, q + j.state_offset);
+    }
+    const Body& body = model_.bodies[static_cast<std::size_t>(side_body[s])];
+    Vec3* out = centre_points_.data() + static_cast<std::size_t>(s) * (centre_points_.size() / 2);
+    for (std::size_t i = 0; i < body.points.size(); ++i) out[i] = above * body.points[i];
+    posed[s] = {{out, body.points.size()}, body.radius};
+  }
+  const DistanceResult d = distance(posed[0], posed[1]);
+  if (d.status == GjkStatus::InvalidInput) return kInf;
+  const double upper = std::max(0.0, d.hull_upper - posed[0].radius - posed[1].radius);
+  if (grad == nullptr || !(upper > 0.0)) return upper;
+  const Vec3 n = -d.direction;  // from a towards b
+  for (int s = 0; s < 2; ++s) {
+    const Vec3& w = s == 0 ? d.witness_a : d.witness_b;
+    const double sign = s == 0 ? -1.0 : 1.0;  // a moving along n comes closer, b moving along n goes away
+    for (int l = 1; l <= side_level[s]; ++l) {
+      const Joint& j = model_.joints[static_cast<std::size_t>(path_[level_begin_[side_body[s]] + l - 1])];
+      const Pose& f = split_frames_[static_cast<std::size_t>(s * max_levels + l - 1)];
+      const Vec3 arm = w - f.translation();
+      double* g = grad + j.state_offset;
+      switch (j.type) {
+        case JointType::Fixed: break;
+        case JointType::Revolute: g[0] += sign * n.dot((f.linear() * j.axis).cross(arm)); break;
+        case JointType::Prismatic: g[0] += sign * n.dot(f.linear() * j.axis); break;
+        case JointType::Translation3d:
+          for (int k = 0; k < 3; ++k) g[k] += sign * n.dot(f.linear().col(k));
+          break;
+        case JointType::Rotation3d:  // about the frame's axes (exact at a zero rotation vector)
+          for (int k = 0; k < 3; ++k) g[k] += sign * n.dot(f.linear().col(k).cross(arm));
+          break;
+      }
+    }
+  }
+  return upper;
 }
 
 void Checker::report(int p, PairDistance& out) const noexcept {
@@ -468,7 +645,8 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
     result_.min_distance = 0.0;
     return result_;
   }
-  ++cycle_;
+  cycle_ = ++stamps_;
+  geo_cycle_ = ++stamps_;
   std::copy(lower.begin(), lower.end(), lower_.begin());
   std::copy(upper.begin(), upper.end(), upper_.begin());
   const Box box{lower_, upper_};
@@ -485,6 +663,10 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
                    : Clock::duration::zero());
   budget.max_pairs = options.max_pairs;
   std::fill(fresh_.begin(), fresh_.end(), 0);
+  // Splitting: distance queries whose exact stage reaches above the margin.
+  splits_ = 0;
+  if (options.type != QueryType::Collision && exact_below_ > margin)
+    for (int s = 2; s <= std::min(options.exact_splits, kMaxExactSplits); s *= 2) splits_ = s;
 
   const int np = static_cast<int>(model_.pairs.size());
   const int n_wanted = std::clamp(options.n, 1, std::max(np, 1));  // NClosest

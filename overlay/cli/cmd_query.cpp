@@ -24,6 +24,7 @@ struct QueryArgs {
   double budget_us = 0.0;
   std::string exact = "band";
   double exact_band = 0.2;
+  int exact_splits = 8;
   bool json = false;
   bool explain = false;
 };
@@ -106,6 +107,7 @@ Exit runQuery(const QueryArgs& args) {
   opt.budget_us = args.budget_us;
   opt.exact_below = parseExact(args.exact, args.margin >= 0.0 ? args.margin : m.safety_margin);
   opt.exact_band = args.exact_band;
+  opt.exact_splits = args.exact_splits;
   const QueryResult& r = checker.query(lower, upper, opt);
   const bool explain = args.explain && r.status == Status::Ok;
   const std::vector<PairExplanation> explained =
@@ -130,7 +132,7 @@ Exit runQuery(const QueryArgs& args) {
       j["pairs"].push_back(o);
     }
     j["stats"] = {{"time_us", r.stats.time_us}, {"pairs_checked", r.stats.pairs_checked},
-                  {"gjk_calls", r.stats.gjk_calls}, {"exact_calls", r.stats.exact_calls},
+                  {"gjk_calls", r.stats.gjk_calls}, {"exact_calls", r.stats.exact_calls}, {"split_pairs", r.stats.split_pairs},
                   {"volumes_swept", r.stats.volumes_swept},
                   {"budget_exhausted", r.stats.budget_exhausted}};
     if (explain) j["explain"] = explainJson(m, explained);
@@ -147,7 +149,8 @@ Exit runQuery(const QueryArgs& args) {
                 << "\n";
     }
     std::cout << "time " << r.stats.time_us << " us, " << r.stats.pairs_checked << " pairs checked, "
-              << r.stats.gjk_calls << " GJK calls, " << r.stats.exact_calls << " exact-stage calls"
+              << r.stats.gjk_calls << " GJK calls, " << r.stats.exact_calls << " exact-stage calls, "
+              << r.stats.split_pairs << " pairs split"
               << (r.stats.budget_exhausted ? ", budget exhausted" : "") << "\n";
     if (explain) printExplain(m, explained, r.margin);
   }
@@ -186,6 +189,12 @@ Runner addQuery(CLI::App& app) {
                   "With --exact band: how far above the margin (metres) a distance query's pairs are refined")
       ->capture_default_str()
       ->check(finiteIn(0.0, kMaxModelLength));
+  sub->add_option("--exact-splits", args->exact_splits,
+                  "Distance queries: a pair in the band whose bound lies well below its distance at the box centre "
+                  "has its box split into up to this many sub-boxes (a power of two), each refined by the exact "
+                  "stage; 0 or 1: never")
+      ->capture_default_str()
+      ->check(CLI::Range(0, kMaxExactSplits));
   sub->add_flag("--json", args->json, "Machine-readable output");
   sub->add_flag("--explain", args->explain,
                 "For every pair whose bound is <= the margin, search the box for its closest configuration and "

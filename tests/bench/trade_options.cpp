@@ -41,7 +41,8 @@ Options parseOptions(int argc, char** argv) {
     if (a == "--help") {
       std::printf("bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]\n"
                   "            [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]\n"
-                  "            [--exact default|margin|all|off|METRES] [--markdown F] [--csv F] [--plot F.png]\n");
+                  "            [--exact default|margin|all|off|METRES] [--splits N]\n"
+                  "            [--markdown F] [--csv F] [--plot F.png]\n");
       std::exit(0);
     }
     if (a == "--quick") {
@@ -85,6 +86,8 @@ Options parseOptions(int argc, char** argv) {
         if (v.empty() || *end != '\0' || !(x >= 0.0)) usageError("--exact: expected default, margin, all, off or a distance in metres, got '" + v + "'");
         o.exact_below = x;
       }
+    } else if (a == "--splits") {
+      o.splits = static_cast<int>(parseWhole(a, v, 0, kccd::kMaxExactSplits));
     } else if (a == "--markdown") {
       o.markdown = v;
     } else if (a == "--csv") {

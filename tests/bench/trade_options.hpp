@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "kccd/query.hpp"
+
 namespace kccd::bench {
 
 /// Which search finds each pair's closest configuration: this program's own, the library's, or both.
@@ -26,6 +28,7 @@ struct Options {
   /// collision queries, the margin plus QueryOptions::exact_band for distance queries);
   /// kExactAtMargin the model's margin; +inf every pair; -inf off; else metres.
   double exact_below = -1.0;
+  int splits = kccd::QueryOptions{}.exact_splits;  ///< QueryOptions::exact_splits of the measured queries
   std::string markdown, csv, plot;
 };
 

@@ -95,6 +95,8 @@ class Checker {
   // Helpers of the phases.
   bool expired(const Budget& budget) noexcept;
   void refine(int pair, double stop_above, Box box) noexcept;
+  bool splitPair(int pair, Box box, double& bound) noexcept;
+  double posedDistance(int pair, const double* q, double* grad) noexcept;
   double refresh(int pair, double stop_above, Box box) noexcept;
   bool exactStage(int pair, double stop_above, Box box, double& bound) noexcept;
   const detail::JointMaps* jointMaps(int joint, Box box) noexcept;
@@ -139,7 +141,20 @@ class Checker {
   std::vector<std::uint8_t> fresh_;          // per pair: recomputed in this query
   std::vector<double> nbest_;
   std::vector<double> lower_, upper_;        // the box of the last query (for sweptVolume())
+  // Splitting a pair's box (splitPair): per sub-box its lower and upper ends; per side and level
+  // the extent of the volume below the level's joint.
+  int splits_ = 0;                           // sub-boxes per split pair this query (0: none)
+  std::vector<double> split_box_;
+  std::vector<double> split_extent_;
+  std::vector<double> centre_;
+  std::vector<Vec3> centre_points_;          // the pair's two bodies posed at one configuration
+  std::vector<double> split_grad_;           // per state value: the posed distance's derivative
+  std::vector<Pose> split_frames_;           // per side and level: the joint frame, posed
+  std::uint64_t stamps_ = 1;                 // the last stamp handed out
   std::uint64_t cycle_ = 1;                  // volumes stamped with it are current (0: never)
+  // Swept spheres, joint maps and chains stamped with it are current: the query's box, or a
+  // sub-box of splitPair (which takes a stamp of its own and leaves a fresh one for the box).
+  std::uint64_t geo_cycle_ = 1;
   QueryResult result_;
 };
 
