@@ -454,17 +454,22 @@ double Checker::refresh(int p, double stop_above, Box box) noexcept {
   return bound;
 }
 
+// The joint swept at `level` (1 up to the body's levels) of `body`'s path.
+const Joint& Checker::levelJoint(int body, int level) const noexcept {
+  return model_.joints[static_cast<std::size_t>(path_[level_begin_[body] + level - 1])];
+}
+
 // Splits the box of pair p, refined for its distance with the bound `bound`, when the bound lies
 // more than kSplitGap below an upper bound on the pair's true smallest distance (its distance at
-// two configurations of the box: the centre, and the corner the gradient there points to). The sub-boxes: splits_ of them, made
-// by halving level by level each sub-box's state value that moves the pair's points farthest over
-// its interval (width times the extent of the volume below its joint, from the whole box's swept
-// spheres; metres for translations): a choice from the geometry only, the same in every sweep
-// mode. Each sub-box is refined by the exact stage from `bound` (which holds for every part); the
+// two configurations of the box: the centre, and the corner the gradient there points to), and
+// some accurate joint moves it. The sub-boxes: splits_ of them, made by halving level by level
+// each sub-box's state value that moves the pair's points farthest over its interval (width
+// times the extent of the volume below its joint, from the whole box's swept spheres; metres for
+// translations): a choice from the geometry only, the same in every sweep mode. Each sub-box is refined by the exact stage from `bound` (which holds for every part); the
 // pair's bound becomes the smallest over the sub-boxes, which cover the box, up to exact_below_.
-// Stops early when a sub-box gains nothing. The exact stage runs under stamps of its own (geo_cycle_), and a fresh
-// stamp is left for the box, so the spheres, joint maps and chains are recomputed for it when
-// next needed; the point volumes (cycle_) are not touched.
+// Stops early when a sub-box gains nothing. The exact stage runs under stamps of its own
+// (geo_cycle_), and a fresh stamp is left for the box, so the spheres, joint maps and chains are
+// recomputed for it when next needed; the point volumes (cycle_) are not touched.
 bool Checker::splitPair(int p, Box box, double& bound) noexcept {
   const BodyPair& pair = model_.pairs[p];
   Entry& e = table_[p];
@@ -476,8 +481,7 @@ bool Checker::splitPair(int p, Box box, double& bound) noexcept {
   bool accurate = false;
   for (int s = 0; s < 2; ++s)
     for (int l = 1; l <= side_level[s]; ++l)
-      accurate = accurate ||
-                 model_.joints[static_cast<std::size_t>(path_[level_begin_[side_body[s]] + l - 1])].sweep == SweepMode::Accurate;
+      accurate = accurate || levelJoint(side_body[s], l).sweep == SweepMode::Accurate;
   if (!accurate) return true;
   // An upper bound on the true smallest distance: the nominal distance (no error bounds) at the
   // box centre and at the corner the distance's gradient there points away from, both
@@ -498,13 +502,6 @@ bool Checker::splitPair(int p, Box box, double& bound) noexcept {
     }
   const Vec3 witness_a = e.witness_a, witness_b = e.witness_b, direction = e.direction;
   const bool gjk = e.gjk;
-  auto restore = [&]() {
-    e.witness_a = witness_a;
-    e.witness_b = witness_b;
-    e.direction = direction;
-    e.gjk = gjk;
-    geo_cycle_ = ++stamps_;
-  };
   ++result_.stats.split_pairs;
   auto lo = [&](int leaf) { return split_box_.data() + 2 * static_cast<std::size_t>(leaf) * nsz; };
   auto hi = [&](int leaf) { return lo(leaf) + nsz; };
@@ -517,7 +514,7 @@ bool Checker::splitPair(int p, Box box, double& bound) noexcept {
       double move = 0.0;
       for (int s = 0; s < 2; ++s)
         for (int l = 1; l <= side_level[s]; ++l) {
-          const Joint& j = model_.joints[static_cast<std::size_t>(path_[level_begin_[side_body[s]] + l - 1])];
+          const Joint& j = levelJoint(side_body[s], l);
           const double extent = split_extent_[static_cast<std::size_t>(s * max_levels + l - 1)];
           const bool turns = j.type == JointType::Revolute || j.type == JointType::Rotation3d;
           for (int k = 0; k < j.dof; ++k) {
@@ -551,10 +548,14 @@ bool Checker::splitPair(int p, Box box, double& bound) noexcept {
       best_b = e.witness_b;
     }
   }
-  restore();
-  // Up to the top of the band: what a distance query asks to be tight. (A bound above it could
-  // exceed what another sweep mode reports for the same pair when its point volumes already put
-  // the pair above the band: the modes would no longer be monotone.)
+  // The entry as the whole box left it, and a fresh stamp for the box's spheres, maps and chains.
+  e.witness_a = witness_a;
+  e.witness_b = witness_b;
+  e.direction = direction;
+  e.gjk = gjk;
+  geo_cycle_ = ++stamps_;
+  // Up to the top of the band: what a distance query asks to be tight (beyond it, the point
+  // volumes' bound is what every other pair reports).
   split = std::min(split, exact_below_);
   if (split > bound && split < kInf) {
     bound = split;
@@ -578,7 +579,7 @@ double Checker::posedDistance(int p, const double* q, double* grad) noexcept {
   for (int s = 0; s < 2; ++s) {
     Pose above = Pose::Identity();  // from the frame below level l's motion to the common frame
     for (int l = side_level[s]; l >= 1; --l) {
-      const Joint& j = model_.joints[static_cast<std::size_t>(path_[level_begin_[side_body[s]] + l - 1])];
+      const Joint& j = levelJoint(side_body[s], l);
       const Pose frame = above * j.origin;
       split_frames_[static_cast<std::size_t>(s * max_levels + l - 1)] = frame;
       above = frame * jointMotion(j, q + j.state_offset);
@@ -597,7 +598,7 @@ double Checker::posedDistance(int p, const double* q, double* grad) noexcept {
     const Vec3& w = s == 0 ? d.witness_a : d.witness_b;
     const double sign = s == 0 ? -1.0 : 1.0;  // a moving along n comes closer, b moving along n goes away
     for (int l = 1; l <= side_level[s]; ++l) {
-      const Joint& j = model_.joints[static_cast<std::size_t>(path_[level_begin_[side_body[s]] + l - 1])];
+      const Joint& j = levelJoint(side_body[s], l);
       const Pose& f = split_frames_[static_cast<std::size_t>(s * max_levels + l - 1)];
       const Vec3 arm = w - f.translation();
       double* g = grad + j.state_offset;

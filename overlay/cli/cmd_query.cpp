@@ -24,7 +24,7 @@ struct QueryArgs {
   double budget_us = 0.0;
   std::string exact = "band";
   double exact_band = 0.2;
-  int exact_splits = 8;
+  int exact_splits = QueryOptions{}.exact_splits;
   bool json = false;
   bool explain = false;
 };
@@ -190,9 +190,9 @@ Runner addQuery(CLI::App& app) {
       ->capture_default_str()
       ->check(finiteIn(0.0, kMaxModelLength));
   sub->add_option("--exact-splits", args->exact_splits,
-                  "Distance queries: a pair in the band whose bound lies well below its distance at the box centre "
-                  "has its box split into up to this many sub-boxes (a power of two), each refined by the exact "
-                  "stage; 0 or 1: never")
+                  "Distance queries: a pair in the band, moved by some accurate joint, whose bound lies more than "
+                  "3 mm below its distance at a configuration of the box has its box split into up to this many "
+                  "sub-boxes (a power of two), each refined by the exact stage; 0 or 1: never")
       ->capture_default_str()
       ->check(CLI::Range(0, kMaxExactSplits));
   sub->add_flag("--json", args->json, "Machine-readable output");

@@ -87,7 +87,7 @@ using bench::parseOptions;
 // The measured queries' exact stage (--exact), the same for every setting; kExactAtMargin is
 // resolved to the model's margin.
 double g_exact_below = -1.0;
-int g_splits = 8;  // QueryOptions::exact_splits of the measured queries (--splits)
+int g_splits = QueryOptions{}.exact_splits;  // of the measured queries (--splits)
 double exactBelow(const Model& m) { return g_exact_below == bench::kExactAtMargin ? m.safety_margin : g_exact_below; }
 
 [[noreturn]] void fail(const std::string& message) {

@@ -97,6 +97,7 @@ class Checker {
   void refine(int pair, double stop_above, Box box) noexcept;
   bool splitPair(int pair, Box box, double& bound) noexcept;
   double posedDistance(int pair, const double* q, double* grad) noexcept;
+  const Joint& levelJoint(int body, int level) const noexcept;
   double refresh(int pair, double stop_above, Box box) noexcept;
   bool exactStage(int pair, double stop_above, Box box, double& bound) noexcept;
   const detail::JointMaps* jointMaps(int joint, Box box) noexcept;
