@@ -67,7 +67,8 @@ ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, 
   // point volumes use); apexes below reach beyond it, and then the core's own sphere counts too.
   const double swept_extent = swept.center.norm() + swept.radius;
   const double point_extent = below_in_swept ? swept_extent : std::max(extent, swept_extent);
-  double growth = maps.fixed_growth + maps.point_growth * point_extent;
+  const bool rotation_apexes = tangent && maps.rotation_apexes;
+  double growth = maps.fixed_growth + (rotation_apexes ? maps.apex_point_growth : maps.point_growth) * point_extent;
   if (maps.revolute && !tangent) {
     // The core's own sphere and box hold it too: the smallest of the bounds serves (a smaller
     // growth keeps the chord chain inside the point volumes, which use the swept sphere).
@@ -80,6 +81,7 @@ ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, 
   // position; an apex lies rho (1 / cos - 1) beyond the arc's middle, a true position.
   double overshoot = below_overshoot * out.max_scale;
   if (maps.revolute && tangent) overshoot += maps.apex_excess * rhoBound(maps.axis, swept);
+  if (rotation_apexes) overshoot += maps.apex_excess * point_extent;
   out.overshoot = overshoot == 0.0 ? 0.0 : roundedUp(overshoot, 8) + roundingGuard(swept_extent, 32);
   return out;
 }
@@ -151,7 +153,7 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work
       const Sphere& s = sphereBelow(chain, level - 1);
       const ChainLevel* hull = level >= 2 ? &chain.levels[static_cast<std::size_t>(level) - 2] : nullptr;
       const int first = top;
-      for (int v = 0; v < lv.count; ++v) {
+      auto push = [&](int v) {
         ChainEntry e;
         e.row = lv.maps->lin[v].transpose() * row;
         e.offset = offset + row.dot(lv.maps->off[v]);
@@ -168,7 +170,17 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work
           --k;
         }
         stack[k] = e;
+      };
+      if (!lv.maps->shared_lin) {
+        for (int v = 0; v < lv.count; ++v) push(v);
+        return;
       }
+      // Maps that share their linear part (translations) differ only by the offset: the child
+      // of the largest offset along the row is the best of them, whatever lies below.
+      int best_v = 0;
+      for (int v = 1; v < lv.count; ++v)
+        if (row.dot(lv.maps->off[v]) > row.dot(lv.maps->off[best_v])) best_v = v;
+      push(best_v);
     };
     expand(depth, d, 0.0);
     while (top > 0) {
@@ -201,7 +213,8 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work
     const ChainLevel& lv = chain.levels[static_cast<std::size_t>(l)];
     const int v = work.best_choice[l];
     x = lv.maps->lin[v] * x + lv.maps->off[v];
-    key = key * 10u + static_cast<std::uint64_t>(v) + 1u;
+    static_assert(JointMaps::kMax < 16, "one hex digit per level");
+    key = key * 16u + static_cast<std::uint64_t>(v) + 1u;
     scale *= lv.max_scale;
   }
   // Rounding: values and the point are sums of products through `depth` levels of magnitude at

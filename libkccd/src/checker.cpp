@@ -46,6 +46,7 @@ Checker::Checker(const Model& model) : model_(model) {
   const int nj = static_cast<int>(model.joints.size());
   joint_maps_.resize(nj);
   joint_maps_stamp_.assign(nj, 0);
+  trig_.resize(nj);
   int max_levels = 0;
   for (int l : levels_) max_levels = std::max(max_levels, l);
   for (int variant = 0; variant < 2; ++variant) {
@@ -224,7 +225,8 @@ const Checker::Volume* Checker::volume(int body, int level, Box box) noexcept {
   const Sphere* below_sphere = sphere(body, level - 1, box);
   if (below_sphere == nullptr) return nullptr;
   const double below_radius = radius;
-  int n = detail::sweepJoint(joint, lo, hi, view(*below).points, scratch_.data(), radius, v.capacity,
+  const detail::RevoluteTrig& trig = revoluteTrig(path_[idx - 1], box);
+  int n = detail::sweepJoint(joint, lo, hi, trig, view(*below).points, scratch_.data(), radius, v.capacity,
                              scratch_dist_.data(), *below_sphere);
   if (n < 0) return nullptr;
   n = detail::reduceToBudget(scratch_.data(), n, v.capacity, scratch_dist_.data(), scratch_order_.data(), radius);
@@ -236,7 +238,7 @@ const Checker::Volume* Checker::volume(int body, int level, Box box) noexcept {
   // smaller radius can be kept; it costs a farthest-point selection per sweep.
   if (tight_volumes_ && radius - below_radius > kCoarseCover * (below_sphere->radius + 1e-9)) {
     double alt_radius = below_radius;
-    int m = detail::sweepJoint(joint, lo, hi, view(*below).points, scratch_alt_.data(), alt_radius,
+    int m = detail::sweepJoint(joint, lo, hi, trig, view(*below).points, scratch_alt_.data(), alt_radius,
                                std::numeric_limits<int>::max(), scratch_dist_.data(), *below_sphere);
     if (m > 0) {
       m = detail::reduceToBudget(scratch_alt_.data(), m, v.capacity, scratch_dist_.data(), scratch_order_.data(),
@@ -270,7 +272,7 @@ const Sphere* Checker::sphere(int body, int level, Box box) noexcept {
   if (below == nullptr) return nullptr;
   const Joint& joint = model_.joints[path_[idx - 1]];
   v.swept_sphere = detail::sweepSphere(joint, box.lower.data() + joint.state_offset,
-                                       box.upper.data() + joint.state_offset, *below);
+                                       box.upper.data() + joint.state_offset, revoluteTrig(path_[idx - 1], box), *below);
   if (!v.swept_sphere.center.allFinite() || !std::isfinite(v.swept_sphere.radius)) return nullptr;
   v.sphere_stamp = geo_cycle_;
   return &v.swept_sphere;
@@ -284,6 +286,19 @@ SschView Checker::sweptVolume(int body, int frame) noexcept {
     return v == nullptr ? SschView{} : view(*v);
   }
   return {};
+}
+
+// The trigonometry of a revolute joint's interval in `box`, made when the interval differs from
+// the one it was last made for (every body swept through the joint shares it; other joints get
+// an unused default).
+const detail::RevoluteTrig& Checker::revoluteTrig(int joint, Box box) noexcept {
+  detail::RevoluteTrig& t = trig_[static_cast<std::size_t>(joint)];
+  const Joint& j = model_.joints[static_cast<std::size_t>(joint)];
+  if (j.type != JointType::Revolute) return t;
+  const double lo = box.lower[static_cast<std::size_t>(j.state_offset)];
+  const double hi = box.upper[static_cast<std::size_t>(j.state_offset)];
+  if (t.lo != lo || t.hi != hi) t = detail::revoluteTrig(lo, hi);
+  return t;
 }
 
 const detail::JointMaps* Checker::jointMaps(int joint, Box box) noexcept {

@@ -14,6 +14,10 @@ namespace {
 constexpr double kPi = 3.141592653589793;
 constexpr double kTwoPi = 6.283185307179586;
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Rotation3d boxes of a smaller reach (radians) get apexes in the exact stage (jointMaps()).
+constexpr double kMaxRotationApexReach = 0.3;
+// An icosahedron's circumradius over its inradius (sqrt(3) sqrt(phi^2 + 1) / phi^2), rounded up.
+constexpr double kIcosahedron = 1.2584086;
 
 // Pieces for a revolute interval of width `width` (capped at a full turn).
 int revolutePieces(double width) {
@@ -42,10 +46,12 @@ Arc revoluteArc(double lo, double hi) {
   return {start, std::min(kTwoPi, roundedUp(width, 2) + 2.0 * start_error)};
 }
 
+// The largest |p| (one square root: sqrt is monotone and correctly rounded, so this is the
+// largest of the rounded norms).
 double maxNorm(std::span<const Vec3> pts) {
   double m = 0.0;
-  for (const Vec3& p : pts) m = std::max(m, p.norm());
-  return m;
+  for (const Vec3& p : pts) m = std::max(m, p.squaredNorm());
+  return std::sqrt(m);
 }
 
 // Revolute sweep in the joint frame (the point volumes of the first stage, whatever the joint's
@@ -53,13 +59,10 @@ double maxNorm(std::span<const Vec3> pts) {
 // largest sagitta rho (1 - cos(step / 2)), an error second order in the interval width. The point
 // budget is applied by reduceToBudget(), whose error is measured against the hull of the kept
 // points. Tangent apexes (accurate joints) are used by the exact stage (jointMaps()).
-int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in, Vec3* out, double& radius,
+int sweepRevolute(const Joint& j, const RevoluteTrig& trig, std::span<const Vec3> in, Vec3* out, double& radius,
                   int budget, double* rho, double rho_bound) {
   const Vec3& a = j.axis;
-  const Arc arc = revoluteArc(lo, hi);
-  lo = arc.start;
-  const double width = arc.width;
-  const int pieces = revolutePieces(width);
+  const int pieces = trig.pieces;
   const int n_in = static_cast<int>(in.size());
   // Points are written straight into the parent frame: with A = R_o axial + t, B = R_o radial and
   // C = R_o (axis x radial), the point rotated by angle q is A + cos(q) B + sin(q) C.
@@ -67,7 +70,7 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
   const Vec3& t = j.origin.translation();
   const double in_norm = maxNorm(in);
   if (pieces == 0) {  // a single angle: exact
-    const double c = std::cos(lo), s = std::sin(lo);
+    const double c = trig.c_end[0], s = trig.s_end[0];
     for (int i = 0; i < n_in; ++i) {
       const Vec3 axial = a.dot(in[i]) * a;
       const Vec3 radial = in[i] - axial;
@@ -76,23 +79,20 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
     radius += roundingGuard(in_norm + t.norm(), 32);
     return n_in;
   }
-  const double step = width / pieces;
-  double c_end[5], s_end[5];
-  for (int k = 0; k <= pieces; ++k) {
-    c_end[k] = std::cos(lo + k * step);
-    s_end[k] = std::sin(lo + k * step);
-  }
-  const double half_cos = std::cos(0.5 * step);
-  const double c_centre = std::cos(lo + 0.5 * width), s_centre = std::sin(lo + 0.5 * width);
-  const double sagitta = 1.0 - half_cos;                   // per unit rho
-  const double half_chord = 2.0 * std::sin(0.25 * width);  // per unit rho
+  const double* c_end = trig.c_end;
+  const double* s_end = trig.s_end;
+  const double half_cos = trig.half_cos;
+  const double c_centre = trig.c_mid, s_centre = trig.s_mid;
+  const double sagitta = 1.0 - half_cos;       // per unit rho
+  const double half_chord = trig.half_chord;  // per unit rho
   // Chords for the points farthest from the axis, as many as the budget holds; the arc's middle
-  // point (radius growth rho * 2 sin(w / 4)) for the rest.
-  for (int i = 0; i < n_in; ++i) rho[i] = (in[i] - a.dot(in[i]) * a).norm();
-  double chord_from = 0.0;  // points with rho >= chord_from get chords
+  // point (radius growth rho * 2 sin(w / 4)) for the rest. Squared distances from the axis
+  // throughout (the order and the largest are those of the distances; one square root at the end).
+  for (int i = 0; i < n_in; ++i) rho[i] = (in[i] - a.dot(in[i]) * a).squaredNorm();
+  double chord_from = 0.0;  // points with rho^2 >= chord_from get chords
   const int chords_fit = std::min(n_in, (budget - n_in) / pieces);
   if (chords_fit < n_in) {
-    // The chords_fit-th largest rho.
+    // The chords_fit-th largest rho^2.
     double* r = rho + n_in;
     for (int i = 0; i < n_in; ++i) r[i] = rho[i];
     if (chords_fit <= 0) {
@@ -102,29 +102,35 @@ int sweepRevolute(const Joint& j, double lo, double hi, std::span<const Vec3> in
       chord_from = r[chords_fit - 1];
     }
   }
-  double mid_growth = 0.0;
+  // With Ra the axis in the parent frame and Rp the point rotated by the origin: the axial part
+  // R_o axial = (a.p) Ra, the radial part Rp - (a.p) Ra, and R_o (a x p) = Ra x Rp.
+  const Vec3 ra = rot * a;
+  double axis_sq = 0.0;  // largest rho^2 of the points kept on the axis
+  double mid_sq = 0.0;   // largest rho^2 of the points kept at their arc's middle
   int n = 0;
   int chords = 0;
   for (int i = 0; i < n_in; ++i) {
     const Vec3& p = in[i];
-    const Vec3 axial = a.dot(p) * a;
-    const Vec3 radial = p - axial;
-    if (rho[i] <= 1e-12 * (1.0 + p.norm())) {  // on the axis: it stays within 2 rho of itself
-      out[n++] = rot * p + t;
-      mid_growth = std::max(mid_growth, 2.0 * rho[i]);
+    const Vec3 rp = rot * p;
+    // On the axis (rho <= 1e-12 (1 + |p|) when 1e-24 (1 + |p|^2) holds): it stays within 2 rho of itself.
+    if (rho[i] <= 1e-24 * (1.0 + p.squaredNorm())) {
+      out[n++] = rp + t;
+      axis_sq = std::max(axis_sq, rho[i]);
       continue;
     }
-    const Vec3 A = rot * axial + t;
-    const Vec3 B = rot * radial;
-    const Vec3 C = rot * a.cross(radial);
+    const double ap = a.dot(p);
+    const Vec3 A = ap * ra + t;
+    const Vec3 B = rp - ap * ra;
+    const Vec3 C = ra.cross(rp);
     if (rho[i] >= chord_from && chords < chords_fit) {
       for (int k = 0; k <= pieces; ++k) out[n++] = A + c_end[k] * B + s_end[k] * C;
       ++chords;
     } else {
       out[n++] = A + c_centre * B + s_centre * C;
-      mid_growth = std::max(mid_growth, rho[i] * half_chord);
+      mid_sq = std::max(mid_sq, rho[i]);
     }
   }
+  const double mid_growth = std::max(2.0 * std::sqrt(axis_sq), std::sqrt(mid_sq) * half_chord);
   // The growth: the sagitta of the farthest point the volume can hold (rho_bound, from the swept
   // sphere below: the same value the exact stage uses, so that its chord chains stay inside these
   // volumes), plus the middle points' distance to their chord ends.
@@ -232,6 +238,35 @@ double hullDistanceBound(const Vec3& p, const Vec3* kept, int k, double enough) 
 
 }  // namespace
 
+RevoluteTrig revoluteTrig(double lo, double hi) noexcept {
+  RevoluteTrig t;
+  t.lo = lo;
+  t.hi = hi;
+  const Arc arc = revoluteArc(lo, hi);
+  t.start = arc.start;
+  t.width = arc.width;
+  t.pieces = revolutePieces(arc.width);
+  if (t.pieces == 0) {
+    t.c_end[0] = std::cos(arc.start);
+    t.s_end[0] = std::sin(arc.start);
+    t.c_mid = t.c_end[0];
+    t.s_mid = t.s_end[0];
+    return t;
+  }
+  const double step = arc.width / t.pieces;
+  for (int k = 0; k <= t.pieces; ++k) {
+    t.c_end[k] = std::cos(arc.start + k * step);
+    t.s_end[k] = std::sin(arc.start + k * step);
+  }
+  t.half_cos = std::cos(0.5 * step);
+  t.c_mid = std::cos(arc.start + 0.5 * arc.width);
+  t.s_mid = std::sin(arc.start + 0.5 * arc.width);
+  t.c_half = std::cos(0.5 * arc.width);
+  t.s_half = std::sin(0.5 * arc.width);
+  t.half_chord = 2.0 * std::sin(0.25 * arc.width);
+  return t;
+}
+
 int sweepExpansion(const Joint& joint) noexcept {
   const int pieces = revolutePieces(kTwoPi);
   switch (joint.type) {
@@ -245,10 +280,11 @@ double rhoBound(const Vec3& axis, const Sphere& s) noexcept {
   return (s.center - axis.dot(s.center) * axis).norm() + s.radius;
 }
 
-int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span<const Vec3> in, Vec3* out,
-               double& radius, int budget, double* rho, const Sphere& below) noexcept {
+int sweepJoint(const Joint& joint, const double* lo, const double* hi, const RevoluteTrig& trig,
+               std::span<const Vec3> in, Vec3* out, double& radius, int budget, double* rho,
+               const Sphere& below) noexcept {
   if (joint.type == JointType::Revolute)  // writes straight into the parent frame
-    return sweepRevolute(joint, lo[0], hi[0], in, out, radius, budget, rho, rhoBound(joint.axis, below));
+    return sweepRevolute(joint, trig, in, out, radius, budget, rho, rhoBound(joint.axis, below));
   int n = 0;
   const double in_norm = maxNorm(in);
   switch (joint.type) {
@@ -410,16 +446,53 @@ JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi) noex
     }
     case JointType::Rotation3d: {
       const Rotation3 r3 = rotation3(box3(joint, lo, hi));
-      add(rot * r3.rot, t, 1.0);
+      const Eigen::Matrix3d centre = rot * r3.rot;
+      add(centre, t, 1.0);
       m.point_growth = roundedUp(rotationChord(r3.reach), 4);
-      break;
+      m.chord_count = m.count;
+      // Apexes. Every rotation of the box is the centre's times exp(v), |v| <= reach =: r. With
+      // w = (sin|v| / |v|) v, exp(v) p lies within (1 - cos r) |p| of p + w x p (its second-order
+      // part), and |w| <= r puts w in the icosahedron with vertices n of norm s = kIcosahedron r
+      // (its inscribed ball has radius r), so p + w x p is a convex combination of the
+      // p + n x p; each lies within (s - sin s + 1 - cos s) |p| <= (s^3 / 6 + s^2 / 2) |p| of
+      // exp(n) p. Hence the hull of the images under the twelve maps centre exp(n), grown by
+      // (s^3 / 6 + s^2 / 2 + r^2 / 2) |p|, holds every motion: second order in r where the chord
+      // map's ball is first order. The apexes turn by s, beyond the box: at most (s - r) |p| past
+      // a true position.
+      const double r = r3.reach;
+      if (r < kMaxRotationApexReach) {
+        const double s = roundedUp(kIcosahedron * r, 2);
+        const double growth = roundedUp(s * s * s / 6.0 + s * s / 2.0 + r * r / 2.0, 8) + 16.0 * kEps;
+        if (growth < 0.5 * m.point_growth) {
+          // Rodrigues with one sine and cosine for all twelve: exp(s u) = I + sin s [u] + (1 - cos s) [u]^2.
+          constexpr double kPhi = 1.618033988749895;
+          const double sin_s = std::sin(s), versine = 2.0 * std::sin(0.5 * s) * std::sin(0.5 * s);
+          for (int k = 0; k < 3; ++k)
+            for (const double a : {1.0, -1.0})
+              for (const double b : {kPhi, -kPhi}) {
+                Vec3 u = Vec3::Zero();  // (0, +-1, +-phi) and its cyclic shifts, normalised
+                u[(k + 1) % 3] = a;
+                u[(k + 2) % 3] = b;
+                u.normalize();
+                Eigen::Matrix3d cross;
+                cross << 0.0, -u.z(), u.y(), u.z(), 0.0, -u.x(), -u.y(), u.x(), 0.0;
+                add(centre * (Eigen::Matrix3d::Identity() + sin_s * cross + versine * (cross * cross)), t, 1.0);
+              }
+          m.rotation_apexes = true;
+          m.apex_point_growth = growth;
+          m.apex_excess = roundedUp(s - r, 4) + 8.0 * kEps;
+        }
+      }
+      return m;
     }
   }
   m.chord_count = m.count;
+  m.shared_lin = joint.type != JointType::Revolute && joint.type != JointType::Rotation3d;
   return m;
 }
 
-Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const Sphere& in) noexcept {
+Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const RevoluteTrig& trig,
+                   const Sphere& in) noexcept {
   Sphere out = in;
   const Vec3& c = in.center;
   switch (joint.type) {
@@ -431,15 +504,12 @@ Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const
       const Vec3 axial = a.dot(c) * a;
       const Vec3 radial = c - axial;
       const double rho = radial.norm();
-      const Arc arc = revoluteArc(lo[0], hi[0]);
-      const double width = arc.width;
-      if (width >= kPi) {
+      if (trig.width >= kPi) {
         out.center = axial;
         out.radius += rho;
       } else {
-        const double mid = arc.start + 0.5 * width;
-        out.center = axial + std::cos(0.5 * width) * (std::cos(mid) * radial + std::sin(mid) * a.cross(radial));
-        out.radius += rho * std::sin(0.5 * width);
+        out.center = axial + trig.c_half * (trig.c_mid * radial + trig.s_mid * a.cross(radial));
+        out.radius += rho * trig.s_half;
       }
       out.radius += roundingGuard(c.norm(), 16);
       break;

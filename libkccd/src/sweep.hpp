@@ -11,6 +11,24 @@ namespace kccd::detail {
 /// Largest angle one revolute piece may span; wider intervals are split into equal pieces.
 inline constexpr double kMaxPieceAngle = 1.5707963267948966;  // pi / 2
 
+/// A revolute interval [lo, hi] as the arc its sweeps cover (start and width, widened by rounding:
+/// docs/algorithms.md section 1) and the sines and cosines they use: made once per joint and box,
+/// shared by every body swept through the joint. Default-constructed: made for no interval.
+struct RevoluteTrig {
+  static constexpr int kMaxPieces = 4;  // 2 pi / kMaxPieceAngle
+  double lo = 0.0, hi = -1.0;  ///< the interval it was made for (lo > hi: none)
+  double start = 0.0, width = 0.0;
+  int pieces = 0;              ///< 0: a single angle, start
+  double c_end[kMaxPieces + 1] = {}, s_end[kMaxPieces + 1] = {};  ///< the pieces' ends
+  double half_cos = 1.0;       ///< cos(step / 2)
+  double c_mid = 1.0, s_mid = 0.0;    ///< the arc's middle
+  double c_half = 1.0, s_half = 0.0;  ///< cos and sin of width / 2
+  double half_chord = 0.0;     ///< 2 sin(width / 4)
+};
+
+/// The arc and trigonometry of the revolute interval [lo, hi] (finite values).
+RevoluteTrig revoluteTrig(double lo, double hi) noexcept;
+
 /// How many output points one input point can become in sweepJoint() (worst case).
 int sweepExpansion(const Joint& joint) noexcept;
 
@@ -22,8 +40,10 @@ int sweepExpansion(const Joint& joint) noexcept;
 /// that depend on how far points can lie from the axis or origin use it, as the exact stage does.
 /// A revolute sweep covers the arcs of the points farthest from the axis by chords and the others
 /// by their middle point, as far as `budget` output points allow; `rho` needs room for 2 n values.
-int sweepJoint(const Joint& joint, const double* lo, const double* hi, std::span<const Vec3> in, Vec3* out,
-               double& radius, int budget, double* rho, const Sphere& below) noexcept;
+/// `trig` is revoluteTrig(lo[0], hi[0]) for a revolute joint (ignored for the others).
+int sweepJoint(const Joint& joint, const double* lo, const double* hi, const RevoluteTrig& trig,
+               std::span<const Vec3> in, Vec3* out, double& radius, int budget, double* rho,
+               const Sphere& below) noexcept;
 
 /// The largest distance from the axis (through the origin) of a point of sphere s.
 double rhoBound(const Vec3& axis, const Sphere& s) noexcept;
@@ -33,9 +53,11 @@ double rhoBound(const Vec3& axis, const Sphere& s) noexcept;
 /// revolute joint the tangent apexes (radial part scaled by 1 / cos(step / 2)). Covering with the
 /// first `chord_count` maps needs the radius to grow by `sagitta` times the distance from the
 /// axis; every cover adds `fixed_growth` plus `point_growth` times the distance from the joint
-/// frame's origin (3-DOF joints: the box around its centre).
+/// frame's origin (3-DOF joints: the box around its centre). A rotation3d box of small reach also
+/// has apexes: its centre rotation composed with the twelve rotations of an icosahedron around
+/// the reach ball, whose cover (all maps) grows by `apex_point_growth` per unit distance instead.
 struct JointMaps {
-  static constexpr int kMax = 9;
+  static constexpr int kMax = 13;
   int count = 0;
   int chord_count = 0;
   Eigen::Matrix3d lin[kMax];
@@ -44,9 +66,12 @@ struct JointMaps {
   bool revolute = false;     ///< a revolute interval of non-zero width (sagitta applies)
   Vec3 axis = Vec3::UnitZ();
   double sagitta = 0.0;
-  double apex_excess = 0.0;  ///< an apex lies at most this times rho beyond its arc (1 / cos - 1)
+  double apex_excess = 0.0;  ///< an apex lies at most this times rho (rotation3d: |p|) beyond the motion
   double fixed_growth = 0.0;
   double point_growth = 0.0;
+  bool shared_lin = false;        ///< every map has the same linear part (translations)
+  bool rotation_apexes = false;   ///< rotation3d apexes follow the chord map
+  double apex_point_growth = 0.0; ///< point_growth of the cover with the rotation3d apexes
   double offset_norm = 0.0;  ///< bound on |off|
 };
 
@@ -55,7 +80,9 @@ JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi) noex
 
 /// A sphere containing every position of sphere `in` under the joint's motion over [lo, hi],
 /// in the joint's parent frame (cheap: no points are swept).
-Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const Sphere& in) noexcept;
+/// `trig` as for sweepJoint().
+Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const RevoluteTrig& trig,
+                   const Sphere& in) noexcept;
 
 /// Keeps at most `budget` of the n points (farthest-point selection) in pts[0..k) and grows
 /// `radius` by an upper bound on the largest distance from a dropped point to the hull of the

@@ -13,6 +13,7 @@
 
 namespace kccd::detail {
 struct JointMaps;
+struct RevoluteTrig;
 struct ChainLevel;
 struct ChainEntry;
 struct ChainView;
@@ -101,6 +102,7 @@ class Checker {
   double refresh(int pair, double stop_above, Box box) noexcept;
   bool exactStage(int pair, double stop_above, Box box, double& bound) noexcept;
   const detail::JointMaps* jointMaps(int joint, Box box) noexcept;
+  const detail::RevoluteTrig& revoluteTrig(int joint, Box box) noexcept;
   bool chain(int body, int level, int variant, Box box, detail::ChainView& out) noexcept;
   void report(int pair, PairDistance& out) const noexcept;
   const Volume* volume(int body, int level, Box box) noexcept;
@@ -123,6 +125,7 @@ class Checker {
   std::vector<double> scratch_dist_;
   std::vector<Vec3> scratch_alt_;            // the other cover of a sweep
   std::vector<int> scratch_order_;
+  std::vector<detail::RevoluteTrig> trig_;   // per joint: its last interval's trigonometry
   // The exact stage: per joint its vertex maps for this query, per body and level the chain
   // level (variant 0: chords only; 1: each joint's own mode), and the search's scratch.
   std::vector<detail::JointMaps> joint_maps_;
