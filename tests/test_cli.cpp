@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "kccd/query.hpp"
 #include "support/files.hpp"
 #include "support/run_program.hpp"
 
@@ -105,6 +106,18 @@ TEST(Cli, QueryExactStageChoices) {
     const Outcome r = runKccd(box + " --exact-splits " + bad, true);
     EXPECT_EQ(r.code, 2) << bad;
     EXPECT_NE(r.out.find("--exact-splits"), std::string::npos) << r.out;
+  }
+  // A split gap of 0 splits whenever a split could gain: never looser, at least as many splits.
+  const auto fine = nlohmann::json::parse(runKccd(box + " --exact-split-gap 0").out);
+  EXPECT_GE(fine["stats"]["split_pairs"].get<int>(), runs["band"]["stats"]["split_pairs"].get<int>());
+  for (std::size_t k = 0; k < fine["pairs"].size(); ++k) {
+    const double d = runs["band"]["pairs"][k]["distance"].get<double>();
+    EXPECT_GE(fine["pairs"][k]["distance"].get<double>(), d - 2.0 * kccd::kExactDistanceTolerance - 1e-3 * d);
+  }
+  for (const char* bad : {"-1", "nan", "1e9", "wide"}) {
+    const Outcome r = runKccd(box + " --exact-split-gap " + bad, true);
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_NE(r.out.find("--exact-split-gap"), std::string::npos) << r.out;
   }
   for (const char* bad : {"sometimes", "-1", "nan", "2e6"}) {
     const Outcome r = runKccd(box + " --exact " + bad, true);

@@ -315,14 +315,26 @@ TEST(Queries, RevoluteSweepBoundIsTightForASpinningPoint) {
     const double d = c.query(lo, hi, options(QueryType::Distances)).pairs[0].distance;
     EXPECT_LE(d, 0.5);  // at q = pi/2 the tip is 0.5 away
     EXPECT_GT(d, 0.5 - sagitta - 1e-9);
-    // With the exact stage, accurate (tangent apexes) is exact here; fast keeps the sagitta.
+    // With the exact stage, fast keeps the sagitta. Accurate's chord chains prove the pair clear,
+    // so its distance is refined by splitting the box (eight arcs of 11.25 degrees, each losing
+    // its sagitta), not by the apexes.
     QueryOptions exact = options(QueryType::Distances);
     exact.exact_below = std::numeric_limits<double>::infinity();
     c.reset();
-    const double e = c.query(lo, hi, exact).pairs[0].distance;
+    const QueryResult& r = c.query(lo, hi, exact);
+    const double e = r.pairs[0].distance;
     EXPECT_LE(e, 0.5);
     EXPECT_GE(e, d);
-    EXPECT_GT(e, mode == SweepMode::Accurate ? 0.5 - 1e-9 : 0.5 - sagitta - 1e-9);
+    const double eighth = 1.0 - std::cos(0.7853981633974483 / 8.0);
+    EXPECT_GT(e, mode == SweepMode::Accurate ? 0.5 - eighth - 1e-9 : 0.5 - sagitta - 1e-9);
+    EXPECT_EQ(r.stats.split_pairs, mode == SweepMode::Accurate ? 1 : 0);
+    // A verdict the chord chains cannot decide is searched with the apexes, which are exact here:
+    // with a margin just below the truth, accurate proves the box clear and fast cannot.
+    QueryOptions verdict = options(QueryType::Collision);
+    verdict.margin = 0.499;
+    c.reset();
+    const QueryResult& v = c.query(lo, hi, verdict);
+    EXPECT_EQ(v.collision, mode == SweepMode::Fast);
   }
 }
 
@@ -372,6 +384,18 @@ TEST(Queries, SplittingTightensAWideBodyOnAWideArc) {
       if (splits < 8) EXPECT_LT(s, d) << splits;
       if (splits > 8) EXPECT_GT(s, d) << splits;
     }
+    // The split gap: a gap above what a split could gain (the truth less the whole box's bound)
+    // leaves the box whole; one below it splits.
+    o.exact_splits = 8;
+    o.exact_split_gap = truth - whole + 0.01;
+    c.reset();
+    const QueryResult& wide_gap = c.query(lo, hi, o);
+    EXPECT_EQ(wide_gap.stats.split_pairs, 0);
+    EXPECT_EQ(wide_gap.pairs[0].distance, whole);
+    o.exact_split_gap = truth - whole - 0.01;
+    c.reset();
+    EXPECT_EQ(c.query(lo, hi, o).stats.split_pairs, 1);
+    o.exact_split_gap = QueryOptions{}.exact_split_gap;
     // The band caps what a split may reach: with a band of 0.1 m the bound stays within it.
     o.exact_splits = 8;
     o.exact_band = 0.1;
@@ -384,9 +408,10 @@ TEST(Queries, SplitBoundsStayBelowTheSearchedMinimum) {
   // Random trees and boxes, distance queries splitting up to 32 sub-boxes per pair with every pair
   // in the band: each bound must lie below the smallest distance kccd::closestConfiguration finds
   // in the box (a configuration of the box: an upper bound on the true minimum; its own search,
-  // no exact stage and no splitting). The split pairs must be tighter than unsplit ones.
+  // no exact stage and no splitting). The split pairs must be tighter than unsplit ones, and a
+  // split gap of zero (split whenever a split could gain anything) never looser than the default.
   std::mt19937_64 rng(77);
-  long split = 0, compared = 0, tighter = 0;
+  long split = 0, compared = 0, tighter = 0, finer = 0;
   for (int i = 0; i < testing::casesFor(2000, 400); ++i) {
     const Model m = testing::randomModel(rng, 5, 4);
     if (m.pairs.empty()) continue;
@@ -395,27 +420,35 @@ TEST(Queries, SplitBoundsStayBelowTheSearchedMinimum) {
     QueryOptions o = options(QueryType::Distances);
     o.exact_band = 5.0;
     o.exact_splits = kMaxExactSplits;
-    Checker c(m), plain(m);
+    Checker c(m), plain(m), fine(m);
     const QueryResult& r = c.query(lower, upper, o);
     ASSERT_EQ(r.status, Status::Ok);
     split += r.stats.split_pairs;
+    o.exact_split_gap = 0.0;
+    const QueryResult& g = fine.query(lower, upper, o);
+    ASSERT_EQ(g.status, Status::Ok);
     o.exact_splits = 0;
     const QueryResult& u = plain.query(lower, upper, o);
     for (std::size_t k = 0; k < r.pairs.size(); ++k) {
-      const double bound = r.pairs[k].distance;
+      const double bound = r.pairs[k].distance, gap0 = g.pairs[k].distance;
       EXPECT_GE(bound, u.pairs[k].distance - 1e-12) << "case " << i << " pair " << k;
       tighter += bound > u.pairs[k].distance + 1e-6;
-      if (!(bound > 0.0) || bound == u.pairs[k].distance) continue;
+      // Up to the exact stage's tolerance (its searches start from what earlier pairs left).
+      EXPECT_GE(gap0, bound - 2.0 * kExactDistanceTolerance - 1e-3 * bound) << "case " << i << " pair " << k;
+      finer += gap0 > bound + 1e-6;
+      if (!(std::max(bound, gap0) > 0.0) || (bound == u.pairs[k].distance && gap0 == bound)) continue;
       const ClosestConfiguration found = closestConfiguration(m, static_cast<int>(k), lower, upper, {.starts = 4});
       ++compared;
       EXPECT_LE(bound, found.distance + 1e-9) << "case " << i << " pair " << k;
+      EXPECT_LE(gap0, found.distance + 1e-9) << "case " << i << " pair " << k;
     }
   }
   std::cout << "[ property ] " << split << " pairs split, " << compared << " searched, " << tighter
-            << " tighter than unsplit\n";
+            << " tighter than unsplit, " << finer << " tighter with a split gap of 0\n";
   EXPECT_GT(split, 10);
   EXPECT_GT(compared, 10);
   EXPECT_GT(tighter, 10);
+  EXPECT_GT(finer, 10);
 }
 
 TEST(Queries, Translation3dBoxBoundIsExactInTheExactStage) {

@@ -68,6 +68,7 @@ ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, 
   const double swept_extent = swept.center.norm() + swept.radius;
   const double point_extent = below_in_swept ? swept_extent : std::max(extent, swept_extent);
   const bool rotation_apexes = tangent && maps.rotation_apexes;
+  out.rotation_apexes = rotation_apexes;
   double growth = maps.fixed_growth + (rotation_apexes ? maps.apex_point_growth : maps.point_growth) * point_extent;
   if (maps.revolute && !tangent) {
     // The core's own sphere and box hold it too: the smallest of the bounds serves (a smaller

@@ -20,6 +20,7 @@ struct ChainLevel {
   double growth = 0.0;
   Sphere core;
   double max_scale = 1.0;  ///< largest operator norm among the maps used
+  bool rotation_apexes = false;  ///< the maps include a rotation3d joint's apexes
   /// How far the core set may lie beyond the true swept core (apexes reach past their arcs).
   double overshoot = 0.0;
   /// A box around the core set (the images of the box below), often tighter than `core`.

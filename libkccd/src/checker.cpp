@@ -73,6 +73,8 @@ Checker::Checker(const Model& model) : model_(model) {
   for (const Body& body : model.bodies) most_points = std::max(most_points, body.points.size());
   centre_points_.assign(2 * most_points, Vec3::Zero());
   split_grad_.assign(ns, 0.0);
+  split_order_.assign(static_cast<std::size_t>(kMaxExactSplits), 0);
+  split_key_.assign(static_cast<std::size_t>(kMaxExactSplits), 0.0);
   split_frames_.assign(2 * static_cast<std::size_t>(std::max(max_levels, 1)), Pose::Identity());
   chain_choice_.assign(std::max(max_levels, 1), 0);
   chain_best_.assign(2 * static_cast<std::size_t>(std::max(max_levels, 1)), 0);
@@ -352,6 +354,14 @@ bool Checker::chain(int body, int level, int variant, Box box, detail::ChainView
   return true;
 }
 
+namespace {
+bool hasRotationApexes(const detail::ChainView& c) {
+  for (const detail::ChainLevel& l : c.levels)
+    if (l.rotation_apexes) return true;
+  return false;
+}
+}  // namespace
+
 // Refines a pair's bound with the exact stage: the chord chains first, then (when an accurate
 // joint adds apexes) the chains in each joint's mode; the bound is the best of all. Returns false
 // on a numerical failure.
@@ -365,6 +375,7 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
   const double stop_below =
       result_.type == QueryType::Collision || exact_below_ <= result_.margin ? result_.margin : -kInf;
   double chord_upper = kInf;  // upper bound on the distance of the chord chains' cores
+  double chord_lower = -kInf; // the chord chains' lower bound
   // A pair already clear of the margin is refined for its distance only: supports to within
   // kExactDistanceTolerance (their slack counted in the bound) and GJK to a relative 1e-3.
   const bool for_distance = bound > result_.margin;
@@ -381,6 +392,13 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
     // Nor can they lift a distance above that: refined for its distance, a pair whose bound is
     // already within the tolerance of it keeps the chord chains' bound.
     if (variant == 1 && for_distance && chord_upper - ca.radius - cb.radius <= bound + kExactDistanceGain) break;
+    // Once the chord chains prove the pair clear, the apexes could only tighten its distance. A
+    // revolute joint's apexes cost a third map per level for that (the searches' tree grows from
+    // 2^n to 3^n leaves), which splitting the box gains more cheaply (bench_trade: the same
+    // looseness bins in two thirds of the time); a rotation3d joint's apexes remove a pose error's
+    // first-order growth, which no split of the box can shrink, and stay. (The chord chains lie
+    // inside every budget's point volumes, so this choice does not depend on the point budget.)
+    if (variant == 1 && chord_lower > result_.margin && !hasRotationApexes(ca) && !hasRotationApexes(cb)) break;
     detail::SetsInfo info;
     info.scale_a = detail::chainExtent(ca);
     info.scale_b = detail::chainExtent(cb);
@@ -401,7 +419,10 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
     const DistanceResult d = detail::gjkDistance(support_a, support_b, ca.radius, cb.radius, info, opt);
     ++result_.stats.exact_calls;
     if (d.status == GjkStatus::InvalidInput || !std::isfinite(d.distance)) return false;
-    if (variant == 0) chord_upper = d.hull_upper;
+    if (variant == 0) {
+      chord_upper = d.hull_upper;
+      chord_lower = d.distance;
+    }
     if (d.distance > bound) {
       bound = d.distance;
       e.witness_a = d.witness_a;
@@ -475,7 +496,7 @@ const Joint& Checker::levelJoint(int body, int level) const noexcept {
 }
 
 // Splits the box of pair p, refined for its distance with the bound `bound`, when the bound lies
-// more than kSplitGap below an upper bound on the pair's true smallest distance (its distance at
+// more than split_gap_ (QueryOptions::exact_split_gap) below an upper bound on the pair's true smallest distance (its distance at
 // two configurations of the box: the centre, and the corner the gradient there points to), and
 // some accurate joint moves it. The sub-boxes: splits_ of them, made by halving level by level
 // each sub-box's state value that moves the pair's points farthest over its interval (width
@@ -504,11 +525,11 @@ bool Checker::splitPair(int p, Box box, double& bound) noexcept {
   std::fill(split_grad_.begin(), split_grad_.end(), 0.0);
   for (std::size_t k = 0; k < nsz; ++k) centre_[k] = box.lower[k] + 0.5 * (box.upper[k] - box.lower[k]);
   double upper = posedDistance(p, centre_.data(), split_grad_.data());
-  if (!(upper - bound > kSplitGap)) return true;
+  if (!(upper - bound > split_gap_)) return true;
   for (std::size_t k = 0; k < nsz; ++k)
     if (split_grad_[k] != 0.0) centre_[k] = split_grad_[k] > 0.0 ? box.lower[k] : box.upper[k];
   upper = std::min(upper, posedDistance(p, centre_.data(), nullptr));
-  if (!(upper - bound > kSplitGap)) return true;
+  if (!(upper - bound > split_gap_)) return true;
   for (int s = 0; s < 2; ++s)
     for (int l = 1; l <= side_level[s]; ++l) {
       const Sphere* below = sphere(side_body[s], l - 1, box);
@@ -548,14 +569,27 @@ bool Checker::splitPair(int p, Box box, double& bound) noexcept {
       hi(leaf)[arg] = mid;
       lo(other)[arg] = mid;
     }
+  // The sub-box nearest the obstacle first (by the nominal distance at its centre): the smallest
+  // bound is then found early, and every later sub-box's search stops once it is proven above it
+  // (or above the band's top), since only the smallest counts.
+  for (int leaf = 0; leaf < leaves; ++leaf) {
+    for (std::size_t k = 0; k < nsz; ++k) centre_[k] = lo(leaf)[k] + 0.5 * (hi(leaf)[k] - lo(leaf)[k]);
+    split_order_[static_cast<std::size_t>(leaf)] = leaf;
+    const double key = posedDistance(p, centre_.data(), nullptr);
+    split_key_[static_cast<std::size_t>(leaf)] = std::isnan(key) ? kInf : key;
+  }
+  std::sort(split_order_.begin(), split_order_.begin() + leaves,
+            [&](int x, int y) { return split_key_[static_cast<std::size_t>(x)] < split_key_[static_cast<std::size_t>(y)]; });
   double split = kInf;
   Vec3 best_a = witness_a, best_b = witness_b;
-  for (int leaf = 0; leaf < leaves && split > bound; ++leaf) {
+  for (int i = 0; i < leaves && split > bound; ++i) {
+    const int leaf = split_order_[static_cast<std::size_t>(i)];
     geo_cycle_ = ++stamps_;
     double b = bound;
     e.witness_a = witness_a;
     e.witness_b = witness_b;
-    if (!exactStage(p, kInf, Box{std::span<const double>(lo(leaf), nsz), std::span<const double>(hi(leaf), nsz)}, b))
+    if (!exactStage(p, std::min(split, exact_below_),
+                    Box{std::span<const double>(lo(leaf), nsz), std::span<const double>(hi(leaf), nsz)}, b))
       return false;
     if (b < split) {
       split = b;
@@ -580,21 +614,26 @@ bool Checker::splitPair(int p, Box box, double& bound) noexcept {
   return true;
 }
 
-// The nominal distance of pair p at configuration q (error bounds not applied): its two bodies
-// posed in the pair's common-ancestor frame, an upper bound from GJK (the hulls' upper distance
-// less the radii). With `grad`, adds to it the distance's derivative along each state value of the
-// pair's joints (the witness points moved by each joint's motion, along the separating
-// direction). Used to choose whether to split; +inf when GJK fails.
+// An upper bound on pair p's smallest distance at configuration q over its joints' error bounds:
+// its two bodies posed in the pair's common-ancestor frame without error, GJK's upper distance
+// (the hulls' less the radii), less every translation3d error bound on either path (an error of
+// that length along the separating direction is one of the pose's true values, and moves the
+// witness points that much closer; rotation errors are not counted). With `grad`, adds to it the
+// nominal distance's derivative along each state value of the pair's joints (the witness points
+// moved by each joint's motion, along the separating direction). Used to choose whether and how
+// to split; +inf when GJK fails.
 double Checker::posedDistance(int p, const double* q, double* grad) noexcept {
   const BodyPair& pair = model_.pairs[p];
   const int side_level[2] = {pair_level_[2 * p], pair_level_[2 * p + 1]};
   const int side_body[2] = {pair.a, pair.b};
   const int max_levels = static_cast<int>(split_extent_.size() / 2);
   SschView posed[2];
+  double error = 0.0;  // translation error bounds on both paths
   for (int s = 0; s < 2; ++s) {
     Pose above = Pose::Identity();  // from the frame below level l's motion to the common frame
     for (int l = side_level[s]; l >= 1; --l) {
       const Joint& j = levelJoint(side_body[s], l);
+      if (j.type == JointType::Translation3d) error += j.error;
       const Pose frame = above * j.origin;
       split_frames_[static_cast<std::size_t>(s * max_levels + l - 1)] = frame;
       above = frame * jointMotion(j, q + j.state_offset);
@@ -606,8 +645,9 @@ double Checker::posedDistance(int p, const double* q, double* grad) noexcept {
   }
   const DistanceResult d = distance(posed[0], posed[1]);
   if (d.status == GjkStatus::InvalidInput) return kInf;
-  const double upper = std::max(0.0, d.hull_upper - posed[0].radius - posed[1].radius);
-  if (grad == nullptr || !(upper > 0.0)) return upper;
+  const double nominal = std::max(0.0, d.hull_upper - posed[0].radius - posed[1].radius);
+  const double upper = std::max(0.0, nominal - error);
+  if (grad == nullptr || !(nominal > 0.0)) return upper;
   const Vec3 n = -d.direction;  // from a towards b
   for (int s = 0; s < 2; ++s) {
     const Vec3& w = s == 0 ? d.witness_a : d.witness_b;
@@ -683,6 +723,7 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   splits_ = 0;
   if (options.type != QueryType::Collision && exact_below_ > margin)
     for (int s = 2; s <= std::min(options.exact_splits, kMaxExactSplits); s *= 2) splits_ = s;
+  split_gap_ = options.exact_split_gap >= 0.0 ? options.exact_split_gap : QueryOptions{}.exact_split_gap;
 
   const int np = static_cast<int>(model_.pairs.size());
   const int n_wanted = std::clamp(options.n, 1, std::max(np, 1));  // NClosest

@@ -25,6 +25,7 @@ struct QueryArgs {
   std::string exact = "band";
   double exact_band = 0.2;
   int exact_splits = QueryOptions{}.exact_splits;
+  double exact_split_gap = QueryOptions{}.exact_split_gap;
   bool json = false;
   bool explain = false;
 };
@@ -108,6 +109,7 @@ Exit runQuery(const QueryArgs& args) {
   opt.exact_below = parseExact(args.exact, args.margin >= 0.0 ? args.margin : m.safety_margin);
   opt.exact_band = args.exact_band;
   opt.exact_splits = args.exact_splits;
+  opt.exact_split_gap = args.exact_split_gap;
   const QueryResult& r = checker.query(lower, upper, opt);
   const bool explain = args.explain && r.status == Status::Ok;
   const std::vector<PairExplanation> explained =
@@ -191,10 +193,15 @@ Runner addQuery(CLI::App& app) {
       ->check(finiteIn(0.0, kMaxModelLength));
   sub->add_option("--exact-splits", args->exact_splits,
                   "Distance queries: a pair in the band, moved by some accurate joint, whose bound lies more than "
-                  "3 mm below its distance at a configuration of the box has its box split into up to this many "
-                  "sub-boxes (a power of two), each refined by the exact stage; 0 or 1: never")
+                  "--exact-split-gap below its distance at a configuration of the box has its box split into up to "
+                  "this many sub-boxes (a power of two), each refined by the exact stage; 0 or 1: never")
       ->capture_default_str()
       ->check(CLI::Range(0, kMaxExactSplits));
+  sub->add_option("--exact-split-gap", args->exact_split_gap,
+                  "Metres: how far a pair's bound may lie below its distance at a configuration of the box before "
+                  "the box is split (the looseness accepted before paying for splits; smaller is tighter and slower)")
+      ->capture_default_str()
+      ->check(finiteIn(0.0, kMaxModelLength));
   sub->add_flag("--json", args->json, "Machine-readable output");
   sub->add_flag("--explain", args->explain,
                 "For every pair whose bound is <= the margin, search the box for its closest configuration and "

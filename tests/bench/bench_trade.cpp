@@ -38,7 +38,7 @@
 //
 // Usage: bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]
 //                    [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]
-//                    [--exact default|margin|all|off|METRES] [--splits N]
+//                    [--exact default|margin|all|off|METRES] [--splits N] [--split-gap METRES]
 //                    [--markdown F] [--csv F] [--plot F.png]
 // Exit status: 0 done, 1 error, 2 bad option, 3 a bound violation, 4 a found distance below the
 // exact bound at its own configuration (a wrong search).
@@ -88,6 +88,7 @@ using bench::parseOptions;
 // resolved to the model's margin.
 double g_exact_below = -1.0;
 int g_splits = QueryOptions{}.exact_splits;  // of the measured queries (--splits)
+double g_split_gap = QueryOptions{}.exact_split_gap;  // of the measured queries (--split-gap)
 double exactBelow(const Model& m) { return g_exact_below == bench::kExactAtMargin ? m.safety_margin : g_exact_below; }
 
 [[noreturn]] void fail(const std::string& message) {
@@ -201,7 +202,7 @@ double coldTime(Checker& checker, const Box& box, bool at_centre, QueryType type
   for (int r = 0; r < repeats; ++r) {
     checker.reset();
     const auto t0 = Clock::now();
-    const QueryResult& res = checker.query(lo, hi, {.type = type, .exact_below = exact_below, .exact_splits = g_splits});
+    const QueryResult& res = checker.query(lo, hi, {.type = type, .exact_below = exact_below, .exact_splits = g_splits, .exact_split_gap = g_split_gap});
     const double us = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
     if (res.status != Status::Ok) fail(std::string("unexpected query status ") + toString(res.status));
     best = std::min(best, us);
@@ -213,7 +214,7 @@ double coldTime(Checker& checker, const Box& box, bool at_centre, QueryType type
 std::vector<double> distancesBounds(Checker& checker, const Box& box, bool at_centre) {
   checker.reset();
   const QueryResult& r = checker.query(at_centre ? box.centre : box.lower, at_centre ? box.centre : box.upper,
-                                       {.type = QueryType::Distances, .exact_below = exactBelow(checker.model()), .exact_splits = g_splits});
+                                       {.type = QueryType::Distances, .exact_below = exactBelow(checker.model()), .exact_splits = g_splits, .exact_split_gap = g_split_gap});
   std::vector<double> out(checker.model().pairs.size(), 0.0);
   for (const PairDistance& p : r.pairs) out[static_cast<std::size_t>(p.pair)] = p.distance;
   return out;
@@ -665,7 +666,7 @@ std::string exactName(double below) {
 std::string markdownNotes(const Options& o) {
   std::ostringstream md;
   md << "Exact stage: " << exactName(o.exact_below) << "; box splitting (QueryOptions::exact_splits): "
-     << (o.splits > 1 ? "up to " + std::to_string(o.splits) + " sub-boxes per pair" : std::string("off"))
+     << (o.splits > 1 ? "up to " + std::to_string(o.splits) + " sub-boxes per pair, split gap " + num(o.split_gap * 1e3, "%g") + " mm" : std::string("off"))
      << ". \"/ verdict-only\": the median distances query over the median distances query whose exact stage "
         "refines only the pairs within the margin (the verdicts), measured interleaved on the same boxes. "
         "Looseness in band: found distance minus bound over every pair whose bound is within "
@@ -769,6 +770,7 @@ int main(int argc, char** argv) try {
   const Options o = parseOptions(argc, argv);
   g_exact_below = o.exact_below;
   g_splits = o.splits;
+  g_split_gap = o.split_gap;
   const auto start = Clock::now();
   std::vector<SetSummary> sets;
   std::string md = "## Speed / accuracy trade (bench_trade)\n\n" + markdownNotes(o);

@@ -41,7 +41,7 @@ Options parseOptions(int argc, char** argv) {
     if (a == "--help") {
       std::printf("bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]\n"
                   "            [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]\n"
-                  "            [--exact default|margin|all|off|METRES] [--splits N]\n"
+                  "            [--exact default|margin|all|off|METRES] [--splits N] [--split-gap METRES]\n"
                   "            [--markdown F] [--csv F] [--plot F.png]\n");
       std::exit(0);
     }
@@ -88,6 +88,11 @@ Options parseOptions(int argc, char** argv) {
       }
     } else if (a == "--splits") {
       o.splits = static_cast<int>(parseWhole(a, v, 0, kccd::kMaxExactSplits));
+    } else if (a == "--split-gap") {
+      char* end = nullptr;
+      const double x = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || !(x >= 0.0 && x <= 1e3)) usageError("--split-gap: expected metres >= 0, got '" + v + "'");
+      o.split_gap = x;
     } else if (a == "--markdown") {
       o.markdown = v;
     } else if (a == "--csv") {

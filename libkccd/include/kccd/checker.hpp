@@ -148,10 +148,13 @@ class Checker {
   // Splitting a pair's box (splitPair): per sub-box its lower and upper ends; per side and level
   // the extent of the volume below the level's joint.
   int splits_ = 0;                           // sub-boxes per split pair this query (0: none)
+  double split_gap_ = 0.0;                    // QueryOptions::exact_split_gap, resolved
   std::vector<double> split_box_;
   std::vector<double> split_extent_;
   std::vector<double> centre_;
   std::vector<Vec3> centre_points_;          // the pair's two bodies posed at one configuration
+  std::vector<int> split_order_;             // sub-boxes in the order they are refined
+  std::vector<double> split_key_;            // per sub-box: the posed distance at its centre
   std::vector<double> split_grad_;           // per state value: the posed distance's derivative
   std::vector<Pose> split_frames_;           // per side and level: the joint frame, posed
   std::uint64_t stamps_ = 1;                 // the last stamp handed out

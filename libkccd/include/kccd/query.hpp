@@ -41,10 +41,6 @@ inline constexpr double kExactDistanceTolerance = 1e-3;
 /// The most sub-boxes QueryOptions::exact_splits may ask for.
 inline constexpr int kMaxExactSplits = 32;
 
-/// A pair is split only when its bound lies more than this (metres) below its distance at a
-/// configuration of the box (the centre, or the corner the distance's gradient points to): the
-/// most splitting could gain.
-inline constexpr double kSplitGap = 3e-3;
 
 /// What a query asks and how long it may take.
 struct QueryOptions {
@@ -66,13 +62,19 @@ struct QueryOptions {
   double exact_band = 0.2;
   /// A distance query's pair refined for its distance (clear of the margin, within the band),
   /// moved by at least one accurate joint (splitting is accurate's refinement), whose bound lies
-  /// more than kSplitGap below its distance at a configuration of the box has its box split into
+  /// more than exact_split_gap below its distance at a configuration of the box has its box split into
   /// up to this many sub-boxes (halving, level by level, the state value that moves the pair's
   /// points farthest), each refined by the exact stage: the bound is the smallest over them, up to
   /// the band's top. The exact stage bounds the convex hull of a swept chain, which for wide arcs
   /// of long chains or wide bodies reaches far inside the sweep; sub-boxes shrink that. Rounded
   /// down to a power of two, at most kMaxExactSplits; 0 or 1: never. Collision queries never split.
   int exact_splits = 8;
+  /// How far (metres) a pair's bound may lie below its distance at a configuration of the box (the
+  /// centre, or the corner the distance's gradient points to) before its box is split: the most a
+  /// split could gain, so the looseness a distance query accepts on a pair before paying for
+  /// splitting. Smaller: tighter distances, more splits (a smaller gap never gives a lower bound).
+  /// NaN or negative: the default.
+  double exact_split_gap = 0.015;
   /// Point volumes for display: where a sweep's budget forces a coarse cover, also try chords for
   /// every point reduced to the budget by hull distance, and keep the tighter. Slower; the
   /// verdicts do not change (the exact stage decides them).
