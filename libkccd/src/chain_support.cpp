@@ -179,8 +179,14 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work
       // Maps that share their linear part (translations) differ only by the offset: the child
       // of the largest offset along the row is the best of them, whatever lies below.
       int best_v = 0;
-      for (int v = 1; v < lv.count; ++v)
-        if (row.dot(lv.maps->off[v]) > row.dot(lv.maps->off[best_v])) best_v = v;
+      double best_off = row.dot(lv.maps->off[0]);
+      for (int v = 1; v < lv.count; ++v) {
+        const double o = row.dot(lv.maps->off[v]);
+        if (o > best_off) {
+          best_off = o;
+          best_v = v;
+        }
+      }
       push(best_v);
     };
     expand(depth, d, 0.0);

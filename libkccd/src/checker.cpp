@@ -306,7 +306,8 @@ const detail::RevoluteTrig& Checker::revoluteTrig(int joint, Box box) noexcept {
 const detail::JointMaps* Checker::jointMaps(int joint, Box box) noexcept {
   if (joint_maps_stamp_[joint] != geo_cycle_) {
     const Joint& j = model_.joints[joint];
-    joint_maps_[joint] = detail::jointMaps(j, box.lower.data() + j.state_offset, box.upper.data() + j.state_offset);
+    joint_maps_[joint] = detail::jointMaps(j, box.lower.data() + j.state_offset, box.upper.data() + j.state_offset,
+                                           revoluteTrig(joint, box));
     joint_maps_stamp_[joint] = geo_cycle_;
   }
   return &joint_maps_[joint];

@@ -377,7 +377,7 @@ int reduceToBudget(Vec3* pts, int n, int budget, double* dist, int* order, doubl
   return budget;
 }
 
-JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi) noexcept {
+JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi, const RevoluteTrig& trig) noexcept {
   JointMaps m;
   const Eigen::Matrix3d& rot = joint.origin.linear();
   const Vec3& t = joint.origin.translation();
@@ -398,21 +398,20 @@ JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi) noex
       Eigen::Matrix3d cross;
       cross << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
       auto rotation = [&](double c, double s) -> Eigen::Matrix3d { return rot * (axial + c * radial + s * cross); };
-      const Arc arc = revoluteArc(lo[0], hi[0]);
-      const int pieces = revolutePieces(arc.width);
+      const int pieces = trig.pieces;
       if (pieces == 0) {
-        add(rotation(std::cos(arc.start), std::sin(arc.start)), t, 1.0);
+        add(rotation(trig.c_end[0], trig.s_end[0]), t, 1.0);
         break;
       }
       m.revolute = true;
-      const double step = arc.width / pieces;
-      const double half_cos = std::cos(0.5 * step);
-      for (int k = 0; k <= pieces; ++k) add(rotation(std::cos(arc.start + k * step), std::sin(arc.start + k * step)), t, 1.0);
+      const double step = trig.width / pieces;
+      const double half_cos = trig.half_cos;
+      for (int k = 0; k <= pieces; ++k) add(rotation(trig.c_end[k], trig.s_end[k]), t, 1.0);
       m.chord_count = m.count;
       // Tangent apexes: the middle direction scaled by 1 / cos(step / 2) (the operator norm).
       const double apex_scale = roundedUp(1.0 / half_cos, 4);
       for (int k = 0; k < pieces; ++k) {
-        const double mid = arc.start + (k + 0.5) * step;
+        const double mid = trig.start + (k + 0.5) * step;
         add(rotation(std::cos(mid) / half_cos, std::sin(mid) / half_cos), t, apex_scale);
       }
       m.sagitta = roundedUp(1.0 - half_cos, 8) + 8.0 * kEps;

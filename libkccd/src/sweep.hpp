@@ -17,7 +17,7 @@ inline constexpr double kMaxPieceAngle = 1.5707963267948966;  // pi / 2
 struct RevoluteTrig {
   static constexpr int kMaxPieces = 4;  // 2 pi / kMaxPieceAngle
   double lo = 0.0, hi = -1.0;  ///< the interval it was made for (lo > hi: none)
-  double start = 0.0, width = 0.0;
+  double start = 0.0, width = 0.0;  ///< the arc: its first angle (in [0, 2 pi)) and width
   int pieces = 0;              ///< 0: a single angle, start
   double c_end[kMaxPieces + 1] = {}, s_end[kMaxPieces + 1] = {};  ///< the pieces' ends
   double half_cos = 1.0;       ///< cos(step / 2)
@@ -75,8 +75,9 @@ struct JointMaps {
   double offset_norm = 0.0;  ///< bound on |off|
 };
 
-/// The vertex maps of `joint` over [lo, hi] (values finite; the caller checks).
-JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi) noexcept;
+/// The vertex maps of `joint` over [lo, hi] (values finite; the caller checks). `trig` is
+/// revoluteTrig(lo[0], hi[0]) for a revolute joint (ignored for the others).
+JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi, const RevoluteTrig& trig) noexcept;
 
 /// A sphere containing every position of sphere `in` under the joint's motion over [lo, hi],
 /// in the joint's parent frame (cheap: no points are swept).
