@@ -393,13 +393,17 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
     // Nor can they lift a distance above that: refined for its distance, a pair whose bound is
     // already within the tolerance of it keeps the chord chains' bound.
     if (variant == 1 && for_distance && chord_upper - ca.radius - cb.radius <= bound + kExactDistanceGain) break;
-    // Once the chord chains prove the pair clear, the apexes could only tighten its distance. A
-    // revolute joint's apexes cost a third map per level for that (the searches' tree grows from
-    // 2^n to 3^n leaves), which splitting the box gains more cheaply (bench_trade: the same
-    // looseness bins in two thirds of the time); a rotation3d joint's apexes remove a pose error's
-    // first-order growth, which no split of the box can shrink, and stay. (The chord chains lie
-    // inside every budget's point volumes, so this choice does not depend on the point budget.)
-    if (variant == 1 && chord_lower > result_.margin && !hasRotationApexes(ca) && !hasRotationApexes(cb)) break;
+    // Once the chord chains prove the pair clear (the verdict), the apexes could only tighten its
+    // distance. On the whole box a revolute joint's apexes cost a third map per level for that (the
+    // searches' tree grows from 2^n to 3^n leaves, over the widest arcs): a distance query's
+    // splitting tightens the pair instead, and its sub-boxes (arcs halved) are searched with every
+    // apex (bench_trade: about 60 % of the time at much the same looseness). A rotation3d joint's
+    // apexes remove a pose error's first-order growth, which no split of the box can shrink, and
+    // stay. The chord chains lie inside every budget's point volumes, so this choice does not
+    // depend on the budget, and splitting still only raises a bound.
+    if (variant == 1 && !in_sub_box_ && chord_lower > result_.margin && !hasRotationApexes(ca) &&
+        !hasRotationApexes(cb))
+      break;
     detail::SetsInfo info;
     info.scale_a = detail::chainExtent(ca);
     info.scale_b = detail::chainExtent(cb);
@@ -589,9 +593,11 @@ bool Checker::splitPair(int p, Box box, double& bound) noexcept {
     double b = bound;
     e.witness_a = witness_a;
     e.witness_b = witness_b;
-    if (!exactStage(p, std::min(split, exact_below_),
-                    Box{std::span<const double>(lo(leaf), nsz), std::span<const double>(hi(leaf), nsz)}, b))
-      return false;
+    in_sub_box_ = true;
+    const bool ok = exactStage(p, std::min(split, exact_below_),
+                               Box{std::span<const double>(lo(leaf), nsz), std::span<const double>(hi(leaf), nsz)}, b);
+    in_sub_box_ = false;
+    if (!ok) return false;
     if (b < split) {
       split = b;
       best_a = e.witness_a;

@@ -149,6 +149,7 @@ class Checker {
   // the extent of the volume below the level's joint.
   int splits_ = 0;                           // sub-boxes per split pair this query (0: none)
   double split_gap_ = 0.0;                    // QueryOptions::exact_split_gap, resolved
+  bool in_sub_box_ = false;                   // the exact stage is refining a sub-box of a split
   std::vector<double> split_box_;
   std::vector<double> split_extent_;
   std::vector<double> centre_;
