@@ -154,10 +154,10 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work
       const Sphere& s = sphereBelow(chain, level - 1);
       const ChainLevel* hull = level >= 2 ? &chain.levels[static_cast<std::size_t>(level) - 2] : nullptr;
       const int first = top;
-      auto push = [&](int v) {
+      auto push = [&](int v, double row_off) {  // row_off: row . off[v]
         ChainEntry e;
         e.row = lv.maps->lin[v].transpose() * row;
-        e.offset = offset + row.dot(lv.maps->off[v]);
+        e.offset = offset + row_off;
         const double row_norm = e.row.norm();
         e.bound = e.offset + e.row.dot(s.center) + row_norm * s.radius;
         if (hull != nullptr && hull->has_box) {
@@ -173,7 +173,7 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work
         stack[k] = e;
       };
       if (!lv.maps->shared_lin) {
-        for (int v = 0; v < lv.count; ++v) push(v);
+        for (int v = 0; v < lv.count; ++v) push(v, row.dot(lv.maps->off[v]));
         return;
       }
       // Maps that share their linear part (translations) differ only by the offset: the child
@@ -187,7 +187,7 @@ SupportHit chainSupport(const ChainView& chain, const Vec3& dir, ChainWork& work
           best_v = v;
         }
       }
-      push(best_v);
+      push(best_v, best_off);
     };
     expand(depth, d, 0.0);
     while (top > 0) {

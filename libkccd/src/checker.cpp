@@ -501,16 +501,17 @@ const Joint& Checker::levelJoint(int body, int level) const noexcept {
 }
 
 // Splits the box of pair p, refined for its distance with the bound `bound`, when the bound lies
-// more than split_gap_ (QueryOptions::exact_split_gap) below an upper bound on the pair's true smallest distance (its distance at
-// two configurations of the box: the centre, and the corner the gradient there points to), and
-// some accurate joint moves it. The sub-boxes: splits_ of them, made by halving level by level
-// each sub-box's state value that moves the pair's points farthest over its interval (width
-// times the extent of the volume below its joint, from the whole box's swept spheres; metres for
-// translations): a choice from the geometry only, the same in every sweep mode. Each sub-box is refined by the exact stage from `bound` (which holds for every part); the
-// pair's bound becomes the smallest over the sub-boxes, which cover the box, up to exact_below_.
-// Stops early when a sub-box gains nothing. The exact stage runs under stamps of its own
-// (geo_cycle_), and a fresh stamp is left for the box, so the spheres, joint maps and chains are
-// recomputed for it when next needed; the point volumes (cycle_) are not touched.
+// more than split_gap_ (QueryOptions::exact_split_gap) below an upper bound on the pair's true
+// smallest distance (its distance at two configurations of the box: the centre, and the corner
+// the gradient there points to), and some accurate joint moves it. The sub-boxes: splits_ of
+// them, made by halving level by level each sub-box's state value that moves the pair's points
+// farthest over its interval (width times the extent of the volume below its joint, from the
+// whole box's swept spheres; metres for translations): a choice from the geometry only, the same
+// in every sweep mode. Each sub-box is refined by the exact stage from `bound` (which holds for
+// every part); the pair's bound becomes the smallest over the sub-boxes, which cover the box, up
+// to exact_below_. Stops early when a sub-box gains nothing. The exact stage runs under stamps of
+// its own (geo_cycle_), and a fresh stamp is left for the box, so the spheres, joint maps and
+// chains are recomputed for it when next needed; the point volumes (cycle_) are not touched.
 bool Checker::splitPair(int p, Box box, double& bound) noexcept {
   const BodyPair& pair = model_.pairs[p];
   Entry& e = table_[p];

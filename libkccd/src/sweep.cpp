@@ -19,6 +19,13 @@ constexpr double kMaxRotationApexReach = 0.3;
 // An icosahedron's circumradius over its inradius (sqrt(3) sqrt(phi^2 + 1) / phi^2), rounded up.
 constexpr double kIcosahedron = 1.2584086;
 
+// The matrix of v x . (so that crossMatrix(v) p = v x p).
+Eigen::Matrix3d crossMatrix(const Vec3& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
 // Pieces for a revolute interval of width `width` (capped at a full turn).
 int revolutePieces(double width) {
   if (!(width > 0.0)) return 0;
@@ -395,8 +402,7 @@ JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi, cons
       const Vec3& a = joint.axis;
       const Eigen::Matrix3d axial = a * a.transpose();
       const Eigen::Matrix3d radial = Eigen::Matrix3d::Identity() - axial;
-      Eigen::Matrix3d cross;
-      cross << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+      const Eigen::Matrix3d cross = crossMatrix(a);
       auto rotation = [&](double c, double s) -> Eigen::Matrix3d { return rot * (axial + c * radial + s * cross); };
       const int pieces = trig.pieces;
       if (pieces == 0) {
@@ -473,8 +479,7 @@ JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi, cons
                 u[(k + 1) % 3] = a;
                 u[(k + 2) % 3] = b;
                 u.normalize();
-                Eigen::Matrix3d cross;
-                cross << 0.0, -u.z(), u.y(), u.z(), 0.0, -u.x(), -u.y(), u.x(), 0.0;
+                const Eigen::Matrix3d cross = crossMatrix(u);
                 add(centre * (Eigen::Matrix3d::Identity() + sin_s * cross + versine * (cross * cross)), t, 1.0);
               }
           m.rotation_apexes = true;

@@ -41,7 +41,6 @@ inline constexpr double kExactDistanceTolerance = 1e-3;
 /// The most sub-boxes QueryOptions::exact_splits may ask for.
 inline constexpr int kMaxExactSplits = 32;
 
-
 /// What a query asks and how long it may take.
 struct QueryOptions {
   QueryType type = QueryType::Collision;
