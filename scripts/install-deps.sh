@@ -10,13 +10,14 @@ packages=(
   libcoin-dev inventor-data liburdfdom-dev libassimp-dev
   libosmesa6-dev libgl-dev libegl-dev libopengl-dev libegl-mesa0
   libopencv-dev libpng-dev libtinyxml2-dev libapriltag-dev
+  python3-dev pybind11-dev python3-numpy
 )
 # --fuzz: also the compiler and runtime of the libFuzzer targets (scripts/fuzz.sh).
 [ "${1:-}" = "--fuzz" ] && packages+=(clang-14 libclang-rt-14-dev)
 # --tests: also what the labelling page's tests run: Debian's chromium, node and npm (below), and
-# npm's playwright-core in tests/e2e (scripts/test.sh).
+# npm's playwright-core in tests/e2e (scripts/test.sh); and the Python package's: pytest, mypy.
 tests=0
-[ "${1:-}" = "--tests" ] && tests=1 && packages+=(chromium)
+[ "${1:-}" = "--tests" ] && tests=1 && packages+=(chromium python3-pytest mypy)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,0 +1,43 @@
+"""KCCD: strictly conservative continuous collision detection for robots.
+
+Every distance a query reports is a guaranteed lower bound over every configuration in the interval
+box it was given. Lengths are metres, angles radians, states in Model.state_names order.
+
+    import kccd
+    model = kccd.Model.load("data/demo_arm.yaml")
+    checker = kccd.Checker(model)
+    r = checker.query(lower, upper, type="distances")
+    r.status, r.collision, r.min_distance, r.distance, r.witness_a
+"""
+
+from ._kccd import (
+    BrakingParams,
+    Camera,
+    Checker,
+    GlContextError,
+    InputError,
+    Model,
+    QueryResult,
+    Status,
+    __version__,
+    braking_intervals,
+    overlay_recording,
+    render,
+    synthesize_recording,
+)
+
+__all__ = [
+    "BrakingParams",
+    "Camera",
+    "Checker",
+    "GlContextError",
+    "InputError",
+    "Model",
+    "QueryResult",
+    "Status",
+    "__version__",
+    "braking_intervals",
+    "overlay_recording",
+    "render",
+    "synthesize_recording",
+]

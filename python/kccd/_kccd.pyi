@@ -1,0 +1,231 @@
+"""Types of the C++ extension kccd._kccd (re-exported by the kccd package)."""
+
+import enum
+from collections.abc import Callable, Sequence
+from typing import Any, Literal, TypedDict
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+_ArrayLike = npt.ArrayLike
+_QueryType = Literal["collision", "closest", "nclosest", "distances"]
+_Exact = Literal["band", "margin", "all", "off"] | float
+
+class InputError(ValueError):
+    """Input that cannot be used; str() is 'source[:line[:column]]: field: problem'."""
+
+    source: str
+    line: int
+    column: int
+    field: str
+    problem: str
+
+class GlContextError(RuntimeError):
+    """No off-screen GL context (EGL or OSMesa) could be made."""
+
+class Status(enum.IntEnum):
+    """A query's outcome; anything but OK means 'unsafe, stop'."""
+
+    OK = 0
+    WRONG_STATE_SIZE = 1
+    NON_FINITE_STATE = 2
+    LOWER_ABOVE_UPPER = 3
+    EXACT_NEEDS_POINT = 4
+    NUMERICAL_FAILURE = 5
+
+class Model:
+    """A robot and its cell; immutable; pickles through its YAML text."""
+
+    @staticmethod
+    def load(path: str) -> Model: ...
+    @staticmethod
+    def from_yaml(text: str, source: str = "<string>") -> Model: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def margin(self) -> float: ...
+    @property
+    def point_budget(self) -> int: ...
+    @property
+    def state_size(self) -> int: ...
+    @property
+    def state_names(self) -> list[str]: ...
+    @property
+    def joints(self) -> list[str]: ...
+    @property
+    def bodies(self) -> list[str]: ...
+    @property
+    def pairs(self) -> list[tuple[str, str]]: ...
+    @property
+    def yaml(self) -> str: ...
+    @property
+    def source(self) -> str: ...
+    def __getstate__(self) -> tuple[str, str]: ...
+    def __setstate__(self, state: tuple[str, str]) -> None: ...
+
+class QueryResult:
+    """One query's answer; every distance is a lower bound over the whole box (metres)."""
+
+    @property
+    def status(self) -> Status: ...
+    @property
+    def type(self) -> str: ...
+    @property
+    def collision(self) -> bool: ...
+    @property
+    def min_distance(self) -> float: ...
+    @property
+    def margin(self) -> float: ...
+    @property
+    def pair(self) -> npt.NDArray[np.int32]: ...
+    @property
+    def body_a(self) -> npt.NDArray[np.int32]: ...
+    @property
+    def body_b(self) -> npt.NDArray[np.int32]: ...
+    @property
+    def distance(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def witness_a(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def witness_b(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def fresh(self) -> npt.NDArray[np.bool_]: ...
+    @property
+    def has_witness(self) -> npt.NDArray[np.bool_]: ...
+    @property
+    def stats(self) -> dict[str, Any]: ...
+    def __len__(self) -> int: ...
+
+class _ManyResult(TypedDict):
+    status: npt.NDArray[np.int8]
+    collision: npt.NDArray[np.bool_]
+    min_distance: npt.NDArray[np.float64]
+
+class Checker:
+    """Answers queries over interval boxes; one Checker per thread."""
+
+    def __init__(self, model: Model, budget_us: float | None = None) -> None: ...
+    def query(
+        self,
+        lower: _ArrayLike,
+        upper: _ArrayLike | None = None,
+        *,
+        type: _QueryType = "collision",
+        n: int = 1,
+        margin: float | None = None,
+        exact: _Exact | None = None,
+    ) -> QueryResult: ...
+    def query_many(
+        self,
+        lowers: _ArrayLike,
+        uppers: _ArrayLike | None = None,
+        *,
+        type: _QueryType = "collision",
+        n: int = 1,
+        margin: float | None = None,
+        exact: _Exact | None = None,
+        threads: int = 1,
+        reuse: bool = False,
+    ) -> _ManyResult: ...
+    def reset(self) -> None: ...
+    @property
+    def model(self) -> Model: ...
+    @property
+    def budget_us(self) -> float | None: ...
+
+class BrakingParams:
+    """Braking of one state value (SI units)."""
+
+    position_error: float
+    velocity_error: float
+    latency: float
+    max_acceleration: float
+    deceleration: float
+    def __init__(
+        self,
+        *,
+        position_error: float = 0.0,
+        velocity_error: float = 0.0,
+        latency: float = 0.0,
+        max_acceleration: float = 0.0,
+        deceleration: float = 1.0,
+    ) -> None: ...
+
+def braking_intervals(
+    model: Model, q: _ArrayLike, v: _ArrayLike, params: BrakingParams | Sequence[BrakingParams]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+
+class Camera:
+    """A fixed, calibrated camera (intrinsics, distortion, world -> camera pose)."""
+
+    @staticmethod
+    def load(path: str) -> Camera: ...
+    def save(self, path: str) -> None: ...
+    @property
+    def width(self) -> int: ...
+    @property
+    def height(self) -> int: ...
+    @property
+    def camera_matrix(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def distortion(self) -> list[float]: ...
+    @property
+    def rvec(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def tvec(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def reprojection_rms_px(self) -> float | None: ...
+    @property
+    def rotation_sigma_deg(self) -> float | None: ...
+    @property
+    def position_sigma_m(self) -> float | None: ...
+
+class _Rendering(TypedDict):
+    rgba: npt.NDArray[np.uint8]
+    labels: npt.NDArray[np.uint8] | None
+    status: list[str]
+    distances: list[float]
+
+def render(
+    model: Model,
+    camera: Camera,
+    *,
+    state: _ArrayLike | None = None,
+    lower: _ArrayLike | None = None,
+    upper: _ArrayLike | None = None,
+    mask: bool = False,
+    legend: bool = True,
+) -> _Rendering: ...
+def overlay_recording(
+    model: Model,
+    camera: Camera,
+    video: str,
+    states: str,
+    *,
+    output: str = "",
+    report: str = "",
+    contact_sheet: str = "",
+    time_offset: float = 0.0,
+    swept: bool = False,
+    jobs: int = 0,
+    frames: str = "",
+    contact_frames: int = 12,
+    progress: Callable[[int, int, float], object] | None = None,
+) -> dict[str, Any]: ...
+def synthesize_recording(
+    model: str,
+    output: str,
+    *,
+    camera: str = "",
+    seconds: float = 5.0,
+    fps: float = 25.0,
+    log_rate: float = 125.0,
+    time_offset: float = 0.137,
+    seed: int = 1,
+    codec: str = "ffv1",
+    collision: bool = True,
+    replace: bool = False,
+    progress: Callable[[float], object] | None = None,
+) -> dict[str, Any]: ...

@@ -1,0 +1,147 @@
+// The main job from Python: kccd.overlay_recording (a recording and its state log checked and drawn
+// frame by frame) and kccd.synthesize_recording (a synthetic recording with ground truth).
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+
+#include <nlohmann/json.hpp>
+
+#include "bindings.hpp"
+#include "kccd/calib/camera.hpp"
+#include "kccd/overlay/frame_times.hpp"
+#include "kccd/overlay/overlay_recording.hpp"
+#include "kccd/overlay/synth.hpp"
+#include "kccd/overlay/video_sink.hpp"
+#include "kccd/state_log.hpp"
+
+namespace kccd::python {
+
+namespace {
+
+py::object toPython(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
+// Calls a Python progress callback from C++ with the GIL held; the first exception it raises is
+// kept (later calls are skipped) and raised when the job has finished.
+struct ProgressRelay {
+  py::object callback;
+  std::optional<py::error_already_set> error;
+  template <class... A>
+  void operator()(A... args) {
+    if (callback.is_none() || error) return;
+    py::gil_scoped_acquire gil;
+    try {
+      callback(args...);
+    } catch (py::error_already_set& e) {
+      error = std::move(e);
+    }
+  }
+  void rethrow() {
+    if (error) throw std::move(*error);
+  }
+};
+
+}  // namespace
+
+void bindOverlay(py::module_& m) {
+  m.def(
+      "overlay_recording",
+      [](const std::shared_ptr<ModelHandle>& h, const calib::Camera& camera, const std::string& video,
+         const std::string& states, const std::string& output, const std::string& report, const std::string& contact_sheet,
+         double time_offset, bool swept, int jobs, const std::string& frames, int contact_frames,
+         const py::object& progress) {
+        const Model& model = *h->model;
+        const StateLog log = loadStateLog(states, model);
+        overlay::OverlayInputs in{model, camera, log, video, {}, "video " + video, "camera", ""};
+        overlay::OverlayOptions o;
+        o.time_offset = time_offset;
+        o.swept = swept;
+        o.jobs = jobs;
+        o.frames = overlay::parseFrameRange(frames, "frames");
+        if (contact_frames < 1 || contact_frames > 64) throw py::value_error("contact_frames: expected 1 to 64");
+        o.contact_frames = contact_sheet.empty() ? 0 : static_cast<std::size_t>(contact_frames);
+        overlay::VideoSink sink({.video = output, .codec = "", .video_label = "output " + output, .png_dir = "", .png_label = ""});
+        ProgressRelay relay{progress, {}};
+        nlohmann::json full;
+        {
+          py::gil_scoped_release release;
+          const overlay::OverlayReport r = overlay::overlayRecording(
+              in, o, sink.active() ? &sink : nullptr,
+              [&](const overlay::OverlayProgress& p) { relay(p.frames_done, p.frames_expected, p.frames_per_second); });
+          full = overlay::reportJson(r, model, true);
+          if (!output.empty()) full["video"] = output;
+          if (!contact_sheet.empty()) {
+            if (r.contact_sheet.empty()) throw InputError("contact_sheet " + contact_sheet + ": no frame was drawn (see frames)");
+            overlay::writePngAtomically(contact_sheet, r.contact_sheet, "contact_sheet " + contact_sheet);
+            full["contact_sheet"] = contact_sheet;
+          }
+          sink.commit();
+          if (!report.empty()) overlay::writeFileAtomically(report, full.dump(1) + "\n", "report " + report);
+        }
+        relay.rethrow();
+        return toPython(full);
+      },
+      py::arg("model"), py::arg("camera"), py::arg("video"), py::arg("states"), py::kw_only(), py::arg("output") = "",
+      py::arg("report") = "", py::arg("contact_sheet") = "", py::arg("time_offset") = 0.0, py::arg("swept") = false,
+      py::arg("jobs") = 0, py::arg("frames") = "", py::arg("contact_frames") = 12, py::arg("progress") = py::none(),
+      R"doc(The main job, as `kccd overlay`: every frame of `video` (a file or an image-sequence pattern) checked at
+the state the log `states` (CSV) gives at its time (log time = frame time + time_offset, seconds), the
+volumes drawn and composited. Outputs, each written under a temporary name and renamed when complete:
+`output` (.mp4, .mkv or .avi), `report` (.json, the format of `kccd overlay --report`), `contact_sheet`
+(.png of contact_frames frames). swept: braking-interval volumes. jobs: drawing threads (0: all cores).
+frames: 'FIRST:END:STEP' of the frames drawn (all are checked). progress(frames_done, frames_expected,
+frames_per_second) is called after each frame with the GIL held. Returns the report as a dict (with
+per-frame records under 'frames'). Raises InputError naming the input and place.)doc");
+
+  m.def(
+      "synthesize_recording",
+      [](const std::string& model, const std::string& output, const std::string& camera, double seconds, double fps,
+         double log_rate, double time_offset, std::uint64_t seed, const std::string& codec, bool collision, bool replace,
+         const py::object& progress) {
+        overlay::SynthOptions o;
+        o.model = model;
+        o.output = output;
+        o.camera = camera;
+        o.seconds = seconds;
+        o.fps = fps;
+        o.log_rate = log_rate;
+        o.time_offset = time_offset;
+        o.seed = seed;
+        o.codec = codec;
+        o.collision = collision;
+        o.replace = replace;
+        ProgressRelay relay{progress, {}};
+        overlay::SynthResult r;
+        {
+          py::gil_scoped_release release;
+          r = overlay::synthesizeRecording(o, [&](double fraction) { relay(fraction); });
+        }
+        relay.rethrow();
+        py::dict d;
+        d["folder"] = r.folder.string();
+        d["video"] = (r.folder / r.video_file).string();
+        d["states"] = (r.folder / "states.csv").string();
+        d["camera"] = (r.folder / "camera_true.yaml").string();
+        d["frames"] = r.frames;
+        d["width"] = r.width;
+        d["height"] = r.height;
+        d["fps"] = r.fps;
+        d["log_rate"] = r.log_rate;
+        d["time_offset"] = r.time_offset;
+        d["log_rows"] = r.log_rows;
+        d["min_distance"] = r.min_distance;
+        d["colliding_frames"] = r.colliding_frames;
+        d["near_frames"] = r.near_frames;
+        d["collision_intervals"] = r.collision_intervals;
+        d["seconds"] = r.seconds;
+        return d;
+      },
+      py::arg("model"), py::arg("output"), py::kw_only(), py::arg("camera") = "", py::arg("seconds") = 5.0,
+      py::arg("fps") = 25.0, py::arg("log_rate") = 125.0, py::arg("time_offset") = 0.137, py::arg("seed") = 1,
+      py::arg("codec") = "ffv1", py::arg("collision") = true, py::arg("replace") = false, py::arg("progress") = py::none(),
+      R"doc(A synthetic recording with ground truth, as `kccd synth`: in the new folder `output`, the video, the state
+log states.csv, the true camera camera_true.yaml, tags, masks and synth.json (the folder appears only when
+complete). model: a model file. progress(fraction) is called after each frame with the GIL held. Returns
+a dict with the files' paths and the truth: per-frame 'min_distance' (metres), 'colliding_frames',
+'near_frames', 'collision_intervals' ([first, last] frames).)doc");
+}
+
+}  // namespace kccd::python
