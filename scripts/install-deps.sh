@@ -17,7 +17,7 @@ packages=(
 # --tests: also what the labelling page's tests run: Debian's chromium, node and npm (below), and
 # npm's playwright-core in tests/e2e (scripts/test.sh); and the Python package's: pytest, mypy.
 tests=0
-[ "${1:-}" = "--tests" ] && tests=1 && packages+=(chromium python3-pytest mypy)
+[ "${1:-}" = "--tests" ] && tests=1 && packages+=(chromium python3-pytest python3-yaml python3-matplotlib mypy)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -56,69 +56,86 @@ QueryOptions makeOptions(const Model& model, const std::string& type, int n, con
   return o;
 }
 
-// A query's answer copied out of the checker's buffers (fresh NumPy arrays).
+// A query's answer copied out of the checker's buffers; its NumPy arrays (fresh, never views of
+// the checker) are made on first access, so a query that only reads the verdict pays for none.
 struct PyResult {
-  py::object status;
-  std::string type;
+  int status = 0;
+  QueryType type = QueryType::Collision;
   bool collision = true;
   double min_distance = 0.0, margin = 0.0;
-  py::array_t<std::int32_t> pair, body_a, body_b;
-  py::array_t<double> distance, witness_a, witness_b;
-  py::array_t<bool> fresh, has_witness;
-  py::dict stats;
+  QueryStats stats;
+  std::vector<PairDistance> pairs;
+  std::shared_ptr<ModelHandle> model;
+  py::object arrays;  // a tuple of the arrays below, once made
+
+  enum Field { kPair, kBodyA, kBodyB, kDistance, kWitnessA, kWitnessB, kFresh, kHasWitness };
+  py::object array(Field f) {
+    if (!arrays) arrays = makeArrays();
+    return arrays[py::int_(static_cast<int>(f))];
+  }
+
+ private:
+  py::tuple makeArrays() const {
+    const auto n = static_cast<py::ssize_t>(pairs.size());
+    py::array_t<std::int32_t> pair(n), body_a(n), body_b(n);
+    py::array_t<double> distance(n), witness_a({n, py::ssize_t{3}}), witness_b({n, py::ssize_t{3}});
+    py::array_t<bool> fresh(n), has_witness(n);
+    auto pr = pair.mutable_unchecked<1>();
+    auto ba = body_a.mutable_unchecked<1>();
+    auto bb = body_b.mutable_unchecked<1>();
+    auto di = distance.mutable_unchecked<1>();
+    auto wa = witness_a.mutable_unchecked<2>();
+    auto wb = witness_b.mutable_unchecked<2>();
+    auto fr = fresh.mutable_unchecked<1>();
+    auto hw = has_witness.mutable_unchecked<1>();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (py::ssize_t i = 0; i < n; ++i) {
+      const PairDistance& p = pairs[static_cast<std::size_t>(i)];
+      const BodyPair& bp = model->model->pairs[static_cast<std::size_t>(p.pair)];
+      pr(i) = p.pair;
+      ba(i) = bp.a;
+      bb(i) = bp.b;
+      di(i) = p.distance;
+      for (int k = 0; k < 3; ++k) {
+        wa(i, k) = p.has_witness ? p.witness_a[k] : nan;
+        wb(i, k) = p.has_witness ? p.witness_b[k] : nan;
+      }
+      fr(i) = p.fresh;
+      hw(i) = p.has_witness;
+    }
+    return py::make_tuple(pair, body_a, body_b, distance, witness_a, witness_b, fresh, has_witness);
+  }
 };
 
-// kccd.Status, made once by bindChecker (kept for the interpreter's life).
-PyObject* g_status = nullptr;
-py::object statusEnum() { return py::reinterpret_borrow<py::object>(g_status); }
+// kccd.Status's members by value, made once by bindChecker (kept for the interpreter's life).
+std::vector<PyObject*> g_status;
+py::object statusObject(int value) {
+  return py::reinterpret_borrow<py::object>(g_status[static_cast<std::size_t>(value)]);
+}
 
-PyResult copyResult(const Model& model, const QueryResult& r) {
+PyResult copyResult(const std::shared_ptr<ModelHandle>& model, const QueryResult& r) {
   PyResult out;
-  out.status = statusEnum()(static_cast<int>(r.status));
-  out.type = toString(r.type);
+  out.status = static_cast<int>(r.status);
+  out.type = r.type;
   out.collision = r.collision;
   out.min_distance = r.min_distance;
   out.margin = r.margin;
-  const auto n = static_cast<py::ssize_t>(r.pairs.size());
-  out.pair = py::array_t<std::int32_t>(n);
-  out.body_a = py::array_t<std::int32_t>(n);
-  out.body_b = py::array_t<std::int32_t>(n);
-  out.distance = py::array_t<double>(n);
-  out.witness_a = py::array_t<double>({n, py::ssize_t{3}});
-  out.witness_b = py::array_t<double>({n, py::ssize_t{3}});
-  out.fresh = py::array_t<bool>(n);
-  out.has_witness = py::array_t<bool>(n);
-  auto pr = out.pair.mutable_unchecked<1>();
-  auto ba = out.body_a.mutable_unchecked<1>();
-  auto bb = out.body_b.mutable_unchecked<1>();
-  auto di = out.distance.mutable_unchecked<1>();
-  auto wa = out.witness_a.mutable_unchecked<2>();
-  auto wb = out.witness_b.mutable_unchecked<2>();
-  auto fr = out.fresh.mutable_unchecked<1>();
-  auto hw = out.has_witness.mutable_unchecked<1>();
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (py::ssize_t i = 0; i < n; ++i) {
-    const PairDistance& p = r.pairs[static_cast<std::size_t>(i)];
-    const BodyPair& bp = model.pairs[static_cast<std::size_t>(p.pair)];
-    pr(i) = p.pair;
-    ba(i) = bp.a;
-    bb(i) = bp.b;
-    di(i) = p.distance;
-    for (int k = 0; k < 3; ++k) {
-      wa(i, k) = p.has_witness ? p.witness_a[k] : nan;
-      wb(i, k) = p.has_witness ? p.witness_b[k] : nan;
-    }
-    fr(i) = p.fresh;
-    hw(i) = p.has_witness;
-  }
-  out.stats["time_us"] = r.stats.time_us;
-  out.stats["pairs_checked"] = r.stats.pairs_checked;
-  out.stats["gjk_calls"] = r.stats.gjk_calls;
-  out.stats["exact_calls"] = r.stats.exact_calls;
-  out.stats["split_pairs"] = r.stats.split_pairs;
-  out.stats["volumes_swept"] = r.stats.volumes_swept;
-  out.stats["budget_exhausted"] = r.stats.budget_exhausted;
+  out.stats = r.stats;
+  out.pairs.assign(r.pairs.begin(), r.pairs.end());
+  out.model = model;
   return out;
+}
+
+py::dict statsDict(const QueryStats& s) {
+  py::dict d;
+  d["time_us"] = s.time_us;
+  d["pairs_checked"] = s.pairs_checked;
+  d["gjk_calls"] = s.gjk_calls;
+  d["exact_calls"] = s.exact_calls;
+  d["split_pairs"] = s.split_pairs;
+  d["volumes_swept"] = s.volumes_swept;
+  d["budget_exhausted"] = s.budget_exhausted;
+  return d;
 }
 
 // A Checker with its model kept alive and a guard against use from two threads at once.
@@ -144,7 +161,7 @@ class PyChecker {
       py::gil_scoped_release release;
       r = &checker_.query(lo, hi, o);
     }
-    return copyResult(m, *r);
+    return copyResult(handle_, *r);
   }
 
   py::dict queryMany(const py::object& lowers, const py::object& uppers, const std::string& type, int n,
@@ -238,28 +255,37 @@ void bindChecker(py::module_& m) {
   py::object status = py::module_::import("enum").attr("IntEnum")("Status", members, py::arg("module") = "kccd");
   status.attr("__doc__") = "A query's outcome. Anything but OK means 'unsafe, stop' (the answer counts as a collision).";
   m.attr("Status") = status;
-  g_status = status.inc_ref().ptr();
+  for (const auto& [name, s] : names) g_status.push_back(status(static_cast<int>(s)).inc_ref().ptr());
 
   py::class_<PyResult>(m, "QueryResult", "One query's answer: every distance is a lower bound over the whole box.")
-      .def_readonly("status", &PyResult::status, "kccd.Status; anything but OK is unsafe")
-      .def_readonly("type", &PyResult::type, "'collision', 'closest', 'nclosest' or 'distances'")
+      .def_property_readonly("status", [](const PyResult& r) { return statusObject(r.status); },
+                             "kccd.Status; anything but OK is unsafe")
+      .def_property_readonly("type", [](const PyResult& r) { return toString(r.type); },
+                             "'collision', 'closest', 'nclosest' or 'distances'")
       .def_readonly("collision", &PyResult::collision, "Some pair's bound is within the margin (or the status is not OK).")
       .def_readonly("min_distance", &PyResult::min_distance, "Smallest lower bound over all pairs (metres; inf without pairs).")
       .def_readonly("margin", &PyResult::margin, "The margin used (metres).")
-      .def_readonly("pair", &PyResult::pair, "int32 (N,): index into Model.pairs of each reported pair")
-      .def_readonly("body_a", &PyResult::body_a, "int32 (N,): index into Model.bodies")
-      .def_readonly("body_b", &PyResult::body_b, "int32 (N,): index into Model.bodies")
-      .def_readonly("distance", &PyResult::distance, "float64 (N,): lower bound over the box (metres)")
-      .def_readonly("witness_a", &PyResult::witness_a,
-                    "float64 (N, 3): closest points found, in the pair's common-ancestor frame (NaN without a witness)")
-      .def_readonly("witness_b", &PyResult::witness_b, "float64 (N, 3): as witness_a, on body b")
-      .def_readonly("fresh", &PyResult::fresh, "bool (N,): recomputed in this query (else carried over from earlier ones)")
-      .def_readonly("has_witness", &PyResult::has_witness, "bool (N,): witness points are valid")
-      .def_readonly("stats", &PyResult::stats, "time_us, pairs_checked, gjk_calls, exact_calls, split_pairs, volumes_swept, budget_exhausted")
-      .def("__len__", [](const PyResult& r) { return r.distance.size(); })
+      .def_property_readonly("pair", [](PyResult& r) { return r.array(PyResult::kPair); },
+                             "int32 (N,): index into Model.pairs of each reported pair")
+      .def_property_readonly("body_a", [](PyResult& r) { return r.array(PyResult::kBodyA); }, "int32 (N,): index into Model.bodies")
+      .def_property_readonly("body_b", [](PyResult& r) { return r.array(PyResult::kBodyB); }, "int32 (N,): index into Model.bodies")
+      .def_property_readonly("distance", [](PyResult& r) { return r.array(PyResult::kDistance); },
+                             "float64 (N,): lower bound over the box (metres)")
+      .def_property_readonly("witness_a", [](PyResult& r) { return r.array(PyResult::kWitnessA); },
+                             "float64 (N, 3): closest points found, in the pair's common-ancestor frame (NaN without a witness)")
+      .def_property_readonly("witness_b", [](PyResult& r) { return r.array(PyResult::kWitnessB); },
+                             "float64 (N, 3): as witness_a, on body b")
+      .def_property_readonly("fresh", [](PyResult& r) { return r.array(PyResult::kFresh); },
+                             "bool (N,): recomputed in this query (else carried over from earlier ones)")
+      .def_property_readonly("has_witness", [](PyResult& r) { return r.array(PyResult::kHasWitness); },
+                             "bool (N,): witness points are valid")
+      .def_property_readonly("stats", [](const PyResult& r) { return statsDict(r.stats); },
+                             "time_us, pairs_checked, gjk_calls, exact_calls, split_pairs, volumes_swept, budget_exhausted")
+      .def("__len__", [](const PyResult& r) { return r.pairs.size(); })
       .def("__repr__", [](const PyResult& r) {
-        return "<kccd.QueryResult " + py::str(r.status.attr("name")).cast<std::string>() + " " + r.type + (r.collision ? " collision" : " clear") +
-               " min_distance=" + std::to_string(r.min_distance) + " pairs=" + std::to_string(r.distance.size()) + ">";
+        return "<kccd.QueryResult " + py::str(statusObject(r.status).attr("name")).cast<std::string>() + " " +
+               toString(r.type) + (r.collision ? " collision" : " clear") + " min_distance=" + std::to_string(r.min_distance) +
+               " pairs=" + std::to_string(r.pairs.size()) + ">";
       });
 
   py::class_<PyChecker>(m, "Checker", R"doc(

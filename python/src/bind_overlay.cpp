@@ -19,23 +19,34 @@ namespace {
 
 py::object toPython(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
-// Calls a Python progress callback from C++ with the GIL held; the first exception it raises is
-// kept (later calls are skipped) and raised when the job has finished.
+// Thrown through a job when its progress callback raised: the job stops and writes nothing.
+struct CallbackRaised {};
+
+// Calls a Python progress callback from C++ with the GIL held. An exception it raises is kept and
+// stops the job (CallbackRaised); run() then raises it in Python.
 struct ProgressRelay {
   py::object callback;
   std::optional<py::error_already_set> error;
   template <class... A>
   void operator()(A... args) {
-    if (callback.is_none() || error) return;
+    if (callback.is_none()) return;
     py::gil_scoped_acquire gil;
     try {
       callback(args...);
     } catch (py::error_already_set& e) {
       error = std::move(e);
+      throw CallbackRaised{};
     }
   }
-  void rethrow() {
-    if (error) throw std::move(*error);
+  // Runs `job` with the GIL released; raises the callback's exception if it stopped the job.
+  template <class F>
+  void run(F&& job) {
+    try {
+      py::gil_scoped_release release;
+      job();
+    } catch (const CallbackRaised&) {
+      throw std::move(*error);
+    }
   }
 };
 
@@ -61,8 +72,7 @@ void bindOverlay(py::module_& m) {
         overlay::VideoSink sink({.video = output, .codec = "", .video_label = "output " + output, .png_dir = "", .png_label = ""});
         ProgressRelay relay{progress, {}};
         nlohmann::json full;
-        {
-          py::gil_scoped_release release;
+        relay.run([&] {
           const overlay::OverlayReport r = overlay::overlayRecording(
               in, o, sink.active() ? &sink : nullptr,
               [&](const overlay::OverlayProgress& p) { relay(p.frames_done, p.frames_expected, p.frames_per_second); });
@@ -75,8 +85,7 @@ void bindOverlay(py::module_& m) {
           }
           sink.commit();
           if (!report.empty()) overlay::writeFileAtomically(report, full.dump(1) + "\n", "report " + report);
-        }
-        relay.rethrow();
+        });
         return toPython(full);
       },
       py::arg("model"), py::arg("camera"), py::arg("video"), py::arg("states"), py::kw_only(), py::arg("output") = "",
@@ -110,11 +119,7 @@ per-frame records under 'frames'). Raises InputError naming the input and place.
         o.replace = replace;
         ProgressRelay relay{progress, {}};
         overlay::SynthResult r;
-        {
-          py::gil_scoped_release release;
-          r = overlay::synthesizeRecording(o, [&](double fraction) { relay(fraction); });
-        }
-        relay.rethrow();
+        relay.run([&] { r = overlay::synthesizeRecording(o, [&](double fraction) { relay(fraction); }); });
         py::dict d;
         d["folder"] = r.folder.string();
         d["video"] = (r.folder / r.video_file).string();

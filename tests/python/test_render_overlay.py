@@ -1,0 +1,91 @@
+"""kccd.render, kccd.Camera and the main job from Python: images as NumPy arrays, the overlay of a
+short synthetic recording equal to `kccd overlay`'s report, progress callbacks, errors."""
+
+import json
+import pathlib
+import subprocess
+
+import numpy as np
+import pytest
+
+import kccd
+from conftest import DATA
+
+
+def test_render_rgba_and_labels(arm: kccd.Model, camera: kccd.Camera) -> None:
+    img = kccd.render(arm, camera, state=[0.3, -0.5, 0.8], mask=True)
+    rgba, labels = img["rgba"], img["labels"]
+    assert labels is not None
+    assert rgba.shape == (camera.height, camera.width, 4) and rgba.dtype == np.uint8 and rgba.flags["C_CONTIGUOUS"]
+    assert labels.shape == (camera.height, camera.width) and labels.dtype == np.uint8
+    drawn = set(np.unique(labels)) - {0}
+    assert drawn and max(drawn) <= len(arm.bodies)
+    assert img["status"] == ["clear"] * len(arm.bodies)
+    # A clear volume is tinted green: where a label is, green dominates red (RGBA order).
+    inside = (labels > 0) & (rgba[..., 3] > 0)
+    assert inside.any()
+    assert rgba[..., 1][inside].mean() > rgba[..., 0][inside].mean()
+    assert kccd.render(arm, camera, state=[0.3, -0.5, 0.8])["labels"] is None
+
+
+def test_render_swept_box_and_errors(arm: kccd.Model, camera: kccd.Camera) -> None:
+    still = kccd.render(arm, camera, state=[0.3, -0.5, 0.8], mask=True)["labels"]
+    swept = kccd.render(arm, camera, lower=[0.0, -0.7, 0.6], upper=[0.6, -0.3, 1.0], mask=True)["labels"]
+    assert still is not None and swept is not None
+    assert (swept > 0).sum() > (still > 0).sum()  # the swept arm covers more of the image
+    with pytest.raises(ValueError, match="lower, upper"):
+        kccd.render(arm, camera, lower=[0.0] * 3)
+    with pytest.raises(ValueError, match="state"):
+        kccd.render(arm, camera, state=[0.0])
+
+
+def test_camera_round_trip_and_errors(camera: kccd.Camera, tmp_path: pathlib.Path) -> None:
+    camera.save(str(tmp_path / "cam.yaml"))
+    again = kccd.Camera.load(str(tmp_path / "cam.yaml"))
+    assert np.array_equal(again.camera_matrix, camera.camera_matrix)
+    assert np.array_equal(again.rvec, camera.rvec) and np.array_equal(again.tvec, camera.tvec)
+    (tmp_path / "bad.yaml").write_text((DATA / "demo_camera.yaml").read_text().replace("width:", "wdth:"))
+    with pytest.raises(kccd.InputError) as e:
+        kccd.Camera.load(str(tmp_path / "bad.yaml"))
+    assert "bad.yaml" in e.value.source
+
+
+def test_overlay_equals_cli(cli, arm: kccd.Model, tmp_path: pathlib.Path) -> None:
+    fractions: list[float] = []
+    s = kccd.synthesize_recording(str(DATA / "demo_arm.yaml"), str(tmp_path / "rec"), seconds=1.0,
+                                  progress=fractions.append)
+    assert s["frames"] == 25 and len(fractions) == 25 and fractions[-1] == 1.0
+    assert s["collision_intervals"] and len(s["min_distance"]) == 25
+    calls: list[tuple[int, int, float]] = []
+    camera = kccd.Camera.load(s["camera"])
+    rep = kccd.overlay_recording(arm, camera, s["video"], s["states"], output=str(tmp_path / "py.mp4"),
+                                 report=str(tmp_path / "py.json"), time_offset=s["time_offset"], jobs=2,
+                                 progress=lambda *a: calls.append(a))
+    assert [c[0] for c in calls] == list(range(1, 26))
+    assert rep["frames_total"] == 25 and rep["colliding"] > 0
+    assert (tmp_path / "py.mp4").stat().st_size > 0
+    subprocess.run([str(cli), "overlay", str(DATA / "demo_arm.yaml"), "--camera", s["camera"], "--video", s["video"],
+                    "--states", s["states"], "--time-offset", repr(s["time_offset"]), "--report",
+                    str(tmp_path / "cli.json"), "-o", str(tmp_path / "cli.mp4"), "--quiet"], check=True)
+    cli_rep = json.loads((tmp_path / "cli.json").read_text())
+    py_rep = json.loads((tmp_path / "py.json").read_text())
+    for key in ("frames_total", "within_margin", "colliding", "no_state", "unsafe", "time_offset", "margin"):
+        assert py_rep[key] == cli_rep[key] == rep[key]
+    assert py_rep["frames"] == cli_rep["frames"] == rep["frames"]
+
+
+def test_overlay_errors_and_progress_exceptions(arm: kccd.Model, camera: kccd.Camera, tmp_path: pathlib.Path) -> None:
+    states = tmp_path / "s.csv"
+    states.write_text("time,shoulder_yaw,shoulder_pitch,elbow\n0,0,0,0\n0.1,0,0,x\n")
+    with pytest.raises(kccd.InputError) as e:
+        kccd.overlay_recording(arm, camera, str(tmp_path / "none.mkv"), str(states))
+    assert e.value.line == 3 and "s.csv" in e.value.source
+    s = kccd.synthesize_recording(str(DATA / "demo_arm.yaml"), str(tmp_path / "rec"), seconds=0.2)
+
+    def stop(*_: object) -> None:
+        raise KeyError("from the callback")
+
+    with pytest.raises(KeyError, match="from the callback"):
+        kccd.overlay_recording(arm, kccd.Camera.load(s["camera"]), s["video"], s["states"], progress=stop,
+                               time_offset=s["time_offset"], report=str(tmp_path / "r.json"))
+    assert not (tmp_path / "r.json").exists()
