@@ -381,8 +381,12 @@ TEST(Queries, SplittingTightensAWideBodyOnAWideArc) {
       c.reset();
       const double s = c.query(lo, hi, o).pairs[0].distance;
       EXPECT_LE(s, truth) << splits;
-      if (splits < 8) EXPECT_LT(s, d) << splits;
-      if (splits > 8) EXPECT_GT(s, d) << splits;
+      if (splits < 8) {
+        EXPECT_LT(s, d) << splits;
+      }
+      if (splits > 8) {
+        EXPECT_GT(s, d) << splits;
+      }
     }
     // The split gap: a gap above what a split could gain (the truth less the whole box's bound)
     // leaves the box whole; one below it splits.

@@ -1,6 +1,8 @@
 // Names of the query value types (kccd/query.hpp).
 #include "kccd/query.hpp"
 
+#include <limits>
+
 namespace kccd {
 
 const char* toString(Status status) {
@@ -23,6 +25,21 @@ const char* toString(QueryType type) {
     case QueryType::Distances: return "distances";
   }
   return "?";
+}
+
+std::optional<QueryType> queryTypeFromString(std::string_view name) {
+  for (const QueryType t : {QueryType::Collision, QueryType::Closest, QueryType::NClosest, QueryType::Distances})
+    if (name == toString(t)) return t;
+  return std::nullopt;
+}
+
+std::optional<double> exactBelowFromWord(std::string_view word, double margin) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  if (word == "band") return -1.0;
+  if (word == "margin") return margin;
+  if (word == "all") return kInf;
+  if (word == "off") return -kInf;
+  return std::nullopt;
 }
 
 }  // namespace kccd

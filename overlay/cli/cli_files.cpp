@@ -5,16 +5,15 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "cli_args.hpp"
+#include "kccd/overlay/video_sink.hpp"
 
 namespace kccd::cli {
 
@@ -65,30 +64,8 @@ void editFile(const std::string& path, const std::function<std::string(const std
   writeFileAtomically(path, edited);  // keeps the file's mode
 }
 
-void checkOutputPath(const std::string& path, const std::string& option, const std::string& extension) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != extension) throw UsageError(option + " " + path + ": the output must be a " + extension + " file");
-  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  if (!dir.empty() && !std::filesystem::is_directory(dir))
-    throw UsageError(option + " " + path + ": directory " + dir.string() + " does not exist");
-}
-
 void writePngAtomically(const std::string& path, const cv::Mat& image, const std::string& option) {
-  std::vector<uchar> png;
-  bool ok = false;
-  try {
-    ok = cv::imencode(".png", image, png);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  if (!ok) throw UsageError(option + " " + path + ": cannot encode the image");
-  writeFileAtomically(path, std::string(png.begin(), png.end()), option + " " + path);
-}
-
-bool sameFile(const std::string& a, const std::string& b) {
-  std::error_code ec;
-  return std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec) && std::filesystem::equivalent(a, b, ec);
+  overlay::writePngAtomically(path, image, option + " " + path);
 }
 
 }  // namespace kccd::cli

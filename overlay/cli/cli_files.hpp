@@ -16,18 +16,14 @@ namespace kccd::cli {
 /// also returns the file's text as it was read.
 Model loadOrExplain(const std::string& path, std::string* text = nullptr);
 
-/// Files are written through kccd::overlay's staged outputs (one temporary name, one rename).
+/// Files are written through kccd::overlay's staged outputs (one temporary name, one rename), and
+/// output paths checked by its checkOutputPath and sameFile.
+using overlay::checkOutputPath;
+using overlay::sameFile;
 using overlay::writeFileAtomically;
 
-/// Checks an output path before any work: its extension (lower-cased) is `extension` and its folder
-/// exists. Throws UsageError "<option> <path>: ...".
-void checkOutputPath(const std::string& path, const std::string& option, const std::string& extension);
-
-/// Whether two paths name one existing file (a link, another spelling).
-bool sameFile(const std::string& a, const std::string& b);
-
-/// Encodes `image` as PNG in memory and writes it with writeFileAtomically. Throws UsageError
-/// "<option> <path>: ..." when it cannot be encoded or written.
+/// Encodes `image` as PNG and writes it atomically (overlay::writePngAtomically), errors naming
+/// "<option> <path>".
 void writePngAtomically(const std::string& path, const cv::Mat& image, const std::string& option);
 
 /// Replaces the text of the file at `path` by `edit(text)`, atomically, holding an exclusive lock

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 #include <iostream>
 #include <optional>
 
@@ -20,7 +19,6 @@
 namespace kccd::cli {
 namespace {
 
-namespace fs = std::filesystem;
 
 struct OverlayArgs {
   std::string model, camera, video, states, output, png_dir, report, frames, frame_times, ignore_columns, codec, contact_sheet;
@@ -31,12 +29,6 @@ struct OverlayArgs {
   bool swept = false, plain = false, quiet = false, json = false, visuals = false;
   int jobs = 0;  // 0: hardware threads
 };
-
-std::string lowerExtension(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
 
 // "S" (seconds) sets the offset; "auto:A:B" asks for a search of [A, B].
 void parseTimeOffset(const std::string& text, overlay::OverlayOptions& o) {
@@ -65,21 +57,9 @@ Exit runOverlay(const OverlayArgs& a) {
   const calib::Camera camera = calib::loadCamera(a.camera);
   if (a.output.empty() && a.png_dir.empty() && a.report.empty() && a.contact_sheet.empty())
     throw UsageError("nothing to write: give -o VIDEO, --png-dir DIR, --report FILE and/or --contact-sheet FILE");
-  if (!a.contact_sheet.empty()) checkOutputPath(a.contact_sheet, "--contact-sheet", ".png");
-  if (!a.output.empty()) {
-    const std::string ext = lowerExtension(a.output);
-    if (ext != ".mp4" && ext != ".mkv" && ext != ".avi")
-      throw UsageError("-o " + a.output + ": the output must be a .mp4, .mkv or .avi file");
-    checkOutputPath(a.output, "-o", ext);
-  }
-  if (!a.report.empty()) checkOutputPath(a.report, "--report", ".json");
-  {  // inputs stay untouched: no output may replace one
-    std::error_code ec;
-    for (const std::string& in : {a.video, a.states, a.model, a.camera, a.frame_times})
-      for (const std::string& outp : {a.output, a.report})
-        if (!in.empty() && !outp.empty() && fs::equivalent(in, outp, ec))
-          throw UsageError(outp + ": is an input of this run (" + in + "); write the output elsewhere");
-  }
+  const overlay::OverlayOutputs outputs{
+      .video = a.output, .png_dir = a.png_dir, .report = a.report, .contact_sheet = a.contact_sheet};
+  overlay::checkOverlayOutputs(outputs, std::vector<std::string>{a.video, a.states, a.model, a.camera, a.frame_times});
   if (!a.codec.empty() && a.codec.size() != 4)
     throw UsageError("--codec " + a.codec + ": a FourCC is 4 characters (e.g. mp4v, avc1, MJPG, FFV1)");
   overlay::OverlayOptions o;
@@ -120,21 +100,8 @@ Exit runOverlay(const OverlayArgs& a) {
       });
   progress.finish();
 
-  nlohmann::json j = overlay::reportJson(r, model, false);
-  if (!a.output.empty()) j["video"] = a.output;
-  if (!a.png_dir.empty()) j["png_dir"] = a.png_dir;
-  if (!a.contact_sheet.empty()) {
-    if (r.contact_sheet.empty()) throw UsageError("--contact-sheet " + a.contact_sheet + ": no frame was drawn (see --frames)");
-    writePngAtomically(a.contact_sheet, r.contact_sheet, "--contact-sheet");
-    j["contact_sheet"] = a.contact_sheet;
-  }
-  sink.commit();
-  if (!a.report.empty()) {
-    nlohmann::json full = overlay::reportJson(r, model, true);
-    for (const char* key : {"video", "png_dir", "contact_sheet"})
-      if (j.contains(key)) full[key] = j[key];
-    writeFileAtomically(a.report, full.dump(1) + "\n", "--report " + a.report);
-  }
+  nlohmann::json j = overlay::writeOverlayOutputs(outputs, r, model, sink);
+  j.erase("frames");  // the summary printed by --json
 
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   const std::size_t frames = r.frames.size();

@@ -2,7 +2,6 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
-#include <limits>
 #include <memory>
 
 #include "cli_args.hpp"
@@ -33,10 +32,7 @@ struct QueryArgs {
 // --exact: which pairs the exact stage refines (QueryOptions::exact_below); `margin` is the
 // query's margin (the model's unless --margin).
 double parseExact(const std::string& e, double margin) {
-  if (e == "band") return -1.0;
-  if (e == "margin") return margin;
-  if (e == "all") return std::numeric_limits<double>::infinity();
-  if (e == "off") return -std::numeric_limits<double>::infinity();
+  if (const std::optional<double> word = exactBelowFromWord(e, margin)) return *word;
   try {
     std::size_t used = 0;
     const double d = std::stod(e, &used);
@@ -47,10 +43,7 @@ double parseExact(const std::string& e, double margin) {
 }
 
 QueryType parseType(const std::string& t) {
-  if (t == "collision") return QueryType::Collision;
-  if (t == "closest") return QueryType::Closest;
-  if (t == "nclosest") return QueryType::NClosest;
-  if (t == "distances") return QueryType::Distances;
+  if (const std::optional<QueryType> type = queryTypeFromString(t)) return *type;
   throw UsageError("--type: unknown query type '" + t + "' (collision, closest, nclosest, distances)");
 }
 

@@ -17,10 +17,12 @@
 #include <thread>
 
 #include <opencv2/core/utils/logger.hpp>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "kccd/input_error.hpp"
 #include "kccd/overlay/contact_sheet.hpp"
+#include "kccd/overlay/staged_output.hpp"
 #include "kccd/overlay/video_source.hpp"
 #include "kccd/render/projection.hpp"
 
@@ -301,6 +303,37 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   }
   if (opt.contact_frames > 0) report.contact_sheet = sheet.compose();
   return report;
+}
+
+void checkOverlayOutputs(const OverlayOutputs& out, std::span<const std::string> inputs) {
+  if (!out.contact_sheet.empty()) checkOutputPath(out.contact_sheet, out.contact_sheet_option, ".png");
+  if (!out.video.empty()) {
+    const std::string ext = lowerExtension(out.video);
+    if (ext != ".mp4" && ext != ".mkv" && ext != ".avi")
+      throw OutputError(out.video_option + " " + out.video + ": the output must be a .mp4, .mkv or .avi file");
+    checkOutputPath(out.video, out.video_option, ext);
+  }
+  if (!out.report.empty()) checkOutputPath(out.report, out.report_option, ".json");
+  for (const std::string& in : inputs)
+    for (const std::string& written : {out.video, out.report})
+      if (!in.empty() && !written.empty() && sameFile(in, written))
+        throw OutputError(written + ": is an input of this run (" + in + "); write the output elsewhere");
+}
+
+nlohmann::json writeOverlayOutputs(const OverlayOutputs& out, const OverlayReport& report, const Model& model,
+                                   VideoSink& sink) {
+  nlohmann::json j = reportJson(report, model, true);
+  if (!out.video.empty()) j["video"] = out.video;
+  if (!out.png_dir.empty()) j["png_dir"] = out.png_dir;
+  if (!out.contact_sheet.empty()) {
+    const std::string name = out.contact_sheet_option + " " + out.contact_sheet;
+    if (report.contact_sheet.empty()) throw OutputError(name + ": no frame was drawn (see " + out.frames_option + ")");
+    writePngAtomically(out.contact_sheet, report.contact_sheet, name);
+    j["contact_sheet"] = out.contact_sheet;
+  }
+  sink.commit();
+  if (!out.report.empty()) writeFileAtomically(out.report, j.dump(1) + "\n", out.report_option + " " + out.report);
+  return j;
 }
 
 }  // namespace kccd::overlay

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -144,6 +145,24 @@ void writeFileAtomically(const fs::path& path, const std::string& bytes, const s
   ::close(fd);
   if (!ok) throw OutputError(shown + ": write failed (" + errnoText(err) + ")");
   out.commit();
+}
+
+std::string lowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+void checkOutputPath(const std::string& path, const std::string& option, const std::string& extension) {
+  if (lowerExtension(path) != extension) throw OutputError(option + " " + path + ": the output must be a " + extension + " file");
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  if (!dir.empty() && !std::filesystem::is_directory(dir))
+    throw OutputError(option + " " + path + ": directory " + dir.string() + " does not exist");
+}
+
+bool sameFile(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  return std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec) && std::filesystem::equivalent(a, b, ec);
 }
 
 }  // namespace kccd::overlay

@@ -1,6 +1,5 @@
 #include "kccd/overlay/video_sink.hpp"
 
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -11,12 +10,9 @@
 
 namespace kccd::overlay {
 
-namespace fs = std::filesystem;
-
 int videoFourcc(const std::string& path, const std::string& codec) {
   if (codec.size() == 4) return cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]);
-  std::string ext = fs::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = lowerExtension(path);
   if (ext == ".mkv") return cv::VideoWriter::fourcc('F', 'F', 'V', '1');
   if (ext == ".avi") return cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
   return cv::VideoWriter::fourcc('m', 'p', '4', 'v');

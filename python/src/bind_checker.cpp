@@ -16,21 +16,13 @@ namespace kccd::python {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-QueryType parseType(const std::string& t) {
-  if (t == "collision") return QueryType::Collision;
-  if (t == "closest") return QueryType::Closest;
-  if (t == "nclosest") return QueryType::NClosest;
-  if (t == "distances") return QueryType::Distances;
-  throw py::value_error("type: expected 'collision', 'closest', 'nclosest' or 'distances', got '" + t + "'");
-}
-
 // What a query asks, from the Python arguments (as `kccd query`'s options).
 QueryOptions makeOptions(const Model& model, const std::string& type, int n, const py::object& margin,
                          const py::object& exact, double budget_us) {
   QueryOptions o;
-  o.type = parseType(type);
+  const std::optional<QueryType> t = queryTypeFromString(type);
+  if (!t) throw py::value_error("type: expected 'collision', 'closest', 'nclosest' or 'distances', got '" + type + "'");
+  o.type = *t;
   if (n < 1) throw py::value_error("n: expected at least 1, got " + std::to_string(n));
   o.n = n;
   if (!margin.is_none()) {
@@ -42,11 +34,9 @@ QueryOptions makeOptions(const Model& model, const std::string& type, int n, con
   if (exact.is_none()) {
   } else if (py::isinstance<py::str>(exact)) {
     const std::string e = exact.cast<std::string>();
-    if (e == "band") o.exact_below = -1.0;
-    else if (e == "margin") o.exact_below = mg;
-    else if (e == "all") o.exact_below = kInf;
-    else if (e == "off") o.exact_below = -kInf;
-    else throw py::value_error("exact: expected 'band', 'margin', 'all', 'off' or metres, got '" + e + "'");
+    const std::optional<double> below = exactBelowFromWord(e, mg);
+    if (!below) throw py::value_error("exact: expected 'band', 'margin', 'all', 'off' or metres, got '" + e + "'");
+    o.exact_below = *below;
   } else {
     const double d = exact.cast<double>();
     if (!(d >= 0.0 && d <= kMaxModelLength)) throw py::value_error("exact: expected metres from 0 to 1e6");

@@ -7,7 +7,6 @@
 
 #include "bindings.hpp"
 #include "kccd/calib/camera.hpp"
-#include "kccd/overlay/frame_times.hpp"
 #include "kccd/overlay/overlay_recording.hpp"
 #include "kccd/overlay/synth.hpp"
 #include "kccd/overlay/video_sink.hpp"
@@ -69,6 +68,14 @@ void bindOverlay(py::module_& m) {
         o.frames = overlay::parseFrameRange(frames, "frames");
         if (contact_frames < 1 || contact_frames > 64) throw py::value_error("contact_frames: expected 1 to 64");
         o.contact_frames = contact_sheet.empty() ? 0 : static_cast<std::size_t>(contact_frames);
+        const overlay::OverlayOutputs outputs{.video = output,
+                                              .report = report,
+                                              .contact_sheet = contact_sheet,
+                                              .video_option = "output",
+                                              .report_option = "report",
+                                              .contact_sheet_option = "contact_sheet",
+                                              .frames_option = "frames"};
+        overlay::checkOverlayOutputs(outputs, std::vector<std::string>{video, states, h->source});
         overlay::VideoSink sink({.video = output, .codec = "", .video_label = "output " + output, .png_dir = "", .png_label = ""});
         ProgressRelay relay{progress, {}};
         nlohmann::json full;
@@ -76,15 +83,7 @@ void bindOverlay(py::module_& m) {
           const overlay::OverlayReport r = overlay::overlayRecording(
               in, o, sink.active() ? &sink : nullptr,
               [&](const overlay::OverlayProgress& p) { relay(p.frames_done, p.frames_expected, p.frames_per_second); });
-          full = overlay::reportJson(r, model, true);
-          if (!output.empty()) full["video"] = output;
-          if (!contact_sheet.empty()) {
-            if (r.contact_sheet.empty()) throw InputError("contact_sheet " + contact_sheet + ": no frame was drawn (see frames)");
-            overlay::writePngAtomically(contact_sheet, r.contact_sheet, "contact_sheet " + contact_sheet);
-            full["contact_sheet"] = contact_sheet;
-          }
-          sink.commit();
-          if (!report.empty()) overlay::writeFileAtomically(report, full.dump(1) + "\n", "report " + report);
+          full = overlay::writeOverlayOutputs(outputs, r, model, sink);
         });
         return toPython(full);
       },
@@ -93,7 +92,8 @@ void bindOverlay(py::module_& m) {
       py::arg("jobs") = 0, py::arg("frames") = "", py::arg("contact_frames") = 12, py::arg("progress") = py::none(),
       R"doc(The main job, as `kccd overlay`: every frame of `video` (a file or an image-sequence pattern) checked at
 the state the log `states` (CSV) gives at its time (log time = frame time + time_offset, seconds), the
-volumes drawn and composited. Outputs, each written under a temporary name and renamed when complete:
+volumes drawn and composited. Outputs, checked before any frame is decoded (extension, an existing
+folder, not one of the inputs) and each written under a temporary name and renamed when complete:
 `output` (.mp4, .mkv or .avi), `report` (.json, the format of `kccd overlay --report`), `contact_sheet`
 (.png of contact_frames frames). swept: braking-interval volumes. jobs: drawing threads (0: all cores).
 frames: 'FIRST:END:STEP' of the frames drawn (all are checked). progress(frames_done, frames_expected,

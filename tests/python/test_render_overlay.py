@@ -81,11 +81,21 @@ def test_overlay_errors_and_progress_exceptions(arm: kccd.Model, camera: kccd.Ca
         kccd.overlay_recording(arm, camera, str(tmp_path / "none.mkv"), str(states))
     assert e.value.line == 3 and "s.csv" in e.value.source
     s = kccd.synthesize_recording(str(DATA / "demo_arm.yaml"), str(tmp_path / "rec"), seconds=0.2)
+    rec_camera = kccd.Camera.load(s["camera"])
+    # Outputs are checked before any frame is decoded, as `kccd overlay` checks them.
+    kept = pathlib.Path(s["video"]).read_bytes()
+    with pytest.raises(kccd.InputError, match="is an input of this run"):
+        kccd.overlay_recording(arm, rec_camera, s["video"], s["states"], output=s["video"])
+    assert pathlib.Path(s["video"]).read_bytes() == kept
+    with pytest.raises(kccd.InputError, match=r"output .*\.mov: the output must be a \.mp4, \.mkv or \.avi file"):
+        kccd.overlay_recording(arm, rec_camera, s["video"], s["states"], output=str(tmp_path / "x.mov"))
+    with pytest.raises(kccd.InputError, match="does not exist"):
+        kccd.overlay_recording(arm, rec_camera, s["video"], s["states"], report=str(tmp_path / "no" / "r.json"))
 
     def stop(*_: object) -> None:
         raise KeyError("from the callback")
 
     with pytest.raises(KeyError, match="from the callback"):
-        kccd.overlay_recording(arm, kccd.Camera.load(s["camera"]), s["video"], s["states"], progress=stop,
+        kccd.overlay_recording(arm, rec_camera, s["video"], s["states"], progress=stop,
                                time_offset=s["time_offset"], report=str(tmp_path / "r.json"))
     assert not (tmp_path / "r.json").exists()

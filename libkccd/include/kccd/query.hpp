@@ -3,7 +3,9 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
+#include <string_view>
 
 #include "kccd/types.hpp"
 
@@ -28,6 +30,8 @@ enum class QueryType : std::uint8_t {
   Distances,  ///< every checked pair
 };
 const char* toString(QueryType type);
+/// The query type toString names ("collision", "closest", "nclosest", "distances"); none otherwise.
+std::optional<QueryType> queryTypeFromString(std::string_view name);
 
 /// The largest time budget a query honours (about 11.6 days, in microseconds); larger is unlimited.
 inline constexpr double kMaxBudgetUs = 1e12;
@@ -79,6 +83,11 @@ struct QueryOptions {
   /// verdicts do not change (the exact stage decides them).
   bool tight_volumes = false;
 };
+
+/// QueryOptions::exact_below for the words of `kccd query --exact`: "band" (the default, -1),
+/// "margin" (`margin`, the query's margin), "all" (+inf: every pair), "off" (-inf: none); none for
+/// any other text (a distance in metres is the caller's to read).
+std::optional<double> exactBelowFromWord(std::string_view word, double margin);
 
 /// One pair in a result. `distance` is a lower bound over the whole interval box.
 struct PairDistance {

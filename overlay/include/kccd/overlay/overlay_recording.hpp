@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -97,6 +98,24 @@ struct OverlayReport {
 OverlayReport overlayRecording(const OverlayInputs& inputs, const OverlayOptions& options, FrameSink* sink,
                                const std::function<void(const OverlayProgress&)>& progress = {});
 
+/// Where a run's results are written (empty: not written) and how errors name them ("-o", ...).
+struct OverlayOutputs {
+  std::string video;          ///< .mp4, .mkv or .avi, written by the VideoSink
+  std::string png_dir;        ///< the VideoSink's PNG folder (named in the report only)
+  std::string report;         ///< .json: the report with every frame's record
+  std::string contact_sheet;  ///< .png: OverlayReport::contact_sheet
+  std::string video_option = "-o", report_option = "--report", contact_sheet_option = "--contact-sheet";
+  std::string frames_option = "--frames";  ///< named when no frame was drawn for the contact sheet
+};
+/// Checks the outputs before a run: each one's extension and folder (checkOutputPath), and that
+/// neither the video nor the report is one of `inputs` (sameFile: no output may replace an input).
+/// Throws OutputError "OPTION PATH: problem".
+void checkOverlayOutputs(const OverlayOutputs& outputs, std::span<const std::string> inputs);
+/// After a run: writes the contact sheet, commits `sink`, writes the report (each staged, in that
+/// order) and returns the report (reportJson with frames) naming the files written under "video",
+/// "png_dir" and "contact_sheet". Throws OutputError (e.g. a contact sheet with no frame drawn).
+nlohmann::json writeOverlayOutputs(const OverlayOutputs& outputs, const OverlayReport& report, const Model& model,
+                                   VideoSink& sink);
 /// The report as JSON (the format of `kccd overlay --report`, docs/formats.md section 9): the
 /// summary, and with `with_frames` the per-frame records.
 nlohmann::json reportJson(const OverlayReport& report, const Model& model, bool with_frames);

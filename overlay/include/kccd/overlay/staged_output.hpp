@@ -58,6 +58,16 @@ class StagedOutput {
   bool committed_ = false;
 };
 
+/// The extension of `path` in lower case, with its dot (".mp4"; empty when none).
+std::string lowerExtension(const std::string& path);
+
+/// Checks an output path before any work: its extension (lower-cased) is `extension` and its folder
+/// exists. Throws OutputError "<option> <path>: ..." (`option` names it, e.g. "-o").
+void checkOutputPath(const std::string& path, const std::string& option, const std::string& extension);
+
+/// Whether two paths name one existing file (a link, another spelling).
+bool sameFile(const std::string& a, const std::string& b);
+
 /// Writes `bytes` to `path` through a StagedOutput: readers never see a partial file, a symbolic
 /// link stays a link, an existing file keeps its mode, a new one gets plainCreateMode. `label`
 /// names the output in errors (default: the path). Throws OutputError.
