@@ -6,13 +6,25 @@ from ._kccd import Checker as Checker
 from ._kccd import GlContextError as GlContextError
 from ._kccd import InputError as InputError
 from ._kccd import Model as Model
+from ._kccd import PoseStatus as PoseStatus
 from ._kccd import QueryResult as QueryResult
 from ._kccd import Status as Status
+from ._kccd import TagDetection as TagDetection
+from ._kccd import TagLayout as TagLayout
 from ._kccd import __version__ as __version__
 from ._kccd import braking_intervals as braking_intervals
+from ._kccd import detect_tags as detect_tags
+from ._kccd import explain as explain
+from ._kccd import fit as fit
+from ._kccd import import_urdf as import_urdf
 from ._kccd import overlay_recording as overlay_recording
+from ._kccd import prove_pairs as prove_pairs
+from ._kccd import read_frame as read_frame
+from ._kccd import read_image as read_image
 from ._kccd import render as render
+from ._kccd import solve_pose as solve_pose
 from ._kccd import synthesize_recording as synthesize_recording
+from ._kccd import tag_correspondences as tag_correspondences
 
 __all__ = [
     "BrakingParams",
@@ -21,11 +33,23 @@ __all__ = [
     "GlContextError",
     "InputError",
     "Model",
+    "PoseStatus",
     "QueryResult",
     "Status",
+    "TagDetection",
+    "TagLayout",
     "__version__",
     "braking_intervals",
+    "detect_tags",
+    "explain",
+    "fit",
+    "import_urdf",
     "overlay_recording",
+    "prove_pairs",
+    "read_frame",
+    "read_image",
     "render",
+    "solve_pose",
     "synthesize_recording",
+    "tag_correspondences",
 ]

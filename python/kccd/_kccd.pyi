@@ -62,6 +62,7 @@ class Model:
     def yaml(self) -> str: ...
     @property
     def source(self) -> str: ...
+    def with_body_geometry(self, body: str, points: _ArrayLike, radius: float) -> Model: ...
     def __getstate__(self) -> tuple[str, str]: ...
     def __setstate__(self, state: tuple[str, str]) -> None: ...
 
@@ -161,7 +162,7 @@ class Camera:
     """A fixed, calibrated camera (intrinsics, distortion, world -> camera pose)."""
 
     @staticmethod
-    def load(path: str) -> Camera: ...
+    def load(path: str, require_pose: bool = True) -> Camera: ...
     def save(self, path: str) -> None: ...
     @property
     def width(self) -> int: ...
@@ -229,3 +230,168 @@ def synthesize_recording(
     replace: bool = False,
     progress: Callable[[float], object] | None = None,
 ) -> dict[str, Any]: ...
+
+class _Explanation(TypedDict):
+    pair: int
+    a: str
+    b: str
+    bound: float
+    distance: float
+    verdict: Literal["clear", "possible", "real"]
+    state: npt.NDArray[np.float64]
+    point_a: npt.NDArray[np.float64]
+    point_b: npt.NDArray[np.float64]
+    evaluations: int
+
+def explain(
+    model: Model,
+    lower: _ArrayLike,
+    upper: _ArrayLike | None = None,
+    *,
+    margin: float | None = None,
+    starts: int = 12,
+    max_steps: int = 200,
+    seed: int = 1,
+) -> list[_Explanation]: ...
+
+class _Fit(TypedDict):
+    points: npt.NDArray[np.float64]
+    radius: float
+    volume: float
+    hull_volume: float
+    sphere_volume: float
+    capsule_volume: float
+    hull_vertices: int
+    evaluations: int
+    triangles: int
+    primitives: int
+    yaml: str
+
+def fit(
+    part_path: str,
+    points: int = 8,
+    *,
+    part: str = "",
+    merge: bool = False,
+    scale: Sequence[float] = (1.0, 1.0, 1.0),
+    max_evaluations: int = 4000,
+    seed: int = 1,
+    exact_hull: bool = False,
+    progress: Callable[[float], object] | None = None,
+) -> _Fit: ...
+def import_urdf(
+    urdf_path: str,
+    *,
+    srdf: str = "",
+    points: int = 8,
+    safety_margin: float = 0.02,
+    packages: dict[str, str] = {},
+    visuals: bool = True,
+    hulls: bool = False,
+    keep_adjacent: bool = False,
+    progress: Callable[[float], object] | None = None,
+) -> str: ...
+
+_Verdict = Literal["never", "always_touching", "meets", "undecided", "unbounded"]
+
+class _PairProof(TypedDict):
+    a: str
+    b: str
+    frame: str
+    verdict: _Verdict
+    adjacent: bool
+    rigid: bool
+    checked: bool
+    boxes: int
+    ignored: str | None
+    ignore_reason: str | None
+    bound: float | None
+    witness_state: npt.NDArray[np.float64] | None
+    witness_distance: float | None
+    note: str
+
+class _Proofs(TypedDict):
+    margin: float
+    pairs: list[_PairProof]
+    ignore: list[tuple[str, str, str]]
+    dropped: list[tuple[str, str, str]]
+    model: Model
+
+def prove_pairs(
+    model: Model,
+    *,
+    margin: float | None = None,
+    max_boxes: int = 2000,
+    keep_adjacent: bool = False,
+    progress: Callable[[float], object] | None = None,
+) -> _Proofs: ...
+def read_image(path: str) -> npt.NDArray[np.uint8]: ...
+def read_frame(video: str, index: int) -> npt.NDArray[np.uint8]: ...
+
+class TagDetection:
+    """One detected AprilTag (tag36h11)."""
+
+    @property
+    def id(self) -> int: ...
+    @property
+    def corners(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def hamming(self) -> int: ...
+    @property
+    def decision_margin(self) -> float: ...
+
+def detect_tags(image: npt.NDArray[np.uint8]) -> list[TagDetection]: ...
+
+class TagLayout:
+    """Where AprilTags are placed in the world."""
+
+    @staticmethod
+    def load(path: str) -> TagLayout: ...
+    @staticmethod
+    def from_yaml(text: str, source: str = "<string>") -> TagLayout: ...
+    @property
+    def ids(self) -> list[int]: ...
+    def corners(self, id: int) -> npt.NDArray[np.float64]: ...
+    def __len__(self) -> int: ...
+
+class _Correspondences(TypedDict):
+    names: list[str]
+    pixels: npt.NDArray[np.float64]
+    world: npt.NDArray[np.float64]
+    unknown_ids: list[int]
+
+def tag_correspondences(
+    detections: Sequence[TagDetection], layout: TagLayout, image: str = "image"
+) -> _Correspondences: ...
+
+class PoseStatus(enum.IntEnum):
+    """How a pose solve ended; only SOLVED comes with a camera."""
+
+    SOLVED = 0
+    TOO_FEW_POINTS = 1
+    COLLINEAR = 2
+    POOR_GEOMETRY = 3
+    TOO_FEW_INLIERS = 4
+
+class _Pose(TypedDict):
+    status: PoseStatus
+    message: str
+    camera: Camera | None
+    residuals_px: npt.NDArray[np.float64]
+    inlier: npt.NDArray[np.bool_]
+    rejected: list[str]
+    inliers: int
+    covariance: npt.NDArray[np.float64] | None
+    reprojection_rms_px: float | None
+    rotation_sigma_deg: float | None
+    position_sigma_m: float | None
+
+def solve_pose(
+    intrinsics: Camera,
+    pixels: _ArrayLike,
+    world: _ArrayLike,
+    names: Sequence[str] | None = None,
+    *,
+    ransac_threshold_px: float = 8.0,
+    min_inliers: int = 6,
+) -> _Pose: ...

@@ -2,7 +2,11 @@
 // NumPy argument checks every binding uses.
 #include <pybind11/stl.h>
 
+#include <cmath>
+#include <cstdio>
+
 #include "bindings.hpp"
+#include "kccd/modelling/yaml_edit.hpp"
 #include "kccd/model.hpp"
 
 namespace kccd::python {
@@ -28,14 +32,6 @@ py::array realArray(const py::handle& value, const char* name) {
   return a;
 }
 
-std::shared_ptr<ModelHandle> fromText(std::string text, std::string source) {
-  auto h = std::make_shared<ModelHandle>();
-  h->model = std::make_shared<const Model>(parseModel(text, source));
-  h->text = std::move(text);
-  h->source = std::move(source);
-  return h;
-}
-
 std::vector<std::string> names(const auto& items) {
   std::vector<std::string> out;
   for (const auto& i : items) out.push_back(i.name);
@@ -43,6 +39,14 @@ std::vector<std::string> names(const auto& items) {
 }
 
 }  // namespace
+
+std::shared_ptr<ModelHandle> modelFromText(std::string text, std::string source) {
+  auto h = std::make_shared<ModelHandle>();
+  h->model = std::make_shared<const Model>(parseModel(text, source));
+  h->text = std::move(text);
+  h->source = std::move(source);
+  return h;
+}
 
 std::vector<double> stateVector(const py::handle& value, const char* name, int length) {
   const py::array a = realArray(value, name);
@@ -61,6 +65,14 @@ py::array_t<double, py::array::c_style> stateMatrix(const py::handle& value, con
   return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
 }
 
+py::array_t<double, py::array::c_style> pointMatrix(const py::handle& value, const char* name, int cols) {
+  const py::array a = realArray(value, name);
+  if (a.ndim() != 2 || a.shape(1) != cols)
+    throw py::value_error(std::string(name) + ": expected shape (N, " + std::to_string(cols) +
+                          ") (one point per row), got " + shapeText(a));
+  return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+}
+
 void bindModel(py::module_& m) {
   py::class_<ModelHandle, std::shared_ptr<ModelHandle>> model(m, "Model", R"doc(
 A robot and its cell: joints, bodies (sphere swept convex hulls) and the checked body pairs.
@@ -71,10 +83,10 @@ Pickles through its YAML text (and the file it came from, against which mesh pat
           "load",
           [](const std::string& path) {
             std::string text = readModelText(path);
-            return fromText(std::move(text), path);
+            return modelFromText(std::move(text), path);
           },
           py::arg("path"), "Reads a `kccd: 1` YAML model file; raises InputError naming the file, line and field.")
-      .def_static("from_yaml", &fromText, py::arg("text"), py::arg("source") = "<string>",
+      .def_static("from_yaml", &modelFromText, py::arg("text"), py::arg("source") = "<string>",
                   "Parses YAML text; `source` names it in error messages (and is where relative mesh paths resolve).")
       .def_property_readonly("name", [](const ModelHandle& h) { return h.model->name; })
       .def_property_readonly("margin", [](const ModelHandle& h) { return h.model->safety_margin; },
@@ -101,6 +113,36 @@ Pickles through its YAML text (and the file it came from, against which mesh pat
       .def_property_readonly("yaml", [](const ModelHandle& h) { return h.text; }, "The YAML text it was read from.")
       .def_property_readonly("source", [](const ModelHandle& h) { return h.source; },
                              "The file it was read from (or the name given to from_yaml).")
+      .def(
+          "with_body_geometry",
+          [](const ModelHandle& h, const std::string& body, const py::handle& points, double radius) {
+            const auto p = pointMatrix(points, "points", 3);
+            if (p.shape(0) < 1) throw py::value_error("points: expected at least one core point");
+            if (!(radius >= 0.0) || !std::isfinite(radius)) throw py::value_error("radius: must be a finite number >= 0 (metres)");
+            // Every digit kept (17 significant digits read back exactly); the radius rounded up.
+            std::string flow = "[";
+            const auto v = p.unchecked<2>();
+            char buf[32];
+            for (py::ssize_t i = 0; i < p.shape(0); ++i) {
+              flow += i ? ", [" : "[";
+              for (int k = 0; k < 3; ++k) {
+                if (!std::isfinite(v(i, k))) throw py::value_error("points: must be finite");
+                std::snprintf(buf, sizeof buf, "%.17g", v(i, k));
+                if (k) flow += ", ";
+                flow += buf;
+              }
+              flow += "]";
+            }
+            flow += "]";
+            const std::string text =
+                modelling::withBodyGeometry(h.text, h.source, body, flow, modelling::yamlNumber(radius, true));
+            return modelFromText(text, h.source);
+          },
+          py::arg("body"), py::arg("points"), py::arg("radius"),
+          R"doc(A new Model with body `body`'s core points (float64 (K, 3), in its frame, metres) and radius
+(metres, written rounded up to 10 significant digits, never smaller) replaced, everything else in the text kept
+(comments, order, layout), as `kccd fit --model --body` does. Raises InputError when the body is missing or the
+edited model does not load.)doc")
       .def("__repr__",
            [](const ModelHandle& h) {
              return "<kccd.Model '" + h.model->name + "': " + std::to_string(h.model->joints.size()) + " joints, " +
@@ -110,7 +152,7 @@ Pickles through its YAML text (and the file it came from, against which mesh pat
       .def(py::pickle([](const ModelHandle& h) { return py::make_tuple(h.text, h.source); },
                       [](const py::tuple& t) {
                         if (t.size() != 2) throw py::value_error("kccd.Model: bad pickle state");
-                        return fromText(t[0].cast<std::string>(), t[1].cast<std::string>());
+                        return modelFromText(t[0].cast<std::string>(), t[1].cast<std::string>());
                       }));
 }
 

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bindings.hpp"
+#include "progress_relay.hpp"
 #include "kccd/calib/camera.hpp"
 #include "kccd/overlay/overlay_recording.hpp"
 #include "kccd/overlay/synth.hpp"
@@ -17,37 +18,6 @@ namespace kccd::python {
 namespace {
 
 py::object toPython(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
-
-// Thrown through a job when its progress callback raised: the job stops and writes nothing.
-struct CallbackRaised {};
-
-// Calls a Python progress callback from C++ with the GIL held. An exception it raises is kept and
-// stops the job (CallbackRaised); run() then raises it in Python.
-struct ProgressRelay {
-  py::object callback;
-  std::optional<py::error_already_set> error;
-  template <class... A>
-  void operator()(A... args) {
-    if (callback.is_none()) return;
-    py::gil_scoped_acquire gil;
-    try {
-      callback(args...);
-    } catch (py::error_already_set& e) {
-      error = std::move(e);
-      throw CallbackRaised{};
-    }
-  }
-  // Runs `job` with the GIL released; raises the callback's exception if it stopped the job.
-  template <class F>
-  void run(F&& job) {
-    try {
-      py::gil_scoped_release release;
-      job();
-    } catch (const CallbackRaised&) {
-      throw std::move(*error);
-    }
-  }
-};
 
 }  // namespace
 

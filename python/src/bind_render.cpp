@@ -42,8 +42,14 @@ void bindRender(py::module_& m) {
   py::class_<calib::Camera>(m, "Camera", R"doc(
 A fixed camera: intrinsics, OpenCV distortion and its pose (world -> camera, Rodrigues rvec and tvec in
 metres), as `kccd calib` writes it. Load with Camera.load(path).)doc")
-      .def_static("load", [](const std::string& path) { return calib::loadCamera(path); }, py::arg("path"),
-                  "Reads a camera file with a pose; raises InputError naming the file, line and field.")
+      .def_static(
+          "load",
+          [](const std::string& path, bool require_pose) {
+            return calib::loadCamera(path, require_pose ? calib::CameraPose::Required : calib::CameraPose::Optional);
+          },
+          py::arg("path"), py::arg("require_pose") = true,
+          "Reads a camera file; raises InputError naming the file, line and field. require_pose=False also reads "
+          "an intrinsics file without a pose (OpenCV's calibration output: rvec = tvec = 0), as solve_pose takes.")
       .def("save", [](const calib::Camera& c, const std::string& path) { calib::saveCamera(c, path); }, py::arg("path"),
            "Writes the camera file (under a temporary name, renamed when complete).")
       .def_readonly("width", &calib::Camera::width)

@@ -29,10 +29,18 @@ std::vector<double> stateVector(const py::handle& value, const char* name, int l
 /// `value` as a C-contiguous float64 (rows, cols) array, the same checks; `rows` < 0: any.
 py::array_t<double, py::array::c_style> stateMatrix(const py::handle& value, const char* name, int cols);
 
+/// `value` as a C-contiguous float64 (N, cols) array of points (pixels, world points), the same checks.
+py::array_t<double, py::array::c_style> pointMatrix(const py::handle& value, const char* name, int cols);
+/// A handle on the model parsed from `text` (`source` names it in errors). Throws InputError.
+std::shared_ptr<ModelHandle> modelFromText(std::string text, std::string source);
+
 void bindErrors(py::module_& m);
 void bindModel(py::module_& m);
 void bindChecker(py::module_& m);
 void bindRender(py::module_& m);
 void bindOverlay(py::module_& m);
+void bindExplain(py::module_& m);
+void bindModelling(py::module_& m);
+void bindCalib(py::module_& m);
 
 }  // namespace kccd::python

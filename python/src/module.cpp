@@ -9,4 +9,7 @@ PYBIND11_MODULE(_kccd, m) {
   kccd::python::bindChecker(m);
   kccd::python::bindRender(m);
   kccd::python::bindOverlay(m);
+  kccd::python::bindExplain(m);
+  kccd::python::bindModelling(m);
+  kccd::python::bindCalib(m);
 }

@@ -1,0 +1,247 @@
+// Calibration from Python: images and recording frames as NumPy arrays, AprilTag detection, tag
+// layouts and the correspondences they give, and the camera pose solved from correspondences with
+// the statuses and quality figures of `kccd calib`.
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <opencv2/imgproc.hpp>
+#include <set>
+
+#include "bindings.hpp"
+#include "kccd/calib/camera.hpp"
+#include "kccd/calib/image_file.hpp"
+#include "kccd/calib/pose.hpp"
+#include "kccd/calib/tag_detect.hpp"
+#include "kccd/calib/tag_layout.hpp"
+#include "kccd/overlay/calib_gather.hpp"
+
+namespace kccd::python {
+
+namespace {
+
+// A decoded 8-bit BGR picture as a fresh RGB uint8 (H, W, 3) array.
+py::array_t<std::uint8_t> rgbArray(const cv::Mat& bgr) {
+  cv::Mat rgb;
+  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+  py::array_t<std::uint8_t> out({rgb.rows, rgb.cols, 3});
+  const std::size_t row = static_cast<std::size_t>(rgb.cols) * 3;
+  for (int r = 0; r < rgb.rows; ++r) std::memcpy(out.mutable_data() + r * static_cast<py::ssize_t>(row), rgb.ptr(r), row);
+  return out;
+}
+
+// `image` (uint8 (H, W) grey, (H, W, 3) RGB or (H, W, 4) RGBA) as an 8-bit grey cv::Mat of its own,
+// converted with the weights `kccd calib` uses on its BGR frames.
+cv::Mat greyOf(const py::handle& image) {
+  py::array a = py::array::ensure(image);
+  if (!a) {
+    PyErr_Clear();
+    throw py::type_error("image: expected a NumPy array of uint8 pixels");
+  }
+  if (a.dtype().kind() != 'u' || a.dtype().itemsize() != 1)
+    throw py::type_error("image: expected dtype uint8, got dtype " + py::str(a.dtype()).cast<std::string>());
+  const int channels = a.ndim() == 2 ? 1 : (a.ndim() == 3 ? static_cast<int>(a.shape(2)) : 0);
+  if (channels != 1 && channels != 3 && channels != 4)
+    throw py::value_error("image: expected shape (H, W) grey, (H, W, 3) RGB or (H, W, 4) RGBA");
+  if (a.shape(0) < 1 || a.shape(1) < 1) throw py::value_error("image: is empty");
+  if (a.shape(0) > calib::kMaxImageSide || a.shape(1) > calib::kMaxImageSide)
+    throw py::value_error("image: larger than " + std::to_string(calib::kMaxImageSide) + " pixels a side");
+  const auto c = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(a);
+  const cv::Mat view(static_cast<int>(c.shape(0)), static_cast<int>(c.shape(1)), CV_8UC(channels),
+                     const_cast<std::uint8_t*>(c.data()));
+  cv::Mat grey;
+  if (channels == 1) grey = view.clone();
+  if (channels == 3) cv::cvtColor(view, grey, cv::COLOR_RGB2GRAY);
+  if (channels == 4) cv::cvtColor(view, grey, cv::COLOR_RGBA2GRAY);
+  return grey;
+}
+
+py::array_t<double> rows(const std::vector<std::array<double, 3>>& v, int cols) {
+  py::array_t<double> out({static_cast<py::ssize_t>(v.size()), static_cast<py::ssize_t>(cols)});
+  auto o = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < v.size(); ++i)
+    for (int k = 0; k < cols; ++k) o(static_cast<py::ssize_t>(i), k) = v[i][static_cast<std::size_t>(k)];
+  return out;
+}
+
+}  // namespace
+
+void bindCalib(py::module_& m) {
+  m.def(
+      "read_image",
+      [](const std::string& path) { return rgbArray(calib::readImageFile(path, calib::ImageColour::Bgr)); },
+      py::arg("path"),
+      "An image file (PNG, JPEG, TIFF, BMP, ...) as uint8 (H, W, 3) RGB, C-contiguous. Raises InputError naming "
+      "the file.");
+  m.def(
+      "read_frame",
+      [](const std::string& video, int index) {
+        if (index < 0) throw py::value_error("index: must be >= 0");
+        overlay::RecordingFrames f;
+        {
+          py::gil_scoped_release release;
+          f = overlay::readRecordingFrames(video, {index});
+        }
+        return rgbArray(f.frames.at(0));
+      },
+      py::arg("video"), py::arg("index"),
+      "Frame `index` (from 0) of a recording (a video file or an image-sequence pattern with a '%') as uint8 "
+      "(H, W, 3) RGB, decoded in order up to it. Raises InputError naming the recording and the frame.");
+
+  py::class_<calib::TagDetection>(m, "TagDetection", "One detected AprilTag (family tag36h11).")
+      .def_readonly("id", &calib::TagDetection::id)
+      .def_property_readonly(
+          "corners",
+          [](const calib::TagDetection& d) {
+            std::vector<std::array<double, 3>> c;
+            for (const cv::Point2d& p : d.corners) c.push_back({p.x, p.y, 0.0});
+            return rows(c, 2);
+          },
+          "float64 (4, 2): the corners in pixels (OpenCV convention: pixel centres at integers), in AprilTag's "
+          "order p0..p3, counter-clockwise as seen in the image, p0 at the tag frame's (-s/2, -s/2)")
+      .def_readonly("hamming", &calib::TagDetection::hamming, "bits corrected in decoding (0 ... 2)")
+      .def_readonly("decision_margin", &calib::TagDetection::decision_margin, "AprilTag's decoding quality")
+      .def("__repr__", [](const calib::TagDetection& d) { return "<kccd.TagDetection id " + std::to_string(d.id) + ">"; });
+
+  m.def(
+      "detect_tags",
+      [](const py::handle& image) {
+        cv::Mat grey = greyOf(image);
+        py::gil_scoped_release release;
+        return calib::detectTags(grey);
+      },
+      py::arg("image"),
+      "The tag36h11 AprilTags in `image` (uint8 (H, W) grey, (H, W, 3) RGB or (H, W, 4) RGBA; converted to grey "
+      "as `kccd calib` does), full resolution with refined edges, in the detector's order. The GIL is released.");
+
+  py::class_<calib::TagLayout>(m, "TagLayout", "Where AprilTags are placed in the world (a tag layout file).")
+      .def_static("load", &calib::loadTagLayout, py::arg("path"),
+                  "Reads a tag layout file; raises InputError naming the file, line and field.")
+      .def_static("from_yaml", &calib::parseTagLayout, py::arg("text"), py::arg("source") = "<string>",
+                  "Parses tag layout text; `source` names it in errors.")
+      .def_property_readonly("ids",
+                             [](const calib::TagLayout& l) {
+                               std::vector<int> ids;
+                               for (const calib::Tag& t : l.tags) ids.push_back(t.id);
+                               return ids;
+                             },
+                             "The tag ids, in file order.")
+      .def(
+          "corners",
+          [](const calib::TagLayout& l, int id) {
+            const calib::Tag* t = l.find(id);
+            if (!t) throw py::key_error("tag " + std::to_string(id) + " is not in the layout");
+            std::vector<std::array<double, 3>> c;
+            for (const cv::Point3d& p : t->corners()) c.push_back({p.x, p.y, p.z});
+            return rows(c, 3);
+          },
+          py::arg("id"), "float64 (4, 3): tag `id`'s corners in the world (metres), in TagDetection.corners' order.")
+      .def("__len__", [](const calib::TagLayout& l) { return l.tags.size(); });
+
+  m.def(
+      "tag_correspondences",
+      [](const std::vector<calib::TagDetection>& detections, const calib::TagLayout& layout, const std::string& image) {
+        const calib::TagCorrespondences tc = calib::tagCorrespondences(detections, layout, image);
+        std::vector<std::string> names;
+        std::vector<std::array<double, 3>> px, world;
+        for (const calib::Correspondence& c : tc.points) {
+          names.push_back(c.name);
+          px.push_back({c.pixel.x, c.pixel.y, 0.0});
+          world.push_back({c.world.x, c.world.y, c.world.z});
+        }
+        py::dict out;
+        out["names"] = names;
+        out["pixels"] = rows(px, 2);
+        out["world"] = rows(world, 3);
+        out["unknown_ids"] = tc.unknown_ids;
+        return out;
+      },
+      py::arg("detections"), py::arg("layout"), py::arg("image") = "image",
+      "Pairs each detected corner of a layout tag with its world point: a dict with 'names' ('tag3.c0' ... "
+      "'tag3.c3'), 'pixels' float64 (N, 2), 'world' float64 (N, 3) (metres), in detection then corner order, and "
+      "'unknown_ids' (detected ids the layout lacks). A tag detected twice raises InputError naming `image`.");
+
+  py::list members;
+  const std::pair<const char*, calib::PoseStatus> statuses[] = {
+      {"SOLVED", calib::PoseStatus::Solved},
+      {"TOO_FEW_POINTS", calib::PoseStatus::TooFewPoints},
+      {"COLLINEAR", calib::PoseStatus::Collinear},
+      {"POOR_GEOMETRY", calib::PoseStatus::PoorGeometry},
+      {"TOO_FEW_INLIERS", calib::PoseStatus::TooFewInliers}};
+  for (const auto& [name, s] : statuses) members.append(py::make_tuple(name, static_cast<int>(s)));
+  py::object pose_status = py::module_::import("enum").attr("IntEnum")("PoseStatus", members, py::arg("module") = "kccd");
+  pose_status.attr("__doc__") = "How a pose solve ended; only SOLVED comes with a camera.";
+  m.attr("PoseStatus") = pose_status;
+
+  m.def(
+      "solve_pose",
+      [pose_status](const calib::Camera& intrinsics, const py::handle& pixels, const py::handle& world,
+                    const std::optional<std::vector<std::string>>& names, double threshold, int min_inliers) {
+        const auto px = pointMatrix(pixels, "pixels", 2);
+        const auto wd = pointMatrix(world, "world", 3);
+        if (px.shape(0) != wd.shape(0))
+          throw py::value_error("pixels, world: " + std::to_string(px.shape(0)) + " pixels but " +
+                                std::to_string(wd.shape(0)) + " world points");
+        if (names && static_cast<py::ssize_t>(names->size()) != px.shape(0))
+          throw py::value_error("names: " + std::to_string(names->size()) + " names for " + std::to_string(px.shape(0)) +
+                                " points");
+        if (!(threshold > 0.0)) throw py::value_error("ransac_threshold_px: must be > 0");
+        if (min_inliers < 4) throw py::value_error("min_inliers: must be >= 4");
+        std::vector<calib::Correspondence> points;
+        const auto p = px.unchecked<2>();
+        const auto w = wd.unchecked<2>();
+        for (py::ssize_t i = 0; i < px.shape(0); ++i)
+          points.push_back({names ? (*names)[static_cast<std::size_t>(i)] : "p" + std::to_string(i),
+                            {p(i, 0), p(i, 1)},
+                            {w(i, 0), w(i, 1), w(i, 2)}});
+        calib::PoseOptions options;
+        options.ransac_threshold_px = threshold;
+        options.min_inliers = min_inliers;
+        const calib::Camera start = overlay::intrinsicsOf(intrinsics);
+        calib::PoseResult r;
+        {
+          py::gil_scoped_release release;
+          r = calib::solvePose(start, points, options);
+        }
+        const bool solved = r.status == calib::PoseStatus::Solved;
+        py::array_t<double> residuals(static_cast<py::ssize_t>(r.residuals.size()));
+        py::array_t<bool> inlier(static_cast<py::ssize_t>(r.residuals.size()));
+        for (std::size_t i = 0; i < r.residuals.size(); ++i) {
+          residuals.mutable_data()[i] = r.residuals[i].px;
+          inlier.mutable_data()[i] = r.residuals[i].inlier;
+        }
+        py::dict out;
+        out["status"] = pose_status(static_cast<int>(r.status));
+        out["message"] = r.message;
+        out["camera"] = solved ? py::cast(r.camera) : py::object(py::none());
+        out["residuals_px"] = residuals;
+        out["inlier"] = inlier;
+        out["rejected"] = r.rejected;
+        out["inliers"] = r.inliers;
+        if (solved) {
+          py::array_t<double> cov({6, 6});
+          for (int i = 0; i < 6; ++i)
+            for (int j = 0; j < 6; ++j) cov.mutable_at(i, j) = r.covariance(i, j);
+          out["covariance"] = cov;
+        } else {
+          out["covariance"] = py::none();
+        }
+        out["reprojection_rms_px"] = solved ? py::cast(r.camera.reprojection_rms_px) : py::object(py::none());
+        out["rotation_sigma_deg"] = solved ? py::cast(r.camera.rotation_sigma_deg) : py::object(py::none());
+        out["position_sigma_m"] = solved ? py::cast(r.camera.position_sigma_m) : py::object(py::none());
+        return out;
+      },
+      py::arg("intrinsics"), py::arg("pixels"), py::arg("world"), py::arg("names") = py::none(), py::kw_only(),
+      py::arg("ransac_threshold_px") = 8.0, py::arg("min_inliers") = 6,
+      R"doc(The camera's pose (world -> camera) from 2-D <-> 3-D correspondences, as `kccd calib`: P3P RANSAC,
+SQPnP and Levenberg-Marquardt on the inliers, refusing degenerate or ill-conditioned sets. intrinsics: a Camera
+(its pose and quality figures are ignored; Camera.load(path, require_pose=False) reads an intrinsics file);
+pixels float64 (N, 2) (OpenCV convention: pixel centres at integers); world float64 (N, 3) (metres); names: one
+per point (default 'p0', 'p1', ...), used in 'rejected' and 'message'. Returns a dict: 'status' (kccd.PoseStatus),
+'message' (one line: what was found, and for a failure what to add), 'camera' (a Camera with the pose and its
+quality, SOLVED only, else None), 'residuals_px' float64 (N,) and 'inlier' bool (N,) under the best pose found
+(empty when none), 'rejected' (names), 'inliers', 'covariance' float64 (6, 6) of (rvec, tvec) or None, and
+'reprojection_rms_px', 'rotation_sigma_deg', 'position_sigma_m' (None unless SOLVED). Raises InputError for a
+non-finite coordinate, an empty or repeated name, or invalid intrinsics.)doc");
+}
+
+}  // namespace kccd::python

@@ -1,0 +1,196 @@
+"""kccd.fit, kccd.import_urdf, kccd.prove_pairs, Model.with_body_geometry and kccd.explain: equal to
+the commands' JSON on the same inputs, checked against oracles of their own (an exact point-to-hull
+distance by enumerating faces, point queries at the witnesses), and bad input named."""
+
+import itertools
+import json
+import pathlib
+import subprocess
+
+import numpy as np
+import pytest
+import yaml
+
+import kccd
+from conftest import DATA, ROOT
+
+URDF = ROOT / "tests" / "data" / "urdf"
+
+
+def hull_distance(p: np.ndarray, core: np.ndarray) -> np.ndarray:
+    """Exact distance of points p (S, 3) to conv(core) (K, 3): the closest point lies in the relative
+    interior of a face spanned by at most 4 core points, so the smallest distance to the affine
+    hulls of all subsets whose projection has non-negative barycentric weights is the distance."""
+    best = np.full(len(p), np.inf)
+    for size in range(1, min(4, len(core)) + 1):
+        for subset in itertools.combinations(range(len(core)), size):
+            v = core[list(subset)]
+            if size == 1:
+                best = np.minimum(best, np.linalg.norm(p - v[0], axis=1))
+                continue
+            e = (v[1:] - v[0]).T  # (3, size-1)
+            g = e.T @ e
+            if abs(np.linalg.det(g)) < 1e-18:
+                continue
+            w = np.linalg.solve(g, e.T @ (p - v[0]).T)  # (size-1, S)
+            inside = (w >= -1e-12).all(axis=0) & (w.sum(axis=0) <= 1 + 1e-12)
+            d = np.linalg.norm(p - (v[0] + (e @ w).T), axis=1)
+            best = np.where(inside, np.minimum(best, d), best)
+    return best
+
+
+def write_stl(path: pathlib.Path, triangles: np.ndarray) -> None:
+    lines = ["solid part"]
+    for t in triangles:
+        lines += ["facet normal 0 0 0", "outer loop", *[f"vertex {x!r} {y!r} {z!r}" for x, y, z in t],
+                  "endloop", "endfacet"]
+    path.write_text("\n".join(lines + ["endsolid part"]) + "\n")
+
+
+@pytest.mark.parametrize("k", [1, 3, 6])
+def test_fit_covers_every_point(tmp_path: pathlib.Path, k: int) -> None:
+    rng = np.random.default_rng(k)
+    # A bent bar of random triangles: 0.4 m long, a few cm thick, off the origin.
+    s = rng.uniform(0, 1, (60, 3))
+    pts = np.stack([0.4 * s[:, 0], 0.03 * s[:, 1] + 0.1 * s[:, 0] ** 2, 0.05 * s[:, 2]], axis=1) + [0.2, -0.1, 0.3]
+    tris = pts[rng.integers(0, len(pts), (120, 3))]
+    write_stl(tmp_path / "bar.stl", tris)
+    seen: list[float] = []
+    f = kccd.fit(str(tmp_path / "bar.stl"), k, max_evaluations=600, progress=seen.append)
+    assert f["points"].shape == (k, 3) and f["points"].dtype == np.float64
+    assert seen and seen == sorted(seen) and seen[-1] == 1.0
+    d = hull_distance(tris.reshape(-1, 3), f["points"])
+    assert d.max() <= f["radius"], "a vertex of the part lies outside the fitted SSCH"
+    assert d.max() >= 0.9 * f["radius"], "the radius is far larger than the part needs"
+    assert f["volume"] >= f["hull_volume"] > 0
+    assert f["triangles"] == 120
+
+
+def test_fit_equals_cli(cli) -> None:
+    part = DATA / "parts" / "gripper.iv"
+    j = json.loads(subprocess.run([str(cli), "fit", str(part), "-k", "4", "--evaluations", "800", "--json"],
+                                  check=True, capture_output=True, text=True).stdout)
+    f = kccd.fit(str(part), 4, max_evaluations=800)
+    assert f["points"].tolist() == j["points"] and f["radius"] == j["radius"]
+    assert f["volume"] == j["volume"] and f["hull_volume"] == j["hull_volume"]
+    assert f["hull_vertices"] == j["hull_vertices"] and f["evaluations"] == j["evaluations"]
+    h = kccd.fit(str(part), exact_hull=True)
+    assert len(h["points"]) == h["hull_vertices"] and h["volume"] < f["volume"]
+
+
+def test_fit_errors(tmp_path: pathlib.Path) -> None:
+    with pytest.raises(kccd.InputError) as e:
+        kccd.fit(str(tmp_path / "missing.stl"))
+    assert "missing.stl" in str(e.value) and e.value.source.endswith("missing.stl")
+    bad = tmp_path / "bad.stl"
+    bad.write_text("solid x\nfacet normal 0 0 0\nouter loop\nvertex 0 0 nan\nvertex 1 0 0\nvertex 0 1 0\nendloop\n"
+                   "endfacet\nendsolid x\n")
+    with pytest.raises(kccd.InputError):
+        kccd.fit(str(bad))
+    for k in (0, 17):
+        with pytest.raises(ValueError, match="points"):
+            kccd.fit(str(DATA / "parts" / "gripper.iv"), k)
+
+    def stop(_: float) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        kccd.fit(str(DATA / "parts" / "gripper.iv"), 2, progress=stop)
+
+
+def test_with_body_geometry(arm: kccd.Model) -> None:
+    f = kccd.fit(str(DATA / "parts" / "gripper.iv"), 2, max_evaluations=300)
+    m = arm.with_body_geometry("gripper", f["points"], f["radius"])
+    assert m.bodies == arm.bodies and m.source == arm.source and m.yaml != arm.yaml
+    assert arm.yaml.count("\n") == m.yaml.count("\n"), "the rest of the text is kept"
+    # The gripper is now a different volume: some query must see it.
+    c0, c1 = kccd.Checker(arm), kccd.Checker(m)
+    q = [0.3, 0.4, 0.6]
+    assert c0.query(q, type="distances").distance.tolist() != c1.query(q, type="distances").distance.tolist()
+    with pytest.raises(kccd.InputError, match="nothing"):
+        arm.with_body_geometry("nothing", f["points"], f["radius"])
+    with pytest.raises(ValueError, match="points"):
+        arm.with_body_geometry("gripper", np.zeros((2, 2)), 0.1)
+    with pytest.raises(ValueError, match="radius"):
+        arm.with_body_geometry("gripper", f["points"], float("nan"))
+
+
+def test_import_urdf_equals_cli(cli) -> None:
+    args = dict(srdf=str(URDF / "two_link.srdf"), packages={"kccd_test": str(URDF)}, points=3)
+    fractions: list[float] = []
+    text = kccd.import_urdf(str(URDF / "two_link.urdf"), progress=fractions.append, **args)  # type: ignore[arg-type]
+    out = subprocess.run([str(cli), "import", str(URDF / "two_link.urdf"), "--srdf", args["srdf"], "--package-path",
+                          f"kccd_test={URDF}", "-k", "3", "-q"], check=True, capture_output=True, text=True).stdout
+    assert text == out
+    assert fractions and fractions[-1] == 1.0
+    m = kccd.Model.from_yaml(text, "two_link.yaml")
+    assert m.state_size > 0 and m.bodies
+    with pytest.raises(kccd.InputError, match="kccd_test"):
+        kccd.import_urdf(str(URDF / "two_link.urdf"))
+    with pytest.raises(ValueError, match="safety_margin"):
+        kccd.import_urdf(str(URDF / "two_link.urdf"), safety_margin=-1.0)
+
+
+def test_prove_pairs_equals_cli_and_holds(cli, arm: kccd.Model) -> None:
+    p = kccd.prove_pairs(arm, max_boxes=300)
+    j = json.loads(subprocess.run([str(cli), "pairs", str(DATA / "demo_arm.yaml"), "--json", "--max-boxes", "300"],
+                                  check=True, capture_output=True, text=True).stdout)
+    assert p["margin"] == j["margin"]
+    assert [(q["a"], q["b"], q["verdict"], q["boxes"]) for q in p["pairs"]] == \
+        [(q["a"], q["b"], q["verdict"], q["boxes"]) for q in j["pairs"]]
+    for mine, theirs in zip(p["pairs"], j["pairs"]):
+        assert mine["bound"] == theirs.get("bound") and mine["ignore_reason"] == theirs.get("ignore_reason")
+    assert [list(e) for e in p["ignore"]] == j["ignore"]
+    pruned = p["model"]
+    assert set(pruned.pairs) == {(a, b) for a, b in arm.pairs} - {(a, b) for a, b, _ in p["ignore"]}
+    # The proofs hold at sampled states: a pair proven never within the margin keeps its distance
+    # above the proven bound; a witness is within the margin.
+    names = arm.bodies
+    checker = kccd.Checker(arm)
+    rng = np.random.default_rng(5)
+    doc_limits = np.array([j["limits"] for j in yaml.safe_load(arm.yaml)["joints"]])
+    never = [q for q in p["pairs"] if q["verdict"] == "never" and (q["a"], q["b"]) in arm.pairs]
+    assert never and any(q["verdict"] == "meets" for q in p["pairs"])
+    index = {pair: k for k, pair in enumerate(arm.pairs)}
+    for state in rng.uniform(doc_limits[:, 0], doc_limits[:, 1], (200, 3)):
+        r = checker.query(state, type="distances")
+        dist = dict(zip(r.pair.tolist(), r.distance.tolist()))
+        for q in never:
+            assert dist[index[(q["a"], q["b"])]] >= q["bound"] - 1e-12
+    for q in p["pairs"]:
+        if q["verdict"] == "meets" and (q["a"], q["b"]) in index:
+            r = checker.query(q["witness_state"], type="distances")
+            assert r.distance[r.pair.tolist().index(index[(q["a"], q["b"])])] <= p["margin"]
+    assert names == pruned.bodies
+    with pytest.raises(ValueError, match="max_boxes"):
+        kccd.prove_pairs(arm, max_boxes=0)
+
+
+def test_explain_equals_cli_and_its_configurations(cli, arm: kccd.Model) -> None:
+    lower, upper = [0.3, 0.4, 0.6], [0.5, 1.2, 1.4]
+    e = kccd.explain(arm, lower, upper)
+    j = json.loads(subprocess.run([str(cli), "query", str(DATA / "demo_arm.yaml"), "--json", "--type", "distances",
+                                   "--explain", "--lower", ",".join(map(repr, lower)), "--upper",
+                                   ",".join(map(repr, upper))], check=True, capture_output=True, text=True).stdout)
+    assert len(e) == len(j["explain"]) > 0
+    checker = kccd.Checker(arm)
+    for mine, theirs in zip(e, j["explain"]):
+        assert (mine["a"], mine["b"], mine["verdict"]) == (theirs["a"], theirs["b"], theirs["verdict"])
+        assert mine["bound"] == theirs["bound"] and mine["distance"] == theirs["distance"]
+        assert mine["state"].tolist() == [theirs["state"][n] for n in arm.state_names]
+        assert mine["point_a"].tolist() == theirs["point_a"]
+        # The configuration lies in the box, and a point query there agrees with its distance.
+        assert (np.array(lower) <= mine["state"]).all() and (mine["state"] <= np.array(upper)).all()
+        r = checker.query(mine["state"], type="distances", exact="all")
+        at = r.distance[r.pair.tolist().index(mine["pair"])]
+        assert mine["bound"] <= at <= mine["distance"] + 1e-9
+        assert mine["distance"] - at < 1e-6
+    # A point state: nothing flagged where the query sees no pair within the margin; a real collision where it does.
+    assert not checker.query([0.0, -1.2, 0.0]).collision and kccd.explain(arm, [0.0, -1.2, 0.0]) == []
+    assert [x["verdict"] for x in kccd.explain(arm, [0.0, 0.0, 0.0])] == ["real"]
+    with pytest.raises(ValueError):
+        kccd.explain(arm, [0.5, 0.4, 0.6], [0.3, 1.2, 1.4])
+    with pytest.raises(ValueError, match="lower"):
+        kccd.explain(arm, [0.5, 0.4])
+    with pytest.raises(ValueError, match="starts"):
+        kccd.explain(arm, lower, upper, starts=0)
