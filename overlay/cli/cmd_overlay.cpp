@@ -25,7 +25,9 @@ struct OverlayArgs {
   int contact_frames = 12;
   std::string time_offset_text = "0";  // seconds, or auto:A:B
   double max_gap = 0.0, fps = 0.0;
-  double latency = 0.01, deceleration = 5.0, max_acceleration = 0.0, position_error = 0.0, velocity_error = 0.0;
+  double latency = overlay::kOverlayBraking.latency, deceleration = overlay::kOverlayBraking.deceleration,
+         max_acceleration = overlay::kOverlayBraking.max_acceleration,
+         position_error = overlay::kOverlayBraking.position_error, velocity_error = overlay::kOverlayBraking.velocity_error;
   bool swept = false, plain = false, quiet = false, json = false, visuals = false;
   int jobs = 0;  // 0: hardware threads
 };

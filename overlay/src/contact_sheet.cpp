@@ -47,13 +47,14 @@ cv::Mat ContactSheet::compose() const {
   const int cols = static_cast<int>(std::min<std::size_t>(4, pick.size()));
   const int rows = static_cast<int>((pick.size() + cols - 1) / cols);
   const int caption_h = 22, gap = 4;
-  const int tile_h = pick.front()->image.rows;
+  int tile_h = 0;  // the tallest tile: frames of several cameras may differ in aspect
+  for (const Tile* t : pick) tile_h = std::max(tile_h, t->image.rows);
   cv::Mat sheet(rows * (tile_h + caption_h + gap) + gap, cols * (tile_width_ + gap) + gap, CV_8UC3, cv::Scalar(40, 40, 40));
   for (std::size_t i = 0; i < pick.size(); ++i) {
     const int r = static_cast<int>(i) / cols, c = static_cast<int>(i) % cols;
     const int x = gap + c * (tile_width_ + gap), y = gap + r * (tile_h + caption_h + gap);
     const cv::Mat& img = pick[i]->image;
-    img.copyTo(sheet(cv::Rect(x, y, img.cols, std::min(img.rows, tile_h))));
+    img.copyTo(sheet(cv::Rect(x, y, img.cols, img.rows)));
     cv::putText(sheet, pick[i]->caption, {x + 2, y + tile_h + 16}, cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
   }
   return sheet;

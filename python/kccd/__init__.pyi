@@ -13,6 +13,7 @@ from ._kccd import TagDetection as TagDetection
 from ._kccd import TagLayout as TagLayout
 from ._kccd import __version__ as __version__
 from ._kccd import braking_intervals as braking_intervals
+from ._kccd import contact_sheet as contact_sheet
 from ._kccd import detect_tags as detect_tags
 from ._kccd import explain as explain
 from ._kccd import fit as fit
@@ -20,6 +21,7 @@ from ._kccd import import_urdf as import_urdf
 from ._kccd import overlay_recording as overlay_recording
 from ._kccd import prove_pairs as prove_pairs
 from ._kccd import read_frame as read_frame
+from ._kccd import read_frames as read_frames
 from ._kccd import read_image as read_image
 from ._kccd import render as render
 from ._kccd import solve_pose as solve_pose
@@ -40,6 +42,7 @@ __all__ = [
     "TagLayout",
     "__version__",
     "braking_intervals",
+    "contact_sheet",
     "detect_tags",
     "explain",
     "fit",
@@ -47,6 +50,7 @@ __all__ = [
     "overlay_recording",
     "prove_pairs",
     "read_frame",
+    "read_frames",
     "read_image",
     "render",
     "solve_pose",

@@ -210,6 +210,7 @@ def overlay_recording(
     contact_sheet: str = "",
     time_offset: float = 0.0,
     swept: bool = False,
+    braking: BrakingParams | None = None,
     jobs: int = 0,
     frames: str = "",
     contact_frames: int = 12,
@@ -327,6 +328,10 @@ def prove_pairs(
 ) -> _Proofs: ...
 def read_image(path: str) -> npt.NDArray[np.uint8]: ...
 def read_frame(video: str, index: int) -> npt.NDArray[np.uint8]: ...
+def read_frames(video: str, indices: Sequence[int]) -> list[npt.NDArray[np.uint8]]: ...
+def contact_sheet(
+    frames: Sequence[npt.NDArray[np.uint8]], captions: Sequence[str], output: str, *, tile_width: int = 320
+) -> None: ...
 
 class TagDetection:
     """One detected AprilTag (tag36h11)."""

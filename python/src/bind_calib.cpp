@@ -87,6 +87,24 @@ void bindCalib(py::module_& m) {
       "Frame `index` (from 0) of a recording (a video file or an image-sequence pattern with a '%') as uint8 "
       "(H, W, 3) RGB, decoded in order up to it. Raises InputError naming the recording and the frame.");
 
+  m.def(
+      "read_frames",
+      [](const std::string& video, const std::vector<int>& indices) {
+        for (int i : indices)
+          if (i < 0) throw py::value_error("indices: must be >= 0");
+        overlay::RecordingFrames f;
+        if (!indices.empty()) {
+          py::gil_scoped_release release;
+          f = overlay::readRecordingFrames(video, indices);
+        }
+        py::list out;
+        for (const cv::Mat& frame : f.frames) out.append(rgbArray(frame));
+        return out;
+      },
+      py::arg("video"), py::arg("indices"),
+      "Frames `indices` (from 0, any order) of a recording as uint8 (H, W, 3) RGB arrays, in the order asked for, "
+      "decoded once up to the last one. Raises InputError naming the recording and the frame.");
+
   py::class_<calib::TagDetection>(m, "TagDetection", "One detected AprilTag (family tag36h11).")
       .def_readonly("id", &calib::TagDetection::id)
       .def_property_readonly(

@@ -3,12 +3,17 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "bindings.hpp"
 #include "progress_relay.hpp"
 #include "kccd/calib/camera.hpp"
+#include "kccd/overlay/contact_sheet.hpp"
 #include "kccd/overlay/overlay_recording.hpp"
+#include "kccd/overlay/staged_output.hpp"
 #include "kccd/overlay/synth.hpp"
 #include "kccd/overlay/video_sink.hpp"
 #include "kccd/state_log.hpp"
@@ -23,17 +28,60 @@ py::object toPython(const nlohmann::json& j) { return py::module_::import("json"
 
 void bindOverlay(py::module_& m) {
   m.def(
+      "contact_sheet",
+      [](const std::vector<py::array>& frames, const std::vector<std::string>& captions, const std::string& output,
+         int tile_width) {
+        if (frames.size() != captions.size())
+          throw py::value_error("captions: " + std::to_string(captions.size()) + " captions for " +
+                                std::to_string(frames.size()) + " frames");
+        if (frames.empty()) throw py::value_error("frames: give at least one frame");
+        if (tile_width < 16 || tile_width > 4096) throw py::value_error("tile_width: must be 16 ... 4096 pixels");
+        if (output.empty() || overlay::lowerExtension(output) != ".png")
+          throw py::value_error("output: must be a .png file");
+        std::vector<cv::Mat> bgr;
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+          const py::array& a = frames[i];
+          if (a.dtype().kind() != 'u' || a.dtype().itemsize() != 1 || a.ndim() != 3 || a.shape(2) != 3 ||
+              a.shape(0) < 1 || a.shape(1) < 1)
+            throw py::value_error("frames[" + std::to_string(i) + "]: expected uint8 (H, W, 3) RGB");
+          const auto c = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(a);
+          const cv::Mat view(static_cast<int>(c.shape(0)), static_cast<int>(c.shape(1)), CV_8UC3,
+                             const_cast<std::uint8_t*>(c.data()));
+          cv::Mat b;
+          cv::cvtColor(view, b, cv::COLOR_RGB2BGR);
+          bgr.push_back(b);
+        }
+        {
+          py::gil_scoped_release release;
+          // One more than the frames: the sheet then keeps every frame offered (none is thinned out).
+          overlay::ContactSheet sheet(bgr.size() + 1, tile_width);
+          for (std::size_t i = 0; i < bgr.size(); ++i) sheet.add(i, bgr[i], captions[i], 0.0);
+          overlay::writePngAtomically(output, sheet.compose(), "output");
+        }
+      },
+      py::arg("frames"), py::arg("captions"), py::arg("output"), py::kw_only(), py::arg("tile_width") = 320,
+      R"doc(Writes a contact sheet, as `kccd overlay --contact-sheet` draws one: `frames` (uint8 (H, W, 3) RGB each)
+side by side, in order, on a grid of at most 4 columns, each scaled to tile_width pixels and captioned with its
+caption. output: a .png, written under a temporary name and renamed when complete.)doc");
+
+
+  m.def(
       "overlay_recording",
       [](const std::shared_ptr<ModelHandle>& h, const calib::Camera& camera, const std::string& video,
          const std::string& states, const std::string& output, const std::string& report, const std::string& contact_sheet,
-         double time_offset, bool swept, int jobs, const std::string& frames, int contact_frames,
-         const py::object& progress) {
+         double time_offset, bool swept, const std::optional<BrakingParams>& braking, int jobs, const std::string& frames,
+         int contact_frames, const py::object& progress) {
         const Model& model = *h->model;
         const StateLog log = loadStateLog(states, model);
         overlay::OverlayInputs in{model, camera, log, video, {}, "video " + video, "camera", ""};
         overlay::OverlayOptions o;
         o.time_offset = time_offset;
         o.swept = swept;
+        if (braking) {
+          if (!(braking->deceleration > 0.0) || !std::isfinite(braking->deceleration))
+            throw py::value_error("braking: deceleration must be a finite number > 0");
+          o.braking = *braking;
+        }
         o.jobs = jobs;
         o.frames = overlay::parseFrameRange(frames, "frames");
         if (contact_frames < 1 || contact_frames > 64) throw py::value_error("contact_frames: expected 1 to 64");
@@ -59,13 +107,14 @@ void bindOverlay(py::module_& m) {
       },
       py::arg("model"), py::arg("camera"), py::arg("video"), py::arg("states"), py::kw_only(), py::arg("output") = "",
       py::arg("report") = "", py::arg("contact_sheet") = "", py::arg("time_offset") = 0.0, py::arg("swept") = false,
-      py::arg("jobs") = 0, py::arg("frames") = "", py::arg("contact_frames") = 12, py::arg("progress") = py::none(),
+      py::arg("braking") = py::none(), py::arg("jobs") = 0, py::arg("frames") = "", py::arg("contact_frames") = 12, py::arg("progress") = py::none(),
       R"doc(The main job, as `kccd overlay`: every frame of `video` (a file or an image-sequence pattern) checked at
 the state the log `states` (CSV) gives at its time (log time = frame time + time_offset, seconds), the
 volumes drawn and composited. Outputs, checked before any frame is decoded (extension, an existing
 folder, not one of the inputs) and each written under a temporary name and renamed when complete:
 `output` (.mp4, .mkv or .avi), `report` (.json, the format of `kccd overlay --report`), `contact_sheet`
-(.png of contact_frames frames). swept: braking-interval volumes. jobs: drawing threads (0: all cores).
+(.png of contact_frames frames). swept: braking-interval volumes, with `braking` (a BrakingParams for every
+joint; None: kccd overlay's defaults, latency 0.01 s and deceleration 5). jobs: drawing threads (0: all cores).
 frames: 'FIRST:END:STEP' of the frames drawn (all are checked). progress(frames_done, frames_expected,
 frames_per_second) is called after each frame with the GIL held. Returns the report as a dict (with
 per-frame records under 'frames'). Raises InputError naming the input and place.)doc");

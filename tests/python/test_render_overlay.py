@@ -99,3 +99,34 @@ def test_overlay_errors_and_progress_exceptions(arm: kccd.Model, camera: kccd.Ca
         kccd.overlay_recording(arm, rec_camera, s["video"], s["states"], progress=stop,
                                time_offset=s["time_offset"], report=str(tmp_path / "r.json"))
     assert not (tmp_path / "r.json").exists()
+
+
+def test_contact_sheet_of_frames_of_two_sizes(tmp_path: pathlib.Path) -> None:
+    wide = np.zeros((90, 160, 3), np.uint8)
+    wide[..., 0] = 200  # red
+    tall = np.zeros((240, 160, 3), np.uint8)
+    tall[..., 2] = 200  # blue, taller than the first tile
+    kccd.contact_sheet([wide, tall, wide], ["a #1", "b #2", "a #3"], str(tmp_path / "sheet.png"), tile_width=160)
+    sheet = kccd.read_image(str(tmp_path / "sheet.png"))
+    # Three tiles in a row, as tall as the tallest, every tile drawn whole.
+    assert sheet.shape[1] == 3 * 164 + 4 and sheet.shape[0] >= 240 + 22
+    assert (sheet[4:94, 4:164] == [200, 0, 0]).all()
+    assert (sheet[4:244, 168:328] == [0, 0, 200]).all()
+    assert (sheet[4:94, 332:492] == [200, 0, 0]).all()
+    with pytest.raises(ValueError, match="captions"):
+        kccd.contact_sheet([wide], [], str(tmp_path / "x.png"))
+    with pytest.raises(ValueError, match=r"frames\[0\]"):
+        kccd.contact_sheet([wide[..., 0]], ["x"], str(tmp_path / "x.png"))
+    with pytest.raises(ValueError, match="png"):
+        kccd.contact_sheet([wide], ["x"], str(tmp_path / "x.jpg"))
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_read_frames_equal_read_frame(tmp_path: pathlib.Path) -> None:
+    s = kccd.synthesize_recording(str(DATA / "demo_arm.yaml"), str(tmp_path / "rec"), seconds=0.4)
+    frames = kccd.read_frames(s["video"], [7, 2, 7])
+    assert len(frames) == 3 and (frames[0] == frames[2]).all()
+    assert (frames[1] == kccd.read_frame(s["video"], 2)).all() and (frames[0] == kccd.read_frame(s["video"], 7)).all()
+    assert kccd.read_frames(s["video"], []) == []
+    with pytest.raises(ValueError, match="indices"):
+        kccd.read_frames(s["video"], [-1])

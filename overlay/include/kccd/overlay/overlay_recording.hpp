@@ -47,6 +47,10 @@ struct OverlayInputs {
 };
 
 /// How a run checks and draws.
+/// The braking a run assumes with `swept` unless told otherwise (kccd overlay's defaults): 10 ms of
+/// latency, 5 rad/s^2 (or m/s^2) of guaranteed deceleration, every state value.
+inline constexpr BrakingParams kOverlayBraking{.latency = 0.01, .deceleration = 5.0};
+
 struct OverlayOptions {
   double time_offset = 0.0;            ///< log time = frame time + offset (s)
   /// Search [lo, hi] for the offset instead (findTimeOffset; a first pass over the video).
@@ -55,7 +59,7 @@ struct OverlayOptions {
   double max_gap = 0.0;                ///< the largest log gap bridged (s); <= 0: 1.5 x the median period
   double fps = 0.0;                    ///< the video's frame rate; <= 0: as the video declares
   bool swept = false;                  ///< braking-interval swept volumes (BrakingParams per joint)
-  BrakingParams braking;               ///< every state value's braking, with `swept`
+  BrakingParams braking = kOverlayBraking;  ///< every state value's braking, with `swept`
   bool plain = false;                  ///< volumes only: no legend, no status line
   bool visuals = false;                ///< also draw the model's visual geometry at the logged state
   FrameRange frames;                   ///< the frames drawn and handed on

@@ -1,0 +1,813 @@
+"""Batch overlay of many recordings on a Dask cluster: ``python3 -m kccd.batch MANIFEST.yaml --out DIR``.
+
+One task per recording runs :func:`kccd.overlay_recording` in a Dask worker process. Inputs are read
+from paths every worker sees (shared storage); each recording's outputs are written into a hidden
+staging folder under DIR and renamed to ``DIR/<id>/`` only when all of them are complete, so a
+killed worker never leaves a folder that looks complete. A failed task is retried once, then
+reported with its one-line reason while the others finish. ``DIR/summary.json`` and
+``DIR/summary.md`` sum the fleet up.
+
+The manifest (paths relative to it)::
+
+    kccd_batch: 1
+    defaults: {model: robot.yaml, camera: cam.yaml, time_offset: 0.137, swept: false}
+    recordings:
+      - {id: cell3-2026-11-20-a, video: rec/a.mkv, states: rec/a.csv}
+      - {id: cell3-2026-11-20-b, video: rec/b.mkv, states: rec/b.csv, swept: true}
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import fnmatch
+import hashlib
+import json
+import logging
+import math
+import os
+import re
+import shutil
+import sys
+import tempfile
+import time
+import uuid
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import yaml
+
+from . import _kccd as _core
+
+#: What each recording's folder holds when it is complete.
+OUTPUT_FILES = ("overlay.mp4", "report.json", "contact_sheet.png", "inputs.json")
+_TOPIC = "kccd-batch"
+_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,127}")
+_RECORDING_KEYS = ("id", "video", "states", "model", "camera", "time_offset", "swept", "braking")
+_DEFAULT_KEYS = ("model", "camera", "time_offset", "swept", "braking")
+#: The braking of swept volumes unless a manifest says otherwise (kccd overlay's defaults).
+DEFAULT_BRAKING = {"latency": 0.01, "deceleration": 5.0, "max_acceleration": 0.0, "position_error": 0.0,
+                   "velocity_error": 0.0}
+
+
+class ManifestError(ValueError):
+    """A manifest that cannot be run: str() is one line 'file:line: field: problem'."""
+
+
+class RecordingFailed(RuntimeError):
+    """A recording's task failed; str() is its one-line reason."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Recording:
+    """One recording of a manifest, its paths made absolute."""
+
+    id: str
+    video: str
+    states: str
+    model: str
+    camera: str
+    time_offset: float
+    swept: bool
+    line: int  #: where the manifest lists it (1-based)
+    braking: tuple[tuple[str, float], ...] = tuple(DEFAULT_BRAKING.items())  #: with swept, every joint
+
+
+# --------------------------------------------------------------------------------------------
+# The manifest
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
+    """The recordings of the manifest at `path`, in its order. Checks its structure (one YAML
+    document, known keys, ``kccd_batch: 1``, ids explicit, unique and fit for a folder name) and,
+    with `check_inputs`, that every input exists and every model and camera loads. Raises
+    ManifestError naming the file, line and field."""
+    try:
+        with open(path, "rb") as f:
+            raw = f.read(16 << 20)
+    except OSError as e:
+        raise ManifestError(f"{path}: cannot read: {e.strerror}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ManifestError(f"{path}: not UTF-8 text (byte {e.start})") from None
+
+    def fail(node: yaml.Node | None, field: str, problem: str) -> ManifestError:
+        where = f"{path}:{node.start_mark.line + 1}" if node is not None else path
+        return ManifestError(f"{where}: {field}: {problem}")
+
+    loader: Any = yaml.SafeLoader(text)  # partly untyped in its stubs
+    try:
+        root = loader.get_single_node()
+    except yaml.MarkedYAMLError as e:
+        line = e.problem_mark.line + 1 if e.problem_mark else 0
+        raise ManifestError(f"{path}:{line}: yaml: {_one_line(str(e.problem or e.context))}") from None
+    except yaml.YAMLError as e:
+        raise ManifestError(f"{path}: yaml: {_one_line(str(e))}") from None
+    finally:
+        loader.dispose()
+    if not isinstance(root, yaml.MappingNode):
+        raise fail(root, "manifest", "expected a mapping with kccd_batch, defaults and recordings")
+
+    def mapping(node: yaml.Node, field: str, allowed: Sequence[str]) -> dict[str, yaml.Node]:
+        if not isinstance(node, yaml.MappingNode):
+            raise fail(node, field, "expected a mapping")
+        out: dict[str, yaml.Node] = {}
+        for k, v in node.value:
+            if not isinstance(k, yaml.ScalarNode):
+                raise fail(k, field, "keys must be plain words")
+            if k.value in out:
+                raise fail(k, f"{field}.{k.value}", "given twice")
+            if k.value not in allowed:
+                raise fail(k, f"{field}.{k.value}", "unknown field (known: " + ", ".join(allowed) + ")")
+            out[k.value] = v
+        return out
+
+    def scalar(node: yaml.Node, field: str) -> Any:
+        if not isinstance(node, yaml.ScalarNode):
+            raise fail(node, field, "expected a single value")
+        c: Any = yaml.SafeLoader("")
+        try:
+            return c.construct_object(node)
+        except yaml.YAMLError as e:
+            raise fail(node, field, _one_line(str(e))) from None
+        finally:
+            c.dispose()
+
+    def text_field(node: yaml.Node, field: str) -> str:
+        v = scalar(node, field)
+        if not isinstance(v, str) or not v:
+            raise fail(node, field, "expected a non-empty text")
+        return v
+
+    def number_field(node: yaml.Node, field: str) -> float:
+        v = scalar(node, field)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or abs(v) > 1e6:
+            raise fail(node, field, "expected a finite number of seconds (|x| <= 1e6)")
+        return float(v)
+
+    def bool_field(node: yaml.Node, field: str) -> bool:
+        v = scalar(node, field)
+        if not isinstance(v, bool):
+            raise fail(node, field, "expected true or false")
+        return v
+
+    def braking_field(node: yaml.Node, field: str) -> tuple[tuple[str, float], ...]:
+        given = mapping(node, field, tuple(DEFAULT_BRAKING))
+        out = dict(DEFAULT_BRAKING)
+        for key, v in given.items():
+            x = scalar(v, f"{field}.{key}")
+            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x) or x < 0 \
+                    or (key == "deceleration" and x <= 0):
+                raise fail(v, f"{field}.{key}", "expected a finite number " + ("> 0" if key == "deceleration" else ">= 0")
+                           + " (SI units: s, rad or m, per s, per s^2)")
+            out[key] = float(x)
+        return tuple(out.items())
+
+    top = mapping(root, "manifest", ("kccd_batch", "defaults", "recordings"))
+    if "kccd_batch" not in top:
+        raise fail(root, "kccd_batch", "missing (the first line of a batch manifest is kccd_batch: 1)")
+    version = scalar(top["kccd_batch"], "kccd_batch")
+    if version != 1 or isinstance(version, bool):
+        raise fail(top["kccd_batch"], "kccd_batch", f"unsupported version {version!r} (this kccd reads 1)")
+    defaults = mapping(top["defaults"], "defaults", _DEFAULT_KEYS) if "defaults" in top else {}
+    if "recordings" not in top:
+        raise fail(root, "recordings", "missing")
+    seq = top["recordings"]
+    if not isinstance(seq, yaml.SequenceNode) or not seq.value:
+        raise fail(seq, "recordings", "expected a non-empty list")
+
+    base = os.path.dirname(os.path.abspath(path))
+
+    def resolve(node: yaml.Node, field: str) -> str:
+        return os.path.normpath(os.path.join(base, text_field(node, field)))
+
+    out: list[Recording] = []
+    first_line: dict[str, int] = {}
+    for i, item in enumerate(seq.value):
+        name = f"recordings[{i}]"
+        rec = mapping(item, name, _RECORDING_KEYS)
+        for key in ("id", "video", "states"):
+            if key not in rec:
+                raise fail(item, f"{name}.{key}", "missing")
+        rid = text_field(rec["id"], f"{name}.id")
+        if not _ID.fullmatch(rid):
+            raise fail(rec["id"], f"{name}.id", f"'{rid}' is not a folder name (letters, digits, '.', '_', '-'; "
+                       "at most 128; not starting with '.', '_' or '-')")
+        if rid in first_line:
+            raise fail(rec["id"], f"{name}.id", f"'{rid}' is also the id on line {first_line[rid]}")
+        first_line[rid] = item.start_mark.line + 1
+        merged = {**defaults, **rec}
+
+        def where(key: str, rec: dict[str, yaml.Node] = rec, name: str = name) -> str:
+            return f"{name}.{key}" if key in rec else f"defaults.{key}"
+
+        for key in ("model", "camera"):
+            if key not in merged:
+                raise fail(item, f"{name}.{key}", "missing (give it here or in defaults)")
+        out.append(Recording(
+            id=rid,
+            video=resolve(rec["video"], f"{name}.video"),
+            states=resolve(rec["states"], f"{name}.states"),
+            model=resolve(merged["model"], f"{name}.model" if "model" in rec else "defaults.model"),
+            camera=resolve(merged["camera"], f"{name}.camera" if "camera" in rec else "defaults.camera"),
+            time_offset=number_field(merged["time_offset"], where("time_offset")) if "time_offset" in merged else 0.0,
+            swept=bool_field(merged["swept"], where("swept")) if "swept" in merged else False,
+            line=item.start_mark.line + 1,
+            braking=braking_field(merged["braking"], where("braking"))
+            if "braking" in merged else tuple(DEFAULT_BRAKING.items()),
+        ))
+
+    if check_inputs:
+        checked: set[tuple[str, str]] = set()
+        for r, item in zip(out, seq.value):
+            rec_keys = mapping(item, "", _RECORDING_KEYS)
+            for key in ("video", "states", "model", "camera"):
+                p = getattr(r, key)
+                node = rec_keys.get(key, defaults.get(key))
+                field = (f"recordings[{out.index(r)}].{key}" if key in rec_keys else f"defaults.{key}")
+                if key == "video" and "%" in os.path.basename(p):
+                    if not os.path.isdir(os.path.dirname(p)):
+                        raise fail(node, field, f"{p}: the image sequence's folder does not exist")
+                elif not os.path.isfile(p):
+                    raise fail(node, field, f"{p}: no such file")
+                if key in ("model", "camera") and (key, p) not in checked:
+                    checked.add((key, p))
+                    try:
+                        if key == "model":
+                            _core.Model.load(p)
+                        else:
+                            _core.Camera.load(p)
+                    except _core.InputError as e:
+                        raise fail(node, field, _one_line(str(e))) from None
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Provenance: what made a recording's outputs
+
+
+def _sequence_files(pattern: str) -> list[str]:
+    """The files of an image-sequence pattern, numbered from 0 or 1 as the video reader does."""
+    files: list[str] = []
+    for start in (0, 1):
+        k = start
+        while os.path.isfile(pattern % k):
+            files.append(pattern % k)
+            k += 1
+        if files:
+            break
+    return files
+
+
+def _input_files(path: str) -> list[str]:
+    return _sequence_files(path) if "%" in os.path.basename(path) else [path]
+
+
+def _file_record(path: str, digest: str | None = None) -> dict[str, Any]:
+    files = _input_files(path)
+    stats = [os.stat(f) for f in files]
+    if digest is None:
+        h = hashlib.sha256()
+        for f in files:
+            with open(f, "rb") as fh:
+                for block in iter(lambda: fh.read(1 << 20), b""):
+                    h.update(block)
+        digest = h.hexdigest()
+    return {"path": path, "sha256": digest, "bytes": sum(s.st_size for s in stats),
+            "mtime_ns": max((s.st_mtime_ns for s in stats), default=0), "files": len(files)}
+
+
+def provenance(rec: Recording) -> dict[str, Any]:
+    """The inputs' hashes, the options and the kccd version a recording's outputs are made from."""
+    return {
+        "id": rec.id,
+        "kccd_version": _core.__version__,
+        "time_offset": rec.time_offset,
+        "swept": rec.swept,
+        "braking": dict(rec.braking),
+        "inputs": {key: _file_record(getattr(rec, key)) for key in ("video", "states", "model", "camera")},
+    }
+
+
+def is_complete(rec: Recording, out_dir: str) -> bool:
+    """True when ``out_dir/<id>/`` holds every output, made by this kccd version with these options
+    from these inputs. An input with the recorded size and modification time counts as unchanged;
+    one whose size or time differ is hashed again (a touched file with the same content still
+    counts as unchanged)."""
+    folder = os.path.join(out_dir, rec.id)
+    if not all(os.path.isfile(os.path.join(folder, f)) for f in OUTPUT_FILES):
+        return False
+    try:
+        with open(os.path.join(folder, "inputs.json"), encoding="utf-8") as f:
+            made = json.load(f)
+        if made.get("kccd_version") != _core.__version__ or made.get("time_offset") != rec.time_offset \
+                or made.get("swept") != rec.swept or (rec.swept and made.get("braking") != dict(rec.braking)):
+            return False
+        for key in ("video", "states", "model", "camera"):
+            old = made["inputs"][key]
+            path = getattr(rec, key)
+            if old.get("path") != path:
+                return False
+            now = _file_record(path, digest=old["sha256"])
+            if now["bytes"] == old["bytes"] and now["mtime_ns"] == old["mtime_ns"] and now["files"] == old["files"]:
+                continue
+            if _file_record(path)["sha256"] != old["sha256"]:
+                return False
+        return True
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+
+
+# --------------------------------------------------------------------------------------------
+# The task: one recording on one worker
+
+
+def _write_json(path: str, value: Any) -> None:
+    tmp = f"{path}.tmp-{uuid.uuid4().hex}"
+    with open(tmp, "w", encoding="utf-8") as f:
+        json.dump(value, f, indent=2, sort_keys=True)
+        f.write("\n")
+    os.replace(tmp, path)
+
+
+def _publish(message: dict[str, Any]) -> None:
+    try:
+        from distributed import get_worker
+
+        get_worker().log_event(_TOPIC, message)
+    except (ImportError, ValueError):
+        pass  # not on a Dask worker (run_recording called directly)
+
+
+def colliding_intervals(report: dict[str, Any]) -> list[dict[str, Any]]:
+    """Runs of consecutive colliding frames of an overlay report: first and last frame index and
+    their video times (seconds)."""
+    out: list[dict[str, Any]] = []
+    for fr in report.get("frames", []):
+        if fr.get("status") != "colliding":
+            continue
+        if out and out[-1]["last_frame"] == fr["index"] - 1:
+            out[-1]["last_frame"] = fr["index"]
+            out[-1]["end_s"] = fr["time"]
+        else:
+            out.append({"first_frame": fr["index"], "last_frame": fr["index"], "start_s": fr["time"],
+                        "end_s": fr["time"]})
+    return out
+
+
+def recording_summary(rec_id: str, report: dict[str, Any]) -> dict[str, Any]:
+    """A done recording's line of summary.json, from its report."""
+    frames = report.get("frames", [])
+    return {
+        "id": rec_id,
+        "status": "done",
+        "reason": "",
+        "frames_total": report["frames_total"],
+        "clear": sum(1 for f in frames if f.get("status") == "clear"),
+        "within_margin": report["within_margin"],
+        "colliding": report["colliding"],
+        "no_state": report["no_state"],
+        "unsafe": report.get("unsafe", 0),
+        "colliding_intervals": colliding_intervals(report),
+    }
+
+
+def run_recording(rec: Recording, out_dir: str, jobs: int = 0, contact_frames: int = 12) -> dict[str, Any]:
+    """Runs the overlay of one recording into ``out_dir/<id>/`` (staged: written into a hidden
+    folder, renamed when every output is complete) and returns its summary line. Any failure is
+    raised as RecordingFailed with a one-line reason, and nothing is left behind."""
+    stage = ""
+    try:
+        os.makedirs(out_dir, exist_ok=True)
+        stage = tempfile.mkdtemp(prefix=f".{rec.id}.partial-", dir=out_dir)
+        os.chmod(stage, 0o755)  # mkdtemp's 0700 would hide the outputs from the others sharing the storage
+        made = provenance(rec)
+        model = _core.Model.load(rec.model)
+        camera = _core.Camera.load(rec.camera)
+        last = [0.0]
+
+        def progress(done: int, expected: int, fps: float) -> None:
+            now = time.monotonic()
+            if now - last[0] >= 1.0 or (expected and done >= expected):
+                last[0] = now
+                _publish({"id": rec.id, "frames_done": done, "frames_expected": expected, "fps": fps})
+
+        report = _core.overlay_recording(
+            model, camera, rec.video, rec.states,
+            output=os.path.join(stage, "overlay.mp4"), report=os.path.join(stage, "report.json"),
+            contact_sheet=os.path.join(stage, "contact_sheet.png"), time_offset=rec.time_offset,
+            swept=rec.swept, braking=_core.BrakingParams(**dict(rec.braking)), jobs=jobs, contact_frames=contact_frames, progress=progress)
+        # The report names its outputs as they are once committed: beside it.
+        report["video"] = "overlay.mp4"
+        report["contact_sheet"] = "contact_sheet.png"
+        _write_json(os.path.join(stage, "report.json"), report)
+        _write_json(os.path.join(stage, "inputs.json"), made)
+        final = os.path.join(out_dir, rec.id)
+        old = ""
+        if os.path.lexists(final):
+            old = os.path.join(out_dir, f".{rec.id}.old-{uuid.uuid4().hex}")
+            os.rename(final, old)
+        os.rename(stage, final)
+        stage = ""
+        if old:
+            shutil.rmtree(old, ignore_errors=True)
+        _publish({"id": rec.id, "frames_done": report["frames_total"], "frames_expected": report["frames_total"],
+                  "done": True})
+        return recording_summary(rec.id, report)
+    except Exception as e:  # noqa: BLE001 - every failure becomes the recording's one-line reason
+        reason = _one_line(str(e)) or type(e).__name__
+        raise RecordingFailed(reason) from None
+    finally:
+        if stage:
+            shutil.rmtree(stage, ignore_errors=True)
+
+
+# --------------------------------------------------------------------------------------------
+# The batch
+
+
+@dataclasses.dataclass
+class BatchResult:
+    """What a batch did: the summary written to summary.json, and where."""
+
+    summary: dict[str, Any]
+    summary_json: str
+    summary_md: str
+
+    @property
+    def failed(self) -> list[str]:
+        return [r["id"] for r in self.summary["recordings"] if r["status"] == "failed"]
+
+
+@dataclasses.dataclass
+class BatchProgress:
+    """The state of a batch, as the progress callback sees it."""
+
+    total: int
+    done: int = 0
+    running: int = 0
+    failed: int = 0
+    skipped: int = 0
+    frames_done: int = 0
+    frames_per_second: float = 0.0
+    eta_s: float | None = None
+    dashboard: str = ""
+
+
+def _dashboard(client: Any) -> str:
+    try:
+        return str(client.dashboard_link or "")
+    except Exception:  # noqa: BLE001 - no dashboard (bokeh missing, or a remote scheduler without one)
+        return ""
+
+
+def _reason(future: Any) -> str:
+    try:
+        e = future.exception()
+    except Exception as ex:  # noqa: BLE001
+        e = ex
+    if isinstance(e, RecordingFailed):
+        return str(e)
+    name = type(e).__name__
+    if name == "KilledWorker":
+        return "the worker running it was lost twice (killed, out of memory, or its machine went away)"
+    return _one_line(f"{name}: {e}") if str(e) else name
+
+
+def summarize(records: list[dict[str, Any]], elapsed_s: float, workers: int) -> dict[str, Any]:
+    """summary.json's content from the recordings' lines."""
+    done = [r for r in records if r["status"] == "done"]
+    totals = {k: sum(r.get(k, 0) for r in done) for k in ("frames_total", "clear", "within_margin", "colliding",
+                                                          "no_state", "unsafe")}
+    look = [r["id"] for r in records if r["status"] == "failed" or r.get("colliding", 0) or r.get("unsafe", 0)]
+    ran = sum(r.get("frames_total", 0) for r in done if not r.get("skipped"))
+    return {
+        "kccd_batch": 1,
+        "kccd_version": _core.__version__,
+        "recordings": records,
+        "totals": {"recordings": len(records), "done": len(done), "failed": len(records) - len(done), **totals},
+        "needs_look": look,
+        "run": {"workers": workers, "elapsed_s": round(elapsed_s, 3),
+                "frames_per_second": round(ran / elapsed_s, 2) if elapsed_s > 0 else 0.0},
+    }
+
+
+def _clock(t: float) -> str:
+    m, s = divmod(max(t, 0.0), 60.0)
+    return f"{int(m)}:{s:06.3f}"
+
+
+def summary_markdown(summary: dict[str, Any]) -> str:
+    """summary.md: the fleet's totals, what needs a person's look (with each one's contact sheet),
+    per recording its frame counts and colliding intervals, and the failures."""
+    t = summary["totals"]
+    lines = ["# KCCD batch overlay", "",
+             f"{t['recordings']} recordings: {t['done']} done, {t['failed']} failed. Frames: {t['frames_total']} "
+             f"({t['clear']} clear, {t['within_margin']} within the margin, {t['colliding']} colliding, "
+             f"{t['no_state']} without a state, {t['unsafe']} unsafe).", ""]
+    by_id = {r["id"]: r for r in summary["recordings"]}
+    if summary["needs_look"]:
+        lines += ["## Needs a person's look", ""]
+        sheet = summary.get("colliding_frames", {})
+        if sheet.get("file"):
+            lines += [f"The middle frame of each colliding interval ({len(sheet['frames'])} frames):", "",
+                      f"![colliding frames]({sheet['file']})", ""]
+        elif sheet.get("problem"):
+            lines += [f"(No sheet of colliding frames: {sheet['problem']})", ""]
+        for rid in summary["needs_look"]:
+            r = by_id[rid]
+            if r["status"] == "failed":
+                lines += [f"- **{rid}**: failed: {r['reason']}"]
+                continue
+            spans = ", ".join(f"{_clock(c['start_s'])}–{_clock(c['end_s'])} (frames {c['first_frame']}–"
+                              f"{c['last_frame']})" for c in r["colliding_intervals"]) or "none"
+            lines += [f"- **{rid}**: {r['colliding']} colliding frames, {r['unsafe']} unsafe; colliding: {spans}",
+                      "", f"  ![{rid}]({rid}/contact_sheet.png)", ""]
+        lines += [""]
+    else:
+        lines += ["Nothing needs a look: no recording failed and no frame collides.", ""]
+    lines += ["## Recordings", "",
+              "| id | status | frames | clear | within margin | colliding | no state | colliding intervals (video time) |",
+              "|---|---|---|---|---|---|---|---|"]
+    for r in summary["recordings"]:
+        if r["status"] == "failed":
+            lines += [f"| {r['id']} | failed | | | | | | {r['reason'].replace('|', '/')} |"]
+            continue
+        spans = "; ".join(f"{_clock(c['start_s'])}–{_clock(c['end_s'])}" for c in r["colliding_intervals"])
+        lines += [f"| [{r['id']}]({r['id']}/report.json) | done{' (kept)' if r.get('skipped') else ''} | "
+                  f"{r['frames_total']} | {r['clear']} | {r['within_margin']} | {r['colliding']} | {r['no_state']} | "
+                  f"{spans or '–'} |"]
+    run = summary["run"]
+    lines += ["", f"Run: {run['workers']} workers, {run['elapsed_s']:.1f} s, {run['frames_per_second']:.1f} frames/s "
+              f"over the cluster; kccd {summary['kccd_version']}.", ""]
+    return "\n".join(lines)
+
+
+def _write_text(path: str, text: str) -> None:
+    tmp = f"{path}.tmp-{uuid.uuid4().hex}"
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+def _stale(out_dir: str) -> None:
+    """Removes staging folders a killed run left (hidden .<id>.partial-* and .<id>.old-*)."""
+    try:
+        names = os.listdir(out_dir)
+    except OSError:
+        return
+    for n in names:
+        if n.startswith(".") and (".partial-" in n or ".old-" in n):
+            shutil.rmtree(os.path.join(out_dir, n), ignore_errors=True)
+
+
+def run_batch(
+    manifest: str,
+    out_dir: str,
+    *,
+    client: Any = None,
+    scheduler: str | None = None,
+    workers: int = 1,
+    resume: bool = False,
+    only: str | None = None,
+    jobs: int = 0,
+    contact_frames: int = 12,
+    progress: Callable[[BatchProgress], None] | None = None,
+) -> BatchResult:
+    """Runs the overlay of every recording of `manifest` (those whose id matches the glob `only`)
+    into `out_dir`: on `client` when given, else on the scheduler at `scheduler`
+    (tcp://HOST:PORT), else on a local cluster of `workers` processes. `jobs`: drawing threads per
+    recording (0: the worker machine's cores divided among its workers). `resume`: recordings whose
+    outputs are complete (is_complete) are kept, not run again. Raises ManifestError before
+    anything starts; a failing recording is retried once, then reported in the summary."""
+    recordings = read_manifest(manifest)
+    if only is not None:
+        recordings = [r for r in recordings if fnmatch.fnmatchcase(r.id, only)]
+        if not recordings:
+            raise ManifestError(f"{manifest}: --only {only}: no recording id matches")
+    if workers < 1:
+        raise ValueError("workers: must be >= 1")
+    os.makedirs(out_dir, exist_ok=True)
+    out_dir = os.path.abspath(out_dir)
+    _stale(out_dir)
+    t0 = time.monotonic()
+    kept = [r for r in recordings if resume and is_complete(r, out_dir)]
+    todo = [r for r in recordings if r not in kept]
+    records: dict[str, dict[str, Any]] = {}
+    for r in kept:
+        with open(os.path.join(out_dir, r.id, "report.json"), encoding="utf-8") as f:
+            records[r.id] = {**recording_summary(r.id, json.load(f)), "skipped": True}
+
+    state = BatchProgress(total=len(recordings), done=len(kept), skipped=len(kept))
+    own_cluster = None
+    n_workers = workers
+    if todo:
+        import dask
+        import distributed
+
+        dist: Any = distributed  # untyped: its calls are not checked
+        Client, LocalCluster = dist.Client, dist.LocalCluster
+
+        if client is None:
+            if scheduler:
+                client = Client(scheduler)
+            else:
+                # A worker lost while running a task: its task runs once more, then fails.
+                dask.config.set({"distributed.scheduler.allowed-failures": 1})
+                own_cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                           dashboard_address=":0", silence_logs=logging.ERROR)
+                client = Client(own_cluster)
+        try:
+            info = client.scheduler_info().get("workers", {})
+            n_workers = max(1, len(info))
+            slots = sum(int(w.get("nthreads", 1)) for w in info.values()) or n_workers
+            state.dashboard = _dashboard(client)
+            per_job = jobs
+            if per_job <= 0:
+                per_job = max(1, (os.cpu_count() or 1) // max(1, n_workers)) if own_cluster is not None else 0
+            futures = {client.submit(run_recording, r, out_dir, per_job, contact_frames, pure=False, retries=1,
+                                     key=f"kccd-overlay-{r.id}-{uuid.uuid4().hex[:8]}"): r for r in todo}
+            frames: dict[str, tuple[int, int]] = {}
+            seen_until = 0.0
+            ids = {r.id for r in todo}
+            pending = set(futures)
+            last_report = 0.0
+            while pending:
+                time.sleep(0.25)
+                for fut in [x for x in pending if x.done()]:
+                    pending.discard(fut)
+                    r = futures[fut]
+                    if fut.status == "finished":
+                        records[r.id] = fut.result()
+                        state.done += 1
+                        frames[r.id] = (records[r.id]["frames_total"], records[r.id]["frames_total"])
+                    else:
+                        records[r.id] = {"id": r.id, "status": "failed", "reason": _reason(fut), "frames_total": 0,
+                                         "clear": 0, "within_margin": 0, "colliding": 0, "no_state": 0,
+                                         "unsafe": 0, "colliding_intervals": []}
+                        state.failed += 1
+                try:
+                    events = client.get_events(_TOPIC)
+                except Exception:  # noqa: BLE001 - progress is best effort
+                    events = ()
+                for stamp, msg in events:
+                    if stamp <= seen_until or not isinstance(msg, dict) or msg.get("id") not in ids:
+                        continue
+                    seen_until = max(seen_until, stamp)
+                    if msg["id"] not in records:
+                        frames[msg["id"]] = (int(msg["frames_done"]), int(msg["frames_expected"]))
+                now = time.monotonic()
+                if progress is not None and (now - last_report >= 1.0 or not pending):
+                    last_report = now
+                    processing = client.processing()
+                    assigned = sum(1 for keys in processing.values() for k in keys if str(k).startswith("kccd-overlay-"))
+                    state.running = min(assigned, slots)
+                    state.frames_done = sum(d for d, _ in frames.values())
+                    elapsed = now - t0
+                    state.frames_per_second = state.frames_done / elapsed if elapsed > 0 else 0.0
+                    known = [e for d, e in frames.values() if e > 0]
+                    mean = sum(known) / len(known) if known else 0.0
+                    remaining = sum(max(e - d, 0) for d, e in frames.values()) + \
+                        mean * (len(todo) - len(frames) - state.failed)
+                    state.eta_s = remaining / state.frames_per_second if state.frames_per_second > 0 and known else None
+                    progress(dataclasses.replace(state))
+        finally:
+            if own_cluster is not None:
+                client.close()
+                own_cluster.close()
+    _stale(out_dir)
+    ordered = [records[r.id] for r in recordings]
+    summary = summarize(ordered, time.monotonic() - t0, n_workers)
+    summary["colliding_frames"] = colliding_sheet(summary, out_dir)
+    js = os.path.join(out_dir, "summary.json")
+    md = os.path.join(out_dir, "summary.md")
+    _write_json(js, summary)
+    _write_text(md, summary_markdown(summary))
+    return BatchResult(summary, js, md)
+
+
+def colliding_sheet(summary: dict[str, Any], out_dir: str, per_recording: int = 4, most: int = 24) -> dict[str, Any]:
+    """DIR/colliding_frames.png: the middle frame of each colliding interval (at most `per_recording`
+    per recording, `most` in all) of the recordings that collide, from their overlay videos, each
+    captioned with its recording, frame and time. Returns what summary.json says of it."""
+    picks: list[tuple[str, int, float]] = []
+    for r in summary["recordings"]:
+        if r["status"] != "done":
+            continue
+        for c in r["colliding_intervals"][:per_recording]:
+            mid = (c["first_frame"] + c["last_frame"]) // 2
+            t = c["start_s"] + (c["end_s"] - c["start_s"]) * (mid - c["first_frame"]) / max(1, c["last_frame"] - c["first_frame"])
+            picks.append((r["id"], mid, t))
+    picks = picks[:most]
+    path = os.path.join(out_dir, "colliding_frames.png")
+    if not picks:
+        if os.path.exists(path):
+            os.remove(path)
+        return {"file": None, "frames": []}
+    images, captions = [], []
+    try:
+        by_id: dict[str, list[tuple[int, float]]] = {}
+        for rid, idx, t in picks:
+            by_id.setdefault(rid, []).append((idx, t))
+        for rid, frames in by_id.items():
+            got = _core.read_frames(os.path.join(out_dir, rid, "overlay.mp4"), [i for i, _ in frames])
+            images += got
+            captions += [f"{rid} #{i} {t:.2f} s" for i, t in frames]
+        _core.contact_sheet(images, captions, path)
+    except (_core.InputError, OSError) as e:
+        return {"file": None, "frames": [], "problem": _one_line(str(e))}
+    return {"file": "colliding_frames.png", "frames": [{"id": rid, "frame": i} for rid, i, _ in picks]}
+
+
+# --------------------------------------------------------------------------------------------
+# The command
+
+
+def _terminal(stream: Any) -> Callable[[BatchProgress], None]:
+    tty = stream.isatty()
+    printed = [0.0]
+
+    def show(p: BatchProgress) -> None:
+        eta = f", ETA {p.eta_s / 60:.1f} min" if p.eta_s is not None else ""
+        line = (f"recordings {p.done}/{p.total} done, {p.running} running, {p.failed} failed"
+                f"{f' ({p.skipped} kept)' if p.skipped else ''}; {p.frames_done} frames, "
+                f"{p.frames_per_second:.1f} frames/s over the cluster{eta}")
+        if tty:
+            stream.write("\r" + line.ljust(110))
+            stream.flush()
+        elif time.monotonic() - printed[0] >= 10.0:
+            printed[0] = time.monotonic()
+            stream.write(line + "\n")
+            stream.flush()
+
+    return show
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python3 -m kccd.batch",
+        description="Overlay many recordings (kccd overlay on each) on a Dask cluster and sum them up. Each "
+                    "recording's outputs go to DIR/<id>/ (overlay.mp4, report.json as kccd overlay --report, "
+                    "contact_sheet.png, inputs.json), renamed into place only when complete; DIR/summary.json and "
+                    "DIR/summary.md sum the fleet up. Inputs are read from paths every worker sees.",
+        epilog="Exit status: 0 every recording done, 1 some failed (retried once; see summary.md), 2 bad manifest "
+               "or options (nothing started).")
+    parser.add_argument("manifest", help="batch manifest (YAML, kccd_batch: 1; paths relative to it)")
+    parser.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                       help="a running Dask scheduler (dask-scheduler; workers started with dask-worker)")
+    where.add_argument("--workers", type=int, default=1, metavar="N",
+                       help="local cluster of N worker processes (default 1; one GL context each)")
+    parser.add_argument("--resume", action="store_true",
+                        help="keep recordings whose outputs are complete (same inputs, options and kccd version)")
+    parser.add_argument("--only", metavar="GLOB", help="only the recordings whose id matches (fnmatch: cell3-*)")
+    parser.add_argument("--jobs", type=int, default=0, metavar="N",
+                        help="drawing threads per recording (default: the local cores divided among the workers; "
+                             "on a remote scheduler each worker's cores)")
+    parser.add_argument("--contact-frames", type=int, default=12, metavar="N", help="frames per contact sheet")
+    parser.add_argument("-q", "--quiet", action="store_true", help="no progress, only the last line and errors")
+    args = parser.parse_args(argv)
+    if args.workers < 1:
+        parser.error("--workers: must be >= 1")
+    if args.jobs < 0 or args.contact_frames < 1:
+        parser.error("--jobs must be >= 0 and --contact-frames >= 1")
+    show = None if args.quiet else _terminal(sys.stderr)
+    announced = [False]
+
+    def relay(p: BatchProgress) -> None:
+        if not announced[0] and not args.quiet:
+            announced[0] = True
+            if p.dashboard:
+                sys.stderr.write(f"Dask dashboard: {p.dashboard}\n")
+        if show is not None:
+            show(p)
+
+    try:
+        result = run_batch(args.manifest, args.out, scheduler=args.scheduler, workers=args.workers,
+                           resume=args.resume, only=args.only, jobs=args.jobs, contact_frames=args.contact_frames,
+                           progress=relay)
+    except ManifestError as e:
+        sys.stderr.write(f"kccd.batch: {e}\n")
+        return 2
+    except OSError as e:
+        sys.stderr.write(f"kccd.batch: {args.out}: {e.strerror}\n")
+        return 2
+    if show is not None and sys.stderr.isatty():
+        sys.stderr.write("\n")
+    t = result.summary["totals"]
+    for r in result.summary["recordings"]:
+        if r["status"] == "failed":
+            sys.stderr.write(f"kccd.batch: {r['id']}: failed: {r['reason']}\n")
+    print(f"{t['done']} of {t['recordings']} recordings done, {t['failed']} failed; {t['colliding']} colliding frames; "
+          f"{len(result.summary['needs_look'])} recordings need a look: {result.summary_md}")
+    return 1 if t["failed"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

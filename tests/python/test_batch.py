@@ -1,0 +1,218 @@
+"""kccd.batch on a local Dask cluster of 2 worker processes: three short synthetic recordings (one
+with a corrupted video) give two outputs equal to `kccd overlay` on each and one reported failure;
+a worker killed mid-run has its recording run again to completion; --resume runs only what is
+missing or changed; manifest mistakes are named by line and start nothing."""
+
+import json
+import os
+import pathlib
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+import kccd
+from conftest import DATA
+
+distributed = pytest.importorskip("distributed")
+from kccd import batch  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def fleet(tmp_path_factory: pytest.TempPathFactory) -> pathlib.Path:
+    root = tmp_path_factory.mktemp("fleet")
+    shutil.copy(DATA / "demo_arm.yaml", root / "arm.yaml")
+    for name, seconds, seed in (("a", 1.0, 1), ("b", 1.0, 2), ("long", 6.0, 3)):
+        kccd.synthesize_recording(str(root / "arm.yaml"), str(root / name), seconds=seconds, seed=seed)
+    (root / "c").mkdir()
+    shutil.copy(root / "b" / "states.csv", root / "c" / "states.csv")
+    (root / "c" / "video.mkv").write_bytes((root / "b" / "video.mkv").read_bytes()[:4000])
+    (root / "fleet.yaml").write_text(
+        "kccd_batch: 1\n"
+        "defaults: {model: arm.yaml, camera: a/camera_true.yaml, time_offset: 0.137}\n"
+        "recordings:\n"
+        "  - {id: cell-a, video: a/video.mkv, states: a/states.csv}\n"
+        "  - {id: cell-b, video: b/video.mkv, states: b/states.csv, swept: true}\n"
+        "  - {id: cell-c, video: c/video.mkv, states: c/states.csv}\n")
+    return root
+
+
+@pytest.fixture(scope="module")
+def client():  # type: ignore[no-untyped-def]
+    import dask
+
+    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
+        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
+                                      silence_logs=40) as cluster, distributed.Client(cluster) as c:
+            yield c
+
+
+def cli_report(cli: pathlib.Path, fleet: pathlib.Path, rec: str, out: pathlib.Path, swept: bool) -> dict:
+    args = [str(cli), "overlay", str(fleet / "arm.yaml"), "--camera", str(fleet / "a" / "camera_true.yaml"), "--video",
+            str(fleet / rec / "video.mkv"), "--states", str(fleet / rec / "states.csv"), "--time-offset", "0.137",
+            "--report", str(out / "report.json"), "-o", str(out / "overlay.mp4"), "--quiet"]
+    subprocess.run(args + (["--swept"] if swept else []), check=True)
+    return json.loads((out / "report.json").read_text())
+
+
+def test_batch_equals_overlay_and_reports_the_failure(cli, fleet: pathlib.Path, client, tmp_path: pathlib.Path) -> None:
+    seen: list[batch.BatchProgress] = []
+    result = batch.run_batch(str(fleet / "fleet.yaml"), str(tmp_path / "out"), client=client, progress=seen.append)
+    out = tmp_path / "out"
+    assert result.failed == ["cell-c"]
+    s = json.loads((out / "summary.json").read_text())
+    by_id = {r["id"]: r for r in s["recordings"]}
+    assert [r["id"] for r in s["recordings"]] == ["cell-a", "cell-b", "cell-c"]
+    assert by_id["cell-c"]["status"] == "failed" and "c/video.mkv" in by_id["cell-c"]["reason"]
+    assert "\n" not in by_id["cell-c"]["reason"]
+    assert not (out / "cell-c").exists()
+    assert sorted(os.listdir(out)) == ["cell-a", "cell-b", "colliding_frames.png", "summary.json", "summary.md"]
+    total = {"frames_total": 0, "colliding": 0, "within_margin": 0, "clear": 0}
+    for rec, swept in (("a", False), ("b", True)):
+        rid = f"cell-{rec}"
+        assert sorted(os.listdir(out / rid)) == sorted(batch.OUTPUT_FILES)
+        mine = json.loads((out / rid / "report.json").read_text())
+        ref_dir = tmp_path / f"ref-{rec}"
+        ref_dir.mkdir()
+        ref = cli_report(cli, fleet, rec, ref_dir, swept)
+        assert mine["video"] == "overlay.mp4" and mine["contact_sheet"] == "contact_sheet.png"
+        for key in set(ref) | set(mine):
+            if key not in ("video", "contact_sheet"):
+                assert mine[key] == ref[key], key
+        # The same frames drawn: the videos decode to the same pictures.
+        n = ref["frames_total"]
+        picks = [0, n // 2, n - 1]
+        for x, y in zip(kccd.read_frames(str(out / rid / "overlay.mp4"), picks),
+                        kccd.read_frames(str(ref_dir / "overlay.mp4"), picks)):
+            assert (x == y).all()
+        line = by_id[rid]
+        assert line["status"] == "done" and line["frames_total"] == n
+        assert line["colliding"] == sum(f["status"] == "colliding" for f in ref["frames"])
+        assert line["clear"] + line["within_margin"] + line["colliding"] + line["no_state"] == n
+        intervals = line["colliding_intervals"]
+        assert sum(i["last_frame"] - i["first_frame"] + 1 for i in intervals) == line["colliding"]
+        for i in intervals:
+            assert ref["frames"][i["first_frame"]]["status"] == "colliding"
+            assert ref["frames"][i["first_frame"]]["time"] == i["start_s"]
+            assert i["first_frame"] == 0 or ref["frames"][i["first_frame"] - 1]["status"] != "colliding"
+        for k in total:
+            total[k] += line[k]
+    for k, v in total.items():
+        assert s["totals"][k] == v
+    assert s["totals"]["done"] == 2 and s["totals"]["failed"] == 1
+    assert set(s["needs_look"]) >= {"cell-c"}
+    md = (out / "summary.md").read_text()
+    assert "cell-c" in md and "failed" in md and "colliding_frames.png" in md
+    assert s["colliding_frames"]["file"] == "colliding_frames.png" and s["colliding_frames"]["frames"]
+    assert seen and seen[-1].done == 2 and seen[-1].failed == 1 and seen[-1].frames_done >= total["frames_total"]
+
+
+def test_killed_worker_is_retried(fleet: pathlib.Path, client, tmp_path: pathlib.Path) -> None:
+    manifest = tmp_path / "one.yaml"
+    manifest.write_text(f"kccd_batch: 1\nrecordings:\n  - {{id: long, video: {fleet}/long/video.mkv, states: "
+                        f"{fleet}/long/states.csv, model: {fleet}/arm.yaml, camera: {fleet}/a/camera_true.yaml, "
+                        "time_offset: 0.137}\n")
+    result: list[batch.BatchResult] = []
+    frames: list[int] = []
+    job = threading.Thread(target=lambda: result.append(batch.run_batch(
+        str(manifest), str(tmp_path / "out"), client=client, jobs=1, progress=lambda p: frames.append(p.frames_done))))
+    job.start()
+    pids = client.run(os.getpid)
+    victim = None
+    deadline = time.monotonic() + 60
+    while victim is None and time.monotonic() < deadline:
+        time.sleep(0.1)
+        if frames and frames[-1] > 0:
+            victim = next((w for w, keys in client.processing().items() if keys), None)
+    assert victim is not None, "the recording never started"
+    staging = [n for n in os.listdir(tmp_path / "out") if ".partial-" in n]
+    assert staging, "a running recording writes into a hidden staging folder"
+    os.kill(pids[victim], signal.SIGKILL)
+    job.join(timeout=240)
+    assert not job.is_alive() and result
+    s = result[0].summary
+    assert s["recordings"][0]["status"] == "done", s["recordings"][0]
+    assert s["recordings"][0]["frames_total"] == 150
+    assert sorted(os.listdir(tmp_path / "out")) == ["colliding_frames.png", "long", "summary.json", "summary.md"] or \
+        sorted(os.listdir(tmp_path / "out")) == ["long", "summary.json", "summary.md"]
+    assert sorted(os.listdir(tmp_path / "out" / "long")) == sorted(batch.OUTPUT_FILES)
+
+
+def test_resume_runs_only_what_is_missing(fleet: pathlib.Path, client, tmp_path: pathlib.Path) -> None:
+    work = tmp_path / "fleet"
+    shutil.copytree(fleet, work, ignore=shutil.ignore_patterns("long", "c"))
+    text = (work / "fleet.yaml").read_text()
+    (work / "fleet.yaml").write_text(text[: text.index("  - {id: cell-c")])
+    out = tmp_path / "out"
+    batch.run_batch(str(work / "fleet.yaml"), str(out), client=client, only="cell-a")
+    assert sorted(p.name for p in out.iterdir() if p.is_dir()) == ["cell-a"]
+    first = (out / "cell-a" / "overlay.mp4").stat()
+    # An interrupted run leaves a staging folder; resuming removes it and runs only cell-b.
+    (out / ".cell-b.partial-0123").mkdir()
+    (out / ".cell-b.partial-0123" / "overlay.mp4").write_bytes(b"half")
+    r = batch.run_batch(str(work / "fleet.yaml"), str(out), client=client, resume=True)
+    kept = {x["id"]: x.get("skipped", False) for x in r.summary["recordings"]}
+    assert kept == {"cell-a": True, "cell-b": False}
+    assert (out / "cell-a" / "overlay.mp4").stat().st_ino == first.st_ino
+    assert not any(".partial-" in n for n in os.listdir(out))
+    # A touched input with the same content is still the same input; a changed one runs again.
+    os.utime(work / "a" / "states.csv")
+    r = batch.run_batch(str(work / "fleet.yaml"), str(out), client=client, resume=True)
+    assert all(x.get("skipped") for x in r.summary["recordings"])
+    states = (work / "a" / "states.csv").read_text().splitlines()
+    states[5] = states[5][:-1] + ("1" if states[5][-1] != "1" else "2")
+    (work / "a" / "states.csv").write_text("\n".join(states) + "\n")
+    r = batch.run_batch(str(work / "fleet.yaml"), str(out), client=client, resume=True)
+    assert {x["id"]: x.get("skipped", False) for x in r.summary["recordings"]} == {"cell-a": False, "cell-b": True}
+    assert (out / "cell-a" / "overlay.mp4").stat().st_ino != first.st_ino
+
+
+@pytest.mark.parametrize("body, where", [
+    ("kccd_batch: 2\nrecordings: []\n", "1: kccd_batch: unsupported version"),
+    ("kccd_batch: 1\nrecordings:\n  - {id: x, video: a/video.mkv, states: a/states.csv, model: arm.yaml, "
+     "camera: a/camera_true.yaml}\n  - {id: x, video: b/video.mkv, states: b/states.csv, model: arm.yaml, "
+     "camera: a/camera_true.yaml}\n", "4: recordings[1].id: 'x' is also the id on line 3"),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: x, video: a/video.mkv, states: a/states.csv, colour: red}\n", "4: recordings[0].colour: unknown field"),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: x, states: a/states.csv}\n", "4: recordings[0].video: missing"),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: ../x, video: a/video.mkv, states: a/states.csv}\n", "4: recordings[0].id: '../x' is not a folder name"),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml, time_offset: soon}\nrecordings:\n"
+     "  - {id: x, video: a/video.mkv, states: a/states.csv}\n", "2: defaults.time_offset: expected a finite number"),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: x, video: a/missing.mkv, states: a/states.csv}\n", "4: recordings[0].video: "),
+    ("kccd_batch: 1\ndefaults: {model: a/states.csv, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: x, video: a/video.mkv, states: a/states.csv}\n", "2: defaults.model: "),
+    ("kccd_batch: 1\nrecordings:\n  - {id: x, video: a/video.mkv, states: a/states.csv}\n",
+     "3: recordings[0].model: missing (give it here or in defaults)"),
+    ("kccd_batch: 1\nrecordings: [\n", "yaml: "),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: x, video: a/video.mkv, states: a/states.csv, braking: {deceleration: 0}}\n",
+     "4: recordings[0].braking.deceleration: expected a finite number > 0"),
+])
+def test_manifest_mistakes(fleet: pathlib.Path, tmp_path: pathlib.Path, body: str, where: str) -> None:
+    manifest = fleet / f"bad-{abs(hash(body))}.yaml"
+    manifest.write_text(body)
+    with pytest.raises(batch.ManifestError) as e:
+        batch.read_manifest(str(manifest))
+    assert str(e.value).startswith(f"{manifest}:") and where in str(e.value), str(e.value)
+    assert "\n" not in str(e.value)
+    run = subprocess.run([sys.executable, "-m", "kccd.batch", str(manifest), "--out", str(tmp_path / "out")],
+                         capture_output=True, text=True)
+    assert run.returncode == 2 and where in run.stderr and not (tmp_path / "out").exists()
+
+
+def test_only_and_usage(fleet: pathlib.Path, tmp_path: pathlib.Path) -> None:
+    with pytest.raises(batch.ManifestError, match="no recording id matches"):
+        batch.run_batch(str(fleet / "fleet.yaml"), str(tmp_path / "out"), only="nothing-*")
+    assert not (tmp_path / "out").exists()
+    run = subprocess.run([sys.executable, "-m", "kccd.batch", "--help"], capture_output=True, text=True)
+    assert run.returncode == 0 and "--scheduler" in run.stdout and "Exit status" in run.stdout
+    run = subprocess.run([sys.executable, "-m", "kccd.batch", str(fleet / "fleet.yaml"), "--out", str(tmp_path / "o"),
+                          "--workers", "0"], capture_output=True, text=True)
+    assert run.returncode == 2 and "--workers" in run.stderr
