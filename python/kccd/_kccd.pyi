@@ -215,6 +215,7 @@ def overlay_recording(
     frames: str = "",
     contact_frames: int = 12,
     progress: Callable[[int, int, float], object] | None = None,
+    progress_every: float = 0.0,
 ) -> dict[str, Any]: ...
 def synthesize_recording(
     model: str,

@@ -3,6 +3,7 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include <chrono>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -70,8 +71,10 @@ caption. output: a .png, written under a temporary name and renamed when complet
       [](const std::shared_ptr<ModelHandle>& h, const calib::Camera& camera, const std::string& video,
          const std::string& states, const std::string& output, const std::string& report, const std::string& contact_sheet,
          double time_offset, bool swept, const std::optional<BrakingParams>& braking, int jobs, const std::string& frames,
-         int contact_frames, const py::object& progress) {
+         int contact_frames, const py::object& progress, double progress_every) {
         const Model& model = *h->model;
+        if (!(progress_every >= 0.0) || !std::isfinite(progress_every))
+          throw py::value_error("progress_every: must be a finite number of seconds >= 0");
         const StateLog log = loadStateLog(states, model);
         overlay::OverlayInputs in{model, camera, log, video, {}, "video " + video, "camera", ""};
         overlay::OverlayOptions o;
@@ -100,7 +103,17 @@ caption. output: a .png, written under a temporary name and renamed when complet
         relay.run([&] {
           const overlay::OverlayReport r = overlay::overlayRecording(
               in, o, sink.active() ? &sink : nullptr,
-              [&](const overlay::OverlayProgress& p) { relay(p.frames_done, p.frames_expected, p.frames_per_second); });
+              [&, last = std::chrono::steady_clock::time_point{}](const overlay::OverlayProgress& p) mutable {
+                // Throttled before the GIL is asked for: each acquisition may wait for Python's
+                // switch interval while other Python threads run (a Dask worker's event loop).
+                const auto now = std::chrono::steady_clock::now();
+                const bool last_frame = p.frames_expected > 0 && p.frames_done >= p.frames_expected;
+                if (!last_frame && last.time_since_epoch().count() != 0 &&
+                    std::chrono::duration<double>(now - last).count() < progress_every)
+                  return;
+                last = now;
+                relay(p.frames_done, p.frames_expected, p.frames_per_second);
+              });
           full = overlay::writeOverlayOutputs(outputs, r, model, sink);
         });
         return toPython(full);
@@ -108,6 +121,7 @@ caption. output: a .png, written under a temporary name and renamed when complet
       py::arg("model"), py::arg("camera"), py::arg("video"), py::arg("states"), py::kw_only(), py::arg("output") = "",
       py::arg("report") = "", py::arg("contact_sheet") = "", py::arg("time_offset") = 0.0, py::arg("swept") = false,
       py::arg("braking") = py::none(), py::arg("jobs") = 0, py::arg("frames") = "", py::arg("contact_frames") = 12, py::arg("progress") = py::none(),
+      py::arg("progress_every") = 0.0,
       R"doc(The main job, as `kccd overlay`: every frame of `video` (a file or an image-sequence pattern) checked at
 the state the log `states` (CSV) gives at its time (log time = frame time + time_offset, seconds), the
 volumes drawn and composited. Outputs, checked before any frame is decoded (extension, an existing
@@ -116,7 +130,8 @@ folder, not one of the inputs) and each written under a temporary name and renam
 (.png of contact_frames frames). swept: braking-interval volumes, with `braking` (a BrakingParams for every
 joint; None: kccd overlay's defaults, latency 0.01 s and deceleration 5). jobs: drawing threads (0: all cores).
 frames: 'FIRST:END:STEP' of the frames drawn (all are checked). progress(frames_done, frames_expected,
-frames_per_second) is called after each frame with the GIL held. Returns the report as a dict (with
+frames_per_second) is called after each frame with the GIL held (progress_every: at most once per that many
+seconds, and after the last frame). Returns the report as a dict (with
 per-frame records under 'frames'). Raises InputError naming the input and place.)doc");
 
   m.def(

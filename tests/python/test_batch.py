@@ -216,3 +216,14 @@ def test_only_and_usage(fleet: pathlib.Path, tmp_path: pathlib.Path) -> None:
     run = subprocess.run([sys.executable, "-m", "kccd.batch", str(fleet / "fleet.yaml"), "--out", str(tmp_path / "o"),
                           "--workers", "0"], capture_output=True, text=True)
     assert run.returncode == 2 and "--workers" in run.stderr
+
+
+def test_command_on_its_own_local_cluster(fleet: pathlib.Path, tmp_path: pathlib.Path) -> None:
+    run = subprocess.run([sys.executable, "-m", "kccd.batch", str(fleet / "fleet.yaml"), "--out", str(tmp_path / "o"),
+                          "--workers", "2", "--only", "cell-[ac]"], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 1, run.stderr  # cell-c fails
+    assert "1 of 2 recordings done, 1 failed" in run.stdout
+    assert "Dask dashboard: http" in run.stderr and "cell-c: failed: " in run.stderr
+    s = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert [r["id"] for r in s["recordings"]] == ["cell-a", "cell-c"] and s["run"]["workers"] == 2
+    assert sorted(os.listdir(tmp_path / "o" / "cell-a")) == sorted(batch.OUTPUT_FILES)
