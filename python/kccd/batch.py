@@ -28,6 +28,7 @@ import math
 import os
 import re
 import shutil
+import stat
 import sys
 import tempfile
 import time
@@ -39,6 +40,8 @@ import yaml
 
 from . import _kccd as _core
 
+#: The largest manifest read (bytes).
+MAX_MANIFEST_BYTES = 4 << 20
 #: What each recording's folder holds when it is complete.
 OUTPUT_FILES = ("overlay.mp4", "report.json", "contact_sheet.png", "inputs.json")
 _TOPIC = "kccd-batch"
@@ -89,10 +92,15 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
     with `check_inputs`, that every input exists and every model and camera loads. Raises
     ManifestError naming the file, line and field."""
     try:
+        st = os.stat(path)
+        if not stat.S_ISREG(st.st_mode):
+            raise ManifestError(f"{path}: manifest: not a regular file")
+        if st.st_size > MAX_MANIFEST_BYTES:
+            raise ManifestError(f"{path}: manifest: {st.st_size} bytes, more than {MAX_MANIFEST_BYTES}")
         with open(path, "rb") as f:
-            raw = f.read(16 << 20)
+            raw = f.read(MAX_MANIFEST_BYTES + 1)
     except OSError as e:
-        raise ManifestError(f"{path}: cannot read: {e.strerror}") from None
+        raise ManifestError(f"{path}: manifest: cannot read ({e.strerror})") from None
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as e:
@@ -102,16 +110,21 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
         where = f"{path}:{node.start_mark.line + 1}" if node is not None else path
         return ManifestError(f"{where}: {field}: {problem}")
 
-    loader: Any = yaml.SafeLoader(text)  # partly untyped in its stubs
+    loader: Any = None
     try:
+        loader = yaml.SafeLoader(text)  # partly untyped in its stubs
         root = loader.get_single_node()
     except yaml.MarkedYAMLError as e:
         line = e.problem_mark.line + 1 if e.problem_mark else 0
         raise ManifestError(f"{path}:{line}: yaml: {_one_line(str(e.problem or e.context))}") from None
+    except yaml.reader.ReaderError as e:
+        line = text[: max(0, e.position)].count("\n") + 1
+        raise ManifestError(f"{path}:{line}: yaml: character #x{e.character:04x} is not allowed") from None
     except yaml.YAMLError as e:
         raise ManifestError(f"{path}: yaml: {_one_line(str(e))}") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
     if not isinstance(root, yaml.MappingNode):
         raise fail(root, "manifest", "expected a mapping with kccd_batch, defaults and recordings")
 
