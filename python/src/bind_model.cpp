@@ -57,20 +57,27 @@ std::vector<double> stateVector(const py::handle& value, const char* name, int l
   return std::vector<double>(d.data(), d.data() + length);
 }
 
-py::array_t<double, py::array::c_style> stateMatrix(const py::handle& value, const char* name, int cols) {
+namespace {
+
+// `value` as a C-contiguous float64 (rows, cols) array; `rows` and `what` say in the message what
+// a row is ("M", "one row per box, ...").
+py::array_t<double, py::array::c_style> realMatrix(const py::handle& value, const char* name, int cols,
+                                                   const char* rows, const char* what) {
   const py::array a = realArray(value, name);
   if (a.ndim() != 2 || a.shape(1) != cols)
-    throw py::value_error(std::string(name) + ": expected shape (M, " + std::to_string(cols) +
-                          ") (one row per box, one column per state value), got " + shapeText(a));
+    throw py::value_error(std::string(name) + ": expected shape (" + rows + ", " + std::to_string(cols) + ") (" +
+                          what + "), got " + shapeText(a));
   return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
 }
 
+}  // namespace
+
+py::array_t<double, py::array::c_style> stateMatrix(const py::handle& value, const char* name, int cols) {
+  return realMatrix(value, name, cols, "M", "one row per box, one column per state value");
+}
+
 py::array_t<double, py::array::c_style> pointMatrix(const py::handle& value, const char* name, int cols) {
-  const py::array a = realArray(value, name);
-  if (a.ndim() != 2 || a.shape(1) != cols)
-    throw py::value_error(std::string(name) + ": expected shape (N, " + std::to_string(cols) +
-                          ") (one point per row), got " + shapeText(a));
-  return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+  return realMatrix(value, name, cols, "N", "one point per row");
 }
 
 void bindModel(py::module_& m) {

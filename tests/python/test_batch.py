@@ -18,7 +18,7 @@ import pytest
 import kccd
 from conftest import DATA
 
-distributed = pytest.importorskip("distributed")
+import distributed  # noqa: E402  (scripts/install-deps.sh installs it: the batch is tested, never skipped)
 from kccd import batch  # noqa: E402
 
 
