@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import fcntl
 import fnmatch
 import hashlib
 import json
@@ -45,6 +46,10 @@ MAX_MANIFEST_BYTES = 4 << 20
 #: What each recording's folder holds when it is complete.
 OUTPUT_FILES = ("overlay.mp4", "report.json", "contact_sheet.png", "inputs.json")
 _TOPIC = "kccd-batch"
+#: What the batch itself writes in DIR: no recording may take these names.
+_RESERVED = ("summary.json", "summary.md", "colliding_frames.png")
+#: Held (flock) while a batch writes in DIR: one run per output folder.
+_LOCK = ".kccd-batch.lock"
 #: The environment of local worker processes (Dask's default, less MALLOC_TRIM_THRESHOLD_).
 _WORKER_ENVIRON = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1}
 _ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,127}")
@@ -57,6 +62,11 @@ DEFAULT_BRAKING = {"latency": 0.01, "deceleration": 5.0, "max_acceleration": 0.0
 
 class ManifestError(ValueError):
     """A manifest that cannot be run: str() is one line 'file:line: field: problem'."""
+
+
+class BatchError(RuntimeError):
+    """A batch that cannot start (its output folder is in use, the scheduler cannot be reached):
+    str() is one line."""
 
 
 class RecordingFailed(RuntimeError):
@@ -148,10 +158,20 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
         c: Any = yaml.SafeLoader("")
         try:
             return c.construct_object(node)
-        except yaml.YAMLError as e:
-            raise fail(node, field, _one_line(str(e))) from None
+        except Exception as e:  # noqa: BLE001 - PyYAML's constructors raise more than YAMLError for bad tags
+            raise fail(node, field, _one_line(str(e)) or f"cannot read this {node.tag} value") from None
         finally:
             c.dispose()
+
+    def finite(v: Any) -> float | None:
+        """v as a finite float, or None (bools, text, huge ints and non-finite values)."""
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            return None
+        try:
+            x = float(v)
+        except OverflowError:
+            return None
+        return x if math.isfinite(x) else None
 
     def text_field(node: yaml.Node, field: str) -> str:
         v = scalar(node, field)
@@ -160,10 +180,10 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
         return v
 
     def number_field(node: yaml.Node, field: str) -> float:
-        v = scalar(node, field)
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or abs(v) > 1e6:
+        x = finite(scalar(node, field))
+        if x is None or abs(x) > 1e6:
             raise fail(node, field, "expected a finite number of seconds (|x| <= 1e6)")
-        return float(v)
+        return x
 
     def bool_field(node: yaml.Node, field: str) -> bool:
         v = scalar(node, field)
@@ -175,12 +195,11 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
         given = mapping(node, field, tuple(DEFAULT_BRAKING))
         out = dict(DEFAULT_BRAKING)
         for key, v in given.items():
-            x = scalar(v, f"{field}.{key}")
-            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x) or x < 0 \
-                    or (key == "deceleration" and x <= 0):
+            x = finite(scalar(v, f"{field}.{key}"))
+            if x is None or x < 0 or (key == "deceleration" and x <= 0):
                 raise fail(v, f"{field}.{key}", "expected a finite number " + ("> 0" if key == "deceleration" else ">= 0")
                            + " (SI units: s, rad or m, per s, per s^2)")
-            out[key] = float(x)
+            out[key] = x
         return tuple(out.items())
 
     top = mapping(root, "manifest", ("kccd_batch", "defaults", "recordings"))
@@ -213,9 +232,11 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
         if not _ID.fullmatch(rid):
             raise fail(rec["id"], f"{name}.id", f"'{rid}' is not a folder name (letters, digits, '.', '_', '-'; "
                        "at most 128; not starting with '.', '_' or '-')")
+        if rid.lower() in _RESERVED:
+            raise fail(rec["id"], f"{name}.id", f"'{rid}' is the name of a file the batch writes in DIR")
         if rid in first_line:
             raise fail(rec["id"], f"{name}.id", f"'{rid}' is also the id on line {first_line[rid]}")
-        first_line[rid] = item.start_mark.line + 1
+        first_line[rid] = rec["id"].start_mark.line + 1
         merged = {**defaults, **rec}
 
         def where(key: str, rec: dict[str, yaml.Node] = rec, name: str = name) -> str:
@@ -245,9 +266,13 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
                 p = getattr(r, key)
                 node = rec_keys.get(key, defaults.get(key))
                 field = (f"recordings[{out.index(r)}].{key}" if key in rec_keys else f"defaults.{key}")
-                if key == "video" and "%" in os.path.basename(p):
-                    if not os.path.isdir(os.path.dirname(p)):
-                        raise fail(node, field, f"{p}: the image sequence's folder does not exist")
+                if key == "video" and _is_sequence(p):
+                    try:
+                        frames = _sequence_files(p)
+                    except (TypeError, ValueError) as e:
+                        raise fail(node, field, f"{p}: not an image-sequence pattern ({_one_line(str(e))})") from None
+                    if not frames:
+                        raise fail(node, field, f"{p}: no image of the sequence (numbered from 0 or 1) exists")
                 elif not os.path.isfile(p):
                     raise fail(node, field, f"{p}: no such file")
                 if key in ("model", "camera") and (key, p) not in checked:
@@ -279,8 +304,13 @@ def _sequence_files(pattern: str) -> list[str]:
     return files
 
 
+def _is_sequence(path: str) -> bool:
+    """A path with a '%' is an image-sequence pattern (the rule of kccd's video reader)."""
+    return "%" in path
+
+
 def _input_files(path: str) -> list[str]:
-    return _sequence_files(path) if "%" in os.path.basename(path) else [path]
+    return _sequence_files(path) if _is_sequence(path) else [path]
 
 
 def _file_record(path: str, digest: str | None = None) -> dict[str, Any]:
@@ -297,7 +327,7 @@ def _file_record(path: str, digest: str | None = None) -> dict[str, Any]:
             "mtime_ns": max((s.st_mtime_ns for s in stats), default=0), "files": len(files)}
 
 
-def provenance(rec: Recording) -> dict[str, Any]:
+def provenance(rec: Recording, contact_frames: int = 12) -> dict[str, Any]:
     """The inputs' hashes, the options and the kccd version a recording's outputs are made from."""
     return {
         "id": rec.id,
@@ -305,37 +335,40 @@ def provenance(rec: Recording) -> dict[str, Any]:
         "time_offset": rec.time_offset,
         "swept": rec.swept,
         "braking": dict(rec.braking),
+        "contact_frames": contact_frames,
         "inputs": {key: _file_record(getattr(rec, key)) for key in ("video", "states", "model", "camera")},
     }
 
 
-def is_complete(rec: Recording, out_dir: str) -> bool:
-    """True when ``out_dir/<id>/`` holds every output, made by this kccd version with these options
-    from these inputs. An input with the recorded size and modification time counts as unchanged;
-    one whose size or time differ is hashed again (a touched file with the same content still
-    counts as unchanged)."""
+def complete_summary(rec: Recording, out_dir: str, contact_frames: int = 12) -> dict[str, Any] | None:
+    """The summary line of ``out_dir/<id>/`` when it holds every output, made by this kccd version
+    with these options from these inputs; else None. An input with the recorded size and
+    modification time counts as unchanged; one whose size or time differ is hashed again (a
+    touched file with the same content still counts as unchanged)."""
     folder = os.path.join(out_dir, rec.id)
     if not all(os.path.isfile(os.path.join(folder, f)) for f in OUTPUT_FILES):
-        return False
+        return None
     try:
         with open(os.path.join(folder, "inputs.json"), encoding="utf-8") as f:
             made = json.load(f)
         if made.get("kccd_version") != _core.__version__ or made.get("time_offset") != rec.time_offset \
-                or made.get("swept") != rec.swept or (rec.swept and made.get("braking") != dict(rec.braking)):
-            return False
+                or made.get("swept") != rec.swept or made.get("braking") != dict(rec.braking) \
+                or made.get("contact_frames") != contact_frames:
+            return None
         for key in ("video", "states", "model", "camera"):
             old = made["inputs"][key]
             path = getattr(rec, key)
             if old.get("path") != path:
-                return False
+                return None
             now = _file_record(path, digest=old["sha256"])
             if now["bytes"] == old["bytes"] and now["mtime_ns"] == old["mtime_ns"] and now["files"] == old["files"]:
                 continue
             if _file_record(path)["sha256"] != old["sha256"]:
-                return False
-        return True
-    except (OSError, ValueError, KeyError, TypeError):
-        return False
+                return None
+        with open(os.path.join(folder, "report.json"), encoding="utf-8") as f:
+            return {**recording_summary(rec.id, json.load(f)), "skipped": True}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
 
 
 # --------------------------------------------------------------------------------------------
@@ -392,34 +425,36 @@ def recording_summary(rec_id: str, report: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def run_recording(rec: Recording, out_dir: str, jobs: int = 0, contact_frames: int = 12) -> dict[str, Any]:
+def run_recording(rec: Recording, out_dir: str, jobs: int = 0, contact_frames: int = 12,
+                  run: str = "") -> dict[str, Any]:
     """Runs the overlay of one recording into ``out_dir/<id>/`` (staged: written into a hidden
-    folder, renamed when every output is complete) and returns its summary line. Any failure is
-    raised as RecordingFailed with a one-line reason, and nothing is left behind."""
+    folder, renamed when every output is complete) and returns its summary line. `run` tags its
+    progress events. Any failure is raised as RecordingFailed with a one-line reason, and nothing
+    is left behind."""
     stage = ""
+    final = os.path.join(out_dir, rec.id)
     try:
         os.makedirs(out_dir, exist_ok=True)
         stage = tempfile.mkdtemp(prefix=f".{rec.id}.partial-", dir=out_dir)
         os.chmod(stage, 0o755)  # mkdtemp's 0700 would hide the outputs from the others sharing the storage
-        made = provenance(rec)
+        made = provenance(rec, contact_frames)
         model = _core.Model.load(rec.model)
         camera = _core.Camera.load(rec.camera)
 
         def progress(done: int, expected: int, fps: float) -> None:
-            _publish({"id": rec.id, "frames_done": done, "frames_expected": expected, "fps": fps})
+            _publish({"run": run, "id": rec.id, "frames_done": done, "frames_expected": expected, "fps": fps})
 
         report = _core.overlay_recording(
             model, camera, rec.video, rec.states,
             output=os.path.join(stage, "overlay.mp4"), report=os.path.join(stage, "report.json"),
             contact_sheet=os.path.join(stage, "contact_sheet.png"), time_offset=rec.time_offset,
-            swept=rec.swept, braking=_core.BrakingParams(**dict(rec.braking)), jobs=jobs, contact_frames=contact_frames, progress=progress,
-            progress_every=1.0)
+            swept=rec.swept, braking=_core.BrakingParams(**dict(rec.braking)) if rec.swept else None, jobs=jobs,
+            contact_frames=contact_frames, progress=progress, progress_every=1.0)
         # The report names its outputs as they are once committed: beside it.
         report["video"] = "overlay.mp4"
         report["contact_sheet"] = "contact_sheet.png"
         _write_json(os.path.join(stage, "report.json"), report)
         _write_json(os.path.join(stage, "inputs.json"), made)
-        final = os.path.join(out_dir, rec.id)
         old = ""
         if os.path.lexists(final):
             old = os.path.join(out_dir, f".{rec.id}.old-{uuid.uuid4().hex}")
@@ -428,11 +463,12 @@ def run_recording(rec: Recording, out_dir: str, jobs: int = 0, contact_frames: i
         stage = ""
         if old:
             shutil.rmtree(old, ignore_errors=True)
-        _publish({"id": rec.id, "frames_done": report["frames_total"], "frames_expected": report["frames_total"],
-                  "done": True})
+        _publish({"run": run, "id": rec.id, "frames_done": report["frames_total"],
+                  "frames_expected": report["frames_total"], "done": True})
         return recording_summary(rec.id, report)
     except Exception as e:  # noqa: BLE001 - every failure becomes the recording's one-line reason
-        reason = _one_line(str(e)) or type(e).__name__
+        # The staging folder's random name would make the reason differ from run to run.
+        reason = _one_line(str(e).replace(stage, final) if stage else str(e)) or type(e).__name__
         raise RecordingFailed(reason) from None
     finally:
         if stage:
@@ -487,7 +523,8 @@ def _reason(future: Any) -> str:
         return str(e)
     name = type(e).__name__
     if name == "KilledWorker":
-        return "the worker running it was lost twice (killed, out of memory, or its machine went away)"
+        return ("the worker running it was lost (killed, out of memory, or its machine went away) as often as the "
+                "scheduler allows (allowed-failures)")
     return _one_line(f"{name}: {e}") if str(e) else name
 
 
@@ -567,14 +604,18 @@ def _write_text(path: str, text: str) -> None:
     os.replace(tmp, path)
 
 
+_LEFTOVER = re.compile(r"\.([A-Za-z0-9][A-Za-z0-9._-]{0,127})\.(partial-[A-Za-z0-9_]{8}|old-[0-9a-f]{32})")
+
+
 def _stale(out_dir: str) -> None:
-    """Removes staging folders a killed run left (hidden .<id>.partial-* and .<id>.old-*)."""
+    """Removes the staging folders a killed run left (.<id>.partial-XXXXXXXX, .<id>.old-<hex>; the
+    caller holds the folder's lock, so no other run is writing them)."""
     try:
         names = os.listdir(out_dir)
     except OSError:
         return
     for n in names:
-        if n.startswith(".") and (".partial-" in n or ".old-" in n):
+        if _LEFTOVER.fullmatch(n):
             shutil.rmtree(os.path.join(out_dir, n), ignore_errors=True)
 
 
@@ -605,19 +646,39 @@ def run_batch(
             raise ManifestError(f"{manifest}: --only {only}: no recording id matches")
     if workers is not None and workers < 1:
         raise ValueError("workers: must be >= 1")
-    os.makedirs(out_dir, exist_ok=True)
-    out_dir = os.path.abspath(out_dir)
+    if not 1 <= contact_frames <= 64:
+        raise ValueError("contact_frames: must be 1 ... 64")
+    try:
+        os.makedirs(out_dir, exist_ok=True)
+        lock = open(os.path.join(out_dir, _LOCK), "a")  # noqa: SIM115 - held until the end of the run
+    except OSError as e:
+        raise BatchError(f"{out_dir}: cannot write there ({e.strerror or e})") from None
+    try:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise BatchError(f"{out_dir}: another kccd.batch run is writing there (it holds {_LOCK})") from None
+        return _locked_batch(recordings, os.path.abspath(out_dir), client, scheduler, workers, resume, jobs,
+                             contact_frames, progress)
+    finally:
+        lock.close()
+
+
+def _locked_batch(recordings: list[Recording], out_dir: str, client: Any, scheduler: str | None, workers: int | None,
+                  resume: bool, jobs: int, contact_frames: int,
+                  progress: Callable[[BatchProgress], None] | None) -> BatchResult:
     _stale(out_dir)
     t0 = time.monotonic()
-    kept = [r for r in recordings if resume and is_complete(r, out_dir)]
-    todo = [r for r in recordings if r not in kept]
     records: dict[str, dict[str, Any]] = {}
-    for r in kept:
-        with open(os.path.join(out_dir, r.id, "report.json"), encoding="utf-8") as f:
-            records[r.id] = {**recording_summary(r.id, json.load(f)), "skipped": True}
+    for r in recordings:
+        line = complete_summary(r, out_dir, contact_frames) if resume else None
+        if line is not None:
+            records[r.id] = line
+    todo = [r for r in recordings if r.id not in records]
 
-    state = BatchProgress(total=len(recordings), done=len(kept), skipped=len(kept))
+    state = BatchProgress(total=len(recordings), done=len(records), skipped=len(records))
     own_cluster = None
+    own_client = False
     if workers is None:
         workers = max(1, min(os.cpu_count() or 1, len(todo)))
     n_workers = workers
@@ -626,20 +687,24 @@ def run_batch(
         import distributed
 
         dist: Any = distributed  # untyped: its calls are not checked
-        Client, LocalCluster = dist.Client, dist.LocalCluster
-
         if client is None:
+            own_client = True
             if scheduler:
-                client = Client(scheduler)
+                try:
+                    client = dist.Client(scheduler, timeout=30)
+                except Exception as e:  # noqa: BLE001 - a bad address, a refused or timed-out connection
+                    raise BatchError(f"--scheduler {scheduler}: cannot connect ({_one_line(str(e)) or type(e).__name__})") \
+                        from None
             else:
                 # A worker lost while running a task: its task runs once more, then fails. Workers
                 # without Dask's MALLOC_TRIM_THRESHOLD_: trimming the heap after every frame's
                 # buffers costs 10 % of the overlay's time (measured: 4.92 against 4.45 s).
                 with dask.config.set({"distributed.scheduler.allowed-failures": 1,
                                       "distributed.nanny.pre-spawn-environ": _WORKER_ENVIRON}):
-                    own_cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                               dashboard_address=":0", silence_logs=logging.ERROR)
-                client = Client(own_cluster)
+                    own_cluster = dist.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                                    dashboard_address=":0", silence_logs=logging.ERROR)
+                client = dist.Client(own_cluster)
+        pending: set[Any] = set()
         try:
             info = client.scheduler_info().get("workers", {})
             n_workers = max(1, len(info))
@@ -648,11 +713,12 @@ def run_batch(
             per_job = jobs
             if per_job <= 0:
                 per_job = max(1, (os.cpu_count() or 1) // max(1, n_workers)) if own_cluster is not None else 0
-            futures = {client.submit(run_recording, r, out_dir, per_job, contact_frames, pure=False, retries=1,
-                                     key=f"kccd-overlay-{r.id}-{uuid.uuid4().hex[:8]}"): r for r in todo}
-            frames: dict[str, tuple[int, int]] = {}
+            run = uuid.uuid4().hex
+            futures = {client.submit(run_recording, r, out_dir, per_job, contact_frames, run, pure=False, retries=1,
+                                     key=f"kccd-overlay-{r.id}-{run[:8]}"): r for r in todo}
+            frames: dict[str, tuple[int, int]] = {}  # per recording running or done: frames done, expected
+            failed: set[str] = set()
             seen_until = 0.0
-            ids = {r.id for r in todo}
             pending = set(futures)
             last_report = 0.0
             while pending:
@@ -669,15 +735,17 @@ def run_batch(
                                          "clear": 0, "within_margin": 0, "colliding": 0, "no_state": 0,
                                          "unsafe": 0, "colliding_intervals": []}
                         state.failed += 1
+                        failed.add(r.id)
+                        frames.pop(r.id, None)
                 try:
                     events = client.get_events(_TOPIC)
                 except Exception:  # noqa: BLE001 - progress is best effort
                     events = ()
                 for stamp, msg in events:
-                    if stamp <= seen_until or not isinstance(msg, dict) or msg.get("id") not in ids:
+                    if stamp <= seen_until or not isinstance(msg, dict) or msg.get("run") != run:
                         continue
                     seen_until = max(seen_until, stamp)
-                    if msg["id"] not in records:
+                    if msg.get("id") not in records:
                         frames[msg["id"]] = (int(msg["frames_done"]), int(msg["frames_expected"]))
                 now = time.monotonic()
                 if progress is not None and (now - last_report >= 1.0 or not pending):
@@ -688,15 +756,21 @@ def run_batch(
                     state.frames_done = sum(d for d, _ in frames.values())
                     elapsed = now - t0
                     state.frames_per_second = state.frames_done / elapsed if elapsed > 0 else 0.0
-                    known = [e for d, e in frames.values() if e > 0]
+                    known = [e for _, e in frames.values() if e > 0]
                     mean = sum(known) / len(known) if known else 0.0
-                    remaining = sum(max(e - d, 0) for d, e in frames.values()) + \
-                        mean * (len(todo) - len(frames) - state.failed)
+                    not_started = len(todo) - len(set(frames) | failed)
+                    remaining = sum(max(e - d, 0) for d, e in frames.values()) + mean * max(0, not_started)
                     state.eta_s = remaining / state.frames_per_second if state.frames_per_second > 0 and known else None
                     progress(dataclasses.replace(state))
         finally:
-            if own_cluster is not None:
+            if pending:  # interrupted: nothing of this run keeps running on the cluster
+                try:
+                    client.cancel(list(pending))
+                except Exception:  # noqa: BLE001
+                    pass
+            if own_client:
                 client.close()
+            if own_cluster is not None:
                 own_cluster.close()
     _stale(out_dir)
     ordered = [records[r.id] for r in recordings]
@@ -789,13 +863,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--jobs", type=int, default=0, metavar="N",
                         help="drawing threads per recording (default: the local cores divided among the workers; "
                              "on a remote scheduler each worker's cores)")
-    parser.add_argument("--contact-frames", type=int, default=12, metavar="N", help="frames per contact sheet")
+    parser.add_argument("--contact-frames", type=int, default=12, metavar="N",
+                        help="frames per recording's contact sheet (1 ... 64, default 12)")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress, only the last line and errors")
     args = parser.parse_args(argv)
     if args.workers is not None and args.workers < 1:
         parser.error("--workers: must be >= 1")
-    if args.jobs < 0 or args.contact_frames < 1:
-        parser.error("--jobs must be >= 0 and --contact-frames >= 1")
+    if args.jobs < 0:
+        parser.error("--jobs: must be >= 0")
+    if not 1 <= args.contact_frames <= 64:
+        parser.error("--contact-frames: must be 1 ... 64")
     show = None if args.quiet else _terminal(sys.stderr)
     announced = [False]
 
@@ -811,11 +888,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         result = run_batch(args.manifest, args.out, scheduler=args.scheduler, workers=args.workers,
                            resume=args.resume, only=args.only, jobs=args.jobs, contact_frames=args.contact_frames,
                            progress=relay)
-    except ManifestError as e:
+    except (ManifestError, BatchError) as e:
         sys.stderr.write(f"kccd.batch: {e}\n")
         return 2
-    except OSError as e:
-        sys.stderr.write(f"kccd.batch: {args.out}: {e.strerror}\n")
+    except OSError as e:  # the output folder (writing the summary), or the cluster's own files
+        place = f"{e.filename}: " if e.filename else ""
+        sys.stderr.write(f"kccd.batch: {place}{e.strerror or _one_line(str(e))}\n")
         return 2
     if show is not None and sys.stderr.isatty():
         sys.stderr.write("\n")

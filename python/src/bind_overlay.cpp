@@ -81,9 +81,15 @@ caption. output: a .png, written under a temporary name and renamed when complet
         o.time_offset = time_offset;
         o.swept = swept;
         if (braking) {
-          if (!(braking->deceleration > 0.0) || !std::isfinite(braking->deceleration))
+          if (!swept) throw py::value_error("braking: only with swept=True (static volumes do not brake)");
+          const BrakingParams& b = *braking;
+          for (const auto& [field, value] : {std::pair{"position_error", b.position_error}, {"velocity_error", b.velocity_error},
+                                             {"latency", b.latency}, {"max_acceleration", b.max_acceleration}})
+            if (!(value >= 0.0) || !std::isfinite(value))
+              throw py::value_error(std::string("braking: ") + field + " must be a finite number >= 0");
+          if (!(b.deceleration > 0.0) || !std::isfinite(b.deceleration))
             throw py::value_error("braking: deceleration must be a finite number > 0");
-          o.braking = *braking;
+          o.braking = b;
         }
         o.jobs = jobs;
         o.frames = overlay::parseFrameRange(frames, "frames");

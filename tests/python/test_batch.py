@@ -51,6 +51,11 @@ def client():  # type: ignore[no-untyped-def]
             yield c
 
 
+def visible(folder: pathlib.Path) -> list[str]:
+    """What a folder holds, without its hidden names (the batch's lock file)."""
+    return sorted(n for n in os.listdir(folder) if not n.startswith("."))
+
+
 def cli_report(cli: pathlib.Path, fleet: pathlib.Path, rec: str, out: pathlib.Path, swept: bool) -> dict:
     args = [str(cli), "overlay", str(fleet / "arm.yaml"), "--camera", str(fleet / "a" / "camera_true.yaml"), "--video",
             str(fleet / rec / "video.mkv"), "--states", str(fleet / rec / "states.csv"), "--time-offset", "0.137",
@@ -70,7 +75,8 @@ def test_batch_equals_overlay_and_reports_the_failure(cli, fleet: pathlib.Path, 
     assert by_id["cell-c"]["status"] == "failed" and "c/video.mkv" in by_id["cell-c"]["reason"]
     assert "\n" not in by_id["cell-c"]["reason"]
     assert not (out / "cell-c").exists()
-    assert sorted(os.listdir(out)) == ["cell-a", "cell-b", "colliding_frames.png", "summary.json", "summary.md"]
+    assert visible(out) == ["cell-a", "cell-b", "colliding_frames.png", "summary.json", "summary.md"]
+    assert sorted(os.listdir(out)) == [".kccd-batch.lock"] + visible(out), "no staging folder is left"
     total = {"frames_total": 0, "colliding": 0, "within_margin": 0, "clear": 0}
     for rec, swept in (("a", False), ("b", True)):
         rid = f"cell-{rec}"
@@ -125,21 +131,23 @@ def test_killed_worker_is_retried(fleet: pathlib.Path, client, tmp_path: pathlib
     victim = None
     deadline = time.monotonic() + 60
     while victim is None and time.monotonic() < deadline:
-        time.sleep(0.1)
-        if frames and frames[-1] > 0:
+        time.sleep(0.05)
+        if frames and frames[-1] >= 10:
             victim = next((w for w, keys in client.processing().items() if keys), None)
     assert victim is not None, "the recording never started"
-    staging = [n for n in os.listdir(tmp_path / "out") if ".partial-" in n]
-    assert staging, "a running recording writes into a hidden staging folder"
+    before = frames[-1]
     os.kill(pids[victim], signal.SIGKILL)
+    killed_at = len(frames)
     job.join(timeout=240)
     assert not job.is_alive() and result
+    # The task ran again from its first frame: the progress fell back below where it was.
+    assert min(frames[killed_at:]) < before < 150, (before, frames)
     s = result[0].summary
     assert s["recordings"][0]["status"] == "done", s["recordings"][0]
     assert s["recordings"][0]["frames_total"] == 150
-    assert sorted(os.listdir(tmp_path / "out")) == ["colliding_frames.png", "long", "summary.json", "summary.md"] or \
-        sorted(os.listdir(tmp_path / "out")) == ["long", "summary.json", "summary.md"]
     assert sorted(os.listdir(tmp_path / "out" / "long")) == sorted(batch.OUTPUT_FILES)
+    # The killed worker's staging folder is gone, and nothing but the outputs is there.
+    assert [n for n in os.listdir(tmp_path / "out") if n.startswith(".")] == [".kccd-batch.lock"]
 
 
 def test_resume_runs_only_what_is_missing(fleet: pathlib.Path, client, tmp_path: pathlib.Path) -> None:
@@ -150,10 +158,17 @@ def test_resume_runs_only_what_is_missing(fleet: pathlib.Path, client, tmp_path:
     out = tmp_path / "out"
     batch.run_batch(str(work / "fleet.yaml"), str(out), client=client, only="cell-a")
     assert sorted(p.name for p in out.iterdir() if p.is_dir()) == ["cell-a"]
+    # Another run into the same folder while this one holds it is refused.
+    import fcntl
+
+    with open(out / ".kccd-batch.lock", "a") as held:
+        fcntl.flock(held, fcntl.LOCK_EX)
+        with pytest.raises(batch.BatchError, match="another kccd.batch run"):
+            batch.run_batch(str(work / "fleet.yaml"), str(out), client=client)
     first = (out / "cell-a" / "overlay.mp4").stat()
     # An interrupted run leaves a staging folder; resuming removes it and runs only cell-b.
-    (out / ".cell-b.partial-0123").mkdir()
-    (out / ".cell-b.partial-0123" / "overlay.mp4").write_bytes(b"half")
+    (out / ".cell-b.partial-0123abcd").mkdir()
+    (out / ".cell-b.partial-0123abcd" / "overlay.mp4").write_bytes(b"half")
     r = batch.run_batch(str(work / "fleet.yaml"), str(out), client=client, resume=True)
     kept = {x["id"]: x.get("skipped", False) for x in r.summary["recordings"]}
     assert kept == {"cell-a": True, "cell-b": False}
@@ -169,6 +184,9 @@ def test_resume_runs_only_what_is_missing(fleet: pathlib.Path, client, tmp_path:
     r = batch.run_batch(str(work / "fleet.yaml"), str(out), client=client, resume=True)
     assert {x["id"]: x.get("skipped", False) for x in r.summary["recordings"]} == {"cell-a": False, "cell-b": True}
     assert (out / "cell-a" / "overlay.mp4").stat().st_ino != first.st_ino
+    # Other options are other outputs: a different contact sheet runs both again.
+    r = batch.run_batch(str(work / "fleet.yaml"), str(out), client=client, resume=True, contact_frames=4)
+    assert not any(x.get("skipped") for x in r.summary["recordings"])
 
 
 @pytest.mark.parametrize("body, where", [
@@ -176,6 +194,9 @@ def test_resume_runs_only_what_is_missing(fleet: pathlib.Path, client, tmp_path:
     ("kccd_batch: 1\nrecordings:\n  - {id: x, video: a/video.mkv, states: a/states.csv, model: arm.yaml, "
      "camera: a/camera_true.yaml}\n  - {id: x, video: b/video.mkv, states: b/states.csv, model: arm.yaml, "
      "camera: a/camera_true.yaml}\n", "4: recordings[1].id: 'x' is also the id on line 3"),
+    ("kccd_batch: 1\nrecordings:\n  -\n    video: a/video.mkv\n    id: x\n    states: a/states.csv\n    model: arm.yaml\n"
+     "    camera: a/camera_true.yaml\n  - {id: x, video: b/video.mkv, states: b/states.csv, model: arm.yaml, "
+     "camera: a/camera_true.yaml}\n", "9: recordings[1].id: 'x' is also the id on line 5"),
     ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
      "  - {id: x, video: a/video.mkv, states: a/states.csv, colour: red}\n", "4: recordings[0].colour: unknown field"),
     ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
@@ -191,6 +212,13 @@ def test_resume_runs_only_what_is_missing(fleet: pathlib.Path, client, tmp_path:
     ("kccd_batch: 1\nrecordings:\n  - {id: x, video: a/video.mkv, states: a/states.csv}\n",
      "3: recordings[0].model: missing (give it here or in defaults)"),
     ("kccd_batch: 1\nrecordings: [\n", "yaml: "),
+    ("kccd_batch: !!int one\nrecordings: []\n", "1: kccd_batch: "),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml, time_offset: 1" + "0" * 400 + "}\n"
+     "recordings:\n  - {id: x, video: a/video.mkv, states: a/states.csv}\n", "2: defaults.time_offset: "),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: Summary.JSON, video: a/video.mkv, states: a/states.csv}\n", "4: recordings[0].id: 'Summary.JSON' is the name"),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: x, video: a/frame_%06d.png, states: a/states.csv}\n", "4: recordings[0].video: "),
     ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
      "  - {id: x, video: a/video.mkv, states: a/states.csv, braking: {deceleration: 0}}\n",
      "4: recordings[0].braking.deceleration: expected a finite number > 0"),
@@ -213,9 +241,11 @@ def test_only_and_usage(fleet: pathlib.Path, tmp_path: pathlib.Path) -> None:
     assert not (tmp_path / "out").exists()
     run = subprocess.run([sys.executable, "-m", "kccd.batch", "--help"], capture_output=True, text=True)
     assert run.returncode == 0 and "--scheduler" in run.stdout and "Exit status" in run.stdout
-    run = subprocess.run([sys.executable, "-m", "kccd.batch", str(fleet / "fleet.yaml"), "--out", str(tmp_path / "o"),
-                          "--workers", "0"], capture_output=True, text=True)
-    assert run.returncode == 2 and "--workers" in run.stderr
+    for bad, word in ((["--workers", "0"], "--workers"), (["--contact-frames", "65"], "--contact-frames"),
+                      (["--scheduler", "nonsense://x"], "--scheduler nonsense://x: cannot connect")):
+        run = subprocess.run([sys.executable, "-m", "kccd.batch", str(fleet / "fleet.yaml"), "--out",
+                              str(tmp_path / "o")] + bad, capture_output=True, text=True, timeout=120)
+        assert run.returncode == 2 and word in run.stderr and "Traceback" not in run.stderr, run.stderr
 
 
 def test_command_on_its_own_local_cluster(fleet: pathlib.Path, tmp_path: pathlib.Path) -> None:
@@ -227,6 +257,7 @@ def test_command_on_its_own_local_cluster(fleet: pathlib.Path, tmp_path: pathlib
     s = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert [r["id"] for r in s["recordings"]] == ["cell-a", "cell-c"] and s["run"]["workers"] == 2
     assert sorted(os.listdir(tmp_path / "o" / "cell-a")) == sorted(batch.OUTPUT_FILES)
+    assert "cell-a" in visible(tmp_path / "o")
 
 
 def test_manifest_reader_survives_mutations(fleet: pathlib.Path, tmp_path: pathlib.Path) -> None:
@@ -237,7 +268,8 @@ def test_manifest_reader_survives_mutations(fleet: pathlib.Path, tmp_path: pathl
 
     good = (fleet / "fleet.yaml").read_bytes()
     specials = [b"{", b"}", b"[", b"]", b":", b"- ", b"&a", b"*a", b"!!binary", b"\t", b"\x00", b"\xff", b"'",
-                b'"', b"%YAML 1.1\n", b"---\n", b"1e999", b"-.inf", b".nan", b"~", b"<<: *a", b"\n  ", b"#"]
+                b'"', b"%YAML 1.1\n", b"---\n", b"1e999", b"-.inf", b".nan", b"~", b"<<: *a", b"\n  ", b"#",
+                b"!!int ", b"!!float ", b"!!bool ", b"!!timestamp ", b"1" + b"0" * 400, b"%"]
     rng = random.Random(11)
     path = fleet / "mutant.yaml"
     outcomes = {"read": 0, "refused": 0}

@@ -157,10 +157,11 @@ def test_prove_pairs_equals_cli_and_holds(cli, arm: kccd.Model) -> None:
         dist = dict(zip(r.pair.tolist(), r.distance.tolist()))
         for q in never:
             assert dist[index[(q["a"], q["b"])]] >= q["bound"] - 1e-12
-    for q in p["pairs"]:
-        if q["verdict"] == "meets" and (q["a"], q["b"]) in index:
-            r = checker.query(q["witness_state"], type="distances")
-            assert r.distance[r.pair.tolist().index(index[(q["a"], q["b"])])] <= p["margin"]
+    meets = [q for q in p["pairs"] if q["verdict"] == "meets" and (q["a"], q["b"]) in index]
+    assert meets, "the arm has checked pairs that meet"
+    for q in meets:
+        r = checker.query(q["witness_state"], type="distances")
+        assert r.distance[r.pair.tolist().index(index[(q["a"], q["b"])])] <= p["margin"]
     assert names == pruned.bodies
     with pytest.raises(ValueError, match="max_boxes"):
         kccd.prove_pairs(arm, max_boxes=0)

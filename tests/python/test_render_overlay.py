@@ -130,3 +130,18 @@ def test_read_frames_equal_read_frame(tmp_path: pathlib.Path) -> None:
     assert kccd.read_frames(s["video"], []) == []
     with pytest.raises(ValueError, match="indices"):
         kccd.read_frames(s["video"], [-1])
+
+
+def test_overlay_braking_is_checked(arm: kccd.Model, camera: kccd.Camera, tmp_path: pathlib.Path) -> None:
+    states = tmp_path / "s.csv"
+    states.write_text("time,shoulder_yaw,shoulder_pitch,elbow\n0,0,0,0\n0.1,0,0,0\n")
+    video = str(tmp_path / "none_%04d.png")
+    with pytest.raises(ValueError, match="only with swept=True"):
+        kccd.overlay_recording(arm, camera, video, str(states), braking=kccd.BrakingParams(latency=0.01))
+    for field in ("latency", "position_error", "velocity_error", "max_acceleration"):
+        with pytest.raises(ValueError, match=f"braking: {field}"):
+            kccd.overlay_recording(arm, camera, video, str(states), swept=True,
+                                   braking=kccd.BrakingParams(**{field: -1.0}))  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="deceleration"):
+        kccd.overlay_recording(arm, camera, video, str(states), swept=True,
+                               braking=kccd.BrakingParams(deceleration=float("nan")))
