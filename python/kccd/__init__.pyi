@@ -18,6 +18,7 @@ from ._kccd import detect_tags as detect_tags
 from ._kccd import explain as explain
 from ._kccd import fit as fit
 from ._kccd import import_urdf as import_urdf
+from ._kccd import overlay_braking as overlay_braking
 from ._kccd import overlay_recording as overlay_recording
 from ._kccd import prove_pairs as prove_pairs
 from ._kccd import read_frame as read_frame
@@ -47,6 +48,7 @@ __all__ = [
     "explain",
     "fit",
     "import_urdf",
+    "overlay_braking",
     "overlay_recording",
     "prove_pairs",
     "read_frame",

@@ -56,8 +56,8 @@ _ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,127}")
 _RECORDING_KEYS = ("id", "video", "states", "model", "camera", "time_offset", "swept", "braking")
 _DEFAULT_KEYS = ("model", "camera", "time_offset", "swept", "braking")
 #: The braking of swept volumes unless a manifest says otherwise (kccd overlay's defaults).
-DEFAULT_BRAKING = {"latency": 0.01, "deceleration": 5.0, "max_acceleration": 0.0, "position_error": 0.0,
-                   "velocity_error": 0.0}
+DEFAULT_BRAKING = {field: float(getattr(_core.overlay_braking(), field))
+                   for field in ("latency", "deceleration", "max_acceleration", "position_error", "velocity_error")}
 
 
 class ManifestError(ValueError):
@@ -221,6 +221,7 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
         return os.path.normpath(os.path.join(base, text_field(node, field)))
 
     out: list[Recording] = []
+    inputs: list[tuple[str, str, yaml.Node, str]] = []  # kind, path, its node, its field: checked below
     first_line: dict[str, int] = {}
     for i, item in enumerate(seq.value):
         name = f"recordings[{i}]"
@@ -245,12 +246,11 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
         for key in ("model", "camera"):
             if key not in merged:
                 raise fail(item, f"{name}.{key}", "missing (give it here or in defaults)")
+        paths = {key: resolve(merged[key], where(key)) for key in ("video", "states", "model", "camera")}
+        inputs += [(key, paths[key], merged[key], where(key)) for key in paths]
         out.append(Recording(
             id=rid,
-            video=resolve(rec["video"], f"{name}.video"),
-            states=resolve(rec["states"], f"{name}.states"),
-            model=resolve(merged["model"], f"{name}.model" if "model" in rec else "defaults.model"),
-            camera=resolve(merged["camera"], f"{name}.camera" if "camera" in rec else "defaults.camera"),
+            **paths,
             time_offset=number_field(merged["time_offset"], where("time_offset")) if "time_offset" in merged else 0.0,
             swept=bool_field(merged["swept"], where("swept")) if "swept" in merged else False,
             line=item.start_mark.line + 1,
@@ -260,30 +260,25 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
 
     if check_inputs:
         checked: set[tuple[str, str]] = set()
-        for r, item in zip(out, seq.value):
-            rec_keys = mapping(item, "", _RECORDING_KEYS)
-            for key in ("video", "states", "model", "camera"):
-                p = getattr(r, key)
-                node = rec_keys.get(key, defaults.get(key))
-                field = (f"recordings[{out.index(r)}].{key}" if key in rec_keys else f"defaults.{key}")
-                if key == "video" and _is_sequence(p):
-                    try:
-                        frames = _sequence_files(p)
-                    except (TypeError, ValueError) as e:
-                        raise fail(node, field, f"{p}: not an image-sequence pattern ({_one_line(str(e))})") from None
-                    if not frames:
-                        raise fail(node, field, f"{p}: no image of the sequence (numbered from 0 or 1) exists")
-                elif not os.path.isfile(p):
-                    raise fail(node, field, f"{p}: no such file")
-                if key in ("model", "camera") and (key, p) not in checked:
-                    checked.add((key, p))
-                    try:
-                        if key == "model":
-                            _core.Model.load(p)
-                        else:
-                            _core.Camera.load(p)
-                    except _core.InputError as e:
-                        raise fail(node, field, _one_line(str(e))) from None
+        for key, p, node, field in inputs:
+            if key == "video" and _is_sequence(p):
+                try:
+                    frames = _sequence_files(p)
+                except (TypeError, ValueError) as e:
+                    raise fail(node, field, f"{p}: not an image-sequence pattern ({_one_line(str(e))})") from None
+                if not frames:
+                    raise fail(node, field, f"{p}: no image of the sequence (numbered from 0 or 1) exists")
+            elif not os.path.isfile(p):
+                raise fail(node, field, f"{p}: no such file")
+            if key in ("model", "camera") and (key, p) not in checked:
+                checked.add((key, p))
+                try:
+                    if key == "model":
+                        _core.Model.load(p)
+                    else:
+                        _core.Camera.load(p)
+                except _core.InputError as e:
+                    raise fail(node, field, _one_line(str(e))) from None
     return out
 
 
@@ -375,12 +370,16 @@ def complete_summary(rec: Recording, out_dir: str, contact_frames: int = 12) -> 
 # The task: one recording on one worker
 
 
-def _write_json(path: str, value: Any) -> None:
+def _write_text(path: str, text: str) -> None:
+    """Writes `text` under a temporary name beside `path`, then renames it: never a partial file."""
     tmp = f"{path}.tmp-{uuid.uuid4().hex}"
     with open(tmp, "w", encoding="utf-8") as f:
-        json.dump(value, f, indent=2, sort_keys=True)
-        f.write("\n")
+        f.write(text)
     os.replace(tmp, path)
+
+
+def _write_json(path: str, value: Any) -> None:
+    _write_text(path, json.dumps(value, indent=2, sort_keys=True) + "\n")
 
 
 def _publish(message: dict[str, Any]) -> None:
@@ -597,14 +596,7 @@ def summary_markdown(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def _write_text(path: str, text: str) -> None:
-    tmp = f"{path}.tmp-{uuid.uuid4().hex}"
-    with open(tmp, "w", encoding="utf-8") as f:
-        f.write(text)
-    os.replace(tmp, path)
-
-
-_LEFTOVER = re.compile(r"\.([A-Za-z0-9][A-Za-z0-9._-]{0,127})\.(partial-[A-Za-z0-9_]{8}|old-[0-9a-f]{32})")
+_LEFTOVER = re.compile(rf"\.({_ID.pattern})\.(partial-[A-Za-z0-9_]{{8}}|old-[0-9a-f]{{32}})")
 
 
 def _stale(out_dir: str) -> None:

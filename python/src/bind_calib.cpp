@@ -3,10 +3,10 @@
 // the statuses and quality figures of `kccd calib`.
 #include <pybind11/stl.h>
 
-#include <cstring>
 #include <opencv2/imgproc.hpp>
 #include <set>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
 #include "kccd/calib/camera.hpp"
 #include "kccd/calib/image_file.hpp"
@@ -23,10 +23,7 @@ namespace {
 py::array_t<std::uint8_t> rgbArray(const cv::Mat& bgr) {
   cv::Mat rgb;
   cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
-  py::array_t<std::uint8_t> out({rgb.rows, rgb.cols, 3});
-  const std::size_t row = static_cast<std::size_t>(rgb.cols) * 3;
-  for (int r = 0; r < rgb.rows; ++r) std::memcpy(out.mutable_data() + r * static_cast<py::ssize_t>(row), rgb.ptr(r), row);
-  return out;
+  return imageArray(rgb);
 }
 
 // `image` (uint8 (H, W) grey, (H, W, 3) RGB or (H, W, 4) RGBA) as an 8-bit grey cv::Mat of its own,

@@ -4,22 +4,11 @@
 
 #include <cmath>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
 #include "kccd/explain.hpp"
 
 namespace kccd::python {
-
-namespace {
-
-py::array_t<double> array(const std::vector<double>& v) {
-  py::array_t<double> out(static_cast<py::ssize_t>(v.size()));
-  std::copy(v.begin(), v.end(), out.mutable_data());
-  return out;
-}
-
-py::array_t<double> point(const Vec3& p) { return array({p.x(), p.y(), p.z()}); }
-
-}  // namespace
 
 void bindExplain(py::module_& m) {
   m.def(
@@ -51,9 +40,9 @@ void bindExplain(py::module_& m) {
           d["bound"] = e.bound;
           d["distance"] = e.closest.distance;
           d["verdict"] = toString(e.verdict);
-          d["state"] = array(e.closest.state);
-          d["point_a"] = point(e.closest.point_a);
-          d["point_b"] = point(e.closest.point_b);
+          d["state"] = floatArray(e.closest.state);
+          d["point_a"] = floatArray({e.closest.point_a.data(), 3});
+          d["point_b"] = floatArray({e.closest.point_b.data(), 3});
           d["evaluations"] = e.closest.evaluations;
           out.append(d);
         }

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
 #include "kccd/modelling/fit.hpp"
 #include "kccd/modelling/pair_proof.hpp"
@@ -15,14 +16,6 @@
 namespace kccd::python {
 
 namespace {
-
-py::array_t<double> points(const std::vector<Vec3>& v) {
-  py::array_t<double> out({static_cast<py::ssize_t>(v.size()), py::ssize_t{3}});
-  auto o = out.mutable_unchecked<2>();
-  for (std::size_t i = 0; i < v.size(); ++i)
-    for (int k = 0; k < 3; ++k) o(static_cast<py::ssize_t>(i), k) = v[i][k];
-  return out;
-}
 
 py::list entries(const std::vector<modelling::IgnoreEntry>& list) {
   py::list out;
@@ -62,7 +55,7 @@ void bindModelling(py::module_& m) {
         const std::string points_yaml = modelling::flowPoints(r.points);
         const std::string radius_yaml = modelling::yamlNumber(r.radius, true);
         py::dict d;
-        d["points"] = points(r.points);
+        d["points"] = pointRows(r.points);
         d["radius"] = std::stod(radius_yaml);
         d["volume"] = r.volume;
         d["hull_volume"] = r.hull_volume;
@@ -153,9 +146,7 @@ Raises InputError naming the file, line and element on any problem.)doc");
           o["ignore_reason"] = why.empty() ? py::object(py::none()) : py::object(py::str(why));
           o["bound"] = (r.verdict == modelling::Verdict::Never || r.rigid) ? py::object(py::float_(r.bound)) : py::object(py::none());
           if (r.verdict == modelling::Verdict::Meets) {
-            py::array_t<double> w(static_cast<py::ssize_t>(r.witness.size()));
-            std::copy(r.witness.begin(), r.witness.end(), w.mutable_data());
-            o["witness_state"] = w;
+            o["witness_state"] = floatArray(r.witness);
             o["witness_distance"] = r.witness_distance;
           } else {
             o["witness_state"] = py::none();

@@ -28,6 +28,9 @@ py::object toPython(const nlohmann::json& j) { return py::module_::import("json"
 }  // namespace
 
 void bindOverlay(py::module_& m) {
+  m.def("overlay_braking", [] { return overlay::kOverlayBraking; },
+        "kccd overlay's braking for swept volumes, every joint (latency 0.01 s, deceleration 5): the default of "
+        "overlay_recording(braking=) and of kccd.batch. A fresh copy each call.");
   m.def(
       "contact_sheet",
       [](const std::vector<py::array>& frames, const std::vector<std::string>& captions, const std::string& output,

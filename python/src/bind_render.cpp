@@ -4,6 +4,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
 #include "kccd/calib/camera.hpp"
 #include "kccd/render/model_view.hpp"
@@ -17,22 +18,6 @@ py::array_t<double> matrix3(const cv::Matx33d& k) {
   auto o = out.mutable_unchecked<2>();
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) o(r, c) = k(r, c);
-  return out;
-}
-
-py::array_t<double> vector3(const cv::Vec3d& v) {
-  py::array_t<double> out(3);
-  for (int k = 0; k < 3; ++k) out.mutable_data()[k] = v[k];
-  return out;
-}
-
-// A cv::Mat of 8-bit pixels as a fresh C-contiguous uint8 array (H, W[, C]).
-py::array_t<std::uint8_t> image(const cv::Mat& m) {
-  std::vector<py::ssize_t> shape{m.rows, m.cols};
-  if (m.channels() > 1) shape.push_back(m.channels());
-  py::array_t<std::uint8_t> out(shape);
-  const std::size_t row = static_cast<std::size_t>(m.cols) * static_cast<std::size_t>(m.channels());
-  for (int r = 0; r < m.rows; ++r) std::memcpy(out.mutable_data() + r * row, m.ptr(r), row);
   return out;
 }
 
@@ -58,9 +43,9 @@ metres), as `kccd calib` writes it. Load with Camera.load(path).)doc")
                              "float64 (3, 3): fx 0 cx; 0 fy cy; 0 0 1 (pixels)")
       .def_property_readonly("distortion", [](const calib::Camera& c) { return c.distortion; },
                              "OpenCV order: k1 k2 p1 p2 [k3 ...]")
-      .def_property_readonly("rvec", [](const calib::Camera& c) { return vector3(c.rvec); },
+      .def_property_readonly("rvec", [](const calib::Camera& c) { return floatArray(c.rvec.val); },
                              "float64 (3,): world -> camera rotation (Rodrigues vector, radians)")
-      .def_property_readonly("tvec", [](const calib::Camera& c) { return vector3(c.tvec); },
+      .def_property_readonly("tvec", [](const calib::Camera& c) { return floatArray(c.tvec.val); },
                              "float64 (3,): world -> camera translation (metres)")
       .def_readonly("reprojection_rms_px", &calib::Camera::reprojection_rms_px)
       .def_readonly("rotation_sigma_deg", &calib::Camera::rotation_sigma_deg)
@@ -103,8 +88,8 @@ metres), as `kccd calib` writes it. Load with Camera.load(path).)doc")
           distances = f.distances;
         }
         py::dict out;
-        out["rgba"] = image(rgba);
-        out["labels"] = mask ? py::object(image(labels)) : py::object(py::none());
+        out["rgba"] = imageArray(rgba);
+        out["labels"] = mask ? py::object(imageArray(labels)) : py::object(py::none());
         py::list sts;
         for (SafetyStatus s : status) sts.append(toString(s));
         out["status"] = sts;

@@ -145,3 +145,10 @@ def test_overlay_braking_is_checked(arm: kccd.Model, camera: kccd.Camera, tmp_pa
     with pytest.raises(ValueError, match="deceleration"):
         kccd.overlay_recording(arm, camera, video, str(states), swept=True,
                                braking=kccd.BrakingParams(deceleration=float("nan")))
+
+
+def test_overlay_braking_is_the_commands() -> None:
+    b = kccd.overlay_braking()
+    assert (b.latency, b.deceleration, b.max_acceleration, b.position_error, b.velocity_error) == (0.01, 5.0, 0, 0, 0)
+    b.latency = 1.0
+    assert kccd.overlay_braking().latency == 0.01, "each call is a fresh copy"
