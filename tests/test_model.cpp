@@ -132,6 +132,14 @@ TEST(Model, EveryMistakeGetsOneClearMessage) {
       {"YAML syntax", edit("name: t", "name: [t"), {"cell.yaml:", "YAML syntax error"}},
       {"world as joint name", edit("name: slide", "name: world"), {"'world' is reserved"}},
       {"pair with itself", edit("ignore: [[arm, tool]]", "ignore: [[arm, arm]]"), {"a body paired with itself"}},
+      {"negative tolerance", edit("    radius: 0.05\n", "    radius: 0.05\n    tolerance: -0.001\n"),
+       {"cell.yaml:33:", "body 'arm'.tolerance", "must be >= 0"}},
+      {"pieces of a link in two frames",
+       edit("    radius: 0.05\n  - name: tool\n", "    radius: 0.05\n    link: limb\n  - name: tool\n    link: limb\n"),
+       {"body 'tool'.link", "piece of link 'limb' in frame 'slide'", "body 'arm' of that link is in frame 'base'"}},
+      {"a link named like a whole body", edit("    radius: 0.05\n", "    radius: 0.05\n    link: floor\n"),
+       {"cell.yaml:33:", "body 'arm'.link", "piece of link 'floor' in frame 'base'", "body 'floor' of that link"}},
+      {"empty link name", edit("    radius: 0.05\n", "    radius: 0.05\n    link: \"\"\n"), {"cell.yaml:33:", "body 'arm'.link", "must not be empty"}},
       {"same-frame include", edit("ignore: [[arm, tool]]", "include: [[floor, floor]]"), {"a body paired with itself"}},
       {"bad check", edit("ignore: [[arm, tool]]", "check: some"), {"pairs.check", "expected 'all' or 'none'"}},
       // The model used must be the model written: YAML's rules, not the first value that fits.
@@ -170,6 +178,34 @@ std::string edit_text(std::string text, const std::string& from, const std::stri
 }
 
 // visuals: appearance only, in a frame, one shape each; mesh paths relative to the model file.
+// Pieces of a concave link: one `link:` name over bodies in one frame; the tolerance each body
+// meets is kept; bodies in one frame are never paired, so pieces are never checked against
+// each other.
+TEST(Model, PiecesOfALinkAndTheirTolerances) {
+  std::string text = edit("  - name: tool\n    frame: slide\n    points: [[0, 0, 0]]\n    radius: 0.02\n",
+                          "  - name: tool/1\n    link: tool\n    frame: slide\n    points: [[0, 0, 0]]\n"
+                          "    radius: 0.02\n    tolerance: 0.002\n  - name: tool/2\n    link: tool\n"
+                          "    frame: slide\n    points: [[0.1, 0, 0]]\n    radius: 0.02\n");
+  text.replace(text.find("ignore: [[arm, tool]]"), 21, "ignore: [[arm, tool/1]]");
+  const Model m = parseModel(text, "pieces.yaml");
+  const Body& a = m.bodies[m.bodyIndex("tool/1")];
+  const Body& b = m.bodies[m.bodyIndex("tool/2")];
+  EXPECT_EQ(a.linkName(), "tool");
+  EXPECT_EQ(b.linkName(), "tool");
+  EXPECT_EQ(m.bodies[m.bodyIndex("arm")].linkName(), "arm");
+  EXPECT_DOUBLE_EQ(a.tolerance, 0.002);
+  EXPECT_LT(b.tolerance, 0.0);  // not recorded
+  const int ia = m.bodyIndex("tool/1"), ib = m.bodyIndex("tool/2");
+  for (const BodyPair& p : m.pairs) EXPECT_FALSE((p.a == ia && p.b == ib) || (p.a == ib && p.b == ia));
+  // A piece may not take a whole body's name as its link, nor a whole body a link's name.
+  EXPECT_NE(loadError(edit("  - name: box\n    frame: turn", "  - name: box\n    link: arm\n    frame: base"))
+                .find("body 'box'.link: link 'arm' is also a whole body's name"),
+            std::string::npos);
+  std::string later = text;
+  later.replace(later.find("  - name: box\n"), 14, "  - name: tool\n");
+  EXPECT_NE(loadError(later).find("'tool' is already the link of body 'tool/1'"), std::string::npos) << loadError(later);
+}
+
 TEST(Model, VisualsLoadAndTheirMistakesPointAtTheLine) {
   const std::string visuals = kGood + R"(visuals:
   - frame: base

@@ -3,18 +3,26 @@
 // renderer) taken one by one, each kind of request, and visuals placed at the state.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <iostream>
 #include <limits>
+#include <random>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/checker.hpp"
 #include "kccd/render/model_view.hpp"
 #include "kccd/render/scene.hpp"
 #include "kccd/render/visuals.hpp"
+#include "support/cameras.hpp"
+#include "support/silhouette.hpp"
 
 namespace {
 
@@ -98,6 +106,86 @@ TEST_F(ModelViewTest, NoImageAskedIsTheQueryAlone) {
   EXPECT_TRUE(counted.images.mask.empty());
   EXPECT_TRUE(counted.images.visibility.empty());
   EXPECT_FALSE(drawn.images.bgra.empty());
+}
+
+// A body with more points than the model's point budget is drawn as it is (its own points and
+// radius), not as the checker's reduced stand-in: its mask lies within the mask's edge bound of
+// an independent silhouette of its own SSCH (tests/support/silhouette.hpp). The stand-in (the
+// checker's volume) is drawn too, and is visibly larger: the check can fail.
+TEST(ModelViewBudget, BodyAboveThePointBudgetIsDrawnAsItIs) {
+  std::mt19937_64 rng(44);
+  std::normal_distribution<double> g;
+  std::vector<Vec3> pts;  // 14 points of an elongated link, far more than the budget of 4
+  for (int i = 0; i < 14; ++i) {
+    Vec3 d(g(rng), g(rng), g(rng));
+    d.normalize();
+    pts.push_back(Vec3(0.25 * d.x(), 0.06 * d.y(), 0.05 * d.z()));
+  }
+  std::ostringstream yaml;
+  yaml.precision(17);
+  yaml << "kccd: 1\nname: budget\nsafety_margin: 0.01\npoint_budget: 4\n"
+       << "joints:\n  - {name: j, type: revolute, parent: world, axis: [0, 0, 1], origin: {xyz: [0, 0, 0.1]}}\n"
+       << "bodies:\n  - {name: link, frame: j, radius: 0.01, points: [";
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    yaml << (i ? ", " : "") << "[" << pts[i].x() << ", " << pts[i].y() << ", " << pts[i].z() << "]";
+  yaml << "]}\n  - {name: post, frame: world, radius: 0.02, points: [[1, 1, 0], [1, 1, 0.3]]}\n";
+  const Model m = parseModel(yaml.str(), "budget.yaml");
+  calib::Camera cam = kccd::testing::lookAt(Vec3(0.9, -0.7, 0.8), Vec3(0, 0, 0.1), 320, 240, 400.0, {0, 0, 0, 0, 0});
+  const std::vector<double> q = {0.7};
+  ModelView view(m, cam);
+  ModelViewRequest request;
+  request.state = q;
+  request.colour = false;
+  const ModelFrame f = view.draw(request);
+  const cv::Mat drawn = f.images.mask == 1;
+  // The independent silhouette of the body's own volume at its pose: the volume is convex and in
+  // front of a distortion-free camera, so its outline is the convex hull of the projections of
+  // its points moved by the radius in 2,000 directions, filled at 7x.
+  const Pose pose = Pose(Eigen::Translation3d(0, 0, 0.1) * Eigen::AngleAxisd(0.7, Vec3::UnitZ()));
+  const int k = kccd::testing::kSilhouetteScale;
+  std::vector<cv::Point3d> surface;
+  const double golden = 3.14159265358979 * (3.0 - std::sqrt(5.0));
+  for (const Vec3& p : pts)
+    for (int i = 0; i < 2000; ++i) {
+      const double z = 1.0 - (2.0 * i + 1.0) / 2000, s = std::sqrt(1.0 - z * z);
+      const Vec3 w = pose * p + m.bodies[0].radius * Vec3(s * std::cos(golden * i), s * std::sin(golden * i), z);
+      surface.emplace_back(w.x(), w.y(), w.z());
+    }
+  std::vector<cv::Point2d> image;
+  cv::projectPoints(surface, cam.rvec, cam.tvec, cam.camera_matrix, cv::noArray(), image);
+  std::vector<cv::Point> fine_pts;
+  for (const cv::Point2d& p : image)  // pixel x's centre is the centre of fine pixel 7x + 3 (1/16 px units)
+    fine_pts.emplace_back(cvRound((p.x * k + k / 2) * 16), cvRound((p.y * k + k / 2) * 16));
+  std::vector<cv::Point> outline;
+  cv::convexHull(fine_pts, outline);
+  cv::Mat fine = cv::Mat::zeros(cam.height * k, cam.width * k, CV_8UC1);
+  cv::fillConvexPoly(fine, outline, cv::Scalar(255), cv::LINE_8, 4);
+  cv::Mat to_inside, to_outside;
+  cv::distanceTransform(fine == 0, to_inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::distanceTransform(fine != 0, to_outside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  double far = 0.0;
+  int silhouette = 0;
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) {
+      const int fy = y * k + k / 2, fx = x * k + k / 2;
+      const bool in = fine.at<uchar>(fy, fx) != 0;
+      silhouette += in;
+      if ((drawn.at<uchar>(y, x) != 0) == in) continue;
+      far = std::max(far, static_cast<double>((in ? to_outside : to_inside).at<float>(fy, fx)) / k);
+    }
+  ASSERT_GT(silhouette, 2000);
+  EXPECT_LE(far, f.images.mask_edge_px + 0.15) << "drawn " << cv::countNonZero(drawn) << " px, silhouette " << silhouette;
+  // The checker's stand-in for this body: 4 points and a larger radius, a larger silhouette.
+  Checker checker(m);
+  checker.query(q, q, QueryOptions{.type = QueryType::Distances});
+  const SschView standin = checker.sweptVolume(0, kWorld);
+  ASSERT_LE(standin.points.size(), 4u);
+  Renderer renderer(cam);
+  const Volume v{standin.points, standin.radius, SafetyStatus::Clear, "link"};
+  const int larger = cv::countNonZero(renderer.render(std::span<const Volume>(&v, 1), Style{}, false, true).mask);
+  std::cout << "body of 14 points, budget 4: drawn " << cv::countNonZero(drawn) << " px, own silhouette " << silhouette
+            << " px (farthest disagreeing pixel " << far << " px), the stand-in " << larger << " px\n";
+  EXPECT_GT(larger, 1.1 * silhouette);
 }
 
 TEST_F(ModelViewTest, BoxDrawsTheSweptVolumes) {

@@ -129,7 +129,7 @@ void parseBodies(const Reader& r, const YAML::Node& list, Model& m) {
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YAML::Node n = list[i];
     const std::string f = "bodies[" + std::to_string(i) + "]";
-    r.onlyKeys(n, f, {"name", "frame", "points", "radius"});
+    r.onlyKeys(n, f, {"name", "frame", "points", "radius", "link", "tolerance"});
     Body b;
     b.name = r.text(r.require(n, "name", f), f + ".name");
     const std::string fb = "body '" + b.name + "'";
@@ -143,6 +143,28 @@ void parseBodies(const Reader& r, const YAML::Node& list, Model& m) {
     const YAML::Node rad = r.require(n, "radius", fb);
     b.radius = r.length(rad, fb + ".radius");
     if (b.radius < 0.0) r.fail(rad, fb + ".radius", "negative radius");
+    if (n["tolerance"]) {
+      b.tolerance = r.length(n["tolerance"], fb + ".tolerance");
+      if (b.tolerance < 0.0) r.fail(n["tolerance"], fb + ".tolerance", "must be >= 0");
+    }
+    if (n["link"]) {
+      b.link = r.text(n["link"], fb + ".link");
+      if (b.link.empty()) r.fail(n["link"], fb + ".link", "empty link name");
+      // Pieces of one link move together: the same frame as the link's other pieces, and no
+      // whole body may carry the link's name.
+      for (const Body& o : m.bodies) {
+        if (o.linkName() == b.link && o.frame != b.frame)
+          r.fail(n["link"], fb + ".link", "piece of link '" + b.link + "' in frame '" + m.frameName(b.frame) +
+                                              "', but body '" + o.name + "' of that link is in frame '" +
+                                              m.frameName(o.frame) + "'");
+        if (o.link.empty() && o.name == b.link && o.name != b.name)
+          r.fail(n["link"], fb + ".link", "link '" + b.link + "' is also a whole body's name");
+      }
+    } else {
+      for (const Body& o : m.bodies)
+        if (o.link == b.name)
+          r.fail(n["name"], f + ".name", "'" + b.name + "' is already the link of body '" + o.name + "'");
+    }
     m.bodies.push_back(std::move(b));
   }
 }

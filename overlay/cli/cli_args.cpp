@@ -1,5 +1,6 @@
 #include "cli_args.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <regex>
@@ -127,6 +128,15 @@ std::vector<std::string> splitCommas(const std::string& text) {
     at = comma + 1;
   }
   return out;
+}
+
+int piecesOption(const std::string& text) {
+  if (text == "auto") return 8;
+  int n = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+  if (ec != std::errc() || end != text.data() + text.size() || n < 1 || n > 64)
+    throw UsageError("--pieces: expected auto or a number of pieces 1 ... 64, got '" + text + "'");
+  return n;
 }
 
 }  // namespace kccd::cli

@@ -44,4 +44,7 @@ StateBox parseStateBox(const Model& m, const std::string& state, const std::stri
 /// Checks a `--points` value (the number of core points of a fit).
 void checkCorePoints(int k);
 
+/// `--pieces auto|N`: the most convex pieces a concave link may split into (auto: 8); N in 1 ... 64.
+int piecesOption(const std::string& text);
+
 }  // namespace kccd::cli

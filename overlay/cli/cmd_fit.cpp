@@ -9,7 +9,10 @@
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
+#include "kccd/modelling/convex_hull.hpp"
+#include "kccd/modelling/convex_pieces.hpp"
 #include "kccd/modelling/fit.hpp"
+#include "kccd/modelling/urdf_import.hpp"
 #include "kccd/modelling/yaml_edit.hpp"
 
 namespace kccd::cli {
@@ -21,54 +24,103 @@ struct FitArgs {
   std::string part, name, frame = "world", model, body;
   bool merge = false, json = false, quiet = false, hull = false;
   int evaluations = 4000;
+  double tolerance_mm = 0.0;  // > 0: the fewest points meeting it (--tolerance)
+  std::string pieces = "1";
+  double concavity_mm = modelling::kDefaultConcavityMm;
+};
+
+// One fitted piece (or the whole part) as a body snippet.
+struct FittedBody {
+  modelling::FitResult fit;
+  double concavity = 0.0;
 };
 
 Exit runFit(const FitArgs& args) {
   checkCorePoints(args.points);
   if (args.model.empty() != args.body.empty()) throw UsageError("--model and --body go together");
+  const int max_pieces = piecesOption(args.pieces);
   const auto t0 = std::chrono::steady_clock::now();
   modelling::Part part;
   part = modelling::readPart(args.part_file, {.part = args.part, .merge = args.merge});
-  modelling::FitResult r;
-  if (args.hull) {
-    r = modelling::exactHull(part);
+  modelling::PieceSplit split;
+  if (max_pieces > 1) {
+    split = modelling::splitConcave(part, {.max_pieces = max_pieces, .concavity = args.concavity_mm * 1e-3});
   } else {
-    Progress progress("fitting " + std::filesystem::path(args.part_file).filename().string(), args.quiet || args.json);
-    r = modelling::fit(part, {.points = args.points,
-                              .max_evaluations = args.evaluations,
-                              .progress = [&](double f) { progress.update(f); }});
+    split.pieces.push_back(part);
+    split.concavity.push_back(0.0);
   }
-  const std::string points_yaml = modelling::flowPoints(r.points);
-  const std::string radius_yaml = modelling::yamlNumber(r.radius, true);  // never smaller than fitted
-  const double volume = r.volume;
+  const int count = static_cast<int>(split.pieces.size());
+  if (count > 1 && !args.model.empty())
+    throw UsageError("--model replaces one body, but " + args.part_file + " splits into " + std::to_string(count) +
+                     " pieces (--pieces 1 fits it whole; kccd import writes a link's pieces)");
+  std::vector<FittedBody> fitted;
+  {
+    Progress progress("fitting " + std::filesystem::path(args.part_file).filename().string(),
+                      args.quiet || args.json || args.hull);
+    for (int k = 0; k < count; ++k) {
+      const modelling::FitOptions options{.points = args.points,
+                                          .max_evaluations = args.evaluations,
+                                          .progress = [&](double f) { progress.update((k + f) / count); }};
+      const modelling::Part& piece = split.pieces[k];
+      FittedBody b;
+      b.fit = args.hull                ? modelling::exactHull(piece)
+              : args.tolerance_mm > 0 ? modelling::fitToTolerance(piece, args.tolerance_mm * 1e-3, options)
+                                      : modelling::fit(piece, options);
+      b.concavity = split.concavity[k];
+      fitted.push_back(std::move(b));
+    }
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const double hull = r.hull_volume;
-  auto ratio = [&](double v) { return hull > 0 ? v / hull : std::numeric_limits<double>::infinity(); };
-  const std::string body_name =
+  const std::string stem =
       args.name.empty() ? (args.body.empty() ? std::filesystem::path(args.part_file).stem().string() : args.body)
                         : args.name;
+  auto nameOf = [&](int k) { return count > 1 ? stem + "/" + std::to_string(k + 1) : stem; };
+  // The bound each body meets, rounded up to a micrometre as the model file records it.
+  auto toleranceYaml = [](const modelling::FitResult& r) { return modelling::yamlNumber(std::ceil(r.outside * 1e6) / 1e6); };
 
-  if (!args.model.empty())
+  if (!args.model.empty()) {
+    const modelling::FitResult& r = fitted[0].fit;
     editFile(args.model, [&](const std::string& text) {
-      return modelling::withBodyGeometry(text, args.model, args.body, points_yaml, radius_yaml);
+      return modelling::withBodyGeometry(text, args.model, args.body, modelling::flowPoints(r.points),
+                                         modelling::yamlNumber(r.radius, true));
     });
+  }
   if (args.json) {
-    nlohmann::json j;
-    j["points"] = nlohmann::json::array();
-    for (const Vec3& v : r.points) j["points"].push_back(vec3(v));
-    j["radius"] = std::stod(radius_yaml);
-    j["volume"] = volume;
-    j["hull_volume"] = hull;
-    j["volume_ratio"] = number(ratio(volume));
-    if (!args.hull)
-      j["baselines"] = {{"sphere_volume", r.sphere_volume}, {"sphere_ratio", number(ratio(r.sphere_volume))},
-                        {"capsule_volume", r.capsule_volume}, {"capsule_ratio", number(ratio(r.capsule_volume))}};
-    j["k"] = static_cast<int>(r.points.size());
+    auto describe = [&](const modelling::FitResult& r) {
+      nlohmann::json j;
+      const double hull = r.hull_volume;
+      auto ratio = [&](double v) { return hull > 0 ? v / hull : std::numeric_limits<double>::infinity(); };
+      j["points"] = nlohmann::json::array();
+      for (const Vec3& v : r.points) j["points"].push_back(vec3(v));
+      j["radius"] = std::stod(modelling::yamlNumber(r.radius, true));
+      j["volume"] = r.volume;
+      j["hull_volume"] = hull;
+      j["volume_ratio"] = number(ratio(r.volume));
+      if (!args.hull)
+        j["baselines"] = {{"sphere_volume", r.sphere_volume}, {"sphere_ratio", number(ratio(r.sphere_volume))},
+                          {"capsule_volume", r.capsule_volume}, {"capsule_ratio", number(ratio(r.capsule_volume))}};
+      j["k"] = static_cast<int>(r.points.size());
+      j["hull_vertices"] = r.hull_vertices;
+      j["evaluations"] = r.evaluations;
+      j["outside"] = r.outside;
+      j["tolerance"] = std::stod(toleranceYaml(r));
+      j["method"] = r.method;
+      return j;
+    };
+    nlohmann::json j = count == 1 ? describe(fitted[0].fit) : nlohmann::json::object();
+    if (count > 1) {
+      j["pieces"] = nlohmann::json::array();
+      for (int k = 0; k < count; ++k) {
+        nlohmann::json p = describe(fitted[k].fit);
+        p["name"] = nameOf(k);
+        p["concavity"] = fitted[k].concavity;
+        j["pieces"].push_back(std::move(p));
+      }
+    }
+    if (split.measured) j["concavity"] = split.whole_concavity;
     j["exact_hull"] = args.hull;
     j["triangles"] = part.triangles;
     j["primitives"] = part.primitives;
-    j["hull_vertices"] = r.hull_vertices;
-    j["evaluations"] = r.evaluations;
     j["time_s"] = seconds;
     if (!args.model.empty()) j["written"] = {{"model", args.model}, {"body", args.body}};
     std::cout << j.dump(2) << "\n";
@@ -76,20 +128,36 @@ Exit runFit(const FitArgs& args) {
   }
   std::ostringstream out;
   out << "# kccd fit " << args.part_file << ": " << part.triangles << " triangles, " << part.primitives
-      << " analytic primitives, " << r.hull_vertices << " hull vertices, " << seconds << " s\n"
-      << "# "
-      << (args.hull ? "exact convex hull, " + std::to_string(r.points.size()) + " points"
-                    : "K = " + std::to_string(args.points))
-      << ": volume " << formatNumber(volume, 6) << " = " << formatNumber(ratio(volume), 4) << " x convex hull ("
-      << formatNumber(hull, 6) << ")\n";
-  if (!args.hull)
-    out << "# baselines: bounding sphere (K = 1) " << formatNumber(ratio(r.sphere_volume), 4)
-        << " x hull, PCA capsule (K = 2) " << formatNumber(ratio(r.capsule_volume), 4) << " x hull\n";
+      << " analytic primitives, "
+      << (count == 1 ? fitted[0].fit.hull_vertices : static_cast<int>(modelling::convexHull(part.samples()).vertices.size()))
+      << " hull vertices, " << seconds << " s\n";
+  if (split.measured)
+    out << "# concavity " << formatNumber(split.whole_concavity * 1e3, 3) << " mm"
+        << (count > 1 ? ": " + std::to_string(count) + " convex pieces" : std::string(", one piece")) << "\n";
+  for (int k = 0; k < count; ++k) {
+    const modelling::FitResult& r = fitted[k].fit;
+    const double hull = r.hull_volume;
+    auto ratio = [&](double v) { return hull > 0 ? v / hull : std::numeric_limits<double>::infinity(); };
+    out << "# " << (count > 1 ? nameOf(k) + ": " : "")
+        << (args.hull                ? "exact convex hull, " + std::to_string(r.points.size()) + " points"
+            : args.tolerance_mm > 0 ? std::string(r.method) + ", " + std::to_string(r.points.size()) + " points"
+                                    : "K = " + std::to_string(args.points))
+        << ": volume " << formatNumber(r.volume, 6) << " = " << formatNumber(ratio(r.volume), 4) << " x convex hull ("
+        << formatNumber(hull, 6) << "), at most " << formatNumber(r.outside * 1e3, 3) << " mm outside it\n";
+    if (!args.hull && count == 1)
+      out << "# baselines: bounding sphere (K = 1) " << formatNumber(ratio(r.sphere_volume), 4)
+          << " x hull, PCA capsule (K = 2) " << formatNumber(ratio(r.capsule_volume), 4) << " x hull\n";
+  }
   if (!args.model.empty()) out << "# written into " << args.model << ", body " << args.body << "\n";
-  out << "- name: " << body_name << "\n"
-      << "  frame: " << args.frame << "\n"
-      << "  points: " << points_yaml << "\n"
-      << "  radius: " << radius_yaml << "\n";
+  for (int k = 0; k < count; ++k) {
+    const modelling::FitResult& r = fitted[k].fit;
+    out << "- name: " << nameOf(k) << "\n";
+    if (count > 1) out << "  link: " << stem << "\n";
+    out << "  frame: " << args.frame << "\n"
+        << "  points: " << modelling::flowPoints(r.points) << "\n"
+        << "  radius: " << modelling::yamlNumber(r.radius, true) << "\n"
+        << "  tolerance: " << toleranceYaml(r) << "\n";
+  }
   std::cout << out.str();
   return Exit::Ok;
 }
@@ -122,6 +190,19 @@ Runner addFit(CLI::App& app) {
                 "costs more the more vertices (for the links of pairs that work close together)")
       ->excludes(points)
       ->excludes(evaluations);
+  sub->add_option("--tolerance", args->tolerance_mm,
+                  "Millimetres the volume may reach outside the part's convex hull: the fewest points that meet it "
+                  "(the K fit when it does, else hull vertices added farthest first)")
+      ->check(finiteIn(1e-6, 1e6))
+      ->excludes("--hull");
+  sub->add_option("--pieces", args->pieces,
+                  "A concave part in convex pieces: auto (up to 8) or N; it splits while its concavity exceeds "
+                  "--concavity (each piece a body LINK/1, LINK/2, ... with link: LINK)")
+      ->capture_default_str();
+  sub->add_option("--concavity", args->concavity_mm,
+                  "Millimetres of empty space inside the hull (hull surface to the mesh) above which a part splits")
+      ->capture_default_str()
+      ->check(finiteIn(1e-3, 1e6));
   sub->add_flag("--json", args->json, "Machine-readable output");
   sub->add_flag("--quiet,-q", args->quiet, "No progress display");
   sub->footer(

@@ -21,6 +21,10 @@ struct ImportArgs {
   std::vector<std::string> packages;
   bool quiet = false, pairs = false, no_visuals = false, keep_adjacent = false, hulls = false;
   int max_boxes = 2000;
+  double tolerance_mm = modelling::kDefaultToleranceMm;
+  std::string pieces = "auto";
+  double concavity_mm = modelling::kDefaultConcavityMm;
+  bool fixed_k = false;  // -k given: a fixed K fit instead of the tolerance
 };
 
 // `--pairs`: the pairs `kccd pairs` proves never to come within the margin, or to touch at every
@@ -57,6 +61,9 @@ Exit runImport(const ImportArgs& args) {
   modelling::ImportOptions opt;
   opt.srdf = args.srdf;
   opt.points = args.points;
+  opt.tolerance = args.fixed_k ? 0.0 : args.tolerance_mm * 1e-3;
+  opt.max_pieces = piecesOption(args.pieces);
+  opt.concavity = args.concavity_mm * 1e-3;
   opt.safety_margin = args.margin;
   opt.visuals = !args.no_visuals;
   opt.keep_adjacent = args.keep_adjacent;
@@ -94,7 +101,23 @@ Runner addImport(CLI::App& app) {
       "a conservative SSCH");
   sub->add_option("urdf", args->urdf, "URDF file")->required();
   sub->add_option("--srdf", args->srdf, "SRDF file: its disable_collisions become pairs: ignore");
-  sub->add_option("--points,-k", args->points, "Core points per link (1 ... 16)")->capture_default_str();
+  CLI::Option* points = sub->add_option("--points,-k", args->points,
+                                        "Expert knob: exactly K core points per link (1 ... 16), instead of --tolerance");
+  CLI::Option* tolerance =
+      sub->add_option("--tolerance", args->tolerance_mm,
+                      "Millimetres each link's volume may reach outside the link's convex hull: per link the fewest "
+                      "points that meet it (the K = 8 fit, else hull vertices added farthest first)")
+          ->capture_default_str()
+          ->check(finiteIn(1e-6, 1e6))
+          ->excludes(points);
+  sub->add_option("--pieces", args->pieces,
+                  "Concave links in convex pieces: auto (up to 8) or N (1: never split); a link splits while its "
+                  "concavity exceeds --concavity")
+      ->capture_default_str();
+  sub->add_option("--concavity", args->concavity_mm,
+                  "Millimetres of empty space inside a link's hull (hull surface to the mesh) above which it splits")
+      ->capture_default_str()
+      ->check(finiteIn(1e-3, 1e6));
   sub->add_option("--margin", args->margin, "safety_margin written into the model (metres)")
       ->capture_default_str()
       ->check(finiteIn(0.0, kMaxModelLength));
@@ -108,7 +131,8 @@ Runner addImport(CLI::App& app) {
   sub->add_flag("--hulls", args->hulls,
                 "Bodies are the links' convex hulls (every hull vertex, no fit): a tight but slow reference model "
                 "to measure what a fit costs (kccd query on both)")
-      ->excludes(sub->get_option("--points"));
+      ->excludes(points)
+      ->excludes(tolerance);
   sub->add_flag("--keep-adjacent", args->keep_adjacent,
                 "Check links joined by one moving joint (by default they are ignored, as MoveIt does: reason adjacent)");
   sub->add_option("--max-boxes", args->max_boxes, "With --pairs: boxes per pair before a pair is undecided")
@@ -126,7 +150,10 @@ Runner addImport(CLI::App& app) {
       "MoveIt's rule; --keep-adjacent checks them), the SRDF's disable_collisions (srdf), and with --pairs the pairs proven never "
       "within the margin (never) or touching at every configuration (always_touching).\n"
       "Exit status: 0 done, 2 bad input.");
-  return [args] { return runImport(*args); };
+  return [args, points] {
+    args->fixed_k = points->count() > 0;
+    return runImport(*args);
+  };
 }
 
 }  // namespace kccd::cli

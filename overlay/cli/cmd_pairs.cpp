@@ -52,7 +52,9 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
                                  .ignored_pairs = args.ignored,
                                  .progress = [&](double f) { progress.update(f); }});
   }
-  const std::vector<const modelling::PairSurvey*> order = modelling::byConcern(s);
+  const std::vector<const modelling::PairSurvey*> order = modelling::byConcern(s.pairs);
+  // Reported by link: the pieces of a concave link are one link (its closest pieces named).
+  const std::vector<const modelling::PairSurvey*> link_order = modelling::byConcern(s.links);
   const double n = static_cast<double>(std::max<std::size_t>(1, s.samples));
   if (args.json) {
     nlohmann::json j{{"margin", s.margin},         {"states", random ? nlohmann::json("random") : nlohmann::json(args.states)},
@@ -69,6 +71,16 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
       if (p->overlapping > 0) o["max_penetration"] = p->max_penetration;
       j["pairs"].push_back(o);
     }
+    j["links"] = nlohmann::json::array();
+    for (const auto* p : link_order) {
+      nlohmann::json o{{"a", m.bodies[p->a].linkName()}, {"b", m.bodies[p->b].linkName()},
+                       {"closest_bodies", {m.bodies[p->a].name, m.bodies[p->b].name}},
+                       {"body_pairs", p->body_pairs}, {"checked", p->checked}, {"within", p->within},
+                       {"fraction", p->within / n}, {"overlapping", p->overlapping},
+                       {"min_distance", number(p->min_distance)}, {"min_time", number(p->min_time)}};
+      if (p->within > 0) o["first_within"] = p->first_within, o["last_within"] = p->last_within;
+      j["links"].push_back(o);
+    }
     std::cout << j.dump(2) << "\n";
     return Exit::Ok;
   }
@@ -79,7 +91,7 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
   std::cout << std::left << std::setw(44) << "  pair" << std::setw(16) << "within margin" << std::setw(14)
             << "closest (m)" << std::setw(12) << when << "note\n";
   int quiet_pairs = 0;
-  for (const auto* p : order) {
+  for (const auto* p : link_order) {
     if (p->within == 0 && !args.all) {
       ++quiet_pairs;
       continue;
@@ -94,7 +106,11 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
     if (p->within > 0 && !random)
       note += "; " + formatNumber(p->first_within, 6) + " ... " + formatNumber(p->last_within, 6) + " s";
     if (!p->checked) note = "(ignored: " + modelling::currentIgnoreReason(m, p->a, p->b) + ") " + note;
-    std::cout << "  " << std::left << std::setw(42) << pairName(m, p->a, p->b) << std::setw(16)
+    if (p->body_pairs > 1)
+      note += (note.empty() ? "" : "; ") + std::string("closest pieces ") + pairName(m, p->a, p->b) + " of " +
+              std::to_string(p->body_pairs) + " piece pairs";
+    std::cout << "  " << std::left << std::setw(42) << (m.bodies[p->a].linkName() + " - " + m.bodies[p->b].linkName())
+              << std::setw(16)
               << (std::to_string(p->within) + " (" + formatNumber(100.0 * f, 3) + " %)") << std::setw(14)
               << (std::isnan(p->min_distance) ? std::string("-") : formatNumber(p->min_distance, 4)) << std::setw(12)
               << (std::isnan(p->min_time) ? std::string("-") : formatNumber(p->min_time, 6)) << note << "\n";

@@ -13,6 +13,15 @@
 
 namespace kccd::overlay {
 
+std::vector<std::array<std::string, 2>> linkPairs(const Model& model, const std::vector<std::array<int, 2>>& pairs) {
+  std::vector<std::array<std::string, 2>> out;
+  for (const auto& p : pairs) {
+    const std::array<std::string, 2> l{model.bodies[p[0]].linkName(), model.bodies[p[1]].linkName()};
+    if (std::find(out.begin(), out.end(), l) == out.end()) out.push_back(l);
+  }
+  return out;
+}
+
 const char* FrameRecord::queryStatusText() const {
   return braking_failed ? "no_braking_box" : not_finite ? "volume_not_finite" : toString(query);
 }
@@ -101,10 +110,9 @@ void FrameAnnotator::drawStatusLine(cv::Mat& bgr, const FrameRecord& rec) const 
       }
       if (!rec.pairs.empty()) {
         s << "  within margin: ";
-        const auto& bodies = scene_.model.bodies;
-        for (std::size_t i = 0; i < rec.pairs.size() && i < 3; ++i)
-          s << (i ? ", " : "") << bodies[rec.pairs[i][0]].name << "-" << bodies[rec.pairs[i][1]].name;
-        if (rec.pairs.size() > 3) s << " +" << rec.pairs.size() - 3;
+        const std::vector<std::array<std::string, 2>> links = linkPairs(scene_.model, rec.pairs);
+        for (std::size_t i = 0; i < links.size() && i < 3; ++i) s << (i ? ", " : "") << links[i][0] << "-" << links[i][1];
+        if (links.size() > 3) s << " +" << links.size() - 3;
       }
     }
   }

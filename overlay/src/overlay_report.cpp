@@ -43,6 +43,8 @@ nlohmann::json reportJson(const OverlayReport& report, const Model& model, bool 
     for (double v : r.values) f["state_values"].push_back(numberOrNull(v));
     f["pairs_within_margin"] = nlohmann::json::array();
     for (const auto& p : r.pairs) f["pairs_within_margin"].push_back({model.bodies[p[0]].name, model.bodies[p[1]].name});
+    f["links_within_margin"] = nlohmann::json::array();
+    for (const auto& l : linkPairs(model, r.pairs)) f["links_within_margin"].push_back({l[0], l[1]});
     if (r.match != StateMatch::None) f["query_status"] = r.queryStatusText();
     f["written"] = r.written;
     frames.push_back(std::move(f));

@@ -269,6 +269,8 @@ class _Fit(TypedDict):
     evaluations: int
     triangles: int
     primitives: int
+    outside: float
+    method: str
     yaml: str
 
 def fit(
@@ -281,13 +283,17 @@ def fit(
     max_evaluations: int = 4000,
     seed: int = 1,
     exact_hull: bool = False,
+    tolerance: float | None = None,
     progress: Callable[[float], object] | None = None,
 ) -> _Fit: ...
 def import_urdf(
     urdf_path: str,
     *,
     srdf: str = "",
-    points: int = 8,
+    points: int | None = None,
+    tolerance: float = 2.0,
+    pieces: int | str = "auto",
+    concavity: float = 20.0,
     safety_margin: float = 0.02,
     packages: dict[str, str] = {},
     visuals: bool = True,

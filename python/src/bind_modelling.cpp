@@ -2,6 +2,7 @@
 // to model text) and kccd.prove_pairs (which pairs can never meet, and the ignore list that follows).
 #include <pybind11/stl.h>
 
+#include <optional>
 #include <string>
 
 #include "arrays.hpp"
@@ -35,9 +36,13 @@ void bindModelling(py::module_& m) {
   m.def(
       "fit",
       [](const std::string& path, int k, const std::string& part_name, bool merge, const std::array<double, 3>& scale,
-         int max_evaluations, std::uint64_t seed, bool exact_hull, const py::object& progress) {
+         int max_evaluations, std::uint64_t seed, bool exact_hull, const std::optional<double>& tolerance,
+         const py::object& progress) {
         checkPoints(k);
         if (max_evaluations < 1) throw py::value_error("max_evaluations: must be >= 1");
+        if (tolerance && !(*tolerance >= 1e-6 && *tolerance <= 1e6))
+          throw py::value_error("tolerance: must be a number of millimetres in 1e-6 ... 1e6");
+        if (tolerance && exact_hull) throw py::value_error("tolerance: not with exact_hull (the hull has none)");
         ProgressRelay relay{progress, {}};
         modelling::Part part;
         modelling::FitResult r;
@@ -45,6 +50,12 @@ void bindModelling(py::module_& m) {
           part = modelling::readPart(path, {.part = part_name, .merge = merge, .scale = {scale[0], scale[1], scale[2]}});
           if (exact_hull) {
             r = modelling::exactHull(part);
+          } else if (tolerance) {
+            r = modelling::fitToTolerance(part, *tolerance * 1e-3,
+                                          {.points = k,
+                                           .max_evaluations = max_evaluations,
+                                           .seed = seed,
+                                           .progress = [&](double f) { relay(f); }});
           } else {
             r = modelling::fit(part, {.points = k,
                                       .max_evaluations = max_evaluations,
@@ -65,36 +76,56 @@ void bindModelling(py::module_& m) {
         d["evaluations"] = r.evaluations;
         d["triangles"] = part.triangles;
         d["primitives"] = part.primitives;
+        d["outside"] = r.outside;
+        d["method"] = std::string(r.method);
         d["yaml"] = "{points: " + points_yaml + ", radius: " + radius_yaml + "}";
         return d;
       },
       py::arg("part_path"), py::arg("points") = 8, py::kw_only(), py::arg("part") = "", py::arg("merge") = false,
       py::arg("scale") = std::array<double, 3>{1.0, 1.0, 1.0}, py::arg("max_evaluations") = 4000, py::arg("seed") = 1,
-      py::arg("exact_hull") = false, py::arg("progress") = py::none(),
+      py::arg("exact_hull") = false, py::arg("tolerance") = py::none(), py::arg("progress") = py::none(),
       R"doc(Fits a conservative SSCH (`points` core points, 1 ... 16, and a radius) to a rigid part, as `kccd fit`:
 every point of the part lies inside it, and its volume is as small as the search finds. part_path: Open Inventor
 (.iv), VRML (.wrl), STL or any mesh Assimp reads (OBJ, COLLADA, PLY, glTF, ...). part: one DEF'd node alone;
 merge: accept several top-level parts as one body; scale: per axis, in the file's frame; exact_hull: no fit,
-the part's own convex hull (every hull vertex a core point). progress(fraction) is called with the GIL held.
+the part's own convex hull (every hull vertex a core point); tolerance: millimetres the volume may reach outside
+the part's hull, as `kccd fit --tolerance` (the K = points fit when it meets it, else the fewest hull vertices
+that do). progress(fraction) is called with the GIL held.
 Returns a dict: 'points' float64 (K, 3) in the part's frame (metres, 10 significant digits), 'radius' (rounded
 up: the SSCH still covers the part when written as printed), 'volume', 'hull_volume', 'sphere_volume',
 'capsule_volume' (m^3: the fit, the part's hull, and the one-sphere and principal-axis-capsule baselines),
-'hull_vertices', 'evaluations', 'triangles', 'primitives', and 'yaml' (the body's geometry as a model file
+'hull_vertices', 'evaluations', 'triangles', 'primitives', 'outside' (metres: how far the volume may reach
+outside the part's hull, an upper bound), 'method' ('fit', 'hull' or 'simplified hull'), and 'yaml' (the body's geometry as a model file
 writes it: {points: [...], radius: ...}; see Model.with_body_geometry). Raises InputError naming the file and
 place for a part that cannot be read. The GIL is released while fitting.)doc");
 
   m.def(
       "import_urdf",
-      [](const std::string& path, const std::string& srdf, int k, double safety_margin,
+      [](const std::string& path, const std::string& srdf, const std::optional<int>& k, double tolerance,
+         const py::object& pieces, double concavity, double safety_margin,
          const std::map<std::string, std::string>& packages, bool visuals, bool hulls, bool keep_adjacent,
          const py::object& progress) {
-        checkPoints(k);
+        if (k) checkPoints(*k);
+        if (!(tolerance >= 1e-6 && tolerance <= 1e6))
+          throw py::value_error("tolerance: must be a number of millimetres in 1e-6 ... 1e6");
+        if (!(concavity >= 1e-3 && concavity <= 1e6))
+          throw py::value_error("concavity: must be a number of millimetres in 1e-3 ... 1e6");
+        int max_pieces = 8;
+        if (py::isinstance<py::str>(pieces)) {
+          if (pieces.cast<std::string>() != "auto") throw py::value_error("pieces: 'auto' or a number 1 ... 64");
+        } else {
+          max_pieces = pieces.cast<int>();
+          if (max_pieces < 1 || max_pieces > 64) throw py::value_error("pieces: 'auto' or a number 1 ... 64");
+        }
         if (!(safety_margin >= 0.0)) throw py::value_error("safety_margin: must be a number >= 0 (metres)");
         ProgressRelay relay{progress, {}};
         std::string text;
         relay.run([&] {
           text = modelling::importUrdf(path, {.srdf = srdf,
-                                              .points = k,
+                                              .points = k ? *k : 8,
+                                              .tolerance = k ? 0.0 : tolerance * 1e-3,
+                                              .max_pieces = max_pieces,
+                                              .concavity = concavity * 1e-3,
                                               .safety_margin = safety_margin,
                                               .packages = packages,
                                               .visuals = visuals,
@@ -104,12 +135,16 @@ place for a part that cannot be read. The GIL is released while fitting.)doc");
         });
         return text;
       },
-      py::arg("urdf_path"), py::kw_only(), py::arg("srdf") = "", py::arg("points") = 8, py::arg("safety_margin") = 0.02,
+      py::arg("urdf_path"), py::kw_only(), py::arg("srdf") = "", py::arg("points") = py::none(),
+      py::arg("tolerance") = modelling::kDefaultToleranceMm, py::arg("pieces") = "auto",
+      py::arg("concavity") = modelling::kDefaultConcavityMm, py::arg("safety_margin") = 0.02,
       py::arg("packages") = std::map<std::string, std::string>{}, py::arg("visuals") = true, py::arg("hulls") = false,
       py::arg("keep_adjacent") = false, py::arg("progress") = py::none(),
       R"doc(Converts a URDF into model text (YAML, `kccd: 1`), as `kccd import`: joints and origins one to one, each
-link's collision geometry fitted with a conservative SSCH of `points` core points (hulls=True: the links' convex
-hulls, a tight and slow reference). `pairs: ignore` lists rigidly joined links, adjacent links (unless
+link's collision geometry fitted with a conservative SSCH within `tolerance` millimetres of the link's hull (the
+fewest points that meet it), or of exactly `points` core points when given (hulls=True: the links' convex hulls,
+a tight and slow reference). pieces: 'auto' (up to 8) or N: a link whose concavity exceeds `concavity`
+millimetres splits into convex pieces, bodies LINK/1, LINK/2, ... with link: LINK. `pairs: ignore` lists rigidly joined links, adjacent links (unless
 keep_adjacent) and the SRDF's disable_collisions (srdf: its path). packages: package:// NAME -> directory.
 visuals: write each link's <visual> meshes for drawing. safety_margin: metres. progress(fraction) is called with
 the GIL held. Returns the text (kccd.Model.from_yaml(text) loads it; write it to a .yaml file to keep it).

@@ -44,11 +44,13 @@ std::vector<Volume> staticSceneVolumes(const Model& model, Checker& checker, std
   if (!framePoses(model, state, poses)) return out;  // the checker's (unsafe) volumes as they are
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
     const Body& b = model.bodies[i];
-    // Only where the checker's volume is the body moved rigidly: no error bound, the same points,
-    // and a radius grown by no more than rounding (the checker adds a guard of a few ulps; the
-    // drawn radius takes 1 nm more, fixed per body so that its mesh stays cached).
+    // A body moved rigidly is drawn as it is: its own points and radius, whatever the point
+    // budget (the checker may hold a reduced stand-in with a larger radius: an engine detail).
+    // The drawn radius takes 1 nm more than the body's, covering the checker's rounding guard,
+    // fixed per body so that its mesh stays cached. A body below a joint with an error bound
+    // keeps the checker's grown volume.
     const double drawn = b.radius * (1.0 + 1e-9) + 1e-9;
-    if (out[i].points.size() != b.points.size() || hasErrorBound(model, b.frame) || out[i].radius > drawn) continue;
+    if (hasErrorBound(model, b.frame)) continue;
     out[i].points = b.points;
     out[i].radius = drawn;
     out[i].pose = framePose(poses, b.frame);

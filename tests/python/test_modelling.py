@@ -98,6 +98,43 @@ def test_fit_errors(tmp_path: pathlib.Path) -> None:
         kccd.fit(str(DATA / "parts" / "gripper.iv"), 2, progress=stop)
 
 
+def test_fit_to_a_tolerance_equals_cli_and_holds(cli, tmp_path: pathlib.Path) -> None:
+    # A 48-sided cylinder, 4 cm across and 0.25 m long: its hull has 96 vertices.
+    a = np.linspace(0, 2 * np.pi, 48, endpoint=False)
+    rim = np.stack([0.02 * np.cos(a), 0.02 * np.sin(a)], axis=1)
+    tris = []
+    for i in range(48):
+        j = (i + 1) % 48
+        p0, p1 = rim[i], rim[j]
+        tris += [[[*p0, 0], [*p1, 0], [*p1, 0.25]], [[*p0, 0], [*p1, 0.25], [*p0, 0.25]],
+                 [[0, 0, 0], [*p1, 0], [*p0, 0]], [[0, 0, 0.25], [*p0, 0.25], [*p1, 0.25]]]
+    part = tmp_path / "cyl.stl"
+    write_stl(part, np.array(tris))
+    f = kccd.fit(str(part), tolerance=0.5, max_evaluations=600)
+    j = json.loads(subprocess.run([str(cli), "fit", str(part), "--tolerance", "0.5", "--evaluations", "600", "--json"],
+                                  check=True, capture_output=True, text=True).stdout)
+    assert f["points"].tolist() == j["points"] and f["radius"] == j["radius"] and f["method"] == j["method"]
+    assert f["outside"] == j["outside"] <= 0.5e-3
+    assert len(f["points"]) < 96
+    verts = np.array(tris).reshape(-1, 3)
+    assert hull_distance(verts, f["points"]).max() <= f["radius"], "a vertex lies outside the volume"
+    with pytest.raises(ValueError, match="tolerance"):
+        kccd.fit(str(part), tolerance=0.0)
+
+
+def test_import_urdf_to_a_tolerance_equals_cli(cli) -> None:
+    args = ["--srdf", str(URDF / "two_link.srdf"), "--package-path", f"kccd_test={URDF}"]
+    text = kccd.import_urdf(str(URDF / "two_link.urdf"), srdf=str(URDF / "two_link.srdf"),
+                            packages={"kccd_test": str(URDF)}, tolerance=1.0)
+    out = subprocess.run([str(cli), "import", str(URDF / "two_link.urdf"), *args, "--tolerance", "1", "-q"],
+                         check=True, capture_output=True, text=True).stdout
+    assert text == out
+    bodies = yaml.safe_load(text)["bodies"]
+    assert bodies and all(0 <= float(b["tolerance"]) <= 1e-3 for b in bodies)  # YAML 1.1 reads 1e-06 as text
+    with pytest.raises(ValueError, match="pieces"):
+        kccd.import_urdf(str(URDF / "two_link.urdf"), pieces="many")
+
+
 def test_with_body_geometry(arm: kccd.Model) -> None:
     f = kccd.fit(str(DATA / "parts" / "gripper.iv"), 2, max_evaluations=300)
     m = arm.with_body_geometry("gripper", f["points"], f["radius"])

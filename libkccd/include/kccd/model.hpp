@@ -43,6 +43,14 @@ struct Body {
   int frame = kWorld;
   std::vector<Vec3> points;
   double radius = 0.0;
+  /// The link this body is a convex piece of (a concave link modelled in pieces: every piece in
+  /// the link's frame); empty when the body is a whole link. See linkName().
+  std::string link;
+  /// How far the volume may reach outside its link's (piece's) convex hull, as fitted (metres);
+  /// negative when the file does not say. Informative: the checks use the points and radius.
+  double tolerance = -1.0;
+  /// The link the user knows the body as: `link` when it is a piece, else its own name.
+  const std::string& linkName() const { return link.empty() ? name : link; }
 };
 
 /// How a link looks, for drawing only (never checked for collision): a mesh file or a

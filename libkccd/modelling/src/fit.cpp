@@ -88,6 +88,50 @@ class Objective {
   GjkOptions options_{.max_iterations = 64, .relative_tolerance = 1e-7};
 };
 
+// The part's hull for measuring how far a volume reaches outside it: planes of its faces
+// (solids) and its vertices. Built on the part's points and points on its balls' surfaces.
+struct OutsideHull {
+  std::vector<Vec3> vertices;
+  std::vector<Vec3> normals;  // unit, outward
+  std::vector<double> offsets;
+  bool solid = false;
+};
+
+OutsideHull outsideHull(const Part& part) {
+  OutsideHull o;
+  const std::vector<Vec3> samples = part.samples(162);
+  if (samples.empty()) return o;
+  const ConvexHull h = convexHull(samples);
+  for (int i : h.vertices) o.vertices.push_back(samples[i]);
+  if (h.dimension == 3) {
+    for (const auto& t : h.triangles) {
+      const Vec3 n = (samples[t[1]] - samples[t[0]]).cross(samples[t[2]] - samples[t[0]]);
+      if (!(n.norm() > 0.0)) continue;
+      o.normals.push_back(n.normalized());
+      o.offsets.push_back(o.normals.back().dot(samples[t[0]]));
+    }
+    o.solid = !o.normals.empty();
+  }
+  return o;
+}
+
+// Signed distance from x to the hull: the distance outside (an upper bound, through GJK), minus
+// the depth inside (the distance to the nearest face plane: a ball of that radius lies inside).
+double signedDistance(const Vec3& x, const OutsideHull& h) {
+  if (h.solid) {
+    double worst = -INFINITY;
+    for (std::size_t f = 0; f < h.normals.size(); ++f) worst = std::max(worst, h.normals[f].dot(x) - h.offsets[f]);
+    if (worst <= 0.0) return worst;
+  }
+  return hullDistanceUpper(x, h.vertices);
+}
+
+double outsideOf(std::span<const Vec3> core, double radius, const OutsideHull& h) {
+  double worst = -INFINITY;
+  for (const Vec3& p : core) worst = std::max(worst, signedDistance(p, h));
+  return std::max(0.0, worst + radius);
+}
+
 // What a covering radius is measured against: the hull vertices of the part's points (the
 // hull is computed once per part), its balls and its input rounding guard.
 struct Cover {
@@ -348,6 +392,8 @@ FitResult exactHull(const Part& part) {
   result.volume = sschVolume(result.points, result.radius);
   result.hull_volume = convexHull(part.samples()).volume;
   result.hull_vertices = static_cast<int>(h.vertices.size());
+  result.outside = outsideDistance(result.points, result.radius, part);
+  result.method = "hull";
   return result;
 }
 
@@ -494,8 +540,162 @@ FitResult fit(const Part& part, const FitOptions& options) {
     for (int i = 0; i < 3; ++i) p(i) = std::stod(yamlNumber(p(i)));
   result.radius = coverRadius(result.points, cover);
   result.volume = sschVolume(result.points, result.radius);
+  result.outside = outsideDistance(result.points, result.radius, part);
   if (options.progress) options.progress(1.0);
   return result;
+}
+
+double outsideDistance(std::span<const Vec3> core, double radius, const Part& part) {
+  return outsideOf(core, radius, outsideHull(part));
+}
+
+namespace {
+
+// The simplified hull at depth rho: each hull vertex (balls by their circumscribed polytopes) has
+// a candidate core point, the vertex moved inwards by rho along its angle-weighted normal; the
+// candidates of the vertices farthest from the kept points' hull are added one at a time until
+// the volume (radius: the covering radius) reaches at most `tolerance` outside the part's hull
+// H, or every candidate is in. rho = 0 keeps hull vertices (a radius of about the tolerance); a
+// larger rho trades depth for a larger radius, and on rounded parts for far fewer points.
+FitResult simplifiedHull(const Part& part, const OutsideHull& h, double tolerance, double rho) {
+  std::vector<Vec3> samples = part.points;
+  for (const Sphere& b : part.balls)
+    for (const Vec3& v : circumscribedUnitSphere()) samples.push_back(b.center + b.radius * v);
+  const ConvexHull hull = convexHull(samples);
+  Cover cover;
+  cover.guard = part.coordinate_guard;
+  for (int i : hull.vertices) cover.vertices.push_back(samples[i]);
+  const std::vector<Vec3>& vertex = cover.vertices;
+  const std::size_t n = vertex.size();
+  std::vector<Vec3> candidate = vertex;
+  if (rho > 0.0 && hull.dimension == 3) {
+    std::vector<Vec3> normal(samples.size(), Vec3::Zero());
+    for (const auto& t : hull.triangles) {
+      const Vec3 nn = (samples[t[1]] - samples[t[0]]).cross(samples[t[2]] - samples[t[0]]);
+      if (!(nn.norm() > 0.0)) continue;
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 e1 = samples[t[(k + 1) % 3]] - samples[t[k]], e2 = samples[t[(k + 2) % 3]] - samples[t[k]];
+        normal[t[k]] += std::atan2(e1.cross(e2).norm(), e1.dot(e2)) * nn.normalized();
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3& nv = normal[hull.vertices[i]];
+      if (nv.norm() > 0.0) candidate[i] = vertex[i] - rho * nv.normalized();
+    }
+  }
+  for (Vec3& p : candidate)
+    for (int a = 0; a < 3; ++a) p(a) = std::stod(yamlNumber(p(a)));  // as printed
+  std::vector<double> depth(n);  // signed distance of each candidate to H
+  for (std::size_t i = 0; i < n; ++i) depth[i] = signedDistance(candidate[i], h);
+  FitResult result;
+  result.hull_vertices = static_cast<int>(n);
+  result.method = "simplified hull";
+  std::vector<Vec3> core;
+  std::vector<char> used(n, 0);
+  double worst_depth = -INFINITY;
+  auto take = [&](std::size_t i) {
+    used[i] = 1;
+    core.push_back(candidate[i]);
+    worst_depth = std::max(worst_depth, depth[i]);
+  };
+  // Four spread-out vertices: the farthest from the centroid, then each farthest from those.
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& p : vertex) mean += p;
+  mean /= static_cast<double>(std::max<std::size_t>(n, 1));
+  std::vector<double> nearest(n, INFINITY);
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if ((vertex[i] - mean).squaredNorm() > (vertex[next] - mean).squaredNorm()) next = i;
+  for (int k = 0; k < 4 && k < static_cast<int>(n); ++k) {
+    take(next);
+    for (std::size_t i = 0; i < n; ++i) nearest[i] = std::min(nearest[i], (vertex[i] - vertex[next]).squaredNorm());
+    next = static_cast<std::size_t>(std::max_element(nearest.begin(), nearest.end()) - nearest.begin());
+    if (used[next]) break;
+  }
+  // Then the candidate of the vertex farthest from the kept points' hull while that distance
+  // (the radius) plus the shallowest kept point's signed distance exceeds the tolerance. A
+  // vertex's distance only falls as the hull grows: one within the best-known distance is not
+  // measured again.
+  std::vector<double> d(n, INFINITY);
+  std::vector<Vec3> directions(n, Vec3::UnitX());
+  const GjkOptions options{.max_iterations = 64, .relative_tolerance = 1e-9};
+  const double aim = 0.98 * tolerance;  // room for the exact radius's rounding guard
+  while (true) {
+    double far = -1.0;
+    std::size_t pick = n;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (d[i] <= far) continue;
+      GjkOptions o = options;
+      o.warm_start = &directions[i];
+      const DistanceResult r = distance(SschView{std::span<const Vec3>(&vertex[i], 1), 0.0}, SschView{core, 0.0}, o);
+      directions[i] = r.direction;
+      d[i] = r.hull_upper;
+      if (d[i] > far) far = d[i], pick = i;
+    }
+    if (pick == n || far + worst_depth <= aim) break;
+    if (used[pick]) {  // its own candidate is in and it is still too far: the depth is too deep
+      std::size_t other = n;
+      for (std::size_t i = 0; i < n; ++i)
+        if (!used[i] && (other == n || d[i] > d[other])) other = i;
+      if (other == n) break;
+      pick = other;
+    }
+    take(pick);
+  }
+  result.points = core;
+  result.radius = coverRadius(result.points, cover);
+  result.volume = sschVolume(result.points, result.radius);
+  result.hull_volume = hull.dimension == 3 ? hull.volume : 0.0;
+  result.outside = outsideOf(result.points, result.radius, h);
+  return result;
+}
+
+// The fewest points meeting the tolerance over depths from 0 to 45 % of the part's thinnest
+// extent (ties: the smaller volume).
+FitResult bestSimplifiedHull(const Part& part, const OutsideHull& h, double tolerance) {
+  Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+  const Eigen::Matrix3d axes = hull::principalFrame(h.vertices).axes;
+  for (const Vec3& p : h.vertices) {
+    const Vec3 q = axes.transpose() * p;
+    lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+  }
+  const double thin = h.vertices.empty() ? 0.0 : (hi - lo).minCoeff();
+  std::vector<double> depths{0.0};
+  for (double f : {0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0})
+    if (f * tolerance < 0.45 * thin) depths.push_back(f * tolerance);
+  for (double f : {0.1, 0.2, 0.3, 0.45}) depths.push_back(f * thin);
+  FitResult best;
+  bool have = false;
+  for (const double rho : depths) {
+    FitResult r = simplifiedHull(part, h, tolerance, rho);
+    const bool meets = r.outside <= tolerance;
+    const bool best_meets = have && best.outside <= tolerance;
+    if (!have || (meets && !best_meets) ||
+        (meets == best_meets && (r.points.size() < best.points.size() ||
+                                 (r.points.size() == best.points.size() && r.volume < best.volume))))
+      best = std::move(r), have = true;
+  }
+  return best;
+}
+
+}  // namespace
+
+FitResult fitToTolerance(const Part& part, double tolerance, const FitOptions& options) {
+  if (!(tolerance > 0.0) || !std::isfinite(tolerance))
+    throw std::invalid_argument("the tolerance must be a positive length (got " + yamlNumber(tolerance) + ")");
+  if (part.empty()) throw std::invalid_argument("the part has no geometry");
+  const OutsideHull h = outsideHull(part);
+  FitResult hull = bestSimplifiedHull(part, h, tolerance);
+  if (hull.points.size() <= static_cast<std::size_t>(options.points) && hull.outside <= tolerance) {
+    if (options.progress) options.progress(1.0);
+    return hull;
+  }
+  FitResult fitted = fit(part, options);  // sets fitted.outside
+  if (fitted.outside <= tolerance) return fitted;
+  hull.evaluations = fitted.evaluations;
+  hull.sphere_volume = fitted.sphere_volume;
+  hull.capsule_volume = fitted.capsule_volume;
+  return hull;
 }
 
 }  // namespace kccd::modelling

@@ -109,8 +109,7 @@ void collect(const aiScene& scene, const aiNode& node, const Eigen::Affine3d& to
         };
         // Polygons as fans of triangles (the vertices, all a fit needs, are exactly the polygon's).
         for (unsigned k = 1; k + 1 < face.mNumIndices; ++k) {
-          part.points.insert(part.points.end(), {point(0), point(k), point(k + 1)});
-          ++part.triangles;
+          part.addTriangle(point(0), point(k), point(k + 1));
         }
       }
     }
@@ -367,6 +366,9 @@ Part readMesh(const std::string& data, const std::string& path, const std::strin
         take(at, xyz, sizeof xyz);
         part.points.emplace_back(xyz[0], xyz[1], xyz[2]);
       }
+      // The child writes each triangle's three points in turn (addTriangle).
+      if (part.points.size() == 3 * counts[0])
+        for (int k = 0; k + 2 < static_cast<int>(part.points.size()); k += 3) part.faces.push_back({k, k + 1, k + 2});
       return part;
     }
   }

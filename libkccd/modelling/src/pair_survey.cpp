@@ -29,6 +29,27 @@ Survey surveyStates(const Model& model, const StateLog& log, const SurveyOptions
     s.min_distance = INFINITY;
     out.pairs.push_back(s);
   }
+  // Link pairs: each body pair's link pair, in order of first appearance.
+  std::vector<std::size_t> link_of(out.pairs.size());
+  for (std::size_t i = 0; i < out.pairs.size(); ++i) {
+    const PairSurvey& s = out.pairs[i];
+    const std::string& la = model.bodies[s.a].linkName();
+    const std::string& lb = model.bodies[s.b].linkName();
+    std::size_t k = 0;
+    for (; k < out.links.size(); ++k) {
+      const std::string& ka = model.bodies[out.links[k].a].linkName();
+      const std::string& kb = model.bodies[out.links[k].b].linkName();
+      if (out.links[k].checked == s.checked && ((ka == la && kb == lb) || (ka == lb && kb == la))) break;
+    }
+    if (k == out.links.size()) {
+      out.links.push_back(s);
+    } else {
+      ++out.links[k].body_pairs;
+    }
+    link_of[i] = k;
+  }
+  std::vector<double> row_min(out.links.size());
+  std::vector<char> row_overlap(out.links.size());
   Checker checker(m);
   const QueryOptions q{.type = QueryType::Distances, .margin = out.margin};
   const std::size_t rows = log.rows();
@@ -43,8 +64,13 @@ Survey surveyStates(const Model& model, const StateLog& log, const SurveyOptions
       continue;
     }
     bool red = false;
+    std::fill(row_min.begin(), row_min.end(), INFINITY);
+    std::fill(row_overlap.begin(), row_overlap.end(), 0);
     for (const PairDistance& d : r.pairs) {
       PairSurvey& s = out.pairs[d.pair];
+      PairSurvey& l = out.links[link_of[d.pair]];
+      if (d.distance < row_min[link_of[d.pair]]) row_min[link_of[d.pair]] = d.distance;
+      if (d.distance < l.min_distance) l.min_distance = d.distance, l.min_time = t, l.a = s.a, l.b = s.b;
       if (d.distance < s.min_distance) s.min_distance = d.distance, s.min_time = t;
       if (d.distance > out.margin) continue;
       if (s.within++ == 0) s.first_within = t;
@@ -54,12 +80,22 @@ Survey surveyStates(const Model& model, const StateLog& log, const SurveyOptions
         ++s.overlapping;
         const Penetration p = penetration(checker.sweptVolume(s.a, s.lca), checker.sweptVolume(s.b, s.lca));
         if (p.overlapping) s.max_penetration = std::max(s.max_penetration, p.depth);
+        l.max_penetration = std::max(l.max_penetration, s.max_penetration);
+        row_overlap[link_of[d.pair]] = 1;
       }
+    }
+    for (std::size_t k = 0; k < out.links.size(); ++k) {
+      PairSurvey& l = out.links[k];
+      l.overlapping += row_overlap[k];
+      if (!(row_min[k] <= out.margin)) continue;
+      if (l.within++ == 0) l.first_within = t;
+      l.last_within = t;
     }
     out.samples_within += red;
   }
-  for (PairSurvey& s : out.pairs)
-    if (!std::isfinite(s.min_distance)) s.min_distance = s.min_time = std::nan("");  // no Ok sample
+  for (std::vector<PairSurvey>* list : {&out.pairs, &out.links})
+    for (PairSurvey& s : *list)
+      if (!std::isfinite(s.min_distance)) s.min_distance = s.min_time = std::nan("");  // no Ok sample
   if (options.progress) options.progress(1.0);
   return out;
 }
@@ -79,9 +115,9 @@ StateLog randomStates(const Model& model, int count, std::uint64_t seed) {
   return log;
 }
 
-std::vector<const PairSurvey*> byConcern(const Survey& survey) {
+std::vector<const PairSurvey*> byConcern(const std::vector<PairSurvey>& pairs) {
   std::vector<const PairSurvey*> order;
-  for (const PairSurvey& p : survey.pairs) order.push_back(&p);
+  for (const PairSurvey& p : pairs) order.push_back(&p);
   std::stable_sort(order.begin(), order.end(), [](const PairSurvey* x, const PairSurvey* y) {
     return x->within != y->within ? x->within > y->within : x->min_distance < y->min_distance;
   });

@@ -74,7 +74,16 @@ void Part::addBox(const Eigen::Affine3d& transform, const Vec3& size) {
                                       (i & 4 ? 0.5 : -0.5) * size.z()));
 }
 
+void Part::addTriangle(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const int n = static_cast<int>(points.size());
+  points.insert(points.end(), {a, b, c});
+  faces.push_back({n, n + 1, n + 2});
+  ++triangles;
+}
+
 void Part::append(const Part& other) {
+  const int offset = static_cast<int>(points.size());
+  for (const auto& f : other.faces) faces.push_back({f[0] + offset, f[1] + offset, f[2] + offset});
   points.insert(points.end(), other.points.begin(), other.points.end());
   balls.insert(balls.end(), other.balls.begin(), other.balls.end());
   triangles += other.triangles;

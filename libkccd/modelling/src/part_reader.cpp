@@ -136,11 +136,11 @@ void triangle(void* data, SoCallbackAction* action, const SoPrimitiveVertex* v1,
               const SoPrimitiveVertex* v3) {
   auto* c = static_cast<Collector*>(data);
   const Eigen::Affine3d m = toEigen(action->getModelMatrix());
-  for (const SoPrimitiveVertex* v : {v1, v2, v3}) {
+  auto at = [&](const SoPrimitiveVertex* v) {
     const SbVec3f& p = v->getPoint();
-    c->part.points.push_back(m * Vec3(p[0], p[1], p[2]));
-  }
-  ++c->part.triangles;
+    return Vec3(m * Vec3(p[0], p[1], p[2]));
+  };
+  c->part.addTriangle(at(v1), at(v2), at(v3));
 }
 
 // A size of an analytic primitive: finite and not negative (zero is a degenerate but exact shape).
@@ -371,13 +371,14 @@ Part readStl(const std::string& data, const std::string& path, const Vec3& scale
   if (data.size() >= 84 && data.size() == 84 + 50ull * count) {
     for (std::uint32_t t = 0; t < count; ++t) {
       const char* rec = data.data() + 84 + 50ull * t + 12;  // skip the normal
+      Vec3 corner[3];
       for (int k = 0; k < 3; ++k) {
         float xyz[3];
         std::memcpy(xyz, rec + 12 * k, 12);
-        add(Vec3(xyz[0], xyz[1], xyz[2]));
+        corner[k] = Vec3(xyz[0], xyz[1], xyz[2]).cwiseProduct(scale);
       }
+      part.addTriangle(corner[0], corner[1], corner[2]);
     }
-    part.triangles = static_cast<int>(count);
   } else {
     if (data.compare(0, 5, "solid") != 0)
       throw PartError(path + ": not an STL file (neither ASCII 'solid' nor a binary triangle count)");
@@ -391,7 +392,11 @@ Part readStl(const std::string& data, const std::string& path, const Vec3& scale
         throw PartError(path + ": malformed vertex after " + std::to_string(part.points.size()) +
                                  " vertices");
       add(v);
-      if (++line_vertices % 3 == 0) ++part.triangles;
+      if (++line_vertices % 3 == 0) {
+        const int n = static_cast<int>(part.points.size());
+        part.faces.push_back({n - 3, n - 2, n - 1});
+        ++part.triangles;
+      }
     }
     if (line_vertices % 3 != 0) throw PartError(path + ": truncated facet (vertex count not a multiple of 3)");
   }

@@ -18,6 +18,7 @@
 
 #include "kccd/model.hpp"
 #include "kccd/modelling/convex_hull.hpp"
+#include "kccd/modelling/convex_pieces.hpp"
 #include "kccd/modelling/fit.hpp"
 #include "kccd/modelling/pair_proof.hpp"
 #include "kccd/modelling/part.hpp"
@@ -339,7 +340,7 @@ int collisionLine(const tinyxml2::XMLDocument& doc, const std::string& name) {
 
 std::vector<IgnoreEntry> readSrdf(const tinyxml2::XMLDocument& doc, const std::string& path,
                                                  const std::set<std::string>& links,
-                                                 const std::set<std::string>& bodies) {
+                                                 const std::map<std::string, std::vector<std::string>>& bodies) {
   const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
   if (!robot) throw UrdfError(path + ": not an SRDF file (no <robot> element)");
   std::vector<IgnoreEntry> out;
@@ -354,7 +355,9 @@ std::vector<IgnoreEntry> readSrdf(const tinyxml2::XMLDocument& doc, const std::s
       if (!links.count(l))
         throw UrdfError(path + ":" + std::to_string(e->GetLineNum()) + ": link '" + l +
                                  "' is not in the URDF");
-    if (bodies.count(a) && bodies.count(b) && std::string(a) != b) out.push_back({a, b, IgnoreReason::Srdf});
+    if (bodies.count(a) && bodies.count(b) && std::string(a) != b)
+      for (const std::string& pa : bodies.at(a))  // every piece of one link against every piece of the other
+        for (const std::string& pb : bodies.at(b)) out.push_back({pa, pb, IgnoreReason::Srdf});
   }
   return out;
 }
@@ -461,49 +464,86 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
       if (child) queue.push_back(child);
     }
   }
+  std::map<std::string, std::vector<std::string>> pieces_of;  // link -> its bodies (SRDF pairs)
   int fitted = 0, with_geometry = 0;
+  std::size_t most_points = 0;  // the largest body's core points
   for (const auto& link : order)
     if (!link->collision_array.empty()) ++with_geometry;
   for (const auto& link : order) {
     if (link->collision_array.empty()) continue;
     const Part part = linkPart(path, *link, options);
     if (part.empty()) continue;
-    FitOptions fo;
-    fo.points = options.points;
-    if (options.progress)
-      fo.progress = [&](double f) { options.progress((fitted + f) / std::max(1, with_geometry)); };
-    bodies << "  - name: " << link->name << "\n"
-           << "    frame: " << frame_of.at(link->name) << "\n";
-    if (options.hulls) {  // the hull's vertices (balls by circumscribed polytopes), no fit
-      const FitResult hull = exactHull(part);
-      bodies << "    points: " << flowPoints(hull.points) << "\n"
-             << "    radius: " << yamlNumber(hull.radius, true) << "   # the convex hull of the collision geometry\n";
+    PieceSplit split;
+    if (options.max_pieces > 1) {
+      split = splitConcave(part, {.max_pieces = options.max_pieces, .concavity = options.concavity});
     } else {
-      const FitResult fit_result = fit(part, fo);
-      bodies << "    points: " << flowPoints(fit_result.points) << "\n"
-             << "    radius: " << yamlNumber(fit_result.radius, true) << "   # volume " << yamlNumber(fit_result.volume)
-             << " m^3, hull " << yamlNumber(fit_result.hull_volume) << " m^3\n";
+      split.pieces.push_back(part);
+      split.concavity.push_back(0.0);
     }
-    body_names.insert(link->name);
+    const int count = static_cast<int>(split.pieces.size());
+    for (int k = 0; k < count; ++k) {
+      const Part& piece = split.pieces[k];
+      FitOptions fo;
+      fo.points = options.points;
+      if (options.progress)
+        fo.progress = [&](double f) { options.progress((fitted + (k + f) / count) / std::max(1, with_geometry)); };
+      const std::string name = count > 1 ? link->name + "/" + std::to_string(k + 1) : link->name;
+      bodies << "  - name: " << name << "\n";
+      if (count > 1)
+        bodies << "    link: " << link->name << "   # piece " << k + 1 << " of " << count << ", concavity about "
+               << yamlNumber(std::round(split.concavity[k] * 1e4) / 1e4) << " m (the link's: "
+               << yamlNumber(std::round(split.whole_concavity * 1e4) / 1e4) << " m)\n";
+      bodies << "    frame: " << frame_of.at(link->name) << "\n";
+      FitResult r;
+      std::string how;
+      if (options.hulls) {  // the hull's vertices (balls by circumscribed polytopes), no fit
+        r = exactHull(piece);
+        how = "the convex hull of the collision geometry";
+      } else if (options.tolerance > 0.0) {
+        r = fitToTolerance(piece, options.tolerance, fo);
+        how = std::string(r.method) + ", " + std::to_string(r.points.size()) + " points";
+      } else {
+        r = fit(piece, fo);
+        how = "K = " + std::to_string(r.points.size()) + " fit";
+      }
+      bodies << "    points: " << flowPoints(r.points) << "\n"
+             << "    radius: " << yamlNumber(r.radius, true) << "   # " << how << ": volume " << yamlNumber(r.volume)
+             << " m^3, hull " << yamlNumber(r.hull_volume) << " m^3\n"
+             << "    tolerance: " << yamlNumber(std::ceil(r.outside * 1e6) / 1e6)
+             << "   # at most this far outside the link's convex hull (m)\n";
+      body_names.insert(name);
+      pieces_of[link->name].push_back(name);
+      most_points = std::max(most_points, r.points.size());
+    }
     ++fitted;
   }
   std::ostringstream visuals;
   if (options.visuals)
     for (const auto& link : order) writeVisuals(visuals, path, *link, frame_of.at(link->name), options);
   std::vector<IgnoreEntry> ignore;
-  if (!options.srdf.empty()) ignore = readSrdf(srdf, options.srdf, link_names, body_names);
+  if (!options.srdf.empty()) ignore = readSrdf(srdf, options.srdf, link_names, pieces_of);
 
   const auto compose = [&] {
     std::ostringstream out;
     out << "# Imported from " << std::filesystem::path(path).filename().string()
         << (options.srdf.empty() ? "" : " and " + std::filesystem::path(options.srdf).filename().string())
         << " by kccd import ("
-        << (options.hulls ? std::string("convex hulls, no fit")
-                          : std::to_string(options.points) + " core points per link")
+        << (options.hulls              ? std::string("convex hulls, no fit")
+            : options.tolerance > 0.0 ? "each link within " + yamlNumber(options.tolerance * 1e3) + " mm of its hull"
+                                      : std::to_string(options.points) + " core points per link")
+        << (options.max_pieces > 1
+                ? ", concave links in up to " + std::to_string(options.max_pieces) + " pieces (concavity above " +
+                      yamlNumber(options.concavity * 1e3) + " mm)"
+                : std::string())
         << ")\n"
         << "kccd: 1\n"
         << "name: " << urdf->getName() << "\n"
         << "safety_margin: " << yamlNumber(options.safety_margin) << "\n";
+    // A point budget below a body's point count makes the checker reduce that body on every query
+    // (a larger radius, and the reduction's own cost): the budget holds the largest body.
+    if (most_points > 32)
+      out << "point_budget: " << std::min<std::size_t>(most_points, 4096)
+          << "   # the largest body's core points: no body is reduced in a static query\n";
     const std::string jt = joints.str(), bt = bodies.str();
     out << "joints:" << (jt.empty() ? " []\n" : "\n" + jt);
     out << "bodies:" << (bt.empty() ? " []\n" : "\n" + bt);

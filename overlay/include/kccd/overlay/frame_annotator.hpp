@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
@@ -39,6 +40,10 @@ struct FrameRecord {
   /// The report's "query_status": "no_braking_box", "volume_not_finite" or the query's status word.
   const char* queryStatusText() const;
 };
+
+/// The links (Body::linkName) of body pairs, each link pair once, in order: the pieces of a
+/// concave link are one link to the user.
+std::vector<std::array<std::string, 2>> linkPairs(const Model& model, const std::vector<std::array<int, 2>>& pairs);
 
 /// How every frame of a run is checked and drawn.
 struct AnnotatorSettings {

@@ -23,9 +23,10 @@ std::vector<SafetyStatus> bodyStatus(const Model& model, const QueryResult& resu
 std::vector<Volume> sceneVolumes(const Model& model, Checker& checker, const std::vector<SafetyStatus>& status);
 
 /// The static volumes at one configuration `state` (the checker's last query must be that point
-/// state). A body moved rigidly keeps its own points (radius + 1 nm, covering the checker's
-/// rounding guard) with its frame's pose, so its mesh stays cached while the robot moves; a body below a joint with an error bound (which grows its volume)
-/// takes the checker's world volume. The point views refer to the model and the checker.
+/// state). A body moved rigidly is drawn as it is, whatever the model's point budget: its own
+/// points (radius + 1 nm, covering the checker's rounding guard) with its frame's pose, so its
+/// mesh stays cached while the robot moves; a body below a joint with an error bound (which
+/// grows its volume) takes the checker's world volume. The point views refer to the model and the checker.
 std::vector<Volume> staticSceneVolumes(const Model& model, Checker& checker, std::span<const double> state,
                                        const std::vector<SafetyStatus>& status);
 

@@ -26,6 +26,8 @@ struct PairSurvey {
   double first_within = 0.0;        ///< first and last time within the margin (when within > 0)
   double last_within = 0.0;
   double max_penetration = 0.0;     ///< deepest overlap, libccd's MPR estimate (reporting only, not a bound)
+  int body_pairs = 1;               ///< in Survey::links: the body pairs joined (pieces of concave links); a, b
+                                    ///< are then the closest pieces (at min_distance)
 };
 
 struct SurveyOptions {
@@ -41,6 +43,10 @@ struct Survey {
   std::size_t samples_within = 0;   ///< rows where some checked pair is within the margin (a red frame)
   std::size_t unsafe = 0;           ///< rows whose query did not end Ok (counted as within)
   std::vector<PairSurvey> pairs;    ///< checked pairs in Model::pairs order, then ignored ones
+  /// The same per pair of links (Body::linkName: the pieces of a concave link are one link), in
+  /// order of first appearance in `pairs`: within a sample a link pair is as close as its closest
+  /// pieces. Equal to `pairs` for a model without pieces.
+  std::vector<PairSurvey> links;
 };
 
 /// Queries every row of `log` (recorded for `model`) as a point state, distances of every
@@ -52,7 +58,7 @@ Survey surveyStates(const Model& model, const StateLog& log, const SurveyOptions
 /// collision" sampling. The same seed gives the same states.
 StateLog randomStates(const Model& model, int count, std::uint64_t seed);
 
-/// The survey's pairs by concern: most often within the margin first, then the closest (stable).
-std::vector<const PairSurvey*> byConcern(const Survey& survey);
+/// Pairs by concern: most often within the margin first, then the closest (stable).
+std::vector<const PairSurvey*> byConcern(const std::vector<PairSurvey>& pairs);
 
 }  // namespace kccd::modelling

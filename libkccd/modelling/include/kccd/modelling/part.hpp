@@ -2,6 +2,7 @@
 // whose convex hull contains every point of the part.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -19,6 +20,9 @@ struct Part {
   std::vector<Vec3> points;
   std::vector<Sphere> balls;
   int triangles = 0;            ///< mesh triangles read
+  /// The mesh triangles as indices into `points` (mesh readers fill it; primitives add none):
+  /// what splitting a concave part into convex pieces cuts.
+  std::vector<std::array<int, 3>> faces;
   int primitives = 0;           ///< analytic spheres, cylinders and cones covered exactly
   double coordinate_guard = 0.0;  ///< extra radius for single-precision input (metres)
 
@@ -35,6 +39,8 @@ struct Part {
   void addConeY(const Eigen::Affine3d& transform, double bottom_radius, double height);
   /// An axis-aligned box of the given full sizes, centred at the origin.
   void addBox(const Eigen::Affine3d& transform, const Vec3& size);
+  /// Appends one mesh triangle: three points and their face.
+  void addTriangle(const Vec3& a, const Vec3& b, const Vec3& c);
   /// Appends another part's geometry.
   void append(const Part& other);
 };
