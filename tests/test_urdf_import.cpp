@@ -1,15 +1,21 @@
 // URDF/SRDF import of the test robot and its errors.
+#include <array>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <random>
+#include <sstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "kccd/checker.hpp"
 #include "kccd/input_error.hpp"
 #include "kccd/kinematics.hpp"
 #include "kccd/model.hpp"
 #include "kccd/modelling/urdf_import.hpp"
+#include "support/files.hpp"
 #include "support/reference_distance.hpp"
 
 namespace km = kccd::modelling;
@@ -241,4 +247,95 @@ TEST(UrdfImport, HullBodiesAreTheLinksConvexHulls) {
       EXPECT_LE(static_cast<double>(kccd::testing::referencePointHullDistance(p, f.points)), f.radius + 1e-9)
           << b.name << " " << p.transpose();
   }
+}
+
+namespace {
+
+// An ASCII STL of boxes (12 triangles each), each box [lo, hi].
+std::string boxesStl(const std::vector<std::array<Vec3, 2>>& boxes) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "solid boxes\n";
+  static constexpr int kFaces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+  for (const auto& [lo, hi] : boxes) {
+    auto corner = [&](int i) { return Vec3(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z()); };
+    for (const auto& f : kFaces)
+      for (const std::array<int, 3> t : {std::array<int, 3>{f[0], f[1], f[2]}, std::array<int, 3>{f[0], f[2], f[3]}}) {
+        out << "facet normal 0 0 0\nouter loop\n";
+        for (int i : t) out << "vertex " << corner(i).x() << " " << corner(i).y() << " " << corner(i).z() << "\n";
+        out << "endloop\nendfacet\n";
+      }
+  }
+  return out.str() + "endsolid boxes\n";
+}
+
+}  // namespace
+
+// A forearm ending in a fork around a wrist (the KR5's shape): the default import splits the
+// forearm into pieces (bodies forearm/1, ... with link: forearm, each within the tolerance of its
+// piece's hull), which leave the wrist in the gap clear of a 1 mm margin where the forearm's one
+// hull holds it (the gap leaves 15 mm each side; a piece may keep up to the 10 mm concavity); the pieces hold every vertex of the mesh, and the point budget holds every body.
+TEST(UrdfImport, ConcaveLinkInPiecesClearsWhatItsHullHolds) {
+  const std::string tag = "kccd_import_pieces";
+  kccd::testing::writeScratch(tag, "forearm.stl",
+                              boxesStl({{Vec3(0.0, -0.06, -0.04), Vec3(0.2, 0.06, 0.04)},
+                                        {Vec3(0.19, -0.06, -0.04), Vec3(0.32, -0.03, 0.04)},
+                                        {Vec3(0.19, 0.03, -0.04), Vec3(0.32, 0.06, 0.04)}}));
+  kccd::testing::writeScratch(tag, "wrist.stl", boxesStl({{Vec3(-0.02, -0.015, -0.02), Vec3(0.02, 0.015, 0.02)}}));
+  const std::string urdf = kccd::testing::writeScratch(tag, "fork.urdf", R"(<?xml version="1.0"?>
+<robot name="fork">
+  <link name="base"/>
+  <link name="forearm"><collision><geometry><mesh filename="forearm.stl"/></geometry></collision></link>
+  <link name="wrist"><collision><geometry><mesh filename="wrist.stl"/></geometry></collision></link>
+  <link name="tip"/>
+  <joint name="elbow" type="revolute"><parent link="base"/><child link="forearm"/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="pitch" type="revolute"><parent link="forearm"/><child link="tip"/><origin xyz="0.26 0 0"/>
+    <axis xyz="0 1 0"/><limit lower="-0.5" upper="0.5" effort="1" velocity="1"/></joint>
+  <joint name="roll" type="revolute"><parent link="tip"/><child link="wrist"/>
+    <axis xyz="1 0 0"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+</robot>
+)");
+  km::ImportOptions opt;
+  opt.safety_margin = 0.001;
+  opt.visuals = false;
+  opt.concavity = 0.01;
+  const std::string text = km::importUrdf(urdf, opt);
+  const Model m = kccd::parseModel(text, "fork (imported)");
+  std::vector<int> pieces;
+  for (std::size_t i = 0; i < m.bodies.size(); ++i)
+    if (m.bodies[i].link == "forearm") pieces.push_back(static_cast<int>(i));
+  ASSERT_GE(pieces.size(), 2u) << text;
+  std::size_t most = 0;
+  for (const kccd::Body& b : m.bodies) {
+    EXPECT_GE(b.tolerance, 0.0) << b.name;
+    EXPECT_LE(b.tolerance, opt.tolerance) << b.name;
+    most = std::max(most, b.points.size());
+  }
+  EXPECT_GE(static_cast<std::size_t>(m.point_budget), most);
+  EXPECT_EQ(m.bodies[pieces[0]].name, "forearm/1");
+  // The wrist is clear of every piece at the zero state, and (the pitch joint turns it) in a
+  // band of states; the forearm's one hull holds it.
+  opt.max_pieces = 1;
+  const Model whole = kccd::parseModel(km::importUrdf(urdf, opt), "fork (whole)");
+  ASSERT_EQ(whole.bodies.size(), 2u);
+  kccd::Checker in_pieces(m), in_one(whole);
+  const kccd::QueryOptions q{.type = kccd::QueryType::Distances};
+  for (const double pitch : {0.0, 0.2, -0.2}) {
+    const std::vector<double> s{0.3, pitch, 1.0};
+    EXPECT_GT(in_pieces.query(s, s, q).min_distance, opt.safety_margin) << pitch;
+    EXPECT_EQ(in_one.query(s, s, q).min_distance, 0.0) << pitch;
+  }
+  // Every vertex of the forearm mesh lies inside one of its pieces.
+  for (const double x : {0.0, 0.19, 0.2, 0.32})
+    for (const double y : {-0.06, -0.03, 0.03, 0.06})
+      for (const double z : {-0.04, 0.04}) {
+        const Vec3 v(x, y, z);
+        if (x > 0.2 && std::abs(y) < 0.03) continue;  // the gap
+        double best = INFINITY;
+        for (int i : pieces)
+          best = std::min(best, static_cast<double>(kccd::testing::referencePointHullDistance(v, m.bodies[i].points)) -
+                                    m.bodies[i].radius);
+        EXPECT_LE(best, 0.0) << v.transpose();
+      }
 }

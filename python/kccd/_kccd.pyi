@@ -293,7 +293,7 @@ def import_urdf(
     points: int | None = None,
     tolerance: float = 2.0,
     pieces: int | str = "auto",
-    concavity: float = 20.0,
+    concavity: float = 40.0,
     safety_margin: float = 0.02,
     packages: dict[str, str] = {},
     visuals: bool = True,

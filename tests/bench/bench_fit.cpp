@@ -284,7 +284,9 @@ BENCHMARK_CAPTURE(BM_PairLooseness, wam, "wam/wam.urdf")
 // which pieces can be). `ratio_*` divide by K = 8's time, measured interleaved in the same loop.
 // The KR5 and WAM come from Debian's dart-doc; the Panda and xArm from the folder
 // $KCCD_REAL_ROBOTS (panda/panda.urdf, xarm7_realsense/description/xarm7.urdf); a robot that is
-// not there is skipped.
+// not there is skipped. KCCD_BENCH_TOLERANCE_MM and KCCD_BENCH_CONCAVITY_MM set the default import's tolerance and
+// concavity, and
+// KCCD_BENCH_BUDGET every model's point budget, to measure other choices.
 struct Robot {
   std::string urdf;
   std::map<std::string, std::string> packages;
@@ -310,6 +312,8 @@ const kccd::Model& importedModel(const std::string& robot, int mode) {
     km::ImportOptions o;
     o.visuals = false;
     o.packages = r.packages;
+    if (const char* t = std::getenv("KCCD_BENCH_TOLERANCE_MM")) o.tolerance = std::atof(t) * 1e-3;  // other defaults
+    if (const char* c = std::getenv("KCCD_BENCH_CONCAVITY_MM")) o.concavity = std::atof(c) * 1e-3;
     if (mode == kEight) o.tolerance = 0.0, o.max_pieces = 1;
     if (mode == kHulls) o.hulls = true, o.max_pieces = 1;
     const std::string text = km::importUrdf(r.urdf, o);

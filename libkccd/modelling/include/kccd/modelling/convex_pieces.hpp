@@ -11,7 +11,7 @@ namespace kccd::modelling {
 
 struct PieceOptions {
   int max_pieces = 8;         ///< at most this many pieces (1: never split)
-  double concavity = 0.02;    ///< split while a piece's concavity exceeds this (metres)
+  double concavity = 0.04;    ///< split while a piece's concavity exceeds this (metres)
   int resolution = 64;        ///< voxels along the part's longest side for measuring concavity
 };
 
