@@ -254,6 +254,12 @@ TEST(Cli, OptionErrorsFollowTheOneLineContract) {
       {"query " + kDemo + " --state 0,0,0 --margin -1", "--margin: must be in [0, 1e+06]"},
       {"pairs " + kDemo + " --max-boxes 0", "--max-boxes: expected a whole number"},
       {"query " + kDemo + " --state \"$(printf '0,\\033[31m,0')\"", "\\x1b[31m"},
+      {"fit " + std::string(KCCD_DATA_DIR) + "/parts/gripper.iv --tolerance 0", "--tolerance: must be in [1e-06, 1e+06]"},
+      {"fit " + std::string(KCCD_DATA_DIR) + "/parts/gripper.iv --pieces many", "--pieces: expected auto or a number"},
+      {"fit " + std::string(KCCD_DATA_DIR) + "/parts/gripper.iv --tolerance 1 --hull", "excludes"},
+      {"import x.urdf --pieces 0", "--pieces: expected auto or a number of pieces 1 ... 64, got '0'"},
+      {"import x.urdf -k 8 --tolerance 1", "excludes"},
+      {"import x.urdf --concavity nan", "--concavity: must be a finite number"},
   };
   for (const Case& c : cases) {
     const Outcome r = runKccd(c.args);

@@ -129,7 +129,7 @@ Runner addImport(CLI::App& app) {
                 "Also prove which pairs never come within the margin inside the joint limits, or always touch, "
                 "and ignore them (as kccd pairs --write)");
   sub->add_flag("--hulls", args->hulls,
-                "Bodies are the links' convex hulls (every hull vertex, no fit): a tight but slow reference model "
+                "Bodies are the links' (with --pieces, each piece's) convex hulls (every hull vertex, no fit): a tight but slow reference model "
                 "to measure what a fit costs (kccd query on both)")
       ->excludes(points)
       ->excludes(tolerance);

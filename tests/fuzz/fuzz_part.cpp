@@ -15,6 +15,7 @@
 
 #include "fuzz_support.hpp"
 #include "kccd/input_error.hpp"
+#include "kccd/modelling/convex_pieces.hpp"
 #include "kccd/modelling/part.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -26,7 +27,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     kccd::modelling::ReadOptions options;
     options.merge = (data[0] & 8) != 0;
     options.mesh_time_limit_s = 4.0;  // an endless Assimp read ends well within libFuzzer's timeout
-    (void)kccd::modelling::readPart(path, options);
+    const kccd::modelling::Part part = kccd::modelling::readPart(path, options);
+    // A mesh read is split into convex pieces as kccd import would (coarse, to stay fast).
+    if (part.faces.size() <= 20000) (void)kccd::modelling::splitConcave(part, {.max_pieces = 4, .concavity = 1e-9, .resolution = 12});
   } catch (const kccd::InputError& e) {
     kccd::fuzz::checkMessage(e.what(), path);
   }

@@ -266,7 +266,8 @@ PieceSplit splitConcave(const Part& part, const PieceOptions& options) {
   }
   Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
   for (const Vec3& p : part.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  if (!((hi - lo).maxCoeff() > 0.0) || !std::isfinite(extent)) {
+  // A flat part has no empty space; one whose extent overflows cannot be put on a grid.
+  if (!((hi - lo).maxCoeff() > 0.0) || !std::isfinite((hi - lo).maxCoeff()) || !std::isfinite(extent)) {
     out.pieces.push_back(part);
     out.concavity.push_back(0.0);
     return out;
