@@ -130,6 +130,18 @@ std::vector<std::string> splitCommas(const std::string& text) {
   return out;
 }
 
+void addPieceOptions(CLI::App& sub, std::string& pieces, double& concavity_mm, const std::string& what) {
+  sub.add_option("--pieces", pieces,
+                 what + " in convex pieces: auto (up to 8) or N (1: never split); it splits while its concavity exceeds "
+                        "--concavity")
+      ->capture_default_str();
+  sub.add_option("--concavity", concavity_mm,
+                 "Millimetres of empty space inside the hull (the hull's surface to the mesh's solid) above which it "
+                 "splits")
+      ->capture_default_str()
+      ->check(finiteIn(1e-3, 1e6));
+}
+
 int piecesOption(const std::string& text) {
   if (text == "auto") return 8;
   int n = 0;

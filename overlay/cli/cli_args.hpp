@@ -47,4 +47,7 @@ void checkCorePoints(int k);
 /// `--pieces auto|N`: the most convex pieces a concave link may split into (auto: 8); N in 1 ... 64.
 int piecesOption(const std::string& text);
 
+/// Adds `--pieces auto|N` and `--concavity MM` (kccd fit and kccd import); `what` opens --pieces' help.
+void addPieceOptions(CLI::App& sub, std::string& pieces, double& concavity_mm, const std::string& what);
+
 }  // namespace kccd::cli

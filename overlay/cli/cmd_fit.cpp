@@ -195,14 +195,7 @@ Runner addFit(CLI::App& app) {
                   "(the K fit when it does, else hull vertices added farthest first)")
       ->check(finiteIn(1e-6, 1e6))
       ->excludes("--hull");
-  sub->add_option("--pieces", args->pieces,
-                  "A concave part in convex pieces: auto (up to 8) or N; it splits while its concavity exceeds "
-                  "--concavity (each piece a body LINK/1, LINK/2, ... with link: LINK)")
-      ->capture_default_str();
-  sub->add_option("--concavity", args->concavity_mm,
-                  "Millimetres of empty space inside the hull (hull surface to the mesh) above which a part splits")
-      ->capture_default_str()
-      ->check(finiteIn(1e-3, 1e6));
+  addPieceOptions(*sub, args->pieces, args->concavity_mm, "A concave part (each piece a body NAME/1, NAME/2, ... with link: NAME)");
   sub->add_flag("--json", args->json, "Machine-readable output");
   sub->add_flag("--quiet,-q", args->quiet, "No progress display");
   sub->footer(

@@ -110,14 +110,7 @@ Runner addImport(CLI::App& app) {
           ->capture_default_str()
           ->check(finiteIn(1e-6, 1e6))
           ->excludes(points);
-  sub->add_option("--pieces", args->pieces,
-                  "Concave links in convex pieces: auto (up to 8) or N (1: never split); a link splits while its "
-                  "concavity exceeds --concavity")
-      ->capture_default_str();
-  sub->add_option("--concavity", args->concavity_mm,
-                  "Millimetres of empty space inside a link's hull (hull surface to the mesh) above which it splits")
-      ->capture_default_str()
-      ->check(finiteIn(1e-3, 1e6));
+  addPieceOptions(*sub, args->pieces, args->concavity_mm, "Concave links (each piece a body LINK/1, LINK/2, ... with link: LINK)");
   sub->add_option("--margin", args->margin, "safety_margin written into the model (metres)")
       ->capture_default_str()
       ->check(finiteIn(0.0, kMaxModelLength));
