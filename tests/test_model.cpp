@@ -138,7 +138,7 @@ TEST(Model, EveryMistakeGetsOneClearMessage) {
        edit("    radius: 0.05\n  - name: tool\n", "    radius: 0.05\n    link: limb\n  - name: tool\n    link: limb\n"),
        {"body 'tool'.link", "piece of link 'limb' in frame 'slide'", "body 'arm' of that link is in frame 'base'"}},
       {"a link named like a whole body", edit("    radius: 0.05\n", "    radius: 0.05\n    link: floor\n"),
-       {"cell.yaml:33:", "body 'arm'.link", "piece of link 'floor' in frame 'base'", "body 'floor' of that link"}},
+       {"cell.yaml:33:", "body 'arm'.link", "link 'floor' is also a whole body's name"}},
       {"empty link name", edit("    radius: 0.05\n", "    radius: 0.05\n    link: \"\"\n"), {"cell.yaml:33:", "body 'arm'.link", "must not be empty"}},
       {"same-frame include", edit("ignore: [[arm, tool]]", "include: [[floor, floor]]"), {"a body paired with itself"}},
       {"bad check", edit("ignore: [[arm, tool]]", "check: some"), {"pairs.check", "expected 'all' or 'none'"}},

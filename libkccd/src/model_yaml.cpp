@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 
 #include "kccd/file_reader.hpp"
 #include "kccd/model.hpp"
@@ -126,6 +127,7 @@ void parseJoints(const Reader& r, const YAML::Node& list, Model& m) {
 
 void parseBodies(const Reader& r, const YAML::Node& list, Model& m) {
   if (!list.IsSequence()) r.fail(list, "bodies", "expected a list");
+  std::map<std::string, int> links;  // link name -> its first piece (body index)
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YAML::Node n = list[i];
     const std::string f = "bodies[" + std::to_string(i) + "]";
@@ -152,18 +154,17 @@ void parseBodies(const Reader& r, const YAML::Node& list, Model& m) {
       if (b.link.empty()) r.fail(n["link"], fb + ".link", "empty link name");
       // Pieces of one link move together: the same frame as the link's other pieces, and no
       // whole body may carry the link's name.
-      for (const Body& o : m.bodies) {
-        if (o.linkName() == b.link && o.frame != b.frame)
-          r.fail(n["link"], fb + ".link", "piece of link '" + b.link + "' in frame '" + m.frameName(b.frame) +
-                                              "', but body '" + o.name + "' of that link is in frame '" +
-                                              m.frameName(o.frame) + "'");
-        if (o.link.empty() && o.name == b.link && o.name != b.name)
-          r.fail(n["link"], fb + ".link", "link '" + b.link + "' is also a whole body's name");
-      }
-    } else {
-      for (const Body& o : m.bodies)
-        if (o.link == b.name)
-          r.fail(n["name"], f + ".name", "'" + b.name + "' is already the link of body '" + o.name + "'");
+      const int whole = m.bodyIndex(b.link);
+      if (whole >= 0 && m.bodies[whole].link.empty())
+        r.fail(n["link"], fb + ".link", "link '" + b.link + "' is also a whole body's name");
+      const auto [it, fresh] = links.try_emplace(b.link, static_cast<int>(m.bodies.size()));
+      const Body& first = fresh ? b : m.bodies[it->second];
+      if (first.frame != b.frame)
+        r.fail(n["link"], fb + ".link", "piece of link '" + b.link + "' in frame '" + m.frameName(b.frame) +
+                                            "', but body '" + first.name + "' of that link is in frame '" +
+                                            m.frameName(first.frame) + "'");
+    } else if (const auto it = links.find(b.name); it != links.end()) {
+      r.fail(n["name"], f + ".name", "'" + b.name + "' is already the link of body '" + m.bodies[it->second].name + "'");
     }
     m.bodies.push_back(std::move(b));
   }

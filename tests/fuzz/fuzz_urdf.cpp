@@ -19,8 +19,9 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = kccd::fuzz::writeInput("fuzz_urdf", "input.urdf", data, size);
   try {
-    // One core point: the fit stays quick; meshes are looked up next to the input (none there).
-    (void)kccd::modelling::importUrdf(path, {.points = 1});
+    // One core point and a 1 m tolerance: the fits stay quick (the simplified hull meets it with
+    // four points, the K = 1 fit is tried); meshes are looked up next to the input (none there).
+    (void)kccd::modelling::importUrdf(path, {.points = 1, .tolerance = 1.0});
   } catch (const kccd::InputError& e) {
     kccd::fuzz::checkMessage(e.what(), path);
   }

@@ -36,8 +36,10 @@ struct Grid {
   Vec3 centre(int x, int y, int z) const { return origin + h * Vec3(x + 0.5, y + 0.5, z + 0.5); }
   std::array<int, 3> cell(const Vec3& p) const {
     std::array<int, 3> c;
-    for (int a = 0; a < 3; ++a)
-      c[a] = std::clamp(static_cast<int>(std::floor((p(a) - origin(a)) / h)), 0, size[a] - 1);
+    for (int a = 0; a < 3; ++a) {  // clamped before the cast (a NaN lands in cell 0)
+      const double x = std::floor((p(a) - origin(a)) / h);
+      c[a] = x >= 0.0 ? (x < size[a] - 1 ? static_cast<int>(x) : size[a] - 1) : 0;
+    }
     return c;
   }
 };
