@@ -132,6 +132,22 @@ double outsideOf(std::span<const Vec3> core, double radius, const OutsideHull& h
   return std::max(0.0, worst + radius);
 }
 
+// The part's points and its balls' circumscribed polytopes, with their hull: what an exact hull
+// keeps and a simplified hull chooses from (balls lie inside their polytopes: only vertices to cover).
+struct PolytopeHull {
+  std::vector<Vec3> samples;
+  ConvexHull hull;
+};
+
+PolytopeHull polytopeHull(const Part& part) {
+  PolytopeHull p;
+  p.samples = part.points;
+  for (const Sphere& b : part.balls)
+    for (const Vec3& v : circumscribedUnitSphere()) p.samples.push_back(b.center + b.radius * v);
+  p.hull = convexHull(p.samples);
+  return p;
+}
+
 // What a covering radius is measured against: the hull vertices of the part's points (the
 // hull is computed once per part), its balls and its input rounding guard.
 struct Cover {
@@ -214,14 +230,9 @@ Vec3 centroid(const std::vector<Vec3>& points) {
   return sum / static_cast<double>(points.size());
 }
 
-// The hull's vertices moved inwards by r along their (angle-weighted) normals: each stays within
-// r of its vertex, so any core whose SSCH of radius r holds these points' hull covers the part.
-// On rounded parts the moved vertices gather (a cylinder's rim moved by its radius lands on its
-// axis), and a few of them describe the part: seeds for every scale of rounding.
-std::vector<std::vector<Vec3>> offsetClouds(const std::vector<Vec3>& points, const std::vector<double>& radii) {
-  std::vector<std::vector<Vec3>> out;
-  const ConvexHull h = convexHull(points);
-  if (h.dimension < 3) return out;
+// Per point of `points` (the input of the solid hull `h`), the sum of its hull triangles' unit
+// normals weighted by each triangle's angle at it: zero for a point on no triangle.
+std::vector<Vec3> vertexNormals(const std::vector<Vec3>& points, const ConvexHull& h) {
   std::vector<Vec3> normal(points.size(), Vec3::Zero());
   for (const auto& t : h.triangles) {
     const Vec3 n = (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]);
@@ -232,6 +243,18 @@ std::vector<std::vector<Vec3>> offsetClouds(const std::vector<Vec3>& points, con
       normal[t[k]] += angle * n.normalized();
     }
   }
+  return normal;
+}
+
+// The hull's vertices moved inwards by r along their (angle-weighted) normals: each stays within
+// r of its vertex, so any core whose SSCH of radius r holds these points' hull covers the part.
+// On rounded parts the moved vertices gather (a cylinder's rim moved by its radius lands on its
+// axis), and a few of them describe the part: seeds for every scale of rounding.
+std::vector<std::vector<Vec3>> offsetClouds(const std::vector<Vec3>& points, const std::vector<double>& radii) {
+  std::vector<std::vector<Vec3>> out;
+  const ConvexHull h = convexHull(points);
+  if (h.dimension < 3) return out;
+  const std::vector<Vec3> normal = vertexNormals(points, h);
   for (const double r : radii) {
     std::vector<Vec3> cloud;
     for (int i : h.vertices)
@@ -377,14 +400,12 @@ double coveringRadius(std::span<const Vec3> core, const Part& part) { return cov
 
 FitResult exactHull(const Part& part) {
   if (part.empty()) throw std::invalid_argument("the part has no geometry");
-  std::vector<Vec3> samples = part.points;
-  for (const Sphere& b : part.balls)
-    for (const Vec3& v : circumscribedUnitSphere()) samples.push_back(b.center + b.radius * v);
-  const ConvexHull h = convexHull(samples);
+  const PolytopeHull p = polytopeHull(part);
+  const ConvexHull& h = p.hull;
   FitResult result;
-  Cover cover;  // the balls are inside their circumscribed polytopes: only vertices to cover
+  Cover cover;
   cover.guard = part.coordinate_guard;
-  for (int i : h.vertices) cover.vertices.push_back(samples[i]);
+  for (int i : h.vertices) cover.vertices.push_back(p.samples[i]);
   result.points = cover.vertices;
   for (Vec3& p : result.points)  // as printed; the radius below covers the rounding
     for (int i = 0; i < 3; ++i) p(i) = std::stod(yamlNumber(p(i)));
@@ -557,32 +578,21 @@ namespace {
 // the volume (radius: the covering radius) reaches at most `tolerance` outside the part's hull
 // H, or every candidate is in. rho = 0 keeps hull vertices (a radius of about the tolerance); a
 // larger rho trades depth for a larger radius, and on rounded parts for far fewer points.
-FitResult simplifiedHull(const Part& part, const OutsideHull& h, double tolerance, double rho) {
-  std::vector<Vec3> samples = part.points;
-  for (const Sphere& b : part.balls)
-    for (const Vec3& v : circumscribedUnitSphere()) samples.push_back(b.center + b.radius * v);
-  const ConvexHull hull = convexHull(samples);
+// `normal`: vertexNormals of the polytope hull's samples (empty unless it is solid).
+FitResult simplifiedHull(const Part& part, const PolytopeHull& polytope, const std::vector<Vec3>& normal,
+                         const OutsideHull& h, double tolerance, double rho) {
+  const ConvexHull& hull = polytope.hull;
   Cover cover;
   cover.guard = part.coordinate_guard;
-  for (int i : hull.vertices) cover.vertices.push_back(samples[i]);
+  for (int i : hull.vertices) cover.vertices.push_back(polytope.samples[i]);
   const std::vector<Vec3>& vertex = cover.vertices;
   const std::size_t n = vertex.size();
   std::vector<Vec3> candidate = vertex;
-  if (rho > 0.0 && hull.dimension == 3) {
-    std::vector<Vec3> normal(samples.size(), Vec3::Zero());
-    for (const auto& t : hull.triangles) {
-      const Vec3 nn = (samples[t[1]] - samples[t[0]]).cross(samples[t[2]] - samples[t[0]]);
-      if (!(nn.norm() > 0.0)) continue;
-      for (int k = 0; k < 3; ++k) {
-        const Vec3 e1 = samples[t[(k + 1) % 3]] - samples[t[k]], e2 = samples[t[(k + 2) % 3]] - samples[t[k]];
-        normal[t[k]] += std::atan2(e1.cross(e2).norm(), e1.dot(e2)) * nn.normalized();
-      }
-    }
+  if (rho > 0.0 && !normal.empty())
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3& nv = normal[hull.vertices[i]];
       if (nv.norm() > 0.0) candidate[i] = vertex[i] - rho * nv.normalized();
     }
-  }
   for (Vec3& p : candidate)
     for (int a = 0; a < 3; ++a) p(a) = std::stod(yamlNumber(p(a)));  // as printed
   std::vector<double> depth(n);  // signed distance of each candidate to H
@@ -664,10 +674,13 @@ FitResult bestSimplifiedHull(const Part& part, const OutsideHull& h, double tole
   for (double f : {0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0})
     if (f * tolerance < 0.45 * thin) depths.push_back(f * tolerance);
   for (double f : {0.1, 0.2, 0.3, 0.45}) depths.push_back(f * thin);
+  const PolytopeHull polytope = polytopeHull(part);
+  const std::vector<Vec3> normal =
+      polytope.hull.dimension == 3 ? vertexNormals(polytope.samples, polytope.hull) : std::vector<Vec3>{};
   FitResult best;
   bool have = false;
   for (const double rho : depths) {
-    FitResult r = simplifiedHull(part, h, tolerance, rho);
+    FitResult r = simplifiedHull(part, polytope, normal, h, tolerance, rho);
     const bool meets = r.outside <= tolerance;
     const bool best_meets = have && best.outside <= tolerance;
     if (!have || (meets && !best_meets) ||
