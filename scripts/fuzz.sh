@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (clang-14, ASan + UBSan) and runs each for a while on a fresh copy
-# of its seed corpus (tests/fuzz/corpus/NAME plus sample files from data/). Any crash, sanitizer
-# report, leak, time-out or memory blow-up fails the run and leaves the input in build-fuzz/artifacts/.
+# Builds the libFuzzer targets (clang-14, ASan + UBSan, in build-fuzz/) and runs each for a while
+# on a fresh copy of its seed corpus (tests/fuzz/corpus/NAME plus sample files from data/),
+# KCCD_JOBS targets at a time. Any crash, sanitizer report, leak, time-out or memory blow-up fails
+# the run and leaves the input in build-fuzz/artifacts/ and the log in build-fuzz/NAME.log.
 #   scripts/fuzz.sh [--seconds N] [TARGET...]   explore: N seconds each (default 15), a new seed each run
 #   scripts/fuzz.sh --ci [TARGET...]            CI: a fixed seed and a fixed number of inputs per
 #                                               target (about 15 s each here), so a run is repeatable
@@ -26,7 +27,9 @@ bash scripts/install-deps.sh --fuzz
 CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only -DNDEBUG" \
   -DKCCD_BUILD_FUZZERS=ON -DKCCD_BUILD_TESTS=OFF -DKCCD_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build build-fuzz -j "${KCCD_JOBS:-2}" --target "${targets[@]}"
+jobs=${KCCD_JOBS:-2}
+cmake --build build-fuzz -j "$jobs" --target "${targets[@]}"
+out=build-fuzz
 
 ci_runs() {  # inputs per target in --ci mode (about 15 s each on this project's machines)
   case "$1" in
@@ -61,34 +64,47 @@ seeds() {  # extra seed files from data/ per target
     fuzz_urdf) ls tests/data/urdf/*.urdf ;;
   esac
 }
-mkdir -p build-fuzz/artifacts
-status=0
-for t in "${targets[@]}"; do
-  corpus=build-fuzz/corpus/$t
+mkdir -p $out/artifacts
+fuzz_one() {  # target: runs it, then prints its one-line result (and the log's end on failure)
+  local t=$1 corpus=$out/corpus/$1
   rm -rf "$corpus" && mkdir -p "$corpus"
   [ -d "tests/fuzz/corpus/${t#fuzz_}" ] && cp -r "tests/fuzz/corpus/${t#fuzz_}/." "$corpus/"
   for f in $(seeds "$t"); do cp "$f" "$corpus/"; done
   # Leaks: checked for the model loader and the state log reader (our code only); the readers
   # built on Coin3D, OpenCV and urdfdom keep per-process caches the leak checker would report on
   # every input (the ASan test suite checks our own code on those paths, with tests/lsan.supp).
-  leaks=0; case "$t" in fuzz_model|fuzz_states|fuzz_frame_times) leaks=1 ;; esac
-  limits=(-max_total_time="$seconds")
+  local leaks=0; case "$t" in fuzz_model|fuzz_states|fuzz_frame_times) leaks=1 ;; esac
+  local limits=(-max_total_time="$seconds") what="${seconds} s"
   if [ $ci -eq 1 ]; then
     limits+=(-seed=1 -runs="$(ci_runs "$t")")
-    echo "== $t: $(ci_runs "$t") inputs (seed 1) from $(ls "$corpus" | wc -l) seeds"
-  else
-    echo "== $t: ${seconds} s from $(ls "$corpus" | wc -l) seeds"
+    what="$(ci_runs "$t") inputs (seed 1)"
   fi
+  what="$what from $(ls "$corpus" | wc -l) seeds"
   # An out-of-memory stop under ASan can leave libFuzzer stuck: the outer timeout kills it.
   if ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 \
      LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
      timeout -s KILL $((seconds + 120)) "build-fuzz/tests/fuzz/$t" "${limits[@]}" -timeout=10 \
        -rss_limit_mb=2048 -malloc_limit_mb=1024 -max_len=65536 -print_final_stats=1 -detect_leaks=$leaks \
-       -artifact_prefix="build-fuzz/artifacts/$t-" "$corpus" > "build-fuzz/$t.log" 2>&1; then
-    grep -E "stat::number_of_executed_units|stat::new_units_added" "build-fuzz/$t.log" | tr '\n' ' '; echo
+       -artifact_prefix="$out/artifacts/$t-" "$corpus" > "$out/$t.log" 2>&1; then
+    echo "== $t: $what: $(grep -E "stat::number_of_executed_units|stat::new_units_added" "$out/$t.log" | tr '\n' ' ')"
   else
-    echo "fuzz.sh: $t FAILED (log: build-fuzz/$t.log, inputs: build-fuzz/artifacts/)"; tail -40 "build-fuzz/$t.log"
-    status=1
+    echo "fuzz.sh: $t FAILED, $what (log: $out/$t.log, inputs: $out/artifacts/)"; tail -40 "$out/$t.log"
+    return 1
   fi
+}
+# KCCD_JOBS targets at a time; each prints its result when it ends.
+status=0
+running=0
+for t in "${targets[@]}"; do
+  if [ $running -ge "$jobs" ]; then
+    wait -n || status=1
+    running=$((running - 1))
+  fi
+  fuzz_one "$t" &
+  running=$((running + 1))
+done
+while [ $running -gt 0 ]; do
+  wait -n || status=1
+  running=$((running - 1))
 done
 exit $status

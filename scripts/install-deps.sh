@@ -13,13 +13,19 @@ packages=(
   python3-dev pybind11-dev python3-numpy
   python3-yaml python3-distributed python3-dask
 )
-# --fuzz: also the compiler and runtime of the libFuzzer targets (scripts/fuzz.sh).
-[ "${1:-}" = "--fuzz" ] && packages+=(clang-14 libclang-rt-14-dev)
-# --tests: also what the labelling page's tests run: Debian's chromium, node and npm (below), and
-# npm's playwright-core in tests/e2e (scripts/test.sh); and the Python package's: pytest, mypy and
-# typeshed's stubs (PyYAML's, for mypy --strict on kccd.batch).
+# Options (any of them, in any order):
+#   --fuzz   also the compiler and runtime of the libFuzzer targets (scripts/fuzz.sh)
+#   --tests  also what the labelling page's tests run: Debian's chromium, node and npm (below),
+#            and npm's playwright-core in tests/e2e (scripts/test.sh); and the Python package's:
+#            pytest, mypy and typeshed's stubs (PyYAML's, for mypy --strict on kccd.batch).
 tests=0
-[ "${1:-}" = "--tests" ] && tests=1 && packages+=(chromium python3-pytest python3-matplotlib mypy python3-typeshed)
+for arg in "$@"; do
+  case "$arg" in
+    --fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;
+    --tests) tests=1; packages+=(chromium python3-pytest python3-matplotlib mypy python3-typeshed) ;;
+    *) echo "install-deps.sh: unknown option $arg" >&2; exit 2 ;;
+  esac
+done
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

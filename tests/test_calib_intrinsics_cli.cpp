@@ -1,6 +1,7 @@
 // End-to-end: `kccd calib intrinsics` as scripts use it (images in, camera file out, JSON summary,
 // exit codes, one-line errors, nothing written on failure).
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <cmath>
 #include <filesystem>
@@ -67,6 +68,13 @@ TEST_F(IntrinsicsCli, BadInputIsOneLineNamingTheFile) {
     // A PNG cut in the middle: libpng's own message, and nothing else on stderr.
     const std::string bytes = kccd::testing::readText(a);
     std::ofstream(path("cut.png"), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+    // A PNG whose header says it is wider than its data (IHDR's CRC made right): OpenCV's
+    // decoder printed "libpng error: Not enough image data" before kccd's line.
+    std::string wide = bytes;
+    wide[19] = static_cast<char>(wide[19] + 1);
+    const uLong crc = crc32(0, reinterpret_cast<const Bytef*>(wide.data() + 12), 17);
+    for (int k = 0; k < 4; ++k) wide[29 + k] = static_cast<char>((crc >> (24 - 8 * k)) & 0xff);
+    std::ofstream(path("wide.png"), std::ios::binary) << wide;
   }
   struct Case {
     std::string args, expect;
@@ -75,6 +83,7 @@ TEST_F(IntrinsicsCli, BadInputIsOneLineNamingTheFile) {
       {"--image " + a + " " + path("missing.png") + kGrid, path("missing.png") + ": image: no such file"},
       {"--image " + a + " " + path("text.png") + kGrid, path("text.png") + ": image: not an image"},
       {"--image " + a + " " + path("cut.png") + kGrid, path("cut.png") + ": image: a damaged PNG ("},
+      {"--image " + a + " " + path("wide.png") + kGrid, path("wide.png") + ": image: a damaged PNG ("},
       {"--image " + a + " " + dir_.string() + kGrid, dir_.string() + ": image: not a regular file"},
       {"--image " + a + " " + a + kGrid, a + ": image: given twice"},
       {"--image " + a + " --grid 6x4", "--grid needs --tag-size"},

@@ -257,7 +257,9 @@ std::string boxesStl(const std::vector<std::array<Vec3, 2>>& boxes) {
   out.precision(17);
   out << "solid boxes\n";
   static constexpr int kFaces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
-  for (const auto& [lo, hi] : boxes) {
+  for (const auto& box : boxes) {
+    const Vec3& lo = box[0];
+    const Vec3& hi = box[1];
     auto corner = [&](int i) { return Vec3(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z()); };
     for (const auto& f : kFaces)
       for (const std::array<int, 3> t : {std::array<int, 3>{f[0], f[1], f[2]}, std::array<int, 3>{f[0], f[2], f[3]}}) {

@@ -12,6 +12,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "kccd/overlay/video_source.hpp"
+#include "support/files.hpp"
 
 namespace fs = std::filesystem;
 using kccd::overlay::VideoError;
@@ -76,6 +77,37 @@ TEST_F(VideoSourceTest, AVideoAndItsImageSequenceGiveTheSameFrames) {
   EXPECT_FALSE(sequence.read(b));
 }
 
+TEST_F(VideoSourceTest, SequencesCountFromOneWithoutAFrameZeroAndNameADamagedFrame) {
+  fs::create_directories(path("from1"));
+  for (int i = 1; i <= 3; ++i) cv::imwrite(path("from1/f_" + std::to_string(i) + ".png"), frame(i));
+  {
+    VideoSource s(path("from1/f_%d.png"), "--video from1");
+    EXPECT_EQ(s.declaredFrames(), 3u);
+    EXPECT_EQ(s.fps(), 0.0);
+    cv::Mat m;
+    for (int i = 1; i <= 3; ++i) {
+      ASSERT_TRUE(s.read(m));
+      EXPECT_EQ(cv::norm(m, frame(i), cv::NORM_INF), 0.0) << i;
+    }
+    EXPECT_FALSE(s.read(m));
+  }
+  // Frame 2 (the sequence's index 1) cut in half: that frame's error names it and the file, and
+  // the frames before it were read.
+  const std::string f2 = kccd::testing::readText(path("from1/f_2.png"));
+  std::ofstream(path("from1/f_2.png"), std::ios::binary) << f2.substr(0, f2.size() / 2);
+  VideoSource s(path("from1/f_%d.png"), "--video from1");
+  cv::Mat m;
+  ASSERT_TRUE(s.read(m));
+  try {
+    s.read(m);
+    ADD_FAILURE() << "a damaged frame read";
+  } catch (const VideoError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("--video from1: frame 1 cannot be decoded (" + path("from1/f_2.png") + ": image: a damaged PNG (", 0), 0u)
+        << what;
+  }
+}
+
 TEST_F(VideoSourceTest, UnreadableRecordingsAreOneLineNamingThem) {
   EXPECT_EQ(errorOf(path("missing.mkv"), "--video missing.mkv"),
             "--video missing.mkv: no such file (a video file, or an image sequence such as frames/frame_%06d.png)");
@@ -83,7 +115,13 @@ TEST_F(VideoSourceTest, UnreadableRecordingsAreOneLineNamingThem) {
             "--video seq: not a regular file (a video file, or an image sequence such as frames/frame_%06d.png)");
   std::ofstream(path("junk.mp4")) << "not a video\n";
   EXPECT_EQ(errorOf(path("junk.mp4"), "--video junk.mp4"), "--video junk.mp4: cannot open the video (not a video OpenCV reads)");
-  EXPECT_EQ(errorOf(path("seq/none_%06d.png"), "--video none"), "--video none: no image of the sequence can be read");
+  EXPECT_EQ(errorOf(path("seq/none_%06d.png"), "--video none"),
+            "--video none: no image of the sequence can be read (no file " + path("seq/none_000000.png") + " or " +
+                path("seq/none_000001.png") + ")");
+  EXPECT_EQ(errorOf(path("seq/%s_%06d.png"), "--video s"),
+            "--video s: an image sequence's name needs one printf number such as %06d, and no other %");
+  EXPECT_EQ(errorOf(path("seq/%d_%d.png"), "--video dd"),
+            "--video dd: an image sequence's name needs one printf number such as %06d, and no other %");
   // Without a label the path names it.
   EXPECT_EQ(errorOf(path("missing.mkv")).rfind(path("missing.mkv") + ": no such file", 0), 0u);
 }

@@ -2,10 +2,13 @@
 
 #include <png.h>
 
+#include <algorithm>
 #include <cstring>
+#include <functional>
 #include <memory>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/file_reader.hpp"
@@ -14,23 +17,68 @@ namespace kccd::calib {
 
 namespace {
 
-// A PNG that libpng cannot decode: its message (empty when it decodes). libpng's simplified API
-// keeps its messages to itself, where OpenCV's use of libpng prints them on stderr: a damaged PNG
-// is caught here first so that the user sees one line, and sees what is wrong with it.
-std::string pngProblem(std::span<const std::uint8_t> bytes) {
+// PNG files are decoded here with libpng's simplified API, never by OpenCV: OpenCV's use of libpng
+// prints libpng's own messages ("libpng error: ...", "libpng warning: ...") on stderr, where a
+// damaged file must give one line that says what is wrong with it. The simplified API keeps its
+// messages to itself. The pixels are OpenCV's: 16-bit samples keep their high byte in 8-bit
+// output, alpha is dropped (not composited) in BGR and grey output, grey with alpha reads as
+// BGRA when unchanged.
+cv::Mat decodePng(std::span<const std::uint8_t> bytes, ImageColour colour, const std::function<void(const std::string&)>& fail) {
   png_image image;
   std::memset(&image, 0, sizeof image);
   image.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_memory(&image, bytes.data(), bytes.size())) return image.message;
+  if (!png_image_begin_read_from_memory(&image, bytes.data(), bytes.size()))
+    fail("a damaged PNG (" + printable(image.message) + ")");
+  struct Release {
+    png_image* image;
+    ~Release() { png_image_free(image); }
+  } release{&image};
   if (image.width > static_cast<png_uint_32>(kMaxImageSide) || image.height > static_cast<png_uint_32>(kMaxImageSide) ||
-      static_cast<long>(image.width) * image.height > kMaxImagePixels) {
-    png_image_free(&image);
-    return "";  // too large: decodeImage says so
+      static_cast<long>(image.width) * image.height > kMaxImagePixels)
+    fail(std::to_string(image.width) + "x" + std::to_string(image.height) + " is larger than a camera file allows (" +
+         std::to_string(kMaxImageSide) + " a side, " + std::to_string(kMaxImagePixels) + " pixels)");
+  const bool sixteen = (image.format & PNG_FORMAT_FLAG_LINEAR) != 0;  // 16-bit samples, read as stored
+  const bool alpha = (image.format & PNG_FORMAT_FLAG_ALPHA) != 0;
+  const bool col = (image.format & PNG_FORMAT_FLAG_COLOR) != 0;  // a palette expands to its colours
+  image.format = (col ? PNG_FORMAT_FLAG_COLOR | PNG_FORMAT_FLAG_BGR : 0u) | (alpha ? PNG_FORMAT_FLAG_ALPHA : 0u) |
+                 (sixteen ? PNG_FORMAT_FLAG_LINEAR : 0u);
+  const int channels = static_cast<int>(PNG_IMAGE_SAMPLE_CHANNELS(image.format));
+  cv::Mat stored(static_cast<int>(image.height), static_cast<int>(image.width), CV_MAKETYPE(sixteen ? CV_16U : CV_8U, channels));
+  if (!png_image_finish_read(&image, nullptr, stored.data, static_cast<png_int_32>(stored.step[0] / stored.elemSize1()), nullptr))
+    fail("a damaged PNG (" + printable(image.message) + ")");
+  if (sixteen && alpha) {  // the simplified API gives 16-bit colour premultiplied by alpha: undone
+    const int colours = channels - 1;
+    for (int r = 0; r < stored.rows; ++r) {
+      auto* px = stored.ptr<std::uint16_t>(r);
+      for (int c = 0; c < stored.cols; ++c, px += channels) {
+        const std::uint32_t a = px[colours];
+        for (int k = 0; k < colours; ++k)
+          px[k] = a == 0 ? 0 : static_cast<std::uint16_t>(std::min<std::uint32_t>(65535u, (px[k] * 65535u + a / 2) / a));
+      }
+    }
   }
-  image.format = PNG_FORMAT_GRAY;  // the smallest buffer: only the decoding is checked
-  std::unique_ptr<std::uint8_t[]> scratch(new std::uint8_t[PNG_IMAGE_SIZE(image)]);
-  if (!png_image_finish_read(&image, nullptr, scratch.get(), 0, nullptr)) return image.message;
-  return "";
+  if (channels == 2) cv::cvtColor(stored, stored, cv::COLOR_GRAY2BGRA);  // grey + alpha: as OpenCV reads it
+  if (colour == ImageColour::Unchanged) return stored;
+  cv::Mat eight = stored;
+  if (sixteen) {  // the high byte, as OpenCV's 8-bit reading keeps it
+    eight.create(stored.size(), CV_MAKETYPE(CV_8U, stored.channels()));
+    for (int r = 0; r < stored.rows; ++r) {
+      const auto* in = stored.ptr<std::uint16_t>(r);
+      auto* out = eight.ptr<std::uint8_t>(r);
+      for (std::size_t k = 0; k < static_cast<std::size_t>(stored.cols) * stored.channels(); ++k) out[k] = static_cast<std::uint8_t>(in[k] >> 8);
+    }
+  }
+  const int n = eight.channels();
+  if (colour == ImageColour::Grey) {
+    if (n == 1) return eight;
+    cv::Mat grey;
+    cv::cvtColor(eight, grey, n == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+    return grey;
+  }
+  if (n == 3) return eight;
+  cv::Mat bgr;
+  cv::cvtColor(eight, bgr, n == 4 ? cv::COLOR_BGRA2BGR : cv::COLOR_GRAY2BGR);
+  return bgr;
 }
 
 }  // namespace
@@ -41,14 +89,13 @@ cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& sour
   };
   if (bytes.empty()) fail("empty file");
   static constexpr std::uint8_t kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  if (bytes.size() >= 8 && std::memcmp(bytes.data(), kPngSignature, 8) == 0) {
-    const std::string problem = pngProblem(bytes);
-    if (!problem.empty()) fail("a damaged PNG (" + printable(problem) + ")");
-  }
   cv::Mat img;
   try {
+    if (bytes.size() >= 8 && std::memcmp(bytes.data(), kPngSignature, 8) == 0) return decodePng(bytes, colour, fail);
     const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
-    img = cv::imdecode(encoded, colour == ImageColour::Grey ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+    img = cv::imdecode(encoded, colour == ImageColour::Grey  ? cv::IMREAD_GRAYSCALE
+                                : colour == ImageColour::Bgr ? cv::IMREAD_COLOR
+                                                             : cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception&) {
     img.release();
   } catch (const std::bad_alloc&) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <sstream>
 #include <unordered_set>
 
@@ -13,7 +14,6 @@
 namespace kccd::calib {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kPlaneTolerance = 1e-3;  // of the board's extent
 
 std::string plural(std::size_t n, const char* word) {
@@ -68,7 +68,7 @@ double tiltFromHomography(const cv::Matx33d& h, double f, cv::Point2d c) {
   if (!(n1 > 0) || !(n2 > 0)) return std::numeric_limits<double>::quiet_NaN();
   const cv::Vec3d r3 = (r1 / n1).cross(r2 / n2);
   const double nz = std::abs(r3[2]) / std::max(cv::norm(r3), 1e-300);
-  return std::acos(std::clamp(nz, 0.0, 1.0)) * 180.0 / kPi;
+  return std::acos(std::clamp(nz, 0.0, 1.0)) * 180.0 / std::numbers::pi;
 }
 
 // A focal length for the homographies (Zhang's constraints with square pixels and the principal
@@ -378,7 +378,7 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
   for (std::size_t j = 0; j < in.size(); ++j) {
     cv::Matx33d r;
     cv::Rodrigues(rvecs[j], r);
-    const double tilt = std::acos(std::clamp(std::abs(r(2, 2)), 0.0, 1.0)) * 180.0 / kPi;
+    const double tilt = std::acos(std::clamp(std::abs(r(2, 2)), 0.0, 1.0)) * 180.0 / std::numbers::pi;
     result.views[in[j]].tilt_deg = tilt;
     max_tilt = std::max(max_tilt, tilt);
   }

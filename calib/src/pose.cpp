@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <unordered_set>
 
@@ -14,7 +15,6 @@
 namespace kccd::calib {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr std::size_t kMaxTriples = 2000;  // P3P samples; fewer triples than this are all tried
 constexpr std::size_t kMinTriples = 200;   // sampled triples tried before the adaptive stop
 
@@ -128,7 +128,7 @@ double rotationAngleDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
   cv::Matx33d ra, rb;
   cv::Rodrigues(a, ra);
   cv::Rodrigues(b, rb);
-  return cv::norm(logRotation(ra * rb.t())) * 180.0 / kPi;
+  return cv::norm(logRotation(ra * rb.t())) * 180.0 / std::numbers::pi;
 }
 
 void refineLM(const Camera& cam, const std::vector<cv::Point3d>& world, const std::vector<cv::Point2d>& pixel,
@@ -439,7 +439,7 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) g(r, 3 + c) = -rmat(c, r);
   const auto sigmas = [&](const cv::Matx66d& s) {
-    return std::pair<double, double>(std::sqrt(largestEigen(a * s * a.t())) * 180.0 / kPi,
+    return std::pair<double, double>(std::sqrt(largestEigen(a * s * a.t())) * 180.0 / std::numbers::pi,
                                      std::sqrt(largestEigen(g * s * g.t())));
   };
   const auto [rot_sigma, pos_sigma] = sigmas(cov);
@@ -451,7 +451,7 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   for (int p = 0; p < k; ++p)
     for (int q = p + 1; q < k; ++q) {
       const cv::Vec3d x(norm[idx[p]].x, norm[idx[p]].y, 1), y(norm[idx[q]].x, norm[idx[q]].y, 1);
-      extent = std::max(extent, std::acos(std::clamp(x.dot(y) / (cv::norm(x) * cv::norm(y)), -1.0, 1.0)) * 180.0 / kPi);
+      extent = std::max(extent, std::acos(std::clamp(x.dot(y) / (cv::norm(x) * cv::norm(y)), -1.0, 1.0)) * 180.0 / std::numbers::pi);
     }
   if (rot_gate > options.max_rotation_sigma_deg || pos_gate > options.max_position_sigma_ratio * distance) {
     result.status = PoseStatus::PoorGeometry;

@@ -2,8 +2,7 @@
 
 #include <filesystem>
 
-#include <opencv2/imgcodecs.hpp>
-
+#include "kccd/calib/image_file.hpp"
 #include "kccd/file_reader.hpp"
 #include "kccd/overlay/staged_output.hpp"
 
@@ -118,9 +117,14 @@ CaseResult checkCase(const GoldenCase& c, const GoldenRendering& rendering, cons
       continue;
     }
     o.status = GoldenStatus::Failed;
-    o.expected = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
-    if (o.expected.empty()) {
-      o.reason = file.string() + ": not a readable PNG";
+    std::string unreadable;
+    try {
+      o.expected = calib::readImageFile(file.string(), calib::ImageColour::Unchanged);
+    } catch (const calib::ImageError& e) {
+      unreadable = e.what();
+    }
+    if (!unreadable.empty()) {
+      o.reason = unreadable;
     } else if (!sidecar_problem.empty() || !have_sidecar) {
       o.reason = sidecar_problem.empty() ? sidecar.string() + ": missing (it names the mask's bodies and the inputs)" : sidecar_problem;
     } else if (img.output == GoldenOutput::Mask) {

@@ -24,7 +24,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+double sensorSeconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 }  // namespace
 
@@ -192,8 +192,8 @@ struct SensorWriter::Impl {
     if (!ok) error_ = std::string("cannot write mask ") + name;
     if (!error_.empty()) return;
     const auto t4 = Clock::now();
-    stage_s_[0] += seconds(t0, t1), stage_s_[1] += seconds(t1, t2), stage_s_[2] += seconds(t2, t3),
-        stage_s_[3] += seconds(t3, t4);
+    stage_s_[0] += sensorSeconds(t0, t1), stage_s_[1] += sensorSeconds(t1, t2), stage_s_[2] += sensorSeconds(t2, t3),
+        stage_s_[3] += sensorSeconds(t3, t4);
     ++written_;
   }
   cv::VideoWriter& video_;

@@ -13,7 +13,6 @@ endif()
 function(build_and_run name dir program)
   execute_process(COMMAND ${CMAKE_COMMAND} -S ${dir} -B ${WORK_DIR}/${name} -G ${GENERATOR}
                           -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_BUILD_TYPE=Release
-                          "-DCMAKE_CXX_FLAGS=${CONSUMER_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${CONSUMER_FLAGS}"
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "${name}: configuring against the installed package failed (${rc}):\n${out}\n${err}")

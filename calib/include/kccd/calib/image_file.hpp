@@ -1,5 +1,6 @@
-// Reading a camera frame from an image file (PNG, JPEG, TIFF, BMP, ... as OpenCV decodes them),
-// for the calibration commands.
+// Reading an image file: camera frames (PNG, JPEG, TIFF, BMP, ...) for the calibration commands
+// and image-sequence recordings, golden images. PNGs are decoded with libpng's simplified API
+// (whose messages never reach stderr), the other formats by OpenCV.
 #pragma once
 
 #include <cstddef>
@@ -21,8 +22,9 @@ class ImageError : public InputError {
 
 inline constexpr std::size_t kMaxImageFileBytes = std::size_t{256} << 20;  ///< encoded size
 
-/// The pixels an image decodes to: 8-bit BGR (`grey` false) or 8-bit grey.
-enum class ImageColour : std::uint8_t { Bgr, Grey };
+/// The pixels an image decodes to: 8-bit BGR, 8-bit grey, or as stored (8 or 16 bits; grey, BGR
+/// or BGRA, as OpenCV's IMREAD_UNCHANGED gives them).
+enum class ImageColour : std::uint8_t { Bgr, Grey, Unchanged };
 
 /// Decodes an encoded image held in memory; `source` names it in messages. The image must decode
 /// and fit a camera (Camera::validate's bounds: kMaxImageSide a side, kMaxImagePixels). Throws

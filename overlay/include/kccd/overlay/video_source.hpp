@@ -23,9 +23,10 @@ class VideoError : public InputError {
 };
 
 /// A recording's frames, read in order (seeking is not reliable in every codec). A path with a
-/// '%' is an image sequence named by a printf pattern (`frames/frame_%06d.png`, numbered from 0
-/// or 1, read by OpenCV's image reader); any other path must be a regular file that OpenCV's
-/// FFmpeg back end decodes.
+/// '%' is an image sequence named by a printf pattern (`frames/frame_%06d.png`, numbered from 0,
+/// or from 1 when there is no frame 0, up to the first missing number; each file read by
+/// calib::readImageFile); any other path must be a regular file that OpenCV's FFmpeg back end
+/// decodes.
 class VideoSource {
  public:
   /// Opens `path`. `label` names it in errors (default: the path). Throws VideoError.
@@ -47,9 +48,11 @@ class VideoSource {
   std::size_t nextIndex() const { return next_; }
 
  private:
-  std::unique_ptr<cv::VideoCapture> capture_;
+  std::unique_ptr<cv::VideoCapture> capture_;  ///< a video file
   std::string label_;
   bool sequence_ = false;
+  std::string pattern_;                        ///< an image sequence: its printf pattern,
+  std::size_t first_ = 0, length_ = 0;         ///< first number and frame count
   std::size_t next_ = 0;
 };
 
