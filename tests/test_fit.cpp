@@ -144,6 +144,7 @@ TEST(Fit, GeneratedPartsAreContainedForEveryK) {
         break;
     }
     for (int k : {1, 2, 3, 5, 8, 16}) {
+      if (kccd::testing::kSanitized && k == 16 && trial > 0) continue;  // K = 16 once: K = 8's paths, more points
       const km::FitResult f = km::fit(part, quick(k));
       ASSERT_EQ(static_cast<int>(f.points.size()), k);
       expectContains(f, part, truth, "trial " + std::to_string(trial) + " K " + std::to_string(k));
@@ -236,7 +237,8 @@ TEST(Fit, CylindersComeCloseToTheBestPrismFamily) {
   for (const double h : lengths) {
     km::Part cylinder;  // radius 1 along y
     cylinder.addCylinderY(Eigen::Affine3d::Identity(), 1.0, 2.0 * h);
-    for (const int k : {8, 16}) {
+    // Under the sanitizers K = 8 only (K = 16 takes the same paths with twice the points).
+    for (const int k : kccd::testing::kSanitized ? std::vector<int>{8} : std::vector<int>{8, 16}) {
       const km::FitResult f = km::fit(cylinder, {.points = k});
       const double ratio = f.volume / (2.0 * kPi * h), family = bestPrismFamilyRatio(h, k / 2);
       RecordProperty("h" + std::to_string(h) + "_k" + std::to_string(k), std::to_string(ratio));
@@ -300,7 +302,11 @@ TEST(ReadPart, RealInventorModelsAreContained) {
     if (!std::filesystem::exists(kModels + f.path)) GTEST_SKIP() << "inventor-data not installed";
     const km::Part part = km::readPart(kModels + f.path, {.merge = f.merge});
     EXPECT_GT(part.triangles + part.primitives, 0) << f.path;
-    for (int k : {1, 8}) expectContains(km::fit(part, quick(k)), part, {}, f.path);
+    // Under the sanitizers each file is read and fitted once with K = 1, and K = 8 only for the
+    // first (the reader is what differs between the files; the fit's paths are the same).
+    const bool first = std::string(f.path) == "household/mug.iv";
+    for (int k : {1, 8})
+      if (!kccd::testing::kSanitized || k == 1 || first) expectContains(km::fit(part, quick(k)), part, {}, f.path);
   }
 }
 

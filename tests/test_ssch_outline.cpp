@@ -8,6 +8,7 @@
 #include <iostream>
 #include <random>
 #include <tuple>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -15,6 +16,7 @@
 #include "kccd/render/ssch_outline.hpp"
 #include "support/cameras.hpp"
 #include "support/random_shapes.hpp"
+#include "support/sanitized.hpp"
 #include "support/silhouette.hpp"
 
 namespace {
@@ -122,7 +124,11 @@ TEST(RenderOutline, ContainsTheImageAndIsWithinTolerance) {
   int drawn = 0, refused = 0;
   double worst = 0.0;
   std::size_t most = 0;
-  for (const double focal : {300.0, 1000.0, 4000.0})
+  // Under the sanitizers without the longest focal length (the finest outlines and oracle rims:
+  // the same code with more corners).
+  const std::vector<double> focals = kccd::testing::kSanitized ? std::vector<double>{300.0, 1000.0}
+                                                                : std::vector<double>{300.0, 1000.0, 4000.0};
+  for (const double focal : focals)
     for (const Case& k : cases(rng)) {
       SCOPED_TRACE(k.what + ", focal " + std::to_string(focal));
       const OutlineOptions options{.focal_px = focal, .tolerance_px = 0.5, .min_depth = 0.05};
@@ -178,7 +184,7 @@ TEST(RenderOutline, ContainsTheImageAndIsWithinTolerance) {
         ASSERT_LE(d, 0.5 + 2e-3 + 1e-9 * scale * focal) << "corner too far outside";
       }
     }
-  EXPECT_GT(drawn, 120);
+  EXPECT_GT(drawn, 40 * static_cast<int>(focals.size()));
   EXPECT_GT(refused, 0);
   std::cout << drawn << " outlines, " << refused << " refused (nearer than min_depth); farthest corner "
             << worst << " px outside the image (tolerance 0.5); at most " << most << " corners\n";
