@@ -28,7 +28,7 @@ struct OverlayArgs {
   double latency = overlay::kOverlayBraking.latency, deceleration = overlay::kOverlayBraking.deceleration,
          max_acceleration = overlay::kOverlayBraking.max_acceleration,
          position_error = overlay::kOverlayBraking.position_error, velocity_error = overlay::kOverlayBraking.velocity_error;
-  bool swept = false, plain = false, quiet = false, json = false, visuals = false;
+  bool swept = false, plain = false, quiet = false, json = false, visuals = false, timings = false;
   int jobs = 0;  // 0: hardware threads
 };
 
@@ -85,6 +85,7 @@ Exit runOverlay(const OverlayArgs& a) {
   o.plain = a.plain;
   o.visuals = a.visuals;
   o.jobs = a.jobs;
+  o.timings = a.timings;
   o.contact_frames = a.contact_sheet.empty() ? 0 : static_cast<std::size_t>(a.contact_frames);
 
   // Outputs under temporary names, moved into place only when every frame is done.
@@ -122,6 +123,16 @@ Exit runOverlay(const OverlayArgs& a) {
                                              format(r.time_offset_found.correlation, 3) + "); "
                                        : "")
               << format(frames / std::max(r.seconds, 1e-9), 3) << " frames/s with " << r.jobs << " jobs\n";
+  }
+  if (a.timings) {
+    const overlay::StageTimes& t = r.stages;
+    const double n = std::max<double>(1.0, static_cast<double>(frames));
+    std::cerr << "overlay timings: set-up " << format(r.setup_seconds, 3) << " s, frames " << format(r.seconds, 3)
+              << " s with " << r.jobs << " jobs; per frame (ms, each on its own thread):\n";
+    const std::pair<const char*, double> rows[] = {{"decode", t.decode},   {"state", t.state},         {"query", t.query},
+                                                   {"render", t.render},   {"read_back", t.read_back}, {"warp", t.warp},
+                                                   {"composite", t.composite}, {"encode", t.encode}};
+    for (const auto& [name, seconds] : rows) std::cerr << "  " << name << " " << format(1000.0 * seconds / n, 3) << "\n";
   }
   if (const std::optional<std::size_t> first = r.firstUnsafe()) {
     const overlay::FrameRecord& f = r.frames[*first];
@@ -179,6 +190,9 @@ Runner addOverlay(CLI::App& app) {
   sub->add_option("--codec", a->codec, "FourCC of the output video (default by extension)");
   sub->add_option("-j,--jobs", a->jobs, "Worker threads (each with its own GL context; default: hardware threads)")->check(CLI::Range(1, 256));
   sub->add_flag("--json", a->json, "Print the summary as JSON");
+  sub->add_flag("--timings", a->timings,
+                "Where the time went: set-up and per frame decode, state, query, render, read-back, warp, composite and encode "
+                "(ms per frame on stderr; \"timings\" in --report and --json)");
   sub->add_flag("-q,--quiet", a->quiet, "No progress and no summary");
   sub->footer(
       "Each frame's time (index / fps, or --frame-times) plus --time-offset is looked up in the state log: a sample\n"

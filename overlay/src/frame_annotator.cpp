@@ -1,6 +1,7 @@
 #include "kccd/overlay/frame_annotator.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -22,6 +23,12 @@ std::vector<std::array<std::string, 2>> linkPairs(const Model& model, const std:
   return out;
 }
 
+StageTimes& StageTimes::operator+=(const StageTimes& o) {
+  decode += o.decode, state += o.state, query += o.query, render += o.render;
+  read_back += o.read_back, warp += o.warp, composite += o.composite, encode += o.encode;
+  return *this;
+}
+
 const char* FrameRecord::queryStatusText() const {
   return braking_failed ? "no_braking_box" : not_finite ? "volume_not_finite" : toString(query);
 }
@@ -41,6 +48,9 @@ FrameAnnotator::~FrameAnnotator() = default;
 void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
   const Model& m = scene_.model;
   const AnnotatorSettings& set = scene_.settings;
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); };
+  const Clock::time_point t_state = Clock::now();
   const double t = rec.time + set.time_offset;
   rec.match = set.swept ? stateAt(scene_.log, t, set.max_gap, q_, v_) : stateAt(scene_.log, t, set.max_gap, q_);
   render::ModelViewRequest request;
@@ -70,8 +80,14 @@ void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
       }
     }
   }
+  rec.times.state = since(t_state);
   // The view queries from scratch every frame: the answer does not depend on which annotator had which frame.
   const render::ModelFrame drawn = view_.draw(request);
+  const render::FrameTimes& ft = drawn.images.times;
+  rec.times.query = drawn.query_seconds;
+  rec.times.render = ft.prepare + ft.draw;
+  rec.times.read_back = ft.read_back;
+  rec.times.warp = ft.warp + ft.decorate;
   if (drawn.query) {
     const QueryResult& r = *drawn.query;
     rec.query = r.status;
@@ -85,8 +101,10 @@ void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
   const render::Frame& layer = drawn.images;
   for (std::size_t i = 0; i < drawn.first_visual; ++i) rec.not_finite |= layer.visibility[i] == render::Visibility::NotFinite;
   if (rec.not_finite) rec.status = SafetyStatus::Colliding;  // an overflowed volume is unsafe
-  render::compositeOver(bgr, layer.bgra);
+  const Clock::time_point t_composite = Clock::now();
+  render::compositeOver(bgr, layer.bgra, layer.drawn);
   if (!set.plain) drawStatusLine(bgr, rec);
+  rec.times.composite = since(t_composite);
 }
 
 void FrameAnnotator::drawStatusLine(cv::Mat& bgr, const FrameRecord& rec) const {

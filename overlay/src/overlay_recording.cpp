@@ -86,7 +86,9 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   const calib::Camera& camera = in.camera;
   const std::string video_label = in.video_label.empty() ? in.video : in.video_label;
   const std::string camera_label = in.camera_label.empty() ? "camera" : in.camera_label;
+  const auto t_setup = std::chrono::steady_clock::now();
   OverlayReport report;
+  report.timings = opt.timings;
   report.max_gap = opt.max_gap > 0.0 ? opt.max_gap : 1.5 * in.log.medianPeriod();
   report.swept = opt.swept;
   report.margin = model.safety_margin;
@@ -176,6 +178,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
             spare.pop_back();
           }
         }
+        const auto t_decode = std::chrono::steady_clock::now();
         if (!video.read(job.bgr)) {
           if (index == 0) throw VideoError(video_label + ": no frame could be decoded");
           if (expected > 0 && index < expected)
@@ -197,6 +200,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
           else throw VideoError(video_label + ": frame " + count(index) + " is not an 8-bit colour image");
           job.bgr = converted;
         }
+        job.record.times.decode = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_decode).count();
         job.record.time = clock(index);
         if (clock.fromFrameTimes() && !std::isfinite(job.record.time))
           throw InputError(in.frame_times_label + ": no time for frame " + count(index));
@@ -247,6 +251,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   // The writer: frames in input order.
   ContactSheet sheet(std::max<std::size_t>(opt.contact_frames, 1), opt.contact_tile_width);
   const auto t_frames = std::chrono::steady_clock::now();
+  report.setup_seconds = std::chrono::duration<double>(t_frames - t_setup).count();
   try {
     for (std::size_t next = 0;; ++next) {
       FrameJob job;
@@ -261,7 +266,9 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
       FrameRecord& r = job.record;
       if (r.selected) {
         if (sink) {
+          const auto t_encode = std::chrono::steady_clock::now();
           sink->write(job.index, job.bgr);
+          r.times.encode = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_encode).count();
           r.written = true;
           ++report.written;
         }
@@ -300,6 +307,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
     report.within_margin += r.status == SafetyStatus::WithinMargin;
     report.clear += r.status == SafetyStatus::Clear;
     report.unsafe += r.unsafe();
+    report.stages += r.times;
   }
   if (opt.contact_frames > 0) report.contact_sheet = sheet.compose();
   return report;

@@ -28,6 +28,13 @@ nlohmann::json reportJson(const OverlayReport& report, const Model& model, bool 
   j["max_gap"] = report.max_gap;
   j["fps"] = report.fps > 0 ? nlohmann::json(report.fps) : nlohmann::json(nullptr);
   j["margin"] = report.margin;
+  if (report.timings) {
+    const StageTimes& t = report.stages;
+    j["timings"] = {{"setup", report.setup_seconds}, {"frames", report.seconds}, {"jobs", report.jobs},
+                    {"stage_seconds",
+                     {{"decode", t.decode}, {"state", t.state}, {"query", t.query}, {"render", t.render},
+                      {"read_back", t.read_back}, {"warp", t.warp}, {"composite", t.composite}, {"encode", t.encode}}}};
+  }
   if (!with_frames) return j;
   nlohmann::json frames = nlohmann::json::array();
   for (std::size_t i = 0; i < report.frames.size(); ++i) {

@@ -55,8 +55,10 @@ cv::Mat drawLegend(double scale, int thick) {
 Legend::Legend(const Projection& projection, double near)
     : projection_(projection), world_to_camera_(projection.camera().worldToCamera()), near_(near) {}
 
-void Legend::draw(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility,
-                  const Style& style) {
+cv::Rect Legend::draw(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility,
+                      const Style& style) {
+  const cv::Rect image(0, 0, bgra.cols, bgra.rows);
+  cv::Rect touched;
   const int font = cv::FONT_HERSHEY_SIMPLEX;
   const double scale = std::clamp(bgra.rows / 900.0, 0.35, 1.0);
   const int thick = std::max(1, static_cast<int>(std::lround(scale * 2)));
@@ -78,6 +80,7 @@ void Legend::draw(cv::Mat& bgra, std::span<const Volume> volumes, const std::vec
       int baseline = 0;
       const cv::Size size = cv::getTextSize(v.label, font, scale, thick, &baseline);
       text(v.label, cv::Point(static_cast<int>(px.x()) - size.width / 2, static_cast<int>(px.y()) + size.height / 2));
+      touched = image;  // names are rare in overlays: not worth a tighter box
     }
   }
   if (style.legend) {
@@ -90,8 +93,12 @@ void Legend::draw(cv::Mat& bgra, std::span<const Volume> volumes, const std::vec
       legend_box_ = cv::boundingRect(alpha);
     }
     const cv::Rect box = legend_box_ & cv::Rect(0, 0, bgra.cols, bgra.rows);
-    if (!box.empty()) legend_(box).copyTo(bgra(box));  // an image a few pixels high shows none of it
+    if (!box.empty()) {  // an image a few pixels high shows none of it
+      legend_(box).copyTo(bgra(box));
+      touched |= box;
+    }
   }
+  return touched;
 }
 
 }  // namespace detail

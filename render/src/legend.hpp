@@ -19,8 +19,8 @@ class Legend {
   /// For volumes seen through `projection`; names of centres nearer than `near` are not drawn.
   Legend(const Projection& projection, double near);
   /// Draws on `bgra` (the straight-alpha camera image) what `style` asks: the names of the drawn
-  /// volumes (Style::labels) and the legend (Style::legend).
-  void draw(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility, const Style& style);
+  /// volumes (Style::labels) and the legend (Style::legend); returns the rectangle it drew in.
+  cv::Rect draw(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility, const Style& style);
 
  private:
   const Projection& projection_;

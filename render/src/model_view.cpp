@@ -1,5 +1,6 @@
 #include "kccd/render/model_view.hpp"
 
+#include <chrono>
 #include <iterator>
 #include <stdexcept>
 #include <utility>
@@ -43,6 +44,7 @@ ModelFrame ModelView::draw(const ModelViewRequest& request) {
     }
   } else {
     // From scratch every time: the answer does not depend on what this view drew before.
+    const auto t0 = std::chrono::steady_clock::now();
     checker_.reset();
     const QueryResult& r =
         box ? checker_.query(request.lower, request.upper,
@@ -56,6 +58,7 @@ ModelFrame ModelView::draw(const ModelViewRequest& request) {
     if (request.volumes && drawn)
       volumes = box ? sceneVolumes(model_, checker_, out.status)
                     : staticSceneVolumes(model_, checker_, request.state, out.status);
+    out.query_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   if (!drawn) return out;
   for (std::size_t i = 0; i < volumes.size(); ++i) {

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
+#include <limits>
 #include <cmath>
 #include <cstdint>
 
@@ -136,14 +138,64 @@ void drawShaded(const std::vector<const PreparedVolume*>& order, double ambient)
 
 }  // namespace
 
-cv::Mat drawColour(GlTargets& gl, const Projection& projection, const RenderOptions& options,
-                   const std::vector<PreparedVolume>& bodies, const Style& style, Frame& frame, cv::Mat* labels) {
+std::vector<cv::Rect> colourRects(const Projection& projection, const std::vector<PreparedVolume>& bodies,
+                                  const Style& style, double near) {
+  const Pinhole& pin = projection.pinhole();
+  const cv::Rect all(0, 0, pin.width, pin.height);
+  // Smoothed lines reach half their width and a pixel of coverage beyond the vertices; GL projects
+  // in float: four more pixels each way cover both with room to spare.
+  const double margin = (style.shaded ? 0.0 : 0.5 * style.outline_width * projection.supersample()) + 4.0;
+  std::vector<cv::Rect> rects;
+  for (const PreparedVolume& p : bodies) {
+    if (p.fills) return {all};
+    double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+    bool whole = false;
+    auto add = [&](const std::vector<float>& v) {
+      for (std::size_t k = 0; k + 2 < v.size(); k += 3) {
+        const double z = v[k + 2];
+        const double x = pin.fx * v[k] / z + pin.cx, y = pin.fy * v[k + 1] / z + pin.cy;
+        // Clipped by the near plane (or not a number, or far off): the clipped polygon may reach any pixel.
+        if (!(z > near) || !(std::abs(x) < 1e7 && std::abs(y) < 1e7)) {
+          whole = true;
+          return;
+        }
+        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+    };
+    if (p.mesh) add(p.vertices);
+    if (p.outlined()) add(p.outline_vertices);
+    if (whole) return {all};
+    if (!(x0 <= x1)) continue;
+    const int left = static_cast<int>(std::floor(x0 - margin)), top = static_cast<int>(std::floor(y0 - margin));
+    const int right = static_cast<int>(std::ceil(x1 + margin)), bottom = static_cast<int>(std::ceil(y1 + margin));
+    const cv::Rect r = cv::Rect(cv::Point(std::max(left, 0), std::max(top, 0)),
+                                cv::Point(std::min(right, pin.width), std::min(bottom, pin.height))) &
+                       all;
+    if (!r.empty()) rects.push_back(r);
+  }
+  return rects;
+}
+
+void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions& options,
+                const std::vector<PreparedVolume>& bodies, const Style& style, Frame& frame, ColourReadBack& out,
+                cv::Mat* labels) {
+  const auto t0 = std::chrono::steady_clock::now();
   const double near = frame.near, far = frame.far;
   const int w = gl.width, h = gl.height;
   const bool with_labels = labels != nullptr && gl.samples <= 1 && !style.shaded;
   glBindFramebuffer(GL_FRAMEBUFFER, gl.samples > 1 ? gl.ms_fbo : gl.resolve_fbo);
   if (gl.samples <= 1) drawBuffers(true, with_labels);
   setCamera(projection, near, far);
+  // Only the rectangle that will be read back is cleared and drawn (the labels are read whole):
+  // the rasteriser leaves the other tiles alone.
+  out.parts = options.crop ? colourRects(projection, bodies, style, near)
+                           : std::vector<cv::Rect>{cv::Rect(0, 0, projection.pinhole().width, projection.pinhole().height)};
+  cv::Rect rect;
+  for (const cv::Rect& r : out.parts) rect |= r;
+  if (!with_labels) {
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(rect.x, rect.y, rect.width, rect.height);
+  }
   glClearColor(0, 0, 0, 0);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -220,6 +272,7 @@ cv::Mat drawColour(GlTargets& gl, const Projection& projection, const RenderOpti
     }
   glDisable(GL_BLEND);
   }
+  glDisable(GL_SCISSOR_TEST);
   if (gl.samples > 1) {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, gl.ms_fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, gl.resolve_fbo);
@@ -227,15 +280,28 @@ cv::Mat drawColour(GlTargets& gl, const Projection& projection, const RenderOpti
     glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
   glBindFramebuffer(GL_READ_FRAMEBUFFER, gl.resolve_fbo);
-  cv::Mat image(h, w, CV_8UC4);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glFinish();
-  // Colours are drawn with blue in GL's red channel, so the plain RGBA read (llvmpipe's fast
-  // path, no swizzle) returns OpenCV's BGRA order.
-  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, image.data);
+  const auto t1 = std::chrono::steady_clock::now();
+  if (out.image.rows != h || out.image.cols != w || out.image.type() != CV_8UC4) {
+    out.image = cv::Mat::zeros(h, w, CV_8UC4);
+    out.rect = cv::Rect();
+  }
+  out.image(out.rect).setTo(cv::Scalar::all(0));  // the previous frame's pixels
+  out.rect = rect;
+  if (!out.rect.empty()) {
+    // Colours are drawn with blue in GL's red channel, so the plain RGBA read (llvmpipe's fast
+    // path, no swizzle) returns OpenCV's BGRA order. GL's rows are the image's (see setCamera).
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glPixelStorei(GL_PACK_ROW_LENGTH, w);
+    glReadPixels(out.rect.x, out.rect.y, out.rect.width, out.rect.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                 out.image.ptr<uchar>(out.rect.y, out.rect.x));
+    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  }
   if (with_labels) *labels = readLabels(w, h);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  return image;
+  const auto t2 = std::chrono::steady_clock::now();
+  frame.times.draw += std::chrono::duration<double>(t1 - t0).count();
+  frame.times.read_back += std::chrono::duration<double>(t2 - t1).count();
 }
 
 cv::Mat drawMask(GlTargets& gl, const Projection& mask_projection, const std::vector<PreparedVolume>& bodies,

@@ -13,12 +13,30 @@
 
 namespace kccd::render::detail {
 
-/// The colour layer of the pinhole image (CV_8UC4, BGRA, premultiplied alpha) through
-/// `projection`, between frame.near and frame.far; counts polygon fills into `frame`. With
-/// `labels` (and no multisampling, not shaded) the mask labels are drawn in the same pass, just
-/// before the colour, and read into *labels.
-cv::Mat drawColour(GlTargets& gl, const Projection& projection, const RenderOptions& options,
-                   const std::vector<PreparedVolume>& bodies, const Style& style, Frame& frame, cv::Mat* labels = nullptr);
+/// The colour layer's pinhole image, kept from frame to frame so that only what is drawn is read
+/// back: `image` (CV_8UC4, BGRA, premultiplied alpha, the pinhole size) is zero outside `rect`,
+/// and outside the union of `parts` (which `rect` bounds).
+struct ColourReadBack {
+  cv::Mat image;
+  cv::Rect rect;
+  std::vector<cv::Rect> parts;
+};
+
+/// Pinhole rectangles that hold every pixel the colour pass draws of `bodies`, one per drawn
+/// volume (its mesh and outline vertices projected, widened by the smoothed outline's width and a
+/// few pixels for GL's float arithmetic): the whole image alone when a volume fills the view or
+/// reaches the near plane.
+std::vector<cv::Rect> colourRects(const Projection& projection, const std::vector<PreparedVolume>& bodies,
+                                  const Style& style, double near);
+
+/// The colour layer of the pinhole image through `projection`, between frame.near and frame.far,
+/// into `out`: only the rectangle bounding colourRects() is read back, the rest of out.image cleared where the previous
+/// frame's rectangle was; counts polygon fills and times the drawing and the read-back into
+/// `frame`. With `labels` (and no multisampling, not shaded) the mask labels are drawn in the same
+/// pass, just before the colour, and read into *labels (the whole pinhole image).
+void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions& options,
+                const std::vector<PreparedVolume>& bodies, const Style& style, Frame& frame, ColourReadBack& out,
+                cv::Mat* labels = nullptr);
 
 /// The labels alone (a mask without the colour layer, or with the shaded look or multisampling)
 /// through the mask pass's projection (CV_8UC1, the pinhole image): the label attachment of the

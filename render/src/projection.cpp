@@ -46,17 +46,22 @@ Projection::Projection(const Camera& camera, double supersample)
   const int n = camera.width * camera.height;
   cv::Mat normal(n, 1, CV_64FC2);
   std::vector<unsigned char> valid(n, 0);
+  // The blocks are independent: inverted in parallel (the set-up of a long recording's run).
   const int block_rows = std::max(1, (1 << 16) / camera.width);
-  for (int v0 = 0; v0 < camera.height; v0 += block_rows) {
-    const int rows = std::min(block_rows, camera.height - v0), m = rows * camera.width, first = v0 * camera.width;
-    cv::Mat pixels(m, 1, CV_64FC2), block_normal;
-    for (int v = v0, i = 0; v < v0 + rows; ++v)
-      for (int u = 0; u < camera.width; ++u, ++i) pixels.at<cv::Vec2d>(i) = cv::Vec2d(u, v);
-    std::vector<unsigned char> block_valid;
-    calib::undistortPixels(camera, pixels, block_normal, block_valid);
-    block_normal.copyTo(normal.rowRange(first, first + m));
-    std::copy(block_valid.begin(), block_valid.end(), valid.begin() + first);
-  }
+  const int blocks = (camera.height + block_rows - 1) / block_rows;
+  cv::parallel_for_(cv::Range(0, blocks), [&](const cv::Range& range) {
+    for (int b = range.start; b < range.end; ++b) {
+      const int v0 = b * block_rows;
+      const int rows = std::min(block_rows, camera.height - v0), m = rows * camera.width, first = v0 * camera.width;
+      cv::Mat pixels(m, 1, CV_64FC2), block_normal;
+      for (int v = v0, i = 0; v < v0 + rows; ++v)
+        for (int u = 0; u < camera.width; ++u, ++i) pixels.at<cv::Vec2d>(i) = cv::Vec2d(u, v);
+      std::vector<unsigned char> block_valid;
+      calib::undistortPixels(camera, pixels, block_normal, block_valid);
+      block_normal.copyTo(normal.rowRange(first, first + m));
+      std::copy(block_valid.begin(), block_valid.end(), valid.begin() + first);
+    }
+  });
   double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
   for (int i = 0; i < n; ++i)
     if (valid[i]) {

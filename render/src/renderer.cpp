@@ -48,6 +48,7 @@ Renderer::Renderer(const Projection& projection, const RenderOptions& options)
                                             options.msaa_samples, mask.width, mask.height);
   preparer_ = std::make_unique<FramePreparer>(projection_, maskProjection(), options_);
   colour_warp_ = std::make_unique<detail::ColourWarp>(projection_);
+  read_back_ = std::make_unique<detail::ColourReadBack>();
   label_warp_ = std::make_unique<detail::LabelWarp>(maskProjection());
   legend_ = std::make_unique<detail::Legend>(projection_, options_.near);
 }
@@ -63,6 +64,7 @@ const MeshCache& Renderer::meshCache() const { return preparer_->meshCache(); }
 
 Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool want_colour, bool want_mask) {
   if (volumes.size() > 255) throw std::invalid_argument("Renderer: at most 255 volumes (8-bit mask labels)");
+  const auto t_start = std::chrono::steady_clock::now();
   context_->makeCurrent();
   static const bool profile = std::getenv("KCCD_RENDER_PROFILE") != nullptr;
   auto tick = [last = std::chrono::steady_clock::now()](const char* what) mutable {
@@ -82,14 +84,25 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
   // The mask from the colour pass when it can (the overlay look at the colour pass's scale).
   const bool same_pass = want_colour && want_mask && !style.shaded && gl_->samples <= 1 && !mask_projection_;
   cv::Mat labels;
+  using Clock = std::chrono::steady_clock;
+  const auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
+  Clock::time_point t = Clock::now();
+  frame.times.prepare = seconds(t_start, t);
   if (want_colour) {
-    const cv::Mat premultiplied =
-        detail::drawColour(*gl_, projection_, options_, bodies, style, frame, same_pass ? &labels : nullptr);
+    detail::drawColour(*gl_, projection_, options_, bodies, style, frame, *read_back_, same_pass ? &labels : nullptr);
     tick("colour+readback");
-    frame.bgra = colour_warp_->apply(premultiplied);
+    t = Clock::now();
+    detail::TileMask tiles(projection_.camera().width, projection_.camera().height);
+    frame.bgra = colour_warp_->apply(read_back_->image, read_back_->parts, tiles);
     tick("warp+unpremultiply");
-    legend_->draw(frame.bgra, volumes, frame.visibility, style);
+    const Clock::time_point t_warped = Clock::now();
+    frame.times.warp = seconds(t, t_warped);
+    tiles.mark(legend_->draw(frame.bgra, volumes, frame.visibility, style));
+    if (!options_.crop) tiles.mark(cv::Rect(0, 0, frame.bgra.cols, frame.bgra.rows));
+    frame.drawn = tiles.runs();
     tick("decorate");
+    t = Clock::now();
+    frame.times.decorate = seconds(t_warped, t);
   }
   if (want_mask) {
     cv::Mat pinhole_labels = same_pass ? labels : detail::drawMask(*gl_, maskProjection(), bodies, frame.near, frame.far);
@@ -108,6 +121,7 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     frame.mask_edge_px += mesh_error;
     frame.pixels.assign(volumes.size(), 0);
     for (std::size_t i = 0; i < volumes.size(); ++i) frame.pixels[i] = counts[static_cast<std::size_t>(bodies[i].label)];
+    frame.times.mask = seconds(t, Clock::now());
   }
   if (profile) std::fprintf(stderr, "\n");
   return frame;

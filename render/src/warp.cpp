@@ -99,21 +99,91 @@ void straighten(cv::Mat rows) {
 
 }  // namespace
 
-cv::Mat ColourWarp::apply(const cv::Mat& premultiplied) {
-  cv::Mat out;
-  if (projection_.warps()) {
-    if (map_a_.empty()) {  // fixed-point maps: remap's fast path (1/32 px steps)
-      cv::convertMaps(projection_.mapX(), projection_.mapY(), map_a_, map_b_, CV_16SC2);
-      source_rows_ = sourceRows(projection_.mapY(), projection_.pinhole().height);
+TileMask::TileMask(int width, int height)
+    : width_(width), height_(height), tiles_x_((width + kTile - 1) / kTile),
+      on_(static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>((height + kTile - 1) / kTile), 0) {}
+
+cv::Rect TileMask::tile(int t) const {
+  return cv::Rect((t % tiles_x_) * kTile, (t / tiles_x_) * kTile, kTile, kTile) & cv::Rect(0, 0, width_, height_);
+}
+
+void TileMask::mark(const cv::Rect& pixels) {
+  const cv::Rect r = pixels & cv::Rect(0, 0, width_, height_);
+  if (r.empty()) return;
+  for (int ty = r.y / kTile; ty <= (r.y + r.height - 1) / kTile; ++ty)
+    for (int tx = r.x / kTile; tx <= (r.x + r.width - 1) / kTile; ++tx) mark(ty * tiles_x_ + tx);
+}
+
+std::vector<cv::Rect> TileMask::runs() const {
+  std::vector<cv::Rect> out;
+  const int tiles_y = tiles_x_ > 0 ? tiles() / tiles_x_ : 0;
+  for (int ty = 0; ty < tiles_y; ++ty)
+    for (int tx = 0; tx < tiles_x_;) {
+      if (!marked(ty * tiles_x_ + tx)) {
+        ++tx;
+        continue;
+      }
+      const int first = tx;
+      while (tx < tiles_x_ && marked(ty * tiles_x_ + tx)) ++tx;
+      out.push_back(tile(ty * tiles_x_ + first) | tile(ty * tiles_x_ + tx - 1));
     }
-    // Straightened run by run while in cache; rows the warp clears need nothing.
-    warpByRows(premultiplied, out, map_a_, map_b_, cv::INTER_LINEAR, source_rows_, [&](const cv::Mat& rows, bool warped) {
-      if (warped) straighten(rows);
-    });
-  } else {
-    out = premultiplied;
-    cv::parallel_for_(cv::Range(0, out.rows), [&](const cv::Range& rows) { straighten(out.rowRange(rows.start, rows.end)); });
+  return out;
+}
+
+cv::Mat ColourWarp::apply(const cv::Mat& premultiplied, std::span<const cv::Rect> drawn, TileMask& tiles) {
+  const Camera& camera = projection_.camera();
+  cv::Mat out = cv::Mat::zeros(camera.height, camera.width, CV_8UC4);
+  if (tile_source_.empty()) {
+    tile_source_.resize(static_cast<std::size_t>(tiles.tiles()));
+    if (!projection_.warps()) {  // the pinhole image is the camera image
+      for (int t = 0; t < tiles.tiles(); ++t) tile_source_[static_cast<std::size_t>(t)] = tiles.tile(t);
+    } else {
+      cv::convertMaps(projection_.mapX(), projection_.mapY(), map_a_, map_b_, CV_16SC2);  // remap's fast path (1/32 px)
+      // Per tile, the pinhole pixels its bilinear samples may read: the extremes' floors widened
+      // by a pixel each way (the fixed-point rounding and the neighbour). Samples more than a
+      // pixel outside the pinhole image (e.g. the far-off marks of pixels the lens model cannot
+      // invert) read only the constant border and are left out.
+      const cv::Mat& mx = projection_.mapX();
+      const cv::Mat& my = projection_.mapY();
+      const float w = static_cast<float>(projection_.pinhole().width), h = static_cast<float>(projection_.pinhole().height);
+      for (int t = 0; t < tiles.tiles(); ++t) {
+        const cv::Rect px = tiles.tile(t);
+        float x0 = std::numeric_limits<float>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+        for (int y = px.y; y < px.y + px.height; ++y)
+          for (int x = px.x; x < px.x + px.width; ++x) {
+            const float u = mx.at<float>(y, x), v = my.at<float>(y, x);
+            if (!(u > -2.0f && u < w + 1.0f && v > -2.0f && v < h + 1.0f)) continue;
+            x0 = std::min(x0, u), x1 = std::max(x1, u), y0 = std::min(y0, v), y1 = std::max(y1, v);
+          }
+        if (x0 <= x1)
+          tile_source_[static_cast<std::size_t>(t)] =
+              cv::Rect(cv::Point(static_cast<int>(std::floor(x0)) - 1, static_cast<int>(std::floor(y0)) - 1),
+                       cv::Point(static_cast<int>(std::floor(x1)) + 3, static_cast<int>(std::floor(y1)) + 3));
+      }
+    }
   }
+  // Every tile whose samples may read a drawn pixel.
+  for (int t = 0; t < tiles.tiles(); ++t) {
+    const cv::Rect& source = tile_source_[static_cast<std::size_t>(t)];
+    for (const cv::Rect& d : drawn)
+      if (!(source & d).empty()) {
+        tiles.mark(t);
+        break;
+      }
+  }
+  // Warped (or copied) and straightened run by run, in parallel, each run while it is in cache.
+  const std::vector<cv::Rect> runs = tiles.runs();
+  cv::parallel_for_(cv::Range(0, static_cast<int>(runs.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) {
+      const cv::Rect& run = runs[static_cast<std::size_t>(i)];
+      cv::Mat part = out(run);
+      if (projection_.warps())
+        cv::remap(premultiplied, part, map_a_(run), map_b_(run), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+      else
+        premultiplied(run).copyTo(part);
+      straighten(part);
+    }
+  });
   return out;
 }
 

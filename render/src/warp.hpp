@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -13,18 +14,41 @@
 
 namespace kccd::render::detail {
 
+/// Which square tiles of an image hold drawn pixels.
+class TileMask {
+ public:
+  static constexpr int kTile = 16;  ///< pixels per side of a tile
+  TileMask(int width, int height);
+  int tiles() const { return static_cast<int>(on_.size()); }
+  int tilesX() const { return tiles_x_; }
+  /// Tile t's pixels (row-major tiles, clipped to the image).
+  cv::Rect tile(int t) const;
+  void mark(int t) { on_[static_cast<std::size_t>(t)] = 1; }
+  /// Marks every tile that meets `pixels`.
+  void mark(const cv::Rect& pixels);
+  bool marked(int t) const { return on_[static_cast<std::size_t>(t)] != 0; }
+  /// The marked tiles as disjoint rectangles: the runs of marked tiles along each row of tiles.
+  std::vector<cv::Rect> runs() const;
+
+ private:
+  int width_ = 0, height_ = 0, tiles_x_ = 0;
+  std::vector<unsigned char> on_;
+};
+
 /// The colour layer's way into the camera image through one projection (which must outlive it).
 class ColourWarp {
  public:
   explicit ColourWarp(const Projection& projection) : projection_(projection) {}
-  /// The camera image (CV_8UC4, straight alpha) of a premultiplied pinhole image; without a warp
-  /// the pinhole image itself, straightened in place.
-  cv::Mat apply(const cv::Mat& premultiplied);
+  /// The camera image (CV_8UC4, straight alpha) of a premultiplied pinhole image that is zero
+  /// outside the rectangles `drawn` (pinhole pixels); `tiles` (the camera image's) gets the tiles
+  /// whose samples may read them marked, and the result is zero outside those: only they are
+  /// warped. The pixels are those of warping the whole image.
+  cv::Mat apply(const cv::Mat& premultiplied, std::span<const cv::Rect> drawn, TileMask& tiles);
 
  private:
   const Projection& projection_;
-  cv::Mat map_a_, map_b_;                          // remap tables in fixed point
-  std::vector<std::pair<int, int>> source_rows_;   // per output row, the pinhole rows its warp reads
+  cv::Mat map_a_, map_b_;              // remap tables in fixed point
+  std::vector<cv::Rect> tile_source_;  // per camera tile (TileMask order), the pinhole pixels its warp may read
 };
 
 /// The labels' way into the camera image through the mask pass's projection (which must outlive it).

@@ -8,7 +8,7 @@
 // build) the same two runs of that binary are timed in between, and the ratios to it printed.
 // Usage:
 //   bench_overlay KCCD_BINARY [--frames N] [--jobs J] [--dir WORKDIR] [--codec mp4v|MJPG|FFV1]
-//                 [--baseline OTHER_KCCD]
+//                 [--baseline OTHER_KCCD] [--repeat R (rounds, each run's fastest kept; default 3)]
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -22,10 +22,14 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+
+#include <nlohmann/json.hpp>
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/model.hpp"
@@ -142,11 +146,34 @@ double transcode(const std::string& in, const std::string& out, const std::strin
   return since(t0);
 }
 
-double runOverlay(const std::string& command) {
+// Runs a command, returns its wall time; its standard output into `out` when given.
+double runOverlay(const std::string& command, std::string* out = nullptr) {
   const auto t0 = Clock::now();
-  const int rc = std::system(command.c_str());
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) throw std::runtime_error("cannot run: " + command);
+  std::string text;
+  char buf[4096];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) text.append(buf, n);
+  const int rc = pclose(pipe);
   const double s = since(t0);
   if (rc != 0) throw std::runtime_error("failed (" + std::to_string(rc) + "): " + command);
+  if (out) *out = text;
+  return s;
+}
+
+// This build's per-stage times (kccd overlay --timings --json), ms per frame, as a table row.
+struct Stages {
+  double setup = 0.0;
+  std::vector<std::pair<std::string, double>> ms;
+};
+
+Stages stagesOf(const std::string& json, int frames) {
+  const nlohmann::json j = nlohmann::json::parse(json);
+  Stages s;
+  const nlohmann::json& t = j.at("timings");
+  s.setup = t.at("setup").get<double>();
+  for (const char* k : {"decode", "state", "query", "render", "read_back", "warp", "composite", "encode"})
+    s.ms.emplace_back(k, 1000.0 * t.at("stage_seconds").at(k).get<double>() / frames);
   return s;
 }
 
@@ -155,15 +182,16 @@ double runOverlay(const std::string& command) {
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::cerr << "usage: bench_overlay KCCD_BINARY [--frames N] [--jobs J] [--dir WORKDIR] [--codec mp4v|MJPG|FFV1] "
-                 "[--baseline OTHER_KCCD]\n";
+                 "[--baseline OTHER_KCCD] [--repeat R]\n";
     return 2;
   }
   const std::string kccd = argv[1];
-  int frames = 150, jobs = 0;
+  int frames = 150, jobs = 0, repeat = 3;
   std::string dir = (fs::temp_directory_path() / "kccd_bench_overlay").string(), codec = "mp4v", baseline;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
     if (k == "--frames") frames = std::stoi(v);
+    else if (k == "--repeat") repeat = std::max(1, std::stoi(v));
     else if (k == "--jobs") jobs = std::stoi(v);
     else if (k == "--dir") dir = v;
     else if (k == "--codec") codec = v;
@@ -180,17 +208,32 @@ int main(int argc, char** argv) {
     makeVideo(video, codec, frames, fps);
 
     int plain_frames = 0;
-    const double plain = transcode(video, dir + "/plain" + ext, codec, plain_frames);
     const std::string args = " overlay " + model + " --camera " + camera + " --video " + video + " --states " + log +
                              " --quiet" + (jobs > 0 ? " --jobs " + std::to_string(jobs) : "");
     const std::string base = kccd + args;
-    // With a baseline, its runs alternate with this build's (static, static, swept, swept), so a
-    // change in the machine's load falls on both.
+    // Rounds of: transcode, then per look the baseline's run and this build's (alternating, so a
+    // change in the machine's load falls on all of them); each keeps its fastest round (the least
+    // disturbed by other work on a shared machine).
     const std::string other = baseline + args;
-    const double stat_base = baseline.empty() ? 0.0 : runOverlay(other + " -o " + dir + "/base_static" + ext + " --codec " + codec);
-    const double stat = runOverlay(base + " -o " + dir + "/static" + ext + " --codec " + codec);
-    const double swept_base = baseline.empty() ? 0.0 : runOverlay(other + " --swept -o " + dir + "/base_swept" + ext + " --codec " + codec);
-    const double swept = runOverlay(base + " --swept -o " + dir + "/swept" + ext + " --codec " + codec);
+    double plain = 1e300, stat_base = 1e300, stat = 1e300, swept_base = 1e300, swept = 1e300;
+    std::string stat_json, swept_json;
+    auto keep = [](double& best, double t, std::string* json, const std::string& text) {
+      if (t < best) {
+        best = t;
+        if (json) *json = text;
+      }
+    };
+    for (int round = 0; round < repeat; ++round) {
+      std::string text;
+      plain = std::min(plain, transcode(video, dir + "/plain" + ext, codec, plain_frames));
+      if (!baseline.empty()) stat_base = std::min(stat_base, runOverlay(other + " -o " + dir + "/base_static" + ext + " --codec " + codec));
+      keep(stat, runOverlay(base + " --timings --json -o " + dir + "/static" + ext + " --codec " + codec, &text), &stat_json, text);
+      if (!baseline.empty())
+        swept_base = std::min(swept_base, runOverlay(other + " --swept -o " + dir + "/base_swept" + ext + " --codec " + codec));
+      keep(swept, runOverlay(base + " --swept --timings --json -o " + dir + "/swept" + ext + " --codec " + codec, &text), &swept_json,
+           text);
+    }
+    const Stages stat_stages = stagesOf(stat_json, frames), swept_stages = stagesOf(swept_json, frames);
 
     const unsigned hw = std::thread::hardware_concurrency();
     const double f_plain = plain_frames / plain, f_static = frames / stat, f_swept = frames / swept;
@@ -199,6 +242,11 @@ int main(int argc, char** argv) {
     std::printf("  plain transcode (decode + encode): %7.1f fps\n", f_plain);
     std::printf("  kccd overlay, static volumes:      %7.1f fps  (%.0f %% of the transcode)\n", f_static, 100 * f_static / f_plain);
     std::printf("  kccd overlay --swept:              %7.1f fps  (%.0f %% of the transcode)\n", f_swept, 100 * f_swept / f_plain);
+    // Where the time went (each stage on its own thread: decoding, annotating and encoding overlap).
+    std::printf("  per frame, ms        static   swept   (set-up %.3f s and %.3f s)\n", stat_stages.setup, swept_stages.setup);
+    for (std::size_t k = 0; k < stat_stages.ms.size(); ++k)
+      std::printf("    %-12s    %7.2f %7.2f\n", stat_stages.ms[k].first.c_str(), stat_stages.ms[k].second, swept_stages.ms[k].second);
+    std::printf("    %-12s    %7.2f %7.2f\n", "transcode", 1000.0 * plain / plain_frames, 1000.0 * plain / plain_frames);
     if (!baseline.empty()) {
       std::printf("  baseline %s, static volumes: %7.1f fps  (this build %.3f x as fast)\n", baseline.c_str(), frames / stat_base,
                   stat_base / stat);

@@ -22,6 +22,20 @@
 
 namespace kccd::overlay {
 
+/// Where a frame's time went, seconds of wall time on the thread that did each stage (they
+/// overlap across threads: decoding, annotating and encoding run side by side).
+struct StageTimes {
+  double decode = 0.0;     ///< the video's frame into BGR
+  double state = 0.0;      ///< the state (and braking box) at the frame's time
+  double query = 0.0;      ///< the distance query and the volumes to draw
+  double render = 0.0;     ///< meshes, outlines and GL drawing
+  double read_back = 0.0;  ///< the drawn pixels out of GL
+  double warp = 0.0;       ///< the lens warp, straight alpha and the legend
+  double composite = 0.0;  ///< the layer blended onto the frame and the status line
+  double encode = 0.0;     ///< the frame handed to the output (encoded)
+  StageTimes& operator+=(const StageTimes& o);
+};
+
 /// What a run says about one input frame.
 struct FrameRecord {
   double time = 0.0;                  ///< on the video's clock (index / fps, or the frame-times file)
@@ -35,6 +49,7 @@ struct FrameRecord {
   std::vector<double> values;             ///< the state used (empty without one)
   bool selected = false;              ///< drawn (and handed to the sink)
   bool written = false;               ///< handed to a sink that keeps frames
+  StageTimes times;                   ///< where its time went
   /// True when the frame's check cannot be trusted: treat the robot as unsafe.
   bool unsafe() const { return query != Status::Ok || braking_failed || not_finite; }
   /// The report's "query_status": "no_braking_box", "volume_not_finite" or the query's status word.

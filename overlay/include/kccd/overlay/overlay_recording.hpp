@@ -66,6 +66,7 @@ struct OverlayOptions {
   int jobs = 0;                        ///< annotator threads (each with a GL context); <= 0: hardware threads
   std::size_t contact_frames = 0;      ///< frames on the contact sheet (0: none)
   int contact_tile_width = 320;        ///< pixels per contact sheet tile
+  bool timings = false;                ///< the report's JSON gives where the time went ("timings")
 };
 
 /// A run's progress, given after every frame in order.
@@ -88,6 +89,9 @@ struct OverlayReport {
   bool swept = false;
   int jobs = 0;
   double seconds = 0.0;             ///< the frame loop's wall time
+  double setup_seconds = 0.0;       ///< before the first frame: inputs checked, lens maps, first pass
+  StageTimes stages;                ///< every frame's StageTimes summed
+  bool timings = false;             ///< OverlayOptions::timings: reportJson gives setup_seconds and stages
   cv::Mat contact_sheet;            ///< selected frames, captioned (empty when none was asked or drawn)
   /// Index of the first unsafe frame, if any.
   std::optional<std::size_t> firstUnsafe() const;

@@ -57,6 +57,7 @@ struct ModelFrame {
   std::vector<double> distances;
   /// The query's answer (its pairs view the checker: valid until the next draw); none without a state.
   std::optional<QueryResult> query;
+  double query_seconds = 0.0;  ///< the query and the volumes for drawing (images.times has the drawing's)
 };
 
 /// Draws one model for one camera; owns the checker, the renderer (a GL context: one view per

@@ -95,6 +95,9 @@ struct RenderOptions {
   /// outside), so a colour layer needs no mesh; meshes are built only for masks, the shaded look
   /// and volumes reaching nearer than `near`. Needs polygon_fill. Off: from the mesh's silhouette.
   bool outline_from_core = true;
+  /// Clear, draw, read back, warp and hand on (Frame::drawn) only the rectangles the volumes and
+  /// the legend cover; the layer is the same bit for bit. Off: the whole image (for comparison).
+  bool crop = true;
   double tolerance_px = 0.5;   ///< largest outward error of the sphere tessellation, output pixels
   int max_level = 3;           ///< finest sphere tessellation (level 3: 642 vertices, 0.3 % outward)
   int mask_max_level = 4;      ///< finest tessellation when a mask is drawn (level 4: 2562 vertices, 0.08 % outward)
@@ -111,8 +114,23 @@ struct RenderOptions {
 /// What render() produced: the layer (CV_8UC4, BGRA, straight alpha: PNG viewers and
 /// compositing expect it), the mask (CV_8UC1: 0 background, i + 1 for the nearest volume i,
 /// sampled at pixel centres), and per volume the mask pixels it owns.
+/// Where one render() spent its time, seconds (wall clock on the calling thread).
+struct FrameTimes {
+  double prepare = 0.0;    ///< volumes to meshes and outlines, clipping planes
+  double draw = 0.0;       ///< GL drawing, to its end (glFinish)
+  double read_back = 0.0;  ///< the colour layer's pixels out of GL
+  double warp = 0.0;       ///< the distortion warp and straight alpha
+  double decorate = 0.0;   ///< legend and labels
+  double mask = 0.0;       ///< the mask pass, its warp and counts
+};
+
 struct Frame {
   cv::Mat bgra;
+  /// Disjoint rectangles of `bgra` that hold every drawn pixel (the volumes', the legend's):
+  /// outside them the layer is transparent (all zero), so compositing may skip the rest. None
+  /// when nothing is drawn.
+  std::vector<cv::Rect> drawn;
+  FrameTimes times;
   cv::Mat mask;
   std::vector<int> pixels;
   std::vector<Visibility> visibility;  ///< per volume

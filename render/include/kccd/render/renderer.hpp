@@ -20,6 +20,7 @@ class FramePreparer;
 namespace detail {
 class GlTargets;
 class ColourWarp;
+struct ColourReadBack;
 class LabelWarp;
 class Legend;
 }  // namespace detail
@@ -61,6 +62,7 @@ class Renderer {
   std::unique_ptr<detail::GlTargets> gl_;
   std::unique_ptr<FramePreparer> preparer_;
   std::unique_ptr<detail::ColourWarp> colour_warp_;
+  std::unique_ptr<detail::ColourReadBack> read_back_;  // the colour target's pixels, kept between frames
   std::unique_ptr<detail::LabelWarp> label_warp_;
   std::unique_ptr<detail::Legend> legend_;
 };

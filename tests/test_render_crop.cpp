@@ -1,0 +1,105 @@
+// The colour layer drawn, read back and warped only where the volumes and the legend are
+// (RenderOptions::crop) is the whole image's layer bit for bit, and Frame::drawn holds every
+// pixel it draws: random scenes through plain and distorting cameras, supersampled or not, with
+// volumes partly outside the view, reaching behind the near plane or containing the camera.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "kccd/render/composite.hpp"
+#include "kccd/render/renderer.hpp"
+#include "support/cameras.hpp"
+#include "support/random_shapes.hpp"
+
+namespace {
+
+using kccd::SafetyStatus;
+using kccd::Vec3;
+using kccd::calib::Camera;
+using kccd::render::Frame;
+using kccd::render::RenderOptions;
+using kccd::render::Renderer;
+using kccd::render::Style;
+using kccd::render::Volume;
+
+TEST(RenderCrop, TheCroppedLayerIsTheWholeLayerBitForBit) {
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  long drawn_area = 0, image_area = 0;
+  for (int trial = 0; trial < 24; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const Camera c = kccd::testing::randomCamera(rng, trial % 2 == 0, 480, 320);
+    const cv::Vec3d centre = kccd::testing::cameraCentre(c);
+    const Vec3 eye(centre[0], centre[1], centre[2]);
+    std::vector<Volume> scene;
+    std::vector<std::vector<Vec3>> clouds;
+    const int n = 1 + trial % 7;
+    clouds.reserve(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      // Around the origin (what the random cameras look at); in some trials one volume right in
+      // front of the camera (partly behind the near plane) or around it.
+      Vec3 at(0.6 * u(rng), 0.6 * u(rng), 0.6 * u(rng));
+      double radius = 0.01 + 0.08 * std::abs(u(rng));
+      if (i == 0 && trial % 6 == 3) at = eye * 0.97;
+      if (i == 0 && trial % 12 == 5) at = eye, radius = 0.3;
+      const auto cloud = kccd::testing::randomCloud(rng, 1 + static_cast<int>(rng() % 10), at, 0.02 + 0.15 * std::abs(u(rng)));
+      clouds.emplace_back(cloud.begin(), cloud.end());
+      scene.push_back(Volume{clouds.back(), radius, static_cast<SafetyStatus>(i % 4), "body " + std::to_string(i)});
+    }
+    Style style;
+    style.legend = trial % 3 != 0;
+    style.labels = trial % 5 == 1;
+    style.shaded = trial % 7 == 4;
+    style.outline_width = trial % 4 == 2 ? 7.0 : 2.0;
+    RenderOptions cropped, whole;
+    cropped.supersample = whole.supersample = trial % 3 == 1 ? 2.0 : 1.0;
+    cropped.mask_supersample = whole.mask_supersample = cropped.supersample;
+    whole.crop = false;
+    Renderer a(c, cropped), b(c, whole);
+    // Two frames each, the second of the same renderer after the first: what the first read back
+    // must not show through.
+    for (int frame = 0; frame < 2; ++frame) {
+      if (frame == 1)
+        for (Volume& v : scene) v.pose.translation() += Vec3(0.3, -0.2, 0.1);
+      const Frame fa = a.render(scene, style, true, false);
+      const Frame fb = b.render(scene, style, true, false);
+      cv::Mat diff;
+      cv::absdiff(fa.bgra, fb.bgra, diff);
+      EXPECT_EQ(cv::countNonZero(diff.reshape(1)), 0) << "frame " << frame;
+      // Every drawn pixel lies in a rectangle of Frame::drawn; the rectangles are disjoint.
+      cv::Mat inside = cv::Mat::zeros(fa.bgra.size(), CV_8U);
+      for (std::size_t i = 0; i < fa.drawn.size(); ++i) {
+        for (std::size_t j = 0; j < i; ++j) EXPECT_TRUE((fa.drawn[i] & fa.drawn[j]).empty());
+        inside(fa.drawn[i] & cv::Rect(0, 0, inside.cols, inside.rows)).setTo(1);
+        drawn_area += fa.drawn[i].area();
+      }
+      image_area += fa.bgra.total();
+      cv::Mat any;
+      cv::transform(fa.bgra, any, cv::Matx14f(1, 1, 1, 1));
+      any.convertTo(any, CV_8U);
+      cv::Mat outside;
+      cv::compare(any, 0, outside, cv::CMP_GT);
+      outside.setTo(0, inside);
+      EXPECT_EQ(cv::countNonZero(outside), 0) << "frame " << frame;
+      // Compositing only the rectangles gives the whole blend.
+      cv::Mat photo(fa.bgra.size(), CV_8UC3);
+      cv::randu(photo, 0, 256);
+      cv::Mat all = photo.clone(), parts = photo.clone();
+      kccd::render::compositeOver(all, fb.bgra);
+      kccd::render::compositeOver(parts, fa.bgra, fa.drawn);
+      cv::absdiff(all, parts, diff);
+      EXPECT_EQ(cv::countNonZero(diff.reshape(1)), 0) << "frame " << frame;
+    }
+  }
+  // The point of it: far less than the image is handed on.
+  EXPECT_LT(drawn_area, image_area / 2);
+  std::cout << "drawn rectangles: " << 100.0 * static_cast<double>(drawn_area) / static_cast<double>(image_area)
+            << " % of the images\n";
+}
+
+}  // namespace
