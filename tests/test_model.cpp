@@ -80,7 +80,7 @@ TEST(Model, LoadsAValidFile) {
   const std::vector<std::string> names{"base", "slide", "pose.x", "pose.y", "pose.z", "turn.x", "turn.y", "turn.z"};
   EXPECT_EQ(m.stateNames(), names);
   EXPECT_TRUE(m.joints[0].axis.isApprox(Vec3::UnitZ()));  // normalised on load
-  EXPECT_EQ(m.joints[0].sweep, SweepMode::Fast);
+  EXPECT_EQ(m.joints[0].sweep, SweepMode::Accurate);      // `fast` (retired) reads as accurate
   EXPECT_EQ(m.joints[1].sweep, SweepMode::Accurate);      // the default
   EXPECT_TRUE((m.joints[0].origin.linear() * Vec3::UnitX()).isApprox(Vec3::UnitY(), 1e-12));  // yaw 90 deg
   EXPECT_EQ(m.joints[3].state_offset, 5);

@@ -398,9 +398,9 @@ TEST_F(OverlayCli, BadOptions) {
 TEST_F(OverlayCli, UnsafeQueryStatusExitsThreeAndWritesEverything) {
   // `sweep: exact` on the elbow: a swept box that moves the elbow is an unsafe status (ExactNeedsPoint).
   std::string model = readText(kDemo);
-  const std::size_t fast = model.find("sweep: fast");
-  ASSERT_NE(fast, std::string::npos);
-  model.replace(fast, 11, "sweep: exact");
+  const std::size_t elbow = model.find("sweep: accurate", model.find("name: elbow"));
+  ASSERT_NE(elbow, std::string::npos);
+  model.replace(elbow, 15, "sweep: exact");
   const std::string path = out("input_exact.yaml");
   writeText(path, model);
   const Outcome r = runKccd(base(path) + " --swept -o " + out("out.mkv") + " --report " + out("report.json"));

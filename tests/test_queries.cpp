@@ -116,18 +116,13 @@ TEST(Queries, BudgetsOnlyLoosenBounds) {
   }
 }
 
-// The knobs are monotone. Accurate runs everything fast runs (the same point volumes and chord
-// chains) plus the apex chains, so its bound is never below fast's, for every pair and query
-// type. The point budget only shapes the first stage; the exact stage's chord chains lie inside
+// The knobs are monotone. Splitting a pair's box (QueryOptions::exact_splits) only ever raises its
+// bound: the pair keeps the unsplit bound or better, for every pair and query type. The point
+// budget only shapes the first stage; the exact stage's chord chains lie inside
 // every budget's point volumes, so every bound the exact stage decides is the same whatever the
 // budget (up to GJK's tolerance) and so is every verdict.
 TEST(Queries, KnobsAreMonotone) {
   std::mt19937_64 rng(2024);
-  auto withMode = [](Model m, SweepMode mode) {
-    for (Joint& j : m.joints)
-      if (j.sweep != SweepMode::Exact) j.sweep = mode;
-    return m;
-  };
   long compared = 0, tighter = 0, budget_checks = 0, split_pairs = 0;
   for (int i = 0; i < 1500; ++i) {
     const Model base = testing::randomModel(rng, 6, 5);
@@ -139,28 +134,29 @@ TEST(Queries, KnobsAreMonotone) {
       for (int t = 0; t < 4; ++t) {
         QueryOptions o = options(static_cast<QueryType>(t), 2, margin);
         o.exact_below = exact_below;
-        // Modes at the same budget.
-        const Model fast = withMode(base, SweepMode::Fast), accurate = withMode(base, SweepMode::Accurate);
-        Checker cf(fast), ca(accurate);
-        const QueryResult& rf = cf.query(lower, upper, o);
-        const QueryResult& ra = ca.query(lower, upper, o);
-        ASSERT_EQ(rf.status, Status::Ok);
-        ASSERT_EQ(ra.status, Status::Ok);
-        EXPECT_EQ(rf.stats.split_pairs, 0);  // splitting is accurate's
-        split_pairs += ra.stats.split_pairs;
-        if (!rf.collision) {
-          EXPECT_FALSE(ra.collision) << "case " << i;
+        // Without and with splitting, at the same budget.
+        QueryOptions unsplit = o;
+        unsplit.exact_splits = 0;
+        Checker cu(base), cs(base);
+        const QueryResult& ru = cu.query(lower, upper, unsplit);
+        const QueryResult& rs = cs.query(lower, upper, o);
+        ASSERT_EQ(ru.status, Status::Ok);
+        ASSERT_EQ(rs.status, Status::Ok);
+        EXPECT_EQ(ru.stats.split_pairs, 0);
+        split_pairs += rs.stats.split_pairs;
+        if (!ru.collision) {
+          EXPECT_FALSE(rs.collision) << "case " << i;
         }
         if (t == 3) {
-          ASSERT_EQ(rf.pairs.size(), ra.pairs.size());
-          for (std::size_t k = 0; k < rf.pairs.size(); ++k) {
+          ASSERT_EQ(ru.pairs.size(), rs.pairs.size());
+          for (std::size_t k = 0; k < ru.pairs.size(); ++k) {
             ++compared;
-            EXPECT_GE(ra.pairs[k].distance, rf.pairs[k].distance) << "case " << i << " pair " << k;
-            tighter += ra.pairs[k].distance > rf.pairs[k].distance;
+            EXPECT_GE(rs.pairs[k].distance, ru.pairs[k].distance) << "case " << i << " pair " << k;
+            tighter += rs.pairs[k].distance > ru.pairs[k].distance;
           }
         }
-        // Budgets in the same mode.
-        const Model& m = i % 2 ? fast : accurate;
+        // Budgets.
+        const Model& m = base;
         std::vector<double> previous;
         bool previous_clear = false;
         for (const int budget : {4, 8, 16, 64}) {
@@ -196,7 +192,7 @@ TEST(Queries, KnobsAreMonotone) {
     }
   }
   EXPECT_GT(compared, 1000);
-  EXPECT_GT(tighter, compared / 100);  // apexes (and accurate's box splitting) do tighten bounds
+  EXPECT_GT(tighter, compared / 200);  // splitting does tighten bounds
   EXPECT_GT(split_pairs, 0);
   EXPECT_GT(budget_checks, 1000);
 }
@@ -305,37 +301,35 @@ Model turningPastAPoint(const Vec3& obstacle, std::vector<Vec3> moving) {
 TEST(Queries, RevoluteSweepBoundIsTightForASpinningPoint) {
   // A point at radius 1 sweeping 90 degrees towards an obstacle on the arc's far end.
   Model m = turningPastAPoint(Vec3(0, 1.5, 0), {Vec3(1, 0, 0)});
-  for (SweepMode mode : {SweepMode::Fast, SweepMode::Accurate}) {
-    m.joints[0].sweep = mode;
-    Checker c(m);
-    const std::vector<double> lo{0.0}, hi{1.5707963267948966};
-    // The point volumes (pairs above the margin are not refined by default) cover the arc by its
-    // chord and lose at most the sagitta 1 - cos(pi/4).
-    const double sagitta = 1.0 - std::cos(0.7853981633974483);
-    const double d = c.query(lo, hi, options(QueryType::Distances)).pairs[0].distance;
-    EXPECT_LE(d, 0.5);  // at q = pi/2 the tip is 0.5 away
-    EXPECT_GT(d, 0.5 - sagitta - 1e-9);
-    // With the exact stage, fast keeps the sagitta. Accurate's chord chains prove the pair clear,
-    // so its distance is refined by splitting the box (eight arcs of 11.25 degrees, each losing
-    // its sagitta), not by the apexes.
-    QueryOptions exact = options(QueryType::Distances);
-    exact.exact_below = std::numeric_limits<double>::infinity();
-    c.reset();
-    const QueryResult& r = c.query(lo, hi, exact);
-    const double e = r.pairs[0].distance;
-    EXPECT_LE(e, 0.5);
-    EXPECT_GE(e, d);
-    const double eighth = 1.0 - std::cos(0.7853981633974483 / 8.0);
-    EXPECT_GT(e, mode == SweepMode::Accurate ? 0.5 - eighth - 1e-9 : 0.5 - sagitta - 1e-9);
-    EXPECT_EQ(r.stats.split_pairs, mode == SweepMode::Accurate ? 1 : 0);
-    // A verdict the chord chains cannot decide is searched with the apexes, which are exact here:
-    // with a margin just below the truth, accurate proves the box clear and fast cannot.
-    QueryOptions verdict = options(QueryType::Collision);
-    verdict.margin = 0.499;
-    c.reset();
-    const QueryResult& v = c.query(lo, hi, verdict);
-    EXPECT_EQ(v.collision, mode == SweepMode::Fast);
-  }
+  Checker c(m);
+  const std::vector<double> lo{0.0}, hi{1.5707963267948966};
+  // The point volumes (pairs above the margin are not refined by default) cover the arc by its
+  // chord and lose at most the sagitta 1 - cos(pi/4).
+  const double sagitta = 1.0 - std::cos(0.7853981633974483);
+  const double d = c.query(lo, hi, options(QueryType::Distances)).pairs[0].distance;
+  EXPECT_LE(d, 0.5);  // at q = pi/2 the tip is 0.5 away
+  EXPECT_GT(d, 0.5 - sagitta - 1e-9);
+  // With the exact stage, the chord chains prove the pair clear, so its distance is refined by
+  // splitting the box (eight arcs of 11.25 degrees, each losing its sagitta), not by the apexes.
+  QueryOptions exact = options(QueryType::Distances);
+  exact.exact_below = std::numeric_limits<double>::infinity();
+  c.reset();
+  const QueryResult& r = c.query(lo, hi, exact);
+  const double e = r.pairs[0].distance;
+  EXPECT_LE(e, 0.5);
+  EXPECT_GE(e, d);
+  const double eighth = 1.0 - std::cos(0.7853981633974483 / 8.0);
+  EXPECT_GT(e, 0.5 - eighth - 1e-9);
+  EXPECT_EQ(r.stats.split_pairs, 1);
+  // A verdict the chord chains cannot decide is searched with the apexes, which are exact here:
+  // with a margin just below the truth, the box is proven clear (the chords alone, the retired
+  // fast mode, lose the sagitta and could not).
+  QueryOptions verdict = options(QueryType::Collision);
+  verdict.margin = 0.499;
+  c.reset();
+  EXPECT_FALSE(c.query(lo, hi, verdict).collision);
+  ASSERT_GT(0.5 - sagitta, 0.0);
+  EXPECT_LT(0.5 - sagitta, verdict.margin);
 }
 
 TEST(Queries, SplittingTightensAWideBodyOnAWideArc) {
@@ -350,8 +344,7 @@ TEST(Queries, SplittingTightensAWideBodyOnAWideArc) {
   const std::vector<double> lo{-10 * deg}, hi{10 * deg};
   const double hull = 0.5 * std::cos(10 * deg) - 0.4 * std::sin(10 * deg) - 0.35;
   const double piece = 0.5 - (0.5 * std::cos(1.25 * deg) - 0.4 * std::sin(1.25 * deg));
-  for (SweepMode mode : {SweepMode::Fast, SweepMode::Accurate}) {
-    m.joints[0].sweep = mode;
+  {
     Checker c(m);
     QueryOptions o = options(QueryType::Distances);
     o.exact_splits = 0;
@@ -361,11 +354,6 @@ TEST(Queries, SplittingTightensAWideBodyOnAWideArc) {
     EXPECT_EQ(unsplit.stats.split_pairs, 0);
     c.reset();
     const QueryResult& split = c.query(lo, hi, options(QueryType::Distances));  // 8 sub-boxes
-    if (mode == SweepMode::Fast) {  // splitting is part of accurate's refinement
-      EXPECT_EQ(split.stats.split_pairs, 0);
-      EXPECT_EQ(split.pairs[0].distance, whole);
-      continue;
-    }
     EXPECT_EQ(split.stats.split_pairs, 1);
     EXPECT_LE(split.pairs[0].distance, truth);
     EXPECT_GT(split.pairs[0].distance, truth - piece - kExactDistanceTolerance - 1e-3 * truth);
@@ -492,8 +480,8 @@ TEST(Queries, Translation3dBoxBoundIsExactInTheExactStage) {
 TEST(Queries, Rotation3dErrorIsSweptToSecondOrderInTheExactStage) {
   // A ball 1 m out on a rotation3d joint known to within an error of 0.02 rad, and a point obstacle
   // straight ahead. A rotation moves the ball sideways only: the true smallest distance is the
-  // nominal one. The point volumes (and fast) cover the error by a ball of 2 sin(0.01) |p| = 20 mm;
-  // accurate's exact stage by twelve rotations around it, which lose only second order (1.3 r^2 |p|).
+  // nominal one. The point volumes cover the error by a ball of 2 sin(0.01) |p| = 20 mm; the
+  // exact stage by twelve rotations around it, which lose only second order (1.3 r^2 |p|).
   const double theta = 0.02;
   auto scene = [&](const Vec3& obstacle, SweepMode mode) {
     Model m;
@@ -518,9 +506,10 @@ TEST(Queries, Rotation3dErrorIsSweptToSecondOrderInTheExactStage) {
   const double e = accurate.query(zero, zero, exact).pairs[0].distance;
   EXPECT_LE(e, truth + 1e-12);
   EXPECT_GT(e, truth - 1.5 * 1.3 * theta * theta);
-  const Model ahead_fast = scene(Vec3(2.0, 0, 0), SweepMode::Fast);
-  Checker fast(ahead_fast);
-  const double f = fast.query(zero, zero, exact).pairs[0].distance;
+  QueryOptions points = options(QueryType::Distances);
+  points.exact_below = -std::numeric_limits<double>::infinity();  // the point volumes alone
+  Checker first_stage(ahead);
+  const double f = first_stage.query(zero, zero, points).pairs[0].distance;
   EXPECT_LE(f, truth - 0.019);  // the ball: first order
   // Sideways and on diagonals the motion is real; the bound stays below the true minimum (dense
   // over the error ball's sphere, where the minimum lies) and within the ball's first-order cost.
@@ -545,7 +534,7 @@ TEST(Queries, Rotation3dApexBoundsStayBelowTheSampledMinimum) {
   // Random bodies on a rotation3d joint (random origin, box of up to 0.3 rad per component, error
   // up to 0.25 rad) against random static bodies: accurate's exact-stage bound against the
   // smallest distance over dense samples of the box and the error ball (the tests' own forward
-  // kinematics and reference distance), and never looser than fast's (the chord map's ball).
+  // kinematics and reference distance), and never looser than the point volumes' (the ball).
   std::mt19937_64 rng(20261126);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::normal_distribution<double> g;
@@ -589,11 +578,11 @@ TEST(Queries, Rotation3dApexBoundsStayBelowTheSampledMinimum) {
     exact.exact_splits = 0;  // the apexes alone (accurate would also split the box)
     Checker accurate(m);
     const double bound = accurate.query(lo, hi, exact).pairs[0].distance;
-    Model fast_model = m;
-    fast_model.joints[0].sweep = SweepMode::Fast;
-    Checker fast(fast_model);
-    const double fast_bound = fast.query(lo, hi, exact).pairs[0].distance;
-    EXPECT_GE(bound, fast_bound) << c;
+    QueryOptions points = options(QueryType::Distances);
+    points.exact_below = -std::numeric_limits<double>::infinity();  // the point volumes alone: the error as a ball
+    Checker first_stage(m);
+    const double ball_bound = first_stage.query(lo, hi, points).pairs[0].distance;
+    EXPECT_GE(bound, ball_bound) << c;
     double found = std::numeric_limits<double>::infinity();
     for (int s = 0; s < 3000; ++s) {
       const kccd::testing::Sample sample = kccd::testing::sampleBox(rng, m, lo, hi, s % 3);
@@ -604,7 +593,7 @@ TEST(Queries, Rotation3dApexBoundsStayBelowTheSampledMinimum) {
     }
     if (!(found > 0.0)) continue;
     ASSERT_LE(bound, found + 1e-12) << "case " << c << " error " << j.error;
-    if (bound > fast_bound + 1e-3) ++tighter;
+    if (bound > ball_bound + 1e-3) ++tighter;
   }
   // The apexes are in use: accurate is tighter by over a millimetre in many cases.
   EXPECT_GT(tighter, cases / 4);

@@ -95,7 +95,6 @@ const char* toString(JointType type) {
 const char* toString(SweepMode mode) {
   switch (mode) {
     case SweepMode::Exact: return "exact";
-    case SweepMode::Fast: return "fast";
     case SweepMode::Accurate: return "accurate";
   }
   return "?";

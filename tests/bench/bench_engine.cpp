@@ -125,7 +125,7 @@ void report(benchmark::State& state, std::vector<double>& us) {
   state.counters["max_us"] = us.back();
 }
 
-// Args: scene, mode (0 exact/static, 1 fast, 2 accurate), query type, warm (reuse across cycles).
+// Args: scene, mode (0 exact/static, 1 accurate), query type, warm (reuse across cycles).
 void BM_Query(benchmark::State& state) {
   const int scene = static_cast<int>(state.range(0));
   const auto mode = static_cast<SweepMode>(state.range(1));
@@ -298,7 +298,7 @@ void BM_MissedCollisions(benchmark::State& state) {
 
 void QueryArgs(benchmark::internal::Benchmark* b) {
   for (int scene : {0, 1})
-    for (int mode : {0, 1, 2})
+    for (int mode : {0, 1})  // SweepMode: exact (point state), accurate
       for (int type : {0, 1, 2, 3})
         for (int warm : {0, 1}) b->Args({scene, mode, type, warm});
   b->ArgNames({"scene", "mode", "type", "warm"});

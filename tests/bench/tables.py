@@ -35,7 +35,7 @@ def gjk_table(rows):
 
 def engine_tables(rows):
     scenes = ["humanoid", "industrial_cell"]
-    modes = ["exact (point)", "fast", "accurate"]
+    modes = ["exact (point)", "accurate"]
     types = ["collision", "closest", "nclosest (5)", "distances"]
     q = {}
     for r in rows:

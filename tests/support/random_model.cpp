@@ -36,8 +36,7 @@ Model randomModel(std::mt19937_64& rng, int max_joints, int max_bodies, MobileBa
       j.type = type;
       j.origin = m.joints.empty() ? origin : Pose::Identity();
       j.axis = axis;
-      const int mode = uniformInt(rng, 0, 4);
-      j.sweep = mode == 0 ? SweepMode::Exact : mode <= 2 ? SweepMode::Fast : SweepMode::Accurate;
+      j.sweep = uniformInt(rng, 0, 4) == 0 ? SweepMode::Exact : SweepMode::Accurate;
       if (type == JointType::Translation3d) j.error = uniform(rng, 0.0, 1.0) < 0.3 ? 0.0 : uniform(rng, 0.0, 0.05);
       if (type == JointType::Rotation3d) j.error = uniform(rng, 0.0, 1.0) < 0.3 ? 0.0 : uniform(rng, 0.0, 0.4);
       m.joints.push_back(j);
@@ -65,8 +64,7 @@ Model randomModel(std::mt19937_64& rng, int max_joints, int max_bodies, MobileBa
     j.origin.linear() = randomRotation(rng);
     j.origin.translation() = Vec3(uniform(rng, -0.4, 0.4), uniform(rng, -0.4, 0.4), uniform(rng, -0.4, 0.4));
     j.axis = randomUnit(rng);
-    const int mode = uniformInt(rng, 0, 4);
-    j.sweep = mode == 0 ? SweepMode::Exact : mode <= 2 ? SweepMode::Fast : SweepMode::Accurate;
+    j.sweep = uniformInt(rng, 0, 4) == 0 ? SweepMode::Exact : SweepMode::Accurate;
     if (j.type == JointType::Translation3d) j.error = uniform(rng, 0.0, 1.0) < 0.3 ? 0.0 : uniform(rng, 0.0, 0.05);
     if (j.type == JointType::Rotation3d) j.error = uniform(rng, 0.0, 1.0) < 0.3 ? 0.0 : uniform(rng, 0.0, 0.4);
     m.joints.push_back(j);

@@ -18,9 +18,11 @@ inline constexpr int kWorld = -1;
 
 enum class JointType : std::uint8_t { Fixed, Revolute, Prismatic, Translation3d, Rotation3d };
 
-/// How a joint's interval is swept: `Exact` accepts only zero-width intervals; `Fast` (chords,
-/// larger radius) and `Accurate` (tangent apexes, no radius growth) cover any interval.
-enum class SweepMode : std::uint8_t { Exact, Fast, Accurate };
+/// How a joint's interval is swept: `Exact` accepts only zero-width intervals; `Accurate` (chords,
+/// with tangent apexes and box splitting in the exact stage) covers any interval. (The chords-only
+/// `fast` mode is retired: model files may still say `fast`, read as `accurate`; README, "Sweep
+/// modes".)
+enum class SweepMode : std::uint8_t { Exact, Accurate };
 
 /// One joint. Its motion acts in the joint frame given by `origin` (pose in the parent frame at
 /// zero state); its children and bodies move with it.

@@ -64,7 +64,7 @@ struct QueryOptions {
   /// about a millimetre (kExactDistanceTolerance), which costs a fraction of a verdict's search.
   double exact_band = 0.2;
   /// A distance query's pair refined for its distance (clear of the margin, within the band),
-  /// moved by at least one accurate joint (splitting is accurate's refinement), whose bound lies
+  /// moved by at least one swept (accurate) joint, whose bound lies
   /// more than exact_split_gap below its distance at a configuration of the box has its box split into
   /// up to this many sub-boxes (halving, level by level, the state value that moves the pair's
   /// points farthest), each refined by the exact stage: the bound is the smallest over them, up to
