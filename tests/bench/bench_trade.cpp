@@ -752,7 +752,7 @@ void writePlot(const std::string& path, const std::vector<SetSummary>& sets, int
     cells.push_back(std::move(cell));
   }
   std::string error;
-  if (!kccd::bench::writeTradePlot(path, "KCCD sweep modes x point budgets: speed vs looseness and false alarms",
+  if (!kccd::bench::writeTradePlot(path, "KCCD point budgets (accurate sweeps): speed vs looseness and false alarms",
                                    cells, columns, error)) {
     std::fprintf(stderr, "bench_trade: %s\n", error.c_str());
     std::exit(1);
