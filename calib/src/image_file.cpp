@@ -17,6 +17,14 @@ namespace kccd::calib {
 
 namespace {
 
+// A picture no camera file can describe (kMaxImageSide a side, kMaxImagePixels in all): the
+// problem in words, else empty.
+std::string tooLarge(long width, long height) {
+  if (width <= kMaxImageSide && height <= kMaxImageSide && width * height <= kMaxImagePixels) return {};
+  return std::to_string(width) + "x" + std::to_string(height) + " is larger than a camera file allows (" +
+         std::to_string(kMaxImageSide) + " a side, " + std::to_string(kMaxImagePixels) + " pixels)";
+}
+
 // PNG files are decoded here with libpng's simplified API, never by OpenCV: OpenCV's use of libpng
 // prints libpng's own messages ("libpng error: ...", "libpng warning: ...") on stderr, where a
 // damaged file must give one line that says what is wrong with it. The simplified API keeps its
@@ -33,10 +41,8 @@ cv::Mat decodePng(std::span<const std::uint8_t> bytes, ImageColour colour, const
     png_image* image;
     ~Release() { png_image_free(image); }
   } release{&image};
-  if (image.width > static_cast<png_uint_32>(kMaxImageSide) || image.height > static_cast<png_uint_32>(kMaxImageSide) ||
-      static_cast<long>(image.width) * image.height > kMaxImagePixels)
-    fail(std::to_string(image.width) + "x" + std::to_string(image.height) + " is larger than a camera file allows (" +
-         std::to_string(kMaxImageSide) + " a side, " + std::to_string(kMaxImagePixels) + " pixels)");
+  if (const std::string problem = tooLarge(static_cast<long>(image.width), static_cast<long>(image.height)); !problem.empty())
+    fail(problem);
   const bool sixteen = (image.format & PNG_FORMAT_FLAG_LINEAR) != 0;  // 16-bit samples, read as stored
   const bool alpha = (image.format & PNG_FORMAT_FLAG_ALPHA) != 0;
   const bool col = (image.format & PNG_FORMAT_FLAG_COLOR) != 0;  // a palette expands to its colours
@@ -89,9 +95,15 @@ cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& sour
   };
   if (bytes.empty()) fail("empty file");
   static constexpr std::uint8_t kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  if (bytes.size() >= 8 && std::memcmp(bytes.data(), kPngSignature, 8) == 0) {
+    try {
+      return decodePng(bytes, colour, fail);
+    } catch (const std::bad_alloc&) {
+      fail("a PNG too large to decode in the memory available");
+    }
+  }
   cv::Mat img;
   try {
-    if (bytes.size() >= 8 && std::memcmp(bytes.data(), kPngSignature, 8) == 0) return decodePng(bytes, colour, fail);
     const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
     img = cv::imdecode(encoded, colour == ImageColour::Grey  ? cv::IMREAD_GRAYSCALE
                                 : colour == ImageColour::Bgr ? cv::IMREAD_COLOR
@@ -102,9 +114,7 @@ cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& sour
     img.release();
   }
   if (img.empty()) fail("not an image OpenCV can decode (PNG, JPEG, TIFF, BMP, ...)");
-  if (img.cols > kMaxImageSide || img.rows > kMaxImageSide || static_cast<long>(img.cols) * img.rows > kMaxImagePixels)
-    fail(std::to_string(img.cols) + "x" + std::to_string(img.rows) + " is larger than a camera file allows (" +
-         std::to_string(kMaxImageSide) + " a side, " + std::to_string(kMaxImagePixels) + " pixels)");
+  if (const std::string problem = tooLarge(img.cols, img.rows); !problem.empty()) fail(problem);
   return img;
 }
 

@@ -117,14 +117,13 @@ CaseResult checkCase(const GoldenCase& c, const GoldenRendering& rendering, cons
       continue;
     }
     o.status = GoldenStatus::Failed;
-    std::string unreadable;
     try {
       o.expected = calib::readImageFile(file.string(), calib::ImageColour::Unchanged);
     } catch (const calib::ImageError& e) {
-      unreadable = e.what();
+      o.reason = e.what();
     }
-    if (!unreadable.empty()) {
-      o.reason = unreadable;
+    if (!o.reason.empty()) {
+      // the golden itself is unreadable: that is the reason
     } else if (!sidecar_problem.empty() || !have_sidecar) {
       o.reason = sidecar_problem.empty() ? sidecar.string() + ": missing (it names the mask's bodies and the inputs)" : sidecar_problem;
     } else if (img.output == GoldenOutput::Mask) {
