@@ -187,6 +187,18 @@ TEST(Cli, HelpExplainsEverySubcommand) {
 
 namespace {
 
+// Every scratch file and folder of this process (TempDir()/PID_*) is removed when its tests end.
+class ScratchFiles : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    const std::string prefix = std::to_string(getpid()) + "_";
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(::testing::TempDir(), ec))
+      if (e.path().filename().string().rfind(prefix, 0) == 0) std::filesystem::remove_all(e.path(), ec);
+  }
+};
+[[maybe_unused]] ::testing::Environment* const kScratchFiles = ::testing::AddGlobalTestEnvironment(new ScratchFiles);
+
 const std::string kModels = "/usr/share/inventor/data/models/";
 
 std::string scratchCopy(const std::string& from, const std::string& name) {
