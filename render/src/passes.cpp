@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <limits>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 namespace kccd::render::detail {
 namespace {

@@ -66,21 +66,12 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
   if (volumes.size() > 255) throw std::invalid_argument("Renderer: at most 255 volumes (8-bit mask labels)");
   const auto t_start = std::chrono::steady_clock::now();
   context_->makeCurrent();
-  static const bool profile = std::getenv("KCCD_RENDER_PROFILE") != nullptr;
-  auto tick = [last = std::chrono::steady_clock::now()](const char* what) mutable {
-    if (!profile) return;
-    glFinish();
-    const auto now = std::chrono::steady_clock::now();
-    std::fprintf(stderr, "%s %.2f ms  ", what, std::chrono::duration<double, std::milli>(now - last).count());
-    last = now;
-  };
   // Outlines from the cores for the tinted look's colour layer; meshes for the labels, the
   // shaded look, and what the outlines cannot draw.
   const bool outlines = want_colour && !style.shaded && options_.polygon_fill && options_.outline_from_core;
   PreparedFrame prepared = preparer_->prepare(volumes, PrepareNeeds{.outlines = outlines, .meshes = want_mask || !outlines, .mask = want_mask});
   const std::vector<PreparedVolume>& bodies = prepared.volumes;
   Frame frame = std::move(prepared.frame);
-  tick("prepare");
   // The mask from the colour pass when it can (the overlay look at the colour pass's scale).
   const bool same_pass = want_colour && want_mask && !style.shaded && gl_->samples <= 1 && !mask_projection_;
   cv::Mat labels;
@@ -90,17 +81,14 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
   frame.times.prepare = seconds(t_start, t);
   if (want_colour) {
     detail::drawColour(*gl_, projection_, options_, bodies, style, frame, *read_back_, same_pass ? &labels : nullptr);
-    tick("colour+readback");
     t = Clock::now();
     detail::TileMask tiles(projection_.camera().width, projection_.camera().height);
     frame.bgra = colour_warp_->apply(read_back_->image, read_back_->parts, tiles);
-    tick("warp+unpremultiply");
     const Clock::time_point t_warped = Clock::now();
     frame.times.warp = seconds(t, t_warped);
     tiles.mark(legend_->draw(frame.bgra, volumes, frame.visibility, style));
     if (!options_.crop) tiles.mark(cv::Rect(0, 0, frame.bgra.cols, frame.bgra.rows));
     frame.drawn = tiles.runs();
-    tick("decorate");
     t = Clock::now();
     frame.times.decorate = seconds(t_warped, t);
   }
@@ -111,7 +99,6 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     if (fill != bodies.end()) pinhole_labels.setTo(cv::Scalar::all(fill->label));
     std::array<int, 256> counts{};
     frame.mask = label_warp_->apply(pinhole_labels, counts);
-    tick("mask");
     // Each label from the nearest pinhole sample (through a warp) of a mesh drawn a little outside.
     const Projection& mp = maskProjection();
     frame.mask_edge_px = mp.warps() ? std::sqrt(0.5) * mp.stretch() : 0.0;
@@ -123,7 +110,13 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     for (std::size_t i = 0; i < volumes.size(); ++i) frame.pixels[i] = counts[static_cast<std::size_t>(bodies[i].label)];
     frame.times.mask = seconds(t, Clock::now());
   }
-  if (profile) std::fprintf(stderr, "\n");
+  // KCCD_RENDER_PROFILE: each frame's stages on stderr (drawColour ends its drawing with glFinish).
+  static const bool profile = std::getenv("KCCD_RENDER_PROFILE") != nullptr;
+  if (profile) {
+    const FrameTimes& ft = frame.times;
+    std::fprintf(stderr, "prepare %.2f ms  draw %.2f ms  read-back %.2f ms  warp %.2f ms  decorate %.2f ms  mask %.2f ms\n",
+                 1e3 * ft.prepare, 1e3 * ft.draw, 1e3 * ft.read_back, 1e3 * ft.warp, 1e3 * ft.decorate, 1e3 * ft.mask);
+  }
   return frame;
 }
 

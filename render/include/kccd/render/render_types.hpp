@@ -111,9 +111,6 @@ struct RenderOptions {
   SschMeshing meshing = SschMeshing::Direct;
 };
 
-/// What render() produced: the layer (CV_8UC4, BGRA, straight alpha: PNG viewers and
-/// compositing expect it), the mask (CV_8UC1: 0 background, i + 1 for the nearest volume i,
-/// sampled at pixel centres), and per volume the mask pixels it owns.
 /// Where one render() spent its time, seconds (wall clock on the calling thread).
 struct FrameTimes {
   double prepare = 0.0;    ///< volumes to meshes and outlines, clipping planes
@@ -124,6 +121,9 @@ struct FrameTimes {
   double mask = 0.0;       ///< the mask pass, its warp and counts
 };
 
+/// What render() produced: the layer (CV_8UC4, BGRA, straight alpha: PNG viewers and
+/// compositing expect it), the mask (CV_8UC1: 0 background, i + 1 for the nearest volume i,
+/// sampled at pixel centres), and per volume the mask pixels it owns.
 struct Frame {
   cv::Mat bgra;
   /// Disjoint rectangles of `bgra` that hold every drawn pixel (the volumes', the legend's):
