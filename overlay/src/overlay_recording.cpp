@@ -1,11 +1,12 @@
 // The frame pipeline: one reader thread decodes frames in order; annotator threads (one Checker
-// and one Renderer, hence one GL context, each) query, render and composite; the calling thread
-// hands the frames to the sink in input order. At most `2 x jobs + 2` frames are in flight, so
+// and one Renderer, hence one GL context, each, at a lower priority) query, render and composite;
+// the calling thread hands the frames to the sink in input order. At most `2 x jobs + 2` frames are in flight, so
 // memory stays bounded whatever the video's length.
 #include "kccd/overlay/overlay_recording.hpp"
 
 #include <algorithm>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <condition_variable>
 #include <cstdlib>
@@ -15,6 +16,10 @@
 #include <map>
 #include <mutex>
 #include <thread>
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <opencv2/core/utils/logger.hpp>
 #include <nlohmann/json.hpp>
@@ -34,6 +39,22 @@ struct FrameJob {
   cv::Mat bgr;
   FrameRecord record;
 };
+
+// The annotators run this many nice levels below the reader and the writer. Decoding and encoding
+// are the pipeline's serial stages: on a machine with fewer cores than busy threads (the codec's,
+// the annotators', the rasteriser's), a frame's encoding that waits for a core delays every frame
+// behind it, while the annotators only need to keep up on average.
+constexpr int kAnnotatorNice = 10;
+
+// Lowers the calling thread's priority by `steps` nice levels (Linux: nice is per thread; threads
+// it starts, such as the GL rasteriser's, inherit it). Best effort: a refusal changes nothing but speed.
+void lowerThreadPriority(int steps) {
+  if (steps <= 0) return;
+  const auto tid = static_cast<id_t>(::syscall(SYS_gettid));
+  errno = 0;
+  const int now = ::getpriority(PRIO_PROCESS, tid);
+  if (errno == 0) (void)::setpriority(PRIO_PROCESS, tid, std::min(19, now + steps));
+}
 
 }  // namespace
 
@@ -223,6 +244,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   for (int w = 0; w < report.jobs; ++w)
     annotators.emplace_back([&] {
       try {
+        lowerThreadPriority(kAnnotatorNice);
         std::optional<FrameAnnotator> annotator;
         try {
           annotator.emplace(scene);

@@ -68,7 +68,13 @@ Limits limitsOf(const Model& m) {
 
 double DistanceProbe::operator()(std::span<const double> q, int* pair) {
   checker_.reset();  // every state on its own: the answer does not depend on the order of queries
-  const QueryResult& r = checker_.query(q, q, QueryOptions{.type = QueryType::Distances});
+  // A state is a box of zero width: its point volumes are the bodies themselves, so the exact
+  // stage could only repeat their distances (and the search asks for many thousands of states).
+  // Without the pair the closest one is enough (the others are pruned by their bounding spheres);
+  // with it, every distance, so that among equal ones the pair is the last, as always.
+  const QueryResult& r = checker_.query(
+      q, q, QueryOptions{.type = pair ? QueryType::Distances : QueryType::NClosest, .n = 1,
+                         .exact_below = -std::numeric_limits<double>::infinity()});
   if (r.status != Status::Ok) return -1.0;
   if (pair) {
     *pair = -1;

@@ -25,6 +25,8 @@
 #include <utility>
 #include <vector>
 
+#include <sys/resource.h>
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -40,6 +42,23 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// CPU seconds (user + system) of this process's threads, or of its waited-for children.
+double cpuSeconds(int who) {
+  rusage r{};
+  getrusage(who, &r);
+  return static_cast<double>(r.ru_utime.tv_sec + r.ru_stime.tv_sec) + 1e-6 * static_cast<double>(r.ru_utime.tv_usec + r.ru_stime.tv_usec);
+}
+
+// A command's (or the transcode's) fastest wall time, and its CPU time in that round.
+struct Timed {
+  double wall = 1e300, cpu = 0.0;
+  bool keep(double w, double c) {
+    if (w >= wall) return false;
+    wall = w, cpu = c;
+    return true;
+  }
+};
 
 // The sample camera's lens, placed 4.6 m from the humanoid so that all of it is in view.
 kccd::calib::Camera benchCamera() {
@@ -215,47 +234,53 @@ int main(int argc, char** argv) {
     // change in the machine's load falls on all of them); each keeps its fastest round (the least
     // disturbed by other work on a shared machine).
     const std::string other = baseline + args;
-    double plain = 1e300, stat_base = 1e300, stat = 1e300, swept_base = 1e300, swept = 1e300;
+    Timed plain, stat_base, stat, swept_base, swept;
     std::string stat_json, swept_json;
-    auto keep = [](double& best, double t, std::string* json, const std::string& text) {
-      if (t < best) {
-        best = t;
-        if (json) *json = text;
-      }
+    // A command's wall time, and the CPU its process used (the children's CPU clock moves when it is waited for).
+    auto run = [&](Timed& best, const std::string& command, std::string* json) {
+      const double c0 = cpuSeconds(RUSAGE_CHILDREN);
+      std::string text;
+      const double wall = runOverlay(command, json ? &text : nullptr);
+      if (best.keep(wall, cpuSeconds(RUSAGE_CHILDREN) - c0) && json) *json = text;
     };
     for (int round = 0; round < repeat; ++round) {
-      std::string text;
-      plain = std::min(plain, transcode(video, dir + "/plain" + ext, codec, plain_frames));
-      if (!baseline.empty()) stat_base = std::min(stat_base, runOverlay(other + " -o " + dir + "/base_static" + ext + " --codec " + codec));
-      keep(stat, runOverlay(base + " --timings --json -o " + dir + "/static" + ext + " --codec " + codec, &text), &stat_json, text);
-      if (!baseline.empty())
-        swept_base = std::min(swept_base, runOverlay(other + " --swept -o " + dir + "/base_swept" + ext + " --codec " + codec));
-      keep(swept, runOverlay(base + " --swept --timings --json -o " + dir + "/swept" + ext + " --codec " + codec, &text), &swept_json,
-           text);
+      const double c0 = cpuSeconds(RUSAGE_SELF);
+      const double wall = transcode(video, dir + "/plain" + ext, codec, plain_frames);
+      plain.keep(wall, cpuSeconds(RUSAGE_SELF) - c0);
+      if (!baseline.empty()) run(stat_base, other + " -o " + dir + "/base_static" + ext + " --codec " + codec, nullptr);
+      run(stat, base + " --timings --json -o " + dir + "/static" + ext + " --codec " + codec, &stat_json);
+      if (!baseline.empty()) run(swept_base, other + " --swept -o " + dir + "/base_swept" + ext + " --codec " + codec, nullptr);
+      run(swept, base + " --swept --timings --json -o " + dir + "/swept" + ext + " --codec " + codec, &swept_json);
     }
     const Stages stat_stages = stagesOf(stat_json, frames), swept_stages = stagesOf(swept_json, frames);
 
     const unsigned hw = std::thread::hardware_concurrency();
-    const double f_plain = plain_frames / plain, f_static = frames / stat, f_swept = frames / swept;
+    const double f_plain = plain_frames / plain.wall, f_static = frames / stat.wall, f_swept = frames / swept.wall;
     std::printf("bench_overlay: %d frames 1280x720, codec %s, humanoid (26 bodies), %u hardware threads, jobs %s\n",
                 frames, codec.c_str(), hw, jobs > 0 ? std::to_string(jobs).c_str() : "default");
-    std::printf("  plain transcode (decode + encode): %7.1f fps\n", f_plain);
-    std::printf("  kccd overlay, static volumes:      %7.1f fps  (%.0f %% of the transcode)\n", f_static, 100 * f_static / f_plain);
-    std::printf("  kccd overlay --swept:              %7.1f fps  (%.0f %% of the transcode)\n", f_swept, 100 * f_swept / f_plain);
+    // CPU per frame: every thread's user + system time (a 2-core machine has 2 ms of CPU per ms of wall time).
+    auto cpu = [](const Timed& t, int n) { return 1000.0 * t.cpu / n; };
+    std::printf("  plain transcode (decode + encode): %7.1f fps                          CPU %5.1f ms per frame\n", f_plain,
+                cpu(plain, plain_frames));
+    std::printf("  kccd overlay, static volumes:      %7.1f fps  (%3.0f %% of the transcode)  CPU %5.1f ms per frame\n", f_static,
+                100 * f_static / f_plain, cpu(stat, frames));
+    std::printf("  kccd overlay --swept:              %7.1f fps  (%3.0f %% of the transcode)  CPU %5.1f ms per frame\n", f_swept,
+                100 * f_swept / f_plain, cpu(swept, frames));
     // Where the time went (each stage on its own thread: decoding, annotating and encoding overlap).
     std::printf("  per frame, ms        static   swept   (set-up %.3f s and %.3f s)\n", stat_stages.setup, swept_stages.setup);
     for (std::size_t k = 0; k < stat_stages.ms.size(); ++k)
       std::printf("    %-12s    %7.2f %7.2f\n", stat_stages.ms[k].first.c_str(), stat_stages.ms[k].second, swept_stages.ms[k].second);
-    std::printf("    %-12s    %7.2f %7.2f\n", "transcode", 1000.0 * plain / plain_frames, 1000.0 * plain / plain_frames);
+    std::printf("    %-12s    %7.2f %7.2f\n", "transcode", 1000.0 * plain.wall / plain_frames, 1000.0 * plain.wall / plain_frames);
     if (!baseline.empty()) {
-      std::printf("  baseline %s, static volumes: %7.1f fps  (this build %.3f x as fast)\n", baseline.c_str(), frames / stat_base,
-                  stat_base / stat);
-      std::printf("  baseline %s, --swept:        %7.1f fps  (this build %.3f x as fast)\n", baseline.c_str(), frames / swept_base,
-                  swept_base / swept);
+      std::printf("  baseline %s, static volumes: %7.1f fps  (this build %.3f x as fast)  CPU %5.1f ms per frame\n",
+                  baseline.c_str(), frames / stat_base.wall, stat_base.wall / stat.wall, cpu(stat_base, frames));
+      std::printf("  baseline %s, --swept:        %7.1f fps  (this build %.3f x as fast)  CPU %5.1f ms per frame\n",
+                  baseline.c_str(), frames / swept_base.wall, swept_base.wall / swept.wall, cpu(swept_base, frames));
     }
     std::printf("{\"frames\": %d, \"codec\": \"%s\", \"plain_fps\": %.2f, \"static_fps\": %.2f, \"swept_fps\": %.2f, "
-                "\"static_ratio\": %.3f, \"swept_ratio\": %.3f}\n",
-                frames, codec.c_str(), f_plain, f_static, f_swept, f_static / f_plain, f_swept / f_plain);
+                "\"static_ratio\": %.3f, \"swept_ratio\": %.3f, \"plain_cpu_ms\": %.2f, \"static_cpu_ms\": %.2f, \"swept_cpu_ms\": %.2f}\n",
+                frames, codec.c_str(), f_plain, f_static, f_swept, f_static / f_plain, f_swept / f_plain, cpu(plain, plain_frames),
+                cpu(stat, frames), cpu(swept, frames));
     if (plain_frames != frames) std::fprintf(stderr, "bench_overlay: the transcode saw %d frames, not %d\n", plain_frames, frames);
   } catch (const std::exception& e) {
     std::cerr << "bench_overlay: " << e.what() << "\n";
