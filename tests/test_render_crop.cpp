@@ -1,7 +1,9 @@
 // The colour layer drawn, read back and warped only where the volumes and the legend are
 // (RenderOptions::crop) is the whole image's layer bit for bit, and Frame::drawn holds every
 // pixel it draws: random scenes through plain and distorting cameras, supersampled or not, with
-// volumes partly outside the view, reaching behind the near plane or containing the camera.
+// volumes partly outside the view, reaching behind the near plane or containing the camera. And
+// Renderer::renderOnto (the layer blended onto a frame in the warp's pass, without making it)
+// gives the composited frame bit for bit.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -60,7 +62,7 @@ TEST(RenderCrop, TheCroppedLayerIsTheWholeLayerBitForBit) {
     cropped.supersample = whole.supersample = trial % 3 == 1 ? 2.0 : 1.0;
     cropped.mask_supersample = whole.mask_supersample = cropped.supersample;
     whole.crop = false;
-    Renderer a(c, cropped), b(c, whole);
+    Renderer a(c, cropped), b(c, whole), onto(c, cropped);
     // Two frames each, the second of the same renderer after the first: what the first read back
     // must not show through.
     for (int frame = 0; frame < 2; ++frame) {
@@ -94,12 +96,31 @@ TEST(RenderCrop, TheCroppedLayerIsTheWholeLayerBitForBit) {
       kccd::render::compositeOver(parts, fa.bgra, fa.drawn);
       cv::absdiff(all, parts, diff);
       EXPECT_EQ(cv::countNonZero(diff.reshape(1)), 0) << "frame " << frame;
+      // Blended in the warp's pass: the same frame, the same rectangles, no layer.
+      cv::Mat blended = photo.clone();
+      const Frame fo = onto.renderOnto(blended, scene, style);
+      EXPECT_TRUE(fo.bgra.empty());
+      EXPECT_EQ(fo.drawn, fa.drawn) << "frame " << frame;
+      EXPECT_EQ(fo.visibility, fa.visibility) << "frame " << frame;
+      cv::absdiff(all, blended, diff);
+      EXPECT_EQ(cv::countNonZero(diff.reshape(1)), 0) << "frame " << frame;
     }
   }
   // The point of it: far less than the image is handed on.
   EXPECT_LT(drawn_area, image_area / 2);
   std::cout << "drawn rectangles: " << 100.0 * static_cast<double>(drawn_area) / static_cast<double>(image_area)
             << " % of the images\n";
+}
+
+TEST(RenderCrop, RenderOntoRejectsAFrameOfAnotherSizeOrType) {
+  std::mt19937_64 rng(7);
+  const Camera c = kccd::testing::randomCamera(rng, true, 160, 120);
+  Renderer r(c);
+  const std::vector<Vec3> cloud{Vec3::Zero()};
+  const std::vector<Volume> scene{Volume{cloud, 0.1, SafetyStatus::Clear, "ball"}};
+  cv::Mat small(119, 160, CV_8UC3, cv::Scalar::all(0)), grey(120, 160, CV_8UC1, cv::Scalar::all(0));
+  EXPECT_THROW(r.renderOnto(small, scene), std::invalid_argument);
+  EXPECT_THROW(r.renderOnto(grey, scene), std::invalid_argument);
 }
 
 }  // namespace

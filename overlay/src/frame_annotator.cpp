@@ -10,7 +10,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "kccd/input_error.hpp"
-#include "kccd/render/composite.hpp"
 
 namespace kccd::overlay {
 
@@ -60,6 +59,7 @@ void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
   request.colour = rec.selected;  // not selected: the query alone
   request.style.labels = false;
   request.style.legend = !set.plain;
+  request.onto = &bgr;  // the layer composited in the warp's pass
   bool box_ok = true;
   if (rec.match == StateMatch::None) {
     // No state: only the bodies fixed in the world are known; they are drawn grey.
@@ -102,7 +102,6 @@ void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
   for (std::size_t i = 0; i < drawn.first_visual; ++i) rec.not_finite |= layer.visibility[i] == render::Visibility::NotFinite;
   if (rec.not_finite) rec.status = SafetyStatus::Colliding;  // an overflowed volume is unsafe
   const Clock::time_point t_composite = Clock::now();
-  render::compositeOver(bgr, layer.bgra, layer.drawn);
   if (!set.plain) drawStatusLine(bgr, rec);
   rec.times.composite = since(t_composite);
 }
@@ -145,8 +144,17 @@ void FrameAnnotator::drawStatusLine(cv::Mat& bgr, const FrameRecord& rec) const 
       cv::Rect(pad, bgr.rows - size.height - baseline - 3 * pad, size.width + 2 * pad, size.height + baseline + 2 * pad) &
       cv::Rect(0, 0, bgr.cols, bgr.rows);
   if (box.empty()) return;
+  // The background darkened (keeps the text readable on any frame): each byte times 0.35, rounded
+  // as convertTo rounds, through a table made by convertTo itself (a table look-up per byte is
+  // several times faster than convertTo's arithmetic on a strip of the image).
+  static const cv::Mat darken = [] {
+    cv::Mat ramp(1, 256, CV_8U), out;
+    for (int i = 0; i < 256; ++i) ramp.at<uchar>(i) = static_cast<uchar>(i);
+    ramp.convertTo(out, -1, 0.35, 0);
+    return out;
+  }();
   cv::Mat roi = bgr(box);
-  roi.convertTo(roi, -1, 0.35, 0);  // darkened background keeps the text readable on any frame
+  cv::LUT(roi, darken, roi);
   const cv::Point at(box.x + pad, box.y + pad + size.height);
   const cv::Scalar colour = rec.status == SafetyStatus::Clear ? cv::Scalar(255, 255, 255) : render::statusColour(rec.status);
   cv::putText(bgr, text, at, font, scale, colour, thick, cv::LINE_AA);

@@ -6,6 +6,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "kccd/render/composite.hpp"
+
 namespace kccd::render {
 
 cv::Scalar statusColour(SafetyStatus status) {
@@ -84,21 +86,35 @@ cv::Rect Legend::draw(cv::Mat& bgra, std::span<const Volume> volumes, const std:
     }
   }
   if (style.legend) {
-    // Drawn once per image size and copied afterwards.
-    if (legend_.empty() || legend_rows_ != bgra.rows) {
-      legend_rows_ = bgra.rows;
-      legend_ = drawLegend(scale, thick);
-      cv::Mat alpha;
-      cv::extractChannel(legend_, alpha, 3);
-      legend_box_ = cv::boundingRect(alpha);
-    }
-    const cv::Rect box = legend_box_ & cv::Rect(0, 0, bgra.cols, bgra.rows);
+    const cv::Rect box = legendBox(bgra.size());
     if (!box.empty()) {  // an image a few pixels high shows none of it
       legend_(box).copyTo(bgra(box));
       touched |= box;
     }
   }
   return touched;
+}
+
+cv::Rect Legend::legendBox(cv::Size size) {
+  // Drawn once per image height and copied afterwards.
+  if (legend_.empty() || legend_rows_ != size.height) {
+    const double scale = std::clamp(size.height / 900.0, 0.35, 1.0);
+    const int thick = std::max(1, static_cast<int>(std::lround(scale * 2)));
+    legend_rows_ = size.height;
+    legend_ = drawLegend(scale, thick);
+    cv::Mat alpha;
+    cv::extractChannel(legend_, alpha, 3);
+    legend_box_ = cv::boundingRect(alpha);
+  }
+  return legend_box_ & cv::Rect(0, 0, size.width, size.height);
+}
+
+cv::Rect Legend::compositeLegend(cv::Mat& bgr) {
+  const cv::Rect box = legendBox(bgr.size());
+  if (box.empty()) return box;
+  cv::Mat part = bgr(box);
+  compositeOver(part, legend_(box));
+  return box;
 }
 
 }  // namespace detail

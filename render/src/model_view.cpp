@@ -70,7 +70,9 @@ ModelFrame ModelView::draw(const ModelViewRequest& request) {
     std::vector<Volume> look = visualVolumes(model_, visuals_, request.state);
     volumes.insert(volumes.end(), std::make_move_iterator(look.begin()), std::make_move_iterator(look.end()));
   }
-  out.images = renderer_.render(volumes, request.style, request.colour, request.mask);
+  out.images = request.onto && request.colour && !request.mask
+                   ? renderer_.renderOnto(*request.onto, volumes, request.style)
+                   : renderer_.render(volumes, request.style, request.colour, request.mask);
   return out;
 }
 

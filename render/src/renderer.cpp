@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "gl_targets.hpp"
+#include "kccd/render/composite.hpp"
 #include "kccd/render/prepare.hpp"
 #include "legend.hpp"
 #include "passes.hpp"
@@ -63,6 +64,24 @@ const std::string& Renderer::rendererString() const { return context_->renderer(
 const MeshCache& Renderer::meshCache() const { return preparer_->meshCache(); }
 
 Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool want_colour, bool want_mask) {
+  return draw(volumes, style, want_colour, want_mask, nullptr);
+}
+
+Frame Renderer::renderOnto(cv::Mat& bgr, std::span<const Volume> volumes, const Style& style) {
+  const Camera& camera = projection_.camera();
+  if (bgr.type() != CV_8UC3 || bgr.cols != camera.width || bgr.rows != camera.height)
+    throw std::invalid_argument("Renderer::renderOnto: needs a CV_8UC3 image of the camera's size");
+  // Names on the layer and uncropped layers take the layer's way (rare in overlays).
+  if (style.labels || !options_.crop) {
+    Frame frame = draw(volumes, style, true, false, nullptr);
+    compositeOver(bgr, frame.bgra, frame.drawn);
+    frame.bgra.release();
+    return frame;
+  }
+  return draw(volumes, style, true, false, &bgr);
+}
+
+Frame Renderer::draw(std::span<const Volume> volumes, const Style& style, bool want_colour, bool want_mask, cv::Mat* onto) {
   if (volumes.size() > 255) throw std::invalid_argument("Renderer: at most 255 volumes (8-bit mask labels)");
   const auto t_start = std::chrono::steady_clock::now();
   context_->makeCurrent();
@@ -83,11 +102,19 @@ Frame Renderer::render(std::span<const Volume> volumes, const Style& style, bool
     detail::drawColour(*gl_, projection_, options_, bodies, style, frame, *read_back_, same_pass ? &labels : nullptr);
     t = Clock::now();
     detail::TileMask tiles(projection_.camera().width, projection_.camera().height);
-    frame.bgra = colour_warp_->apply(read_back_->image, read_back_->parts, tiles);
-    const Clock::time_point t_warped = Clock::now();
+    Clock::time_point t_warped;
+    if (onto) {  // warped, straightened and blended in one pass; the legend's box is the legend's alone
+      const cv::Rect legend = style.legend ? legend_->legendBox(onto->size()) : cv::Rect();
+      colour_warp_->blendOnto(*onto, read_back_->image, read_back_->parts, tiles, legend);
+      t_warped = Clock::now();
+      if (style.legend) tiles.mark(legend_->compositeLegend(*onto));
+    } else {
+      frame.bgra = colour_warp_->apply(read_back_->image, read_back_->parts, tiles);
+      t_warped = Clock::now();
+      tiles.mark(legend_->draw(frame.bgra, volumes, frame.visibility, style));
+      if (!options_.crop) tiles.mark(cv::Rect(0, 0, frame.bgra.cols, frame.bgra.rows));
+    }
     frame.times.warp = seconds(t, t_warped);
-    tiles.mark(legend_->draw(frame.bgra, volumes, frame.visibility, style));
-    if (!options_.crop) tiles.mark(cv::Rect(0, 0, frame.bgra.cols, frame.bgra.rows));
     frame.drawn = tiles.runs();
     t = Clock::now();
     frame.times.decorate = seconds(t_warped, t);

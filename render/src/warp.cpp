@@ -80,14 +80,20 @@ void warpByRows(const cv::Mat& src, cv::Mat& dst, const cv::Mat& map_a, const cv
   });
 }
 
-// Straight alpha: colour / alpha, through a table, for every pixel of `rows` (CV_8UC4).
-void straighten(cv::Mat rows) {
-  static const std::vector<uchar> unpremultiply = [] {
+// Straight colour from premultiplied, per alpha a: entries a * 256 + c (alpha 0: none).
+const std::vector<uchar>& unpremultiplyTable() {
+  static const std::vector<uchar> table = [] {
     std::vector<uchar> t(256 * 256);
     for (int a = 1; a < 256; ++a)
       for (int c = 0; c < 256; ++c) t[a * 256 + c] = static_cast<uchar>(std::min(255, (c * 255 + a / 2) / a));
     return t;
   }();
+  return table;
+}
+
+// Straight alpha: colour / alpha, through a table, for every pixel of `rows` (CV_8UC4).
+void straighten(cv::Mat rows) {
+  const std::vector<uchar>& unpremultiply = unpremultiplyTable();
   for (int y = 0; y < rows.rows; ++y) {
     uchar* px = rows.ptr<uchar>(y);
     for (int x = 0; x < rows.cols; ++x, px += 4) {
@@ -130,9 +136,7 @@ std::vector<cv::Rect> TileMask::runs() const {
   return out;
 }
 
-cv::Mat ColourWarp::apply(const cv::Mat& premultiplied, std::span<const cv::Rect> drawn, TileMask& tiles) {
-  const Camera& camera = projection_.camera();
-  cv::Mat out = cv::Mat::zeros(camera.height, camera.width, CV_8UC4);
+std::vector<cv::Rect> ColourWarp::markTiles(std::span<const cv::Rect> drawn, TileMask& tiles) {
   if (tile_source_.empty()) {
     tile_source_.resize(static_cast<std::size_t>(tiles.tiles()));
     if (!projection_.warps()) {  // the pinhole image is the camera image
@@ -171,8 +175,14 @@ cv::Mat ColourWarp::apply(const cv::Mat& premultiplied, std::span<const cv::Rect
         break;
       }
   }
+  return tiles.runs();
+}
+
+cv::Mat ColourWarp::apply(const cv::Mat& premultiplied, std::span<const cv::Rect> drawn, TileMask& tiles) {
+  const Camera& camera = projection_.camera();
+  cv::Mat out = cv::Mat::zeros(camera.height, camera.width, CV_8UC4);
+  const std::vector<cv::Rect> runs = markTiles(drawn, tiles);
   // Warped (or copied) and straightened run by run, in parallel, each run while it is in cache.
-  const std::vector<cv::Rect> runs = tiles.runs();
   cv::parallel_for_(cv::Range(0, static_cast<int>(runs.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       const cv::Rect& run = runs[static_cast<std::size_t>(i)];
@@ -185,6 +195,44 @@ cv::Mat ColourWarp::apply(const cv::Mat& premultiplied, std::span<const cv::Rect
     }
   });
   return out;
+}
+
+void ColourWarp::blendOnto(cv::Mat& bgr, const cv::Mat& premultiplied, std::span<const cv::Rect> drawn, TileMask& tiles,
+                           const cv::Rect& keep_out) {
+  const std::vector<cv::Rect> runs = markTiles(drawn, tiles);
+  const std::vector<uchar>& unpremultiply = unpremultiplyTable();
+  // Per run, in parallel: warped into a scratch run (the pinhole pixels themselves without a
+  // warp), then each pixel made straight and blended as straighten() and compositeOver() would.
+  cv::parallel_for_(cv::Range(0, static_cast<int>(runs.size())), [&](const cv::Range& range) {
+    cv::Mat scratch;
+    for (int i = range.start; i < range.end; ++i) {
+      const cv::Rect& run = runs[static_cast<std::size_t>(i)];
+      cv::Mat part;
+      if (projection_.warps()) {
+        scratch.create(run.height, run.width, CV_8UC4);
+        cv::remap(premultiplied, scratch, map_a_(run), map_b_(run), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+        part = scratch;
+      } else {
+        part = premultiplied(run);
+      }
+      for (int y = 0; y < run.height; ++y) {
+        const uchar* px = part.ptr<uchar>(y);
+        uchar* o = bgr.ptr<uchar>(run.y + y, run.x);
+        const bool row_kept = run.y + y >= keep_out.y && run.y + y < keep_out.y + keep_out.height;
+        for (int x = 0; x < run.width; ++x, px += 4, o += 3) {
+          const unsigned a = px[3];
+          if (a == 0) continue;
+          if (row_kept && run.x + x >= keep_out.x && run.x + x < keep_out.x + keep_out.width) continue;
+          if (a == 255) {
+            o[0] = px[0], o[1] = px[1], o[2] = px[2];
+            continue;
+          }
+          const uchar* t = &unpremultiply[a * 256];
+          for (int c = 0; c < 3; ++c) o[c] = static_cast<uchar>((t[px[c]] * a + o[c] * (255 - a) + 127) / 255);
+        }
+      }
+    }
+  });
 }
 
 cv::Mat LabelWarp::apply(const cv::Mat& pinhole_labels, std::array<int, 256>& counts) {

@@ -44,8 +44,16 @@ class ColourWarp {
   /// whose samples may read them marked, and the result is zero outside those: only they are
   /// warped. The pixels are those of warping the whole image.
   cv::Mat apply(const cv::Mat& premultiplied, std::span<const cv::Rect> drawn, TileMask& tiles);
+  /// The same layer composited straight onto `bgr` (CV_8UC3, the camera image's size) as
+  /// compositeOver would, without making it; pixels inside `keep_out` are left alone. `tiles`
+  /// gets the same tiles marked as apply() marks.
+  void blendOnto(cv::Mat& bgr, const cv::Mat& premultiplied, std::span<const cv::Rect> drawn, TileMask& tiles,
+                 const cv::Rect& keep_out);
 
  private:
+  /// Marks the camera tiles whose samples may read a drawn pinhole pixel; returns their runs.
+  std::vector<cv::Rect> markTiles(std::span<const cv::Rect> drawn, TileMask& tiles);
+
   const Projection& projection_;
   cv::Mat map_a_, map_b_;              // remap tables in fixed point
   std::vector<cv::Rect> tile_source_;  // per camera tile (TileMask order), the pinhole pixels its warp may read

@@ -43,6 +43,9 @@ struct ModelViewRequest {
   bool colour = true;         ///< make the colour layer (Frame::bgra)
   bool mask = true;           ///< make the label mask (Frame::mask, Frame::pixels); neither: query only, no images
   Style style;                ///< the colour layer's look: labels, legend, shaded, ...
+  /// When set (with `colour` and without `mask`): the colour layer is composited straight onto
+  /// this CV_8UC3 camera image (see Renderer::renderOnto) instead of made as Frame::bgra.
+  cv::Mat* onto = nullptr;
 };
 
 /// What a ModelView drew: the images with each volume's visibility and pixels, and per body the

@@ -44,6 +44,10 @@ class Renderer {
   /// Renders the colour layer (when `want_colour`) and the mask (when `want_mask`).
   Frame render(std::span<const Volume> volumes, const Style& style = {}, bool want_colour = true,
                bool want_mask = true);
+  /// Renders the colour layer straight onto `bgr` (CV_8UC3, the camera image's size; else
+  /// std::invalid_argument): the pixels compositeOver(bgr, layer, drawn) gives for render()'s
+  /// layer, without making the layer (Frame::bgra stays empty; Frame::drawn says where it drew).
+  Frame renderOnto(cv::Mat& bgr, std::span<const Volume> volumes, const Style& style = {});
 
   /// The GL renderer's name (GL_RENDERER), e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
   const std::string& rendererString() const;
@@ -55,6 +59,8 @@ class Renderer {
   const MeshCache& meshCache() const;
 
  private:
+  Frame draw(std::span<const Volume> volumes, const Style& style, bool want_colour, bool want_mask, cv::Mat* onto);
+
   RenderOptions options_;
   Projection projection_;
   std::unique_ptr<Projection> mask_projection_;  // when the mask uses another pinhole scale
