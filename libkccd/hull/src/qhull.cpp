@@ -10,7 +10,9 @@ namespace kccd::hull {
 
 QhullResult convexHull3(std::span<double> coords) {
   QhullResult result;
-  FILE* devnull = std::fopen("/dev/null", "w");
+  // qhull's messages go nowhere; the sink is opened once (a fit builds thousands of small hulls,
+  // and stdio locks the stream for the threads that share it).
+  static FILE* const devnull = std::fopen("/dev/null", "w");
   qhT qh_storage;
   qhT* qh = &qh_storage;
   QHULL_LIB_CHECK
@@ -32,7 +34,6 @@ QhullResult convexHull3(std::span<double> coords) {
   qh_freeqhull(qh, !qh_ALL);
   int curlong = 0, totlong = 0;
   qh_memfreeshort(qh, &curlong, &totlong);
-  if (devnull) std::fclose(devnull);
   return result;
 }
 
