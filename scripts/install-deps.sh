@@ -10,6 +10,7 @@ packages=(
   libcoin-dev inventor-data liburdfdom-dev libassimp-dev
   libosmesa6-dev libgl-dev libegl-dev libopengl-dev libegl-mesa0
   libopencv-dev libpng-dev libtinyxml2-dev libapriltag-dev
+  zlib1g-dev libzstd-dev liblz4-dev
   python3-dev pybind11-dev python3-numpy
   python3-yaml python3-distributed python3-dask
 )
@@ -37,11 +38,17 @@ if [ $tests = 1 ]; then
   command -v npm >/dev/null 2>&1 || missing+=(npm)
 fi
 root=$(cd "$(dirname "$0")/.." && pwd)
-e2e() {  # the browser test's driver, from npm (the browser itself is Debian's chromium)
+e2e() {  # from npm: the browser test's driver (the browser itself is Debian's chromium), the log fixtures' writers
   [ $tests = 1 ] || return 0
-  [ -d "$root/tests/e2e/node_modules/playwright-core" ] && return 0
-  echo "install-deps: npm ci in tests/e2e (playwright-core)"
-  (cd "$root/tests/e2e" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+  if [ ! -d "$root/tests/e2e/node_modules/playwright-core" ]; then
+    echo "install-deps: npm ci in tests/e2e (playwright-core)"
+    (cd "$root/tests/e2e" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+  fi
+  # The robot-log tests' fixture writers (other projects' MCAP and ROS 2 serialisation).
+  if [ ! -d "$root/tests/bags/node_modules/@mcap/core" ]; then
+    echo "install-deps: npm ci in tests/bags (@mcap/core, @foxglove/rosmsg2-serialization)"
+    (cd "$root/tests/bags" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+  fi
 }
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages present"

@@ -31,6 +31,8 @@ Runner addSynth(CLI::App& app);
 Runner addOverlay(CLI::App& app);
 /// `kccd golden run | update | approve | list` (cmd_golden.cpp).
 Runner addGolden(CLI::App& app);
+/// `kccd bag info` (cmd_bag.cpp).
+Runner addBag(CLI::App& app);
 /// `sheet`, registered on the `calib` subcommand app.
 Runner addCalibSheet(CLI::App& calib);
 /// `kccd calib label`: the labelling page (cmd_calib_label.cpp).

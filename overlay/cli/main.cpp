@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   add(kccd::cli::addSynth);
   add(kccd::cli::addOverlay);
   add(kccd::cli::addGolden);
+  add(kccd::cli::addBag);
   if (argc > 1 && argv[1][0] != '-') {  // CLI11 would only say that a subcommand is required
     std::string names;
     bool known = false;

@@ -1,0 +1,98 @@
+// Reading MCAP files (https://mcap.dev/spec, version 0) as a stream of messages: the records in
+// file order, chunks decompressed one at a time (none, zstd, lz4 frames), CRCs checked where the
+// writer recorded them. The summary section is read only for its CRC: a linear scan needs no
+// index, so a recording that crashed before writing its summary reads the same as a finished one.
+#pragma once
+
+#include <cstdint>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace kccd::logs {
+
+/// A schema record: how a channel's messages are described (e.g. name "sensor_msgs/msg/JointState",
+/// encoding "ros2msg", data the definition text).
+struct Schema {
+  std::uint16_t id = 0;
+  std::string name, encoding, data;
+};
+
+/// A channel record: a topic, its message encoding (e.g. "cdr", "ros1") and its schema (0: none).
+struct Channel {
+  std::uint16_t id = 0, schema_id = 0;
+  std::string topic, message_encoding;
+  std::vector<std::pair<std::string, std::string>> metadata;
+};
+
+/// One message. The views (channel, schema, data) stay valid until the next call to next().
+struct LogMessage {
+  const Channel* channel = nullptr;
+  const Schema* schema = nullptr;  ///< null when the channel has no schema (schema id 0)
+  std::uint32_t sequence = 0;
+  std::uint64_t log_time = 0, publish_time = 0;  ///< nanoseconds
+  std::span<const std::uint8_t> data;
+  std::uint64_t offset = 0;  ///< the file offset of the record (of its chunk when chunked)
+};
+
+/// Streams one MCAP file's messages. Memory is bounded by the largest record or decompressed
+/// chunk, not by the file. Every length field is checked against the bytes that remain before
+/// anything is allocated for it.
+class McapReader {
+ public:
+  /// Opens `path` and checks the leading magic; throws InputError naming the file otherwise.
+  explicit McapReader(const std::string& path);
+  ~McapReader();
+  McapReader(const McapReader&) = delete;
+  McapReader& operator=(const McapReader&) = delete;
+
+  /// The next message in file order; false after the last one. Throws InputError ("FILE: byte N:
+  /// problem") for a CRC mismatch, an unknown compression, a record that contradicts itself or a
+  /// message on a channel never defined. A file cut short ends the stream early: see damage().
+  bool next(LogMessage& out);
+
+  /// Empty, or why the stream ended before the file's proper end (e.g. "cut short at byte 1234
+  /// inside a Chunk record") — the messages before it were read.
+  const std::string& damage() const { return damage_; }
+  /// The header's profile (e.g. "ros2", "ros1") and library.
+  const std::string& profile() const { return profile_; }
+  const std::string& library() const { return library_; }
+  /// The schemas and channels seen so far, by id.
+  const std::map<std::uint16_t, Schema>& schemas() const { return schemas_; }
+  const std::map<std::uint16_t, Channel>& channels() const { return channels_; }
+  /// The file's name as messages show it.
+  const std::string& path() const { return path_; }
+  std::uint64_t fileSize() const { return size_; }
+  /// Chunks read so far, and their compressions (e.g. {"zstd": 12}).
+  const std::map<std::string, int>& chunks() const { return chunks_; }
+
+ private:
+  bool readRecord(std::uint8_t& opcode, std::vector<std::uint8_t>& content, std::uint64_t& at);
+  void handle(std::uint8_t opcode, std::span<const std::uint8_t> content, std::uint64_t at, bool in_chunk);
+  void openChunk(std::span<const std::uint8_t> content, std::uint64_t at);
+  [[noreturn]] void fail(std::uint64_t at, const std::string& problem) const;
+  void cut(std::uint64_t at, const std::string& where);
+
+  std::string path_;
+  std::ifstream in_;
+  std::uint64_t size_ = 0, pos_ = 0;
+  std::uint32_t data_crc_ = 0;        // CRC-32 of every byte read before the Data End record
+  bool data_crc_on_ = true;
+  std::uint32_t summary_crc_ = 0;     // CRC-32 from the summary section's start
+  bool in_summary_ = false, ended_ = false;
+  std::string damage_, profile_, library_;
+  std::map<std::uint16_t, Schema> schemas_;
+  std::map<std::uint16_t, Channel> channels_;
+  std::map<std::string, int> chunks_;
+  std::vector<std::uint8_t> record_;  // the current record's content
+  std::vector<std::uint8_t> chunk_;   // the current chunk's records, decompressed
+  std::uint64_t chunk_at_ = 0, chunk_pos_ = 0;
+  bool pending_ = false;              // handle() found a message for next() to return
+  LogMessage message_;
+};
+
+}  // namespace kccd::logs

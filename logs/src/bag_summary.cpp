@@ -1,0 +1,127 @@
+#include "kccd/logs/bag_summary.hpp"
+
+#include <algorithm>
+#include <memory>
+#include <optional>
+
+#include "kccd/input_error.hpp"
+#include "kccd/logs/decode.hpp"
+#include "kccd/logs/mcap_reader.hpp"
+#include "kccd/logs/message_definition.hpp"
+
+namespace kccd::logs {
+
+double TopicSummary::rate() const {
+  if (count < 2 || last_log_time <= first_log_time) return 0.0;
+  return static_cast<double>(count - 1) / (1e-9 * static_cast<double>(last_log_time - first_log_time));
+}
+
+namespace {
+
+// A whole number of a header field, when it is one that fits (a definition may declare any type).
+std::optional<std::int64_t> whole(const Value& v) {
+  constexpr std::int64_t kLimit = std::int64_t{1} << 33;
+  if (v.kind == Value::Kind::Int && v.i > -kLimit && v.i < kLimit) return v.i;
+  if (v.kind == Value::Kind::UInt && v.u < static_cast<std::uint64_t>(kLimit)) return static_cast<std::int64_t>(v.u);
+  return std::nullopt;
+}
+
+// A header's stamp as nanoseconds: ROS 2's {sec, nanosec}, ROS 1's time (two 32-bit values).
+std::optional<std::int64_t> stampOf(const Value& message) {
+  const Value* header = message.field("header");
+  if (!header) return std::nullopt;
+  const Value* stamp = header->field("stamp");
+  if (!stamp) return std::nullopt;
+  const Value* sec = nullptr;
+  const Value* nsec = nullptr;
+  if (stamp->kind == Value::Kind::Array && stamp->items.size() == 2) sec = &stamp->items[0], nsec = &stamp->items[1];  // ROS 1 time
+  else sec = stamp->field("sec"), nsec = stamp->field("nanosec");
+  if (!sec || !nsec) return std::nullopt;
+  const auto s = whole(*sec), n = whole(*nsec);
+  if (!s || !n) return std::nullopt;
+  return *s * 1000000000 + *n;
+}
+
+struct TopicState {
+  TopicSummary summary;
+  std::optional<MessageDefinitions> types;
+  bool cdr = false;
+  std::vector<float> skews;  // seconds
+};
+
+}  // namespace
+
+BagSummary summarizeBag(const std::string& path) {
+  McapReader reader(path);
+  BagSummary out;
+  out.path = path;
+  out.format = "MCAP";
+  std::map<std::uint16_t, TopicState> by_channel;
+  LogMessage m;
+  while (reader.next(m)) {
+    auto [it, fresh] = by_channel.try_emplace(m.channel->id);
+    TopicState& t = it->second;
+    if (fresh) {
+      t.summary.topic = m.channel->topic;
+      t.summary.message_encoding = m.channel->message_encoding;
+      if (m.schema) t.summary.type = m.schema->name, t.summary.schema_encoding = m.schema->encoding;
+      const bool ros2 = m.schema && m.schema->encoding == "ros2msg" && m.channel->message_encoding == "cdr";
+      const bool ros1 = m.schema && m.schema->encoding == "ros1msg" && m.channel->message_encoding == "ros1";
+      if (!m.schema) t.summary.no_stamps = "no schema";
+      else if (!ros1 && !ros2) t.summary.no_stamps = "schema " + m.schema->encoding + ", messages " + m.channel->message_encoding + ": not decoded";
+      else {
+        try {
+          t.types = MessageDefinitions::parse(m.schema->name, m.schema->data, ros2 ? Dialect::Ros2 : Dialect::Ros1);
+        } catch (const DefinitionError& e) {
+          throw InputError(InputLocation{path, 0, 0, "byte " + std::to_string(m.offset)},
+                           "topic " + printable(t.summary.topic, 60) + ": the definition of " + printable(m.schema->name, 60) +
+                               (e.line() > 0 ? " (line " + std::to_string(e.line()) + " of its schema)" : std::string()) + ": " + printable(e.what(), 200));
+        }
+        t.cdr = ros2;
+        const Field* first = t.types->root().fields.empty() ? nullptr : &t.types->root().fields.front();
+        const bool has_header = first && first->name == "header";
+        if (!has_header) t.summary.no_stamps = "no header";
+      }
+    }
+    TopicSummary& s = t.summary;
+    if (s.count == 0 || m.log_time < s.first_log_time) s.first_log_time = m.log_time;
+    s.last_log_time = std::max(s.last_log_time, m.log_time);
+    ++s.count;
+    if (t.types && s.no_stamps.empty()) {
+      Value v;
+      try {
+        v = t.cdr ? decodeCdr(*t.types, m.data) : decodeRos1(*t.types, m.data);
+      } catch (const DecodeError& e) {
+        throw InputError(InputLocation{path, 0, 0, "byte " + std::to_string(m.offset)},
+                         "topic " + printable(s.topic, 60) + " (" + printable(s.type, 60) + "): message " + std::to_string(s.count) +
+                             " does not decode: byte " + std::to_string(e.offset()) + " of its " + std::to_string(m.data.size()) + ": " + printable(e.what(), 200));
+      }
+      if (const auto stamp = stampOf(v)) {
+        ++s.stamped;
+        if (*stamp == 0) ++s.zero_stamps;
+        else t.skews.push_back(static_cast<float>(1e-9 * (static_cast<double>(m.log_time) - static_cast<double>(*stamp))));
+      }
+    }
+  }
+  out.damage = reader.damage();
+  out.profile = reader.profile();
+  out.library = reader.library();
+  out.chunks = reader.chunks();
+  for (auto& [id, t] : by_channel) {
+    if (!t.skews.empty()) {
+      std::sort(t.skews.begin(), t.skews.end());
+      t.summary.skew_min = t.skews.front();
+      t.summary.skew_max = t.skews.back();
+      t.summary.skew_median = t.skews[t.skews.size() / 2];
+    }
+    TopicSummary& s = t.summary;
+    if (out.messages == 0 || s.first_log_time < out.first_log_time) out.first_log_time = s.first_log_time;
+    out.last_log_time = std::max(out.last_log_time, s.last_log_time);
+    out.messages += s.count;
+    out.topics.push_back(std::move(s));
+  }
+  std::sort(out.topics.begin(), out.topics.end(), [](const TopicSummary& a, const TopicSummary& b) { return a.topic < b.topic; });
+  return out;
+}
+
+}  // namespace kccd::logs

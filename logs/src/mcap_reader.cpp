@@ -1,0 +1,357 @@
+#include "kccd/logs/mcap_reader.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+
+#include <lz4frame.h>
+#include <zlib.h>
+#include <zstd.h>
+
+#include "kccd/input_error.hpp"
+
+namespace kccd::logs {
+namespace {
+
+constexpr std::uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
+enum Op : std::uint8_t {
+  kHeader = 0x01, kFooter = 0x02, kSchema = 0x03, kChannel = 0x04, kMessage = 0x05, kChunk = 0x06,
+  kMessageIndex = 0x07, kChunkIndex = 0x08, kAttachment = 0x09, kAttachmentIndex = 0x0A, kStatistics = 0x0B,
+  kMetadata = 0x0C, kMetadataIndex = 0x0D, kSummaryOffset = 0x0E, kDataEnd = 0x0F,
+};
+// A decompressed chunk may be larger than the file, but not without limit.
+constexpr std::uint64_t kMaxChunk = std::uint64_t{1} << 31;
+
+const char* opName(std::uint8_t op) {
+  static const char* names[] = {"?", "Header", "Footer", "Schema", "Channel", "Message", "Chunk", "Message Index",
+                                "Chunk Index", "Attachment", "Attachment Index", "Statistics", "Metadata",
+                                "Metadata Index", "Summary Offset", "Data End"};
+  return op < 16 ? names[op] : "unknown";
+}
+
+// Little-endian fields of one record, each checked against the record's end.
+class Fields {
+ public:
+  Fields(std::span<const std::uint8_t> b, const char* record) : b_(b), record_(record) {}
+  template <class T>
+  T num(const char* what) {
+    need(sizeof(T), what);
+    T v = 0;
+    for (std::size_t i = 0; i < sizeof(T); ++i) v |= static_cast<T>(static_cast<T>(b_[pos_ + i]) << (8 * i));
+    pos_ += sizeof(T);
+    return v;
+  }
+  std::string str(const char* what) {
+    const std::uint32_t n = num<std::uint32_t>(what);
+    need(n, what);
+    std::string s(reinterpret_cast<const char*>(b_.data() + pos_), n);
+    pos_ += n;
+    return s;
+  }
+  std::span<const std::uint8_t> bytes32(const char* what) { return take(num<std::uint32_t>(what), what); }
+  std::span<const std::uint8_t> bytes64(const char* what) { return take(num<std::uint64_t>(what), what); }
+  std::span<const std::uint8_t> rest() { return take(b_.size() - pos_, "data"); }
+  std::span<const std::uint8_t> take(std::uint64_t n, const char* what) {
+    need(n, what);
+    const auto s = b_.subspan(pos_, static_cast<std::size_t>(n));
+    pos_ += static_cast<std::size_t>(n);
+    return s;
+  }
+  std::size_t position() const { return pos_; }
+
+ private:
+  void need(std::uint64_t n, const char* what) {
+    if (n > b_.size() - pos_)
+      throw std::out_of_range(std::string("the ") + record_ + " record is too short for its " + what + " (" +
+                              std::to_string(n) + " bytes at " + std::to_string(pos_) + " of " + std::to_string(b_.size()) + ")");
+  }
+  std::span<const std::uint8_t> b_;
+  std::size_t pos_ = 0;
+  const char* record_;
+};
+
+std::uint32_t crc32Of(std::uint32_t crc, const std::uint8_t* p, std::size_t n) {
+  while (n > 0) {  // zlib takes 32-bit lengths
+    const std::size_t step = std::min<std::size_t>(n, 1u << 30);
+    crc = static_cast<std::uint32_t>(crc32(crc, p, static_cast<uInt>(step)));
+    p += step, n -= step;
+  }
+  return crc;
+}
+
+}  // namespace
+
+McapReader::McapReader(const std::string& path) : path_(path) {
+  in_.open(path, std::ios::binary);
+  if (!in_) throw InputError(InputLocation{path, 0, 0, "file"}, "cannot be opened");
+  in_.seekg(0, std::ios::end);
+  const std::streamoff end = in_.tellg();
+  in_.seekg(0);
+  if (end < 0) throw InputError(InputLocation{path, 0, 0, "file"}, "cannot be read");
+  size_ = static_cast<std::uint64_t>(end);
+  std::uint8_t magic[8] = {};
+  if (size_ < 8 || !in_.read(reinterpret_cast<char*>(magic), 8) || std::memcmp(magic, kMagic, 8) != 0)
+    throw InputError(InputLocation{path, 0, 0, "byte 0"}, "not an MCAP file (its first 8 bytes are not the MCAP magic)");
+  data_crc_ = crc32Of(0, magic, 8);
+  pos_ = 8;
+}
+
+McapReader::~McapReader() = default;
+
+void McapReader::fail(std::uint64_t at, const std::string& problem) const {
+  throw InputError(InputLocation{path_, 0, 0, "byte " + std::to_string(at)}, problem);
+}
+
+void McapReader::cut(std::uint64_t at, const std::string& where) {
+  damage_ = "cut short at byte " + std::to_string(at) + " of " + std::to_string(size_) + " (" + where + ")";
+  ended_ = true;
+}
+
+bool McapReader::readRecord(std::uint8_t& opcode, std::vector<std::uint8_t>& content, std::uint64_t& at) {
+  at = pos_;
+  if (size_ - pos_ < 9) {
+    if (size_ - pos_ == 8 && in_summary_ == false) {  // the closing magic without a footer
+      cut(pos_, "no Footer record before the closing magic");
+      return false;
+    }
+    cut(pos_, pos_ == size_ ? "no Footer record: the recording did not finish" : "inside a record's opcode and length");
+    return false;
+  }
+  std::uint8_t head[9];
+  in_.read(reinterpret_cast<char*>(head), 9);
+  opcode = head[0];
+  std::uint64_t len = 0;
+  for (int i = 0; i < 8; ++i) len |= static_cast<std::uint64_t>(head[1 + i]) << (8 * i);
+  if (len > size_ - pos_ - 9) {  // never allocated beyond what the file holds
+    cut(pos_, std::string("inside a ") + opName(opcode) + " record of " + std::to_string(len) + " bytes");
+    return false;
+  }
+  content.resize(static_cast<std::size_t>(len));
+  if (len > 0 && !in_.read(reinterpret_cast<char*>(content.data()), static_cast<std::streamsize>(len))) fail(pos_, "cannot be read");
+  if (data_crc_on_ && opcode != kDataEnd) data_crc_ = crc32Of(crc32Of(data_crc_, head, 9), content.data(), content.size());
+  if (in_summary_) {
+    // The summary CRC runs up to the footer's summary_crc field (its last 4 bytes).
+    const std::size_t counted = opcode == kFooter && content.size() >= 4 ? content.size() - 4 : content.size();
+    summary_crc_ = crc32Of(crc32Of(summary_crc_, head, 9), content.data(), counted);
+  }
+  pos_ += 9 + len;
+  return true;
+}
+
+void McapReader::openChunk(std::span<const std::uint8_t> content, std::uint64_t at) {
+  Fields f(content, "Chunk");
+  f.num<std::uint64_t>("message_start_time");
+  f.num<std::uint64_t>("message_end_time");
+  const std::uint64_t size = f.num<std::uint64_t>("uncompressed_size");
+  const std::uint32_t crc = f.num<std::uint32_t>("uncompressed_crc");
+  const std::string compression = f.str("compression");
+  const std::span<const std::uint8_t> records = f.bytes64("records");
+  if (size > kMaxChunk) fail(at, "a chunk of " + std::to_string(size) + " bytes uncompressed, more than this reader takes (2 GiB)");
+  chunk_.clear();
+  if (compression.empty()) {
+    if (records.size() != size) fail(at, "an uncompressed chunk of " + std::to_string(records.size()) + " bytes says it holds " + std::to_string(size));
+    chunk_.assign(records.begin(), records.end());
+  } else if (compression == "zstd") {
+    // Streamed: the buffer grows with what the data really decompresses to, not with the claim.
+    ZSTD_DCtx* z = ZSTD_createDCtx();
+    if (!z) fail(at, "zstd: out of memory");
+    ZSTD_inBuffer inb{records.data(), records.size(), 0};
+    std::size_t ret = 1;
+    while (ret != 0) {
+      const std::size_t have = chunk_.size();
+      if (have >= size) {  // must end exactly at the declared size
+        std::uint8_t probe[1];
+        ZSTD_outBuffer o{probe, 1, 0};
+        ret = ZSTD_decompressStream(z, &o, &inb);
+        if (ZSTD_isError(ret) || o.pos > 0 || (ret != 0 && inb.pos == inb.size)) break;
+        continue;
+      }
+      chunk_.resize(have + static_cast<std::size_t>(std::min<std::uint64_t>(size - have, 1u << 20)));
+      ZSTD_outBuffer o{chunk_.data() + have, chunk_.size() - have, 0};
+      ret = ZSTD_decompressStream(z, &o, &inb);
+      chunk_.resize(have + o.pos);
+      if (ZSTD_isError(ret)) break;
+      if (o.pos == 0 && inb.pos == inb.size && ret != 0) break;  // the input ended first
+    }
+    ZSTD_freeDCtx(z);
+    if (ZSTD_isError(ret)) fail(at, std::string("the zstd chunk does not decompress: ") + ZSTD_getErrorName(ret));
+    if (ret != 0 || chunk_.size() != size)
+      fail(at, "the zstd chunk decompresses to " + std::to_string(chunk_.size()) + " bytes, not the " + std::to_string(size) + " it declares");
+  } else if (compression == "lz4") {
+    LZ4F_dctx* z = nullptr;
+    if (LZ4F_isError(LZ4F_createDecompressionContext(&z, LZ4F_VERSION))) fail(at, "lz4: out of memory");
+    const std::uint8_t* src = records.data();
+    std::size_t left = records.size(), ret = 1;
+    bool error = false;
+    while (left > 0 && ret != 0) {
+      const std::size_t have = chunk_.size();
+      std::size_t out_size = static_cast<std::size_t>(std::min<std::uint64_t>(size - have, 1u << 20));
+      std::uint8_t probe[1];
+      std::uint8_t* dst = probe;
+      if (out_size == 0) out_size = 1;  // anything more is a size mismatch
+      else chunk_.resize(have + out_size), dst = chunk_.data() + have;
+      std::size_t in_size = left;
+      ret = LZ4F_decompress(z, dst, &out_size, src, &in_size, nullptr);
+      if (LZ4F_isError(ret)) {
+        error = true;
+        break;
+      }
+      if (dst == probe) {
+        if (out_size > 0) {
+          chunk_.push_back(probe[0]);
+          break;
+        }
+      } else {
+        chunk_.resize(have + out_size);
+      }
+      src += in_size, left -= in_size;
+      if (in_size == 0 && out_size == 0) break;
+    }
+    LZ4F_freeDecompressionContext(z);
+    if (error) fail(at, std::string("the lz4 chunk does not decompress: ") + LZ4F_getErrorName(ret));
+    if (ret != 0 || chunk_.size() != size)
+      fail(at, "the lz4 chunk decompresses to " + std::to_string(chunk_.size()) + " bytes, not the " + std::to_string(size) + " it declares" +
+                   (ret != 0 ? " (its frame is not complete)" : ""));
+  } else {
+    fail(at, "the chunk's compression '" + printable(compression, 40) + "' is not none, zstd or lz4");
+  }
+  if (crc != 0 && crc32Of(0, chunk_.data(), chunk_.size()) != crc) fail(at, "the chunk's CRC does not match its records (damaged)");
+  ++chunks_[compression.empty() ? "none" : compression];
+  chunk_at_ = at;
+  chunk_pos_ = 0;
+}
+
+void McapReader::handle(std::uint8_t opcode, std::span<const std::uint8_t> content, std::uint64_t at, bool in_chunk) {
+  try {
+    switch (opcode) {
+      case kHeader: {
+        Fields f(content, "Header");
+        profile_ = f.str("profile");
+        library_ = f.str("library");
+        break;
+      }
+      case kSchema: {
+        Fields f(content, "Schema");
+        Schema s;
+        s.id = f.num<std::uint16_t>("id");
+        s.name = f.str("name");
+        s.encoding = f.str("encoding");
+        const auto d = f.bytes32("data");
+        s.data.assign(reinterpret_cast<const char*>(d.data()), d.size());
+        if (s.id == 0) fail(at, "a Schema record with id 0 (reserved for 'no schema')");
+        const auto it = schemas_.find(s.id);
+        if (it != schemas_.end() && (it->second.name != s.name || it->second.encoding != s.encoding || it->second.data != s.data))
+          fail(at, "schema " + std::to_string(s.id) + " is defined twice, differently");
+        schemas_[s.id] = std::move(s);
+        break;
+      }
+      case kChannel: {
+        Fields f(content, "Channel");
+        Channel c;
+        c.id = f.num<std::uint16_t>("id");
+        c.schema_id = f.num<std::uint16_t>("schema_id");
+        c.topic = f.str("topic");
+        c.message_encoding = f.str("message_encoding");
+        const auto map = f.bytes32("metadata");
+        Fields m(map, "Channel metadata");
+        while (m.position() < map.size()) {
+          std::string k = m.str("metadata key");
+          c.metadata.emplace_back(std::move(k), m.str("metadata value"));
+        }
+        if (c.schema_id != 0 && !schemas_.count(c.schema_id))
+          fail(at, "channel " + std::to_string(c.id) + " (" + printable(c.topic, 60) + ") names schema " + std::to_string(c.schema_id) + ", which no earlier record defines");
+        const auto it = channels_.find(c.id);
+        if (it != channels_.end() && (it->second.topic != c.topic || it->second.schema_id != c.schema_id ||
+                                      it->second.message_encoding != c.message_encoding))
+          fail(at, "channel " + std::to_string(c.id) + " is defined twice, differently");
+        channels_[c.id] = std::move(c);
+        break;
+      }
+      case kMessage: {
+        if (in_summary_) fail(at, "a Message record after the Data End record");
+        Fields f(content, "Message");
+        LogMessage& m = message_;
+        const std::uint16_t channel = f.num<std::uint16_t>("channel_id");
+        m.sequence = f.num<std::uint32_t>("sequence");
+        m.log_time = f.num<std::uint64_t>("log_time");
+        m.publish_time = f.num<std::uint64_t>("publish_time");
+        m.data = f.rest();
+        const auto c = channels_.find(channel);
+        if (c == channels_.end()) fail(at, "a message on channel " + std::to_string(channel) + ", which no earlier record defines");
+        m.channel = &c->second;
+        m.schema = nullptr;
+        if (c->second.schema_id != 0) m.schema = &schemas_.at(c->second.schema_id);
+        m.offset = in_chunk ? chunk_at_ : at;
+        pending_ = true;
+        break;
+      }
+      case kChunk:
+        if (in_chunk) fail(at, "a Chunk inside a chunk");
+        if (in_summary_) fail(at, "a Chunk record after the Data End record");
+        openChunk(content, at);
+        break;
+      case kDataEnd: {
+        Fields f(content, "Data End");
+        const std::uint32_t crc = f.num<std::uint32_t>("data_section_crc");
+        if (crc != 0 && crc != data_crc_) fail(at, "the data section's CRC does not match (damaged)");
+        data_crc_on_ = false;
+        in_summary_ = true;
+        summary_crc_ = 0;
+        break;
+      }
+      case kFooter: {
+        Fields f(content, "Footer");
+        const std::uint64_t summary_start = f.num<std::uint64_t>("summary_start");
+        f.num<std::uint64_t>("summary_offset_start");
+        const std::uint32_t crc = f.num<std::uint32_t>("summary_crc");
+        if (crc != 0 && summary_start != 0 && crc != summary_crc_) fail(at, "the summary section's CRC does not match (damaged)");
+        ended_ = true;
+        break;
+      }
+      default:
+        break;  // indexes, statistics, attachments, metadata and records of later versions: not needed to read the messages
+    }
+  } catch (const std::out_of_range& e) {
+    fail(at, e.what());
+  }
+}
+
+bool McapReader::next(LogMessage& out) {
+  for (;;) {
+    if (pending_) {
+      pending_ = false;
+      out = message_;
+      return true;
+    }
+    // Records of the open chunk first.
+    if (chunk_pos_ < chunk_.size()) {
+      const std::size_t left = chunk_.size() - chunk_pos_;
+      if (left < 9) fail(chunk_at_, "the chunk ends inside a record's opcode and length");
+      const std::uint8_t op = chunk_[chunk_pos_];
+      std::uint64_t len = 0;
+      for (int i = 0; i < 8; ++i) len |= static_cast<std::uint64_t>(chunk_[chunk_pos_ + 1 + i]) << (8 * i);
+      if (len > left - 9) fail(chunk_at_, std::string("a ") + opName(op) + " record inside the chunk runs past its end");
+      const std::span<const std::uint8_t> content(chunk_.data() + chunk_pos_ + 9, static_cast<std::size_t>(len));
+      chunk_pos_ += 9 + static_cast<std::size_t>(len);
+      if (op != kSchema && op != kChannel && op != kMessage && op <= kDataEnd)
+        fail(chunk_at_, std::string("a ") + opName(op) + " record inside a chunk (only schemas, channels and messages belong there)");
+      handle(op, content, chunk_at_, true);
+      continue;
+    }
+    if (ended_) return false;
+    std::uint8_t op = 0;
+    std::uint64_t at = 0;
+    if (!readRecord(op, record_, at)) return false;
+    if (at == 8 && op != kHeader) fail(at, "the first record is a " + std::string(opName(op)) + ", not the Header");
+    handle(op, record_, at, false);
+    if (op == kFooter) {
+      // The closing magic.
+      std::uint8_t magic[8] = {};
+      if (size_ - pos_ < 8 || !in_.read(reinterpret_cast<char*>(magic), 8) || std::memcmp(magic, kMagic, 8) != 0)
+        cut(pos_, "no closing magic after the Footer");
+      return false;
+    }
+  }
+}
+
+}  // namespace kccd::logs

@@ -1,0 +1,393 @@
+// Robot logs (kccd::logs) against files other projects' writers made: tests/bags/write_mcap.mjs
+// writes the same recording (200 JointState at 1 kHz with shuffled joint order, 10 RGB images at
+// 30 Hz, header stamps 2 and 35 ms behind the log times) as MCAP with @mcap/core, unchunked and in
+// chunks stored plain, zstd and lz4, with the messages serialised by @foxglove/rosmsg2-serialization,
+// and lists what it wrote in truth.json. Also: every cut of a file reads a prefix with a warning,
+// damaged bytes give one-line errors, and the CDR / ROS 1 decoders against a byte encoder of this
+// file's own, in both byte orders.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "kccd/input_error.hpp"
+#include "kccd/logs/bag_summary.hpp"
+#include "kccd/logs/decode.hpp"
+#include "kccd/logs/mcap_reader.hpp"
+#include "kccd/logs/message_definition.hpp"
+#include "support/files.hpp"
+#include "support/run_program.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace kccd::logs;
+using kccd::testing::readText;
+using kccd::testing::runProgram;
+
+const char* const kFiles[] = {"joint_plain.mcap", "joint_zstd.mcap", "joint_lz4.mcap", "joint_chunked_none.mcap"};
+
+class McapFixtures : public ::testing::Test {
+ protected:
+  // The writer runs once per process (node and tests/bags/node_modules: scripts/install-deps.sh --tests).
+  static void SetUpTestSuite() {
+    dir_ = kccd::testing::scratchFolder("test_logs") / "bags";
+    fs::create_directories(dir_);
+    const auto r = runProgram(std::string(KCCD_NODE) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_mcap.mjs " + dir_.string(), true);
+    ASSERT_EQ(r.code, 0) << "the fixture writer failed (npm ci in tests/bags?): " << r.out;
+    truth_ = nlohmann::json::parse(readText((dir_ / "truth.json").string()));
+  }
+  static std::string file(const std::string& name) { return (dir_ / name).string(); }
+  static std::vector<LogMessage> all(McapReader& r, std::vector<std::vector<std::uint8_t>>* bytes = nullptr) {
+    std::vector<LogMessage> out;
+    LogMessage m;
+    while (r.next(m)) {
+      out.push_back(m);
+      if (bytes) bytes->emplace_back(m.data.begin(), m.data.end());
+    }
+    return out;
+  }
+  static inline fs::path dir_;
+  static inline nlohmann::json truth_;
+};
+
+std::uint64_t ns(const nlohmann::json& s) { return std::stoull(s.get<std::string>()); }
+
+TEST_F(McapFixtures, EveryFileReadsAsWritten) {
+  for (const char* name : kFiles) {
+    SCOPED_TRACE(name);
+    McapReader r(file(name));
+    std::vector<std::vector<std::uint8_t>> bytes;
+    const std::vector<LogMessage> msgs = all(r, &bytes);
+    EXPECT_TRUE(r.damage().empty()) << r.damage();
+    EXPECT_EQ(r.profile(), truth_["profile"]);
+    EXPECT_EQ(r.library(), truth_["library"]);
+    const nlohmann::json& t = truth_["files"][name];
+    if (t["compression"].is_null()) EXPECT_TRUE(r.chunks().empty());
+    else EXPECT_GT(r.chunks().at(t["compression"].get<std::string>().empty() ? "none" : t["compression"].get<std::string>()), 3);
+    // Per topic, the definitions the file stores decode every message to what was written.
+    const MessageDefinitions joint = MessageDefinitions::parse("sensor_msgs/msg/JointState", msgs.front().schema->data, Dialect::Ros2);
+    std::size_t j = 0, i = 0;
+    std::uint64_t last = 0;
+    for (std::size_t k = 0; k < msgs.size(); ++k) {
+      const LogMessage& m = msgs[k];
+      EXPECT_GE(m.log_time, last);  // the writer's order is log-time order
+      last = m.log_time;
+      EXPECT_EQ(m.publish_time, m.log_time);
+      const std::span<const std::uint8_t> data(bytes[k]);
+      if (m.channel->topic == "/joint_states") {
+        ASSERT_LT(j, truth_["joint_states"].size());
+        const nlohmann::json& w = truth_["joint_states"][j++];
+        EXPECT_EQ(m.log_time, ns(w["log_time_ns"]));
+        EXPECT_EQ(m.schema->name, "sensor_msgs/msg/JointState");
+        const Value v = decodeCdr(joint, data);
+        EXPECT_EQ(v.field("header")->field("stamp")->field("sec")->i, w["stamp_sec"].get<std::int64_t>());
+        EXPECT_EQ(v.field("header")->field("stamp")->field("nanosec")->u, w["stamp_nanosec"].get<std::uint64_t>());
+        const Value& names = *v.field("name");
+        ASSERT_EQ(names.items.size(), w["name"].size());
+        for (std::size_t q = 0; q < names.items.size(); ++q) {
+          EXPECT_EQ(names.items[q].s, w["name"][q].get<std::string>());
+          EXPECT_EQ(v.field("position")->items[q].f, w["position"][q].get<double>());
+          EXPECT_EQ(v.field("velocity")->items[q].f, w["velocity"][q].get<double>());
+        }
+        ASSERT_EQ(v.field("effort")->items.size(), w["effort"].size());
+        for (std::size_t q = 0; q < w["effort"].size(); ++q) EXPECT_EQ(v.field("effort")->items[q].f, w["effort"][q].get<double>());
+      } else {
+        ASSERT_EQ(m.channel->topic, "/camera/image_raw");
+        ASSERT_LT(i, truth_["images"].size());
+        const nlohmann::json& w = truth_["images"][i++];
+        EXPECT_EQ(m.log_time, ns(w["log_time_ns"]));
+        const MessageDefinitions image = MessageDefinitions::parse(m.schema->name, m.schema->data, Dialect::Ros2);
+        const Value v = decodeCdr(image, data);
+        EXPECT_EQ(v.field("height")->u, w["height"].get<std::uint64_t>());
+        EXPECT_EQ(v.field("width")->u, w["width"].get<std::uint64_t>());
+        EXPECT_EQ(v.field("encoding")->s, w["encoding"].get<std::string>());
+        EXPECT_EQ(v.field("step")->u, w["step"].get<std::uint64_t>());
+        const Value& px = *v.field("data");
+        ASSERT_EQ(px.kind, Value::Kind::Bytes);
+        EXPECT_EQ(std::accumulate(px.bytes.begin(), px.bytes.end(), 0), w["data_sum"].get<int>());
+        for (std::size_t q = 0; q < 8; ++q) EXPECT_EQ(px.bytes[q], w["data_first8"][q].get<int>());
+      }
+    }
+    EXPECT_EQ(j, truth_["joint_states"].size());
+    EXPECT_EQ(i, truth_["images"].size());
+  }
+}
+
+TEST_F(McapFixtures, BagInfoMatchesTheWriter) {
+  for (const char* name : kFiles) {
+    SCOPED_TRACE(name);
+    const auto r = runProgram(std::string(KCCD_CLI) + " bag info " + file(name) + " --json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["messages"], truth_["joint_states"].size() + truth_["images"].size());
+    EXPECT_TRUE(j["damage"].is_null());
+    const nlohmann::json& topics = truth_["files"][name]["topics"];
+    ASSERT_EQ(j["topics"].size(), topics.size());
+    for (const nlohmann::json& w : topics) {
+      const auto it = std::find_if(j["topics"].begin(), j["topics"].end(), [&](const nlohmann::json& t) { return t["topic"] == w["topic"]; });
+      ASSERT_NE(it, j["topics"].end()) << w["topic"];
+      const nlohmann::json& t = *it;
+      EXPECT_EQ(t["type"], w["schema_name"]);
+      EXPECT_EQ(t["schema_encoding"], w["schema_encoding"]);
+      EXPECT_EQ(t["message_encoding"], w["message_encoding"]);
+      EXPECT_EQ(t["count"], w["count"]);
+      EXPECT_EQ(t["first_log_time_ns"], w["first_log_time_ns"]);
+      EXPECT_EQ(t["last_log_time_ns"], w["last_log_time_ns"]);
+      const double span = 1e-9 * static_cast<double>(ns(w["last_log_time_ns"]) - ns(w["first_log_time_ns"]));
+      EXPECT_NEAR(t["rate_hz"].get<double>(), (w["count"].get<double>() - 1) / span, 1e-6);
+      // The stamps the writer set: 2 ms (joints) and 35 ms (images) behind the log times.
+      const double skew = w["topic"] == "/joint_states" ? 0.002 : 0.035;
+      EXPECT_EQ(t["stamped"], w["count"]);
+      EXPECT_EQ(t["zero_stamps"], 0);
+      for (const char* k : {"min", "median", "max"}) EXPECT_NEAR(t["skew_s"][k].get<double>(), skew, 1e-6) << k;
+    }
+  }
+  // The text form names both topics with their types and the skews in milliseconds.
+  const auto text = runProgram(std::string(KCCD_CLI) + " bag info " + file("joint_zstd.mcap"));
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_NE(text.out.find("/joint_states  sensor_msgs/msg/JointState  200 messages, 1000.0 Hz, skew 2.000 / 2.000 / 2.000 ms"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("/camera/image_raw  sensor_msgs/msg/Image  10 messages"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("chunks: 15 zstd"), std::string::npos) << text.out;
+}
+
+TEST_F(McapFixtures, ACutFileReadsAPrefixWithAWarning) {
+  for (const char* name : kFiles) {
+    SCOPED_TRACE(name);
+    const std::string bytes = readText(file(name));
+    McapReader whole(file(name));
+    std::vector<std::vector<std::uint8_t>> all_bytes;
+    const std::vector<LogMessage> full = all(whole, &all_bytes);
+    std::size_t cuts = 0, shorter = 0;
+    for (std::size_t cut = 8; cut < bytes.size(); cut += 1 + cut % 97) {
+      const std::string path = kccd::testing::writeScratch("test_logs", "cut.mcap", bytes.substr(0, cut));
+      McapReader r(path);
+      std::vector<std::vector<std::uint8_t>> got_bytes;
+      std::vector<LogMessage> got;
+      ASSERT_NO_THROW(got = all(r, &got_bytes)) << "cut at " << cut;
+      ++cuts;
+      EXPECT_FALSE(r.damage().empty()) << "cut at " << cut;
+      EXPECT_NE(r.damage().find("cut short at byte"), std::string::npos) << r.damage();
+      ASSERT_LE(got.size(), full.size());
+      shorter += got.size() < full.size();
+      for (std::size_t k = 0; k < got.size(); ++k) {  // a prefix of the whole file's messages
+        EXPECT_EQ(got[k].log_time, full[k].log_time);
+        EXPECT_EQ(got[k].channel->topic, full[k].channel->topic);
+        EXPECT_EQ(got_bytes[k], all_bytes[k]);
+      }
+    }
+    EXPECT_GT(cuts, 50u);
+    EXPECT_GT(shorter, cuts / 2);
+  }
+  // The command: a bag cut at 60 % of its bytes is summarised with one warning naming the byte.
+  const std::string bytes = readText(file("joint_lz4.mcap"));
+  const std::string path = kccd::testing::writeScratch("test_logs", "sixty.mcap", bytes.substr(0, bytes.size() * 6 / 10));
+  const auto r = runProgram(std::string(KCCD_CLI) + " bag info " + path + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: " + path + ": cut short at byte "), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["messages"].get<int>(), 50);
+  EXPECT_LT(j["messages"].get<int>(), 210);
+  EXPECT_TRUE(j["damage"].is_string());
+}
+
+TEST_F(McapFixtures, DamagedBytesGiveOneLineErrorsOrStillRead) {
+  int errors = 0, read = 0;
+  for (const char* name : {"joint_zstd.mcap", "joint_plain.mcap", "joint_lz4.mcap"}) {
+    const std::string bytes = readText(file(name));
+    for (std::size_t at = 0; at < bytes.size(); at += 1 + at % 211) {
+      std::string damaged = bytes;
+      damaged[at] = static_cast<char>(damaged[at] ^ (1 + at % 255));
+      const std::string path = kccd::testing::writeScratch("test_logs", "damaged.mcap", damaged);
+      try {
+        const BagSummary b = summarizeBag(path);
+        ++read;
+        EXPECT_LE(b.messages, 210u);
+      } catch (const kccd::InputError& e) {
+        ++errors;
+        const std::string what = e.what();
+        EXPECT_EQ(what.rfind(path + ": byte ", 0), 0u) << what;
+        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+      }
+    }
+  }
+  // CRCs and structure catch most damage; bytes inside message payloads may decode to other values.
+  EXPECT_GT(errors, read);
+  std::cout << "damaged files: " << errors << " rejected, " << read << " read\n";
+}
+
+TEST(McapReader, NotAnMcapFileOrNoFile) {
+  const std::string text = kccd::testing::writeScratch("test_logs", "text.mcap", "hello, not a log\n");
+  try {
+    McapReader r(text);
+    FAIL() << "read a text file";
+  } catch (const kccd::InputError& e) {
+    EXPECT_EQ(std::string(e.what()), text + ": byte 0: not an MCAP file (its first 8 bytes are not the MCAP magic)");
+  }
+  EXPECT_THROW(McapReader("/nonexistent/x.mcap"), kccd::InputError);
+  const auto r = runProgram(std::string(KCCD_CLI) + " bag info " + text);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "kccd: " + text + ": byte 0: not an MCAP file (its first 8 bytes are not the MCAP magic)\n");
+}
+
+// An encoder of this file's own (it shares nothing with the decoder): CDR aligned to each
+// primitive's size from after the 4-byte header, either byte order; ROS 1 packed little-endian.
+class Encoder {
+ public:
+  Encoder(bool cdr, bool big) : cdr_(cdr), big_(big) {
+    if (cdr) out_ = {0, static_cast<std::uint8_t>(big ? 0 : 1), 0, 0};
+  }
+  template <class T>
+  void put(T v) {
+    if (cdr_)
+      while ((out_.size() - 4) % sizeof(T) != 0) out_.push_back(0xEE);  // padding need not be zero
+    std::uint8_t b[sizeof(T)];
+    std::memcpy(b, &v, sizeof(T));
+    if (big_) std::reverse(b, b + sizeof(T));
+    out_.insert(out_.end(), b, b + sizeof(T));
+  }
+  void str(const std::string& s) {
+    put<std::uint32_t>(static_cast<std::uint32_t>(s.size() + (cdr_ ? 1 : 0)));
+    out_.insert(out_.end(), s.begin(), s.end());
+    if (cdr_) out_.push_back(0);
+  }
+  std::vector<std::uint8_t> out_;
+
+ private:
+  bool cdr_, big_;
+};
+
+const char* const kJointState2 =
+    "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n"
+    "================================================================================\nMSG: std_msgs/Header\n"
+    "builtin_interfaces/Time stamp\nstring frame_id\n"
+    "================================================================================\nMSG: builtin_interfaces/Time\n"
+    "int32 sec\nuint32 nanosec\n";
+
+TEST(RosMessages, CdrInBothByteOrdersAndRos1) {
+  const MessageDefinitions ros2 = MessageDefinitions::parse("sensor_msgs/msg/JointState", kJointState2, Dialect::Ros2);
+  for (const bool big : {false, true}) {
+    Encoder e(true, big);
+    e.put<std::int32_t>(-7), e.put<std::uint32_t>(123456789), e.str("base");
+    e.put<std::uint32_t>(2), e.str("a"), e.str("bb");
+    e.put<std::uint32_t>(2), e.put<double>(1.5), e.put<double>(-2.25);
+    e.put<std::uint32_t>(1), e.put<double>(0.125);
+    e.put<std::uint32_t>(0);
+    const Value v = decodeCdr(ros2, e.out_);
+    EXPECT_EQ(v.field("header")->field("stamp")->field("sec")->i, -7);
+    EXPECT_EQ(v.field("header")->field("stamp")->field("nanosec")->u, 123456789u);
+    EXPECT_EQ(v.field("header")->field("frame_id")->s, "base");
+    EXPECT_EQ(v.field("name")->items.at(1).s, "bb");
+    EXPECT_EQ(v.field("position")->items.at(1).f, -2.25);
+    EXPECT_EQ(v.field("velocity")->items.at(0).f, 0.125);
+    EXPECT_TRUE(v.field("effort")->items.empty());
+    // Every shorter message is refused at an offset inside it.
+    for (std::size_t n = 0; n < e.out_.size(); ++n) {
+      try {
+        decodeCdr(ros2, std::span(e.out_.data(), n));
+        ADD_FAILURE() << "decoded " << n << " of " << e.out_.size() << " bytes";
+      } catch (const DecodeError& err) {
+        EXPECT_LE(err.offset(), n);
+      }
+    }
+  }
+  // ROS 1: Header has seq and a time; packed, strings without NUL.
+  const std::string def1 =
+      "Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n"
+      "================================================================================\nMSG: std_msgs/Header\n"
+      "uint32 seq\ntime stamp\nstring frame_id\n";
+  const MessageDefinitions ros1 = MessageDefinitions::parse("sensor_msgs/JointState", def1, Dialect::Ros1);
+  Encoder e(false, false);
+  e.put<std::uint32_t>(9), e.put<std::uint32_t>(100), e.put<std::uint32_t>(5), e.str("world");
+  e.put<std::uint32_t>(1), e.str("j");
+  e.put<std::uint32_t>(1), e.put<double>(3.0);
+  e.put<std::uint32_t>(0), e.put<std::uint32_t>(0);
+  const Value v = decodeRos1(ros1, e.out_);
+  EXPECT_EQ(v.field("header")->field("seq")->u, 9u);
+  EXPECT_EQ(v.field("header")->field("stamp")->items.at(0).u, 100u);
+  EXPECT_EQ(v.field("header")->field("stamp")->items.at(1).u, 5u);
+  EXPECT_EQ(v.field("header")->field("frame_id")->s, "world");
+  EXPECT_EQ(v.field("position")->items.at(0).f, 3.0);
+  // A count larger than the bytes left is refused before anything is made for it.
+  Encoder huge(true, false);
+  huge.put<std::int32_t>(0), huge.put<std::uint32_t>(0), huge.str("");
+  huge.put<std::uint32_t>(0x7fffffff);
+  try {
+    decodeCdr(ros2, huge.out_);
+    ADD_FAILURE() << "decoded a sequence of 2^31 strings from 20 bytes";
+  } catch (const DecodeError& err) {
+    EXPECT_NE(std::string(err.what()).find("more than the"), std::string::npos) << err.what();
+  }
+  // Other encapsulations are named.
+  std::vector<std::uint8_t> xcdr2{0x00, 0x07, 0, 0, 1, 2, 3, 4};
+  try {
+    decodeCdr(ros2, xcdr2);
+    ADD_FAILURE();
+  } catch (const DecodeError& err) {
+    EXPECT_NE(std::string(err.what()).find("0x0007 is not plain CDR"), std::string::npos) << err.what();
+  }
+}
+
+TEST(RosMessages, DefinitionsParseTheirSyntaxAndNameTheLineOfAMistake) {
+  // Constants, defaults, comments, bounded and fixed arrays, "pkg/msg/Type" and same-package names.
+  const MessageDefinitions d = MessageDefinitions::parse(
+      "my_pkg/msg/Thing",
+      "# a comment\nint32 LIMIT=5 # a constant\nstring NAME=a#b\nfloat64 x 0.5  # with a default\n"
+      "uint8[4] fixed\nint16[<=3] bounded\nstring<=10 label\nOther[] others\nstd_msgs/msg/Empty e\n"
+      "================================================================================\nMSG: my_pkg/Other\nbool ok\n"
+      "================================================================================\nMSG: std_msgs/msg/Empty\n",
+      Dialect::Ros2);
+  const MessageType& t = d.root();
+  EXPECT_EQ(t.name, "my_pkg/Thing");
+  ASSERT_EQ(t.fields.size(), 6u);
+  EXPECT_EQ(t.fields[0].name, "x");
+  EXPECT_EQ(t.fields[1].array, Field::Array::Fixed);
+  EXPECT_EQ(t.fields[1].length, 4u);
+  EXPECT_EQ(t.fields[2].array, Field::Array::Dynamic);
+  EXPECT_EQ(t.fields[3].primitive, Primitive::String);
+  EXPECT_EQ(t.fields[4].type_name, "my_pkg/Other");
+  EXPECT_EQ(t.fields[5].type_name, "std_msgs/Empty");
+  EXPECT_NE(d.find("std_msgs/Empty"), nullptr);
+  struct Case {
+    std::string text;
+    std::size_t line;
+    std::string problem;
+  };
+  const Case cases[] = {
+      {"int32 a\nfloat64[x] b\n", 2, "'x': not an array length"},
+      {"int32 a\nint32\n", 2, "'int32': expected TYPE NAME"},
+      {"Missing m\n", 0, "the type p/Missing is used but not defined"},
+      {"int32 1bad\n", 1, "'1bad' is not a field name"},
+      {"p/Root r\n", 0, "the type p/Root contains itself"},
+      {"int32 a\n====\nnot a MSG line\n", 3, "expected a 'MSG: pkg/Type' line"},
+  };
+  for (const Case& c : cases) {
+    try {
+      MessageDefinitions::parse("p/Root", c.text, Dialect::Ros2);
+      ADD_FAILURE() << "parsed: " << c.text;
+    } catch (const DefinitionError& e) {
+      EXPECT_EQ(e.line(), c.line) << c.text;
+      EXPECT_NE(std::string(e.what()).find(c.problem), std::string::npos) << e.what();
+    }
+  }
+  // ROS 1: time and duration are primitives, Header is std_msgs/Header.
+  const MessageDefinitions r1 = MessageDefinitions::parse("p/T", "Header h\ntime t\nduration d\n====\nMSG: std_msgs/Header\nuint32 seq\n", Dialect::Ros1);
+  EXPECT_EQ(r1.root().fields[0].type_name, "std_msgs/Header");
+  EXPECT_EQ(r1.root().fields[1].primitive, Primitive::Time);
+  EXPECT_EQ(r1.root().fields[2].primitive, Primitive::Duration);
+  // ROS 2 has no time primitive: a type of that name must be defined.
+  EXPECT_THROW(MessageDefinitions::parse("p/T", "time t\n", Dialect::Ros2), DefinitionError);
+}
+
+}  // namespace
