@@ -14,16 +14,22 @@
 #include <filesystem>
 #include <fstream>
 #include <numeric>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "kccd/input_error.hpp"
 #include "kccd/logs/bag_summary.hpp"
 #include "kccd/logs/decode.hpp"
 #include "kccd/logs/mcap_reader.hpp"
 #include "kccd/logs/message_definition.hpp"
+#include "kccd/calib/camera.hpp"
+#include "kccd/overlay/bag_export.hpp"
 #include "support/files.hpp"
 #include "support/run_program.hpp"
 
@@ -72,8 +78,11 @@ TEST_F(McapFixtures, EveryFileReadsAsWritten) {
     EXPECT_EQ(r.profile(), truth_["profile"]);
     EXPECT_EQ(r.library(), truth_["library"]);
     const nlohmann::json& t = truth_["files"][name];
-    if (t["compression"].is_null()) EXPECT_TRUE(r.chunks().empty());
-    else EXPECT_GT(r.chunks().at(t["compression"].get<std::string>().empty() ? "none" : t["compression"].get<std::string>()), 3);
+    if (t["compression"].is_null()) {
+      EXPECT_TRUE(r.chunks().empty());
+    } else {
+      EXPECT_GT(r.chunks().at(t["compression"].get<std::string>().empty() ? "none" : t["compression"].get<std::string>()), 3);
+    }
     // Per topic, the definitions the file stores decode every message to what was written.
     const MessageDefinitions joint = MessageDefinitions::parse("sensor_msgs/msg/JointState", msgs.front().schema->data, Dialect::Ros2);
     std::size_t j = 0, i = 0;
@@ -101,6 +110,14 @@ TEST_F(McapFixtures, EveryFileReadsAsWritten) {
         }
         ASSERT_EQ(v.field("effort")->items.size(), w["effort"].size());
         for (std::size_t q = 0; q < w["effort"].size(); ++q) EXPECT_EQ(v.field("effort")->items[q].f, w["effort"][q].get<double>());
+      } else if (m.channel->topic == "/camera/camera_info") {
+        const nlohmann::json& w = truth_["camera_infos"][0];
+        const MessageDefinitions info = MessageDefinitions::parse(m.schema->name, m.schema->data, Dialect::Ros2);
+        const Value v = decodeCdr(info, data);
+        EXPECT_EQ(v.field("distortion_model")->s, w["distortion_model"].get<std::string>());
+        ASSERT_EQ(v.field("k")->items.size(), 9u);
+        for (std::size_t q = 0; q < 9; ++q) EXPECT_EQ(v.field("k")->items[q].f, w["k"][q].get<double>());
+        EXPECT_EQ(v.field("roi")->field("do_rectify")->kind, Value::Kind::Bool);
       } else {
         ASSERT_EQ(m.channel->topic, "/camera/image_raw");
         ASSERT_LT(i, truth_["images"].size());
@@ -130,7 +147,7 @@ TEST_F(McapFixtures, BagInfoMatchesTheWriter) {
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(r.err, "");
     const nlohmann::json j = nlohmann::json::parse(r.out);
-    EXPECT_EQ(j["messages"], truth_["joint_states"].size() + truth_["images"].size());
+    EXPECT_EQ(j["messages"], truth_["joint_states"].size() + truth_["images"].size() + truth_["camera_infos"].size());
     EXPECT_TRUE(j["damage"].is_null());
     const nlohmann::json& topics = truth_["files"][name]["topics"];
     ASSERT_EQ(j["topics"].size(), topics.size());
@@ -145,8 +162,12 @@ TEST_F(McapFixtures, BagInfoMatchesTheWriter) {
       EXPECT_EQ(t["first_log_time_ns"], w["first_log_time_ns"]);
       EXPECT_EQ(t["last_log_time_ns"], w["last_log_time_ns"]);
       const double span = 1e-9 * static_cast<double>(ns(w["last_log_time_ns"]) - ns(w["first_log_time_ns"]));
-      EXPECT_NEAR(t["rate_hz"].get<double>(), (w["count"].get<double>() - 1) / span, 1e-6);
-      // The stamps the writer set: 2 ms (joints) and 35 ms (images) behind the log times.
+      if (w["count"] > 1) {
+        EXPECT_NEAR(t["rate_hz"].get<double>(), (w["count"].get<double>() - 1) / span, 1e-6);
+      } else {
+        EXPECT_EQ(t["rate_hz"], 0.0);
+      }
+      // The stamps the writer set: 2 ms (joints) and 35 ms (images, camera info) behind the log times.
       const double skew = w["topic"] == "/joint_states" ? 0.002 : 0.035;
       EXPECT_EQ(t["stamped"], w["count"]);
       EXPECT_EQ(t["zero_stamps"], 0);
@@ -158,7 +179,7 @@ TEST_F(McapFixtures, BagInfoMatchesTheWriter) {
   ASSERT_EQ(text.code, 0) << text.err;
   EXPECT_NE(text.out.find("/joint_states  sensor_msgs/msg/JointState  200 messages, 1000.0 Hz, skew 2.000 / 2.000 / 2.000 ms"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("/camera/image_raw  sensor_msgs/msg/Image  10 messages"), std::string::npos) << text.out;
-  EXPECT_NE(text.out.find("chunks: 15 zstd"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find(" zstd\n"), std::string::npos) << text.out;
 }
 
 TEST_F(McapFixtures, ACutFileReadsAPrefixWithAWarning) {
@@ -198,7 +219,7 @@ TEST_F(McapFixtures, ACutFileReadsAPrefixWithAWarning) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_GT(j["messages"].get<int>(), 50);
-  EXPECT_LT(j["messages"].get<int>(), 210);
+  EXPECT_LT(j["messages"].get<int>(), 211);
   EXPECT_TRUE(j["damage"].is_string());
 }
 
@@ -213,7 +234,7 @@ TEST_F(McapFixtures, DamagedBytesGiveOneLineErrorsOrStillRead) {
       try {
         const BagSummary b = summarizeBag(path);
         ++read;
-        EXPECT_LE(b.messages, 210u);
+        EXPECT_LE(b.messages, 211u);
       } catch (const kccd::InputError& e) {
         ++errors;
         const std::string what = e.what();
@@ -388,6 +409,170 @@ TEST(RosMessages, DefinitionsParseTheirSyntaxAndNameTheLineOfAMistake) {
   EXPECT_EQ(r1.root().fields[2].primitive, Primitive::Duration);
   // ROS 2 has no time primitive: a type of that name must be defined.
   EXPECT_THROW(MessageDefinitions::parse("p/T", "time t\n", Dialect::Ros2), DefinitionError);
+}
+
+// Splits a CSV file into rows of fields.
+std::vector<std::vector<std::string>> csv(const std::string& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(readText(path));
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> f;
+    std::istringstream l(line);
+    for (std::string x; std::getline(l, x, ',');) f.push_back(x);
+    rows.push_back(f);
+  }
+  return rows;
+}
+
+TEST_F(McapFixtures, ExportWritesTheSuitesOwnFiles) {
+  const fs::path out = dir_ / "export";
+  fs::create_directories(out);
+  for (const char* clock : {"header", "log"}) {
+    SCOPED_TRACE(clock);
+    const std::string s = (out / "states.csv").string(), v = (out / "video.mkv").string(), t = (out / "times.csv").string(),
+                      c = (out / "camera.yaml").string();
+    const auto r = runProgram(std::string(KCCD_CLI) + " bag export " + file("joint_lz4.mcap") + " --states " + s + " --video " + v +
+                              " --frame-times " + t + " --camera-info " + c + " --time-source " + clock);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    // Time 0: the earliest exported time on that clock (the first image's: its stamp is 35 ms behind).
+    const bool header = std::string(clock) == "header";
+    const std::uint64_t origin = ns(truth_["images"][0]["log_time_ns"]) - (header ? 35000000 : 0);
+    EXPECT_NE(r.out.find("time 0 of the files: " + std::to_string(origin) + " ns"), std::string::npos) << r.out;
+    // The state log: the first message's joint order, velocities, every message in its own order mapped by name.
+    const auto rows = csv(s);
+    ASSERT_EQ(rows.size(), 201u);
+    ASSERT_EQ(rows[0].size(), 15u);
+    EXPECT_EQ(rows[0][0], "time");
+    EXPECT_EQ(rows[0][1], "joint1");
+    EXPECT_EQ(rows[0][14], "joint7.vel");
+    for (std::size_t i = 0; i < 200; ++i) {
+      const nlohmann::json& w = truth_["joint_states"][i];
+      const std::uint64_t when = header ? std::uint64_t(w["stamp_sec"].get<std::int64_t>()) * 1000000000 + w["stamp_nanosec"].get<std::uint64_t>()
+                                        : ns(w["log_time_ns"]);
+      EXPECT_NEAR(std::stod(rows[i + 1][0]), 1e-9 * static_cast<double>(when - origin), 1e-12) << i;
+      for (std::size_t q = 0; q < 7; ++q) {
+        const std::string name = w["name"][q];
+        const std::size_t col = static_cast<std::size_t>(std::find(rows[0].begin(), rows[0].end(), name) - rows[0].begin());
+        ASSERT_LT(col, 8u) << name;
+        EXPECT_EQ(std::stod(rows[i + 1][col]), w["position"][q].get<double>()) << i << " " << name;
+        EXPECT_EQ(std::stod(rows[i + 1][col + 7]), w["velocity"][q].get<double>()) << i << " " << name;
+      }
+    }
+    // The frames: the video (lossless) holds the images as BGR, the frame-times file their times.
+    const auto times = csv(t);
+    ASSERT_EQ(times.size(), 11u);
+    EXPECT_EQ(times[0], (std::vector<std::string>{"frame", "time"}));
+    cv::VideoCapture cap(v);
+    ASSERT_TRUE(cap.isOpened());
+    for (int i = 0; i < 10; ++i) {
+      const nlohmann::json& w = truth_["images"][i];
+      const std::uint64_t when = ns(w["log_time_ns"]) - (header ? 35000000 : 0);
+      EXPECT_NEAR(std::stod(times[i + 1][1]), 1e-9 * static_cast<double>(when - origin), 1e-12) << i;
+      cv::Mat frame;
+      ASSERT_TRUE(cap.read(frame)) << i;
+      ASSERT_EQ(frame.size(), cv::Size(64, 48));
+      // Byte j of the RGB data is (7 i + j) mod 256: pixel (0, 0) is R = 7i, G = 7i + 1, B = 7i + 2.
+      const cv::Vec3b px = frame.at<cv::Vec3b>(0, 0);
+      EXPECT_EQ(px, cv::Vec3b((7 * i + 2) % 256, (7 * i + 1) % 256, (7 * i) % 256)) << i;
+      long sum = 0;
+      for (int y = 0; y < frame.rows; ++y)
+        for (int x = 0; x < frame.cols; ++x)
+          for (int k = 0; k < 3; ++k) sum += frame.at<cv::Vec3b>(y, x)[k];
+      EXPECT_EQ(sum, w["data_sum"].get<long>()) << i;
+    }
+    // The camera info: an intrinsics file kccd reads.
+    const kccd::calib::Camera cam = kccd::calib::loadCamera(c, kccd::calib::CameraPose::Optional);
+    const nlohmann::json& w = truth_["camera_infos"][0];
+    EXPECT_EQ(cam.width, 64);
+    EXPECT_EQ(cam.height, 48);
+    for (int q = 0; q < 9; ++q) EXPECT_EQ(cam.camera_matrix(q / 3, q % 3), w["k"][q].get<double>());
+    ASSERT_EQ(cam.distortion.size(), 5u);
+    for (std::size_t q = 0; q < 5; ++q) EXPECT_EQ(cam.distortion[q], w["d"][q].get<double>());
+  }
+  // Mistakes: one line naming the option or the bag, nothing written.
+  const std::string s = (out / "bad.csv").string();
+  struct Case {
+    std::string args, message;
+  };
+  const Case cases[] = {
+      {" --states " + s + " --joint-topic /nope", "--joint-topic /nope: " + file("joint_zstd.mcap") + " has no sensor_msgs/JointState topic of that name (it has: /joint_states)"},
+      {" --video " + (out / "v.mkv").string(), "needs --frame-times"},
+      {"", "nothing to write"},
+      {" --states " + (out / "bad.txt").string(), ".csv"},
+  };
+  for (const Case& k : cases) {
+    const auto r = runProgram(std::string(KCCD_CLI) + " bag export " + file("joint_zstd.mcap") + k.args);
+    EXPECT_EQ(r.code, 2) << k.args;
+    EXPECT_NE(r.err.find(k.message), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(s));
+}
+
+TEST(BagImages, EveryEncodingBecomesTheSameBgrFrame) {
+  // A 5x3 BGR image, and the same pixels in every encoding the export reads.
+  cv::Mat bgr(3, 5, CV_8UC3);
+  cv::randu(bgr, 0, 256);
+  const std::string def = "uint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\nuint32 step\nuint8[] data\n";
+  const MessageDefinitions types = MessageDefinitions::parse("sensor_msgs/Image", def, Dialect::Ros1);
+  auto message = [&](const cv::Mat& m, const std::string& enc, std::vector<std::uint8_t>& bytes, int padding) {
+    Encoder e(false, false);
+    const std::size_t step = m.cols * m.elemSize() + static_cast<std::size_t>(padding);
+    e.put<std::uint32_t>(static_cast<std::uint32_t>(m.rows)), e.put<std::uint32_t>(static_cast<std::uint32_t>(m.cols)), e.str(enc);
+    e.put<std::uint8_t>(0), e.put<std::uint32_t>(static_cast<std::uint32_t>(step)), e.put<std::uint32_t>(static_cast<std::uint32_t>(step * m.rows));
+    for (int y = 0; y < m.rows; ++y) {
+      e.out_.insert(e.out_.end(), m.ptr<std::uint8_t>(y), m.ptr<std::uint8_t>(y) + m.cols * m.elemSize());
+      e.out_.insert(e.out_.end(), static_cast<std::size_t>(padding), 0xAB);
+    }
+    bytes = e.out_;
+    return decodeRos1(types, bytes);
+  };
+  cv::Mat rgb, bgra, rgba, grey, grey_bgr;
+  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+  cv::cvtColor(bgr, bgra, cv::COLOR_BGR2BGRA);
+  cv::cvtColor(bgr, rgba, cv::COLOR_BGR2RGBA);
+  for (const auto& [m, enc] : std::vector<std::pair<cv::Mat, std::string>>{{bgr, "bgr8"}, {rgb, "rgb8"}, {bgra, "bgra8"}, {rgba, "rgba8"}})
+    for (const int padding : {0, 3}) {
+      std::vector<std::uint8_t> bytes;
+      const Value v = message(m, enc, bytes, padding);
+      const cv::Mat got = kccd::overlay::imageOf(v, false, "test");
+      cv::Mat diff;
+      cv::absdiff(got, bgr, diff);
+      EXPECT_EQ(cv::countNonZero(diff.reshape(1)), 0) << enc << " padding " << padding;
+    }
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(grey, grey_bgr, cv::COLOR_GRAY2BGR);
+  std::vector<std::uint8_t> bytes;
+  EXPECT_EQ(cv::norm(kccd::overlay::imageOf(message(grey, "mono8", bytes, 0), false, "test"), grey_bgr, cv::NORM_INF), 0);
+  cv::Mat grey16;
+  grey.convertTo(grey16, CV_16U, 256.0);
+  EXPECT_EQ(cv::norm(kccd::overlay::imageOf(message(grey16, "mono16", bytes, 0), false, "test"), grey_bgr, cv::NORM_INF), 0);
+  // Data shorter than its rows, an unknown encoding: one line naming the place.
+  try {
+    Value v = message(bgr, "bgr8", bytes, 0);
+    v.items[5].bytes = v.items[5].bytes.first(10);
+    kccd::overlay::imageOf(v, false, "bag.mcap: byte 7: topic /cam: message 3");
+    ADD_FAILURE();
+  } catch (const kccd::InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("bag.mcap: byte 7: topic /cam: message 3: the image's data (10 bytes)", 0), 0u) << e.what();
+  }
+  EXPECT_THROW(kccd::overlay::imageOf(message(bgr, "yuv422", bytes, 0), false, "x"), kccd::InputError);
+  // Compressed: PNG and JPEG as OpenCV encodes them.
+  const MessageDefinitions ctypes = MessageDefinitions::parse("sensor_msgs/CompressedImage", "string format\nuint8[] data\n", Dialect::Ros1);
+  for (const char* ext : {".png", ".jpg"}) {
+    std::vector<std::uint8_t> enc;
+    cv::imencode(ext, bgr, enc);
+    Encoder e(false, false);
+    e.str(ext + 1), e.put<std::uint32_t>(static_cast<std::uint32_t>(enc.size()));
+    e.out_.insert(e.out_.end(), enc.begin(), enc.end());
+    const Value v = decodeRos1(ctypes, e.out_);
+    const cv::Mat got = kccd::overlay::imageOf(v, true, "x");
+    ASSERT_EQ(got.size(), bgr.size());
+    if (std::string(ext) == ".png") {
+      EXPECT_EQ(cv::norm(got, bgr, cv::NORM_INF), 0);
+    }
+  }
 }
 
 }  // namespace

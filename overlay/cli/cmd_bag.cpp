@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "kccd/input_error.hpp"
 #include "kccd/logs/bag_summary.hpp"
+#include "kccd/overlay/bag_export.hpp"
 
 namespace kccd::cli {
 namespace {
@@ -84,6 +85,30 @@ Exit runBagInfo(const BagInfoArgs& args) {
   return Exit::Ok;
 }
 
+struct BagExportArgs {
+  overlay::BagExportOptions options;
+  std::string time_source = "header";
+  bool quiet = false;
+};
+
+Exit runBagExport(const BagExportArgs& args) {
+  overlay::BagExportOptions o = args.options;
+  o.time_source = args.time_source == "log" ? overlay::TimeSource::Log : overlay::TimeSource::Header;
+  const overlay::BagExportReport r = overlay::exportBag(o);
+  for (const std::string& w : r.warnings) std::cerr << "kccd bag export: warning: " << w << "\n";
+  if (args.quiet) return Exit::Ok;
+  const std::string clock = o.time_source == overlay::TimeSource::Log ? "log times" : "header stamps";
+  std::cout << "time 0 of the files: " << r.origin_ns << " ns (" << clock << ")\n";
+  if (!o.states.empty())
+    std::cout << o.states << ": " << r.states << " states of " << r.joints.size() << " joints from " << r.joint_topic
+              << (r.velocities ? " (with velocities)" : "") << "\n";
+  if (!o.video.empty())
+    std::cout << o.video << ": " << r.frames << " frames " << r.width << "x" << r.height << " from " << r.image_topic << " (nominal "
+              << fixed(r.fps, 3) << " fps; the times are in " << o.frame_times << ")\n";
+  if (!o.camera_info.empty()) std::cout << o.camera_info << ": intrinsics from " << r.camera_info_topic << " (for kccd calib --intrinsics)\n";
+  return Exit::Ok;
+}
+
 }  // namespace
 
 Runner addBag(CLI::App& app) {
@@ -98,7 +123,32 @@ Runner addBag(CLI::App& app) {
       "with a warning naming the byte.");
   info->add_option("bag", args->bag, "The log: an .mcap file")->required();
   info->add_flag("--json", args->json, "Machine-readable output (times in nanoseconds as decimal strings)");
-  return [args] { return runBagInfo(*args); };
+  auto ex = std::make_shared<BagExportArgs>();
+  CLI::App* exp = bag->add_subcommand(
+      "export",
+      "Write a robot log as this suite's own files, so every other command works on it: joint states as a state log "
+      "(--states, columns named as the first joint state names them, with .vel columns when every message gives "
+      "velocities), camera images as a video (--video) with its frame-times file (--frame-times), camera info as an "
+      "intrinsics file (--camera-info, for kccd calib --intrinsics). Times in seconds from the first exported "
+      "message, on the header stamps (or the log times). All outputs appear together or not at all.");
+  exp->add_option("bag", ex->options.bag, "The log: an .mcap file")->required();
+  exp->add_option("--states", ex->options.states, "State log to write (.csv)");
+  exp->add_option("--video", ex->options.video, "Video to write (.mkv lossless FFV1, .mp4 mp4v, .avi MJPG)");
+  exp->add_option("--frame-times", ex->options.frame_times, "Frame-times file to write with --video (.csv)");
+  exp->add_option("--camera-info", ex->options.camera_info, "Intrinsics file to write (.yaml)");
+  exp->add_option("--joint-topic", ex->options.joint_topic, "sensor_msgs/JointState topic (default: the only one)");
+  exp->add_option("--image-topic", ex->options.image_topic, "sensor_msgs/Image or CompressedImage topic (default: the only one)");
+  exp->add_option("--camera-info-topic", ex->options.camera_info_topic, "sensor_msgs/CameraInfo topic (default: the only one)");
+  exp->add_option("--time-source", ex->time_source,
+                  "header: the messages' header stamps (the log time where a stamp is zero, with a warning); log: the times "
+                  "the recorder logged them")
+      ->check(CLI::IsMember({"header", "log"}))
+      ->default_str("header");
+  exp->add_flag("--quiet,-q", ex->quiet, "Print only warnings and errors");
+  return [args, ex, info, exp] {
+    if (exp->parsed()) return runBagExport(*ex);
+    return runBagInfo(*args);
+  };
 }
 
 }  // namespace kccd::cli

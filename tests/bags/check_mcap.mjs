@@ -49,8 +49,12 @@ const plain = {
     is_bigendian: m.is_bigendian, step: m.step,
     data_sum: m.data.reduce((a, b) => a + b, 0), data_first8: Array.from(m.data.slice(0, 8)),
   }),
+  "/camera/camera_info": (m, log) => ({
+    log_time_ns: String(log), width: m.width, height: m.height, distortion_model: m.distortion_model,
+    d: Array.from(m.d), k: Array.from(m.k),
+  }),
 };
-const wantMsgs = { "/joint_states": truth.joint_states, "/camera/image_raw": truth.images };
+const wantMsgs = { "/joint_states": truth.joint_states, "/camera/image_raw": truth.images, "/camera/camera_info": truth.camera_infos };
 
 for (const [file, want] of Object.entries(truth.files)) {
   const buf = fs.readFileSync(path.join(dir, file));

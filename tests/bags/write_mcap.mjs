@@ -11,8 +11,8 @@
 //                             only decompresses, it is used here to verify each frame)
 //   joint_chunked_none.mcap   chunked (4 KiB), no compression
 // plus truth.json: what each file holds and every decoded message, for the tests.
-// Content: 200 sensor_msgs/msg/JointState on /joint_states at 1 kHz and 10
-// sensor_msgs/msg/Image (4x3 rgb8) on /camera/image_raw at 30 Hz, interleaved by
+// Content: 200 sensor_msgs/msg/JointState on /joint_states at 1 kHz, one CameraInfo and 10
+// sensor_msgs/msg/Image (64x48 rgb8) on /camera/image_raw at 30 Hz, interleaved by
 // log time. Fully deterministic: no randomness, no wall clock.
 import fs from "node:fs";
 import path from "node:path";
@@ -41,6 +41,12 @@ const deps = `${SEP}\nMSG: std_msgs/Header\n${HEADER}${SEP}\nMSG: builtin_interf
 const JOINT_STATE_DEF =
   "# This is a message that holds data to describe the state of a set of torque controlled joints.\n" +
   "std_msgs/Header header\n\nstring[] name\n# rad or m\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n" + deps;
+const ROI = "uint32 x_offset\nuint32 y_offset\nuint32 height\nuint32 width\nbool do_rectify\n";
+const CAMERA_INFO_DEF =
+  "# Meta information for a camera.\nstd_msgs/Header header\nuint32 height\nuint32 width\n" +
+  "string distortion_model\nfloat64[] d\nfloat64[9]  k # 3x3 row-major matrix\nfloat64[9]  r\nfloat64[12] p\n" +
+  "uint32 binning_x\nuint32 binning_y\nRegionOfInterest roi\n" +
+  `${SEP}\nMSG: sensor_msgs/RegionOfInterest\n${ROI}` + deps;
 const IMAGE_DEF =
   "# This message contains an uncompressed image\n# (0, 0) is at top-left corner of image\n" +
   "std_msgs/Header header\n\nuint32 height # image height, that is, number of rows\nuint32 width\n\n" +
@@ -65,17 +71,31 @@ for (let i = 0; i < N_JOINTS; i++) {
 const images = [];
 for (let i = 0; i < N_IMAGES; i++) {
   const log = BASE + BigInt(Math.round((i * 1e9) / 30));
-  const data = Uint8Array.from({ length: 36 }, (_, j) => (i * 7 + j) % 256);
+  const data = Uint8Array.from({ length: 64 * 48 * 3 }, (_, j) => (i * 7 + j) % 256);
   images.push({
     log,
     header: { stamp: split(log - 35_000_000n), frame_id: "" },
-    height: 3, width: 4, encoding: "rgb8", is_bigendian: 0, step: 12, data,
+    height: 48, width: 64, encoding: "rgb8", is_bigendian: 0, step: 192, data,
   });
 }
+
+// One camera info, at the base time: a 64x48 camera with a plumb_bob lens.
+const cameraInfos = [{
+  log: BASE,
+  header: { stamp: split(BASE - 35_000_000n), frame_id: "camera" },
+  height: 48, width: 64, distortion_model: "plumb_bob",
+  d: [-0.11, 0.06, 0.0006, -0.0004, -0.01],
+  k: [70, 0, 31.7, 0, 71, 23.9, 0, 0, 1],
+  r: [1, 0, 0, 0, 1, 0, 0, 0, 1],
+  p: [70, 0, 31.7, 0, 0, 71, 23.9, 0, 0, 0, 1, 0],
+  binning_x: 0, binning_y: 0,
+  roi: { x_offset: 0, y_offset: 0, height: 0, width: 0, do_rectify: false },
+}];
 
 const TOPICS = [
   { topic: "/joint_states", schema_name: "sensor_msgs/msg/JointState", def: JOINT_STATE_DEF, msgs: joints },
   { topic: "/camera/image_raw", schema_name: "sensor_msgs/msg/Image", def: IMAGE_DEF, msgs: images },
+  { topic: "/camera/camera_info", schema_name: "sensor_msgs/msg/CameraInfo", def: CAMERA_INFO_DEF, msgs: cameraInfos },
 ];
 // All messages sorted by log time (ties: topic order above), serialized once.
 const records = [];
@@ -147,6 +167,9 @@ const truth = {
     frame_id: m.header.frame_id, height: m.height, width: m.width, encoding: m.encoding,
     is_bigendian: m.is_bigendian, step: m.step,
     data_sum: m.data.reduce((a, b) => a + b, 0), data_first8: Array.from(m.data.slice(0, 8)),
+  })),
+  camera_infos: cameraInfos.map((m) => ({
+    log_time_ns: String(m.log), width: m.width, height: m.height, distortion_model: m.distortion_model, d: m.d, k: m.k,
   })),
 };
 // Objects indented, arrays of objects one element per line, everything else compact.

@@ -1,0 +1,420 @@
+#include "kccd/overlay/bag_export.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "kccd/format_number.hpp"
+#include "kccd/input_error.hpp"
+#include "kccd/logs/decode.hpp"
+#include "kccd/logs/mcap_reader.hpp"
+#include "kccd/logs/message_definition.hpp"
+#include "kccd/overlay/staged_output.hpp"
+#include "kccd/overlay/video_sink.hpp"
+
+namespace kccd::overlay {
+namespace {
+
+using logs::Value;
+
+enum class LogKind { Other, Joints, Image, Compressed, CameraInfo };
+
+LogKind logKindOf(const logs::Channel& c, const logs::Schema* s) {
+  if (!s) return LogKind::Other;
+  const bool ros2 = s->encoding == "ros2msg" && c.message_encoding == "cdr";
+  const bool ros1 = s->encoding == "ros1msg" && c.message_encoding == "ros1";
+  if (!ros1 && !ros2) return LogKind::Other;
+  const std::string t = logs::normalTypeName(s->name);
+  if (t == "sensor_msgs/JointState") return LogKind::Joints;
+  if (t == "sensor_msgs/Image") return LogKind::Image;
+  if (t == "sensor_msgs/CompressedImage") return LogKind::Compressed;
+  if (t == "sensor_msgs/CameraInfo") return LogKind::CameraInfo;
+  return LogKind::Other;
+}
+
+// One channel of a kind the export reads: its definitions, and what the first pass saw.
+struct LogSource {
+  std::string topic;
+  LogKind kind = LogKind::Other;
+  std::optional<logs::MessageDefinitions> types;
+  bool cdr = true;
+  std::size_t count = 0;
+  std::vector<std::string> names;  // joints: the first message's
+  bool all_velocities = true;
+  std::vector<std::int64_t> times;  // images: each message's chosen time
+  std::int64_t first = std::numeric_limits<std::int64_t>::max();  // the earliest chosen time
+};
+
+const Value& fieldOf(const Value& v, const char* field, const std::string& where) {
+  const Value* f = v.field(field);
+  if (!f) throw InputError(where + ": the message has no field '" + field + "'");
+  return *f;
+}
+
+// A message's time on the chosen clock, nanoseconds; `zero` counts header stamps of 0.
+std::int64_t messageTime(const Value& v, const logs::LogMessage& m, TimeSource source, std::size_t& zero) {
+  const auto log = static_cast<std::int64_t>(std::min<std::uint64_t>(m.log_time, std::uint64_t{1} << 62));
+  if (source == TimeSource::Log) return log;
+  const Value* header = v.field("header");
+  const Value* stamp = header ? header->field("stamp") : nullptr;
+  std::int64_t sec = 0, nsec = 0;
+  if (stamp && stamp->kind == Value::Kind::Array && stamp->items.size() == 2) {  // ROS 1 time
+    sec = static_cast<std::int64_t>(stamp->items[0].u), nsec = static_cast<std::int64_t>(stamp->items[1].u);
+  } else if (stamp && stamp->field("sec") && stamp->field("nanosec")) {
+    const double s = stamp->field("sec")->number(), n = stamp->field("nanosec")->number();
+    if (std::abs(s) < 1e10 && n >= 0 && n < 1e10) sec = static_cast<std::int64_t>(s), nsec = static_cast<std::int64_t>(n);
+  }
+  if (sec == 0 && nsec == 0) {
+    ++zero;
+    return log;
+  }
+  return sec * 1000000000 + nsec;
+}
+
+std::string messagePlace(const std::string& bag, const logs::LogMessage& m, std::size_t index) {
+  return bag + ": byte " + std::to_string(m.offset) + ": topic " + printable(m.channel->topic, 60) + ": message " +
+         std::to_string(index + 1);
+}
+
+Value decodeMessage(const LogSource& s, const logs::LogMessage& m, const std::string& at) {
+  try {
+    return s.cdr ? logs::decodeCdr(*s.types, m.data) : logs::decodeRos1(*s.types, m.data);
+  } catch (const logs::DecodeError& e) {
+    throw InputError(at + " (" + printable(m.schema->name, 60) + ") does not decode: byte " + std::to_string(e.offset()) + " of its " +
+                     std::to_string(m.data.size()) + ": " + printable(e.what(), 200));
+  }
+}
+
+std::string chooseTopic(const std::map<std::uint16_t, LogSource>& sources, std::initializer_list<LogKind> kinds, const std::string& given,
+                   const std::string& option, const std::string& what, const std::string& bag) {
+  std::vector<std::string> fits;
+  for (const auto& [id, s] : sources)
+    if (std::find(kinds.begin(), kinds.end(), s.kind) != kinds.end() && std::find(fits.begin(), fits.end(), s.topic) == fits.end())
+      fits.push_back(s.topic);
+  if (!given.empty()) {
+    if (std::find(fits.begin(), fits.end(), given) == fits.end())
+      throw InputError(option + " " + printable(given, 60) + ": " + bag + " has no " + what + " topic of that name" +
+                       (fits.empty() ? std::string(" (it has none)") : " (it has: " + [&] {
+                         std::string l;
+                         for (const auto& f : fits) l += (l.empty() ? "" : ", ") + printable(f, 60);
+                         return l;
+                       }() + ")"));
+    return given;
+  }
+  if (fits.size() == 1) return fits.front();
+  if (fits.empty()) throw InputError(bag + ": no " + what + " topic (see kccd bag info)");
+  std::string l;
+  for (const auto& f : fits) l += (l.empty() ? "" : ", ") + printable(f, 60);
+  throw InputError(bag + ": several " + what + " topics (" + l + "): choose one with " + option);
+}
+
+std::string exactText(double v) { return shortestNumber(v); }
+
+// Seconds since the origin, as the state log and frame-times readers take them.
+std::string secondsText(std::int64_t t, std::uint64_t origin) {
+  return shortestNumber(1e-9 * static_cast<double>(t - static_cast<std::int64_t>(origin)));
+}
+
+std::vector<double> numbersOf(const Value& v) {
+  std::vector<double> out;
+  if (v.kind == Value::Kind::Array)
+    for (const Value& x : v.items) out.push_back(x.number());
+  return out;
+}
+
+}  // namespace
+
+cv::Mat imageOf(const Value& msg, bool compressed, const std::string& at) {
+  if (compressed) {
+    const Value& data = fieldOf(msg, "data", at);
+    if (data.kind != Value::Kind::Bytes || data.bytes.empty()) throw InputError(at + ": a compressed image without data");
+    const cv::Mat buf(1, static_cast<int>(data.bytes.size()), CV_8U, const_cast<std::uint8_t*>(data.bytes.data()));
+    cv::Mat out;
+    try {
+      out = cv::imdecode(buf, cv::IMREAD_COLOR);
+    } catch (const cv::Exception&) {
+      out.release();
+    }
+    if (out.empty()) throw InputError(at + ": the compressed image (format '" + printable(fieldOf(msg, "format", at).s, 40) + "') cannot be decoded");
+    return out;
+  }
+  const double h = fieldOf(msg, "height", at).number(), w = fieldOf(msg, "width", at).number(), step = fieldOf(msg, "step", at).number();
+  const std::string enc = fieldOf(msg, "encoding", at).s;
+  const Value& data = fieldOf(msg, "data", at);
+  if (!(h >= 1 && w >= 1 && h <= 16384 && w <= 16384)) throw InputError(at + ": an image of " + formatNumber(w, 6) + "x" + formatNumber(h, 6) + " pixels");
+  const int rows = static_cast<int>(h), cols = static_cast<int>(w);
+  int type = -1, code = -1;
+  if (enc == "bgr8") type = CV_8UC3;
+  else if (enc == "rgb8") type = CV_8UC3, code = cv::COLOR_RGB2BGR;
+  else if (enc == "bgra8") type = CV_8UC4, code = cv::COLOR_BGRA2BGR;
+  else if (enc == "rgba8") type = CV_8UC4, code = cv::COLOR_RGBA2BGR;
+  else if (enc == "mono8" || enc == "8UC1") type = CV_8UC1, code = cv::COLOR_GRAY2BGR;
+  else if (enc == "mono16" || enc == "16UC1") type = CV_16UC1;
+  else if (enc == "bayer_rggb8") type = CV_8UC1, code = cv::COLOR_BayerBG2BGR;  // OpenCV names the pattern from the second row
+  else if (enc == "bayer_bggr8") type = CV_8UC1, code = cv::COLOR_BayerRG2BGR;
+  else if (enc == "bayer_gbrg8") type = CV_8UC1, code = cv::COLOR_BayerGR2BGR;
+  else if (enc == "bayer_grbg8") type = CV_8UC1, code = cv::COLOR_BayerGB2BGR;
+  else throw InputError(at + ": image encoding '" + printable(enc, 40) + "' is not read (rgb8, bgr8, rgba8, bgra8, mono8, mono16, bayer_*8)");
+  const std::size_t row_bytes = static_cast<std::size_t>(cols) * CV_ELEM_SIZE(type);
+  if (!(step >= static_cast<double>(row_bytes) && step < 1e9) || data.kind != Value::Kind::Bytes ||
+      static_cast<double>(data.bytes.size()) < step * (rows - 1) + static_cast<double>(row_bytes))
+    throw InputError(at + ": the image's data (" + std::to_string(data.kind == Value::Kind::Bytes ? data.bytes.size() : 0) +
+                     " bytes) does not hold " + std::to_string(rows) + " rows of " + formatNumber(step, 10) + " bytes");
+  const cv::Mat view(rows, cols, type, const_cast<std::uint8_t*>(data.bytes.data()), static_cast<std::size_t>(step));
+  cv::Mat out;
+  if (type == CV_16UC1) {
+    cv::Mat m = view;
+    const Value* big = msg.field("is_bigendian");
+    if (big && big->number() != 0) {  // the host is little-endian
+      m = view.clone();
+      for (int r = 0; r < rows; ++r) {
+        auto* p = m.ptr<std::uint16_t>(r);
+        for (int c = 0; c < cols; ++c) p[c] = static_cast<std::uint16_t>((p[c] >> 8) | (p[c] << 8));
+      }
+    }
+    cv::Mat eight;
+    m.convertTo(eight, CV_8U, 1.0 / 256.0);
+    cv::cvtColor(eight, out, cv::COLOR_GRAY2BGR);
+  } else if (code >= 0) {
+    cv::cvtColor(view, out, code);
+  } else {
+    out = view.clone();
+  }
+  return out;
+}
+
+BagExportReport exportBag(const BagExportOptions& o) {
+  if (o.states.empty() && o.video.empty() && o.camera_info.empty())
+    throw InputError("kccd bag export: nothing to write: give --states, --video (with --frame-times) or --camera-info");
+  if (!o.video.empty() && o.frame_times.empty())
+    throw InputError("--video " + o.video + ": needs --frame-times (a bag's frames are not evenly spaced)");
+  if (!o.frame_times.empty() && o.video.empty()) throw InputError("--frame-times " + o.frame_times + ": needs --video");
+  if (!o.states.empty()) checkOutputPath(o.states, "--states", ".csv");
+  if (!o.frame_times.empty()) checkOutputPath(o.frame_times, "--frame-times", ".csv");
+  if (!o.camera_info.empty()) checkOutputPath(o.camera_info, "--camera-info", ".yaml");
+  if (!o.video.empty()) {
+    const std::string ext = lowerExtension(o.video);
+    if (ext != ".mp4" && ext != ".mkv" && ext != ".avi") throw OutputError("--video " + o.video + ": the output must be a .mp4, .mkv or .avi file");
+    checkOutputPath(o.video, "--video", ext);
+  }
+  BagExportReport report;
+  // Pass 1: which topics there are, and what the chosen ones hold.
+  std::map<std::uint16_t, LogSource> sources;
+  std::size_t zero_probe = 0;
+  {
+    logs::McapReader reader(o.bag);
+    logs::LogMessage m;
+    while (reader.next(m)) {
+      auto [it, fresh] = sources.try_emplace(m.channel->id);
+      LogSource& s = it->second;
+      if (fresh) {
+        s.topic = m.channel->topic;
+        s.kind = logKindOf(*m.channel, m.schema);
+        if (s.kind != LogKind::Other) {
+          s.cdr = m.channel->message_encoding == "cdr";
+          try {
+            s.types = logs::MessageDefinitions::parse(m.schema->name, m.schema->data, s.cdr ? logs::Dialect::Ros2 : logs::Dialect::Ros1);
+          } catch (const logs::DefinitionError& e) {
+            throw InputError(o.bag + ": byte " + std::to_string(m.offset) + ": topic " + printable(s.topic, 60) + ": the definition of " +
+                             printable(m.schema->name, 60) + (e.line() ? " (line " + std::to_string(e.line()) + ")" : std::string()) + ": " +
+                             printable(e.what(), 200));
+          }
+        }
+      }
+      if (s.kind == LogKind::Other) continue;
+      const std::string at = messagePlace(o.bag, m, s.count);
+      ++s.count;
+      if (s.kind == LogKind::CameraInfo) continue;
+      const Value v = decodeMessage(s, m, at);
+      const std::int64_t t = messageTime(v, m, o.time_source, zero_probe);
+      s.first = std::min(s.first, t);
+      if (s.kind == LogKind::Joints) {
+        const Value& names = fieldOf(v, "name", at);
+        const std::size_t n = names.items.size();
+        if (s.count == 1)
+          for (const Value& x : names.items) s.names.push_back(x.s);
+        if (numbersOf(fieldOf(v, "velocity", at)).size() != n) s.all_velocities = false;
+      } else {
+        s.times.push_back(t);
+      }
+    }
+    report.damage = reader.damage();
+    if (!report.damage.empty()) report.warnings.push_back(o.bag + ": " + report.damage + "; read up to it");
+  }
+  const LogSource* joints = nullptr;
+  const LogSource* images = nullptr;
+  const LogSource* info = nullptr;
+  auto sourceOf = [&](const std::string& topic) -> const LogSource* {
+    for (const auto& [id, s] : sources)
+      if (s.topic == topic) return &s;
+    return nullptr;
+  };
+  if (!o.states.empty()) joints = sourceOf(report.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, "--joint-topic", "sensor_msgs/JointState", o.bag));
+  if (!o.video.empty()) images = sourceOf(report.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic, "--image-topic", "sensor_msgs/Image or CompressedImage", o.bag));
+  if (!o.camera_info.empty()) info = sourceOf(report.camera_info_topic = chooseTopic(sources, {LogKind::CameraInfo}, o.camera_info_topic, "--camera-info-topic", "sensor_msgs/CameraInfo", o.bag));
+  if (joints) {
+    if (joints->names.empty()) throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": the first joint state names no joint");
+    std::vector<std::string> sorted = joints->names;
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t i = 0; i + 1 < sorted.size(); ++i)
+      if (sorted[i] == sorted[i + 1]) throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": joint '" + printable(sorted[i], 60) + "' is named twice");
+    for (const std::string& n : joints->names)
+      if (n.empty() || n == "time" || n.find_first_of(",\"\r\n") != std::string::npos || (n.size() > 4 && n.compare(n.size() - 4, 4, ".vel") == 0))
+        throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": joint name '" + printable(n, 60) + "' cannot be a state log column");
+    report.joints = joints->names;
+    report.velocities = joints->all_velocities;
+  }
+  if (images) {
+    if (images->times.empty()) throw InputError(o.bag + ": topic " + printable(images->topic, 60) + ": no image");
+    std::vector<std::int64_t> d;
+    for (std::size_t i = 1; i < images->times.size(); ++i)
+      if (images->times[i] > images->times[i - 1]) d.push_back(images->times[i] - images->times[i - 1]);
+    std::sort(d.begin(), d.end());
+    report.fps = d.empty() ? 30.0 : std::clamp(1e9 / static_cast<double>(d[d.size() / 2]), 0.1, 1000.0);
+  }
+  // Pass 2: the outputs, staged; committed together at the end.
+  std::optional<StagedOutput> states_out, times_out;
+  std::ofstream states_file, times_file;
+  if (joints) {
+    states_out.emplace(o.states, StagedOutput::Kind::File, "--states " + o.states);
+    states_file.open(states_out->path(), std::ios::binary);
+    states_file << "time";
+    for (const std::string& n : report.joints) states_file << "," << n;
+    if (report.velocities)
+      for (const std::string& n : report.joints) states_file << "," << n << ".vel";
+    states_file << "\n";
+  }
+  std::unique_ptr<VideoSink> sink;
+  if (images) {
+    times_out.emplace(o.frame_times, StagedOutput::Kind::File, "--frame-times " + o.frame_times);
+    times_file.open(times_out->path(), std::ios::binary);
+    times_file << "frame,time\n";
+    VideoSinkOptions vo;
+    vo.video = o.video;
+    vo.video_label = "--video " + o.video;
+    sink = std::make_unique<VideoSink>(vo);
+  }
+  std::string camera_text;
+  // Time 0 of the files: the earliest time written on the chosen clock (joints and images alike).
+  std::int64_t origin = std::numeric_limits<std::int64_t>::max();
+  for (const LogSource* src : {joints, images})
+    if (src) origin = std::min(origin, src->first);
+  report.origin_ns = origin == std::numeric_limits<std::int64_t>::max() ? 0 : static_cast<std::uint64_t>(std::max<std::int64_t>(origin, 0));
+  std::map<std::uint16_t, std::size_t> index;
+  std::int64_t last_state = 0, last_frame = 0;
+  bool any_state = false, any_frame = false;
+  std::size_t zero = 0, extra_names = 0;
+  {
+    logs::McapReader reader(o.bag);
+    logs::LogMessage m;
+    while (reader.next(m)) {
+      const LogSource& s = sources.at(m.channel->id);
+      if (&s != joints && &s != images && &s != info) continue;
+      const std::size_t k = index[m.channel->id]++;
+      const std::string at = messagePlace(o.bag, m, k);
+      if (&s == info) {
+        if (!camera_text.empty()) continue;  // the first one
+        const Value v = decodeMessage(s, m, at);
+        const Value* K = v.field("k") ? v.field("k") : v.field("K");
+        const Value* D = v.field("d") ? v.field("d") : v.field("D");
+        const std::vector<double> kk = K ? numbersOf(*K) : std::vector<double>{};
+        const std::vector<double> dd = D ? numbersOf(*D) : std::vector<double>{};
+        const std::string model = fieldOf(v, "distortion_model", at).s;
+        if (kk.size() != 9) throw InputError(at + ": camera info without a 3x3 K");
+        if (model != "plumb_bob" && model != "rational_polynomial" && !(model.empty() && dd.empty()))
+          throw InputError(at + ": distortion model '" + printable(model, 40) + "' is not OpenCV's (plumb_bob or rational_polynomial)");
+        std::vector<double> dist = dd;
+        if (dist.empty()) dist.assign(5, 0.0);
+        if (dist.size() != 4 && dist.size() != 5 && dist.size() != 8 && dist.size() != 12 && dist.size() != 14)
+          throw InputError(at + ": " + std::to_string(dist.size()) + " distortion coefficients (OpenCV takes 4, 5, 8, 12 or 14)");
+        std::string t = "%YAML:1.0\n---\n";
+        t += "image_width: " + exactText(fieldOf(v, "width", at).number()) + "\nimage_height: " + exactText(fieldOf(v, "height", at).number()) + "\n";
+        t += "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ ";
+        for (std::size_t i = 0; i < 9; ++i) t += exactText(kk[i]) + (i + 1 < 9 ? ", " : " ]\n");
+        t += "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: " + std::to_string(dist.size()) + "\n   dt: d\n   data: [ ";
+        for (std::size_t i = 0; i < dist.size(); ++i) t += exactText(dist[i]) + (i + 1 < dist.size() ? ", " : " ]\n");
+        camera_text = t;
+        continue;
+      }
+      const Value v = decodeMessage(s, m, at);
+      const std::int64_t time = messageTime(v, m, o.time_source, zero);
+      if (&s == joints) {
+        if (any_state && time <= last_state) {
+          ++report.dropped_states;
+          continue;
+        }
+        const Value& names = fieldOf(v, "name", at);
+        const std::vector<double> pos = numbersOf(fieldOf(v, "position", at)), vel = numbersOf(fieldOf(v, "velocity", at));
+        if (pos.size() != names.items.size()) throw InputError(at + ": " + std::to_string(names.items.size()) + " names but " + std::to_string(pos.size()) + " positions");
+        std::vector<double> row(report.joints.size() * (report.velocities ? 2 : 1), std::nan(""));
+        for (std::size_t i = 0; i < names.items.size(); ++i) {
+          const auto c = std::find(report.joints.begin(), report.joints.end(), names.items[i].s);
+          if (c == report.joints.end()) {  // a joint the first message did not name
+            ++extra_names;
+            continue;
+          }
+          const std::size_t col = static_cast<std::size_t>(c - report.joints.begin());
+          row[col] = pos[i];
+          if (report.velocities) row[report.joints.size() + col] = vel.at(i);
+        }
+        for (std::size_t col = 0; col < row.size(); ++col) {
+          if (std::isnan(row[col]) && col < report.joints.size()) throw InputError(at + ": joint '" + printable(report.joints[col], 60) + "' is not given (every message must name the first message's joints)");
+          if (!std::isfinite(row[col]) || std::abs(row[col]) > 1e300)
+            throw InputError(at + ": joint '" + printable(report.joints[col % report.joints.size()], 60) + "': " + (col < report.joints.size() ? "position " : "velocity ") + formatNumber(row[col], 6) + " is not a finite number");
+        }
+        states_file << secondsText(time, report.origin_ns);
+        for (const double x : row) states_file << "," << exactText(x);
+        states_file << "\n";
+        last_state = time, any_state = true;
+        ++report.states;
+      } else {
+        if (any_frame && time <= last_frame) {
+          ++report.dropped_frames;
+          continue;
+        }
+        const cv::Mat frame = imageOf(v, s.kind == LogKind::Compressed, at);
+        if (report.frames == 0) {
+          report.width = frame.cols, report.height = frame.rows;
+          sink->begin(report.fps, frame.cols, frame.rows);
+        } else if (frame.cols != report.width || frame.rows != report.height) {
+          throw InputError(at + ": the image is " + std::to_string(frame.cols) + "x" + std::to_string(frame.rows) + ", the first was " +
+                           std::to_string(report.width) + "x" + std::to_string(report.height));
+        }
+        sink->write(report.frames, frame);
+        times_file << report.frames << "," << secondsText(time, report.origin_ns) << "\n";
+        last_frame = time, any_frame = true;
+        ++report.frames;
+      }
+    }
+  }
+  report.log_time_stamps = zero;
+  if (zero > 0) report.warnings.push_back(std::to_string(zero) + " messages have a zero header stamp: their log time is used");
+  if (extra_names > 0) report.warnings.push_back(std::to_string(extra_names) + " joint values of joints the first joint state did not name: left out");
+  if (report.dropped_states > 0) report.warnings.push_back(std::to_string(report.dropped_states) + " joint states left out: their time was not after the previous one's");
+  if (report.dropped_frames > 0) report.warnings.push_back(std::to_string(report.dropped_frames) + " images left out: their time was not after the previous one's");
+  if (info && camera_text.empty()) throw InputError(o.bag + ": topic " + printable(info->topic, 60) + ": no camera info message");
+  if (joints && report.states == 0) throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": no joint state");
+  // All or nothing: every output in place only once all are written.
+  if (states_file.is_open()) {
+    states_file.close();
+    if (!states_file) throw OutputError("--states " + o.states + ": cannot be written");
+  }
+  if (times_file.is_open()) {
+    times_file.close();
+    if (!times_file) throw OutputError("--frame-times " + o.frame_times + ": cannot be written");
+  }
+  if (sink) sink->commit();
+  if (states_out) states_out->commit();
+  if (times_out) times_out->commit();
+  if (!camera_text.empty()) writeFileAtomically(o.camera_info, camera_text, "--camera-info " + o.camera_info);
+  return report;
+}
+
+}  // namespace kccd::overlay
