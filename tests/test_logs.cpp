@@ -28,6 +28,7 @@
 #include "kccd/logs/decode.hpp"
 #include "kccd/logs/mcap_reader.hpp"
 #include "kccd/logs/message_definition.hpp"
+#include "kccd/logs/log_reader.hpp"
 #include "kccd/calib/camera.hpp"
 #include "kccd/overlay/bag_export.hpp"
 #include "support/files.hpp"
@@ -50,6 +51,8 @@ class McapFixtures : public ::testing::Test {
     fs::create_directories(dir_);
     const auto r = runProgram(std::string(KCCD_NODE) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_mcap.mjs " + dir_.string(), true);
     ASSERT_EQ(r.code, 0) << "the fixture writer failed (npm ci in tests/bags?): " << r.out;
+    const auto db = runProgram(std::string(KCCD_PYTHON) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_db3.py " + dir_.string(), true);
+    ASSERT_EQ(db.code, 0) << "the sqlite3 fixture writer failed: " << db.out;
     truth_ = nlohmann::json::parse(readText((dir_ / "truth.json").string()));
   }
   static std::string file(const std::string& name) { return (dir_ / name).string(); }
@@ -409,6 +412,77 @@ TEST(RosMessages, DefinitionsParseTheirSyntaxAndNameTheLineOfAMistake) {
   EXPECT_EQ(r1.root().fields[2].primitive, Primitive::Duration);
   // ROS 2 has no time primitive: a type of that name must be defined.
   EXPECT_THROW(MessageDefinitions::parse("p/T", "time t\n", Dialect::Ros2), DefinitionError);
+}
+
+// rosbag2 sqlite3: the same messages, written with Python's sqlite3 in rosbag2's layouts (Humble:
+// no definitions stored, Jazzy: message_definitions, a split folder), rows not in time order.
+TEST_F(McapFixtures, Db3BagsReadAsTheSameMessages) {
+  McapReader mcap(file("joint_plain.mcap"));
+  std::vector<std::vector<std::uint8_t>> want_bytes;
+  const std::vector<LogMessage> want = all(mcap, &want_bytes);
+  std::vector<std::string> topics;
+  for (const LogMessage& m : want) topics.push_back(m.channel->topic);
+  const std::string mcap_info = runProgram(std::string(KCCD_CLI) + " bag info " + file("joint_plain.mcap") + " --json").out;
+  for (const char* name : {"humble.db3", "jazzy.db3", "split"}) {
+    SCOPED_TRACE(name);
+    const std::unique_ptr<LogReader> r = openLog(file(name));
+    EXPECT_EQ(r->format(), "rosbag2 sqlite3");
+    std::vector<std::vector<std::uint8_t>> got_bytes;
+    std::vector<std::string> got_topics;
+    std::vector<std::uint64_t> got_times;
+    LogMessage m;
+    while (r->next(m)) {
+      got_bytes.emplace_back(m.data.begin(), m.data.end());
+      got_topics.push_back(m.channel->topic);
+      got_times.push_back(m.log_time);
+      ASSERT_NE(m.schema, nullptr);  // stored or built in
+    }
+    EXPECT_TRUE(r->damage().empty()) << r->damage();
+    EXPECT_EQ(got_topics, topics);
+    EXPECT_EQ(got_bytes, want_bytes);
+    for (std::size_t k = 0; k < want.size() && k < got_times.size(); ++k) EXPECT_EQ(got_times[k], want[k].log_time) << k;
+    // bag info: the same topics, counts, times and skews as the MCAP file's; where the definitions came from.
+    const auto info = runProgram(std::string(KCCD_CLI) + " bag info " + file(name) + " --json");
+    ASSERT_EQ(info.code, 0) << info.err;
+    nlohmann::json a = nlohmann::json::parse(info.out), b = nlohmann::json::parse(mcap_info);
+    for (nlohmann::json& t : a["topics"]) {
+      EXPECT_EQ(t["definition"], std::string(name) == "jazzy.db3" ? "stored" : "built in");
+      t.erase("definition");
+    }
+    for (nlohmann::json& t : b["topics"]) t.erase("definition");
+    EXPECT_EQ(a["topics"], b["topics"]);
+    EXPECT_EQ(a["messages"], b["messages"]);
+    EXPECT_EQ(a["format"], "rosbag2 sqlite3");
+  }
+  // The export of a .db3 is the export of the MCAP file, byte for byte.
+  auto exportOf = [&](const std::string& bag, const std::string& tag) {
+    const fs::path out = dir_ / ("export_" + tag);
+    fs::create_directories(out);
+    const auto r = runProgram(std::string(KCCD_CLI) + " bag export " + bag + " -q --states " + (out / "s.csv").string() + " --video " +
+                              (out / "v.mkv").string() + " --frame-times " + (out / "t.csv").string() + " --camera-info " + (out / "c.yaml").string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    return std::vector<std::string>{readText((out / "s.csv").string()), readText((out / "t.csv").string()), readText((out / "c.yaml").string())};
+  };
+  EXPECT_EQ(exportOf(file("humble.db3"), "humble"), exportOf(file("joint_zstd.mcap"), "mcap"));
+  EXPECT_EQ(exportOf(file("split"), "split"), exportOf(file("joint_zstd.mcap"), "mcap"));
+  // A damaged database: one line that names it and says what may help.
+  const std::string bytes = readText(file("humble.db3"));
+  const std::string cut = kccd::testing::writeScratch("test_logs", "cut.db3", bytes.substr(0, bytes.size() * 6 / 10));
+  const auto r = runProgram(std::string(KCCD_CLI) + " bag info " + cut);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err.rfind("kccd: " + cut + ": sqlite3: damaged: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(".recover"), std::string::npos) << r.err;
+  // A folder without metadata.yaml, and a ROS 1 bag (not read yet): named.
+  const fs::path empty = dir_ / "empty_folder";
+  fs::create_directories(empty);
+  EXPECT_THROW(openLog(empty.string()), kccd::InputError);
+  const std::string ros1 = kccd::testing::writeScratch("test_logs", "old.bag", "#ROSBAG V2.0\n");
+  try {
+    openLog(ros1);
+    ADD_FAILURE();
+  } catch (const kccd::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("a ROS 1 bag"), std::string::npos) << e.what();
+  }
 }
 
 // Splits a CSV file into rows of fields.

@@ -6,7 +6,7 @@
 
 #include "kccd/input_error.hpp"
 #include "kccd/logs/decode.hpp"
-#include "kccd/logs/mcap_reader.hpp"
+#include "kccd/logs/log_reader.hpp"
 #include "kccd/logs/message_definition.hpp"
 
 namespace kccd::logs {
@@ -52,10 +52,11 @@ struct TopicState {
 }  // namespace
 
 BagSummary summarizeBag(const std::string& path) {
-  McapReader reader(path);
+  const std::unique_ptr<LogReader> log = openLog(path);
+  LogReader& reader = *log;
   BagSummary out;
   out.path = path;
-  out.format = "MCAP";
+  out.format = reader.format();
   std::map<std::uint16_t, TopicState> by_channel;
   LogMessage m;
   while (reader.next(m)) {
@@ -64,16 +65,21 @@ BagSummary summarizeBag(const std::string& path) {
     if (fresh) {
       t.summary.topic = m.channel->topic;
       t.summary.message_encoding = m.channel->message_encoding;
-      if (m.schema) t.summary.type = m.schema->name, t.summary.schema_encoding = m.schema->encoding;
+      if (m.schema) t.summary.type = m.schema->name, t.summary.schema_encoding = m.schema->encoding, t.summary.definition = "stored";
+      for (const auto& [k, v] : m.channel->metadata)
+        if (k == "kccd_definition" && v == "built in") t.summary.definition = "built in";
+      if (!m.schema)
+        for (const auto& [k, v] : m.channel->metadata)
+          if (k == "kccd_no_definition") t.summary.type = v;
       const bool ros2 = m.schema && m.schema->encoding == "ros2msg" && m.channel->message_encoding == "cdr";
       const bool ros1 = m.schema && m.schema->encoding == "ros1msg" && m.channel->message_encoding == "ros1";
-      if (!m.schema) t.summary.no_stamps = "no schema";
+      if (!m.schema) t.summary.no_stamps = "no definition in the log";
       else if (!ros1 && !ros2) t.summary.no_stamps = "schema " + m.schema->encoding + ", messages " + m.channel->message_encoding + ": not decoded";
       else {
         try {
           t.types = MessageDefinitions::parse(m.schema->name, m.schema->data, ros2 ? Dialect::Ros2 : Dialect::Ros1);
         } catch (const DefinitionError& e) {
-          throw InputError(InputLocation{path, 0, 0, "byte " + std::to_string(m.offset)},
+          throw InputError(InputLocation{path, 0, 0, reader.place(m.offset)},
                            "topic " + printable(t.summary.topic, 60) + ": the definition of " + printable(m.schema->name, 60) +
                                (e.line() > 0 ? " (line " + std::to_string(e.line()) + " of its schema)" : std::string()) + ": " + printable(e.what(), 200));
         }
@@ -92,7 +98,7 @@ BagSummary summarizeBag(const std::string& path) {
       try {
         v = t.cdr ? decodeCdr(*t.types, m.data) : decodeRos1(*t.types, m.data);
       } catch (const DecodeError& e) {
-        throw InputError(InputLocation{path, 0, 0, "byte " + std::to_string(m.offset)},
+        throw InputError(InputLocation{path, 0, 0, reader.place(m.offset)},
                          "topic " + printable(s.topic, 60) + " (" + printable(s.type, 60) + "): message " + std::to_string(s.count) +
                              " does not decode: byte " + std::to_string(e.offset()) + " of its " + std::to_string(m.data.size()) + ": " + printable(e.what(), 200));
       }

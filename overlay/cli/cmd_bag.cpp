@@ -54,7 +54,8 @@ Exit runBagInfo(const BagInfoArgs& args) {
                        {"last_log_time_ns", std::to_string(t.last_log_time)},
                        {"rate_hz", t.rate()},
                        {"stamped", t.stamped},
-                       {"zero_stamps", t.zero_stamps}};
+                       {"zero_stamps", t.zero_stamps},
+                       {"definition", t.definition}};
       if (t.stamped > t.zero_stamps) o["skew_s"] = {{"min", t.skew_min}, {"median", t.skew_median}, {"max", t.skew_max}};
       if (!t.no_stamps.empty()) o["no_stamps"] = t.no_stamps;
       j["topics"].push_back(o);
@@ -74,12 +75,13 @@ Exit runBagInfo(const BagInfoArgs& args) {
   }
   std::cout << "\ntopics (skew: log time minus header stamp, min / median / max):\n";
   for (const logs::TopicSummary& t : b.topics) {
-    std::cout << "  " << t.topic << "  " << (t.type.empty() ? "(no schema)" : t.type) << "  " << t.count << " messages";
+    std::cout << "  " << t.topic << "  " << (t.type.empty() ? "(no schema)" : t.type) << "  " << t.count << (t.count == 1 ? " message" : " messages");
     if (t.count > 1) std::cout << ", " << fixed(t.rate(), t.rate() >= 100 ? 1 : 3) << " Hz";
     if (t.stamped > t.zero_stamps)
       std::cout << ", skew " << fixed(1e3 * t.skew_min, 3) << " / " << fixed(1e3 * t.skew_median, 3) << " / " << fixed(1e3 * t.skew_max, 3) << " ms";
     if (t.zero_stamps > 0) std::cout << ", " << t.zero_stamps << " zero stamps";
     if (!t.no_stamps.empty()) std::cout << "  (stamps: " << t.no_stamps << ")";
+    if (t.definition == "built in") std::cout << "  (definition built in: the log stores none)";
     std::cout << "\n";
   }
   return Exit::Ok;
@@ -112,16 +114,16 @@ Exit runBagExport(const BagExportArgs& args) {
 }  // namespace
 
 Runner addBag(CLI::App& app) {
-  CLI::App* bag = app.add_subcommand("bag", "Robot logs: what a log holds (MCAP)");
+  CLI::App* bag = app.add_subcommand("bag", "Robot logs (MCAP, rosbag2 sqlite3): what a log holds, and the log as this suite's own files");
   bag->require_subcommand(1);
   auto args = std::make_shared<BagInfoArgs>();
   CLI::App* info = bag->add_subcommand(
       "info",
       "Topics of a robot log: type, message count, first and last log time, rate, and per topic how far the "
       "messages' header stamps lie behind their log times (decoded from the definitions the log stores). Reads "
-      "MCAP (ROS 2 CDR and ROS 1 messages; chunks none, zstd or lz4). A file cut short is read up to the damage, "
-      "with a warning naming the byte.");
-  info->add_option("bag", args->bag, "The log: an .mcap file")->required();
+      "MCAP (ROS 2 CDR and ROS 1 messages; chunks none, zstd or lz4) and rosbag2 sqlite3 (a .db3 file or a bag "
+      "folder with its metadata.yaml). A log cut short is read up to the damage, with a warning naming where.");
+  info->add_option("bag", args->bag, "The log: an .mcap or .db3 file, or a rosbag2 folder")->required();
   info->add_flag("--json", args->json, "Machine-readable output (times in nanoseconds as decimal strings)");
   auto ex = std::make_shared<BagExportArgs>();
   CLI::App* exp = bag->add_subcommand(
@@ -131,7 +133,7 @@ Runner addBag(CLI::App& app) {
       "velocities), camera images as a video (--video) with its frame-times file (--frame-times), camera info as an "
       "intrinsics file (--camera-info, for kccd calib --intrinsics). Times in seconds from the first exported "
       "message, on the header stamps (or the log times). All outputs appear together or not at all.");
-  exp->add_option("bag", ex->options.bag, "The log: an .mcap file")->required();
+  exp->add_option("bag", ex->options.bag, "The log: an .mcap or .db3 file, or a rosbag2 folder")->required();
   exp->add_option("--states", ex->options.states, "State log to write (.csv)");
   exp->add_option("--video", ex->options.video, "Video to write (.mkv lossless FFV1, .mp4 mp4v, .avi MJPG)");
   exp->add_option("--frame-times", ex->options.frame_times, "Frame-times file to write with --video (.csv)");

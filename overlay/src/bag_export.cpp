@@ -14,7 +14,7 @@
 #include "kccd/format_number.hpp"
 #include "kccd/input_error.hpp"
 #include "kccd/logs/decode.hpp"
-#include "kccd/logs/mcap_reader.hpp"
+#include "kccd/logs/log_reader.hpp"
 #include "kccd/logs/message_definition.hpp"
 #include "kccd/overlay/staged_output.hpp"
 #include "kccd/overlay/video_sink.hpp"
@@ -78,8 +78,8 @@ std::int64_t messageTime(const Value& v, const logs::LogMessage& m, TimeSource s
   return sec * 1000000000 + nsec;
 }
 
-std::string messagePlace(const std::string& bag, const logs::LogMessage& m, std::size_t index) {
-  return bag + ": byte " + std::to_string(m.offset) + ": topic " + printable(m.channel->topic, 60) + ": message " +
+std::string messagePlace(const std::string& bag, const logs::LogReader& r, const logs::LogMessage& m, std::size_t index) {
+  return bag + ": " + r.place(m.offset) + ": topic " + printable(m.channel->topic, 60) + ": message " +
          std::to_string(index + 1);
 }
 
@@ -209,7 +209,8 @@ BagExportReport exportBag(const BagExportOptions& o) {
   std::map<std::uint16_t, LogSource> sources;
   std::size_t zero_probe = 0;
   {
-    logs::McapReader reader(o.bag);
+    const std::unique_ptr<logs::LogReader> log = logs::openLog(o.bag);
+    logs::LogReader& reader = *log;
     logs::LogMessage m;
     while (reader.next(m)) {
       auto [it, fresh] = sources.try_emplace(m.channel->id);
@@ -222,14 +223,14 @@ BagExportReport exportBag(const BagExportOptions& o) {
           try {
             s.types = logs::MessageDefinitions::parse(m.schema->name, m.schema->data, s.cdr ? logs::Dialect::Ros2 : logs::Dialect::Ros1);
           } catch (const logs::DefinitionError& e) {
-            throw InputError(o.bag + ": byte " + std::to_string(m.offset) + ": topic " + printable(s.topic, 60) + ": the definition of " +
+            throw InputError(o.bag + ": " + reader.place(m.offset) + ": topic " + printable(s.topic, 60) + ": the definition of " +
                              printable(m.schema->name, 60) + (e.line() ? " (line " + std::to_string(e.line()) + ")" : std::string()) + ": " +
                              printable(e.what(), 200));
           }
         }
       }
       if (s.kind == LogKind::Other) continue;
-      const std::string at = messagePlace(o.bag, m, s.count);
+      const std::string at = messagePlace(o.bag, reader, m, s.count);
       ++s.count;
       if (s.kind == LogKind::CameraInfo) continue;
       const Value v = decodeMessage(s, m, at);
@@ -312,13 +313,14 @@ BagExportReport exportBag(const BagExportOptions& o) {
   bool any_state = false, any_frame = false;
   std::size_t zero = 0, extra_names = 0;
   {
-    logs::McapReader reader(o.bag);
+    const std::unique_ptr<logs::LogReader> log = logs::openLog(o.bag);
+    logs::LogReader& reader = *log;
     logs::LogMessage m;
     while (reader.next(m)) {
       const LogSource& s = sources.at(m.channel->id);
       if (&s != joints && &s != images && &s != info) continue;
       const std::size_t k = index[m.channel->id]++;
-      const std::string at = messagePlace(o.bag, m, k);
+      const std::string at = messagePlace(o.bag, reader, m, k);
       if (&s == info) {
         if (!camera_text.empty()) continue;  // the first one
         const Value v = decodeMessage(s, m, at);

@@ -181,4 +181,12 @@ const fmt = (v, ind = "") => {
   return JSON.stringify(v);
 };
 fs.writeFileSync(path.join(outDir, "truth.json"), fmt(truth) + "\n");
+// The same serialized messages for write_db3.py (rosbag2's sqlite3 layout, written with Python's
+// sqlite3): one JSON line per message in log-time order, and the definitions by type.
+fs.writeFileSync(path.join(outDir, "messages.jsonl"), records.map((r) => JSON.stringify({
+  topic: TOPICS[r.ti].topic, type: TOPICS[r.ti].schema_name, log_time_ns: String(r.log),
+  data: Buffer.from(r.data).toString("base64"),
+})).join("\n") + "\n");
+fs.writeFileSync(path.join(outDir, "definitions.json"),
+  JSON.stringify(Object.fromEntries(TOPICS.map((t) => [t.schema_name, t.def])), null, 1) + "\n");
 console.log(`wrote ${Object.keys(FILES).join(", ")}, truth.json to ${outDir}`);

@@ -24,13 +24,15 @@ struct TopicSummary {
   double skew_min = 0.0, skew_median = 0.0, skew_max = 0.0;
   /// Why the stamps were not read (no schema, an encoding this reader does not decode, no header).
   std::string no_stamps;
+  /// Where the definition came from: "stored" (in the log), "built in" (the log stores none), "none".
+  std::string definition = "none";
   /// Messages per second between the first and the last (0 for fewer than two).
   double rate() const;
 };
 
 /// A whole log.
 struct BagSummary {
-  std::string path, format;  ///< format: "MCAP"
+  std::string path, format;  ///< format: "MCAP" or "rosbag2 sqlite3"
   std::string profile, library;
   std::uint64_t messages = 0, first_log_time = 0, last_log_time = 0;
   std::vector<TopicSummary> topics;  ///< by topic name
@@ -38,7 +40,7 @@ struct BagSummary {
   std::string damage;  ///< empty, or where the file was cut short (the messages before it are counted)
 };
 
-/// Reads every message of the log at `path` (MCAP) once. Throws InputError for a file that is not
+/// Reads every message of the log at `path` (see openLog) once. Throws InputError for a file that is not
 /// a log this reader knows, a damaged record, a definition that does not parse or a message that
 /// does not decode as its definition says (naming the file, topic, type and byte offset).
 BagSummary summarizeBag(const std::string& path);

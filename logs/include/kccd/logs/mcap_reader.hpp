@@ -13,54 +13,33 @@
 #include <utility>
 #include <vector>
 
+#include "kccd/logs/log_reader.hpp"
+
 namespace kccd::logs {
-
-/// A schema record: how a channel's messages are described (e.g. name "sensor_msgs/msg/JointState",
-/// encoding "ros2msg", data the definition text).
-struct Schema {
-  std::uint16_t id = 0;
-  std::string name, encoding, data;
-};
-
-/// A channel record: a topic, its message encoding (e.g. "cdr", "ros1") and its schema (0: none).
-struct Channel {
-  std::uint16_t id = 0, schema_id = 0;
-  std::string topic, message_encoding;
-  std::vector<std::pair<std::string, std::string>> metadata;
-};
-
-/// One message. The views (channel, schema, data) stay valid until the next call to next().
-struct LogMessage {
-  const Channel* channel = nullptr;
-  const Schema* schema = nullptr;  ///< null when the channel has no schema (schema id 0)
-  std::uint32_t sequence = 0;
-  std::uint64_t log_time = 0, publish_time = 0;  ///< nanoseconds
-  std::span<const std::uint8_t> data;
-  std::uint64_t offset = 0;  ///< the file offset of the record (of its chunk when chunked)
-};
 
 /// Streams one MCAP file's messages. Memory is bounded by the largest record or decompressed
 /// chunk, not by the file. Every length field is checked against the bytes that remain before
 /// anything is allocated for it.
-class McapReader {
+class McapReader final : public LogReader {
  public:
   /// Opens `path` and checks the leading magic; throws InputError naming the file otherwise.
   explicit McapReader(const std::string& path);
-  ~McapReader();
+  ~McapReader() override;
   McapReader(const McapReader&) = delete;
   McapReader& operator=(const McapReader&) = delete;
 
   /// The next message in file order; false after the last one. Throws InputError ("FILE: byte N:
   /// problem") for a CRC mismatch, an unknown compression, a record that contradicts itself or a
   /// message on a channel never defined. A file cut short ends the stream early: see damage().
-  bool next(LogMessage& out);
+  bool next(LogMessage& out) override;
 
   /// Empty, or why the stream ended before the file's proper end (e.g. "cut short at byte 1234
   /// inside a Chunk record") — the messages before it were read.
-  const std::string& damage() const { return damage_; }
+  const std::string& damage() const override { return damage_; }
+  std::string format() const override { return "MCAP"; }
   /// The header's profile (e.g. "ros2", "ros1") and library.
-  const std::string& profile() const { return profile_; }
-  const std::string& library() const { return library_; }
+  std::string profile() const override { return profile_; }
+  std::string library() const override { return library_; }
   /// The schemas and channels seen so far, by id.
   const std::map<std::uint16_t, Schema>& schemas() const { return schemas_; }
   const std::map<std::uint16_t, Channel>& channels() const { return channels_; }
@@ -68,7 +47,7 @@ class McapReader {
   const std::string& path() const { return path_; }
   std::uint64_t fileSize() const { return size_; }
   /// Chunks read so far, and their compressions (e.g. {"zstd": 12}).
-  const std::map<std::string, int>& chunks() const { return chunks_; }
+  std::map<std::string, int> chunks() const override { return chunks_; }
 
  private:
   bool readRecord(std::uint8_t& opcode, std::vector<std::uint8_t>& content, std::uint64_t& at);

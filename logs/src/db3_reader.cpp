@@ -1,0 +1,193 @@
+#include "kccd/logs/db3_reader.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include <sqlite3.h>
+
+#include "kccd/input_error.hpp"
+#include "kccd/logs/message_definition.hpp"
+
+namespace kccd::logs {
+namespace {
+
+const std::string kDefSep = std::string(80, '=') + "\n";
+const std::string kTimeDef = "int32 sec\nuint32 nanosec\n";
+const std::string kHeaderDef = "builtin_interfaces/Time stamp\nstring frame_id\n";
+const std::string kHeaderDeps = kDefSep + "MSG: std_msgs/Header\n" + kHeaderDef + kDefSep + "MSG: builtin_interfaces/Time\n" + kTimeDef;
+
+}  // namespace
+
+std::string builtinDefinition(const std::string& type) {
+  const std::string t = normalTypeName(type);
+  if (t == "sensor_msgs/JointState")
+    return "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n" + kHeaderDeps;
+  if (t == "sensor_msgs/Image")
+    return "std_msgs/Header header\nuint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\nuint32 step\nuint8[] data\n" + kHeaderDeps;
+  if (t == "sensor_msgs/CompressedImage") return "std_msgs/Header header\nstring format\nuint8[] data\n" + kHeaderDeps;
+  if (t == "sensor_msgs/CameraInfo")
+    return "std_msgs/Header header\nuint32 height\nuint32 width\nstring distortion_model\nfloat64[] d\nfloat64[9] k\nfloat64[9] r\n"
+           "float64[12] p\nuint32 binning_x\nuint32 binning_y\nRegionOfInterest roi\n" +
+           kDefSep + "MSG: sensor_msgs/RegionOfInterest\nuint32 x_offset\nuint32 y_offset\nuint32 height\nuint32 width\nbool do_rectify\n" + kHeaderDeps;
+  if (t == "std_msgs/Header") return kHeaderDef + kDefSep + "MSG: builtin_interfaces/Time\n" + kTimeDef;
+  return {};
+}
+
+struct Db3Reader::Db {
+  sqlite3* db = nullptr;
+  sqlite3_stmt* rows = nullptr;
+  ~Db() {
+    if (rows) sqlite3_finalize(rows);
+    if (db) sqlite3_close(db);
+  }
+};
+
+Db3Reader::Db3Reader(std::vector<std::string> files, std::string label) : files_(std::move(files)), label_(std::move(label)) {
+  if (files_.empty()) throw InputError(label_ + ": no .db3 file");
+  if (label_.empty()) label_ = files_.front();
+  open(0);
+}
+
+Db3Reader::~Db3Reader() = default;
+
+std::string Db3Reader::place(std::uint64_t offset) const {
+  // offset: the file's index in the high bits, the row id below.
+  const std::uint64_t file = offset >> 48, row = offset & ((std::uint64_t{1} << 48) - 1);
+  return (files_.size() > 1 ? std::filesystem::path(files_[std::min<std::size_t>(file, files_.size() - 1)]).filename().string() + " " : std::string()) +
+         "row " + std::to_string(row);
+}
+
+void Db3Reader::open(std::size_t index) {
+  file_ = index;
+  db_ = std::make_unique<Db>();
+  const std::string& path = files_[index];
+  auto fail = [&](const std::string& problem) -> void {
+    throw InputError(InputLocation{path, 0, 0, "sqlite3"}, problem);
+  };
+  {
+    std::ifstream in(path, std::ios::binary);
+    char magic[16] = {};
+    if (!in || !in.read(magic, 16) || std::memcmp(magic, "SQLite format 3", 16) != 0)
+      fail(in ? "not an SQLite database (rosbag2 .db3)" : "cannot be opened");
+  }
+  if (sqlite3_open_v2(path.c_str(), &db_->db, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK)
+    fail(std::string("cannot be opened: ") + (db_->db ? sqlite3_errmsg(db_->db) : "out of memory"));
+  auto query = [&](const char* sql) {
+    sqlite3_stmt* st = nullptr;
+    if (sqlite3_prepare_v2(db_->db, sql, -1, &st, nullptr) != SQLITE_OK) {
+      const std::string msg = sqlite3_errmsg(db_->db);
+      if (st) sqlite3_finalize(st);
+      return std::make_pair(static_cast<sqlite3_stmt*>(nullptr), msg);
+    }
+    return std::make_pair(st, std::string());
+  };
+  // The stored definitions (rosbag2 Jazzy and later: message_definitions), by type.
+  std::map<std::string, std::pair<std::string, std::string>> stored;  // type -> (encoding, text)
+  if (auto [st, err] = query("SELECT topic_type, encoding, encoded_message_definition FROM message_definitions"); st) {
+    while (sqlite3_step(st) == SQLITE_ROW) {
+      auto text = [&](int c) {
+        const unsigned char* p = sqlite3_column_text(st, c);
+        return p ? std::string(reinterpret_cast<const char*>(p), static_cast<std::size_t>(sqlite3_column_bytes(st, c))) : std::string();
+      };
+      stored[text(0)] = {text(1), text(2)};
+    }
+    sqlite3_finalize(st);
+  }
+  const auto damaged = [&] {
+    const int code = sqlite3_errcode(db_->db) & 0xff;
+    return code == SQLITE_CORRUPT || code == SQLITE_NOTADB;
+  };
+  const std::string recover = " (sqlite3's .recover command may save the rows that are left)";
+  auto [topics, terr] = query("SELECT id, name, type, serialization_format FROM topics");
+  if (!topics) fail(damaged() ? "damaged: " + terr + recover : "no topics table (" + terr + "): not a rosbag2 sqlite3 file");
+  topic_ids_.clear();
+  int rc = 0;
+  while ((rc = sqlite3_step(topics)) == SQLITE_ROW) {
+    auto text = [&](int c) {
+      const unsigned char* p = sqlite3_column_text(topics, c);
+      return p ? std::string(reinterpret_cast<const char*>(p), static_cast<std::size_t>(sqlite3_column_bytes(topics, c))) : std::string();
+    };
+    const std::int64_t id = sqlite3_column_int64(topics, 0);
+    const std::string name = text(1), type = text(2), format = text(3);
+    auto [it, fresh] = channel_of_topic_.try_emplace(name, static_cast<std::uint16_t>(channels_.size() + 1));
+    if (fresh) {
+      if (channels_.size() >= 65000) {
+        sqlite3_finalize(topics);
+        fail("more than 65000 topics");
+      }
+      Channel c;
+      c.id = it->second;
+      c.topic = name;
+      c.message_encoding = format;
+      // The schema: the stored definition, else the built-in one, else none (counted, not decoded).
+      std::string encoding = "ros2msg", text_def;
+      if (const auto s = stored.find(type); s != stored.end() && !s->second.second.empty()) {
+        encoding = s->second.first == "ros2idl" ? "ros2idl" : "ros2msg";
+        text_def = s->second.second;
+      } else {
+        text_def = builtinDefinition(type);
+        if (!text_def.empty()) c.metadata.emplace_back("kccd_definition", "built in");
+      }
+      if (!text_def.empty()) {
+        Schema s;
+        s.id = c.id;
+        s.name = type;
+        s.encoding = encoding;
+        s.data = text_def;
+        schemas_[s.id] = s;
+        c.schema_id = s.id;
+      } else {
+        c.metadata.emplace_back("kccd_no_definition", type);
+      }
+      channels_[c.id] = c;
+    }
+    topic_ids_[id] = it->second;
+  }
+  sqlite3_finalize(topics);
+  if (rc != SQLITE_DONE) fail(std::string("the topics table cannot be read: ") + sqlite3_errmsg(db_->db) + (damaged() ? recover : ""));
+  auto [rows, merr] = query("SELECT id, topic_id, timestamp, data FROM messages ORDER BY timestamp, id");
+  if (!rows) fail(damaged() ? "damaged: " + merr + recover : "no messages table (" + merr + "): not a rosbag2 sqlite3 file");
+  db_->rows = rows;
+}
+
+bool Db3Reader::next(LogMessage& out) {
+  for (;;) {
+    if (!db_) return false;
+    const int rc = sqlite3_step(db_->rows);
+    if (rc == SQLITE_ROW) {
+      const std::int64_t row = sqlite3_column_int64(db_->rows, 0);
+      const std::int64_t topic = sqlite3_column_int64(db_->rows, 1);
+      const std::int64_t stamp = sqlite3_column_int64(db_->rows, 2);
+      const auto t = topic_ids_.find(topic);
+      if (t == topic_ids_.end())
+        throw InputError(InputLocation{files_[file_], 0, 0, "row " + std::to_string(row)}, "a message of topic id " + std::to_string(topic) + ", which the topics table does not list");
+      const void* blob = sqlite3_column_blob(db_->rows, 3);
+      const int bytes = sqlite3_column_bytes(db_->rows, 3);
+      data_.assign(static_cast<const std::uint8_t*>(blob), static_cast<const std::uint8_t*>(blob) + (blob ? bytes : 0));
+      const Channel& c = channels_.at(t->second);
+      out.channel = &c;
+      out.schema = c.schema_id ? &schemas_.at(c.schema_id) : nullptr;
+      out.sequence = static_cast<std::uint32_t>(row);
+      out.log_time = out.publish_time = static_cast<std::uint64_t>(std::max<std::int64_t>(stamp, 0));
+      out.data = data_;
+      out.offset = (static_cast<std::uint64_t>(file_) << 48) | (static_cast<std::uint64_t>(row) & ((std::uint64_t{1} << 48) - 1));
+      ++row_;
+      return true;
+    }
+    if (rc != SQLITE_DONE) {
+      // A file cut short or damaged: what was read stands, with the damage named.
+      damage_ = files_[file_] + ": " + sqlite3_errmsg(db_->db) + " (after " + std::to_string(row_) + " messages)";
+      db_.reset();
+      return false;
+    }
+    if (file_ + 1 >= files_.size()) {
+      db_.reset();
+      return false;
+    }
+    open(file_ + 1);
+  }
+}
+
+}  // namespace kccd::logs

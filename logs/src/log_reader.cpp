@@ -1,0 +1,73 @@
+#include "kccd/logs/log_reader.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "kccd/input_error.hpp"
+#include "kccd/logs/db3_reader.hpp"
+#include "kccd/logs/mcap_reader.hpp"
+
+namespace kccd::logs {
+
+namespace {
+
+// A rosbag2 folder: its metadata.yaml lists the storage and the files in order.
+std::vector<std::string> folderFiles(const std::string& dir) {
+  const std::filesystem::path meta = std::filesystem::path(dir) / "metadata.yaml";
+  if (!std::filesystem::exists(meta)) throw InputError(InputLocation{dir, 0, 0, "folder"}, "not a rosbag2 folder (no metadata.yaml)");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(meta.string());
+  } catch (const YAML::Exception& e) {
+    throw InputError(InputLocation{meta.string(), static_cast<std::size_t>(e.mark.line + 1), 0, "yaml"}, printable(e.msg, 120));
+  }
+  const YAML::Node info = root["rosbag2_bagfile_information"];
+  if (!info || !info.IsMap()) throw InputError(InputLocation{meta.string(), 0, 0, "rosbag2_bagfile_information"}, "missing");
+  std::string storage;
+  try {
+    storage = info["storage_identifier"] ? info["storage_identifier"].as<std::string>() : "";
+  } catch (const YAML::Exception&) {
+  }
+  std::vector<std::string> files;
+  const YAML::Node paths = info["relative_file_paths"];
+  if (paths && paths.IsSequence())
+    for (const YAML::Node& p : paths) {
+      if (!p.IsScalar()) throw InputError(InputLocation{meta.string(), static_cast<std::size_t>(p.Mark().line + 1), 0, "relative_file_paths"}, "expected file names");
+      const std::string name = p.as<std::string>();
+      if (name.empty() || name.find("..") != std::string::npos || name.front() == '/')
+        throw InputError(InputLocation{meta.string(), static_cast<std::size_t>(p.Mark().line + 1), 0, "relative_file_paths"}, "'" + printable(name, 60) + "' is not a file in the folder");
+      files.push_back((std::filesystem::path(dir) / name).string());
+    }
+  if (files.empty()) throw InputError(InputLocation{meta.string(), 0, 0, "relative_file_paths"}, "lists no file");
+  if (!storage.empty() && storage != "sqlite3" && storage != "mcap")
+    throw InputError(InputLocation{meta.string(), 0, 0, "storage_identifier"}, "'" + printable(storage, 40) + "' is not sqlite3 or mcap");
+  return files;
+}
+
+}  // namespace
+
+std::unique_ptr<LogReader> openLog(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    const std::vector<std::string> files = folderFiles(path);
+    const auto is_mcap = [](const std::string& f) { return f.size() >= 5 && f.compare(f.size() - 5, 5, ".mcap") == 0; };
+    const auto mcaps = std::count_if(files.begin(), files.end(), is_mcap);
+    if (mcaps == 1 && files.size() == 1) return std::make_unique<McapReader>(files.front());
+    if (mcaps > 0) throw InputError(InputLocation{path, 0, 0, "folder"}, "a bag split into several MCAP files: give them one at a time");
+    return std::make_unique<Db3Reader>(files, path);
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(InputLocation{path, 0, 0, "file"}, "cannot be opened");
+  char magic[16] = {};
+  in.read(magic, 16);
+  if (std::memcmp(magic, "SQLite format 3", 16) == 0) return std::make_unique<Db3Reader>(std::vector<std::string>{path});
+  if (std::memcmp(magic, "#ROSBAG V", 9) == 0)
+    throw InputError(InputLocation{path, 0, 0, "byte 0"}, "a ROS 1 bag: not read yet (convert it with `mcap convert` or `rosbags-convert`)");
+  return std::make_unique<McapReader>(path);  // which says what it is not
+}
+
+}  // namespace kccd::logs
