@@ -22,7 +22,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 # The slowest first, so that the jobs end together.
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_urdf fuzz_part fuzz_model fuzz_states fuzz_frame_times fuzz_camera fuzz_tags fuzz_labels fuzz_labels_json fuzz_golden_manifest fuzz_frame fuzz_video fuzz_mcap fuzz_ros_message)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_urdf fuzz_part fuzz_model fuzz_states fuzz_frame_times fuzz_camera fuzz_tags fuzz_labels fuzz_labels_json fuzz_golden_manifest fuzz_frame fuzz_video fuzz_mcap fuzz_ros_message fuzz_ros1_bag)
 bash scripts/install-deps.sh --fuzz
 # -O1 with line tables only: the fuzzers' stacks keep files and lines, and the build is much shorter.
 CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -48,6 +48,7 @@ ci_runs() {  # inputs per target in --ci mode (15-40 s each on this project's ma
     fuzz_urdf) echo 800 ;;    # 20 inputs/s: every model imported is fitted
     fuzz_mcap) echo 60000 ;;
     fuzz_ros_message) echo 300000 ;;
+    fuzz_ros1_bag) echo 60000 ;;
   esac
 }
 
@@ -67,6 +68,7 @@ seeds() {  # extra seed files from data/ per target
     fuzz_urdf) ls tests/data/urdf/*.urdf ;;
     fuzz_mcap) ;;
     fuzz_ros_message) ;;
+    fuzz_ros1_bag) ;;
   esac
 }
 mkdir -p $out/artifacts

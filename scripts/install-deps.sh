@@ -10,7 +10,7 @@ packages=(
   libcoin-dev inventor-data liburdfdom-dev libassimp-dev
   libosmesa6-dev libgl-dev libegl-dev libopengl-dev libegl-mesa0
   libopencv-dev libpng-dev libtinyxml2-dev libapriltag-dev
-  zlib1g-dev libzstd-dev liblz4-dev libsqlite3-dev
+  zlib1g-dev libzstd-dev liblz4-dev libbz2-dev libsqlite3-dev
   python3-dev pybind11-dev python3-numpy
   python3-yaml python3-distributed python3-dask
 )
@@ -18,12 +18,14 @@ packages=(
 #   --fuzz   also the compiler and runtime of the libFuzzer targets (scripts/fuzz.sh)
 #   --tests  also what the labelling page's tests run: Debian's chromium, node and npm (below),
 #            and npm's playwright-core in tests/e2e (scripts/test.sh); and the Python package's:
-#            pytest, mypy and typeshed's stubs (PyYAML's, for mypy --strict on kccd.batch).
+#            pytest, mypy and typeshed's stubs (PyYAML's, for mypy --strict on kccd.batch); and the
+#            robot-log tests' fixture writers: ROS 1's rosbag with its sensor_msgs and lz4
+#            (python3-rosbag, python3-sensor-msgs, python3-roslz4), npm's @mcap/core (tests/bags).
 tests=0
 for arg in "$@"; do
   case "$arg" in
     --fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;
-    --tests) tests=1; packages+=(chromium python3-pytest python3-matplotlib mypy python3-typeshed) ;;
+    --tests) tests=1; packages+=(chromium python3-pytest python3-matplotlib mypy python3-typeshed python3-rosbag python3-sensor-msgs python3-roslz4) ;;
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 2 ;;
   esac
 done

@@ -53,6 +53,8 @@ class McapFixtures : public ::testing::Test {
     ASSERT_EQ(r.code, 0) << "the fixture writer failed (npm ci in tests/bags?): " << r.out;
     const auto db = runProgram(std::string(KCCD_PYTHON) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_db3.py " + dir_.string(), true);
     ASSERT_EQ(db.code, 0) << "the sqlite3 fixture writer failed: " << db.out;
+    const auto ros1 = runProgram(std::string(KCCD_PYTHON) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_ros1.py " + dir_.string(), true);
+    ASSERT_EQ(ros1.code, 0) << "the ROS 1 fixture writer failed (python3-rosbag, python3-sensor-msgs?): " << ros1.out;
     truth_ = nlohmann::json::parse(readText((dir_ / "truth.json").string()));
   }
   static std::string file(const std::string& name) { return (dir_ / name).string(); }
@@ -472,17 +474,64 @@ TEST_F(McapFixtures, Db3BagsReadAsTheSameMessages) {
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err.rfind("kccd: " + cut + ": sqlite3: damaged: ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find(".recover"), std::string::npos) << r.err;
-  // A folder without metadata.yaml, and a ROS 1 bag (not read yet): named.
+  // A folder without metadata.yaml: named.
   const fs::path empty = dir_ / "empty_folder";
   fs::create_directories(empty);
   EXPECT_THROW(openLog(empty.string()), kccd::InputError);
-  const std::string ros1 = kccd::testing::writeScratch("test_logs", "old.bag", "#ROSBAG V2.0\n");
-  try {
-    openLog(ros1);
-    ADD_FAILURE();
-  } catch (const kccd::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("a ROS 1 bag"), std::string::npos) << e.what();
+}
+
+// ROS 1 bags written by ROS 1's rosbag (chunks plain, bz2, lz4) from the same list: the same
+// topics, counts, times and stamps; every cut a prefix with a warning; the same exported bytes.
+TEST_F(McapFixtures, Ros1BagsReadAsTheSameRecording) {
+  const nlohmann::json mcap = nlohmann::json::parse(runProgram(std::string(KCCD_CLI) + " bag info " + file("joint_plain.mcap") + " --json").out);
+  for (const char* name : {"ros1_none.bag", "ros1_bz2.bag", "ros1_lz4.bag"}) {
+    SCOPED_TRACE(name);
+    const auto info = runProgram(std::string(KCCD_CLI) + " bag info " + file(name) + " --json");
+    ASSERT_EQ(info.code, 0) << info.err;
+    nlohmann::json a = nlohmann::json::parse(info.out), b = mcap;
+    EXPECT_EQ(a["format"], "ROS 1 bag");
+    const std::string comp = std::string(name).substr(5, std::string(name).find('.') - 5);
+    EXPECT_GT(a["chunks"][comp].get<int>(), 3);
+    for (nlohmann::json* j : {&a, &b})
+      for (nlohmann::json& t : (*j)["topics"]) {
+        EXPECT_EQ(t["definition"], "stored");
+        t["type"] = kccd::logs::normalTypeName(t["type"].get<std::string>());  // ROS 1 names have no "/msg/"
+        t.erase("schema_encoding"), t.erase("message_encoding");
+      }
+    EXPECT_EQ(a["topics"], b["topics"]);
+    // Every cut reads a prefix of the messages (by topic and time) with the warning.
+    const std::string bytes = readText(file(name));
+    const std::unique_ptr<LogReader> whole = openLog(file(name));
+    std::vector<std::pair<std::string, std::uint64_t>> full;
+    LogMessage m;
+    while (whole->next(m)) full.emplace_back(m.channel->topic, m.log_time);
+    EXPECT_EQ(full.size(), 211u);
+    std::size_t cuts = 0;
+    for (std::size_t cut = 13; cut < bytes.size(); cut += 1 + cut % 173) {
+      const std::string path = kccd::testing::writeScratch("test_logs", "cut.bag", bytes.substr(0, cut));
+      const std::unique_ptr<LogReader> r = openLog(path);
+      std::size_t k = 0;
+      ASSERT_NO_THROW({
+        while (r->next(m)) {
+          ASSERT_LT(k, full.size());
+          EXPECT_EQ(std::make_pair(m.channel->topic, m.log_time), full[k]) << "cut at " << cut;
+          ++k;
+        }
+      }) << "cut at " << cut;
+      EXPECT_NE(r->damage().find("cut short at byte"), std::string::npos) << "cut at " << cut;
+      ++cuts;
+    }
+    EXPECT_GT(cuts, 50u);
   }
+  auto exportOf = [&](const std::string& bag, const std::string& tag) {
+    const fs::path out = dir_ / ("export_" + tag);
+    fs::create_directories(out);
+    const auto r = runProgram(std::string(KCCD_CLI) + " bag export " + bag + " -q --states " + (out / "s.csv").string() + " --video " +
+                              (out / "v.mkv").string() + " --frame-times " + (out / "t.csv").string() + " --camera-info " + (out / "c.yaml").string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    return std::vector<std::string>{readText((out / "s.csv").string()), readText((out / "t.csv").string()), readText((out / "c.yaml").string())};
+  };
+  EXPECT_EQ(exportOf(file("ros1_bz2.bag"), "ros1"), exportOf(file("joint_zstd.mcap"), "mcap1"));
 }
 
 // Splits a CSV file into rows of fields.

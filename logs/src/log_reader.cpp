@@ -10,6 +10,7 @@
 #include "kccd/input_error.hpp"
 #include "kccd/logs/db3_reader.hpp"
 #include "kccd/logs/mcap_reader.hpp"
+#include "kccd/logs/ros1_reader.hpp"
 
 namespace kccd::logs {
 
@@ -65,8 +66,7 @@ std::unique_ptr<LogReader> openLog(const std::string& path) {
   char magic[16] = {};
   in.read(magic, 16);
   if (std::memcmp(magic, "SQLite format 3", 16) == 0) return std::make_unique<Db3Reader>(std::vector<std::string>{path});
-  if (std::memcmp(magic, "#ROSBAG V", 9) == 0)
-    throw InputError(InputLocation{path, 0, 0, "byte 0"}, "a ROS 1 bag: not read yet (convert it with `mcap convert` or `rosbags-convert`)");
+  if (std::memcmp(magic, "#ROSBAG V", 9) == 0) return std::make_unique<Ros1Reader>(path);  // which checks the version
   return std::make_unique<McapReader>(path);  // which says what it is not
 }
 

@@ -4,10 +4,9 @@
 #include <cstring>
 #include <limits>
 
-#include <lz4frame.h>
 #include <zlib.h>
-#include <zstd.h>
 
+#include "decompress.hpp"
 #include "kccd/input_error.hpp"
 
 namespace kccd::logs {
@@ -151,67 +150,10 @@ void McapReader::openChunk(std::span<const std::uint8_t> content, std::uint64_t 
   if (compression.empty()) {
     if (records.size() != size) fail(at, "an uncompressed chunk of " + std::to_string(records.size()) + " bytes says it holds " + std::to_string(size));
     chunk_.assign(records.begin(), records.end());
-  } else if (compression == "zstd") {
+  } else if (compression == "zstd" || compression == "lz4") {
     // Streamed: the buffer grows with what the data really decompresses to, not with the claim.
-    ZSTD_DCtx* z = ZSTD_createDCtx();
-    if (!z) fail(at, "zstd: out of memory");
-    ZSTD_inBuffer inb{records.data(), records.size(), 0};
-    std::size_t ret = 1;
-    while (ret != 0) {
-      const std::size_t have = chunk_.size();
-      if (have >= size) {  // must end exactly at the declared size
-        std::uint8_t probe[1];
-        ZSTD_outBuffer o{probe, 1, 0};
-        ret = ZSTD_decompressStream(z, &o, &inb);
-        if (ZSTD_isError(ret) || o.pos > 0 || (ret != 0 && inb.pos == inb.size)) break;
-        continue;
-      }
-      chunk_.resize(have + static_cast<std::size_t>(std::min<std::uint64_t>(size - have, 1u << 20)));
-      ZSTD_outBuffer o{chunk_.data() + have, chunk_.size() - have, 0};
-      ret = ZSTD_decompressStream(z, &o, &inb);
-      chunk_.resize(have + o.pos);
-      if (ZSTD_isError(ret)) break;
-      if (o.pos == 0 && inb.pos == inb.size && ret != 0) break;  // the input ended first
-    }
-    ZSTD_freeDCtx(z);
-    if (ZSTD_isError(ret)) fail(at, std::string("the zstd chunk does not decompress: ") + ZSTD_getErrorName(ret));
-    if (ret != 0 || chunk_.size() != size)
-      fail(at, "the zstd chunk decompresses to " + std::to_string(chunk_.size()) + " bytes, not the " + std::to_string(size) + " it declares");
-  } else if (compression == "lz4") {
-    LZ4F_dctx* z = nullptr;
-    if (LZ4F_isError(LZ4F_createDecompressionContext(&z, LZ4F_VERSION))) fail(at, "lz4: out of memory");
-    const std::uint8_t* src = records.data();
-    std::size_t left = records.size(), ret = 1;
-    bool error = false;
-    while (left > 0 && ret != 0) {
-      const std::size_t have = chunk_.size();
-      std::size_t out_size = static_cast<std::size_t>(std::min<std::uint64_t>(size - have, 1u << 20));
-      std::uint8_t probe[1];
-      std::uint8_t* dst = probe;
-      if (out_size == 0) out_size = 1;  // anything more is a size mismatch
-      else chunk_.resize(have + out_size), dst = chunk_.data() + have;
-      std::size_t in_size = left;
-      ret = LZ4F_decompress(z, dst, &out_size, src, &in_size, nullptr);
-      if (LZ4F_isError(ret)) {
-        error = true;
-        break;
-      }
-      if (dst == probe) {
-        if (out_size > 0) {
-          chunk_.push_back(probe[0]);
-          break;
-        }
-      } else {
-        chunk_.resize(have + out_size);
-      }
-      src += in_size, left -= in_size;
-      if (in_size == 0 && out_size == 0) break;
-    }
-    LZ4F_freeDecompressionContext(z);
-    if (error) fail(at, std::string("the lz4 chunk does not decompress: ") + LZ4F_getErrorName(ret));
-    if (ret != 0 || chunk_.size() != size)
-      fail(at, "the lz4 chunk decompresses to " + std::to_string(chunk_.size()) + " bytes, not the " + std::to_string(size) + " it declares" +
-                   (ret != 0 ? " (its frame is not complete)" : ""));
+    const std::string problem = detail::decompress(compression, records, size, chunk_);
+    if (!problem.empty()) fail(at, problem);
   } else {
     fail(at, "the chunk's compression '" + printable(compression, 40) + "' is not none, zstd or lz4");
   }

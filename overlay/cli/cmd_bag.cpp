@@ -114,16 +114,16 @@ Exit runBagExport(const BagExportArgs& args) {
 }  // namespace
 
 Runner addBag(CLI::App& app) {
-  CLI::App* bag = app.add_subcommand("bag", "Robot logs (MCAP, rosbag2 sqlite3): what a log holds, and the log as this suite's own files");
+  CLI::App* bag = app.add_subcommand("bag", "Robot logs (MCAP, rosbag2 sqlite3, ROS 1 bags): what a log holds, and the log as this suite's own files");
   bag->require_subcommand(1);
   auto args = std::make_shared<BagInfoArgs>();
   CLI::App* info = bag->add_subcommand(
       "info",
       "Topics of a robot log: type, message count, first and last log time, rate, and per topic how far the "
       "messages' header stamps lie behind their log times (decoded from the definitions the log stores). Reads "
-      "MCAP (ROS 2 CDR and ROS 1 messages; chunks none, zstd or lz4) and rosbag2 sqlite3 (a .db3 file or a bag "
-      "folder with its metadata.yaml). A log cut short is read up to the damage, with a warning naming where.");
-  info->add_option("bag", args->bag, "The log: an .mcap or .db3 file, or a rosbag2 folder")->required();
+      "MCAP (ROS 2 CDR and ROS 1 messages; chunks none, zstd or lz4), rosbag2 sqlite3 (a .db3 file or a bag "
+      "folder with its metadata.yaml) and ROS 1 bags (format 2.0; chunks none, bz2 or lz4). A log cut short is read up to the damage, with a warning naming where.");
+  info->add_option("bag", args->bag, "The log: an .mcap, .db3 or .bag file, or a rosbag2 folder")->required();
   info->add_flag("--json", args->json, "Machine-readable output (times in nanoseconds as decimal strings)");
   auto ex = std::make_shared<BagExportArgs>();
   CLI::App* exp = bag->add_subcommand(
@@ -133,7 +133,7 @@ Runner addBag(CLI::App& app) {
       "velocities), camera images as a video (--video) with its frame-times file (--frame-times), camera info as an "
       "intrinsics file (--camera-info, for kccd calib --intrinsics). Times in seconds from the first exported "
       "message, on the header stamps (or the log times). All outputs appear together or not at all.");
-  exp->add_option("bag", ex->options.bag, "The log: an .mcap or .db3 file, or a rosbag2 folder")->required();
+  exp->add_option("bag", ex->options.bag, "The log: an .mcap, .db3 or .bag file, or a rosbag2 folder")->required();
   exp->add_option("--states", ex->options.states, "State log to write (.csv)");
   exp->add_option("--video", ex->options.video, "Video to write (.mkv lossless FFV1, .mp4 mp4v, .avi MJPG)");
   exp->add_option("--frame-times", ex->options.frame_times, "Frame-times file to write with --video (.csv)");
