@@ -48,7 +48,7 @@ ci_runs() {  # inputs per target in --ci mode (15-40 s each on this project's ma
     fuzz_urdf) echo 800 ;;    # 20 inputs/s: every model imported is fitted
     fuzz_mcap) echo 60000 ;;
     fuzz_ros_message) echo 300000 ;;
-    fuzz_ros1_bag) echo 60000 ;;
+    fuzz_ros1_bag) echo 40000 ;;
   esac
 }
 

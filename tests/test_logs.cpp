@@ -534,6 +534,13 @@ TEST_F(McapFixtures, Ros1BagsReadAsTheSameRecording) {
   EXPECT_EQ(exportOf(file("ros1_bz2.bag"), "ros1"), exportOf(file("joint_zstd.mcap"), "mcap1"));
 }
 
+// Nanoseconds as the decimal text of seconds ("3.3335"): what an exported time must read back as.
+double decimalSeconds(std::uint64_t ns) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%llu.%09llu", static_cast<unsigned long long>(ns / 1000000000), static_cast<unsigned long long>(ns % 1000000000));
+  return std::stod(buf);
+}
+
 // Splits a CSV file into rows of fields.
 std::vector<std::vector<std::string>> csv(const std::string& path) {
   std::vector<std::vector<std::string>> rows;
@@ -573,7 +580,7 @@ TEST_F(McapFixtures, ExportWritesTheSuitesOwnFiles) {
       const nlohmann::json& w = truth_["joint_states"][i];
       const std::uint64_t when = header ? std::uint64_t(w["stamp_sec"].get<std::int64_t>()) * 1000000000 + w["stamp_nanosec"].get<std::uint64_t>()
                                         : ns(w["log_time_ns"]);
-      EXPECT_NEAR(std::stod(rows[i + 1][0]), 1e-9 * static_cast<double>(when - origin), 1e-12) << i;
+      EXPECT_EQ(std::stod(rows[i + 1][0]), decimalSeconds(when - origin)) << i;  // exactly the decimal, not a product with 1e-9
       for (std::size_t q = 0; q < 7; ++q) {
         const std::string name = w["name"][q];
         const std::size_t col = static_cast<std::size_t>(std::find(rows[0].begin(), rows[0].end(), name) - rows[0].begin());
@@ -591,7 +598,7 @@ TEST_F(McapFixtures, ExportWritesTheSuitesOwnFiles) {
     for (int i = 0; i < 10; ++i) {
       const nlohmann::json& w = truth_["images"][i];
       const std::uint64_t when = ns(w["log_time_ns"]) - (header ? 35000000 : 0);
-      EXPECT_NEAR(std::stod(times[i + 1][1]), 1e-9 * static_cast<double>(when - origin), 1e-12) << i;
+      EXPECT_EQ(std::stod(times[i + 1][1]), decimalSeconds(when - origin)) << i;
       cv::Mat frame;
       ASSERT_TRUE(cap.read(frame)) << i;
       ASSERT_EQ(frame.size(), cv::Size(64, 48));

@@ -18,6 +18,12 @@ const std::string kTimeDef = "int32 sec\nuint32 nanosec\n";
 const std::string kHeaderDef = "builtin_interfaces/Time stamp\nstring frame_id\n";
 const std::string kHeaderDeps = kDefSep + "MSG: std_msgs/Header\n" + kHeaderDef + kDefSep + "MSG: builtin_interfaces/Time\n" + kTimeDef;
 
+// A text column of the current row ("" for NULL).
+std::string columnText(sqlite3_stmt* st, int c) {
+  const unsigned char* p = sqlite3_column_text(st, c);
+  return p ? std::string(reinterpret_cast<const char*>(p), static_cast<std::size_t>(sqlite3_column_bytes(st, c))) : std::string();
+}
+
 }  // namespace
 
 std::string builtinDefinition(const std::string& type) {
@@ -85,14 +91,8 @@ void Db3Reader::open(std::size_t index) {
   };
   // The stored definitions (rosbag2 Jazzy and later: message_definitions), by type.
   std::map<std::string, std::pair<std::string, std::string>> stored;  // type -> (encoding, text)
-  if (auto [st, err] = query("SELECT topic_type, encoding, encoded_message_definition FROM message_definitions"); st) {
-    while (sqlite3_step(st) == SQLITE_ROW) {
-      auto text = [&](int c) {
-        const unsigned char* p = sqlite3_column_text(st, c);
-        return p ? std::string(reinterpret_cast<const char*>(p), static_cast<std::size_t>(sqlite3_column_bytes(st, c))) : std::string();
-      };
-      stored[text(0)] = {text(1), text(2)};
-    }
+  if (sqlite3_stmt* st = query("SELECT topic_type, encoding, encoded_message_definition FROM message_definitions").first) {
+    while (sqlite3_step(st) == SQLITE_ROW) stored[columnText(st, 0)] = {columnText(st, 1), columnText(st, 2)};
     sqlite3_finalize(st);
   }
   const auto damaged = [&] {
@@ -100,17 +100,15 @@ void Db3Reader::open(std::size_t index) {
     return code == SQLITE_CORRUPT || code == SQLITE_NOTADB;
   };
   const std::string recover = " (sqlite3's .recover command may save the rows that are left)";
-  auto [topics, terr] = query("SELECT id, name, type, serialization_format FROM topics");
+  const auto topics_query = query("SELECT id, name, type, serialization_format FROM topics");
+  sqlite3_stmt* const topics = topics_query.first;
+  const std::string& terr = topics_query.second;
   if (!topics) fail(damaged() ? "damaged: " + terr + recover : "no topics table (" + terr + "): not a rosbag2 sqlite3 file");
   topic_ids_.clear();
   int rc = 0;
   while ((rc = sqlite3_step(topics)) == SQLITE_ROW) {
-    auto text = [&](int c) {
-      const unsigned char* p = sqlite3_column_text(topics, c);
-      return p ? std::string(reinterpret_cast<const char*>(p), static_cast<std::size_t>(sqlite3_column_bytes(topics, c))) : std::string();
-    };
     const std::int64_t id = sqlite3_column_int64(topics, 0);
-    const std::string name = text(1), type = text(2), format = text(3);
+    const std::string name = columnText(topics, 1), type = columnText(topics, 2), format = columnText(topics, 3);
     auto [it, fresh] = channel_of_topic_.try_emplace(name, static_cast<std::uint16_t>(channels_.size() + 1));
     if (fresh) {
       if (channels_.size() >= 65000) {
@@ -147,7 +145,9 @@ void Db3Reader::open(std::size_t index) {
   }
   sqlite3_finalize(topics);
   if (rc != SQLITE_DONE) fail(std::string("the topics table cannot be read: ") + sqlite3_errmsg(db_->db) + (damaged() ? recover : ""));
-  auto [rows, merr] = query("SELECT id, topic_id, timestamp, data FROM messages ORDER BY timestamp, id");
+  const auto rows_query = query("SELECT id, topic_id, timestamp, data FROM messages ORDER BY timestamp, id");
+  sqlite3_stmt* const rows = rows_query.first;
+  const std::string& merr = rows_query.second;
   if (!rows) fail(damaged() ? "damaged: " + merr + recover : "no messages table (" + merr + "): not a rosbag2 sqlite3 file");
   db_->rows = rows;
 }

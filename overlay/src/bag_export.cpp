@@ -117,9 +117,11 @@ std::string chooseTopic(const std::map<std::uint16_t, LogSource>& sources, std::
 
 std::string exactText(double v) { return shortestNumber(v); }
 
-// Seconds since the origin, as the state log and frame-times readers take them.
+// Seconds since the origin, as the state log and frame-times readers take them: the nanoseconds
+// divided by 1e9 (the double nearest the exact quotient: 3333500000 ns is 3.3335, where a product
+// with 1e-9 gives 3.3335000000000004).
 std::string secondsText(std::int64_t t, std::uint64_t origin) {
-  return shortestNumber(1e-9 * static_cast<double>(t - static_cast<std::int64_t>(origin)));
+  return shortestNumber(static_cast<double>(t - static_cast<std::int64_t>(origin)) / 1e9);
 }
 
 std::vector<double> numbersOf(const Value& v) {
