@@ -705,4 +705,97 @@ TEST(BagImages, EveryEncodingBecomesTheSameBgrFrame) {
   }
 }
 
+// `kccd overlay --bag`: the same frames (PNG bytes) and report as the overlay of the bag's exported
+// files, for a log of each format; the model's joints matched by name; mistakes named.
+TEST_F(McapFixtures, OverlayOfABagIsTheOverlayOfItsExportedFiles) {
+  const fs::path out = dir_ / "overlay";
+  fs::create_directories(out);
+  // Seven revolute joints named as the log names them, each with a capsule; a 64x48 camera 2 m away.
+  std::string model = "kccd: 1\nname: seven\nsafety_margin: 0.02\njoints:\n";
+  for (int k = 1; k <= 7; ++k)
+    model += "  - {name: joint" + std::to_string(k) + ", parent: " + (k == 1 ? std::string("world") : "joint" + std::to_string(k - 1)) +
+             ", type: revolute, origin: {xyz: [0, 0, " + (k == 1 ? "0" : "0.12") + "]}, axis: [" + (k % 2 ? "0, 0, 1" : "0, 1, 0") +
+             "], limits: [-3, 3]}\n";
+  model += "bodies:\n  - {name: base, frame: world, points: [[0.3, 0, 0], [0.3, 0, 0.5]], radius: 0.05}\n";
+  for (int k = 1; k <= 7; ++k)
+    model += "  - {name: link" + std::to_string(k) + ", frame: joint" + std::to_string(k) + ", points: [[0, 0, 0], [0.05, 0, 0.1]], radius: 0.03}\n";
+  const std::string model_path = kccd::testing::writeScratch("test_logs", "seven.yaml", model);
+  const std::string camera_path = kccd::testing::writeScratch(
+      "test_logs", "cam64.yaml",
+      "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+      "   data: [ 40, 0, 31.5, 0, 40, 23.5, 0, 0, 1 ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n"
+      "   data: [ 0, 0, 0, 0, 0 ]\nrvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 1.5707963267948966, 0, 0 ]\n"
+      "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0, 0.5, 2 ]\n");
+  const std::string base = std::string(KCCD_CLI) + " overlay " + model_path + " --camera " + camera_path + " --quiet";
+  auto frames = [&](const fs::path& dir) {
+    std::vector<std::string> v;
+    for (int i = 0; i < 10; ++i) v.push_back(readText((dir / ("frame_" + std::string(6 - std::to_string(i).size(), '0') + std::to_string(i) + ".png")).string()));
+    return v;
+  };
+  auto reportFrames = [&](const fs::path& report) {
+    nlohmann::json f = nlohmann::json::parse(readText(report.string())).at("frames");
+    for (nlohmann::json& x : f) x.erase("written");
+    return f;
+  };
+  for (const char* name : {"joint_zstd.mcap", "humble.db3", "ros1_lz4.bag"}) {
+    SCOPED_TRACE(name);
+    const fs::path d = out / name;
+    fs::create_directories(d);
+    const auto ex = runProgram(std::string(KCCD_CLI) + " bag export " + file(name) + " -q --states " + (d / "s.csv").string() + " --video " +
+                               (d / "v.mkv").string() + " --frame-times " + (d / "t.csv").string());
+    ASSERT_EQ(ex.code, 0) << ex.err;
+    const auto files = runProgram(base + " --video " + (d / "v.mkv").string() + " --states " + (d / "s.csv").string() + " --frame-times " +
+                                  (d / "t.csv").string() + " --png-dir " + (d / "files").string() + " --report " + (d / "files.json").string());
+    ASSERT_EQ(files.code, 0) << files.err;
+    const auto direct = runProgram(base + " --bag " + file(name) + " --png-dir " + (d / "bag").string() + " --report " + (d / "bag.json").string());
+    ASSERT_EQ(direct.code, 0) << direct.err;
+    EXPECT_EQ(direct.err, "");
+    EXPECT_EQ(frames(d / "bag"), frames(d / "files"));
+    const nlohmann::json a = reportFrames(d / "bag.json"), b = reportFrames(d / "files.json");
+    EXPECT_EQ(a, b);
+    ASSERT_EQ(a.size(), 10u);
+  }
+  // The clocks: the images were logged 35 ms after their stamps, the joints 2 ms after theirs. On the
+  // stamps the first image (35 ms before the first log time) precedes every joint state; on the log
+  // times it has the first one exactly. Joint 1 moves 0.001 rad per ms: each frame meets states 33 ms
+  // later on the log clock.
+  const auto header = runProgram(base + " --bag " + file("joint_zstd.mcap") + " --report " + (out / "h.json").string());
+  const auto log = runProgram(base + " --bag " + file("joint_zstd.mcap") + " --time-source log --report " + (out / "l.json").string());
+  ASSERT_EQ(header.code, 0) << header.err;
+  ASSERT_EQ(log.code, 0) << log.err;
+  const nlohmann::json h = reportFrames(out / "h.json"), l = reportFrames(out / "l.json");
+  ASSERT_EQ(h.size(), 10u);
+  ASSERT_EQ(l.size(), 10u);
+  EXPECT_EQ(h.at(0).at("state"), "none");
+  EXPECT_EQ(l.at(0).at("state"), "exact");
+  EXPECT_EQ(l.at(0).at("state_values").at(0).get<double>(), 0.1);
+  for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(h.at(i).at("time"), l.at(i).at("time")) << i;  // the frames' own times: 1/30 s apart
+  // Joint states cover 200 ms: frames 1-5 have one on both clocks (the stamps' runs out after frame 6, the log's after 5).
+  EXPECT_NE(h.at(6).at("state"), "none");
+  EXPECT_EQ(l.at(6).at("state"), "none");
+  for (std::size_t i = 1; i <= 5; ++i) {
+    EXPECT_NEAR(l.at(i).at("state_values").at(0).get<double>() - h.at(i).at("state_values").at(0).get<double>(), 0.033, 1e-9) << i;
+  }
+  // Mistakes: one line each.
+  struct Case {
+    std::string args, message;
+  };
+  std::string renamed = model;  // joint7 renamed elbow, which the log does not name
+  for (std::size_t at; (at = renamed.find("joint7")) != std::string::npos;) renamed.replace(at, 6, "elbow");
+  const std::string other = kccd::testing::writeScratch("test_logs", "elbow.yaml", renamed);
+  const Case cases[] = {
+      {base + " --bag " + file("joint_zstd.mcap") + " --video x.mkv --report r.json", "--video: not with --bag"},
+      {base + " --report r.json", "give --video and --states, or --bag"},
+      {std::string(KCCD_CLI) + " overlay " + other + " --camera " + camera_path + " --bag " + file("joint_zstd.mcap") + " --report " + (out / "e.json").string(),
+       "the joint states do not name the model's state value 'elbow' (they name: joint1, joint2, joint3, joint4, joint5, joint6, joint7)"},
+      {base + " --bag " + file("joint_zstd.mcap") + " --image-topic /nope --report " + (out / "e.json").string(), "--image-topic /nope: "},
+  };
+  for (const Case& c : cases) {
+    const auto r = runProgram(c.args);
+    EXPECT_EQ(r.code, 2) << c.args;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
 }  // namespace

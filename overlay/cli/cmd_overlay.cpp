@@ -11,6 +11,7 @@
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
+#include "kccd/overlay/bag_recording.hpp"
 #include "kccd/overlay/frame_times.hpp"
 #include "kccd/overlay/overlay_recording.hpp"
 #include "kccd/overlay/video_sink.hpp"
@@ -22,6 +23,7 @@ namespace {
 
 struct OverlayArgs {
   std::string model, camera, video, states, output, png_dir, report, frames, frame_times, ignore_columns, codec, contact_sheet;
+  std::string bag, image_topic, joint_topic, time_source = "header";
   int contact_frames = 12;
   std::string time_offset_text = "0";  // seconds, or auto:A:B
   double max_gap = 0.0, fps = 0.0;
@@ -61,14 +63,35 @@ Exit runOverlay(const OverlayArgs& a) {
     throw UsageError("nothing to write: give -o VIDEO, --png-dir DIR, --report FILE and/or --contact-sheet FILE");
   const overlay::OverlayOutputs outputs{
       .video = a.output, .png_dir = a.png_dir, .report = a.report, .contact_sheet = a.contact_sheet};
-  overlay::checkOverlayOutputs(outputs, std::vector<std::string>{a.video, a.states, a.model, a.camera, a.frame_times});
+  overlay::checkOverlayOutputs(outputs, std::vector<std::string>{a.video, a.states, a.model, a.camera, a.frame_times, a.bag});
+  if (!a.bag.empty()) {
+    for (const auto& [given, name] : {std::pair{a.video, "--video"}, {a.states, "--states"}, {a.frame_times, "--frame-times"}, {a.ignore_columns, "--ignore-columns"}})
+      if (!given.empty()) throw UsageError(std::string(name) + ": not with --bag (the log gives the frames, their times and the states)");
+    if (a.fps > 0.0) throw UsageError("--fps: not with --bag (each frame has its own time)");
+  } else {
+    if (a.video.empty() || a.states.empty()) throw UsageError("give --video and --states, or --bag (a robot log)");
+    if (!a.image_topic.empty() || !a.joint_topic.empty()) throw UsageError("--image-topic and --joint-topic go with --bag");
+  }
   if (!a.codec.empty() && a.codec.size() != 4)
     throw UsageError("--codec " + a.codec + ": a FourCC is 4 characters (e.g. mp4v, avc1, MJPG, FFV1)");
   overlay::OverlayOptions o;
   o.frames = overlay::parseFrameRange(a.frames, "--frames");
   parseTimeOffset(a.time_offset_text, o);
-  const StateLog log = loadStateLog(a.states, model, splitCommas(a.ignore_columns));
-  overlay::OverlayInputs in{model, camera, log, a.video, {}, "--video " + a.video, a.camera, "--frame-times " + a.frame_times};
+  std::optional<overlay::BagRecording> bag;
+  if (!a.bag.empty()) {
+    bag = overlay::readBagRecording({.bag = a.bag, .joint_topic = a.joint_topic, .image_topic = a.image_topic,
+                                     .time_source = a.time_source == "log" ? overlay::TimeSource::Log : overlay::TimeSource::Header},
+                                    model);
+    for (const std::string& w : bag->warnings) std::cerr << "kccd overlay: warning: --bag " << a.bag << ": " << w << "\n";
+  }
+  const StateLog log = bag ? std::move(bag->log) : loadStateLog(a.states, model, splitCommas(a.ignore_columns));
+  overlay::OverlayInputs in{model, camera, log, bag ? a.bag : a.video, {},
+                            bag ? "--bag " + a.bag + " (topic " + bag->image_topic + ")" : "--video " + a.video, a.camera,
+                            "--frame-times " + a.frame_times};
+  if (bag) {
+    in.frame_times = bag->frame_times;
+    in.open_frames = bag->open_frames;
+  }
   if (!a.frame_times.empty()) try {
       in.frame_times = overlay::loadFrameTimes(a.frame_times);
     } catch (const overlay::FrameTimesError& e) {
@@ -155,8 +178,17 @@ Runner addOverlay(CLI::App& app) {
   sub->add_option("model", a->model, "Model file (YAML, kccd: 1)")->required();
   sub->add_option("--camera", a->camera, "Camera file (OpenCV YAML: intrinsics, distortion, rvec/tvec); its image size must be the video's")
       ->required();
-  sub->add_option("--video", a->video, "Input video (any OpenCV reads) or image sequence (e.g. frames/frame_%06d.png)")->required();
-  sub->add_option("--states", a->states, "State log (CSV: time and one column per state value, see kccd info)")->required();
+  sub->add_option("--video", a->video, "Input video (any OpenCV reads) or image sequence (e.g. frames/frame_%06d.png); or --bag");
+  sub->add_option("--states", a->states, "State log (CSV: time and one column per state value, see kccd info); or --bag");
+  sub->add_option("--bag", a->bag,
+                  "A robot log instead of --video, --states and --frame-times (MCAP, rosbag2 .db3 or folder, ROS 1 .bag): "
+                  "the image topic's frames at their own times, the joint states matched to the model's joints by name");
+  sub->add_option("--image-topic", a->image_topic, "With --bag: the sensor_msgs/Image or CompressedImage topic (default: the only one)");
+  sub->add_option("--joint-topic", a->joint_topic, "With --bag: the sensor_msgs/JointState topic (default: the only one)");
+  sub->add_option("--time-source", a->time_source,
+                  "With --bag: header (the messages' header stamps; the log time where one is zero) or log (the recorder's times)")
+      ->check(CLI::IsMember({"header", "log"}))
+      ->default_str("header");
   sub->add_option("-o,--output", a->output, "Output video (.mp4: mp4v, .mkv: FFV1 lossless, .avi: MJPG; see --codec)");
   sub->add_option("--png-dir", a->png_dir, "Also (or only) write frame_%06d.png (input frame numbers) into this new or empty folder");
   sub->add_option("--frames", a->frames, "Frames to draw and write: FIRST:END:STEP (from 0, END exclusive; all frames are still checked and reported)");

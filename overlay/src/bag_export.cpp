@@ -19,117 +19,13 @@
 #include "kccd/overlay/staged_output.hpp"
 #include "kccd/overlay/video_sink.hpp"
 
+#include "bag_messages.hpp"
+
 namespace kccd::overlay {
 namespace {
 
+using namespace detail;
 using logs::Value;
-
-enum class LogKind { Other, Joints, Image, Compressed, CameraInfo };
-
-LogKind logKindOf(const logs::Channel& c, const logs::Schema* s) {
-  if (!s) return LogKind::Other;
-  const bool ros2 = s->encoding == "ros2msg" && c.message_encoding == "cdr";
-  const bool ros1 = s->encoding == "ros1msg" && c.message_encoding == "ros1";
-  if (!ros1 && !ros2) return LogKind::Other;
-  const std::string t = logs::normalTypeName(s->name);
-  if (t == "sensor_msgs/JointState") return LogKind::Joints;
-  if (t == "sensor_msgs/Image") return LogKind::Image;
-  if (t == "sensor_msgs/CompressedImage") return LogKind::Compressed;
-  if (t == "sensor_msgs/CameraInfo") return LogKind::CameraInfo;
-  return LogKind::Other;
-}
-
-// One channel of a kind the export reads: its definitions, and what the first pass saw.
-struct LogSource {
-  std::string topic;
-  LogKind kind = LogKind::Other;
-  std::optional<logs::MessageDefinitions> types;
-  bool cdr = true;
-  std::size_t count = 0;
-  std::vector<std::string> names;  // joints: the first message's
-  bool all_velocities = true;
-  std::vector<std::int64_t> times;  // images: each message's chosen time
-  std::int64_t first = std::numeric_limits<std::int64_t>::max();  // the earliest chosen time
-};
-
-const Value& fieldOf(const Value& v, const char* field, const std::string& where) {
-  const Value* f = v.field(field);
-  if (!f) throw InputError(where + ": the message has no field '" + field + "'");
-  return *f;
-}
-
-// A message's time on the chosen clock, nanoseconds; `zero` counts header stamps of 0.
-std::int64_t messageTime(const Value& v, const logs::LogMessage& m, TimeSource source, std::size_t& zero) {
-  const auto log = static_cast<std::int64_t>(std::min<std::uint64_t>(m.log_time, std::uint64_t{1} << 62));
-  if (source == TimeSource::Log) return log;
-  const Value* header = v.field("header");
-  const Value* stamp = header ? header->field("stamp") : nullptr;
-  std::int64_t sec = 0, nsec = 0;
-  if (stamp && stamp->kind == Value::Kind::Array && stamp->items.size() == 2) {  // ROS 1 time
-    sec = static_cast<std::int64_t>(stamp->items[0].u), nsec = static_cast<std::int64_t>(stamp->items[1].u);
-  } else if (stamp && stamp->field("sec") && stamp->field("nanosec")) {
-    const double s = stamp->field("sec")->number(), n = stamp->field("nanosec")->number();
-    if (std::abs(s) < 1e10 && n >= 0 && n < 1e10) sec = static_cast<std::int64_t>(s), nsec = static_cast<std::int64_t>(n);
-  }
-  if (sec == 0 && nsec == 0) {
-    ++zero;
-    return log;
-  }
-  return sec * 1000000000 + nsec;
-}
-
-std::string messagePlace(const std::string& bag, const logs::LogReader& r, const logs::LogMessage& m, std::size_t index) {
-  return bag + ": " + r.place(m.offset) + ": topic " + printable(m.channel->topic, 60) + ": message " +
-         std::to_string(index + 1);
-}
-
-Value decodeMessage(const LogSource& s, const logs::LogMessage& m, const std::string& at) {
-  try {
-    return s.cdr ? logs::decodeCdr(*s.types, m.data) : logs::decodeRos1(*s.types, m.data);
-  } catch (const logs::DecodeError& e) {
-    throw InputError(at + " (" + printable(m.schema->name, 60) + ") does not decode: byte " + std::to_string(e.offset()) + " of its " +
-                     std::to_string(m.data.size()) + ": " + printable(e.what(), 200));
-  }
-}
-
-std::string chooseTopic(const std::map<std::uint16_t, LogSource>& sources, std::initializer_list<LogKind> kinds, const std::string& given,
-                   const std::string& option, const std::string& what, const std::string& bag) {
-  std::vector<std::string> fits;
-  for (const auto& [id, s] : sources)
-    if (std::find(kinds.begin(), kinds.end(), s.kind) != kinds.end() && std::find(fits.begin(), fits.end(), s.topic) == fits.end())
-      fits.push_back(s.topic);
-  if (!given.empty()) {
-    if (std::find(fits.begin(), fits.end(), given) == fits.end())
-      throw InputError(option + " " + printable(given, 60) + ": " + bag + " has no " + what + " topic of that name" +
-                       (fits.empty() ? std::string(" (it has none)") : " (it has: " + [&] {
-                         std::string l;
-                         for (const auto& f : fits) l += (l.empty() ? "" : ", ") + printable(f, 60);
-                         return l;
-                       }() + ")"));
-    return given;
-  }
-  if (fits.size() == 1) return fits.front();
-  if (fits.empty()) throw InputError(bag + ": no " + what + " topic (see kccd bag info)");
-  std::string l;
-  for (const auto& f : fits) l += (l.empty() ? "" : ", ") + printable(f, 60);
-  throw InputError(bag + ": several " + what + " topics (" + l + "): choose one with " + option);
-}
-
-std::string exactText(double v) { return shortestNumber(v); }
-
-// Seconds since the origin, as the state log and frame-times readers take them: the nanoseconds
-// divided by 1e9 (the double nearest the exact quotient: 3333500000 ns is 3.3335, where a product
-// with 1e-9 gives 3.3335000000000004).
-std::string secondsText(std::int64_t t, std::uint64_t origin) {
-  return shortestNumber(static_cast<double>(t - static_cast<std::int64_t>(origin)) / 1e9);
-}
-
-std::vector<double> numbersOf(const Value& v) {
-  std::vector<double> out;
-  if (v.kind == Value::Kind::Array)
-    for (const Value& x : v.items) out.push_back(x.number());
-  return out;
-}
 
 }  // namespace
 
@@ -208,60 +104,14 @@ BagExportReport exportBag(const BagExportOptions& o) {
   }
   BagExportReport report;
   // Pass 1: which topics there are, and what the chosen ones hold.
-  std::map<std::uint16_t, LogSource> sources;
-  std::size_t zero_probe = 0;
-  {
-    const std::unique_ptr<logs::LogReader> log = logs::openLog(o.bag);
-    logs::LogReader& reader = *log;
-    logs::LogMessage m;
-    while (reader.next(m)) {
-      auto [it, fresh] = sources.try_emplace(m.channel->id);
-      LogSource& s = it->second;
-      if (fresh) {
-        s.topic = m.channel->topic;
-        s.kind = logKindOf(*m.channel, m.schema);
-        if (s.kind != LogKind::Other) {
-          s.cdr = m.channel->message_encoding == "cdr";
-          try {
-            s.types = logs::MessageDefinitions::parse(m.schema->name, m.schema->data, s.cdr ? logs::Dialect::Ros2 : logs::Dialect::Ros1);
-          } catch (const logs::DefinitionError& e) {
-            throw InputError(o.bag + ": " + reader.place(m.offset) + ": topic " + printable(s.topic, 60) + ": the definition of " +
-                             printable(m.schema->name, 60) + (e.line() ? " (line " + std::to_string(e.line()) + ")" : std::string()) + ": " +
-                             printable(e.what(), 200));
-          }
-        }
-      }
-      if (s.kind == LogKind::Other) continue;
-      const std::string at = messagePlace(o.bag, reader, m, s.count);
-      ++s.count;
-      if (s.kind == LogKind::CameraInfo) continue;
-      const Value v = decodeMessage(s, m, at);
-      const std::int64_t t = messageTime(v, m, o.time_source, zero_probe);
-      s.first = std::min(s.first, t);
-      if (s.kind == LogKind::Joints) {
-        const Value& names = fieldOf(v, "name", at);
-        const std::size_t n = names.items.size();
-        if (s.count == 1)
-          for (const Value& x : names.items) s.names.push_back(x.s);
-        if (numbersOf(fieldOf(v, "velocity", at)).size() != n) s.all_velocities = false;
-      } else {
-        s.times.push_back(t);
-      }
-    }
-    report.damage = reader.damage();
-    if (!report.damage.empty()) report.warnings.push_back(o.bag + ": " + report.damage + "; read up to it");
-  }
+  std::map<std::uint16_t, LogSource> sources = scanLog(o.bag, o.time_source, report.damage);
+  if (!report.damage.empty()) report.warnings.push_back(o.bag + ": " + report.damage + "; read up to it");
   const LogSource* joints = nullptr;
   const LogSource* images = nullptr;
   const LogSource* info = nullptr;
-  auto sourceOf = [&](const std::string& topic) -> const LogSource* {
-    for (const auto& [id, s] : sources)
-      if (s.topic == topic) return &s;
-    return nullptr;
-  };
-  if (!o.states.empty()) joints = sourceOf(report.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, "--joint-topic", "sensor_msgs/JointState", o.bag));
-  if (!o.video.empty()) images = sourceOf(report.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic, "--image-topic", "sensor_msgs/Image or CompressedImage", o.bag));
-  if (!o.camera_info.empty()) info = sourceOf(report.camera_info_topic = chooseTopic(sources, {LogKind::CameraInfo}, o.camera_info_topic, "--camera-info-topic", "sensor_msgs/CameraInfo", o.bag));
+  if (!o.states.empty()) joints = sourceOf(sources, report.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, "--joint-topic", "sensor_msgs/JointState", o.bag));
+  if (!o.video.empty()) images = sourceOf(sources, report.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic, "--image-topic", "sensor_msgs/Image or CompressedImage", o.bag));
+  if (!o.camera_info.empty()) info = sourceOf(sources, report.camera_info_topic = chooseTopic(sources, {LogKind::CameraInfo}, o.camera_info_topic, "--camera-info-topic", "sensor_msgs/CameraInfo", o.bag));
   if (joints) {
     if (joints->names.empty()) throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": the first joint state names no joint");
     std::vector<std::string> sorted = joints->names;
@@ -276,11 +126,7 @@ BagExportReport exportBag(const BagExportOptions& o) {
   }
   if (images) {
     if (images->times.empty()) throw InputError(o.bag + ": topic " + printable(images->topic, 60) + ": no image");
-    std::vector<std::int64_t> d;
-    for (std::size_t i = 1; i < images->times.size(); ++i)
-      if (images->times[i] > images->times[i - 1]) d.push_back(images->times[i] - images->times[i - 1]);
-    std::sort(d.begin(), d.end());
-    report.fps = d.empty() ? 30.0 : std::clamp(1e9 / static_cast<double>(d[d.size() / 2]), 0.1, 1000.0);
+    report.fps = nominalFps(images->times);
   }
   // Pass 2: the outputs, staged; committed together at the end.
   std::optional<StagedOutput> states_out, times_out;
@@ -309,7 +155,9 @@ BagExportReport exportBag(const BagExportOptions& o) {
   std::int64_t origin = std::numeric_limits<std::int64_t>::max();
   for (const LogSource* src : {joints, images})
     if (src) origin = std::min(origin, src->first);
-  report.origin_ns = origin == std::numeric_limits<std::int64_t>::max() ? 0 : static_cast<std::uint64_t>(std::max<std::int64_t>(origin, 0));
+  report.origin_ns = o.origin_ns                                        ? *o.origin_ns
+                     : origin == std::numeric_limits<std::int64_t>::max() ? 0
+                                                                          : static_cast<std::uint64_t>(std::max<std::int64_t>(origin, 0));
   std::map<std::uint16_t, std::size_t> index;
   std::int64_t last_state = 0, last_frame = 0;
   bool any_state = false, any_frame = false;

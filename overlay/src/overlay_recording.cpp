@@ -143,16 +143,20 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
     throw InputError(e.messageFrom(camera_label));
   }
 
-  VideoSource video(in.video, video_label);
+  auto open = [&]() -> std::unique_ptr<FrameSource> {
+    return in.open_frames ? in.open_frames() : std::make_unique<VideoSource>(in.video, video_label);
+  };
+  const std::unique_ptr<FrameSource> source = open();
+  FrameSource& video = *source;
   report.fps = opt.fps > 0.0 ? opt.fps : video.fps();
   if (in.frame_times.empty() && !(report.fps > 0.0 && report.fps < 1e6))
     throw VideoError(video_label + ": the video gives no frame rate: give --fps or --frame-times");
   const FrameClock clock(in.frame_times, report.fps);
   if (opt.time_offset_search) {  // a first pass over the video
-    VideoSource first_pass(in.video, video_label);
+    const std::unique_ptr<FrameSource> first_pass = open();
     const auto [lo, hi] = *opt.time_offset_search;
     report.time_offset_found =
-        findTimeOffset(first_pass, clock, in.log, report.max_gap, lo, hi,
+        findTimeOffset(*first_pass, clock, in.log, report.max_gap, lo, hi,
                        opt.time_offset_label.empty() ? "time offset search" : opt.time_offset_label);
     report.time_offset = report.time_offset_found.offset;
   }

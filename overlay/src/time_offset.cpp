@@ -1,5 +1,7 @@
 #include "kccd/overlay/time_offset.hpp"
 
+#include "kccd/overlay/frame_source.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -32,7 +34,7 @@ double FrameClock::nominalFps() const {
   return median > 0.0 ? 1.0 / median : 25.0;
 }
 
-TimeOffset findTimeOffset(VideoSource& video, const FrameClock& clock, const StateLog& log, double max_gap, double lo,
+TimeOffset findTimeOffset(FrameSource& video, const FrameClock& clock, const StateLog& log, double max_gap, double lo,
                           double hi, const std::string& label) {
   // Pair k: frames k and k + 1, their times and the image motion between them.
   std::vector<double> t0, t1, motion;

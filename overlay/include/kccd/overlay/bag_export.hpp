@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,9 @@ struct BagExportOptions {
   /// are several or none).
   std::string joint_topic, image_topic, camera_info_topic;
   TimeSource time_source = TimeSource::Header;
+  /// Time 0 of the written files, nanoseconds on the chosen clock; default: the earliest time
+  /// exported (of the joint states and the images alike).
+  std::optional<std::uint64_t> origin_ns;
 };
 
 /// What was written.

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -16,6 +17,7 @@
 #include "kccd/braking.hpp"
 #include "kccd/calib/camera.hpp"
 #include "kccd/model.hpp"
+#include "kccd/overlay/frame_source.hpp"
 #include "kccd/overlay/frame_annotator.hpp"
 #include "kccd/overlay/time_offset.hpp"
 #include "kccd/overlay/video_sink.hpp"
@@ -44,6 +46,9 @@ struct OverlayInputs {
   std::string video_label;          ///< e.g. "--video rec.mkv" (default: the path)
   std::string camera_label;         ///< e.g. the camera file's path (default "camera")
   std::string frame_times_label;    ///< e.g. "--frame-times t.csv"
+  /// Opens the frames instead of `video` (e.g. a robot log's image topic, see bag_recording.hpp);
+  /// called once per pass over the frames.
+  std::function<std::unique_ptr<FrameSource>()> open_frames;
 };
 
 /// How a run checks and draws.

@@ -11,7 +11,7 @@
 
 namespace kccd::overlay {
 
-class VideoSource;
+class FrameSource;
 
 /// Frame i's time on the video clock, in seconds: the i-th entry of a frame-times list (NaN past
 /// its end or where it has none), or i / fps without one.
@@ -52,7 +52,7 @@ struct TimeOffset {
 /// to its end (a frame that cannot be decoded ends the reading). `max_gap` is the largest log gap
 /// bridged (stateAt). Throws TimeOffsetError naming `label` when fewer than 11 frames have
 /// times, the grid exceeds 200,000 steps or the best correlation is below 0.3.
-TimeOffset findTimeOffset(VideoSource& video, const FrameClock& clock, const StateLog& log, double max_gap, double lo,
+TimeOffset findTimeOffset(FrameSource& video, const FrameClock& clock, const StateLog& log, double max_gap, double lo,
                           double hi, const std::string& label);
 
 }  // namespace kccd::overlay

@@ -8,6 +8,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "kccd/input_error.hpp"
+#include "kccd/overlay/frame_source.hpp"
 
 namespace cv {
 class VideoCapture;
@@ -27,25 +28,25 @@ class VideoError : public InputError {
 /// or from 1 when there is no frame 0, up to the first missing number; each file read by
 /// calib::readImageFile); any other path must be a regular file that OpenCV's FFmpeg back end
 /// decodes.
-class VideoSource {
+class VideoSource final : public FrameSource {
  public:
   /// Opens `path`. `label` names it in errors (default: the path). Throws VideoError.
   explicit VideoSource(const std::string& path, const std::string& label = "");
-  ~VideoSource();
+  ~VideoSource() override;
   VideoSource(const VideoSource&) = delete;
   VideoSource& operator=(const VideoSource&) = delete;
 
   /// True for an image sequence.
   bool isSequence() const { return sequence_; }
   /// The frame rate the recording declares, or 0 when it declares none.
-  double fps() const;
+  double fps() const override;
   /// The number of frames the recording declares, or 0 when unknown.
-  std::size_t declaredFrames() const;
+  std::size_t declaredFrames() const override;
   /// Reads the next frame into `frame` (BGR as decoded); false at the end. Throws VideoError
   /// naming the frame's index when the decoder fails on it.
-  bool read(cv::Mat& frame);
+  bool read(cv::Mat& frame) override;
   /// Index of the next frame read() returns (0 before the first).
-  std::size_t nextIndex() const { return next_; }
+  std::size_t nextIndex() const override { return next_; }
 
  private:
   std::unique_ptr<cv::VideoCapture> capture_;  ///< a video file

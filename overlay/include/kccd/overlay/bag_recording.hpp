@@ -1,0 +1,43 @@
+// A robot log read as the overlay's recording (`kccd overlay --bag`): its joint states as a state
+// log of the model's joints, matched by name, and its image topic as frames with their times.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "kccd/model.hpp"
+#include "kccd/overlay/bag_export.hpp"
+#include "kccd/overlay/frame_source.hpp"
+#include "kccd/state_log.hpp"
+
+namespace kccd::overlay {
+
+/// Which log, topics (empty: the one of the fitting type) and clock.
+struct BagRecordingOptions {
+  std::string bag;
+  std::string joint_topic, image_topic;
+  TimeSource time_source = TimeSource::Header;
+};
+
+/// The recording: what OverlayInputs takes, and what was found.
+struct BagRecording {
+  StateLog log;                     ///< the model's state values over time (seconds from origin_ns)
+  std::vector<double> frame_times;  ///< each frame's time on the same clock
+  /// Opens the frames (a pass over the log's image topic, decoded to BGR): OverlayInputs::open_frames.
+  std::function<std::unique_ptr<FrameSource>()> open_frames;
+  std::string joint_topic, image_topic;
+  std::uint64_t origin_ns = 0;
+  double fps = 0.0;               ///< the median frame interval's rate
+  std::vector<std::string> warnings;
+};
+
+/// Reads what the overlay needs from the log. Every state value of `model` must be named by the
+/// joint states (an InputError naming the joint and the names the log has); joints the model
+/// lacks are left out with one warning. Images and joint states whose time is not after the
+/// previous one's on their topic are left out (a warning). Throws InputError.
+BagRecording readBagRecording(const BagRecordingOptions& options, const Model& model);
+
+}  // namespace kccd::overlay

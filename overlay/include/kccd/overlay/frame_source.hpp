@@ -1,0 +1,26 @@
+// A recording's frames, read in order, whatever holds them (a video file, an image sequence, the
+// image topic of a robot log): what the overlay and the time-offset search read.
+#pragma once
+
+#include <cstddef>
+
+#include <opencv2/core.hpp>
+
+namespace kccd::overlay {
+
+/// Frames read in order.
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  /// The frame rate the recording declares, or 0 when it declares none.
+  virtual double fps() const = 0;
+  /// The number of frames the recording declares, or 0 when unknown.
+  virtual std::size_t declaredFrames() const = 0;
+  /// Reads the next frame into `frame` (8-bit BGR, or as decoded); false at the end. Throws an
+  /// InputError naming the frame when it cannot be had.
+  virtual bool read(cv::Mat& frame) = 0;
+  /// Index of the next frame read() returns (0 before the first).
+  virtual std::size_t nextIndex() const = 0;
+};
+
+}  // namespace kccd::overlay
