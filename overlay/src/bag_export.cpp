@@ -202,24 +202,12 @@ BagExportReport exportBag(const BagExportOptions& o) {
           ++report.dropped_states;
           continue;
         }
-        const Value& names = fieldOf(v, "name", at);
-        const std::vector<double> pos = numbersOf(fieldOf(v, "position", at)), vel = numbersOf(fieldOf(v, "velocity", at));
-        if (pos.size() != names.items.size()) throw InputError(at + ": " + std::to_string(names.items.size()) + " names but " + std::to_string(pos.size()) + " positions");
-        std::vector<double> row(report.joints.size() * (report.velocities ? 2 : 1), std::nan(""));
-        for (std::size_t i = 0; i < names.items.size(); ++i) {
-          const auto c = std::find(report.joints.begin(), report.joints.end(), names.items[i].s);
-          if (c == report.joints.end()) {  // a joint the first message did not name
-            ++extra_names;
-            continue;
-          }
-          const std::size_t col = static_cast<std::size_t>(c - report.joints.begin());
-          row[col] = pos[i];
-          if (report.velocities) row[report.joints.size() + col] = vel.at(i);
-        }
-        for (std::size_t col = 0; col < row.size(); ++col) {
-          if (std::isnan(row[col]) && col < report.joints.size()) throw InputError(at + ": joint '" + printable(report.joints[col], 60) + "' is not given (every message must name the first message's joints)");
-          if (!std::isfinite(row[col]) || std::abs(row[col]) > 1e300)
-            throw InputError(at + ": joint '" + printable(report.joints[col % report.joints.size()], 60) + "': " + (col < report.joints.size() ? "position " : "velocity ") + formatNumber(row[col], 6) + " is not a finite number");
+        std::vector<double> row;
+        try {
+          row = jointRow(v, at, report.joints, report.velocities, extra_names);
+        } catch (const InputError& e) {
+          const std::string what = e.what();
+          throw InputError(what.find("' is not given") != std::string::npos ? what + " (every message must name the first message's joints)" : what);
         }
         states_file << secondsText(time, report.origin_ns);
         for (const double x : row) states_file << "," << exactText(x);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -134,7 +135,11 @@ inline std::vector<double> numbersOf(const Value& v) {
 // Pass 1 over a log: every channel, and for those of the kinds read their definitions, message
 // count, first joint names, whether every joint state gives velocities, each image's time and the
 // earliest time on the chosen clock. `damage`: where the log was cut short, if it was.
-inline std::map<std::uint16_t, LogSource> scanLog(const std::string& bag, TimeSource time_source, std::string& damage) {
+// `visit`, when given, sees every decoded joint state and image with its time and place.
+using MessageVisitor = std::function<void(const LogSource&, std::uint16_t channel, const Value&, std::int64_t time, const std::string& at)>;
+
+inline std::map<std::uint16_t, LogSource> scanLog(const std::string& bag, TimeSource time_source, std::string& damage,
+                                                 const MessageVisitor& visit = {}) {
   std::map<std::uint16_t, LogSource> sources;
   std::size_t zero_probe = 0;
   const std::unique_ptr<logs::LogReader> log = logs::openLog(bag);
@@ -164,6 +169,7 @@ inline std::map<std::uint16_t, LogSource> scanLog(const std::string& bag, TimeSo
     const Value v = decodeMessage(s, m, at);
     const std::int64_t t = messageTime(v, m, time_source, zero_probe);
     s.first = std::min(s.first, t);
+    if (visit) visit(s, m.channel->id, v, t, at);
     if (s.kind == LogKind::Joints) {
       const Value& names = fieldOf(v, "name", at);
       const std::size_t n = names.items.size();
@@ -192,6 +198,37 @@ inline double nominalFps(const std::vector<std::int64_t>& times) {
     if (times[i] > times[i - 1]) d.push_back(times[i] - times[i - 1]);
   std::sort(d.begin(), d.end());
   return d.empty() ? 30.0 : std::clamp(1e9 / static_cast<double>(d[d.size() / 2]), 0.1, 1000.0);
+}
+
+// A joint state's values in `columns` order: the positions, then (with `velocities`) the
+// velocities, NaN where the message gives none. Joints not in `columns` are counted in `extra`.
+// Throws InputError naming `at` for a column the message does not name or a value not finite.
+inline std::vector<double> jointRow(const Value& v, const std::string& at, const std::vector<std::string>& columns, bool velocities,
+                                    std::size_t& extra) {
+  const Value& names = fieldOf(v, "name", at);
+  const std::vector<double> pos = numbersOf(fieldOf(v, "position", at)), vel = numbersOf(fieldOf(v, "velocity", at));
+  if (pos.size() != names.items.size())
+    throw InputError(at + ": " + std::to_string(names.items.size()) + " names but " + std::to_string(pos.size()) + " positions");
+  std::vector<double> row(columns.size() * (velocities ? 2 : 1), std::nan(""));
+  for (std::size_t i = 0; i < names.items.size(); ++i) {
+    const auto c = std::find(columns.begin(), columns.end(), names.items[i].s);
+    if (c == columns.end()) {
+      ++extra;
+      continue;
+    }
+    const std::size_t col = static_cast<std::size_t>(c - columns.begin());
+    row[col] = pos[i];
+    if (velocities && i < vel.size()) row[columns.size() + col] = vel[i];
+  }
+  for (std::size_t col = 0; col < row.size(); ++col) {
+    if (std::isnan(row[col]) && col < columns.size())
+      throw InputError(at + ": joint '" + printable(columns[col], 60) + "' is not given");
+    if (col >= columns.size() && std::isnan(row[col])) continue;  // no velocity: the caller decides
+    if (!std::isfinite(row[col]) || std::abs(row[col]) > 1e300)
+      throw InputError(at + ": joint '" + printable(columns[col % columns.size()], 60) + "': " + (col < columns.size() ? "position " : "velocity ") +
+                       formatNumber(row[col], 6) + " is not a finite number");
+  }
+  return row;
 }
 
 }  // namespace kccd::overlay::detail

@@ -1,12 +1,10 @@
 #include "kccd/overlay/bag_recording.hpp"
 
 #include <algorithm>
-#include <filesystem>
-#include <random>
+#include <cmath>
 
 #include "bag_messages.hpp"
 #include "kccd/input_error.hpp"
-#include "kccd/overlay/video_source.hpp"
 
 namespace kccd::overlay {
 namespace {
@@ -57,34 +55,83 @@ class BagFrames final : public FrameSource {
   std::int64_t last_ = 0;
 };
 
-// A folder of this run's own for the exported state log, removed when done.
-struct ScratchFolder {
-  std::filesystem::path path;
-  ScratchFolder() {
-    std::random_device rd;
-    path = std::filesystem::temp_directory_path() / ("kccd-bag-" + std::to_string(rd()) + std::to_string(rd()));
-    std::filesystem::create_directories(path);
-  }
-  ~ScratchFolder() {
-    std::error_code ec;
-    std::filesystem::remove_all(path, ec);
-  }
-};
-
 }  // namespace
 
 BagRecording readBagRecording(const BagRecordingOptions& o, const Model& model) {
   BagRecording rec;
-  // The images first: their topic, times and rate; time 0 is the earliest joint state or image,
-  // as `kccd bag export` makes it.
+  // One pass: every topic, the images' times, and per joint-state topic its rows for the model's
+  // state values (the first problem kept, reported only if that topic is the one used).
+  const std::vector<std::string> wanted = model.stateNames();
+  struct Rows {
+    std::vector<std::int64_t> times;
+    std::vector<std::vector<double>> values;  // positions, then velocities (NaN: none given)
+    bool velocities = true;
+    std::size_t extra = 0, dropped = 0;
+    std::string problem;
+  };
+  std::map<std::uint16_t, Rows> rows;
   std::string damage;
-  const std::map<std::uint16_t, LogSource> sources = scanLog(o.bag, o.time_source, damage);
+  const std::map<std::uint16_t, LogSource> sources =
+      scanLog(o.bag, o.time_source, damage, [&](const LogSource& s, std::uint16_t channel, const logs::Value& v, std::int64_t t, const std::string& at) {
+        if (s.kind != LogKind::Joints) return;
+        Rows& r = rows[channel];
+        if (!r.problem.empty()) return;
+        if (!r.times.empty() && t <= r.times.back()) {
+          ++r.dropped;
+          return;
+        }
+        try {
+          std::vector<double> row = jointRow(v, at, wanted, true, r.extra);
+          for (std::size_t k = wanted.size(); k < row.size(); ++k) r.velocities = r.velocities && !std::isnan(row[k]);
+          r.times.push_back(t);
+          r.values.push_back(std::move(row));
+        } catch (const InputError& e) {
+          r.problem = e.what();
+        }
+      });
+  if (!damage.empty()) rec.warnings.push_back(o.bag + ": " + damage + "; read up to it");
   rec.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic, "--image-topic", "sensor_msgs/Image or CompressedImage", o.bag);
   rec.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, "--joint-topic", "sensor_msgs/JointState", o.bag);
   const LogSource& images = *sourceOf(sources, rec.image_topic);
-  const LogSource& joint_source = *sourceOf(sources, rec.joint_topic);
-  const std::int64_t origin = std::min(images.first, joint_source.first);
-  rec.origin_ns = origin == std::numeric_limits<std::int64_t>::max() ? 0 : static_cast<std::uint64_t>(std::max<std::int64_t>(origin, 0));
+  std::uint16_t joint_channel = 0;
+  for (const auto& [id, src] : sources)
+    if (src.topic == rec.joint_topic) joint_channel = id;
+  const LogSource& joints = sources.at(joint_channel);
+  const Rows& r = rows[joint_channel];
+  if (!r.problem.empty()) {
+    // A state value the log does not name: say which names it has.
+    if (r.problem.find("' is not given") != std::string::npos) {
+      std::string have;
+      for (const std::string& j : joints.names) have += (have.empty() ? "" : ", ") + printable(j, 40);
+      const std::size_t q = r.problem.find("joint '");
+      const std::string name = q == std::string::npos ? std::string() : r.problem.substr(q + 7, r.problem.find('\'', q + 7) - q - 7);
+      throw InputError(o.bag + ": topic " + printable(rec.joint_topic, 60) + ": the joint states do not name the model's state value '" + name +
+                       "' (they name: " + have + ")");
+    }
+    throw InputError(r.problem);
+  }
+  if (r.times.empty()) throw InputError(o.bag + ": topic " + printable(rec.joint_topic, 60) + ": no joint state");
+  const std::int64_t origin = std::min(images.first, joints.first);
+  rec.origin_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(origin, 0));
+  // The state log, as text the state log reader checks like a file.
+  std::string text = "time";
+  for (const std::string& n : wanted) text += "," + n;
+  if (r.velocities)
+    for (const std::string& n : wanted) text += "," + n + ".vel";
+  text += "\n";
+  for (std::size_t i = 0; i < r.times.size(); ++i) {
+    text += secondsText(r.times[i], rec.origin_ns);
+    for (std::size_t k = 0; k < (r.velocities ? r.values[i].size() : wanted.size()); ++k) text += "," + exactText(r.values[i][k]);
+    text += "\n";
+  }
+  rec.log = parseStateLog(text, "--bag " + o.bag + " (topic " + rec.joint_topic + ")", model);
+  if (r.extra > 0) {
+    std::string left_out;
+    for (const std::string& j : joints.names)
+      if (std::find(wanted.begin(), wanted.end(), j) == wanted.end()) left_out += (left_out.empty() ? "" : ", ") + printable(j, 40);
+    rec.warnings.push_back("joints the model lacks, left out: " + (left_out.empty() ? std::to_string(r.extra) + " values" : left_out));
+  }
+  if (r.dropped > 0) rec.warnings.push_back(std::to_string(r.dropped) + " joint states left out: their time was not after the previous one's");
   std::size_t dropped = 0;
   std::int64_t last = 0;
   for (const std::int64_t t : images.times) {
@@ -96,41 +143,8 @@ BagRecording readBagRecording(const BagRecordingOptions& o, const Model& model) 
     rec.frame_times.push_back(static_cast<double>(t - static_cast<std::int64_t>(rec.origin_ns)) / 1e9);
   }
   if (rec.frame_times.empty()) throw InputError(o.bag + ": topic " + printable(rec.image_topic, 60) + ": no image");
-  rec.fps = nominalFps(images.times);
-  // The joint states: the export's state log on the same clock, read against the model.
-  ScratchFolder scratch;
-  const std::string states = (scratch.path / "states.csv").string();
-  BagExportOptions ex;
-  ex.bag = o.bag;
-  ex.states = states;
-  ex.joint_topic = rec.joint_topic;
-  ex.time_source = o.time_source;
-  ex.origin_ns = rec.origin_ns;
-  const BagExportReport r = exportBag(ex);
-  rec.warnings = r.warnings;
   if (dropped > 0) rec.warnings.push_back(std::to_string(dropped) + " images left out: their time was not after the previous one's");
-  const std::vector<std::string> wanted = model.stateNames();
-  for (const std::string& n : wanted)
-    if (std::find(r.joints.begin(), r.joints.end(), n) == r.joints.end()) {
-      std::string have;
-      for (const std::string& j : r.joints) have += (have.empty() ? "" : ", ") + printable(j, 40);
-      throw InputError(o.bag + ": topic " + printable(r.joint_topic, 60) + ": the joint states do not name the model's state value '" + n +
-                       "' (they name: " + have + ")");
-    }
-  std::vector<std::string> ignore;
-  std::string left_out;
-  for (const std::string& j : r.joints)
-    if (std::find(wanted.begin(), wanted.end(), j) == wanted.end()) {
-      ignore.push_back(j);
-      if (r.velocities) ignore.push_back(j + ".vel");
-      left_out += (left_out.empty() ? "" : ", ") + printable(j, 40);
-    }
-  if (!left_out.empty()) rec.warnings.push_back("joints the model lacks, left out: " + left_out);
-  try {
-    rec.log = loadStateLog(states, model, ignore);
-  } catch (const InputError& e) {
-    throw InputError(o.bag + ": topic " + printable(r.joint_topic, 60) + ": " + e.problem());
-  }
+  rec.fps = nominalFps(images.times);
   const std::string bag = o.bag, topic = rec.image_topic;
   const TimeSource clock = o.time_source;
   const double fps = rec.fps;
