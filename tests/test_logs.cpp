@@ -67,6 +67,15 @@ class McapFixtures : public ::testing::Test {
     }
     return out;
   }
+  // `kccd bag export` of `bag` into a folder named by `tag`: the state log, frame times and camera file.
+  static std::vector<std::string> exportOf(const std::string& bag, const std::string& tag) {
+    const fs::path out = dir_ / ("export_" + tag);
+    fs::create_directories(out);
+    const auto r = runProgram(std::string(KCCD_CLI) + " bag export " + bag + " -q --states " + (out / "s.csv").string() + " --video " +
+                              (out / "v.mkv").string() + " --frame-times " + (out / "t.csv").string() + " --camera-info " + (out / "c.yaml").string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    return std::vector<std::string>{readText((out / "s.csv").string()), readText((out / "t.csv").string()), readText((out / "c.yaml").string())};
+  }
   static inline fs::path dir_;
   static inline nlohmann::json truth_;
 };
@@ -457,14 +466,6 @@ TEST_F(McapFixtures, Db3BagsReadAsTheSameMessages) {
     EXPECT_EQ(a["format"], "rosbag2 sqlite3");
   }
   // The export of a .db3 is the export of the MCAP file, byte for byte.
-  auto exportOf = [&](const std::string& bag, const std::string& tag) {
-    const fs::path out = dir_ / ("export_" + tag);
-    fs::create_directories(out);
-    const auto r = runProgram(std::string(KCCD_CLI) + " bag export " + bag + " -q --states " + (out / "s.csv").string() + " --video " +
-                              (out / "v.mkv").string() + " --frame-times " + (out / "t.csv").string() + " --camera-info " + (out / "c.yaml").string());
-    EXPECT_EQ(r.code, 0) << r.err;
-    return std::vector<std::string>{readText((out / "s.csv").string()), readText((out / "t.csv").string()), readText((out / "c.yaml").string())};
-  };
   EXPECT_EQ(exportOf(file("humble.db3"), "humble"), exportOf(file("joint_zstd.mcap"), "mcap"));
   EXPECT_EQ(exportOf(file("split"), "split"), exportOf(file("joint_zstd.mcap"), "mcap"));
   // A damaged database: one line that names it and says what may help.
@@ -523,14 +524,6 @@ TEST_F(McapFixtures, Ros1BagsReadAsTheSameRecording) {
     }
     EXPECT_GT(cuts, 50u);
   }
-  auto exportOf = [&](const std::string& bag, const std::string& tag) {
-    const fs::path out = dir_ / ("export_" + tag);
-    fs::create_directories(out);
-    const auto r = runProgram(std::string(KCCD_CLI) + " bag export " + bag + " -q --states " + (out / "s.csv").string() + " --video " +
-                              (out / "v.mkv").string() + " --frame-times " + (out / "t.csv").string() + " --camera-info " + (out / "c.yaml").string());
-    EXPECT_EQ(r.code, 0) << r.err;
-    return std::vector<std::string>{readText((out / "s.csv").string()), readText((out / "t.csv").string()), readText((out / "c.yaml").string())};
-  };
   EXPECT_EQ(exportOf(file("ros1_bz2.bag"), "ros1"), exportOf(file("joint_zstd.mcap"), "mcap1"));
 }
 

@@ -18,30 +18,6 @@ double TopicSummary::rate() const {
 
 namespace {
 
-// A whole number of a header field, when it is one that fits (a definition may declare any type).
-std::optional<std::int64_t> whole(const Value& v) {
-  constexpr std::int64_t kLimit = std::int64_t{1} << 33;
-  if (v.kind == Value::Kind::Int && v.i > -kLimit && v.i < kLimit) return v.i;
-  if (v.kind == Value::Kind::UInt && v.u < static_cast<std::uint64_t>(kLimit)) return static_cast<std::int64_t>(v.u);
-  return std::nullopt;
-}
-
-// A header's stamp as nanoseconds: ROS 2's {sec, nanosec}, ROS 1's time (two 32-bit values).
-std::optional<std::int64_t> stampOf(const Value& message) {
-  const Value* header = message.field("header");
-  if (!header) return std::nullopt;
-  const Value* stamp = header->field("stamp");
-  if (!stamp) return std::nullopt;
-  const Value* sec = nullptr;
-  const Value* nsec = nullptr;
-  if (stamp->kind == Value::Kind::Array && stamp->items.size() == 2) sec = &stamp->items[0], nsec = &stamp->items[1];  // ROS 1 time
-  else sec = stamp->field("sec"), nsec = stamp->field("nanosec");
-  if (!sec || !nsec) return std::nullopt;
-  const auto s = whole(*sec), n = whole(*nsec);
-  if (!s || !n) return std::nullopt;
-  return *s * 1000000000 + *n;
-}
-
 struct TopicState {
   TopicSummary summary;
   std::optional<MessageDefinitions> types;
@@ -102,7 +78,7 @@ BagSummary summarizeBag(const std::string& path) {
                          "topic " + printable(s.topic, 60) + " (" + printable(s.type, 60) + "): message " + std::to_string(s.count) +
                              " does not decode: byte " + std::to_string(e.offset()) + " of its " + std::to_string(m.data.size()) + ": " + printable(e.what(), 200));
       }
-      if (const auto stamp = stampOf(v)) {
+      if (const auto stamp = headerStamp(v)) {
         ++s.stamped;
         if (*stamp == 0) ++s.zero_stamps;
         else t.skews.push_back(static_cast<float>(1e-9 * (static_cast<double>(m.log_time) - static_cast<double>(*stamp))));

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 
 namespace kccd::logs {
 
@@ -22,6 +23,33 @@ double Value::number() const {
     case Kind::Float: return f;
     default: return std::numeric_limits<double>::quiet_NaN();
   }
+}
+
+namespace {
+
+// A whole number of a header field, when it is one that fits (a definition may declare any type).
+std::optional<std::int64_t> wholeField(const Value& v) {
+  constexpr std::int64_t kLimit = std::int64_t{1} << 33;
+  if (v.kind == Value::Kind::Int && v.i > -kLimit && v.i < kLimit) return v.i;
+  if (v.kind == Value::Kind::UInt && v.u < static_cast<std::uint64_t>(kLimit)) return static_cast<std::int64_t>(v.u);
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<std::int64_t> headerStamp(const Value& message) {
+  const Value* header = message.field("header");
+  if (!header) return std::nullopt;
+  const Value* stamp = header->field("stamp");
+  if (!stamp) return std::nullopt;
+  const Value* sec = nullptr;
+  const Value* nsec = nullptr;
+  if (stamp->kind == Value::Kind::Array && stamp->items.size() == 2) sec = &stamp->items[0], nsec = &stamp->items[1];  // ROS 1 time
+  else sec = stamp->field("sec"), nsec = stamp->field("nanosec");
+  if (!sec || !nsec) return std::nullopt;
+  const auto s = wholeField(*sec), n = wholeField(*nsec);
+  if (!s || !n) return std::nullopt;
+  return *s * 1000000000 + *n;
 }
 
 namespace {
@@ -55,13 +83,16 @@ class Decoder {
     need(pad, "padding");
     pos_ += pad;
   }
-  void need(std::size_t n, const char* what) const {
-    if (n > data_.size() - pos_) fail(std::string("the message ends inside ") + what + " (" + std::to_string(n) + " bytes needed, " + std::to_string(data_.size() - pos_) + " left)");
+  // `what`, and `name` after it when given, says what was being read (the text is made on failure only).
+  void need(std::size_t n, const char* what, const std::string* name = nullptr) const {
+    if (n > data_.size() - pos_)
+      fail(std::string("the message ends inside ") + what + (name ? " " + *name : std::string()) + " (" + std::to_string(n) +
+           " bytes needed, " + std::to_string(data_.size() - pos_) + " left)");
   }
   template <class T>
-  T read(const char* what) {
+  T read(const char* what, const std::string* name = nullptr) {
     align(sizeof(T));
-    need(sizeof(T), what);
+    need(sizeof(T), what, name);
     std::uint8_t b[sizeof(T)];
     std::memcpy(b, data_.data() + pos_, sizeof(T));
     if (big_)
@@ -71,11 +102,13 @@ class Decoder {
     std::memcpy(&v, b, sizeof(T));
     return v;
   }
-  std::uint32_t count(std::size_t least_element_bytes, const std::string& what, const char* unit = "elements") {
-    const std::uint32_t n = read<std::uint32_t>(what.c_str());
-    // No count is believed beyond what the remaining bytes can hold.
+  // A 32-bit count of `what` ("a string", or "the array" followed by `name`), believed only as far
+  // as the remaining bytes can hold it. The message text is made only when it is needed.
+  std::uint32_t count(std::size_t least_element_bytes, const char* what, const std::string* name = nullptr, const char* unit = "elements") {
+    const std::uint32_t n = read<std::uint32_t>(what, name);
     if (least_element_bytes > 0 && n > (data_.size() - pos_) / least_element_bytes)
-      fail(what + " of " + std::to_string(n) + " " + unit + ", more than the " + std::to_string(data_.size() - pos_) + " bytes left hold");
+      fail(std::string(what) + (name ? " " + *name : std::string()) + " of " + std::to_string(n) + " " + unit + ", more than the " +
+           std::to_string(data_.size() - pos_) + " bytes left hold");
     return n;
   }
   static std::size_t sizeOf(Primitive p) {
@@ -118,7 +151,7 @@ class Decoder {
       }
       case Primitive::String: {
         v.kind = Value::Kind::String;
-        const std::uint32_t n = count(1, "a string", "bytes");
+        const std::uint32_t n = count(1, "a string", nullptr, "bytes");
         if (cdr_ && n > 0) {  // CDR counts the terminating NUL
           v.s.assign(reinterpret_cast<const char*>(data_.data() + pos_), n - 1);
           if (data_[pos_ + n - 1] != 0) fail("a string without its terminating NUL");
@@ -144,7 +177,7 @@ class Decoder {
     }
     if (f.array == Field::Array::None) return sub ? message(*sub, depth + 1) : primitive(f.primitive);
     std::size_t n = f.length;
-    if (f.array == Field::Array::Dynamic) n = count(sub ? 0 : sizeOf(f.primitive), "the array " + f.name);
+    if (f.array == Field::Array::Dynamic) n = count(sub ? 0 : sizeOf(f.primitive), "the array", &f.name);
     else if (!sub && n > (data_.size() - pos_) / sizeOf(f.primitive))
       fail("the array " + f.name + " of " + std::to_string(n) + " elements, more than the bytes left hold");
     Value v;

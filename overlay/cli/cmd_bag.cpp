@@ -147,7 +147,7 @@ Runner addBag(CLI::App& app) {
       ->check(CLI::IsMember({"header", "log"}))
       ->default_str("header");
   exp->add_flag("--quiet,-q", ex->quiet, "Print only warnings and errors");
-  return [args, ex, info, exp] {
+  return [args, ex, exp] {
     if (exp->parsed()) return runBagExport(*ex);
     return runBagInfo(*args);
   };

@@ -58,24 +58,17 @@ inline const Value& fieldOf(const Value& v, const char* field, const std::string
   return *f;
 }
 
-// A message's time on the chosen clock, nanoseconds; `zero` counts header stamps of 0.
+// A message's time on the chosen clock, nanoseconds; `zero` counts messages whose header stamp is
+// missing or 0 (they take the log time).
 inline std::int64_t messageTime(const Value& v, const logs::LogMessage& m, TimeSource source, std::size_t& zero) {
   const auto log = static_cast<std::int64_t>(std::min<std::uint64_t>(m.log_time, std::uint64_t{1} << 62));
   if (source == TimeSource::Log) return log;
-  const Value* header = v.field("header");
-  const Value* stamp = header ? header->field("stamp") : nullptr;
-  std::int64_t sec = 0, nsec = 0;
-  if (stamp && stamp->kind == Value::Kind::Array && stamp->items.size() == 2) {  // ROS 1 time
-    sec = static_cast<std::int64_t>(stamp->items[0].u), nsec = static_cast<std::int64_t>(stamp->items[1].u);
-  } else if (stamp && stamp->field("sec") && stamp->field("nanosec")) {
-    const double s = stamp->field("sec")->number(), n = stamp->field("nanosec")->number();
-    if (std::abs(s) < 1e10 && n >= 0 && n < 1e10) sec = static_cast<std::int64_t>(s), nsec = static_cast<std::int64_t>(n);
-  }
-  if (sec == 0 && nsec == 0) {
+  const std::optional<std::int64_t> stamp = logs::headerStamp(v);
+  if (!stamp || *stamp == 0) {  // no stamp, or one left unset
     ++zero;
     return log;
   }
-  return sec * 1000000000 + nsec;
+  return *stamp;
 }
 
 inline std::string messagePlace(const std::string& bag, const logs::LogReader& r, const logs::LogMessage& m, std::size_t index) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -29,5 +30,10 @@ struct Value {
   /// A number of any kind as a double (booleans as 0 and 1); NaN for anything else.
   double number() const;
 };
+
+/// A message's header stamp in nanoseconds: the root's `header.stamp`, ROS 2's {sec, nanosec} or
+/// ROS 1's time. None without one, or when its fields are not whole numbers within ±2^33 (a
+/// definition may declare any type); 0 is a stamp the publisher left unset.
+std::optional<std::int64_t> headerStamp(const Value& message);
 
 }  // namespace kccd::logs
