@@ -22,7 +22,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 # The slowest first, so that the jobs end together.
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_urdf fuzz_part fuzz_model fuzz_states fuzz_frame_times fuzz_camera fuzz_tags fuzz_labels fuzz_labels_json fuzz_golden_manifest fuzz_frame fuzz_video fuzz_mcap fuzz_ros_message fuzz_ros1_bag)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_urdf fuzz_part fuzz_model fuzz_states fuzz_frame_times fuzz_camera fuzz_tags fuzz_labels fuzz_labels_json fuzz_golden_manifest fuzz_frame fuzz_video fuzz_mcap fuzz_ros_message fuzz_ros1_bag fuzz_db3 fuzz_joint_map)
 bash scripts/install-deps.sh --fuzz
 # -O1 with line tables only: the fuzzers' stacks keep files and lines, and the build is much shorter.
 CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -49,6 +49,8 @@ ci_runs() {  # inputs per target in --ci mode (15-40 s each on this project's ma
     fuzz_mcap) echo 60000 ;;
     fuzz_ros_message) echo 300000 ;;
     fuzz_ros1_bag) echo 40000 ;;
+    fuzz_db3) echo 20000 ;;
+    fuzz_joint_map) echo 100000 ;;
   esac
 }
 
@@ -69,6 +71,8 @@ seeds() {  # extra seed files from data/ per target
     fuzz_mcap) ;;
     fuzz_ros_message) ;;
     fuzz_ros1_bag) ;;
+    fuzz_db3) ;;
+    fuzz_joint_map) ;;
   esac
 }
 mkdir -p $out/artifacts

@@ -740,9 +740,13 @@ TEST_F(McapFixtures, OverlayOfABagIsTheOverlayOfItsExportedFiles) {
     const auto files = runProgram(base + " --video " + (d / "v.mkv").string() + " --states " + (d / "s.csv").string() + " --frame-times " +
                                   (d / "t.csv").string() + " --png-dir " + (d / "files").string() + " --report " + (d / "files.json").string());
     ASSERT_EQ(files.code, 0) << files.err;
-    const auto direct = runProgram(base + " --bag " + file(name) + " --png-dir " + (d / "bag").string() + " --report " + (d / "bag.json").string());
+    const auto direct = runProgram(base + " --bag " + file(name) + " --png-dir " + (d / "bag").string() + " --report " + (d / "bag.json").string() +
+                                   " --timeline " + (d / "timeline.png").string());
     ASSERT_EQ(direct.code, 0) << direct.err;
     EXPECT_EQ(direct.err, "");
+    const cv::Mat timeline = cv::imread((d / "timeline.png").string());
+    EXPECT_EQ(timeline.cols, 1600);
+    EXPECT_EQ(nlohmann::json::parse(readText((d / "bag.json").string())).at("timeline"), (d / "timeline.png").string());
     EXPECT_EQ(frames(d / "bag"), frames(d / "files"));
     const nlohmann::json a = reportFrames(d / "bag.json"), b = reportFrames(d / "files.json");
     EXPECT_EQ(a, b);
@@ -789,6 +793,99 @@ TEST_F(McapFixtures, OverlayOfABagIsTheOverlayOfItsExportedFiles) {
     EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   }
+}
+
+// A joint map: a state value read from a logged joint of another name, scaled and offset, one in
+// degrees, one constant; every frame's state values follow from the plain run's. Its mistakes are
+// placed at their line.
+TEST_F(McapFixtures, AJointMapRenamesScalesAndFixesStateValues) {
+  const fs::path out = dir_ / "joint_map";
+  fs::create_directories(out);
+  auto modelText = [](const std::string& j3, const std::string& j7) {
+    std::string model = "kccd: 1\nname: seven\nsafety_margin: 0.02\njoints:\n";
+    for (int k = 1; k <= 7; ++k) {
+      const std::string name = k == 3 ? j3 : k == 7 ? j7 : "joint" + std::to_string(k);
+      model += "  - {name: " + name + ", parent: " + (k == 1 ? std::string("world") : k == 4 ? j3 : "joint" + std::to_string(k - 1)) +
+               ", type: revolute, origin: {xyz: [0, 0, " + (k == 1 ? "0" : "0.12") + "]}, axis: [0, 0, 1], limits: [-300, 300]}\n";
+    }
+    model += "bodies:\n  - {name: base, frame: world, points: [[0.3, 0, 0], [0.3, 0, 0.5]], radius: 0.05}\n";
+    model += "  - {name: tip, frame: " + j7 + ", points: [[0, 0, 0], [0.05, 0, 0.1]], radius: 0.03}\n";
+    return model;
+  };
+  const std::string plain = kccd::testing::writeScratch("test_logs", "map_plain.yaml", modelText("joint3", "joint7"));
+  const std::string renamed = kccd::testing::writeScratch("test_logs", "map_renamed.yaml", modelText("rail", "wrist"));
+  const std::string camera = kccd::testing::writeScratch(
+      "test_logs", "map_cam.yaml",
+      "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+      "   data: [ 40, 0, 31.5, 0, 40, 23.5, 0, 0, 1 ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n"
+      "   data: [ 0, 0, 0, 0, 0 ]\nrvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 1.5707963267948966, 0, 0 ]\n"
+      "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0, 0.5, 2 ]\n");
+  const std::string map = kccd::testing::writeScratch("test_logs", "map.yaml",
+                                                      "kccd_joint_map: 1\njoints:\n"
+                                                      "  wrist: {from: joint7, scale: -2.5, offset: 0.25}\n"
+                                                      "  rail: {constant: 0.125}\n"
+                                                      "  joint2: {from: joint2, degrees: true}\n"
+                                                      "  joint5: joint1\n");
+  const std::string bag = file("joint_lz4.mcap");
+  auto run = [&](const std::string& model, const std::string& extra, const std::string& tag) {
+    const fs::path report = out / (tag + ".json");
+    const auto r = runProgram(std::string(KCCD_CLI) + " overlay " + model + " --camera " + camera + " --bag " + bag + " --report " +
+                              report.string() + " --quiet " + extra);
+    EXPECT_EQ(r.code, 0) << r.err;
+    return std::make_pair(r, r.code == 0 ? nlohmann::json::parse(readText(report.string())).at("frames") : nlohmann::json());
+  };
+  const auto [plain_run, a] = run(plain, "", "plain");
+  const auto [mapped_run, b] = run(renamed, "--joint-map " + map, "mapped");
+  ASSERT_EQ(a.size(), 10u);
+  ASSERT_EQ(b.size(), 10u);
+  EXPECT_EQ(plain_run.err, "");
+  EXPECT_NE(mapped_run.err.find("logged joints the model does not read, left out: joint3, joint5\n"), std::string::npos) << mapped_run.err;
+  int compared = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i].at("state"), b[i].at("state")) << i;
+    if (a[i].at("state") == "none") continue;
+    std::vector<double> p = a[i].at("state_values").get<std::vector<double>>(), q = b[i].at("state_values").get<std::vector<double>>();
+    ASSERT_EQ(p.size(), 7u);
+    ASSERT_EQ(q.size(), 7u);
+    EXPECT_EQ(q[0], p[0]);
+    EXPECT_DOUBLE_EQ(q[1], p[1] * M_PI / 180.0);
+    EXPECT_EQ(q[2], 0.125);
+    EXPECT_EQ(q[3], p[3]);
+    EXPECT_EQ(q[4], p[0]);  // joint5 read from joint1
+    EXPECT_EQ(q[5], p[5]);
+    EXPECT_DOUBLE_EQ(q[6], -2.5 * p[6] + 0.25);
+    ++compared;
+  }
+  EXPECT_GE(compared, 5);
+  // Without the map the renamed model's values are missing; with a map of mistakes, each is placed.
+  struct Case {
+    std::string map, message;
+  };
+  const Case cases[] = {
+      {"", "the joint states do not name the model's state value 'rail' (they name: "},
+      {"kccd_joint_map: 1\njoints:\n  wrist: joint7\n  elbow: joint3\n", "map.yaml:4:3: joints.elbow: the model has no state value of that name"},
+      {"kccd_joint_map: 1\njoints:\n  wrist: joint7\n  rail: {from: joint3, constant: 1}\n", "map.yaml:4:"},
+      {"kccd_joint_map: 1\njoints:\n  wrist: joint7\n  rail: {from: joint3, scale: 0}\n", "joints.rail.scale: 0 would ignore the log"},
+      {"kccd_joint_map: 1\njoints:\n  wrist: joint7\n  rail: {from: joint3, gain: 2}\n", "joints.rail"},
+      {"kccd_joint_map: 2\njoints: {}\n", "kccd_joint_map: expected 1"},
+      {"kccd_joint_map: 1\njoints:\n  wrist: joint7\n  rail: {from: joint9}\n",
+       "the joint states do not name 'joint9', which " },
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.map);
+    std::string extra;
+    if (!c.map.empty()) extra = " --joint-map " + kccd::testing::writeScratch("test_logs", "bad_map.yaml", c.map);
+    const auto r = runProgram(std::string(KCCD_CLI) + " overlay " + renamed + " --camera " + camera + " --bag " + bag + " --report " +
+                              (out / "bad.json").string() + extra);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(out / "bad.json"));
+  }
+  const auto no_bag = runProgram(std::string(KCCD_CLI) + " overlay " + plain + " --camera " + camera + " --video v.mkv --states s.csv --joint-map " + map +
+                                 " --report " + (out / "bad.json").string());
+  EXPECT_EQ(no_bag.code, 2);
+  EXPECT_NE(no_bag.err.find("--joint-map go with --bag"), std::string::npos) << no_bag.err;
 }
 
 }  // namespace

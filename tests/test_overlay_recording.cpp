@@ -18,6 +18,7 @@
 #include "kccd/calib/camera.hpp"
 #include "kccd/checker.hpp"
 #include "kccd/overlay/overlay_recording.hpp"
+#include "kccd/overlay/timeline.hpp"
 #include "kccd/overlay/video_sink.hpp"
 #include "kccd/overlay/video_source.hpp"
 
@@ -240,6 +241,91 @@ TEST_F(OverlayRecording, TheVideoSinkShowsItsOutputsOnlyWhenCommitted) {
   int n = 0;
   while (back.read(f)) EXPECT_EQ(cv::norm(f, inputFrame(n++ == 0 ? 2 : 5), cv::NORM_INF), 0.0);  // FFV1: lossless
   EXPECT_EQ(n, 2);
+}
+
+// The timeline of a report made here: each status's span shaded where its frames' times fall, the
+// curve at each bound's height against the margin line, the list's length bounded.
+TEST(Timeline, SpansCurveAndMarginSitWhereTheReportSays) {
+  const Model model = loadModel(kData + "/demo_arm.yaml");
+  overlay::OverlayReport report;
+  report.margin = 0.02;
+  for (int i = 0; i < 40; ++i) {
+    overlay::FrameRecord f;
+    f.time = 0.1 * i;
+    f.status = SafetyStatus::Clear;
+    f.min_distance = 0.1;
+    if (i >= 10 && i <= 14) f.status = SafetyStatus::WithinMargin, f.min_distance = 0.01, f.pairs = {{0, 1}};
+    if (i >= 20 && i <= 22) f.status = SafetyStatus::Colliding, f.min_distance = 0.0, f.pairs = {{0, 1}};
+    if (i >= 30 && i <= 31) f.status = SafetyStatus::NoState, f.min_distance = std::nan("");
+    report.frames.push_back(f);
+  }
+  report.contact_sheet_frames = {0, 21, 39};
+  const cv::Mat img = overlay::drawTimeline(report, model, "test", 1600);
+  ASSERT_EQ(img.cols, 1600);
+  ASSERT_EQ(img.type(), CV_8UC3);
+  // Columns holding each fill (BGR as drawn), and rows of the curve and the margin line.
+  auto columns = [&](cv::Vec3b c) {
+    std::vector<int> xs;
+    for (int x = 0; x < img.cols; ++x) {
+      int n = 0;
+      for (int y = 0; y < img.rows; ++y) n += img.at<cv::Vec3b>(y, x) == c;
+      if (n > 100) xs.push_back(x);  // a span's full height, not a key swatch
+    }
+    return xs;
+  };
+  const std::vector<int> within = columns({150, 220, 255}), colliding = columns({170, 170, 250}), none = columns({215, 215, 215});
+  ASSERT_FALSE(within.empty());
+  ASSERT_FALSE(colliding.empty());
+  ASSERT_FALSE(none.empty());
+  EXPECT_EQ(within.back() - within.front() + 1, static_cast<int>(within.size()));  // one run each
+  EXPECT_EQ(colliding.back() - colliding.front() + 1, static_cast<int>(colliding.size()));
+  // Widths in proportion to the frames (5, 3, 2 frames), centres in proportion to the times.
+  const double w5 = within.size(), w3 = colliding.size(), w2 = none.size();
+  EXPECT_NEAR(w5 / w3, 5.0 / 3.0, 0.05);
+  EXPECT_NEAR(w2 / w3, 2.0 / 3.0, 0.05);
+  const double c5 = 0.5 * (within.front() + within.back()), c3 = 0.5 * (colliding.front() + colliding.back()),
+               c2 = 0.5 * (none.front() + none.back());
+  const double px_per_s = (c3 - c5) / (2.1 - 1.2);
+  EXPECT_NEAR(c2 - c3, (3.05 - 2.1) * px_per_s, 2.0);
+  EXPECT_NEAR(w3, 0.3 * px_per_s, 2.0);
+  // The curve (the darkest blue) in the colliding span sits on the zero line; in the within span at
+  // half the margin line's height.
+  auto curveRow = [&](int x) {
+    for (int y = 0; y < img.rows; ++y)
+      if (img.at<cv::Vec3b>(y, x) == cv::Vec3b(150, 70, 20)) return y;
+    return -1;
+  };
+  auto marginRow = [&](int x) {
+    for (int y = 0; y < img.rows; ++y)
+      if (img.at<cv::Vec3b>(y, x) == cv::Vec3b(0, 110, 230)) return y;
+    return -1;
+  };
+  const int zero = curveRow(static_cast<int>(c3)), half = curveRow(static_cast<int>(c5));
+  int margin_row = -1;
+  for (int x = within.front(); x <= within.back() && margin_row < 0; ++x) margin_row = marginRow(x);  // the line is dashed
+  ASSERT_GT(zero, 0);
+  ASSERT_GT(half, 0);
+  ASSERT_GT(margin_row, 0);
+  EXPECT_NEAR(static_cast<double>(zero - half) / (zero - margin_row), 0.5, 0.05);
+  EXPECT_LT(curveRow(static_cast<int>(c5 - 0.5 * px_per_s)), margin_row);  // a clear frame's bound above the margin
+  // The list: at most 12 spans, then one line for the rest.
+  auto withSpans = [&](int n) {
+    overlay::OverlayReport r;
+    r.margin = 0.02;
+    for (int i = 0; i < 2 * n; ++i) {
+      overlay::FrameRecord f;
+      f.time = i;
+      f.status = i % 2 ? SafetyStatus::Colliding : SafetyStatus::Clear;
+      f.min_distance = i % 2 ? 0.0 : 0.5;
+      r.frames.push_back(f);
+    }
+    return overlay::drawTimeline(r, model, "spans", 800).rows;
+  };
+  EXPECT_EQ(withSpans(12) - withSpans(11), 22);
+  EXPECT_EQ(withSpans(13) - withSpans(12), 22);  // "... and 1 more"
+  EXPECT_EQ(withSpans(30), withSpans(13));
+  EXPECT_THROW(overlay::drawTimeline(report, model, "x", 100), InputError);
+  EXPECT_THROW(overlay::drawTimeline(overlay::OverlayReport{}, model, "x"), InputError);
 }
 
 }  // namespace

@@ -13,6 +13,10 @@
 namespace kccd::logs {
 namespace {
 
+// sqlite3's own words for the last failure, quoting the file's bytes at most as printable text (a
+// damaged schema's "unrecognized token" quotes whatever it holds).
+std::string db3Message(sqlite3* db) { return printable(sqlite3_errmsg(db), 200); }
+
 const std::string kDefSep = std::string(80, '=') + "\n";
 const std::string kTimeDef = "int32 sec\nuint32 nanosec\n";
 const std::string kHeaderDef = "builtin_interfaces/Time stamp\nstring frame_id\n";
@@ -79,11 +83,11 @@ void Db3Reader::open(std::size_t index) {
       fail(in ? "not an SQLite database (rosbag2 .db3)" : "cannot be opened");
   }
   if (sqlite3_open_v2(path.c_str(), &db_->db, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK)
-    fail(std::string("cannot be opened: ") + (db_->db ? sqlite3_errmsg(db_->db) : "out of memory"));
+    fail(std::string("cannot be opened: ") + (db_->db ? db3Message(db_->db) : "out of memory"));
   auto query = [&](const char* sql) {
     sqlite3_stmt* st = nullptr;
     if (sqlite3_prepare_v2(db_->db, sql, -1, &st, nullptr) != SQLITE_OK) {
-      const std::string msg = sqlite3_errmsg(db_->db);
+      const std::string msg = db3Message(db_->db);
       if (st) sqlite3_finalize(st);
       return std::make_pair(static_cast<sqlite3_stmt*>(nullptr), msg);
     }
@@ -144,7 +148,7 @@ void Db3Reader::open(std::size_t index) {
     topic_ids_[id] = it->second;
   }
   sqlite3_finalize(topics);
-  if (rc != SQLITE_DONE) fail(std::string("the topics table cannot be read: ") + sqlite3_errmsg(db_->db) + (damaged() ? recover : ""));
+  if (rc != SQLITE_DONE) fail(std::string("the topics table cannot be read: ") + db3Message(db_->db) + (damaged() ? recover : ""));
   const auto rows_query = query("SELECT id, topic_id, timestamp, data FROM messages ORDER BY timestamp, id");
   sqlite3_stmt* const rows = rows_query.first;
   const std::string& merr = rows_query.second;
@@ -178,7 +182,7 @@ bool Db3Reader::next(LogMessage& out) {
     }
     if (rc != SQLITE_DONE) {
       // A file cut short or damaged: what was read stands, with the damage named.
-      damage_ = files_[file_] + ": " + sqlite3_errmsg(db_->db) + " (after " + std::to_string(row_) + " messages)";
+      damage_ = files_[file_] + ": " + db3Message(db_->db) + " (after " + std::to_string(row_) + " messages)";
       db_.reset();
       return false;
     }

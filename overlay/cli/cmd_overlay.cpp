@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 
@@ -22,8 +23,8 @@ namespace {
 
 
 struct OverlayArgs {
-  std::string model, camera, video, states, output, png_dir, report, frames, frame_times, ignore_columns, codec, contact_sheet;
-  std::string bag, image_topic, joint_topic, time_source = "header";
+  std::string model, camera, video, states, output, png_dir, report, frames, frame_times, ignore_columns, codec, contact_sheet, timeline;
+  std::string bag, image_topic, joint_topic, joint_map, time_source = "header";
   int contact_frames = 12;
   std::string time_offset_text = "0";  // seconds, or auto:A:B
   double max_gap = 0.0, fps = 0.0;
@@ -59,18 +60,21 @@ Exit runOverlay(const OverlayArgs& a) {
   // Every input and option is checked before any frame is decoded.
   const Model model = loadOrExplain(a.model);
   const calib::Camera camera = calib::loadCamera(a.camera);
-  if (a.output.empty() && a.png_dir.empty() && a.report.empty() && a.contact_sheet.empty())
-    throw UsageError("nothing to write: give -o VIDEO, --png-dir DIR, --report FILE and/or --contact-sheet FILE");
+  if (a.output.empty() && a.png_dir.empty() && a.report.empty() && a.contact_sheet.empty() && a.timeline.empty())
+    throw UsageError("nothing to write: give -o VIDEO, --png-dir DIR, --report FILE, --contact-sheet FILE and/or --timeline FILE");
   const overlay::OverlayOutputs outputs{
-      .video = a.output, .png_dir = a.png_dir, .report = a.report, .contact_sheet = a.contact_sheet};
-  overlay::checkOverlayOutputs(outputs, std::vector<std::string>{a.video, a.states, a.model, a.camera, a.frame_times, a.bag});
+      .video = a.output, .png_dir = a.png_dir, .report = a.report, .contact_sheet = a.contact_sheet, .timeline = a.timeline,
+      .timeline_title = std::filesystem::path(a.bag.empty() ? a.video : a.bag).filename().string() + "  (" +
+                        std::filesystem::path(a.model).filename().string() + ")"};
+  overlay::checkOverlayOutputs(outputs, std::vector<std::string>{a.video, a.states, a.model, a.camera, a.frame_times, a.bag, a.joint_map});
   if (!a.bag.empty()) {
     for (const auto& [given, name] : {std::pair{a.video, "--video"}, {a.states, "--states"}, {a.frame_times, "--frame-times"}, {a.ignore_columns, "--ignore-columns"}})
       if (!given.empty()) throw UsageError(std::string(name) + ": not with --bag (the log gives the frames, their times and the states)");
     if (a.fps > 0.0) throw UsageError("--fps: not with --bag (each frame has its own time)");
   } else {
     if (a.video.empty() || a.states.empty()) throw UsageError("give --video and --states, or --bag (a robot log)");
-    if (!a.image_topic.empty() || !a.joint_topic.empty()) throw UsageError("--image-topic and --joint-topic go with --bag");
+    if (!a.image_topic.empty() || !a.joint_topic.empty() || !a.joint_map.empty())
+      throw UsageError("--image-topic, --joint-topic and --joint-map go with --bag");
   }
   if (!a.codec.empty() && a.codec.size() != 4)
     throw UsageError("--codec " + a.codec + ": a FourCC is 4 characters (e.g. mp4v, avc1, MJPG, FFV1)");
@@ -80,7 +84,8 @@ Exit runOverlay(const OverlayArgs& a) {
   std::optional<overlay::BagRecording> bag;
   if (!a.bag.empty()) {
     bag = overlay::readBagRecording({.bag = a.bag, .joint_topic = a.joint_topic, .image_topic = a.image_topic,
-                                     .time_source = a.time_source == "log" ? overlay::TimeSource::Log : overlay::TimeSource::Header},
+                                     .time_source = a.time_source == "log" ? overlay::TimeSource::Log : overlay::TimeSource::Header,
+                                     .joint_map = a.joint_map.empty() ? overlay::JointMap{} : overlay::loadJointMap(a.joint_map, model)},
                                     model);
     for (const std::string& w : bag->warnings) std::cerr << "kccd overlay: warning: --bag " << a.bag << ": " << w << "\n";
   }
@@ -189,11 +194,17 @@ Runner addOverlay(CLI::App& app) {
                   "With --bag: header (the messages' header stamps; the log time where one is zero) or log (the recorder's times)")
       ->check(CLI::IsMember({"header", "log"}))
       ->default_str("header");
+  sub->add_option("--joint-map", a->joint_map,
+                  "With --bag: YAML (kccd_joint_map: 1) saying which logged joint each state value is read from, with a scale, "
+                  "an offset or degrees, or a constant (see docs/formats.md); values it does not list are read by their own name");
   sub->add_option("-o,--output", a->output, "Output video (.mp4: mp4v, .mkv: FFV1 lossless, .avi: MJPG; see --codec)");
   sub->add_option("--png-dir", a->png_dir, "Also (or only) write frame_%06d.png (input frame numbers) into this new or empty folder");
   sub->add_option("--frames", a->frames, "Frames to draw and write: FIRST:END:STEP (from 0, END exclusive; all frames are still checked and reported)");
   sub->add_option("--contact-sheet", a->contact_sheet,
                   "A .png of --contact-frames drawn frames spread over the run, the most critical one included, captioned");
+  sub->add_option("--timeline", a->timeline,
+                  "A .png of the run over time: the smallest distance bound and the margin, the spans within the margin, colliding "
+                  "or without a state shaded and listed with the link pairs responsible, the contact sheet's frames marked");
   sub->add_option("--contact-frames", a->contact_frames, "Frames on the contact sheet")->check(CLI::Range(1, 64))->capture_default_str();
   sub->add_option("--report", a->report, "Per-frame report (.json): state match, status, min distance, pairs within the margin");
   sub->add_option("--frame-times", a->frame_times, "CSV 'frame,time': each frame's time in seconds (default: index / fps)");

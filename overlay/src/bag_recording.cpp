@@ -61,7 +61,9 @@ BagRecording readBagRecording(const BagRecordingOptions& o, const Model& model) 
   BagRecording rec;
   // One pass: every topic, the images' times, and per joint-state topic its rows for the model's
   // state values (the first problem kept, reported only if that topic is the one used).
-  const std::vector<std::string> wanted = model.stateNames();
+  const JointMap map = o.joint_map.states.empty() ? identityJointMap(model) : o.joint_map;
+  const std::vector<std::string> states = model.stateNames();
+  const std::vector<std::string> wanted = map.logged();  // the logged joints read
   struct Rows {
     std::vector<std::int64_t> times;
     std::vector<std::vector<double>> values;  // positions, then velocities (NaN: none given)
@@ -105,8 +107,12 @@ BagRecording readBagRecording(const BagRecordingOptions& o, const Model& model) 
       for (const std::string& j : joints.names) have += (have.empty() ? "" : ", ") + printable(j, 40);
       const std::size_t q = r.problem.find("joint '");
       const std::string name = q == std::string::npos ? std::string() : r.problem.substr(q + 7, r.problem.find('\'', q + 7) - q - 7);
-      throw InputError(o.bag + ": topic " + printable(rec.joint_topic, 60) + ": the joint states do not name the model's state value '" + name +
-                       "' (they name: " + have + ")");
+      std::string what = "the model's state value '" + name + "'";
+      for (const JointSource& s : map.states)
+        if (s.line > 0 && printable(s.from, 60) == name)
+          what = "'" + name + "', which " + map.source + " (line " + std::to_string(s.line) + ") reads '" + printable(s.state, 60) + "' from";
+      throw InputError(o.bag + ": topic " + printable(rec.joint_topic, 60) + ": the joint states do not name " + what + " (they name: " + have +
+                       ")" + (map.source.empty() ? std::string("; --joint-map can rename, scale or fix a state value") : std::string()));
     }
     throw InputError(r.problem);
   }
@@ -114,14 +120,30 @@ BagRecording readBagRecording(const BagRecordingOptions& o, const Model& model) 
   const std::int64_t origin = std::min(images.first, joints.first);
   rec.origin_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(origin, 0));
   // The state log, as text the state log reader checks like a file.
+  // Each state value from its logged joint (scaled, offset) or constant, in the model's order.
+  std::vector<std::size_t> column(states.size(), 0);
+  for (std::size_t k = 0; k < states.size(); ++k)
+    if (!map.states[k].constant)
+      column[k] = static_cast<std::size_t>(std::find(wanted.begin(), wanted.end(), map.states[k].from) - wanted.begin());
   std::string text = "time";
-  for (const std::string& n : wanted) text += "," + n;
+  for (const std::string& n : states) text += "," + n;
   if (r.velocities)
-    for (const std::string& n : wanted) text += "," + n + ".vel";
+    for (const std::string& n : states) text += "," + n + ".vel";
   text += "\n";
   for (std::size_t i = 0; i < r.times.size(); ++i) {
     text += secondsText(r.times[i], rec.origin_ns);
-    for (std::size_t k = 0; k < (r.velocities ? r.values[i].size() : wanted.size()); ++k) text += "," + exactText(r.values[i][k]);
+    for (std::size_t k = 0; k < states.size(); ++k) {
+      const JointSource& s = map.states[k];
+      text += ',';
+      text += exactText(s.constant ? *s.constant : s.scale == 1.0 && s.offset == 0.0 ? r.values[i][column[k]]
+                                                                                          : s.scale * r.values[i][column[k]] + s.offset);
+    }
+    if (r.velocities)
+      for (std::size_t k = 0; k < states.size(); ++k) {
+        const JointSource& s = map.states[k];
+        text += ',';
+        text += exactText(s.constant ? 0.0 : s.scale * r.values[i][wanted.size() + column[k]]);
+      }
     text += "\n";
   }
   rec.log = parseStateLog(text, "--bag " + o.bag + " (topic " + rec.joint_topic + ")", model);
@@ -129,7 +151,7 @@ BagRecording readBagRecording(const BagRecordingOptions& o, const Model& model) 
     std::string left_out;
     for (const std::string& j : joints.names)
       if (std::find(wanted.begin(), wanted.end(), j) == wanted.end()) left_out += (left_out.empty() ? "" : ", ") + printable(j, 40);
-    rec.warnings.push_back("joints the model lacks, left out: " + (left_out.empty() ? std::to_string(r.extra) + " values" : left_out));
+    rec.warnings.push_back("logged joints the model does not read, left out: " + (left_out.empty() ? std::to_string(r.extra) + " values" : left_out));
   }
   if (r.dropped > 0) rec.warnings.push_back(std::to_string(r.dropped) + " joint states left out: their time was not after the previous one's");
   std::size_t dropped = 0;

@@ -33,7 +33,7 @@ void ContactSheet::add(std::size_t index, const cv::Mat& frame, const std::strin
   }
 }
 
-cv::Mat ContactSheet::compose() const {
+std::vector<const ContactSheet::Tile*> ContactSheet::pick() const {
   std::vector<const Tile*> pick;
   const std::size_t even = has_critical_ ? count_ - 1 : count_;
   for (std::size_t k = 0; k < even && !kept_.empty(); ++k) {
@@ -42,8 +42,19 @@ cv::Mat ContactSheet::compose() const {
   }
   if (has_critical_ && std::none_of(pick.begin(), pick.end(), [&](const Tile* t) { return t->index == critical_.index; }))
     pick.push_back(&critical_);
-  if (pick.empty()) return {};
   std::sort(pick.begin(), pick.end(), [](const Tile* a, const Tile* b) { return a->index < b->index; });
+  return pick;
+}
+
+std::vector<std::size_t> ContactSheet::frames() const {
+  std::vector<std::size_t> out;
+  for (const Tile* t : pick()) out.push_back(t->index);
+  return out;
+}
+
+cv::Mat ContactSheet::compose() const {
+  const std::vector<const Tile*> pick = this->pick();
+  if (pick.empty()) return {};
   const int cols = static_cast<int>(std::min<std::size_t>(4, pick.size()));
   const int rows = static_cast<int>((pick.size() + cols - 1) / cols);
   const int caption_h = 22, gap = 4;

@@ -27,6 +27,7 @@
 
 #include "kccd/input_error.hpp"
 #include "kccd/overlay/contact_sheet.hpp"
+#include "kccd/overlay/timeline.hpp"
 #include "kccd/overlay/staged_output.hpp"
 #include "kccd/overlay/video_source.hpp"
 #include "kccd/render/projection.hpp"
@@ -335,12 +336,16 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
     report.unsafe += r.unsafe();
     report.stages += r.times;
   }
-  if (opt.contact_frames > 0) report.contact_sheet = sheet.compose();
+  if (opt.contact_frames > 0) {
+    report.contact_sheet = sheet.compose();
+    report.contact_sheet_frames = sheet.frames();
+  }
   return report;
 }
 
 void checkOverlayOutputs(const OverlayOutputs& out, std::span<const std::string> inputs) {
   if (!out.contact_sheet.empty()) checkOutputPath(out.contact_sheet, out.contact_sheet_option, ".png");
+  if (!out.timeline.empty()) checkOutputPath(out.timeline, out.timeline_option, ".png");
   if (!out.video.empty()) {
     const std::string ext = lowerExtension(out.video);
     if (ext != ".mp4" && ext != ".mkv" && ext != ".avi")
@@ -349,7 +354,7 @@ void checkOverlayOutputs(const OverlayOutputs& out, std::span<const std::string>
   }
   if (!out.report.empty()) checkOutputPath(out.report, out.report_option, ".json");
   for (const std::string& in : inputs)
-    for (const std::string& written : {out.video, out.report})
+    for (const std::string& written : {out.video, out.report, out.contact_sheet, out.timeline})
       if (!in.empty() && !written.empty() && sameFile(in, written))
         throw OutputError(written + ": is an input of this run (" + in + "); write the output elsewhere");
 }
@@ -364,6 +369,11 @@ nlohmann::json writeOverlayOutputs(const OverlayOutputs& out, const OverlayRepor
     if (report.contact_sheet.empty()) throw OutputError(name + ": no frame was drawn (see " + out.frames_option + ")");
     writePngAtomically(out.contact_sheet, report.contact_sheet, name);
     j["contact_sheet"] = out.contact_sheet;
+  }
+  if (!out.timeline.empty()) {
+    writePngAtomically(out.timeline, drawTimeline(report, model, out.timeline_title.empty() ? out.timeline : out.timeline_title),
+                       out.timeline_option + " " + out.timeline);
+    j["timeline"] = out.timeline;
   }
   sink.commit();
   if (!out.report.empty()) writeFileAtomically(out.report, j.dump(1) + "\n", out.report_option + " " + out.report);

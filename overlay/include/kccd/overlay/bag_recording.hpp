@@ -11,6 +11,7 @@
 #include "kccd/model.hpp"
 #include "kccd/overlay/bag_export.hpp"
 #include "kccd/overlay/frame_source.hpp"
+#include "kccd/overlay/joint_map.hpp"
 #include "kccd/state_log.hpp"
 
 namespace kccd::overlay {
@@ -20,6 +21,8 @@ struct BagRecordingOptions {
   std::string bag;
   std::string joint_topic, image_topic;
   TimeSource time_source = TimeSource::Header;
+  /// Where each state value comes from; empty (no states): every state value by its own name.
+  JointMap joint_map;
 };
 
 /// The recording: what OverlayInputs takes, and what was found.
@@ -34,9 +37,9 @@ struct BagRecording {
   std::vector<std::string> warnings;
 };
 
-/// Reads what the overlay needs from the log. Every state value of `model` must be named by the
-/// joint states (an InputError naming the joint and the names the log has); joints the model
-/// lacks are left out with one warning. Images and joint states whose time is not after the
+/// Reads what the overlay needs from the log. Every state value of `model` must be given by the
+/// joint states, by its own name or as the joint map says (an InputError naming the joint and the
+/// names the log has); logged joints not read are left out with one warning. Images and joint states whose time is not after the
 /// previous one's on their topic are left out (a warning). Throws InputError.
 BagRecording readBagRecording(const BagRecordingOptions& options, const Model& model);
 

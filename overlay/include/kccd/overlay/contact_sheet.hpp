@@ -19,6 +19,8 @@ class ContactSheet {
   void add(std::size_t index, const cv::Mat& frame, const std::string& caption, double priority);
   /// The tiles in index order on a grid (4 columns at most), or an empty Mat when none was added.
   cv::Mat compose() const;
+  /// The indices of the frames compose() shows, in order.
+  std::vector<std::size_t> frames() const;
 
  private:
   struct Tile {
@@ -27,6 +29,7 @@ class ContactSheet {
     std::string caption;
   };
   cv::Mat thumbnail(const cv::Mat& frame) const;
+  std::vector<const Tile*> pick() const;
   std::size_t count_;
   int tile_width_;
   std::size_t stride_ = 1;

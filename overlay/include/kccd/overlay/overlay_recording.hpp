@@ -98,6 +98,7 @@ struct OverlayReport {
   StageTimes stages;                ///< every frame's StageTimes summed
   bool timings = false;             ///< OverlayOptions::timings: reportJson gives setup_seconds and stages
   cv::Mat contact_sheet;            ///< selected frames, captioned (empty when none was asked or drawn)
+  std::vector<std::size_t> contact_sheet_frames;  ///< the indices of the frames on it, in order
   /// Index of the first unsafe frame, if any.
   std::optional<std::size_t> firstUnsafe() const;
 };
@@ -119,14 +120,17 @@ struct OverlayOutputs {
   std::string contact_sheet;  ///< .png: OverlayReport::contact_sheet
   std::string video_option = "-o", report_option = "--report", contact_sheet_option = "--contact-sheet";
   std::string frames_option = "--frames";  ///< named when no frame was drawn for the contact sheet
+  std::string timeline;                    ///< .png: drawTimeline of the run (timeline.hpp)
+  std::string timeline_option = "--timeline";
+  std::string timeline_title;              ///< its caption (e.g. the recording's name)
 };
 /// Checks the outputs before a run: each one's extension and folder (checkOutputPath), and that
 /// neither the video nor the report is one of `inputs` (sameFile: no output may replace an input).
 /// Throws OutputError "OPTION PATH: problem".
 void checkOverlayOutputs(const OverlayOutputs& outputs, std::span<const std::string> inputs);
-/// After a run: writes the contact sheet, commits `sink`, writes the report (each staged, in that
+/// After a run: writes the contact sheet and the timeline, commits `sink`, writes the report (each staged, in that
 /// order) and returns the report (reportJson with frames) naming the files written under "video",
-/// "png_dir" and "contact_sheet". Throws OutputError (e.g. a contact sheet with no frame drawn).
+/// "png_dir", "contact_sheet" and "timeline". Throws OutputError (e.g. a contact sheet with no frame drawn).
 nlohmann::json writeOverlayOutputs(const OverlayOutputs& outputs, const OverlayReport& report, const Model& model,
                                    VideoSink& sink);
 /// The report as JSON (the format of `kccd overlay --report`, docs/formats.md section 9): the
