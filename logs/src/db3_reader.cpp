@@ -48,11 +48,110 @@ std::string builtinDefinition(const std::string& type) {
 struct Db3Reader::Db {
   sqlite3* db = nullptr;
   sqlite3_stmt* rows = nullptr;
+  // A file cut short: the rows it still holds, found one id at a time, in (timestamp, id) order,
+  // read through `row_by_id`.
+  bool salvage = false;
+  std::vector<std::pair<std::int64_t, std::int64_t>> found;  // (timestamp, id)
+  std::size_t next = 0;
+  sqlite3_stmt* row_by_id = nullptr;
+  std::string cut;  // what the header declares against what the file holds
   ~Db() {
     if (rows) sqlite3_finalize(rows);
+    if (row_by_id) sqlite3_finalize(row_by_id);
     if (db) sqlite3_close(db);
   }
 };
+
+namespace {
+
+// The bytes a database file's header declares (page size x the in-header page count, when the
+// count is valid: its version number equals the change counter), or 0 when it declares none.
+std::uint64_t declaredBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char h[100] = {};
+  if (!in.read(reinterpret_cast<char*>(h), 100)) return 0;
+  auto be32 = [&](int at) { return (std::uint32_t{h[at]} << 24) | (std::uint32_t{h[at + 1]} << 16) | (std::uint32_t{h[at + 2]} << 8) | h[at + 3]; };
+  const std::uint32_t page = h[16] == 0 && h[17] == 1 ? 65536u : (std::uint32_t{h[16]} << 8) | h[17];
+  if (page < 512 || (page & (page - 1)) != 0 || be32(24) != be32(92)) return 0;
+  return std::uint64_t{page} * be32(28);
+}
+
+// The VFS a cut file is read through: the default one, except that a read the file cannot fill is
+// an error. sqlite3 otherwise fills the missing tail of the last, partial page with zeros, and a row
+// on that page would read as whole with bytes it never held; through this VFS it is not found.
+struct WholePagesFile {
+  sqlite3_file base;
+  sqlite3_file* real() { return reinterpret_cast<sqlite3_file*>(this + 1); }
+};
+sqlite3_vfs* g_default_vfs = nullptr;
+WholePagesFile* shim(sqlite3_file* f) { return reinterpret_cast<WholePagesFile*>(f); }
+sqlite3_file* realOf(sqlite3_file* f) { return shim(f)->real(); }
+int wpClose(sqlite3_file* f) { return realOf(f)->pMethods->xClose(realOf(f)); }
+int wpRead(sqlite3_file* f, void* buf, int amt, sqlite3_int64 off) {
+  const int rc = realOf(f)->pMethods->xRead(realOf(f), buf, amt, off);
+  return rc == SQLITE_IOERR_SHORT_READ ? SQLITE_IOERR_READ : rc;
+}
+int wpWrite(sqlite3_file*, const void*, int, sqlite3_int64) { return SQLITE_READONLY; }
+int wpTruncate(sqlite3_file*, sqlite3_int64) { return SQLITE_READONLY; }
+int wpSync(sqlite3_file*, int) { return SQLITE_OK; }
+int wpFileSize(sqlite3_file* f, sqlite3_int64* size) { return realOf(f)->pMethods->xFileSize(realOf(f), size); }
+int wpLock(sqlite3_file* f, int l) { return realOf(f)->pMethods->xLock(realOf(f), l); }
+int wpUnlock(sqlite3_file* f, int l) { return realOf(f)->pMethods->xUnlock(realOf(f), l); }
+int wpReserved(sqlite3_file* f, int* out) { return realOf(f)->pMethods->xCheckReservedLock(realOf(f), out); }
+int wpControl(sqlite3_file* f, int op, void* arg) { return realOf(f)->pMethods->xFileControl(realOf(f), op, arg); }
+int wpSector(sqlite3_file* f) { return realOf(f)->pMethods->xSectorSize(realOf(f)); }
+int wpDevice(sqlite3_file* f) { return realOf(f)->pMethods->xDeviceCharacteristics(realOf(f)); }
+const sqlite3_io_methods kWholePagesMethods = {1, wpClose, wpRead, wpWrite, wpTruncate, wpSync, wpFileSize, wpLock,
+                                               wpUnlock, wpReserved, wpControl, wpSector, wpDevice,
+                                               nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+int wpOpen(sqlite3_vfs*, sqlite3_filename name, sqlite3_file* f, int flags, int* out_flags) {
+  f->pMethods = nullptr;
+  const int rc = g_default_vfs->xOpen(g_default_vfs, name, realOf(f), flags, out_flags);
+  if (rc == SQLITE_OK && realOf(f)->pMethods) f->pMethods = &kWholePagesMethods;
+  return rc;
+}
+// The VFS's name, registered once (not the default).
+const char* wholePagesVfs() {
+  static const char* const name = [] {
+    static sqlite3_vfs vfs;
+    g_default_vfs = sqlite3_vfs_find(nullptr);
+    if (!g_default_vfs) return static_cast<const char*>(nullptr);
+    vfs = *g_default_vfs;
+    vfs.zName = "kccd_whole_pages";
+    vfs.szOsFile = static_cast<int>(sizeof(WholePagesFile)) + g_default_vfs->szOsFile;
+    vfs.xOpen = wpOpen;
+    vfs.pNext = nullptr;
+    return sqlite3_vfs_register(&vfs, 0) == SQLITE_OK ? vfs.zName : static_cast<const char*>(nullptr);
+  }();
+  return name;
+}
+
+// The message rows a cut file still holds: each id from 1 looked up alone (sqlite3 then reads only
+// the pages on that row's path), until `kGap` ids in a row are missing or unreadable.
+std::vector<std::pair<std::int64_t, std::int64_t>> salvageRows(sqlite3* db) {
+  constexpr std::int64_t kGap = 4096;
+  std::vector<std::pair<std::int64_t, std::int64_t>> found;
+  sqlite3_stmt* st = nullptr;
+  if (sqlite3_prepare_v2(db, "SELECT timestamp FROM messages WHERE id = ?", -1, &st, nullptr) != SQLITE_OK) {
+    if (st) sqlite3_finalize(st);
+    return found;
+  }
+  for (std::int64_t id = 1, missing = 0; missing < kGap && id < (std::int64_t{1} << 47); ++id) {
+    sqlite3_reset(st);
+    sqlite3_bind_int64(st, 1, id);
+    if (sqlite3_step(st) == SQLITE_ROW) {
+      found.emplace_back(sqlite3_column_int64(st, 0), id);
+      missing = 0;
+    } else {
+      ++missing;
+    }
+  }
+  sqlite3_finalize(st);
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+}  // namespace
 
 Db3Reader::Db3Reader(std::vector<std::string> files, std::string label) : files_(std::move(files)), label_(std::move(label)) {
   if (files_.empty()) throw InputError(label_ + ": no .db3 file");
@@ -61,6 +160,10 @@ Db3Reader::Db3Reader(std::vector<std::string> files, std::string label) : files_
 }
 
 Db3Reader::~Db3Reader() = default;
+
+std::string Db3Reader::filePrefix() const {
+  return files_.size() > 1 ? std::filesystem::path(files_[file_]).filename().string() + ": " : std::string();
+}
 
 std::string Db3Reader::place(std::uint64_t offset) const {
   // offset: the file's index in the high bits, the row id below.
@@ -82,8 +185,21 @@ void Db3Reader::open(std::size_t index) {
     if (!in || !in.read(magic, 16) || std::memcmp(magic, "SQLite format 3", 16) != 0)
       fail(in ? "not an SQLite database (rosbag2 .db3)" : "cannot be opened");
   }
-  if (sqlite3_open_v2(path.c_str(), &db_->db, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK)
+  std::error_code size_error;
+  const std::uint64_t size = std::filesystem::file_size(path, size_error), declared = declaredBytes(path);
+  const bool cut = !size_error && declared > size;
+  if (sqlite3_open_v2(path.c_str(), &db_->db, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, cut ? wholePagesVfs() : nullptr) != SQLITE_OK)
     fail(std::string("cannot be opened: ") + (db_->db ? db3Message(db_->db) : "out of memory"));
+  {
+    // A file shorter than its header declares was cut short (a recorder killed, a copy stopped):
+    // sqlite3 then refuses its schema, whose later tables' pages are gone. Reading with the schema
+    // taken as it is lets the rows that remain be found one by one.
+    if (cut) {
+      db_->salvage = true;
+      db_->cut = "cut short at byte " + std::to_string(size) + " of the " + std::to_string(declared) + " its header declares";
+      sqlite3_exec(db_->db, "PRAGMA writable_schema=ON", nullptr, nullptr, nullptr);
+    }
+  }
   auto query = [&](const char* sql) {
     sqlite3_stmt* st = nullptr;
     if (sqlite3_prepare_v2(db_->db, sql, -1, &st, nullptr) != SQLITE_OK) {
@@ -149,6 +265,13 @@ void Db3Reader::open(std::size_t index) {
   }
   sqlite3_finalize(topics);
   if (rc != SQLITE_DONE) fail(std::string("the topics table cannot be read: ") + db3Message(db_->db) + (damaged() ? recover : ""));
+  if (db_->salvage) {
+    db_->found = salvageRows(db_->db);
+    db_->row_by_id = query("SELECT id, topic_id, timestamp, data FROM messages WHERE id = ?").first;
+    if (!db_->row_by_id || db_->found.empty())
+      fail(db_->cut + ", and no message row is left in what remains");
+    return;
+  }
   const auto rows_query = query("SELECT id, topic_id, timestamp, data FROM messages ORDER BY timestamp, id");
   sqlite3_stmt* const rows = rows_query.first;
   const std::string& merr = rows_query.second;
@@ -159,16 +282,28 @@ void Db3Reader::open(std::size_t index) {
 bool Db3Reader::next(LogMessage& out) {
   for (;;) {
     if (!db_) return false;
-    const int rc = sqlite3_step(db_->rows);
+    sqlite3_stmt* const st = db_->salvage ? db_->row_by_id : db_->rows;
+    int rc = SQLITE_DONE;
+    if (!db_->salvage) {
+      rc = sqlite3_step(st);
+    } else {
+      // The next row found that still reads whole; one that does not is skipped and counted.
+      while (db_->next < db_->found.size()) {
+        sqlite3_reset(st);
+        sqlite3_bind_int64(st, 1, db_->found[db_->next++].second);
+        if ((rc = sqlite3_step(st)) == SQLITE_ROW) break;
+        rc = SQLITE_DONE;
+      }
+    }
     if (rc == SQLITE_ROW) {
-      const std::int64_t row = sqlite3_column_int64(db_->rows, 0);
-      const std::int64_t topic = sqlite3_column_int64(db_->rows, 1);
-      const std::int64_t stamp = sqlite3_column_int64(db_->rows, 2);
+      const std::int64_t row = sqlite3_column_int64(st, 0);
+      const std::int64_t topic = sqlite3_column_int64(st, 1);
+      const std::int64_t stamp = sqlite3_column_int64(st, 2);
       const auto t = topic_ids_.find(topic);
       if (t == topic_ids_.end())
         throw InputError(InputLocation{files_[file_], 0, 0, "row " + std::to_string(row)}, "a message of topic id " + std::to_string(topic) + ", which the topics table does not list");
-      const void* blob = sqlite3_column_blob(db_->rows, 3);
-      const int bytes = sqlite3_column_bytes(db_->rows, 3);
+      const void* blob = sqlite3_column_blob(st, 3);
+      const int bytes = sqlite3_column_bytes(st, 3);
       data_.assign(static_cast<const std::uint8_t*>(blob), static_cast<const std::uint8_t*>(blob) + (blob ? bytes : 0));
       const Channel& c = channels_.at(t->second);
       out.channel = &c;
@@ -182,10 +317,12 @@ bool Db3Reader::next(LogMessage& out) {
     }
     if (rc != SQLITE_DONE) {
       // A file cut short or damaged: what was read stands, with the damage named.
-      damage_ = files_[file_] + ": " + db3Message(db_->db) + " (after " + std::to_string(row_) + " messages)";
+      damage_ = filePrefix() + db3Message(db_->db) + " (after " + std::to_string(row_) + " messages)";
       db_.reset();
       return false;
     }
+    if (db_->salvage && damage_.empty())
+      damage_ = filePrefix() + db_->cut + " (the message rows it still holds are read)";
     if (file_ + 1 >= files_.size()) {
       db_.reset();
       return false;

@@ -29,7 +29,7 @@ std::string fixed(double v, int digits) {
 
 Exit runBagInfo(const BagInfoArgs& args) {
   const logs::BagSummary b = logs::summarizeBag(args.bag);
-  if (!b.damage.empty()) std::cerr << "kccd bag info: warning: " << args.bag << ": " << b.damage << "; " << b.messages << " messages read before it\n";
+  if (!b.damage.empty()) std::cerr << "kccd bag info: warning: " << args.bag << ": " << b.damage << "; " << b.messages << " messages read\n";
   if (args.json) {
     nlohmann::json j;
     j["bag"] = b.path;

@@ -91,7 +91,6 @@ BagRecording readBagRecording(const BagRecordingOptions& o, const Model& model) 
           r.problem = e.what();
         }
       });
-  if (!damage.empty()) rec.warnings.push_back(o.bag + ": " + damage + "; read up to it");
   rec.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic, "--image-topic", "sensor_msgs/Image or CompressedImage", o.bag);
   rec.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, "--joint-topic", "sensor_msgs/JointState", o.bag);
   const LogSource& images = *sourceOf(sources, rec.image_topic);
@@ -117,6 +116,9 @@ BagRecording readBagRecording(const BagRecordingOptions& o, const Model& model) 
     throw InputError(r.problem);
   }
   if (r.times.empty()) throw InputError(o.bag + ": topic " + printable(rec.joint_topic, 60) + ": no joint state");
+  if (!damage.empty())
+    rec.warnings.push_back(damage + "; read up to it: " + std::to_string(images.times.size()) + " images and " + std::to_string(r.times.size()) +
+                           " joint states");
   const std::int64_t origin = std::min(images.first, joints.first);
   rec.origin_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(origin, 0));
   // The state log, as text the state log reader checks like a file.

@@ -33,6 +33,7 @@ class Db3Reader final : public LogReader {
  private:
   struct Db;
   void open(std::size_t file);
+  std::string filePrefix() const;  // the file's name and ": " in a split bag, else ""
   std::vector<std::string> files_;
   std::string label_, damage_;
   std::size_t file_ = 0;
