@@ -273,7 +273,11 @@ TEST(McapReader, NotAnMcapFileOrNoFile) {
   EXPECT_THROW(McapReader("/nonexistent/x.mcap"), kccd::InputError);
   const auto r = runProgram(std::string(KCCD_CLI) + " bag info " + text);
   EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(r.err, "kccd: " + text + ": byte 0: not an MCAP file (its first 8 bytes are not the MCAP magic)\n");
+  EXPECT_EQ(r.err, "kccd: " + text + ": byte 0: not a robot log kccd reads: its first bytes are those of no MCAP file, rosbag2 sqlite3 (.db3) "
+                   "file or ROS 1 bag (a rosbag2 folder is given as the folder)\n");
+  const std::string empty = kccd::testing::writeScratch("test_logs", "empty.db3", "");
+  EXPECT_EQ(runProgram(std::string(KCCD_CLI) + " bag info " + empty).err, "kccd: " + empty + ": byte 0: an empty file, not a robot log\n");
+  EXPECT_EQ(runProgram(std::string(KCCD_CLI) + " bag info /nonexistent/x.db3").err, "kccd: /nonexistent/x.db3: file: cannot be opened (no such file)\n");
 }
 
 // An encoder of this file's own (it shares nothing with the decoder): CDR aligned to each
@@ -798,6 +802,10 @@ TEST_F(McapFixtures, OverlayOfABagIsTheOverlayOfItsExportedFiles) {
   ASSERT_EQ(header.code, 0) << header.err;
   ASSERT_EQ(log.code, 0) << log.err;
   const nlohmann::json h = reportFrames(out / "h.json"), l = reportFrames(out / "l.json");
+  const nlohmann::json source = nlohmann::json::parse(readText((out / "l.json").string())).at("source");
+  EXPECT_EQ(source.at("time_source"), "log");
+  EXPECT_EQ(source.at("image_topic"), "/camera/image_raw");
+  EXPECT_EQ(source.at("bag"), file("joint_zstd.mcap"));
   ASSERT_EQ(h.size(), 10u);
   ASSERT_EQ(l.size(), 10u);
   EXPECT_EQ(h.at(0).at("state"), "none");

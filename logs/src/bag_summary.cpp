@@ -22,7 +22,7 @@ struct TopicState {
   TopicSummary summary;
   std::optional<MessageDefinitions> types;
   bool cdr = false;
-  std::vector<float> skews;  // seconds
+  std::vector<double> skews;  // seconds
 };
 
 }  // namespace
@@ -81,7 +81,12 @@ BagSummary summarizeBag(const std::string& path) {
       if (const auto stamp = headerStamp(v)) {
         ++s.stamped;
         if (*stamp == 0) ++s.zero_stamps;
-        else t.skews.push_back(static_cast<float>(1e-9 * (static_cast<double>(m.log_time) - static_cast<double>(*stamp))));
+        else {
+          // Nanoseconds subtracted exactly (both within 2^62), then divided: 35 ms reads 0.035.
+          const auto log = static_cast<std::int64_t>(std::min<std::uint64_t>(m.log_time, std::uint64_t{1} << 62));
+          const std::int64_t stamped = std::clamp<std::int64_t>(*stamp, -(std::int64_t{1} << 62), std::int64_t{1} << 62);
+          t.skews.push_back(static_cast<double>(log - stamped) / 1e9);
+        }
       }
     }
   }

@@ -1,6 +1,7 @@
 #include "kccd/logs/log_reader.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -62,12 +63,21 @@ std::unique_ptr<LogReader> openLog(const std::string& path) {
     return std::make_unique<Db3Reader>(files, path);
   }
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(InputLocation{path, 0, 0, "file"}, "cannot be opened");
+  if (!in) {
+    const int error = errno;
+    throw InputError(InputLocation{path, 0, 0, "file"},
+                     std::string("cannot be opened (") + (std::filesystem::exists(path, ec) ? std::strerror(error) : "no such file") + ")");
+  }
   char magic[16] = {};
   in.read(magic, 16);
-  if (std::memcmp(magic, "SQLite format 3", 16) == 0) return std::make_unique<Db3Reader>(std::vector<std::string>{path});
-  if (std::memcmp(magic, "#ROSBAG V", 9) == 0) return std::make_unique<Ros1Reader>(path);  // which checks the version
-  return std::make_unique<McapReader>(path);  // which says what it is not
+  const std::streamsize got = in.gcount();
+  if (got == 16 && std::memcmp(magic, "SQLite format 3", 16) == 0) return std::make_unique<Db3Reader>(std::vector<std::string>{path});
+  if (got >= 9 && std::memcmp(magic, "#ROSBAG V", 9) == 0) return std::make_unique<Ros1Reader>(path);  // which checks the version
+  if (got >= 8 && std::memcmp(magic, "\x89MCAP", 5) == 0) return std::make_unique<McapReader>(path);  // which checks the rest
+  throw InputError(InputLocation{path, 0, 0, "byte 0"},
+                   got == 0 ? std::string("an empty file, not a robot log")
+                            : "not a robot log kccd reads: its first bytes are those of no MCAP file, rosbag2 sqlite3 (.db3) file or ROS 1 bag "
+                              "(a rosbag2 folder is given as the folder)");
 }
 
 }  // namespace kccd::logs

@@ -120,7 +120,7 @@ Exit runOverlay(const OverlayArgs& a) {
   overlay::VideoSink sink({.video = a.output, .codec = a.codec, .video_label = "-o " + a.output, .png_dir = a.png_dir,
                            .png_label = "--png-dir " + a.png_dir});
   Progress progress("overlay", a.quiet);
-  const overlay::OverlayReport r =
+  overlay::OverlayReport r =
       overlay::overlayRecording(in, o, sink.active() ? &sink : nullptr, [&](const overlay::OverlayProgress& p) {
         const std::size_t n = p.frames_done, expected = p.frames_expected;
         std::string detail = std::to_string(n) + (expected ? "/" + std::to_string(expected) : "") + " frames, " +
@@ -130,6 +130,9 @@ Exit runOverlay(const OverlayArgs& a) {
         progress.update(expected ? static_cast<double>(n) / static_cast<double>(expected) : 0.0, detail);
       });
   progress.finish();
+  if (bag)
+    r.source = {{"bag", a.bag}, {"image_topic", bag->image_topic}, {"joint_topic", bag->joint_topic}, {"time_source", a.time_source},
+                {"origin_ns", std::to_string(bag->origin_ns)}, {"joint_map", a.joint_map}};
 
   nlohmann::json j = overlay::writeOverlayOutputs(outputs, r, model, sink);
   j.erase("frames");  // the summary printed by --json

@@ -28,6 +28,11 @@ nlohmann::json reportJson(const OverlayReport& report, const Model& model, bool 
   j["max_gap"] = report.max_gap;
   j["fps"] = report.fps > 0 ? nlohmann::json(report.fps) : nlohmann::json(nullptr);
   j["margin"] = report.margin;
+  if (!report.source.empty()) {
+    nlohmann::json& src = j["source"] = nlohmann::json::object();
+    for (const auto& [key, value] : report.source)
+      if (!value.empty()) src[key] = value;
+  }
   if (report.timings) {
     const StageTimes& t = report.stages;
     j["timings"] = {{"setup", report.setup_seconds}, {"frames", report.seconds}, {"jobs", report.jobs},

@@ -99,6 +99,9 @@ struct OverlayReport {
   bool timings = false;             ///< OverlayOptions::timings: reportJson gives setup_seconds and stages
   cv::Mat contact_sheet;            ///< selected frames, captioned (empty when none was asked or drawn)
   std::vector<std::size_t> contact_sheet_frames;  ///< the indices of the frames on it, in order
+  /// How the recording was read (e.g. a robot log's file, topics, clock and time 0), written as
+  /// the report's "source" object when not empty; empty values are left out.
+  std::vector<std::pair<std::string, std::string>> source;
   /// Index of the first unsafe frame, if any.
   std::optional<std::size_t> firstUnsafe() const;
 };
