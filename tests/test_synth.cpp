@@ -21,6 +21,7 @@
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/checker.hpp"
+#include "kccd/format_number.hpp"
 #include "kccd/render/renderer.hpp"
 #include "kccd/render/scene.hpp"
 #include "kccd/state_log.hpp"
@@ -237,6 +238,72 @@ TEST_F(Synth, CalibrationRecoversTheTrueCamera) {
   const cv::Vec3d ct = -(rt.t() * truth.tvec), cg = -(rg.t() * got.tvec);
   EXPECT_LT(cv::norm(angle) * 180.0 / M_PI, 0.05);
   EXPECT_LT(cv::norm(ct - cg), 0.005);
+}
+
+// The recording written as a ROS 2 MCAP bag by other projects' writers (tests/bags/write_recording.mjs:
+// its first frames as PNG CompressedImages, its state log as JointState stamped on the video's clock,
+// names rotated per message): `kccd calib --bag` solves the same camera and draws the same check
+// image (the model at the bag's state of the frame) as `calib --video --states --time`, and
+// `overlay --bag` finds the same states, bounds and statuses as the overlay of the files.
+TEST_F(Synth, ARecordingAsABagCalibratesAndOverlaysAsItsFiles) {
+  const json j = summary();
+  const double offset = j["state_log"]["time_offset"], fps = j["video"]["fps"];
+  const std::vector<cv::Mat> video = readVideo(dir("a") + "/video.mkv");
+  ASSERT_GE(video.size(), 10u);
+  fs::create_directories(dir("bagrec"));
+  std::string times = "frame,time\n";
+  for (int i = 0; i < 10; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/f_%06d.png", i);
+    ASSERT_TRUE(cv::imwrite(dir("bagrec") + name, video[static_cast<std::size_t>(i)]));
+    times += std::to_string(i) + "," + kccd::shortestNumber(i / fps) + "\n";
+  }
+  std::ofstream(dir("bagrec") + "/times.csv") << times;
+  const std::string bag = dir("bagrec") + "/rec.mcap";
+  const Outcome w = kccd::testing::runProgram(std::string(KCCD_NODE) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_recording.mjs " + bag + " --images " +
+                                              dir("bagrec") + "/f_%06d.png --frame-times " + dir("bagrec") + "/times.csv --states " + dir("a") +
+                                              "/states.csv --state-offset " + kccd::shortestNumber(offset), true);
+  ASSERT_EQ(w.code, 0) << "the bag writer failed (npm ci in tests/bags?): " << w.out;
+  // calib: frame 0 of the video with the log's state at its time, against frame 0 of the bag.
+  const std::string common = "calib --intrinsics " + dir("a") + "/intrinsics.yaml --tags " + dir("a") + "/tags.yaml --model " + kHumanoid + " -q";
+  const Outcome files = runKccd(common + " --video " + dir("a") + "/video.mkv --frame 3 --states " + dir("a") + "/states.csv --time " +
+                                kccd::shortestNumber(3 / fps + offset) + " -o " + dir("bagrec") + "/cam_files.yaml --check " + dir("bagrec") + "/check_files.png");
+  const Outcome from_bag = runKccd(common + " --bag " + bag + " --frame 3 -o " + dir("bagrec") + "/cam_bag.yaml --check " + dir("bagrec") + "/check_bag.png");
+  ASSERT_EQ(files.code, 0) << files.err;
+  ASSERT_EQ(from_bag.code, 0) << from_bag.err;
+  EXPECT_EQ(from_bag.err, "");
+  EXPECT_EQ(kccd::testing::readText(dir("bagrec") + "/cam_bag.yaml"), kccd::testing::readText(dir("bagrec") + "/cam_files.yaml"));
+  EXPECT_EQ(kccd::testing::readText(dir("bagrec") + "/check_bag.png"), kccd::testing::readText(dir("bagrec") + "/check_files.png"));
+  // A frame the bag does not have, and options that do not go with --bag: one line each.
+  const Outcome beyond = runKccd(common + " --bag " + bag + " --frame 10 -o " + dir("bagrec") + "/x.yaml");
+  EXPECT_EQ(beyond.code, 2);
+  EXPECT_NE(beyond.err.find("--frame 10: " + bag + " has 10 images on /camera/image_raw/compressed (frames 0 ... 9)"), std::string::npos) << beyond.err;
+  const Outcome both = runKccd(common + " --bag " + bag + " --frame 0 --states " + dir("a") + "/states.csv --time 0 -o " + dir("bagrec") + "/x.yaml");
+  EXPECT_EQ(both.code, 2);
+  EXPECT_NE(both.err.find("not with --bag"), std::string::npos) << both.err;
+  EXPECT_FALSE(fs::exists(dir("bagrec") + "/x.yaml"));
+  // overlay: the bag's ten frames against the first ten of the files' run.
+  const std::string camera = dir("a") + "/camera_true.yaml";
+  const Outcome a = runKccd("overlay " + kHumanoid + " --camera " + camera + " --bag " + bag + " --report " + dir("bagrec") + "/bag.json -q");
+  const Outcome b = runKccd("overlay " + kHumanoid + " --camera " + camera + " --video " + dir("a") + "/video.mkv --states " + dir("a") +
+                            "/states.csv --time-offset " + kccd::shortestNumber(offset) + " --frames 0:10 --report " + dir("bagrec") + "/files.json -q");
+  ASSERT_EQ(a.code, 0) << a.err;
+  ASSERT_EQ(b.code, 0) << b.err;
+  const json ra = json::parse(kccd::testing::readText(dir("bagrec") + "/bag.json")).at("frames");
+  const json rb = json::parse(kccd::testing::readText(dir("bagrec") + "/files.json")).at("frames");
+  ASSERT_EQ(ra.size(), 10u);
+  int with_state = 0;
+  for (std::size_t i = 0; i < 10; ++i) {
+    EXPECT_EQ(ra[i].at("status"), rb[i].at("status")) << i;
+    EXPECT_EQ(ra[i].at("state"), rb[i].at("state")) << i;
+    if (rb[i].at("state") == "none") continue;
+    ++with_state;
+    const std::vector<double> p = ra[i].at("state_values"), q = rb[i].at("state_values");
+    ASSERT_EQ(p.size(), q.size());
+    for (std::size_t k = 0; k < p.size(); ++k) EXPECT_NEAR(p[k], q[k], 1e-9) << i << " " << k;
+    EXPECT_NEAR(ra[i].at("min_distance").get<double>(), rb[i].at("min_distance").get<double>(), 1e-9) << i;
+  }
+  EXPECT_GE(with_state, 9);
 }
 
 // Two runs with one seed write the same bytes: a short recording each (the fixture's is long

@@ -1,7 +1,12 @@
 #include "calib_frames.hpp"
 
+#include <algorithm>
+#include <iostream>
+#include <map>
+
 #include "cli_args.hpp"
 #include "cli_output.hpp"
+#include "kccd/overlay/bag_recording.hpp"
 #include "kccd/overlay/calib_gather.hpp"
 #include "kccd/state_log.hpp"
 
@@ -11,6 +16,43 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
   std::vector<std::string> picture_names = a.images;
   std::vector<cv::Mat> video_pictures;
   std::vector<double> times = a.times;
+  std::optional<overlay::BagRecording> bag;
+  std::vector<std::string> warnings;
+  if (!a.bag.empty()) {
+    if (!a.images.empty() || !a.video.empty()) throw UsageError("--bag: give --image files, --video or --bag, one of them");
+    if (a.video_frames.empty()) throw UsageError("--bag: say which frames of its image topic with --frame N (repeat for several)");
+    if (!a.state_log.empty() || !a.times.empty() || !a.ignore_columns.empty())
+      throw UsageError("--states, --time and --ignore-columns: not with --bag (its joint states give each frame's state at the frame's time)");
+    const overlay::BagRecordingOptions bo{
+        .bag = a.bag,
+        .joint_topic = a.joint_topic,
+        .image_topic = a.image_topic,
+        .time_source = a.time_source == "log" ? overlay::TimeSource::Log : overlay::TimeSource::Header,
+        .joint_map = a.joint_map.empty() || !model ? overlay::JointMap{} : overlay::loadJointMap(a.joint_map, *model)};
+    if (!a.joint_map.empty() && !model) throw UsageError("--joint-map: needs --model");
+    // With a model (and no --state) the joint states give each frame's state; else the images alone.
+    bag = model && a.states.empty() ? overlay::readBagRecording(bo, *model) : overlay::readBagImages(bo);
+    for (const std::string& w : bag->warnings) warnings.push_back("--bag " + a.bag + ": " + w);
+    const int last = *std::max_element(a.video_frames.begin(), a.video_frames.end());
+    if (static_cast<std::size_t>(last) >= bag->frame_times.size())
+      throw UsageError("--frame " + std::to_string(last) + ": " + a.bag + " has " + std::to_string(bag->frame_times.size()) + " images on " +
+                       bag->image_topic + " (frames 0 ... " + std::to_string(bag->frame_times.size() - 1) + ")");
+    // One pass over the image topic, keeping the frames asked for (in the order asked).
+    std::map<int, cv::Mat> kept;
+    for (const int f : a.video_frames) kept[f];
+    const std::unique_ptr<overlay::FrameSource> source = bag->open_frames();
+    cv::Mat frame;
+    for (int i = 0; i <= last && source->read(frame); ++i)
+      if (kept.count(i)) kept[i] = frame.clone();
+    for (const int f : a.video_frames) {
+      if (kept[f].empty()) throw UsageError("--frame " + std::to_string(f) + ": " + a.bag + ": the image could not be read");
+      video_pictures.push_back(kept[f]);
+      picture_names.push_back(a.bag + "#" + std::to_string(f));
+      if (bag->log.rows() > 0) times.push_back(bag->frame_times[static_cast<std::size_t>(f)]);
+    }
+  } else if (!a.image_topic.empty() || !a.joint_topic.empty() || !a.joint_map.empty()) {
+    throw UsageError("--image-topic, --joint-topic and --joint-map go with --bag");
+  }
   if (!a.video.empty()) {
     if (!a.images.empty()) throw UsageError("--video: give --image files or --video with --frame, not both");
     if (a.video_frames.empty()) throw UsageError("--video: say which frames with --frame N (repeat for several)");
@@ -22,8 +64,8 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
         throw UsageError("--video " + a.video + ": no frame rate: give each frame's time with --time");
       for (int f : a.video_frames) times.push_back(f / recording.fps);
     }
-  } else if (!a.video_frames.empty()) {
-    throw UsageError("--frame: needs --video");
+  } else if (!a.video_frames.empty() && a.bag.empty()) {
+    throw UsageError("--frame: needs --video or --bag");
   }
   const std::size_t n = picture_names.empty() ? labels : picture_names.size();
   if (n == 0) throw UsageError("give --image FRAME (with --tags and/or --labels) or --labels LABELS (see kccd calib --help)");
@@ -39,21 +81,22 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
   if (!a.states.empty() && !model) throw UsageError("--state: needs --model");
   if (!a.state_log.empty() && !model) throw UsageError("--states: needs --model");
   if (!a.state_log.empty() && !a.states.empty()) throw UsageError("--state and --states: give one of them");
-  if (a.state_log.empty() != times.empty())
+  if (a.state_log.empty() != times.empty() && !bag)
     throw UsageError(a.state_log.empty() ? "--time: needs --states LOG.csv" : "--states: give each frame's time with --time");
   if (!times.empty() && times.size() != n)
     throw UsageError("--time: given " + std::to_string(times.size()) + " times for " + std::to_string(n) + " frames: give one per frame");
   std::optional<StateLog> log;
   double max_gap = a.max_gap;
-  if (!a.state_log.empty()) {
-    log = loadStateLog(a.state_log, *model, splitCommas(a.ignore_columns));
-    if (max_gap == 0.0) max_gap = 1.5 * log->medianPeriod();
-  }
+  if (!a.state_log.empty()) log = loadStateLog(a.state_log, *model, splitCommas(a.ignore_columns));
+  if (bag && bag->log.rows() > 0) log = std::move(bag->log);
+  if (log && max_gap == 0.0) max_gap = 1.5 * log->medianPeriod();
+  const std::string log_name = bag ? "--bag " + a.bag : a.state_log;
 
   GivenFrames out;
   out.names = std::move(picture_names);
   out.pictures = std::move(video_pictures);
   out.count = n;
+  out.warnings = std::move(warnings);
   out.states.resize(n);
   for (std::size_t f = 0; f < n; ++f) {
     if (!a.states.empty()) {
@@ -61,12 +104,25 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
     } else if (log) {
       std::vector<double> state(static_cast<std::size_t>(model->stateSize()), 0.0);
       if (stateAt(*log, times[f], max_gap, state) == StateMatch::None)
-        throw UsageError("--time " + format(times[f]) + ": " + a.state_log + " has no sample within --max-gap " + format(max_gap) +
+        throw UsageError((bag ? "--frame " + std::to_string(a.video_frames[f]) + " (at " + format(times[f]) + " s)" : "--time " + format(times[f])) + ": " +
+                         log_name + " has no sample within --max-gap " + format(max_gap) +
                          " s of it (the log covers " + format(log->times.front()) + " ... " + format(log->times.back()) + " s)");
       out.states[f] = std::move(state);
     }
   }
   return out;
+}
+
+void addBagOptions(CLI::App& command, FrameOptions& o) {
+  command.add_option("--bag", o.bag,
+                     "A robot log (MCAP, rosbag2 .db3 or folder, ROS 1 .bag) whose image topic's --frame N are the frames; with --model "
+                     "(and no --state) its joint states give each frame's state at the frame's time");
+  command.add_option("--image-topic", o.image_topic, "With --bag: the sensor_msgs/Image or CompressedImage topic (default: the only one)");
+  command.add_option("--joint-topic", o.joint_topic, "With --bag: the sensor_msgs/JointState topic (default: the only one)");
+  command.add_option("--time-source", o.time_source, "With --bag: header (the messages' header stamps) or log (the recorder's times)")
+      ->check(CLI::IsMember({"header", "log"}))
+      ->default_str("header");
+  command.add_option("--joint-map", o.joint_map, "With --bag: which logged joint each state value is read from (see kccd overlay --help)");
 }
 
 }  // namespace kccd::cli

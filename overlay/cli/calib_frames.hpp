@@ -1,6 +1,7 @@
 // The frames of a calibration as the command line gives them: pictures (--image files, or --frame
-// of --video) and each frame's state (--state, or --states at --time). Shared by `kccd calib` and
-// `kccd calib label`, so both read the same options the same way.
+// of --video or of a robot log's --bag) and each frame's state (--state, --states at --time, or the
+// bag's joint states at the frame's time). Shared by `kccd calib` and `kccd calib label`, so both
+// read the same options the same way.
 #pragma once
 
 #include <cstddef>
@@ -8,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <opencv2/core.hpp>
 
 #include "kccd/model.hpp"
@@ -18,6 +20,7 @@ namespace kccd::cli {
 struct FrameOptions {
   std::vector<std::string> images, states;
   std::string state_log, ignore_columns, video;
+  std::string bag, image_topic, joint_topic, joint_map, time_source = "header";  ///< --bag and its options
   std::vector<double> times;
   std::vector<int> video_frames;
   double max_gap = 0.0;  ///< 0: 1.5 x the log's median period
@@ -29,7 +32,11 @@ struct GivenFrames {
   std::vector<cv::Mat> pictures;    ///< the decoded frames of --video; empty: read `names` as image files
   std::vector<std::optional<std::vector<double>>> states;  ///< one per frame
   std::size_t count = 0;            ///< frames (pictures, or labels files when there are none)
+  std::vector<std::string> warnings;  ///< one line each (e.g. a bag cut short)
 };
+
+/// Adds --bag, --image-topic, --joint-topic, --time-source and --joint-map to `command`.
+void addBagOptions(CLI::App& command, FrameOptions& o);
 
 /// Checks the options against each other (`labels` labels files and `tags` a tag layout given)
 /// and reads the recording's frames and the state log. Throws UsageError, or the readers' errors.

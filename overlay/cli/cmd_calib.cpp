@@ -45,6 +45,7 @@ void checkBodyLabels(const calib::Labels& labels, const std::optional<Model>& mo
 // tag layout.
 overlay::GatherInputs gatherInputs(const CalibArgs& a, const calib::Camera& cam, const std::optional<Model>& model) {
   const GivenFrames given = givenFrames(a, a.labels.size(), !a.tags.empty(), model);
+  for (const std::string& w : given.warnings) std::cerr << "kccd calib: warning: " << w << "\n";
   overlay::GatherInputs in;
   in.camera = cam;
   in.camera_name = a.intrinsics;
@@ -146,9 +147,10 @@ Runner addCalib(CLI::App& app) {
   sub->add_option("--video", a->video,
                   "A recording from the fixed camera (a video file or an image sequence such as frames/frame_%06d.png, "
                   "as kccd overlay reads): its frames given by --frame are the frames");
-  sub->add_option("--frame", a->video_frames, "Frame index in --video (from 0; repeat for several frames)")
+  sub->add_option("--frame", a->video_frames, "Frame index in --video or --bag (from 0; repeat for several frames)")
       ->allow_extra_args(false)
       ->check(CLI::Range(0, 100000000));
+  addBagOptions(*sub, *a);
   sub->add_option("--tags", a->tags, "Tag layout: where the AprilTags are in the world");
   sub->add_option("--labels", a->labels, "Labelled points (repeat: one file per --image, same order)")->allow_extra_args(false);
   sub->add_option("--model", a->model, "Model file placing the body labels (and drawn in the check image)");

@@ -60,8 +60,10 @@ Exit runLabel(LabelArgs a) {
   }
   std::optional<Model> model;
   if (!a.model.empty()) model = loadOrExplain(a.model);
-  if (a.images.empty() && a.video.empty()) throw UsageError("calib label: give --image FRAME... or --video V --frame N...");
+  if (a.images.empty() && a.video.empty() && a.bag.empty())
+    throw UsageError("calib label: give --image FRAME..., --video V --frame N... or --bag LOG --frame N...");
   const GivenFrames given = givenFrames(a, a.labels.size(), true, model);
+  for (const std::string& w : given.warnings) std::cerr << "kccd calib label: warning: " << w << "\n";
   if (a.labels.size() != given.count)
     throw UsageError("--labels: given " + std::to_string(a.labels.size()) + " times for " + std::to_string(given.count) +
                      " frames: give one labels file per frame, in the same order");
@@ -135,9 +137,10 @@ Runner addCalibLabel(CLI::App& calib) {
       ->required();
   sub->add_option("--image", a->images, "A frame from the fixed camera (repeat for several frames)")->allow_extra_args(false);
   sub->add_option("--video", a->video, "A recording (video file or image sequence) whose --frame N are the frames");
-  sub->add_option("--frame", a->video_frames, "Frame index in --video (from 0; repeat for several)")
+  sub->add_option("--frame", a->video_frames, "Frame index in --video or --bag (from 0; repeat for several)")
       ->allow_extra_args(false)
       ->check(CLI::Range(0, 100000000));
+  addBagOptions(*sub, *a);
   sub->add_option("--labels", a->labels,
                   "Labels file of each frame (repeat: one per frame, same order): loaded when it exists, written by Save")
       ->allow_extra_args(false);

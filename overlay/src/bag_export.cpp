@@ -159,9 +159,8 @@ BagExportReport exportBag(const BagExportOptions& o) {
                      : origin == std::numeric_limits<std::int64_t>::max() ? 0
                                                                           : static_cast<std::uint64_t>(std::max<std::int64_t>(origin, 0));
   std::map<std::uint16_t, std::size_t> index;
-  std::int64_t last_state = 0, last_frame = 0;
-  bool any_state = false, any_frame = false;
   std::size_t zero = 0, extra_names = 0;
+  IncreasingTimes state_times, frame_times;
   {
     const std::unique_ptr<logs::LogReader> log = logs::openLog(o.bag);
     logs::LogReader& reader = *log;
@@ -198,10 +197,7 @@ BagExportReport exportBag(const BagExportOptions& o) {
       const Value v = decodeMessage(s, m, at);
       const std::int64_t time = messageTime(v, m, o.time_source, zero);
       if (&s == joints) {
-        if (any_state && time <= last_state) {
-          ++report.dropped_states;
-          continue;
-        }
+        if (!state_times.accept(time)) continue;
         std::vector<double> row;
         try {
           row = jointRow(v, at, report.joints, report.velocities, extra_names);
@@ -212,13 +208,9 @@ BagExportReport exportBag(const BagExportOptions& o) {
         states_file << secondsText(time, report.origin_ns);
         for (const double x : row) states_file << "," << exactText(x);
         states_file << "\n";
-        last_state = time, any_state = true;
         ++report.states;
       } else {
-        if (any_frame && time <= last_frame) {
-          ++report.dropped_frames;
-          continue;
-        }
+        if (!frame_times.accept(time)) continue;
         const cv::Mat frame = imageOf(v, s.kind == LogKind::Compressed, at);
         if (report.frames == 0) {
           report.width = frame.cols, report.height = frame.rows;
@@ -229,7 +221,6 @@ BagExportReport exportBag(const BagExportOptions& o) {
         }
         sink->write(report.frames, frame);
         times_file << report.frames << "," << secondsText(time, report.origin_ns) << "\n";
-        last_frame = time, any_frame = true;
         ++report.frames;
       }
     }
@@ -237,8 +228,10 @@ BagExportReport exportBag(const BagExportOptions& o) {
   report.log_time_stamps = zero;
   if (zero > 0) report.warnings.push_back(std::to_string(zero) + " messages have a zero header stamp: their log time is used");
   if (extra_names > 0) report.warnings.push_back(std::to_string(extra_names) + " joint values of joints the first joint state did not name: left out");
-  if (report.dropped_states > 0) report.warnings.push_back(std::to_string(report.dropped_states) + " joint states left out: their time was not after the previous one's");
-  if (report.dropped_frames > 0) report.warnings.push_back(std::to_string(report.dropped_frames) + " images left out: their time was not after the previous one's");
+  report.dropped_states = state_times.dropped;
+  report.dropped_frames = frame_times.dropped;
+  if (state_times.dropped > 0) report.warnings.push_back(state_times.warning("joint states"));
+  if (frame_times.dropped > 0) report.warnings.push_back(frame_times.warning("images"));
   if (info && camera_text.empty()) throw InputError(o.bag + ": topic " + printable(info->topic, 60) + ": no camera info message");
   if (joints && report.states == 0) throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": no joint state");
   // All or nothing: every output in place only once all are written.

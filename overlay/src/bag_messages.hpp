@@ -108,6 +108,27 @@ inline std::string chooseTopic(const std::map<std::uint16_t, LogSource>& sources
   throw InputError(bag + ": several " + what + " topics (" + l + "): choose one with " + option);
 }
 
+// The rule every image and joint state of a topic passes to be used: its time after the previous
+// used one's (the state log and frame-times files need strictly increasing times). The others are
+// counted, for one warning.
+struct IncreasingTimes {
+  bool any = false;
+  std::int64_t last = 0;
+  std::size_t dropped = 0;
+  bool accept(std::int64_t t) {
+    if (any && t <= last) {
+      ++dropped;
+      return false;
+    }
+    any = true, last = t;
+    return true;
+  }
+  // The warning for what was left out ("" when nothing was): `what` names the messages.
+  std::string warning(const std::string& what) const {
+    return dropped == 0 ? std::string() : std::to_string(dropped) + " " + what + " left out: their time was not after the previous one's";
+  }
+};
+
 inline std::string exactText(double v) { return shortestNumber(v); }
 
 // Seconds since the origin, as the state log and frame-times readers take them: the nanoseconds

@@ -35,8 +35,7 @@ class BagFrames final : public FrameSource {
       const logs::Value v = decodeMessage(*source_, m, at);
       std::size_t zero = 0;
       const std::int64_t t = messageTime(v, m, clock_, zero);
-      if (any_ && t <= last_) continue;
-      any_ = true, last_ = t;
+      if (!times_.accept(t)) continue;
       frame = imageOf(v, source_->kind == LogKind::Compressed, at);
       ++next_;
       return true;
@@ -51,37 +50,55 @@ class BagFrames final : public FrameSource {
   std::size_t frames_, next_ = 0, seen_ = 0;
   std::unique_ptr<logs::LogReader> reader_;
   std::optional<LogSource> source_;
-  bool any_ = false;
-  std::int64_t last_ = 0;
+  IncreasingTimes times_;
 };
 
 }  // namespace
 
-BagRecording readBagRecording(const BagRecordingOptions& o, const Model& model) {
+namespace {
+
+// The images' times from the origin (those not after the previous one's left out, with a
+// warning), the nominal rate, and how to open the frames.
+void imageTimes(const BagRecordingOptions& o, const LogSource& images, BagRecording& rec) {
+  IncreasingTimes used;
+  for (const std::int64_t t : images.times)
+    if (used.accept(t)) rec.frame_times.push_back(static_cast<double>(t - static_cast<std::int64_t>(rec.origin_ns)) / 1e9);
+  if (rec.frame_times.empty()) throw InputError(o.bag + ": topic " + printable(rec.image_topic, 60) + ": no image");
+  if (used.dropped > 0) rec.warnings.push_back(used.warning("images"));
+  rec.fps = nominalFps(images.times);
+  const std::string bag = o.bag, topic = rec.image_topic;
+  const TimeSource clock = o.time_source;
+  const double fps = rec.fps;
+  const std::size_t frames = rec.frame_times.size();
+  rec.open_frames = [bag, topic, clock, fps, frames]() -> std::unique_ptr<FrameSource> {
+    return std::make_unique<BagFrames>(bag, topic, clock, fps, frames);
+  };
+}
+
+// readBagRecording, or with no model only the images (no joint topic chosen, no state log).
+BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
   BagRecording rec;
   // One pass: every topic, the images' times, and per joint-state topic its rows for the model's
   // state values (the first problem kept, reported only if that topic is the one used).
-  const JointMap map = o.joint_map.states.empty() ? identityJointMap(model) : o.joint_map;
-  const std::vector<std::string> states = model.stateNames();
+  const JointMap map = !model ? JointMap{} : o.joint_map.states.empty() ? identityJointMap(*model) : o.joint_map;
+  const std::vector<std::string> states = model ? model->stateNames() : std::vector<std::string>{};
   const std::vector<std::string> wanted = map.logged();  // the logged joints read
   struct Rows {
     std::vector<std::int64_t> times;
     std::vector<std::vector<double>> values;  // positions, then velocities (NaN: none given)
     bool velocities = true;
-    std::size_t extra = 0, dropped = 0;
+    std::size_t extra = 0;
+    IncreasingTimes used;
     std::string problem;
   };
   std::map<std::uint16_t, Rows> rows;
   std::string damage;
   const std::map<std::uint16_t, LogSource> sources =
       scanLog(o.bag, o.time_source, damage, [&](const LogSource& s, std::uint16_t channel, const logs::Value& v, std::int64_t t, const std::string& at) {
-        if (s.kind != LogKind::Joints) return;
+        if (s.kind != LogKind::Joints || !model) return;
         Rows& r = rows[channel];
         if (!r.problem.empty()) return;
-        if (!r.times.empty() && t <= r.times.back()) {
-          ++r.dropped;
-          return;
-        }
+        if (!r.used.accept(t)) return;
         try {
           std::vector<double> row = jointRow(v, at, wanted, true, r.extra);
           for (std::size_t k = wanted.size(); k < row.size(); ++k) r.velocities = r.velocities && !std::isnan(row[k]);
@@ -92,8 +109,14 @@ BagRecording readBagRecording(const BagRecordingOptions& o, const Model& model) 
         }
       });
   rec.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic, "--image-topic", "sensor_msgs/Image or CompressedImage", o.bag);
-  rec.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, "--joint-topic", "sensor_msgs/JointState", o.bag);
   const LogSource& images = *sourceOf(sources, rec.image_topic);
+  if (!model) {
+    rec.origin_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(images.first, 0));
+    if (!damage.empty()) rec.warnings.push_back(damage + "; read up to it: " + std::to_string(images.times.size()) + " images");
+    imageTimes(o, images, rec);
+    return rec;
+  }
+  rec.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, "--joint-topic", "sensor_msgs/JointState", o.bag);
   std::uint16_t joint_channel = 0;
   for (const auto& [id, src] : sources)
     if (src.topic == rec.joint_topic) joint_channel = id;
@@ -148,35 +171,22 @@ BagRecording readBagRecording(const BagRecordingOptions& o, const Model& model) 
       }
     text += "\n";
   }
-  rec.log = parseStateLog(text, "--bag " + o.bag + " (topic " + rec.joint_topic + ")", model);
+  rec.log = parseStateLog(text, "--bag " + o.bag + " (topic " + rec.joint_topic + ")", *model);
   if (r.extra > 0) {
     std::string left_out;
     for (const std::string& j : joints.names)
       if (std::find(wanted.begin(), wanted.end(), j) == wanted.end()) left_out += (left_out.empty() ? "" : ", ") + printable(j, 40);
     rec.warnings.push_back("logged joints the model does not read, left out: " + (left_out.empty() ? std::to_string(r.extra) + " values" : left_out));
   }
-  if (r.dropped > 0) rec.warnings.push_back(std::to_string(r.dropped) + " joint states left out: their time was not after the previous one's");
-  std::size_t dropped = 0;
-  std::int64_t last = 0;
-  for (const std::int64_t t : images.times) {
-    if (!rec.frame_times.empty() && t <= last) {
-      ++dropped;
-      continue;
-    }
-    last = t;
-    rec.frame_times.push_back(static_cast<double>(t - static_cast<std::int64_t>(rec.origin_ns)) / 1e9);
-  }
-  if (rec.frame_times.empty()) throw InputError(o.bag + ": topic " + printable(rec.image_topic, 60) + ": no image");
-  if (dropped > 0) rec.warnings.push_back(std::to_string(dropped) + " images left out: their time was not after the previous one's");
-  rec.fps = nominalFps(images.times);
-  const std::string bag = o.bag, topic = rec.image_topic;
-  const TimeSource clock = o.time_source;
-  const double fps = rec.fps;
-  const std::size_t frames = rec.frame_times.size();
-  rec.open_frames = [bag, topic, clock, fps, frames]() -> std::unique_ptr<FrameSource> {
-    return std::make_unique<BagFrames>(bag, topic, clock, fps, frames);
-  };
+  if (r.used.dropped > 0) rec.warnings.push_back(r.used.warning("joint states"));
+  imageTimes(o, images, rec);
   return rec;
 }
+
+}  // namespace
+
+BagRecording readBagRecording(const BagRecordingOptions& options, const Model& model) { return readBag(options, &model); }
+
+BagRecording readBagImages(const BagRecordingOptions& options) { return readBag(options, nullptr); }
 
 }  // namespace kccd::overlay

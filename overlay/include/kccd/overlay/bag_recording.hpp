@@ -43,4 +43,9 @@ struct BagRecording {
 /// previous one's on their topic are left out (a warning). Throws InputError.
 BagRecording readBagRecording(const BagRecordingOptions& options, const Model& model);
 
+/// The log's images alone, for a command without a model: `frame_times`, `open_frames`, `fps`,
+/// `image_topic` and `origin_ns` (time 0: the first image's time); no joint topic is chosen and
+/// `log` is left empty. Throws InputError.
+BagRecording readBagImages(const BagRecordingOptions& options);
+
 }  // namespace kccd::overlay
