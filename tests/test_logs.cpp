@@ -933,4 +933,69 @@ TEST_F(McapFixtures, AJointMapRenamesScalesAndFixesStateValues) {
   EXPECT_NE(no_bag.err.find("--joint-map go with --bag"), std::string::npos) << no_bag.err;
 }
 
+// A golden case on a frame of a robot log: its picture is the image topic's frame and its state the
+// joint states' at that frame's time, so the overlay golden is the frame `overlay --bag` draws,
+// pixel for pixel, whichever format holds the log; golden.json names the bag, topics and clock.
+TEST_F(McapFixtures, AGoldenCaseOnABagFrameIsTheOverlaysFrame) {
+  const fs::path out = dir_ / "golden";
+  fs::remove_all(out);
+  fs::create_directories(out);
+  const std::string model = kccd::testing::writeScratch(
+      "test_logs", "golden_seven.yaml",
+      "kccd: 1\nname: seven\nsafety_margin: 0.02\njoints:\n"
+      "  - {name: joint1, parent: world, type: revolute, axis: [0, 0, 1], limits: [-3, 3]}\n"
+      "  - {name: joint2, parent: joint1, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 1, 0], limits: [-3, 3]}\n"
+      "  - {name: joint3, parent: joint2, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 0, 1], limits: [-3, 3]}\n"
+      "  - {name: joint4, parent: joint3, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 1, 0], limits: [-3, 3]}\n"
+      "  - {name: joint5, parent: joint4, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 0, 1], limits: [-3, 3]}\n"
+      "  - {name: joint6, parent: joint5, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 1, 0], limits: [-3, 3]}\n"
+      "  - {name: joint7, parent: joint6, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 0, 1], limits: [-3, 3]}\n"
+      "bodies:\n  - {name: base, frame: world, points: [[0.3, 0, 0], [0.3, 0, 0.5]], radius: 0.05}\n"
+      "  - {name: arm, frame: joint4, points: [[0, 0, 0], [0.3, 0, 0.1]], radius: 0.04}\n");
+  const std::string camera = kccd::testing::writeScratch(
+      "test_logs", "golden_cam.yaml",
+      "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+      "   data: [ 40, 0, 31.5, 0, 40, 23.5, 0, 0, 1 ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n"
+      "   data: [ 0, 0, 0, 0, 0 ]\nrvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 1.5707963267948966, 0, 0 ]\n"
+      "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0, 0.5, 2 ]\n");
+  const std::string manifest = (out / "manifest.yaml").string();
+  std::ofstream(manifest) << "kccd_golden: 1\ndefaults: {model: " << model << ", camera: " << camera << ", bag: " << file("joint_zstd.mcap")
+                          << ", outputs: [mask, overlay]}\ncases:\n  - {id: mcap-f2, frame: 2}\n  - {id: mcap-f5, frame: 5}\n"
+                          << "  - {id: db3-f5, frame: 5, bag: " << file("jazzy.db3") << "}\n  - {id: ros1-f5, frame: 5, bag: " << file("ros1_bz2.bag")
+                          << "}\n";
+  const auto update = runProgram(std::string(KCCD_CLI) + " golden update " + manifest + " -q");
+  ASSERT_EQ(update.code, 0) << update.err;
+  const auto run = runProgram(std::string(KCCD_CLI) + " golden run " + manifest + " --out " + (out / "results").string() + " -q");
+  EXPECT_EQ(run.code, 0) << run.out << run.err;
+  const auto overlay = runProgram(std::string(KCCD_CLI) + " overlay " + model + " --camera " + camera + " --bag " + file("joint_zstd.mcap") +
+                                  " --png-dir " + (out / "overlay").string() + " -q");
+  ASSERT_EQ(overlay.code, 0) << overlay.err;
+  auto same = [](const cv::Mat& a, const cv::Mat& b) { return a.size() == b.size() && cv::norm(a, b, cv::NORM_INF) == 0; };
+  const cv::Mat drawn2 = cv::imread((out / "overlay" / "frame_000002.png").string()), drawn5 = cv::imread((out / "overlay" / "frame_000005.png").string());
+  ASSERT_FALSE(drawn5.empty());
+  EXPECT_TRUE(same(cv::imread((out / "goldens" / "mcap-f2" / "overlay.png").string()), drawn2));
+  for (const char* id : {"mcap-f5", "db3-f5", "ros1-f5"}) {
+    SCOPED_TRACE(id);
+    EXPECT_TRUE(same(cv::imread((out / "goldens" / id / "overlay.png").string()), drawn5));
+  }
+  EXPECT_FALSE(same(drawn2, drawn5));  // another frame, another state: the comparison can fail
+  const nlohmann::json g = nlohmann::json::parse(readText((out / "goldens" / "mcap-f5" / "golden.json").string())).at("inputs").at("bag");
+  EXPECT_EQ(g.at("frame"), 5);
+  EXPECT_EQ(g.at("image_topic"), "/camera/image_raw");
+  EXPECT_EQ(g.at("joint_topic"), "/joint_states");
+  EXPECT_EQ(g.at("time_source"), "header");
+  // Mistakes: a frame the bag does not have; a bag and a video in one case.
+  std::ofstream(manifest) << "kccd_golden: 1\ndefaults: {model: " << model << ", camera: " << camera << ", bag: " << file("joint_zstd.mcap")
+                          << "}\ncases:\n  - {id: far, frame: 10}\n";
+  const auto far = runProgram(std::string(KCCD_CLI) + " golden run " + manifest + " --out " + (out / "r2").string() + " -q");
+  EXPECT_EQ(far.code, 2);
+  EXPECT_NE(far.err.find("case 'far'.frame: 10: " + file("joint_zstd.mcap") + " has 10 images on /camera/image_raw"), std::string::npos) << far.err;
+  std::ofstream(manifest) << "kccd_golden: 1\ndefaults: {model: " << model << ", camera: " << camera << "}\ncases:\n  - {id: both, frame: 1, bag: "
+                          << file("joint_zstd.mcap") << ", video: v.mkv, states: s.csv}\n";
+  const auto both = runProgram(std::string(KCCD_CLI) + " golden run " + manifest + " --out " + (out / "r3").string() + " -q");
+  EXPECT_EQ(both.code, 2);
+  EXPECT_NE(both.err.find("manifest.yaml:4:"), std::string::npos) << both.err;
+  EXPECT_NE(both.err.find("give video and states, or bag, not both"), std::string::npos) << both.err;
+}
+
 }  // namespace

@@ -24,7 +24,8 @@ bool validId(const std::string& id) {
 
 // The values shared by the cases: the defaults block, then each case on top of it.
 struct Shared {
-  std::string model, camera, states, video;
+  std::string model, camera, states, video, bag, image_topic, joint_topic;
+  bool log_time = false;
   double time_offset = 0.0;
   double supersample = 1.0;
   std::vector<GoldenOutput> outputs{GoldenOutput::Mask, GoldenOutput::Colour};
@@ -49,8 +50,9 @@ class ManifestReader {
     m.goldens = root["goldens"] ? resolve(r_.text(root["goldens"], "goldens")) : resolve("goldens");
     Shared defaults;
     if (const YAML::Node d = root["defaults"]) {
-      if (!d.IsMap()) r_.fail(d, "defaults", "expected a mapping of model, camera, outputs, compare, states, video, time_offset, supersample");
-      r_.onlyKeys(d, "defaults", {"model", "camera", "outputs", "compare", "states", "video", "time_offset", "supersample"});
+      if (!d.IsMap()) r_.fail(d, "defaults", "expected a mapping of model, camera, outputs, compare, states, video, bag, time_offset, supersample");
+      r_.onlyKeys(d, "defaults", {"model", "camera", "outputs", "compare", "states", "video", "bag", "image_topic", "joint_topic", "time_source",
+                                  "time_offset", "supersample"});
       shared(d, "defaults", "defaults", defaults);
     }
     const YAML::Node cases = r_.require(root, "cases", "manifest");
@@ -122,6 +124,14 @@ class ManifestReader {
     if (n["camera"]) s.camera = resolve(r_.text(n["camera"], field + ".camera"));
     if (n["states"]) s.states = resolve(r_.text(n["states"], field + ".states"));
     if (n["video"]) s.video = resolve(r_.text(n["video"], field + ".video"));
+    if (n["bag"]) s.bag = resolve(r_.text(n["bag"], field + ".bag"));
+    if (n["image_topic"]) s.image_topic = r_.text(n["image_topic"], field + ".image_topic");
+    if (n["joint_topic"]) s.joint_topic = r_.text(n["joint_topic"], field + ".joint_topic");
+    if (const YAML::Node t = n["time_source"]) {
+      const std::string word = r_.text(t, field + ".time_source");
+      if (word != "header" && word != "log") r_.fail(t, field + ".time_source", "expected header or log");
+      s.log_time = word == "log";
+    }
     if (n["time_offset"]) s.time_offset = r_.bounded(n["time_offset"], field + ".time_offset", 1e6, "1e6 s");
     if (const YAML::Node ss = n["supersample"]) {
       s.supersample = r_.number(ss, field + ".supersample");
@@ -149,7 +159,8 @@ class ManifestReader {
   GoldenCase readCase(const YAML::Node& n, std::size_t i, const Shared& defaults, std::map<std::string, std::size_t>& ids) const {
     std::string f = "cases[" + std::to_string(i) + "]";
     if (!n.IsMap()) r_.fail(n, f, "expected a mapping with id and state, lower/upper or video/frame");
-    r_.onlyKeys(n, f, {"id", "model", "camera", "outputs", "compare", "state", "lower", "upper", "video", "frame", "states", "time_offset", "supersample"});
+    r_.onlyKeys(n, f, {"id", "model", "camera", "outputs", "compare", "state", "lower", "upper", "video", "frame", "states", "bag", "image_topic",
+                       "joint_topic", "time_source", "time_offset", "supersample"});
     GoldenCase c;
     c.where = r_.where(n);
     const YAML::Node id = r_.require(n, "id", f);
@@ -188,15 +199,25 @@ class ManifestReader {
       const double v = r_.number(n["frame"], f + ".frame");
       if (v != std::floor(v) || v < 0 || v > 1e9) r_.fail(n["frame"], f + ".frame", "expected a frame index from 0");
       c.frame = static_cast<std::int64_t>(v);
-      c.video = s.video;
-      c.states = s.states;
-      if (c.video.empty()) r_.fail(n, f + ".video", "a frame case needs the video (here or in defaults)");
-      if (c.states.empty()) r_.fail(n, f + ".states", "a frame case needs the state log (here or in defaults)");
+      // A case's own video or bag replaces the other given in defaults.
+      const bool own_bag = n["bag"].IsDefined(), own_video = n["video"].IsDefined() || n["states"].IsDefined();
+      if (own_bag && own_video) r_.fail(n["bag"], f + ".bag", "give video and states, or bag, not both");
+      c.bag = own_video ? std::string() : s.bag;
+      if (c.bag.empty()) {
+        c.video = s.video;
+        c.states = s.states;
+        if (c.video.empty()) r_.fail(n, f + ".video", "a frame case needs the video and state log, or a bag (here or in defaults)");
+        if (c.states.empty()) r_.fail(n, f + ".states", "a frame case needs the state log (here or in defaults)");
+      } else {
+        c.image_topic = s.image_topic;
+        c.joint_topic = s.joint_topic;
+        c.log_time = s.log_time;
+      }
     } else {
-      if (n["video"]) r_.fail(n["video"], f + ".video", "video belongs to a frame case (give frame)");
-      if (n["states"]) r_.fail(n["states"], f + ".states", "states belongs to a frame case (give frame)");
+      for (const char* key : {"video", "states", "bag", "image_topic", "joint_topic", "time_source"})
+        if (n[key]) r_.fail(n[key], f + "." + key, std::string(key) + " belongs to a frame case (give frame)");
       for (const GoldenOutput o : c.outputs)
-        if (o == GoldenOutput::Overlay) r_.fail(n, f + ".outputs", "overlay needs a recorded frame (give video, frame and states)");
+        if (o == GoldenOutput::Overlay) r_.fail(n, f + ".outputs", "overlay needs a recorded frame (give frame, with video and states or a bag)");
     }
     return c;
   }

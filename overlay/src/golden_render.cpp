@@ -13,6 +13,7 @@
 #include "kccd/calib/camera.hpp"
 #include "kccd/file_reader.hpp"
 #include "kccd/model.hpp"
+#include "kccd/overlay/bag_recording.hpp"
 #include "kccd/overlay/calib_gather.hpp"
 #include "kccd/overlay/frame_annotator.hpp"
 #include "kccd/render/model_view.hpp"
@@ -21,6 +22,11 @@
 
 namespace kccd::overlay {
 namespace {
+
+// What names a bag's state log in the renderer's caches: the bag, its topics and clock.
+std::string logKey(const GoldenCase& c) {
+  return "bag\n" + c.bag + "\n" + c.image_topic + "\n" + c.joint_topic + "\n" + (c.log_time ? "log" : "header");
+}
 
 constexpr std::uintmax_t kMaxHashedBytes = std::uintmax_t(1) << 34;  // 16 GiB: a long recording
 
@@ -74,6 +80,7 @@ struct GoldenRenderer::Impl {
   std::map<std::string, std::unique_ptr<Model>> models;
   std::map<std::string, calib::Camera> cameras;
   std::map<std::pair<std::string, std::string>, std::unique_ptr<StateLog>> logs;  // (log, model)
+  std::map<std::pair<std::string, std::string>, std::unique_ptr<BagRecording>> bags;  // (logKey, model)
   std::map<std::size_t, LoadedFrame> frames;                                     // per frame case
   std::map<std::string, std::string> hashes;                                     // path -> sha256
   std::map<std::tuple<std::string, std::string, double>, std::unique_ptr<render::ModelView>> views;
@@ -118,7 +125,37 @@ GoldenRenderer::GoldenRenderer(const GoldenManifest& manifest) : impl_(std::make
       if (!values->empty() && values->size() != n)
         throw InputError(where + (values == &c.state ? ".state: " : ".lower: ") + std::to_string(values->size()) +
                          " values, model '" + m.name + "' has " + std::to_string(n) + " (" + c.model + ")");
-    if (c.hasVideo()) {
+    if (!c.bag.empty()) {
+      // The bag's joint states as the state log (read once per bag, topics, clock and model), and
+      // its image topic's frame with that frame's time.
+      const auto key = std::make_pair(logKey(c), c.model);
+      auto it = s.bags.find(key);
+      if (it == s.bags.end()) {
+        BagRecording rec;
+        try {
+          rec = readBagRecording({.bag = c.bag, .joint_topic = c.joint_topic, .image_topic = c.image_topic,
+                                  .time_source = c.log_time ? TimeSource::Log : TimeSource::Header},
+                                 m);
+        } catch (const InputError& e) {
+          throw InputError(where + ".bag: " + e.what());
+        }
+        it = s.bags.emplace(key, std::make_unique<BagRecording>(std::move(rec))).first;
+        s.logs.emplace(key, std::make_unique<StateLog>(it->second->log));
+      }
+      const BagRecording& rec = *it->second;
+      if (static_cast<std::size_t>(c.frame) >= rec.frame_times.size())
+        throw InputError(where + ".frame: " + std::to_string(c.frame) + ": " + c.bag + " has " + std::to_string(rec.frame_times.size()) + " images on " +
+                         rec.image_topic);
+      LoadedFrame f;
+      const std::unique_ptr<FrameSource> frames = rec.open_frames();
+      for (std::int64_t k = 0; k <= c.frame; ++k)
+        if (!frames->read(f.bgr)) throw InputError(where + ".frame: " + c.bag + ": image " + std::to_string(k) + " could not be read");
+      checkPicture(f.bgr, cam, c.bag + "#" + std::to_string(c.frame), c.camera);
+      f.time = rec.frame_times[static_cast<std::size_t>(c.frame)];
+      const cv::Mat flat = f.bgr.isContinuous() ? f.bgr : f.bgr.clone();
+      f.pixels_sha256 = sha256Hex(std::span<const unsigned char>(flat.data, flat.total() * flat.elemSize()));
+      s.frames.emplace(i, std::move(f));
+    } else if (c.hasVideo()) {
       const auto key = std::make_pair(c.states, c.model);
       if (!s.logs.count(key)) s.logs.emplace(key, std::make_unique<StateLog>(loadStateLog(c.states, m)));
       RecordingFrames rf = readRecordingFrames(c.video, {static_cast<int>(c.frame)});
@@ -159,9 +196,17 @@ GoldenRendering GoldenRenderer::render(std::size_t index) {
   std::optional<cv::Mat> overlay;
   if (c.hasVideo()) {
     const LoadedFrame& f = s.frames.at(index);
-    const StateLog& log = *s.logs.at({c.states, c.model});
-    inputs["states"] = {{"file", relativeTo(c.states, s.manifest.folder)}, {"sha256", s.hash(c.states)}};
-    inputs["video"] = {{"file", relativeTo(c.video, s.manifest.folder)}, {"frame", c.frame}, {"time_offset", c.time_offset}};
+    const StateLog& log = *s.logs.at({c.bag.empty() ? c.states : logKey(c), c.model});
+    if (c.bag.empty()) {
+      inputs["states"] = {{"file", relativeTo(c.states, s.manifest.folder)}, {"sha256", s.hash(c.states)}};
+      inputs["video"] = {{"file", relativeTo(c.video, s.manifest.folder)}, {"frame", c.frame}, {"time_offset", c.time_offset}};
+    } else {
+      const BagRecording& rec = *s.bags.at({logKey(c), c.model});
+      // A log may be large (or a folder): its frame's pixels are hashed below, not the whole log.
+      inputs["bag"] = {{"file", relativeTo(c.bag, s.manifest.folder)}, {"frame", c.frame},
+                       {"image_topic", rec.image_topic}, {"joint_topic", rec.joint_topic}, {"time_source", c.log_time ? "log" : "header"},
+                       {"time_offset", c.time_offset}};
+    }
     inputs["video_frame"] = {{"sha256", f.pixels_sha256}};
     const render::Projection projection(s.cameras.at(c.camera), c.supersample);
     AnnotatorSettings settings;

@@ -31,7 +31,10 @@ struct GoldenCase {
   std::vector<GoldenOutput> outputs;
   std::vector<double> state;         ///< a configuration (static volumes), or
   std::vector<double> lower, upper;  ///< a box (swept volumes), or
-  std::string video, states;         ///< a recorded frame composited, its state from the log
+  std::string video, states;         ///< a recorded frame composited, its state from the log, or
+  std::string bag;                   ///< a robot log's frame, its state from the log's joint states
+  std::string image_topic, joint_topic;  ///< with bag: the topics (empty: the one of the fitting type)
+  bool log_time = false;             ///< with bag: the recorder's times, not the header stamps
   std::int64_t frame = -1;
   double time_offset = 0.0;          ///< added to the frame's time to get the log's time (s)
   /// Pinhole scale (1..4) of the mask and colour images: finer masks follow the volumes' edges
@@ -40,7 +43,8 @@ struct GoldenCase {
   MaskTolerance mask;
   ColourTolerance colour, overlay;
   ToleranceSource tolerance_source;
-  bool hasVideo() const { return !video.empty(); }
+  /// A case on a recorded frame (of a video or of a bag).
+  bool hasVideo() const { return !video.empty() || !bag.empty(); }
 };
 
 /// A manifest: where its goldens live and its cases in order.
