@@ -10,6 +10,7 @@
 #include "kccd/input_error.hpp"
 #include "kccd/logs/bag_summary.hpp"
 #include "kccd/overlay/bag_export.hpp"
+#include "kccd/overlay/bag_info.hpp"
 
 namespace kccd::cli {
 namespace {
@@ -31,35 +32,7 @@ Exit runBagInfo(const BagInfoArgs& args) {
   const logs::BagSummary b = logs::summarizeBag(args.bag);
   if (!b.damage.empty()) std::cerr << "kccd bag info: warning: " << args.bag << ": " << b.damage << "; " << b.messages << " messages read\n";
   if (args.json) {
-    nlohmann::json j;
-    j["bag"] = b.path;
-    j["format"] = b.format;
-    j["profile"] = b.profile;
-    j["library"] = b.library;
-    j["messages"] = b.messages;
-    // Nanoseconds as decimal strings: JSON readers keep 53 bits of a number.
-    j["first_log_time_ns"] = std::to_string(b.first_log_time);
-    j["last_log_time_ns"] = std::to_string(b.last_log_time);
-    j["duration_s"] = b.messages > 0 ? seconds(b.last_log_time - b.first_log_time) : 0.0;
-    j["chunks"] = b.chunks;
-    j["damage"] = b.damage.empty() ? nlohmann::json() : nlohmann::json(b.damage);
-    j["topics"] = nlohmann::json::array();
-    for (const logs::TopicSummary& t : b.topics) {
-      nlohmann::json o{{"topic", t.topic},
-                       {"type", t.type},
-                       {"schema_encoding", t.schema_encoding},
-                       {"message_encoding", t.message_encoding},
-                       {"count", t.count},
-                       {"first_log_time_ns", std::to_string(t.first_log_time)},
-                       {"last_log_time_ns", std::to_string(t.last_log_time)},
-                       {"rate_hz", t.rate()},
-                       {"stamped", t.stamped},
-                       {"zero_stamps", t.zero_stamps},
-                       {"definition", t.definition}};
-      if (t.stamped > t.zero_stamps) o["skew_s"] = {{"min", t.skew_min}, {"median", t.skew_median}, {"max", t.skew_max}};
-      if (!t.no_stamps.empty()) o["no_stamps"] = t.no_stamps;
-      j["topics"].push_back(o);
-    }
+    const nlohmann::json j = overlay::bagInfoJson(b);
     std::cout << j.dump(1) << "\n";
     return Exit::Ok;
   }

@@ -2,6 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <future>
+#include <mutex>
+#include <thread>
 
 #include "bag_messages.hpp"
 #include "kccd/input_error.hpp"
@@ -11,16 +17,81 @@ namespace {
 
 using namespace detail;
 
+// Jobs run on a few threads, their results taken in the order the jobs were given (a job's
+// exception is rethrown by take()).
+class OrderedJobs {
+ public:
+  explicit OrderedJobs(unsigned workers) {
+    for (unsigned k = 0; k < workers; ++k)
+      threads_.emplace_back([this] {
+        for (;;) {
+          std::packaged_task<cv::Mat()> job;
+          {
+            std::unique_lock lock(mu_);
+            cv_.wait(lock, [&] { return stop_ || !jobs_.empty(); });
+            if (jobs_.empty()) return;
+            job = std::move(jobs_.front());
+            jobs_.pop_front();
+          }
+          job();
+        }
+      });
+  }
+  ~OrderedJobs() {
+    {
+      std::lock_guard lock(mu_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    for (std::thread& t : threads_) t.join();
+  }
+  void submit(std::function<cv::Mat()> f) {
+    std::packaged_task<cv::Mat()> job(std::move(f));
+    results_.push_back(job.get_future());
+    {
+      std::lock_guard lock(mu_);
+      jobs_.push_back(std::move(job));
+    }
+    cv_.notify_one();
+  }
+  std::size_t pending() const { return results_.size(); }
+  cv::Mat take() {
+    std::future<cv::Mat> r = std::move(results_.front());
+    results_.pop_front();
+    return r.get();
+  }
+
+ private:
+  std::mutex mu_;
+  std::condition_variable cv_;
+  std::deque<std::packaged_task<cv::Mat()>> jobs_;
+  std::deque<std::future<cv::Mat>> results_;  // the caller's side only
+  bool stop_ = false;
+  std::vector<std::thread> threads_;
+};
+
 // The image topic's frames in log order, decoded; the times that are not after the previous
-// frame's are skipped, as readBagRecording skipped them.
+// frame's are skipped, as readBagRecording skipped them. Images are decoded (JPEG, PNG, colour
+// conversions) a few frames ahead on up to 4 threads: a video reader decodes on several threads too.
 class BagFrames final : public FrameSource {
  public:
   BagFrames(std::string bag, std::string topic, TimeSource clock, double fps, std::size_t frames)
-      : bag_(std::move(bag)), topic_(std::move(topic)), clock_(clock), fps_(fps), frames_(frames), reader_(logs::openLog(bag_)) {}
+      : bag_(std::move(bag)), topic_(std::move(topic)), clock_(clock), fps_(fps), frames_(frames), reader_(logs::openLog(bag_)),
+        workers_(std::clamp(std::thread::hardware_concurrency(), 1u, 4u)), jobs_(workers_) {}
   double fps() const override { return fps_; }
   std::size_t declaredFrames() const override { return frames_; }
   std::size_t nextIndex() const override { return next_; }
   bool read(cv::Mat& frame) override {
+    while (!end_ && jobs_.pending() < 2 * workers_) end_ = !submitNext();
+    if (jobs_.pending() == 0) return false;
+    frame = jobs_.take();
+    ++next_;
+    return true;
+  }
+
+ private:
+  // Finds the next image used and has it decoded; false at the end of the log.
+  bool submitNext() {
     logs::LogMessage m;
     while (reader_->next(m)) {
       if (m.channel->topic != topic_) continue;
@@ -31,19 +102,24 @@ class BagFrames final : public FrameSource {
         source_->cdr = m.channel->message_encoding == "cdr";
         source_->types = logs::MessageDefinitions::parse(m.schema->name, m.schema->data, source_->cdr ? logs::Dialect::Ros2 : logs::Dialect::Ros1);
       }
-      const std::string at = messagePlace(bag_, *reader_, m, seen_++);
+      std::string at = messagePlace(bag_, *reader_, m, seen_++);
       const logs::Value v = decodeMessage(*source_, m, at);
       std::size_t zero = 0;
       const std::int64_t t = messageTime(v, m, clock_, zero);
       if (!times_.accept(t)) continue;
-      frame = imageOf(v, source_->kind == LogKind::Compressed, at);
-      ++next_;
+      // The message's bytes are the reader's until its next message: the job keeps a copy.
+      auto owned = std::make_shared<logs::LogMessage>(m);
+      auto bytes = std::make_shared<std::vector<std::uint8_t>>(m.data.begin(), m.data.end());
+      owned->data = *bytes;
+      const LogSource* source = &*source_;
+      jobs_.submit([source, owned, bytes, at = std::move(at)] {
+        return imageOf(decodeMessage(*source, *owned, at), source->kind == LogKind::Compressed, at);
+      });
       return true;
     }
     return false;
   }
 
- private:
   std::string bag_, topic_;
   TimeSource clock_;
   double fps_;
@@ -51,6 +127,9 @@ class BagFrames final : public FrameSource {
   std::unique_ptr<logs::LogReader> reader_;
   std::optional<LogSource> source_;
   IncreasingTimes times_;
+  bool end_ = false;
+  unsigned workers_;
+  OrderedJobs jobs_;  // last: its threads end before the rest goes
 };
 
 }  // namespace

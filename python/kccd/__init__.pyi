@@ -21,6 +21,7 @@ from ._kccd import import_urdf as import_urdf
 from ._kccd import overlay_braking as overlay_braking
 from ._kccd import overlay_recording as overlay_recording
 from ._kccd import prove_pairs as prove_pairs
+from ._kccd import read_bag as read_bag
 from ._kccd import read_frame as read_frame
 from ._kccd import read_frames as read_frames
 from ._kccd import read_image as read_image
@@ -51,6 +52,7 @@ __all__ = [
     "overlay_braking",
     "overlay_recording",
     "prove_pairs",
+    "read_bag",
     "read_frame",
     "read_frames",
     "read_image",

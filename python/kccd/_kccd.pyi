@@ -204,8 +204,8 @@ def render(
 def overlay_recording(
     model: Model,
     camera: Camera,
-    video: str,
-    states: str,
+    video: str = "",
+    states: str = "",
     *,
     output: str = "",
     report: str = "",
@@ -218,6 +218,22 @@ def overlay_recording(
     contact_frames: int = 12,
     progress: Callable[[int, int, float], object] | None = None,
     progress_every: float = 0.0,
+    bag: str = "",
+    image_topic: str = "",
+    joint_topic: str = "",
+    time_source: str = "header",
+    joint_map: str = "",
+    timeline: str = "",
+) -> dict[str, Any]: ...
+def read_bag(
+    path: str,
+    model: Model | None = None,
+    *,
+    image_topic: str = "",
+    joint_topic: str = "",
+    time_source: str = "header",
+    joint_map: str = "",
+    frames: Sequence[int] = (),
 ) -> dict[str, Any]: ...
 def synthesize_recording(
     model: str,

@@ -14,6 +14,11 @@ The manifest (paths relative to it)::
     recordings:
       - {id: cell3-2026-11-20-a, video: rec/a.mkv, states: rec/a.csv}
       - {id: cell3-2026-11-20-b, video: rec/b.mkv, states: rec/b.csv, swept: true}
+      - {id: cell3-2026-11-21, bag: rec/2026-11-21.mcap}
+
+A recording is a video with its state log, or a robot log (``bag``: MCAP, rosbag2 .db3 or folder,
+ROS 1 .bag) read as ``kccd overlay --bag`` reads it (``image_topic``, ``joint_topic``,
+``time_source`` and ``joint_map`` here or in defaults).
 """
 
 from __future__ import annotations
@@ -44,7 +49,7 @@ from . import _kccd as _core
 #: The largest manifest read (bytes).
 MAX_MANIFEST_BYTES = 4 << 20
 #: What each recording's folder holds when it is complete.
-OUTPUT_FILES = ("overlay.mp4", "report.json", "contact_sheet.png", "inputs.json")
+OUTPUT_FILES = ("overlay.mp4", "report.json", "contact_sheet.png", "timeline.png", "inputs.json")
 _TOPIC = "kccd-batch"
 #: What the batch itself writes in DIR: no recording may take these names.
 _RESERVED = ("summary.json", "summary.md", "colliding_frames.png")
@@ -53,8 +58,9 @@ _LOCK = ".kccd-batch.lock"
 #: The environment of local worker processes (Dask's default, less MALLOC_TRIM_THRESHOLD_).
 _WORKER_ENVIRON = {"OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1, "OPENBLAS_NUM_THREADS": 1}
 _ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,127}")
-_RECORDING_KEYS = ("id", "video", "states", "model", "camera", "time_offset", "swept", "braking")
-_DEFAULT_KEYS = ("model", "camera", "time_offset", "swept", "braking")
+_BAG_KEYS = ("image_topic", "joint_topic", "time_source", "joint_map")
+_RECORDING_KEYS = ("id", "video", "states", "bag", "model", "camera", "time_offset", "swept", "braking") + _BAG_KEYS
+_DEFAULT_KEYS = ("model", "camera", "time_offset", "swept", "braking") + _BAG_KEYS
 #: The braking of swept volumes unless a manifest says otherwise (kccd overlay's defaults).
 DEFAULT_BRAKING = {field: float(getattr(_core.overlay_braking(), field))
                    for field in ("latency", "deceleration", "max_acceleration", "position_error", "velocity_error")}
@@ -78,14 +84,24 @@ class Recording:
     """One recording of a manifest, its paths made absolute."""
 
     id: str
-    video: str
-    states: str
+    video: str  #: "" for a robot log
+    states: str  #: "" for a robot log
     model: str
     camera: str
     time_offset: float
     swept: bool
     line: int  #: where the manifest lists it (1-based)
     braking: tuple[tuple[str, float], ...] = tuple(DEFAULT_BRAKING.items())  #: with swept, every joint
+    bag: str = ""  #: a robot log instead of video and states
+    image_topic: str = ""
+    joint_topic: str = ""
+    time_source: str = "header"
+    joint_map: str = ""
+
+    def input_keys(self) -> tuple[str, ...]:
+        """The fields naming this recording's input files."""
+        recording = ("bag",) if self.bag else ("video", "states")
+        return recording + ("model", "camera") + (("joint_map",) if self.joint_map else ())
 
 
 # --------------------------------------------------------------------------------------------
@@ -226,9 +242,16 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
     for i, item in enumerate(seq.value):
         name = f"recordings[{i}]"
         rec = mapping(item, name, _RECORDING_KEYS)
-        for key in ("id", "video", "states"):
-            if key not in rec:
-                raise fail(item, f"{name}.{key}", "missing")
+        if "id" not in rec:
+            raise fail(item, f"{name}.id", "missing")
+        if "bag" in rec:
+            for key in ("video", "states"):
+                if key in rec:
+                    raise fail(rec[key], f"{name}.{key}", "not with bag (the robot log gives the frames and the states)")
+        else:
+            for key in ("video", "states"):
+                if key not in rec:
+                    raise fail(item, f"{name}.{key}", "missing (give video and states, or bag)")
         rid = text_field(rec["id"], f"{name}.id")
         if not _ID.fullmatch(rid):
             raise fail(rec["id"], f"{name}.id", f"'{rid}' is not a folder name (letters, digits, '.', '_', '-'; "
@@ -246,11 +269,27 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
         for key in ("model", "camera"):
             if key not in merged:
                 raise fail(item, f"{name}.{key}", "missing (give it here or in defaults)")
-        paths = {key: resolve(merged[key], where(key)) for key in ("video", "states", "model", "camera")}
+        keys = ("bag", "joint_map", "model", "camera") if "bag" in rec else ("video", "states", "model", "camera")
+        paths = {key: resolve(merged[key], where(key)) for key in keys if key in merged}
         inputs += [(key, paths[key], merged[key], where(key)) for key in paths]
+        if "bag" not in rec:
+            for key in _BAG_KEYS:
+                if key in rec:
+                    raise fail(rec[key], f"{name}.{key}", "goes with bag")
+        topics = {key: text_field(merged[key], where(key)) for key in ("image_topic", "joint_topic") if key in merged and "bag" in rec}
+        time_source = text_field(merged["time_source"], where("time_source")) if "time_source" in merged else "header"
+        if time_source not in ("header", "log"):
+            raise fail(merged["time_source"], where("time_source"), "expected header or log")
         out.append(Recording(
             id=rid,
-            **paths,
+            video=paths.get("video", ""),
+            states=paths.get("states", ""),
+            model=paths["model"],
+            camera=paths["camera"],
+            bag=paths.get("bag", ""),
+            joint_map=paths.get("joint_map", "") if "bag" in rec else "",
+            time_source=time_source,
+            **topics,
             time_offset=number_field(merged["time_offset"], where("time_offset")) if "time_offset" in merged else 0.0,
             swept=bool_field(merged["swept"], where("swept")) if "swept" in merged else False,
             line=item.start_mark.line + 1,
@@ -268,6 +307,9 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
                     raise fail(node, field, f"{p}: not an image-sequence pattern ({_one_line(str(e))})") from None
                 if not frames:
                     raise fail(node, field, f"{p}: no image of the sequence (numbered from 0 or 1) exists")
+            elif key == "bag" and os.path.isdir(p):
+                if not os.path.isfile(os.path.join(p, "metadata.yaml")) and not any(f.endswith(".mcap") for f in os.listdir(p)):
+                    raise fail(node, field, f"{p}: a folder without metadata.yaml (not a rosbag2 bag)")
             elif not os.path.isfile(p):
                 raise fail(node, field, f"{p}: no such file")
             if key in ("model", "camera") and (key, p) not in checked:
@@ -305,6 +347,8 @@ def _is_sequence(path: str) -> bool:
 
 
 def _input_files(path: str) -> list[str]:
+    if os.path.isdir(path):  # a rosbag2 folder: its files
+        return sorted(os.path.join(path, f) for f in os.listdir(path) if os.path.isfile(os.path.join(path, f)))
     return _sequence_files(path) if _is_sequence(path) else [path]
 
 
@@ -331,8 +375,14 @@ def provenance(rec: Recording, contact_frames: int = 12) -> dict[str, Any]:
         "swept": rec.swept,
         "braking": dict(rec.braking),
         "contact_frames": contact_frames,
-        "inputs": {key: _file_record(getattr(rec, key)) for key in ("video", "states", "model", "camera")},
+        "bag": provenance_bag(rec),
+        "inputs": {key: _file_record(getattr(rec, key)) for key in rec.input_keys()},
     }
+
+
+def provenance_bag(rec: Recording) -> dict[str, str] | None:
+    """How a robot log is read (None for a video with its state log)."""
+    return {"image_topic": rec.image_topic, "joint_topic": rec.joint_topic, "time_source": rec.time_source} if rec.bag else None
 
 
 def complete_summary(rec: Recording, out_dir: str, contact_frames: int = 12) -> dict[str, Any] | None:
@@ -348,9 +398,10 @@ def complete_summary(rec: Recording, out_dir: str, contact_frames: int = 12) -> 
             made = json.load(f)
         if made.get("kccd_version") != _core.__version__ or made.get("time_offset") != rec.time_offset \
                 or made.get("swept") != rec.swept or made.get("braking") != dict(rec.braking) \
-                or made.get("contact_frames") != contact_frames:
+                or made.get("contact_frames") != contact_frames or made.get("bag") != provenance_bag(rec) \
+                or sorted(made["inputs"]) != sorted(rec.input_keys()):
             return None
-        for key in ("video", "states", "model", "camera"):
+        for key in rec.input_keys():
             old = made["inputs"][key]
             path = getattr(rec, key)
             if old.get("path") != path:
@@ -446,12 +497,14 @@ def run_recording(rec: Recording, out_dir: str, jobs: int = 0, contact_frames: i
         report = _core.overlay_recording(
             model, camera, rec.video, rec.states,
             output=os.path.join(stage, "overlay.mp4"), report=os.path.join(stage, "report.json"),
-            contact_sheet=os.path.join(stage, "contact_sheet.png"), time_offset=rec.time_offset,
-            swept=rec.swept, braking=_core.BrakingParams(**dict(rec.braking)) if rec.swept else None, jobs=jobs,
-            contact_frames=contact_frames, progress=progress, progress_every=1.0)
+            contact_sheet=os.path.join(stage, "contact_sheet.png"), timeline=os.path.join(stage, "timeline.png"),
+            time_offset=rec.time_offset, swept=rec.swept, braking=_core.BrakingParams(**dict(rec.braking)) if rec.swept else None,
+            jobs=jobs, contact_frames=contact_frames, progress=progress, progress_every=1.0, bag=rec.bag, image_topic=rec.image_topic,
+            joint_topic=rec.joint_topic, time_source=rec.time_source, joint_map=rec.joint_map)
         # The report names its outputs as they are once committed: beside it.
         report["video"] = "overlay.mp4"
         report["contact_sheet"] = "contact_sheet.png"
+        report["timeline"] = "timeline.png"
         _write_json(os.path.join(stage, "report.json"), report)
         _write_json(os.path.join(stage, "inputs.json"), made)
         old = ""

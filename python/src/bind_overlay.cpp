@@ -3,15 +3,24 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstring>
+#include <map>
+#include <filesystem>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "arrays.hpp"
 #include "bindings.hpp"
 #include "progress_relay.hpp"
 #include "kccd/calib/camera.hpp"
+#include "kccd/input_error.hpp"
+#include "kccd/logs/bag_summary.hpp"
+#include "kccd/overlay/bag_info.hpp"
+#include "kccd/overlay/bag_recording.hpp"
 #include "kccd/overlay/contact_sheet.hpp"
 #include "kccd/overlay/overlay_recording.hpp"
 #include "kccd/overlay/staged_output.hpp"
@@ -74,12 +83,32 @@ caption. output: a .png, written under a temporary name and renamed when complet
       [](const std::shared_ptr<ModelHandle>& h, const calib::Camera& camera, const std::string& video,
          const std::string& states, const std::string& output, const std::string& report, const std::string& contact_sheet,
          double time_offset, bool swept, const std::optional<BrakingParams>& braking, int jobs, const std::string& frames,
-         int contact_frames, const py::object& progress, double progress_every) {
+         int contact_frames, const py::object& progress, double progress_every, const std::string& bag, const std::string& image_topic,
+         const std::string& joint_topic, const std::string& time_source, const std::string& joint_map, const std::string& timeline) {
         const Model& model = *h->model;
         if (!(progress_every >= 0.0) || !std::isfinite(progress_every))
           throw py::value_error("progress_every: must be a finite number of seconds >= 0");
-        const StateLog log = loadStateLog(states, model);
-        overlay::OverlayInputs in{model, camera, log, video, {}, "video " + video, "camera", ""};
+        if (bag.empty() == (video.empty() || states.empty()) || (!bag.empty() && (!video.empty() || !states.empty())))
+          throw py::value_error("give video and states, or bag (a robot log), not both");
+        if (bag.empty() && (!image_topic.empty() || !joint_topic.empty() || !joint_map.empty()))
+          throw py::value_error("image_topic, joint_topic and joint_map go with bag");
+        if (time_source != "header" && time_source != "log") throw py::value_error("time_source: expected 'header' or 'log'");
+        std::optional<overlay::BagRecording> rec;
+        if (!bag.empty())
+          rec = overlay::readBagRecording({.bag = bag, .joint_topic = joint_topic, .image_topic = image_topic,
+                                           .time_source = time_source == "log" ? overlay::TimeSource::Log : overlay::TimeSource::Header,
+                                           .joint_map = joint_map.empty() ? overlay::JointMap{} : overlay::loadJointMap(joint_map, model)},
+                                          model);
+        if (rec)
+          for (const std::string& w : rec->warnings)
+            if (PyErr_WarnEx(PyExc_UserWarning, ("bag " + bag + ": " + w).c_str(), 1) < 0) throw py::error_already_set();
+        const StateLog log = rec ? rec->log : loadStateLog(states, model);
+        overlay::OverlayInputs in{model, camera, log, rec ? bag : video, {}, rec ? "bag " + bag + " (topic " + rec->image_topic + ")" : "video " + video,
+                                  "camera", ""};
+        if (rec) {
+          in.frame_times = rec->frame_times;
+          in.open_frames = rec->open_frames;
+        }
         overlay::OverlayOptions o;
         o.time_offset = time_offset;
         o.swept = swept;
@@ -104,13 +133,16 @@ caption. output: a .png, written under a temporary name and renamed when complet
                                               .video_option = "output",
                                               .report_option = "report",
                                               .contact_sheet_option = "contact_sheet",
-                                              .frames_option = "frames"};
-        overlay::checkOverlayOutputs(outputs, std::vector<std::string>{video, states, h->source});
+                                              .frames_option = "frames",
+                                              .timeline = timeline,
+                                              .timeline_option = "timeline",
+                                              .timeline_title = std::filesystem::path(rec ? bag : video).filename().string()};
+        overlay::checkOverlayOutputs(outputs, std::vector<std::string>{video, states, bag, joint_map, h->source});
         overlay::VideoSink sink({.video = output, .codec = "", .video_label = "output " + output, .png_dir = "", .png_label = ""});
         ProgressRelay relay{progress, {}};
         nlohmann::json full;
         relay.run([&] {
-          const overlay::OverlayReport r = overlay::overlayRecording(
+          overlay::OverlayReport r = overlay::overlayRecording(
               in, o, sink.active() ? &sink : nullptr,
               [&, last = std::chrono::steady_clock::time_point{}](const overlay::OverlayProgress& p) mutable {
                 // Throttled before the GIL is asked for: each acquisition may wait for Python's
@@ -123,14 +155,18 @@ caption. output: a .png, written under a temporary name and renamed when complet
                 last = now;
                 relay(p.frames_done, p.frames_expected, p.frames_per_second);
               });
+          if (rec)
+            r.source = {{"bag", bag}, {"image_topic", rec->image_topic}, {"joint_topic", rec->joint_topic}, {"time_source", time_source},
+                        {"origin_ns", std::to_string(rec->origin_ns)}, {"joint_map", joint_map}};
           full = overlay::writeOverlayOutputs(outputs, r, model, sink);
         });
         return toPython(full);
       },
-      py::arg("model"), py::arg("camera"), py::arg("video"), py::arg("states"), py::kw_only(), py::arg("output") = "",
+      py::arg("model"), py::arg("camera"), py::arg("video") = "", py::arg("states") = "", py::kw_only(), py::arg("output") = "",
       py::arg("report") = "", py::arg("contact_sheet") = "", py::arg("time_offset") = 0.0, py::arg("swept") = false,
       py::arg("braking") = py::none(), py::arg("jobs") = 0, py::arg("frames") = "", py::arg("contact_frames") = 12, py::arg("progress") = py::none(),
-      py::arg("progress_every") = 0.0,
+      py::arg("progress_every") = 0.0, py::arg("bag") = "", py::arg("image_topic") = "", py::arg("joint_topic") = "",
+      py::arg("time_source") = "header", py::arg("joint_map") = "", py::arg("timeline") = "",
       R"doc(The main job, as `kccd overlay`: every frame of `video` (a file or an image-sequence pattern) checked at
 the state the log `states` (CSV) gives at its time (log time = frame time + time_offset, seconds), the
 volumes drawn and composited. Outputs, checked before any frame is decoded (extension, an existing
@@ -141,7 +177,81 @@ joint; None: kccd overlay's defaults, latency 0.01 s and deceleration 5). jobs: 
 frames: 'FIRST:END:STEP' of the frames drawn (all are checked). progress(frames_done, frames_expected,
 frames_per_second) is called after each frame with the GIL held (progress_every: at most once per that many
 seconds, and after the last frame). Returns the report as a dict (with
-per-frame records under 'frames'). Raises InputError naming the input and place.)doc");
+per-frame records under 'frames'). Instead of video and states, bag: a robot log (MCAP, rosbag2 .db3 or
+folder, ROS 1 .bag) whose image topic gives the frames at their own times and whose joint states give
+the states, as `kccd overlay --bag` (image_topic, joint_topic: default the only one of the type;
+time_source 'header' or 'log'; joint_map: a joint map file; warnings as UserWarning). timeline: a .png of
+the run over time (`kccd overlay --timeline`). Raises InputError naming the input and place.)doc");
+
+  m.def(
+      "read_bag",
+      [](const std::string& path, const std::shared_ptr<ModelHandle>& h, const std::string& image_topic, const std::string& joint_topic,
+         const std::string& time_source, const std::string& joint_map, const std::vector<long>& frames) {
+        if (time_source != "header" && time_source != "log") throw py::value_error("time_source: expected 'header' or 'log'");
+        if (!h && (!joint_topic.empty() || !joint_map.empty())) throw py::value_error("joint_topic and joint_map need a model");
+        for (const long f : frames)
+          if (f < 0) throw py::value_error("frames: indices from 0");
+        py::dict d;
+        const overlay::BagRecordingOptions o{
+            .bag = path, .joint_topic = joint_topic, .image_topic = image_topic,
+            .time_source = time_source == "log" ? overlay::TimeSource::Log : overlay::TimeSource::Header,
+            .joint_map = joint_map.empty() || !h ? overlay::JointMap{} : overlay::loadJointMap(joint_map, *h->model)};
+        nlohmann::json info;
+        overlay::BagRecording rec;
+        std::vector<cv::Mat> images;
+        {
+          py::gil_scoped_release release;
+          info = overlay::bagInfoJson(logs::summarizeBag(path));
+          if (h || !frames.empty() || !image_topic.empty()) rec = h ? overlay::readBagRecording(o, *h->model) : overlay::readBagImages(o);
+          if (!frames.empty()) {
+            const long last = *std::max_element(frames.begin(), frames.end());
+            if (static_cast<std::size_t>(last) >= rec.frame_times.size())
+              throw InputError(path + ": frame " + std::to_string(last) + ": the image topic " + rec.image_topic + " has " +
+                               std::to_string(rec.frame_times.size()) + " images");
+            std::map<long, cv::Mat> kept;
+            for (const long f : frames) kept[f];
+            const std::unique_ptr<overlay::FrameSource> source = rec.open_frames();
+            cv::Mat frame;
+            for (long i = 0; i <= last && source->read(frame); ++i)
+              if (kept.count(i)) cv::cvtColor(frame, kept[i], cv::COLOR_BGR2RGB);
+            for (const long f : frames) images.push_back(kept[f]);
+          }
+        }
+        d["info"] = toPython(info);
+        if (rec.frame_times.empty()) return d;
+        d["image_topic"] = rec.image_topic;
+        d["frame_times"] = floatArray(rec.frame_times);
+        d["fps"] = rec.fps;
+        d["origin_ns"] = rec.origin_ns;
+        d["warnings"] = rec.warnings;
+        if (h) {
+          d["joint_topic"] = rec.joint_topic;
+          d["state_names"] = rec.log.names;
+          d["times"] = floatArray(rec.log.times);
+          py::array_t<double> states({static_cast<py::ssize_t>(rec.log.rows()), static_cast<py::ssize_t>(rec.log.stateSize())});
+          std::copy(rec.log.values.begin(), rec.log.values.end(), states.mutable_data());
+          d["states"] = states;
+        }
+        if (!frames.empty()) {
+          py::list list;
+          for (const cv::Mat& img : images) {
+            py::array_t<std::uint8_t> a({img.rows, img.cols, 3});
+            for (int y = 0; y < img.rows; ++y) std::memcpy(a.mutable_data(y, 0, 0), img.ptr(y), static_cast<std::size_t>(img.cols) * 3);
+            list.append(a);
+          }
+          d["images"] = list;
+        }
+        return d;
+      },
+      py::arg("path"), py::arg("model") = nullptr, py::kw_only(), py::arg("image_topic") = "", py::arg("joint_topic") = "",
+      py::arg("time_source") = "header", py::arg("joint_map") = "", py::arg("frames") = std::vector<long>{},
+      R"doc(What a robot log (MCAP, rosbag2 .db3 or folder, ROS 1 .bag) holds, as `kccd bag info --json` under 'info'.
+With a model, also what `kccd overlay --bag` reads: 'state_names', 'times' (s, from 'origin_ns' on the chosen
+clock), 'states' (one row per joint state, the model's state values matched by name or by joint_map),
+'joint_topic'; with a model or frames: 'image_topic', 'frame_times' (s, same clock), 'fps' (the median
+interval's rate), 'warnings'. frames: indices of the image topic's frames returned under 'images' as uint8
+(H, W, 3) RGB. time_source: 'header' (header stamps) or 'log' (the recorder's times). Raises InputError
+naming the file, topic and place.)doc");
 
   m.def(
       "synthesize_recording",

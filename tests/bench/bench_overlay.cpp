@@ -35,6 +35,7 @@
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/model.hpp"
+#include "bench/bench_recording.hpp"
 
 namespace {
 
@@ -60,21 +61,6 @@ struct Timed {
   }
 };
 
-// The sample camera's lens, placed 4.6 m from the humanoid so that all of it is in view.
-kccd::calib::Camera benchCamera() {
-  kccd::calib::Camera c = kccd::calib::loadCamera(std::string(KCCD_DATA_DIR) + "/demo_camera.yaml");
-  const cv::Vec3d eye(3.6, -2.6, 1.7), target(0.1, 0.0, 1.0), up(0, 0, 1);
-  const cv::Vec3d z = cv::normalize(target - eye);
-  const cv::Vec3d x = cv::normalize(z.cross(up));
-  const cv::Vec3d y = z.cross(x);
-  const cv::Matx33d r(x[0], x[1], x[2], y[0], y[1], y[2], z[0], z[1], z[2]);
-  cv::Mat rvec;
-  cv::Rodrigues(cv::Mat(r), rvec);
-  c.rvec = cv::Vec3d(rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2));
-  c.tvec = -(r * eye);
-  return c;
-}
-
 int fourcc(const std::string& codec) { return cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]); }
 
 std::string extensionFor(const std::string& codec) {
@@ -86,40 +72,8 @@ std::string extensionFor(const std::string& codec) {
 void makeVideo(const std::string& path, const std::string& codec, int frames, double fps) {
   cv::VideoWriter vw(path, cv::CAP_FFMPEG, fourcc(codec), fps, cv::Size(1280, 720), true);
   if (!vw.isOpened()) throw std::runtime_error("cannot write " + path);
-  cv::Mat noise(720, 1280, CV_8UC3);
   cv::RNG rng(7);
-  for (int i = 0; i < frames; ++i) {
-    cv::Mat f(720, 1280, CV_8UC3);
-    for (int y = 0; y < 720; ++y) {
-      cv::Vec3b* row = f.ptr<cv::Vec3b>(y);
-      for (int x = 0; x < 1280; ++x) row[x] = cv::Vec3b(uchar((x + 3 * i) / 5), uchar(y / 3), uchar((x + y + 5 * i) / 8));
-    }
-    rng.fill(noise, cv::RNG::UNIFORM, 0, 24);
-    f += noise;
-    vw.write(f);
-  }
-}
-
-// Slow sinusoids within the joint limits at 100 Hz (the arms swing, the torso turns).
-void makeLog(const std::string& path, const kccd::Model& m, double seconds) {
-  std::ofstream out(path);
-  out << "time";
-  for (const std::string& n : m.stateNames()) out << "," << n;
-  out << "\n";
-  char buf[64];
-  for (int k = 0; k <= static_cast<int>(seconds * 100) + 1; ++k) {
-    const double t = k * 0.01;
-    out << k / 100 << "." << (k % 100 < 10 ? "0" : "") << k % 100;
-    for (std::size_t j = 0; j < m.joints.size(); ++j) {
-      const auto& joint = m.joints[j];
-      const std::array<double, 2> lim = joint.limits.value_or(std::array<double, 2>{-1.0, 1.0});
-      const double lo = lim[0], hi = lim[1];
-      const double mid = 0.5 * (lo + hi), amp = 0.35 * (hi - lo);
-      std::snprintf(buf, sizeof buf, ",%.6f", mid + amp * std::sin(0.8 * t + 0.7 * static_cast<double>(j)));
-      out << buf;
-    }
-    out << "\n";
-  }
+  for (int i = 0; i < frames; ++i) vw.write(kccd::bench::texturedFrame(i, rng));
 }
 
 // Decode and encode on two threads with a bounded queue: the plain transcode's best.
@@ -222,8 +176,8 @@ int main(int argc, char** argv) {
     const std::string ext = extensionFor(codec);
     const std::string model = std::string(KCCD_DATA_DIR) + "/humanoid.yaml", camera = dir + "/camera.yaml",
                       video = dir + "/in" + ext, log = dir + "/states.csv";
-    kccd::calib::saveCamera(benchCamera(), camera);
-    makeLog(log, kccd::loadModel(model), frames / fps + 1.0);
+    kccd::calib::saveCamera(kccd::bench::benchCamera(), camera);
+    kccd::bench::makeLog(log, kccd::loadModel(model), frames / fps + 1.0);
     makeVideo(video, codec, frames, fps);
 
     int plain_frames = 0;

@@ -85,9 +85,9 @@ def test_batch_equals_overlay_and_reports_the_failure(cli, fleet: pathlib.Path, 
         ref_dir = tmp_path / f"ref-{rec}"
         ref_dir.mkdir()
         ref = cli_report(cli, fleet, rec, ref_dir, swept)
-        assert mine["video"] == "overlay.mp4" and mine["contact_sheet"] == "contact_sheet.png"
+        assert mine["video"] == "overlay.mp4" and mine["contact_sheet"] == "contact_sheet.png" and mine["timeline"] == "timeline.png"
         for key in set(ref) | set(mine):
-            if key not in ("video", "contact_sheet"):
+            if key not in ("video", "contact_sheet", "timeline"):
                 assert mine[key] == ref[key], key
         # The same frames drawn: the videos decode to the same pictures.
         n = ref["frames_total"]
