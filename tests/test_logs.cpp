@@ -998,4 +998,29 @@ TEST_F(McapFixtures, AGoldenCaseOnABagFrameIsTheOverlaysFrame) {
   EXPECT_NE(both.err.find("give video and states, or bag, not both"), std::string::npos) << both.err;
 }
 
+// The same messages written topic by topic (tests/bags/write_mcap.mjs: joint_overlap.mcap, zstd
+// chunks whose time ranges overlap): read in log-time order from the chunk index, as the file
+// written in time order reads, message for message; and the summary, export and overlay agree.
+TEST_F(McapFixtures, ChunksThatOverlapInTimeAreMergedByLogTime) {
+  McapReader ordered(file("joint_zstd.mcap")), overlapping(file("joint_overlap.mcap"));
+  EXPECT_FALSE(ordered.merging());
+  EXPECT_TRUE(overlapping.merging());
+  std::vector<std::vector<std::uint8_t>> a_bytes, b_bytes;
+  const std::vector<LogMessage> a = all(ordered, &a_bytes), b = all(overlapping, &b_bytes);
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a.size(), 211u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].log_time, b[i].log_time) << i;
+    EXPECT_EQ(a[i].channel->topic, b[i].channel->topic) << i;
+    EXPECT_EQ(a[i].sequence, b[i].sequence) << i;
+    EXPECT_EQ(a_bytes[i], b_bytes[i]) << i;
+  }
+  EXPECT_TRUE(overlapping.damage().empty());
+  EXPECT_GT(overlapping.chunks().at("zstd"), 2);
+  const auto info_a = runProgram(std::string(KCCD_CLI) + " bag info " + file("joint_zstd.mcap") + " --json");
+  const auto info_b = runProgram(std::string(KCCD_CLI) + " bag info " + file("joint_overlap.mcap") + " --json");
+  EXPECT_EQ(nlohmann::json::parse(info_a.out)["topics"], nlohmann::json::parse(info_b.out)["topics"]);
+  EXPECT_EQ(exportOf(file("joint_overlap.mcap"), "overlap"), exportOf(file("joint_zstd.mcap"), "mcap"));
+}
+
 }  // namespace

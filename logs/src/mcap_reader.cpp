@@ -93,9 +93,189 @@ McapReader::McapReader(const std::string& path) : path_(path) {
     throw InputError(InputLocation{path, 0, 0, "byte 0"}, "not an MCAP file (its first 8 bytes are not the MCAP magic)");
   data_crc_ = crc32Of(0, magic, 8);
   pos_ = 8;
+  if (!readIndex()) {
+    merge_.reset();
+    schemas_.clear();
+    channels_.clear();
+    in_.clear();
+    in_.seekg(8);
+  }
 }
 
 McapReader::~McapReader() = default;
+
+// Merging chunks that overlap in time: the chunk index in start-time order, the chunks open now
+// (decompressed, their messages sorted by log time) and where each stands.
+struct McapReader::Merge {
+  struct Chunk {
+    std::uint64_t start = 0, end = 0, offset = 0, length = 0;
+  };
+  struct Entry {
+    std::uint64_t log_time = 0;
+    std::size_t record = 0;  // offset of the message's content in the chunk's records
+    std::size_t size = 0;
+  };
+  struct Open {
+    std::uint64_t at = 0;  // the chunk's file offset
+    std::vector<std::uint8_t> records;
+    std::vector<Entry> messages;
+    std::size_t next = 0;
+  };
+  std::vector<Chunk> order;  // by start time, then file offset
+  std::size_t opened = 0;
+  std::vector<std::unique_ptr<Open>> open;
+  std::unique_ptr<Open> last;  // the chunk of the message returned last (its bytes are the caller's until next())
+};
+
+bool McapReader::readIndex() {
+  // Footer: opcode, length 20, summary_start, summary_offset_start, summary_crc; then the magic.
+  constexpr std::uint64_t kFooterBytes = 9 + 20;
+  if (size_ < 8 + kFooterBytes + 8) return false;
+  std::vector<std::uint8_t> tail(kFooterBytes + 8);
+  in_.seekg(static_cast<std::streamoff>(size_ - tail.size()));
+  if (!in_.read(reinterpret_cast<char*>(tail.data()), static_cast<std::streamsize>(tail.size()))) return false;
+  if (tail[0] != kFooter || std::memcmp(tail.data() + kFooterBytes, kMagic, 8) != 0) return false;
+  std::uint64_t summary_start = 0;
+  for (int i = 0; i < 8; ++i) summary_start |= static_cast<std::uint64_t>(tail[9 + i]) << (8 * i);
+  const std::uint64_t summary_end = size_ - tail.size();
+  if (summary_start < 8 || summary_start >= summary_end) return false;
+  std::vector<std::uint8_t> summary(static_cast<std::size_t>(summary_end - summary_start));
+  in_.seekg(static_cast<std::streamoff>(summary_start));
+  if (!in_.read(reinterpret_cast<char*>(summary.data()), static_cast<std::streamsize>(summary.size()))) return false;
+  // A summary whose CRC does not match is left to the linear scan, which names the damage.
+  std::uint32_t crc = 0;
+  for (int i = 0; i < 4; ++i) crc |= static_cast<std::uint32_t>(tail[9 + 16 + i]) << (8 * i);
+  if (crc != 0 && crc32Of(crc32Of(0, summary.data(), summary.size()), tail.data(), 9 + 16) != crc) return false;
+  auto merge = std::make_unique<Merge>();
+  try {
+    for (std::size_t p = 0; p < summary.size();) {
+      if (summary.size() - p < 9) return false;
+      const std::uint8_t op = summary[p];
+      std::uint64_t len = 0;
+      for (int i = 0; i < 8; ++i) len |= static_cast<std::uint64_t>(summary[p + 1 + i]) << (8 * i);
+      if (len > summary.size() - p - 9) return false;
+      const std::span<const std::uint8_t> content(summary.data() + p + 9, static_cast<std::size_t>(len));
+      const std::uint64_t at = summary_start + p;
+      p += 9 + static_cast<std::size_t>(len);
+      if (op == kSchema || op == kChannel) {
+        handle(op, content, at, false);
+      } else if (op == kChunkIndex) {
+        Fields f(content, "Chunk Index");
+        Merge::Chunk c;
+        c.start = f.num<std::uint64_t>("message_start_time");
+        c.end = f.num<std::uint64_t>("message_end_time");
+        c.offset = f.num<std::uint64_t>("chunk_start_offset");
+        c.length = f.num<std::uint64_t>("chunk_length");
+        if (c.offset < 8 || c.length < 9 || c.offset > summary_start || c.length > summary_start - c.offset || c.start > c.end) return false;
+        merge->order.push_back(c);
+      }
+    }
+  } catch (const std::exception&) {
+    return false;  // the linear scan says what is wrong, where
+  }
+  if (merge->order.size() < 2) return false;
+  // Overlap: a chunk (in file order) that starts before an earlier one ends.
+  std::sort(merge->order.begin(), merge->order.end(), [](const Merge::Chunk& a, const Merge::Chunk& b) { return a.offset < b.offset; });
+  bool overlap = false;
+  std::uint64_t latest = 0;
+  for (const Merge::Chunk& c : merge->order) {
+    overlap = overlap || c.start < latest;
+    latest = std::max(latest, c.end);
+  }
+  if (!overlap) return false;
+  // The data section's records between chunks: schemas and channels are taken, and a message outside
+  // every chunk (which the index does not place) leaves the file to the linear scan.
+  std::vector<std::uint8_t> content;
+  for (std::uint64_t p = 8; p < summary_start;) {
+    std::uint8_t head[9];
+    in_.seekg(static_cast<std::streamoff>(p));
+    if (summary_start - p < 9 || !in_.read(reinterpret_cast<char*>(head), 9)) return false;
+    std::uint64_t len = 0;
+    for (int i = 0; i < 8; ++i) len |= static_cast<std::uint64_t>(head[1 + i]) << (8 * i);
+    if (len > summary_start - p - 9) return false;
+    if (head[0] == kMessage) return false;
+    if (head[0] == kSchema || head[0] == kChannel || head[0] == kHeader) {
+      content.resize(static_cast<std::size_t>(len));
+      if (len > 0 && !in_.read(reinterpret_cast<char*>(content.data()), static_cast<std::streamsize>(len))) return false;
+      try {
+        handle(head[0], content, p, false);
+      } catch (const std::exception&) {
+        return false;
+      }
+    }
+    if (head[0] == kDataEnd) break;
+    p += 9 + len;
+  }
+  std::stable_sort(merge->order.begin(), merge->order.end(), [](const Merge::Chunk& a, const Merge::Chunk& b) { return a.start < b.start; });
+  merge_ = std::move(merge);
+  return true;
+}
+
+bool McapReader::nextMerged(LogMessage& out) {
+  Merge& g = *merge_;
+  g.last.reset();
+  for (;;) {
+    // The open chunk with the earliest next message (the earliest opened among equal times).
+    Merge::Open* best = nullptr;
+    for (const auto& o : g.open)
+      if (!best || o->messages[o->next].log_time < best->messages[best->next].log_time) best = o.get();
+    const bool more = g.opened < g.order.size();
+    if (more && (!best || g.order[g.opened].start <= best->messages[best->next].log_time)) {
+      // Open the next chunk by start time: its schemas and channels taken, its messages sorted.
+      const Merge::Chunk& c = g.order[g.opened++];
+      auto o = std::make_unique<Merge::Open>();
+      o->at = c.offset;
+      std::vector<std::uint8_t> record(static_cast<std::size_t>(c.length));
+      in_.clear();
+      in_.seekg(static_cast<std::streamoff>(c.offset));
+      if (!in_.read(reinterpret_cast<char*>(record.data()), static_cast<std::streamsize>(record.size())) || record[0] != kChunk)
+        fail(c.offset, "the chunk index points at no Chunk record here");
+      std::uint64_t len = 0;
+      for (int i = 0; i < 8; ++i) len |= static_cast<std::uint64_t>(record[1 + i]) << (8 * i);
+      if (len != c.length - 9) fail(c.offset, "the chunk index gives this chunk another length than its record");
+      try {
+        decompressChunk(std::span<const std::uint8_t>(record).subspan(9), c.offset, o->records);
+      } catch (const std::out_of_range& e) {
+        fail(c.offset, e.what());
+      }
+      for (std::size_t p = 0; p < o->records.size();) {
+        const std::size_t left = o->records.size() - p;
+        if (left < 9) fail(c.offset, "the chunk ends inside a record's opcode and length");
+        const std::uint8_t op = o->records[p];
+        std::uint64_t n = 0;
+        for (int i = 0; i < 8; ++i) n |= static_cast<std::uint64_t>(o->records[p + 1 + i]) << (8 * i);
+        if (n > left - 9) fail(c.offset, std::string("a ") + opName(op) + " record inside the chunk runs past its end");
+        const std::span<const std::uint8_t> content(o->records.data() + p + 9, static_cast<std::size_t>(n));
+        if (op == kMessage) {
+          if (n < 22) fail(c.offset, "the Message record is too short for its header (" + std::to_string(n) + " bytes)");
+          std::uint64_t t = 0;
+          for (int i = 0; i < 8; ++i) t |= static_cast<std::uint64_t>(content[6 + i]) << (8 * i);
+          o->messages.push_back({t, p + 9, static_cast<std::size_t>(n)});
+        } else if (op == kSchema || op == kChannel) {
+          handle(op, content, c.offset, true);
+        } else if (op <= kDataEnd) {
+          fail(c.offset, std::string("a ") + opName(op) + " record inside a chunk (only schemas, channels and messages belong there)");
+        }
+        p += 9 + static_cast<std::size_t>(n);
+      }
+      std::stable_sort(o->messages.begin(), o->messages.end(), [](const Merge::Entry& a, const Merge::Entry& b) { return a.log_time < b.log_time; });
+      if (!o->messages.empty()) g.open.push_back(std::move(o));
+      continue;
+    }
+    if (!best) return false;
+    const Merge::Entry e = best->messages[best->next++];
+    chunk_at_ = best->at;
+    handle(kMessage, std::span<const std::uint8_t>(best->records.data() + e.record, e.size), best->at, true);
+    pending_ = false;
+    out = message_;
+    if (best->next == best->messages.size()) {  // done: kept until the caller has the message's bytes
+      const auto it = std::find_if(g.open.begin(), g.open.end(), [&](const auto& o) { return o.get() == best; });
+      g.last = std::move(*it);
+      g.open.erase(it);
+    }
+    return true;
+  }
+}
 
 void McapReader::fail(std::uint64_t at, const std::string& problem) const {
   throw InputError(InputLocation{path_, 0, 0, "byte " + std::to_string(at)}, problem);
@@ -138,6 +318,13 @@ bool McapReader::readRecord(std::uint8_t& opcode, std::vector<std::uint8_t>& con
 }
 
 void McapReader::openChunk(std::span<const std::uint8_t> content, std::uint64_t at) {
+  decompressChunk(content, at, chunk_);
+  chunk_at_ = at;
+  chunk_pos_ = 0;
+}
+
+void McapReader::decompressChunk(std::span<const std::uint8_t> content, std::uint64_t at, std::vector<std::uint8_t>& chunk) {
+  std::vector<std::uint8_t>& chunk_ = chunk;
   Fields f(content, "Chunk");
   f.num<std::uint64_t>("message_start_time");
   f.num<std::uint64_t>("message_end_time");
@@ -159,8 +346,6 @@ void McapReader::openChunk(std::span<const std::uint8_t> content, std::uint64_t 
   }
   if (crc != 0 && crc32Of(0, chunk_.data(), chunk_.size()) != crc) fail(at, "the chunk's CRC does not match its records (damaged)");
   ++chunks_[compression.empty() ? "none" : compression];
-  chunk_at_ = at;
-  chunk_pos_ = 0;
 }
 
 void McapReader::handle(std::uint8_t opcode, std::span<const std::uint8_t> content, std::uint64_t at, bool in_chunk) {
@@ -259,6 +444,7 @@ void McapReader::handle(std::uint8_t opcode, std::span<const std::uint8_t> conte
 }
 
 bool McapReader::next(LogMessage& out) {
+  if (merge_) return nextMerged(out);
   for (;;) {
     if (pending_) {
       pending_ = false;

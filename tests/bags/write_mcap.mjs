@@ -10,6 +10,8 @@
 //   joint_lz4.mcap            chunked (4 KiB), lz4 frame (lz4js; @foxglove/wasm-lz4
 //                             only decompresses, it is used here to verify each frame)
 //   joint_chunked_none.mcap   chunked (4 KiB), no compression
+//   joint_overlap.mcap        the same messages topic by topic in zstd chunks: chunk time
+//                             ranges overlap (not in truth.json: its file order differs)
 // plus truth.json: what each file holds and every decoded message, for the tests.
 // Content: 200 sensor_msgs/msg/JointState on /joint_states at 1 kHz, one CameraInfo and 10
 // sensor_msgs/msg/Image (64x48 rgb8) on /camera/image_raw at 30 Hz, interleaved by
@@ -125,7 +127,7 @@ const FILES = {
   "joint_chunked_none.mcap": { compression: "", opts: { chunkSize: CHUNK, compressChunk: compressNone } },
 };
 
-async function writeFile(name, opts) {
+async function writeFile(name, opts, order = records) {
   const parts = [];
   let pos = 0n;
   const writable = { position: () => pos, write: async (b) => { parts.push(Buffer.from(b)); pos += BigInt(b.byteLength); } };
@@ -136,7 +138,7 @@ async function writeFile(name, opts) {
     const schemaId = await w.registerSchema({ name: t.schema_name, encoding: "ros2msg", data: new TextEncoder().encode(t.def) });
     channels.push(await w.registerChannel({ topic: t.topic, schemaId, messageEncoding: "cdr", metadata: new Map() }));
   }
-  for (const r of records) {
+  for (const r of order) {
     await w.addMessage({ channelId: channels[r.ti], sequence: r.seq, logTime: r.log, publishTime: r.log, data: r.data });
   }
   await w.end();
@@ -145,6 +147,11 @@ async function writeFile(name, opts) {
 
 fs.mkdirSync(outDir, { recursive: true });
 for (const [name, f] of Object.entries(FILES)) await writeFile(name, f.opts);
+// The same messages written topic by topic (every joint state, then every image, then the camera
+// info) in zstd chunks of 4 KiB: the chunks' time ranges overlap, and log-time order is the
+// reader's to restore (from the summary's chunk index). Not in truth.json: its file order differs.
+const byTopic = [...records].sort((a, b) => a.ti - b.ti || (a.log < b.log ? -1 : a.log > b.log ? 1 : 0));
+await writeFile("joint_overlap.mcap", { chunkSize: CHUNK, compressChunk: compressZstd }, byTopic);
 
 // ---- truth.json
 const topicInfo = TOPICS.map((t) => ({

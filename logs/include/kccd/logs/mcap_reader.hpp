@@ -1,7 +1,9 @@
-// Reading MCAP files (https://mcap.dev/spec, version 0) as a stream of messages: the records in
-// file order, chunks decompressed one at a time (none, zstd, lz4 frames), CRCs checked where the
-// writer recorded them. The summary section is read only for its CRC: a linear scan needs no
-// index, so a recording that crashed before writing its summary reads the same as a finished one.
+// Reading MCAP files (https://mcap.dev/spec, version 0) as a stream of messages in log-time order:
+// the records in file order, chunks decompressed one at a time (none, zstd, lz4 frames), CRCs
+// checked where the writer recorded them. A linear scan needs no index, so a recording that crashed
+// before writing its summary reads the same as a finished one. Where the summary's chunk index
+// shows chunks whose time ranges overlap (messages written out of time order), the chunks are read
+// by start time instead and their messages merged by log time.
 #pragma once
 
 #include <cstdint>
@@ -18,7 +20,7 @@
 namespace kccd::logs {
 
 /// Streams one MCAP file's messages. Memory is bounded by the largest record or decompressed
-/// chunk, not by the file. Every length field is checked against the bytes that remain before
+/// chunk (by the chunks open at once where chunks overlap in time), not by the file. Every length field is checked against the bytes that remain before
 /// anything is allocated for it.
 class McapReader final : public LogReader {
  public:
@@ -28,7 +30,8 @@ class McapReader final : public LogReader {
   McapReader(const McapReader&) = delete;
   McapReader& operator=(const McapReader&) = delete;
 
-  /// The next message in file order; false after the last one. Throws InputError ("FILE: byte N:
+  /// The next message in log-time order (file order for equal times, and for a file whose chunks
+  /// do not overlap in time or that has no chunk index); false after the last one. Throws InputError ("FILE: byte N:
   /// problem") for a CRC mismatch, an unknown compression, a record that contradicts itself or a
   /// message on a channel never defined. A file cut short ends the stream early: see damage().
   bool next(LogMessage& out) override;
@@ -48,11 +51,17 @@ class McapReader final : public LogReader {
   std::uint64_t fileSize() const { return size_; }
   /// Chunks read so far, and their compressions (e.g. {"zstd": 12}).
   std::map<std::string, int> chunks() const override { return chunks_; }
+  /// True when the chunks overlap in time and are merged by log time (see above).
+  bool merging() const { return merge_ != nullptr; }
 
  private:
   bool readRecord(std::uint8_t& opcode, std::vector<std::uint8_t>& content, std::uint64_t& at);
   void handle(std::uint8_t opcode, std::span<const std::uint8_t> content, std::uint64_t at, bool in_chunk);
   void openChunk(std::span<const std::uint8_t> content, std::uint64_t at);
+  void decompressChunk(std::span<const std::uint8_t> content, std::uint64_t at, std::vector<std::uint8_t>& out);
+  struct Merge;
+  bool readIndex();
+  bool nextMerged(LogMessage& out);
   [[noreturn]] void fail(std::uint64_t at, const std::string& problem) const;
   void cut(std::uint64_t at, const std::string& where);
 
@@ -72,6 +81,7 @@ class McapReader final : public LogReader {
   std::uint64_t chunk_at_ = 0, chunk_pos_ = 0;
   bool pending_ = false;              // handle() found a message for next() to return
   LogMessage message_;
+  std::unique_ptr<Merge> merge_;      // chunks read by start time (overlapping chunks), else null
 };
 
 }  // namespace kccd::logs
