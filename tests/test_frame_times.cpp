@@ -1,4 +1,4 @@
-// Frame-times files (kccd/overlay/frame_times.hpp): the table, and one exact message per mistake.
+// Frame-times files (kccd/overlay/recording/frame_times.hpp): the table, and one exact message per mistake.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -9,7 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "kccd/overlay/frame_times.hpp"
+#include "kccd/overlay/recording/frame_times.hpp"
 
 namespace kccd::overlay {
 namespace {

@@ -7,7 +7,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "kccd/overlay/golden_compare.hpp"
+#include "kccd/overlay/golden/golden_compare.hpp"
 
 namespace kccd::overlay {
 namespace {

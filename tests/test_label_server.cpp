@@ -18,10 +18,10 @@
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/calib/labels.hpp"
-#include "kccd/overlay/calib_gather.hpp"
-#include "kccd/overlay/calib_solve.hpp"
-#include "kccd/overlay/label_server.hpp"
-#include "kccd/overlay/labels_document.hpp"
+#include "kccd/overlay/calibration/calib_gather.hpp"
+#include "kccd/overlay/calibration/calib_solve.hpp"
+#include "kccd/overlay/labelling/label_server.hpp"
+#include "kccd/overlay/labelling/labels_document.hpp"
 #include "support/files.hpp"
 
 // Last: the OpenSSL headers it pulls in define names that clash with Eigen's when they come first.

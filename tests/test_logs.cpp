@@ -30,7 +30,7 @@
 #include "kccd/logs/message_definition.hpp"
 #include "kccd/logs/log_reader.hpp"
 #include "kccd/calib/camera.hpp"
-#include "kccd/overlay/bag_export.hpp"
+#include "kccd/overlay/bags/bag_export.hpp"
 #include "support/files.hpp"
 #include "support/run_program.hpp"
 

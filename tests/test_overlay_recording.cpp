@@ -17,10 +17,10 @@
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/checker.hpp"
-#include "kccd/overlay/overlay_recording.hpp"
-#include "kccd/overlay/timeline.hpp"
-#include "kccd/overlay/video_sink.hpp"
-#include "kccd/overlay/video_source.hpp"
+#include "kccd/overlay/recording/overlay_recording.hpp"
+#include "kccd/overlay/recording/timeline.hpp"
+#include "kccd/overlay/recording/video_sink.hpp"
+#include "kccd/overlay/recording/video_source.hpp"
 
 namespace {
 

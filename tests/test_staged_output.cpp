@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "kccd/overlay/staged_output.hpp"
+#include "kccd/overlay/recording/staged_output.hpp"
 #include "support/files.hpp"
 
 namespace fs = std::filesystem;

@@ -13,8 +13,8 @@
 #include <opencv2/videoio.hpp>
 
 #include "kccd/model.hpp"
-#include "kccd/overlay/time_offset.hpp"
-#include "kccd/overlay/video_source.hpp"
+#include "kccd/overlay/recording/time_offset.hpp"
+#include "kccd/overlay/recording/video_source.hpp"
 #include "kccd/state_log.hpp"
 
 namespace fs = std::filesystem;

@@ -11,7 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "kccd/overlay/video_source.hpp"
+#include "kccd/overlay/recording/video_source.hpp"
 #include "support/files.hpp"
 
 namespace fs = std::filesystem;

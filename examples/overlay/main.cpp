@@ -8,9 +8,9 @@
 
 #include <kccd/calib/camera.hpp>
 #include <kccd/model.hpp>
-#include <kccd/overlay/overlay_recording.hpp>
-#include <kccd/overlay/staged_output.hpp>
-#include <kccd/overlay/video_sink.hpp>
+#include <kccd/overlay/recording/overlay_recording.hpp>
+#include <kccd/overlay/recording/staged_output.hpp>
+#include <kccd/overlay/recording/video_sink.hpp>
 #include <kccd/state_log.hpp>
 #include <nlohmann/json.hpp>
 

@@ -6,8 +6,8 @@
 
 #include "cli_args.hpp"
 #include "cli_output.hpp"
-#include "kccd/overlay/bag_recording.hpp"
-#include "kccd/overlay/calib_gather.hpp"
+#include "kccd/overlay/bags/bag_recording.hpp"
+#include "kccd/overlay/calibration/calib_gather.hpp"
 #include "kccd/state_log.hpp"
 
 namespace kccd::cli {

@@ -13,7 +13,7 @@
 
 
 #include "cli_args.hpp"
-#include "kccd/overlay/video_sink.hpp"
+#include "kccd/overlay/recording/video_sink.hpp"
 
 namespace kccd::cli {
 

@@ -9,8 +9,8 @@
 #include "commands.hpp"
 #include "kccd/input_error.hpp"
 #include "kccd/logs/bag_summary.hpp"
-#include "kccd/overlay/bag_export.hpp"
-#include "kccd/overlay/bag_info.hpp"
+#include "kccd/overlay/bags/bag_export.hpp"
+#include "kccd/overlay/bags/bag_info.hpp"
 
 namespace kccd::cli {
 namespace {

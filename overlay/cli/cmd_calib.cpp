@@ -12,10 +12,10 @@
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
-#include "kccd/overlay/calib_check.hpp"
-#include "kccd/overlay/calib_gather.hpp"
-#include "kccd/overlay/calib_report.hpp"
-#include "kccd/overlay/calib_solve.hpp"
+#include "kccd/overlay/calibration/calib_check.hpp"
+#include "kccd/overlay/calibration/calib_gather.hpp"
+#include "kccd/overlay/calibration/calib_report.hpp"
+#include "kccd/overlay/calibration/calib_solve.hpp"
 #include "kccd/state_log.hpp"
 
 namespace kccd::cli {

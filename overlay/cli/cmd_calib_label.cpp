@@ -16,8 +16,8 @@
 #include "cli_files.hpp"
 #include "commands.hpp"
 #include "kccd/calib/image_file.hpp"
-#include "kccd/overlay/calib_gather.hpp"
-#include "kccd/overlay/label_server.hpp"
+#include "kccd/overlay/calibration/calib_gather.hpp"
+#include "kccd/overlay/labelling/label_server.hpp"
 
 namespace kccd::cli {
 namespace {

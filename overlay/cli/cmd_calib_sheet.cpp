@@ -10,8 +10,8 @@
 #include "cli_files.hpp"
 #include "commands.hpp"
 #include "kccd/calib/image_file.hpp"
-#include "kccd/overlay/calib_drawing.hpp"
-#include "kccd/overlay/labelling_candidates.hpp"
+#include "kccd/overlay/calibration/calib_drawing.hpp"
+#include "kccd/overlay/labelling/labelling_candidates.hpp"
 
 namespace kccd::cli {
 namespace {

@@ -15,11 +15,11 @@
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/file_reader.hpp"
-#include "kccd/overlay/golden_check.hpp"
-#include "kccd/overlay/golden_manifest.hpp"
-#include "kccd/overlay/golden_render.hpp"
-#include "kccd/overlay/golden_report.hpp"
-#include "kccd/overlay/staged_output.hpp"
+#include "kccd/overlay/golden/golden_check.hpp"
+#include "kccd/overlay/golden/golden_manifest.hpp"
+#include "kccd/overlay/golden/golden_render.hpp"
+#include "kccd/overlay/golden/golden_report.hpp"
+#include "kccd/overlay/recording/staged_output.hpp"
 #include "kccd/render/gl_context.hpp"
 
 namespace kccd::cli {

@@ -12,10 +12,10 @@
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
-#include "kccd/overlay/bag_recording.hpp"
-#include "kccd/overlay/frame_times.hpp"
-#include "kccd/overlay/overlay_recording.hpp"
-#include "kccd/overlay/video_sink.hpp"
+#include "kccd/overlay/bags/bag_recording.hpp"
+#include "kccd/overlay/recording/frame_times.hpp"
+#include "kccd/overlay/recording/overlay_recording.hpp"
+#include "kccd/overlay/recording/video_sink.hpp"
 #include "kccd/state_log.hpp"
 
 namespace kccd::cli {

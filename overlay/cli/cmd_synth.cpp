@@ -1,5 +1,5 @@
 // `kccd synth MODEL -o DIR`: a synthetic recording with ground truth (kccd::overlay::
-// synthesizeRecording, kccd/overlay/synth.hpp) — the options, the call, the summary line.
+// synthesizeRecording, kccd/overlay/synth/synth.hpp) — the options, the call, the summary line.
 #include <iostream>
 #include <memory>
 #include <string>
@@ -7,7 +7,7 @@
 #include "cli_args.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
-#include "kccd/overlay/synth.hpp"
+#include "kccd/overlay/synth/synth.hpp"
 
 namespace kccd::cli {
 namespace {

@@ -13,7 +13,7 @@
 #include "kccd/calib/pose.hpp"
 #include "kccd/calib/tag_detect.hpp"
 #include "kccd/calib/tag_layout.hpp"
-#include "kccd/overlay/calib_gather.hpp"
+#include "kccd/overlay/calibration/calib_gather.hpp"
 
 namespace kccd::python {
 

@@ -29,9 +29,9 @@
 #include <opencv2/videoio.hpp>
 
 #include "bench/bench_recording.hpp"
-#include "kccd/overlay/bag_recording.hpp"
-#include "kccd/overlay/frame_times.hpp"
-#include "kccd/overlay/video_source.hpp"
+#include "kccd/overlay/bags/bag_recording.hpp"
+#include "kccd/overlay/recording/frame_times.hpp"
+#include "kccd/overlay/recording/video_source.hpp"
 #include "kccd/state_log.hpp"
 
 namespace {

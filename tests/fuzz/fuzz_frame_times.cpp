@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "fuzz_support.hpp"
-#include "kccd/overlay/frame_times.hpp"
+#include "kccd/overlay/recording/frame_times.hpp"
 #include "kccd/input_error.hpp"
 
 namespace {

@@ -9,7 +9,7 @@
 
 #include "fuzz_support.hpp"
 #include "kccd/input_error.hpp"
-#include "kccd/overlay/golden_manifest.hpp"
+#include "kccd/overlay/golden/golden_manifest.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

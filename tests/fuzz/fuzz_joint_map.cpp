@@ -12,7 +12,7 @@
 #include "fuzz_support.hpp"
 #include "kccd/input_error.hpp"
 #include "kccd/model.hpp"
-#include "kccd/overlay/joint_map.hpp"
+#include "kccd/overlay/bags/joint_map.hpp"
 
 namespace {
 

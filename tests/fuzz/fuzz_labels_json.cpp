@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "kccd/calib/labels.hpp"
-#include "kccd/overlay/labels_document.hpp"
+#include "kccd/overlay/labelling/labels_document.hpp"
 
 namespace {
 

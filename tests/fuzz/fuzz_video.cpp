@@ -11,7 +11,7 @@
 
 #include "fuzz_support.hpp"
 #include "kccd/input_error.hpp"
-#include "kccd/overlay/video_source.hpp"
+#include "kccd/overlay/recording/video_source.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = kccd::fuzz::writeInput("fuzz_video", "clip.mkv", data, size);

@@ -1,8 +1,8 @@
-// The tag scene renderer (kccd/overlay/tag_scene.hpp, the room of `kccd synth`) under the names the
+// The tag scene renderer (kccd/overlay/synth/tag_scene.hpp, the room of `kccd synth`) under the names the
 // image tests use.
 #pragma once
 
-#include "kccd/overlay/tag_scene.hpp"
+#include "kccd/overlay/synth/tag_scene.hpp"
 
 namespace kccd::testing {
 

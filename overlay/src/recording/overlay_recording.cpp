@@ -1,0 +1,383 @@
+// The frame pipeline: one reader thread decodes frames in order; annotator threads (one Checker
+// and one Renderer, hence one GL context, each, at a lower priority) query, render and composite;
+// the calling thread hands the frames to the sink in input order. At most `2 x jobs + 2` frames are in flight, so
+// memory stays bounded whatever the video's length.
+#include "kccd/overlay/recording/overlay_recording.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cerrno>
+#include <cmath>
+#include <condition_variable>
+#include <cstdlib>
+#include <deque>
+#include <exception>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <opencv2/core/utils/logger.hpp>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "kccd/input_error.hpp"
+#include "kccd/overlay/recording/contact_sheet.hpp"
+#include "kccd/overlay/recording/timeline.hpp"
+#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/recording/video_source.hpp"
+#include "kccd/render/projection.hpp"
+
+namespace kccd::overlay {
+namespace {
+
+struct FrameJob {
+  std::size_t index = 0;
+  cv::Mat bgr;
+  FrameRecord record;
+};
+
+// The annotators run this many nice levels below the reader and the writer. Decoding and encoding
+// are the pipeline's serial stages: on a machine with fewer cores than busy threads (the codec's,
+// the annotators', the rasteriser's), a frame's encoding that waits for a core delays every frame
+// behind it, while the annotators only need to keep up on average.
+constexpr int kAnnotatorNice = 10;
+
+// Lowers the calling thread's priority by `steps` nice levels (Linux: nice is per thread; threads
+// it starts, such as the GL rasteriser's, inherit it). Best effort: a refusal changes nothing but speed.
+void lowerThreadPriority(int steps) {
+  if (steps <= 0) return;
+  const auto tid = static_cast<id_t>(::syscall(SYS_gettid));
+  errno = 0;
+  const int now = ::getpriority(PRIO_PROCESS, tid);
+  if (errno == 0) (void)::setpriority(PRIO_PROCESS, tid, std::min(19, now + steps));
+}
+
+}  // namespace
+
+bool FrameRange::contains(std::size_t i) const {
+  const long n = static_cast<long>(i);
+  return n >= first && (end < 0 || n < end) && (n - first) % step == 0;
+}
+
+FrameRange parseFrameRange(const std::string& text, const std::string& label) {
+  FrameRange s;
+  if (text.empty()) return s;
+  std::vector<std::string> parts;
+  std::size_t at = 0;
+  for (;;) {
+    const std::size_t colon = text.find(':', at);
+    parts.push_back(text.substr(at, colon == std::string::npos ? std::string::npos : colon - at));
+    if (colon == std::string::npos) break;
+    at = colon + 1;
+  }
+  const InputError bad(label + " " + text +
+                       ": expected FIRST, FIRST:END or FIRST:END:STEP (frame numbers from 0, END exclusive, each part "
+                       "optional, STEP >= 1)");
+  if (parts.size() > 3) throw bad;
+  auto number = [&](const std::string& p, long fallback) -> long {
+    if (p.empty()) return fallback;
+    if (p.size() > 12 || p.find_first_not_of("0123456789") != std::string::npos) throw bad;
+    return std::stol(p);
+  };
+  s.first = number(parts[0], 0);
+  if (parts.size() == 1) {
+    if (parts[0].empty()) throw bad;
+    s.end = s.first + 1;
+    return s;
+  }
+  s.end = number(parts[1], -1);
+  if (parts.size() == 3) s.step = number(parts[2], 1);
+  if (s.step < 1 || (s.end >= 0 && s.end <= s.first)) throw bad;
+  return s;
+}
+
+std::optional<std::size_t> OverlayReport::firstUnsafe() const {
+  for (std::size_t i = 0; i < frames.size(); ++i)
+    if (frames[i].unsafe()) return i;
+  return std::nullopt;
+}
+
+OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& opt, FrameSink* sink,
+                               const std::function<void(const OverlayProgress&)>& progress) {
+  const Model& model = in.model;
+  const calib::Camera& camera = in.camera;
+  const std::string video_label = in.video_label.empty() ? in.video : in.video_label;
+  const std::string camera_label = in.camera_label.empty() ? "camera" : in.camera_label;
+  const auto t_setup = std::chrono::steady_clock::now();
+  OverlayReport report;
+  report.timings = opt.timings;
+  report.max_gap = opt.max_gap > 0.0 ? opt.max_gap : 1.5 * in.log.medianPeriod();
+  report.swept = opt.swept;
+  report.margin = model.safety_margin;
+  report.time_offset = opt.time_offset;
+  report.time_offset_search = opt.time_offset_search;
+
+  std::vector<render::LoadedVisual> visuals;
+  if (opt.visuals) {
+    if (model.visuals.empty()) throw InputError("visuals: the model has no visuals:");
+    if (model.visuals.size() + model.bodies.size() > 255) throw InputError("visuals: more than 255 bodies and visuals to draw");
+    visuals = render::loadVisuals(model);
+  }
+  AnnotatorSettings settings;
+  settings.max_gap = report.max_gap;
+  settings.swept = opt.swept;
+  settings.plain = opt.plain;
+  if (opt.swept) settings.braking.assign(static_cast<std::size_t>(model.stateSize()), opt.braking);
+
+  // Errors are reported once, by the caller: FFmpeg's and OpenCV's own log lines are silenced (set
+  // OPENCV_FFMPEG_LOGLEVEL to see FFmpeg's). FFmpeg reads videos, OpenCV's image reader sequences.
+  setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  // No mask is drawn: its finer pinhole image (and its per-pixel distortion map) is not built. The
+  // colour pass's map is built once here for every annotator.
+  render::RenderOptions render_options;
+  render_options.mask_supersample = render_options.supersample;
+  std::optional<render::Projection> projection;
+  try {
+    projection.emplace(camera, render_options.supersample);
+  } catch (const calib::CameraError& e) {
+    throw InputError(e.messageFrom(camera_label));
+  }
+
+  auto open = [&]() -> std::unique_ptr<FrameSource> {
+    return in.open_frames ? in.open_frames() : std::make_unique<VideoSource>(in.video, video_label);
+  };
+  const std::unique_ptr<FrameSource> source = open();
+  FrameSource& video = *source;
+  report.fps = opt.fps > 0.0 ? opt.fps : video.fps();
+  if (in.frame_times.empty() && !(report.fps > 0.0 && report.fps < 1e6))
+    throw VideoError(video_label + ": the video gives no frame rate: give --fps or --frame-times");
+  const FrameClock clock(in.frame_times, report.fps);
+  if (opt.time_offset_search) {  // a first pass over the video
+    const std::unique_ptr<FrameSource> first_pass = open();
+    const auto [lo, hi] = *opt.time_offset_search;
+    report.time_offset_found =
+        findTimeOffset(*first_pass, clock, in.log, report.max_gap, lo, hi,
+                       opt.time_offset_label.empty() ? "time offset search" : opt.time_offset_label);
+    report.time_offset = report.time_offset_found.offset;
+  }
+  settings.time_offset = report.time_offset;
+  const std::size_t expected = video.declaredFrames();
+  if (sink) sink->begin(clock.nominalFps(), camera.width, camera.height);
+
+  const AnnotatorScene scene{model, in.log, *projection, render_options, visuals, settings};
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  report.jobs = opt.jobs > 0 ? opt.jobs : static_cast<int>(hw);
+  const std::size_t max_in_flight = 2 * static_cast<std::size_t>(report.jobs) + 2;
+
+  // Shared between the reader, the annotators and the writer (this thread), under one mutex.
+  std::mutex mu;
+  std::condition_variable cv;
+  std::deque<FrameJob> todo;
+  std::map<std::size_t, FrameJob> done;
+  std::vector<cv::Mat> spare;  // handed-on frames' buffers, decoded into again (no allocation per frame)
+  std::size_t in_flight = 0, decoded = 0;
+  bool reader_done = false, abort = false;
+  std::exception_ptr error;
+  auto fail = [&](std::exception_ptr e) {
+    std::lock_guard lock(mu);
+    if (!error) error = e;
+    abort = true;
+    cv.notify_all();
+  };
+  const auto count = [](std::size_t n) { return std::to_string(n); };
+
+  std::thread reader([&] {
+    try {
+      for (std::size_t index = 0;; ++index) {
+        {
+          std::unique_lock lock(mu);
+          cv.wait(lock, [&] { return abort || in_flight < max_in_flight; });
+          if (abort) return;
+        }
+        FrameJob job;
+        job.index = index;
+        {
+          std::lock_guard lock(mu);
+          if (!spare.empty()) {
+            job.bgr = std::move(spare.back());
+            spare.pop_back();
+          }
+        }
+        const auto t_decode = std::chrono::steady_clock::now();
+        if (!video.read(job.bgr)) {
+          if (index == 0) throw VideoError(video_label + ": no frame could be decoded");
+          if (expected > 0 && index < expected)
+            throw VideoError(video_label + ": the video ends after " + count(index) + " of the " + count(expected) +
+                             " frames its header declares (truncated or damaged)");
+          if (!in.frame_times.empty() && index < in.frame_times.size())
+            throw InputError(in.frame_times_label + ": lists frames up to " + count(in.frame_times.size() - 1) +
+                             " but the video ends after " + count(index) + " frames");
+          break;
+        }
+        if (job.bgr.cols != camera.width || job.bgr.rows != camera.height)
+          throw VideoError(video_label + ": frame " + count(index) + " is " + std::to_string(job.bgr.cols) + "x" +
+                           std::to_string(job.bgr.rows) + " but " + camera_label + " is calibrated for " +
+                           std::to_string(camera.width) + "x" + std::to_string(camera.height));
+        if (job.bgr.type() != CV_8UC3) {
+          cv::Mat converted;
+          if (job.bgr.channels() == 1) cv::cvtColor(job.bgr, converted, cv::COLOR_GRAY2BGR);
+          else if (job.bgr.channels() == 4) cv::cvtColor(job.bgr, converted, cv::COLOR_BGRA2BGR);
+          else throw VideoError(video_label + ": frame " + count(index) + " is not an 8-bit colour image");
+          job.bgr = converted;
+        }
+        job.record.times.decode = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_decode).count();
+        job.record.time = clock(index);
+        if (clock.fromFrameTimes() && !std::isfinite(job.record.time))
+          throw InputError(in.frame_times_label + ": no time for frame " + count(index));
+        job.record.selected = opt.frames.contains(index);
+        std::lock_guard lock(mu);
+        todo.push_back(std::move(job));
+        ++in_flight;
+        decoded = index + 1;
+        cv.notify_all();
+      }
+      std::lock_guard lock(mu);
+      reader_done = true;
+      cv.notify_all();
+    } catch (...) {
+      fail(std::current_exception());
+    }
+  });
+
+  std::vector<std::thread> annotators;
+  for (int w = 0; w < report.jobs; ++w)
+    annotators.emplace_back([&] {
+      try {
+        lowerThreadPriority(kAnnotatorNice);
+        std::optional<FrameAnnotator> annotator;
+        try {
+          annotator.emplace(scene);
+        } catch (const calib::CameraError& e) {
+          throw InputError(e.messageFrom(camera_label));
+        }
+        for (;;) {
+          FrameJob job;
+          {
+            std::unique_lock lock(mu);
+            cv.wait(lock, [&] { return abort || !todo.empty() || reader_done; });
+            if (abort || todo.empty()) return;
+            job = std::move(todo.front());
+            todo.pop_front();
+          }
+          annotator->annotate(job.bgr, job.record);
+          std::lock_guard lock(mu);
+          done.emplace(job.index, std::move(job));
+          cv.notify_all();
+        }
+      } catch (...) {
+        fail(std::current_exception());
+      }
+    });
+
+  // The writer: frames in input order.
+  ContactSheet sheet(std::max<std::size_t>(opt.contact_frames, 1), opt.contact_tile_width);
+  const auto t_frames = std::chrono::steady_clock::now();
+  report.setup_seconds = std::chrono::duration<double>(t_frames - t_setup).count();
+  try {
+    for (std::size_t next = 0;; ++next) {
+      FrameJob job;
+      {
+        std::unique_lock lock(mu);
+        cv.wait(lock, [&] { return abort || done.count(next) > 0 || (reader_done && next >= decoded); });
+        if (abort) break;
+        if (done.count(next) == 0) break;  // every frame handed on
+        job = std::move(done.at(next));
+        done.erase(next);
+      }
+      FrameRecord& r = job.record;
+      if (r.selected) {
+        if (sink) {
+          const auto t_encode = std::chrono::steady_clock::now();
+          sink->write(job.index, job.bgr);
+          r.times.encode = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_encode).count();
+          r.written = true;
+          ++report.written;
+        }
+        if (opt.contact_frames > 0) {
+          std::string caption = "#" + count(job.index) + "  " + messageNumber(r.time, 4) + " s  " + toString(r.status);
+          if (std::isfinite(r.min_distance)) caption += "  " + messageNumber(r.min_distance * 1000, 3) + " mm";
+          // The most critical frame is always on the sheet: colliding first, then the nearest.
+          const double priority = r.unsafe() || r.status == SafetyStatus::Colliding ? -1.0
+                                  : std::isfinite(r.min_distance)                   ? r.min_distance
+                                                                                    : std::numeric_limits<double>::infinity();
+          sheet.add(job.index, job.bgr, caption, priority);
+        }
+      }
+      report.frames.push_back(std::move(job.record));
+      {
+        std::lock_guard lock(mu);
+        if (job.bgr.u != nullptr && job.bgr.u->refcount == 1) spare.push_back(std::move(job.bgr));
+        --in_flight;
+        cv.notify_all();
+      }
+      if (progress) {
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_frames).count();
+        progress(OverlayProgress{next + 1, expected, elapsed > 0 ? static_cast<double>(next + 1) / elapsed : 0.0});
+      }
+    }
+  } catch (...) {
+    fail(std::current_exception());
+  }
+  reader.join();
+  for (std::thread& t : annotators) t.join();
+  if (error) std::rethrow_exception(error);
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_frames).count();
+  for (const FrameRecord& r : report.frames) {
+    report.no_state += r.status == SafetyStatus::NoState;
+    report.colliding += r.status == SafetyStatus::Colliding;
+    report.within_margin += r.status == SafetyStatus::WithinMargin;
+    report.clear += r.status == SafetyStatus::Clear;
+    report.unsafe += r.unsafe();
+    report.stages += r.times;
+  }
+  if (opt.contact_frames > 0) {
+    report.contact_sheet = sheet.compose();
+    report.contact_sheet_frames = sheet.frames();
+  }
+  return report;
+}
+
+void checkOverlayOutputs(const OverlayOutputs& out, std::span<const std::string> inputs) {
+  if (!out.contact_sheet.empty()) checkOutputPath(out.contact_sheet, out.contact_sheet_option, ".png");
+  if (!out.timeline.empty()) checkOutputPath(out.timeline, out.timeline_option, ".png");
+  if (!out.video.empty()) {
+    const std::string ext = lowerExtension(out.video);
+    if (ext != ".mp4" && ext != ".mkv" && ext != ".avi")
+      throw OutputError(out.video_option + " " + out.video + ": the output must be a .mp4, .mkv or .avi file");
+    checkOutputPath(out.video, out.video_option, ext);
+  }
+  if (!out.report.empty()) checkOutputPath(out.report, out.report_option, ".json");
+  for (const std::string& in : inputs)
+    for (const std::string& written : {out.video, out.report, out.contact_sheet, out.timeline})
+      if (!in.empty() && !written.empty() && sameFile(in, written))
+        throw OutputError(written + ": is an input of this run (" + in + "); write the output elsewhere");
+}
+
+nlohmann::json writeOverlayOutputs(const OverlayOutputs& out, const OverlayReport& report, const Model& model,
+                                   VideoSink& sink) {
+  nlohmann::json j = reportJson(report, model, true);
+  if (!out.video.empty()) j["video"] = out.video;
+  if (!out.png_dir.empty()) j["png_dir"] = out.png_dir;
+  if (!out.contact_sheet.empty()) {
+    const std::string name = out.contact_sheet_option + " " + out.contact_sheet;
+    if (report.contact_sheet.empty()) throw OutputError(name + ": no frame was drawn (see " + out.frames_option + ")");
+    writePngAtomically(out.contact_sheet, report.contact_sheet, name);
+    j["contact_sheet"] = out.contact_sheet;
+  }
+  if (!out.timeline.empty()) {
+    writePngAtomically(out.timeline, drawTimeline(report, model, out.timeline_title.empty() ? out.timeline : out.timeline_title),
+                       out.timeline_option + " " + out.timeline);
+    j["timeline"] = out.timeline;
+  }
+  sink.commit();
+  if (!out.report.empty()) writeFileAtomically(out.report, j.dump(1) + "\n", out.report_option + " " + out.report);
+  return j;
+}
+
+}  // namespace kccd::overlay
