@@ -1,0 +1,295 @@
+"""The batch manifest of :mod:`kccd.batch` (docs/formats.md section 13): read node by node, every
+mistake one line ``file:line: field: problem``, every input checked before anything starts."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import re
+import stat
+from collections.abc import Sequence
+from typing import Any
+
+import yaml
+
+from . import _kccd as _core
+
+#: The largest manifest read (bytes).
+MAX_MANIFEST_BYTES = 4 << 20
+#: What the batch itself writes in DIR: no recording may take these names.
+_RESERVED = ("summary.json", "summary.md", "colliding_frames.png")
+_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,127}")
+_BAG_KEYS = ("image_topic", "joint_topic", "time_source", "joint_map")
+_RECORDING_KEYS = ("id", "video", "states", "bag", "model", "camera", "time_offset", "swept", "braking") + _BAG_KEYS
+_DEFAULT_KEYS = ("model", "camera", "time_offset", "swept", "braking") + _BAG_KEYS
+#: The braking of swept volumes unless a manifest says otherwise (kccd overlay's defaults).
+DEFAULT_BRAKING = {field: float(getattr(_core.overlay_braking(), field))
+                   for field in ("latency", "deceleration", "max_acceleration", "position_error", "velocity_error")}
+
+
+class ManifestError(ValueError):
+    """A manifest that cannot be run: str() is one line 'file:line: field: problem'."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Recording:
+    """One recording of a manifest, its paths made absolute."""
+
+    id: str
+    video: str  #: "" for a robot log
+    states: str  #: "" for a robot log
+    model: str
+    camera: str
+    time_offset: float
+    swept: bool
+    line: int  #: where the manifest lists it (1-based)
+    braking: tuple[tuple[str, float], ...] = tuple(DEFAULT_BRAKING.items())  #: with swept, every joint
+    bag: str = ""  #: a robot log instead of video and states
+    image_topic: str = ""
+    joint_topic: str = ""
+    time_source: str = "header"
+    joint_map: str = ""
+
+    def input_keys(self) -> tuple[str, ...]:
+        """The fields naming this recording's input files."""
+        recording = ("bag",) if self.bag else ("video", "states")
+        return recording + ("model", "camera") + (("joint_map",) if self.joint_map else ())
+
+
+# --------------------------------------------------------------------------------------------
+# The manifest
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
+    """The recordings of the manifest at `path`, in its order. Checks its structure (one YAML
+    document, known keys, ``kccd_batch: 1``, ids explicit, unique and fit for a folder name) and,
+    with `check_inputs`, that every input exists and every model and camera loads. Raises
+    ManifestError naming the file, line and field."""
+    try:
+        st = os.stat(path)
+        if not stat.S_ISREG(st.st_mode):
+            raise ManifestError(f"{path}: manifest: not a regular file")
+        if st.st_size > MAX_MANIFEST_BYTES:
+            raise ManifestError(f"{path}: manifest: {st.st_size} bytes, more than {MAX_MANIFEST_BYTES}")
+        with open(path, "rb") as f:
+            raw = f.read(MAX_MANIFEST_BYTES + 1)
+    except OSError as e:
+        raise ManifestError(f"{path}: manifest: cannot read ({e.strerror})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ManifestError(f"{path}: not UTF-8 text (byte {e.start})") from None
+
+    def fail(node: yaml.Node | None, field: str, problem: str) -> ManifestError:
+        where = f"{path}:{node.start_mark.line + 1}" if node is not None else path
+        return ManifestError(f"{where}: {field}: {problem}")
+
+    loader: Any = None
+    try:
+        loader = yaml.SafeLoader(text)  # partly untyped in its stubs
+        root = loader.get_single_node()
+    except yaml.MarkedYAMLError as e:
+        line = e.problem_mark.line + 1 if e.problem_mark else 0
+        raise ManifestError(f"{path}:{line}: yaml: {_one_line(str(e.problem or e.context))}") from None
+    except yaml.reader.ReaderError as e:
+        line = text[: max(0, e.position)].count("\n") + 1
+        raise ManifestError(f"{path}:{line}: yaml: character #x{e.character:04x} is not allowed") from None
+    except yaml.YAMLError as e:
+        raise ManifestError(f"{path}: yaml: {_one_line(str(e))}") from None
+    finally:
+        if loader is not None:
+            loader.dispose()
+    if not isinstance(root, yaml.MappingNode):
+        raise fail(root, "manifest", "expected a mapping with kccd_batch, defaults and recordings")
+
+    def mapping(node: yaml.Node, field: str, allowed: Sequence[str]) -> dict[str, yaml.Node]:
+        if not isinstance(node, yaml.MappingNode):
+            raise fail(node, field, "expected a mapping")
+        out: dict[str, yaml.Node] = {}
+        for k, v in node.value:
+            if not isinstance(k, yaml.ScalarNode):
+                raise fail(k, field, "keys must be plain words")
+            if k.value in out:
+                raise fail(k, f"{field}.{k.value}", "given twice")
+            if k.value not in allowed:
+                raise fail(k, f"{field}.{k.value}", "unknown field (known: " + ", ".join(allowed) + ")")
+            out[k.value] = v
+        return out
+
+    def scalar(node: yaml.Node, field: str) -> Any:
+        if not isinstance(node, yaml.ScalarNode):
+            raise fail(node, field, "expected a single value")
+        c: Any = yaml.SafeLoader("")
+        try:
+            return c.construct_object(node)
+        except Exception as e:  # noqa: BLE001 - PyYAML's constructors raise more than YAMLError for bad tags
+            raise fail(node, field, _one_line(str(e)) or f"cannot read this {node.tag} value") from None
+        finally:
+            c.dispose()
+
+    def finite(v: Any) -> float | None:
+        """v as a finite float, or None (bools, text, huge ints and non-finite values)."""
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            return None
+        try:
+            x = float(v)
+        except OverflowError:
+            return None
+        return x if math.isfinite(x) else None
+
+    def text_field(node: yaml.Node, field: str) -> str:
+        v = scalar(node, field)
+        if not isinstance(v, str) or not v:
+            raise fail(node, field, "expected a non-empty text")
+        return v
+
+    def number_field(node: yaml.Node, field: str) -> float:
+        x = finite(scalar(node, field))
+        if x is None or abs(x) > 1e6:
+            raise fail(node, field, "expected a finite number of seconds (|x| <= 1e6)")
+        return x
+
+    def bool_field(node: yaml.Node, field: str) -> bool:
+        v = scalar(node, field)
+        if not isinstance(v, bool):
+            raise fail(node, field, "expected true or false")
+        return v
+
+    def braking_field(node: yaml.Node, field: str) -> tuple[tuple[str, float], ...]:
+        given = mapping(node, field, tuple(DEFAULT_BRAKING))
+        out = dict(DEFAULT_BRAKING)
+        for key, v in given.items():
+            x = finite(scalar(v, f"{field}.{key}"))
+            if x is None or x < 0 or (key == "deceleration" and x <= 0):
+                raise fail(v, f"{field}.{key}", "expected a finite number " + ("> 0" if key == "deceleration" else ">= 0")
+                           + " (SI units: s, rad or m, per s, per s^2)")
+            out[key] = x
+        return tuple(out.items())
+
+    top = mapping(root, "manifest", ("kccd_batch", "defaults", "recordings"))
+    if "kccd_batch" not in top:
+        raise fail(root, "kccd_batch", "missing (the first line of a batch manifest is kccd_batch: 1)")
+    version = scalar(top["kccd_batch"], "kccd_batch")
+    if version != 1 or isinstance(version, bool):
+        raise fail(top["kccd_batch"], "kccd_batch", f"unsupported version {version!r} (this kccd reads 1)")
+    defaults = mapping(top["defaults"], "defaults", _DEFAULT_KEYS) if "defaults" in top else {}
+    if "recordings" not in top:
+        raise fail(root, "recordings", "missing")
+    seq = top["recordings"]
+    if not isinstance(seq, yaml.SequenceNode) or not seq.value:
+        raise fail(seq, "recordings", "expected a non-empty list")
+
+    base = os.path.dirname(os.path.abspath(path))
+
+    def resolve(node: yaml.Node, field: str) -> str:
+        return os.path.normpath(os.path.join(base, text_field(node, field)))
+
+    out: list[Recording] = []
+    inputs: list[tuple[str, str, yaml.Node, str]] = []  # kind, path, its node, its field: checked below
+    first_line: dict[str, int] = {}
+    for i, item in enumerate(seq.value):
+        name = f"recordings[{i}]"
+        rec = mapping(item, name, _RECORDING_KEYS)
+        if "id" not in rec:
+            raise fail(item, f"{name}.id", "missing")
+        if "bag" in rec:
+            for key in ("video", "states"):
+                if key in rec:
+                    raise fail(rec[key], f"{name}.{key}", "not with bag (the robot log gives the frames and the states)")
+        else:
+            for key in ("video", "states"):
+                if key not in rec:
+                    raise fail(item, f"{name}.{key}", "missing (give video and states, or bag)")
+        rid = text_field(rec["id"], f"{name}.id")
+        if not _ID.fullmatch(rid):
+            raise fail(rec["id"], f"{name}.id", f"'{rid}' is not a folder name (letters, digits, '.', '_', '-'; "
+                       "at most 128; not starting with '.', '_' or '-')")
+        if rid.lower() in _RESERVED:
+            raise fail(rec["id"], f"{name}.id", f"'{rid}' is the name of a file the batch writes in DIR")
+        if rid in first_line:
+            raise fail(rec["id"], f"{name}.id", f"'{rid}' is also the id on line {first_line[rid]}")
+        first_line[rid] = rec["id"].start_mark.line + 1
+        merged = {**defaults, **rec}
+
+        def where(key: str, rec: dict[str, yaml.Node] = rec, name: str = name) -> str:
+            return f"{name}.{key}" if key in rec else f"defaults.{key}"
+
+        for key in ("model", "camera"):
+            if key not in merged:
+                raise fail(item, f"{name}.{key}", "missing (give it here or in defaults)")
+        keys = ("bag", "joint_map", "model", "camera") if "bag" in rec else ("video", "states", "model", "camera")
+        paths = {key: resolve(merged[key], where(key)) for key in keys if key in merged}
+        inputs += [(key, paths[key], merged[key], where(key)) for key in paths]
+        if "bag" not in rec:
+            for key in _BAG_KEYS:
+                if key in rec:
+                    raise fail(rec[key], f"{name}.{key}", "goes with bag")
+        topics = {key: text_field(merged[key], where(key)) for key in ("image_topic", "joint_topic") if key in merged and "bag" in rec}
+        time_source = text_field(merged["time_source"], where("time_source")) if "time_source" in merged else "header"
+        if time_source not in ("header", "log"):
+            raise fail(merged["time_source"], where("time_source"), "expected header or log")
+        out.append(Recording(
+            id=rid,
+            video=paths.get("video", ""),
+            states=paths.get("states", ""),
+            model=paths["model"],
+            camera=paths["camera"],
+            bag=paths.get("bag", ""),
+            joint_map=paths.get("joint_map", "") if "bag" in rec else "",
+            time_source=time_source,
+            **topics,
+            time_offset=number_field(merged["time_offset"], where("time_offset")) if "time_offset" in merged else 0.0,
+            swept=bool_field(merged["swept"], where("swept")) if "swept" in merged else False,
+            line=item.start_mark.line + 1,
+            braking=braking_field(merged["braking"], where("braking"))
+            if "braking" in merged else tuple(DEFAULT_BRAKING.items()),
+        ))
+
+    if check_inputs:
+        checked: set[tuple[str, str]] = set()
+        for key, p, node, field in inputs:
+            if key == "video" and _is_sequence(p):
+                try:
+                    frames = _sequence_files(p)
+                except (TypeError, ValueError) as e:
+                    raise fail(node, field, f"{p}: not an image-sequence pattern ({_one_line(str(e))})") from None
+                if not frames:
+                    raise fail(node, field, f"{p}: no image of the sequence (numbered from 0 or 1) exists")
+            elif key == "bag" and os.path.isdir(p):
+                if not os.path.isfile(os.path.join(p, "metadata.yaml")) and not any(f.endswith(".mcap") for f in os.listdir(p)):
+                    raise fail(node, field, f"{p}: a folder without metadata.yaml (not a rosbag2 bag)")
+            elif not os.path.isfile(p):
+                raise fail(node, field, f"{p}: no such file")
+            if key in ("model", "camera") and (key, p) not in checked:
+                checked.add((key, p))
+                try:
+                    if key == "model":
+                        _core.Model.load(p)
+                    else:
+                        _core.Camera.load(p)
+                except _core.InputError as e:
+                    raise fail(node, field, _one_line(str(e))) from None
+    return out
+
+
+def _sequence_files(pattern: str) -> list[str]:
+    """The files of an image-sequence pattern, numbered from 0 or 1 as the video reader does."""
+    files: list[str] = []
+    for start in (0, 1):
+        k = start
+        while os.path.isfile(pattern % k):
+            files.append(pattern % k)
+            k += 1
+        if files:
+            break
+    return files
+
+
+def _is_sequence(path: str) -> bool:
+    """A path with a '%' is an image-sequence pattern (the rule of kccd's video reader)."""
+    return "%" in path
