@@ -9,12 +9,29 @@ import os
 import re
 import subprocess
 import sys
+import textwrap
 
 
 def help_of(kccd: str, words: list[str]) -> str:
     run = subprocess.run([kccd, *words, "--help"], capture_output=True, text=True, check=True)
     # The binary's path as the user types it.
     return run.stdout.replace(kccd, "kccd")
+
+
+def wrapped(text: str, width: int = 100) -> str:
+    """The help text with long lines wrapped, each continuation under its description's column
+    (the words are the program's own, only the line breaks differ)."""
+    out: list[str] = []
+    for line in text.splitlines():
+        if len(line) <= width:
+            out.append(line)
+            continue
+        m = re.match(r"^(\s*\S.*?\s{2,})(\S.*)$", line)
+        column = len(m.group(1)) if m and len(m.group(1)) < width // 2 else len(line) - len(line.lstrip())
+        head, rest = line[:column], line[column:]
+        out.extend(textwrap.wrap(rest, width=width, initial_indent=head, subsequent_indent=" " * column,
+                                 break_long_words=False, break_on_hyphens=False) or [line])
+    return "\n".join(out)
 
 
 def subcommands(text: str) -> list[tuple[str, str]]:
@@ -42,7 +59,7 @@ def main() -> int:
         name = "-".join(words)
         title = "kccd " + " ".join(words)
         with open(os.path.join(out, "cli", name + ".md"), "w", encoding="utf-8") as f:
-            f.write(f"# `{title}`\n\n{summary}\n\n```text\n{text.rstrip()}\n```\n")
+            f.write(f"# `{title}`\n\n{summary}\n\n```text\n{wrapped(text.rstrip())}\n```\n")
         pages.append((name, title))
         for sub, sub_summary in subcommands(text):
             write(words + [sub], sub_summary)

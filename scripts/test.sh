@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Builds KCCD and runs the whole test suite: a Release build, then the same tests under
+# Builds KCCD and runs the whole test suite: a Release build and its tests, the documentation site
+# (scripts/docs.sh: a warning fails), then the same tests under
 # AddressSanitizer + UndefinedBehaviorSanitizer, then every libFuzzer target briefly. The
 # sanitizer build is GCC at -O1 -g1 (the reports' stacks keep files and lines; its tests run 1.3x
 # faster than clang-14's ASan at -O1, 1.8x faster than with libFuzzer's coverage too, so the fuzz
@@ -43,12 +44,13 @@ cmake_build() {  # build dir, cmake args...
   cmake -S . -B "$dir" -G Ninja "$@" >/dev/null
   cmake --build "$dir" -j "$jobs"
 }
-deps=(--tests)
+deps=(--tests --docs)
 [ $fuzz -eq 1 ] && deps+=(--fuzz)
 stage "Installing dependencies" bash scripts/install-deps.sh "${deps[@]}"
 if [ $release -eq 1 ]; then
   stage "Release build" cmake_build build -DCMAKE_BUILD_TYPE=Release
   stage "Release tests" ctest --test-dir build -j "$jobs" --output-on-failure
+  stage "Documentation site (warnings are errors)" bash scripts/docs.sh build
 fi
 if [ $sanitize -eq 1 ]; then
   stage "ASan + UBSan build" cmake_build build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKCCD_SANITIZE=ON \

@@ -1,7 +1,7 @@
 """KCCD: strictly conservative continuous collision detection for robots.
 
 Every distance a query reports is a guaranteed lower bound over every configuration in the interval
-box it was given. Lengths are metres, angles radians, states in Model.state_names order.
+box it was given. Lengths are metres, angles radians, states in Model.state_names order::
 
     import kccd
     model = kccd.Model.load("data/demo_arm.yaml")

@@ -1,7 +1,7 @@
 // Calibration benchmarks on one rendered 1280x720 frame with 8 tags on a floor and two walls
 // (support/tag_scene.hpp; blur 0.8 px, noise 2 grey levels, textured background), seen from 2.2 m
 // through a camera with mild lens distortion:
-// - BM_DetectTags:     AprilTag detection alone (the baseline the README compares against);
+// - BM_DetectTags:     AprilTag detection alone (the baseline docs/explanation/benchmarks.md compares against);
 // - BM_DetectAndSolve: detection, tagCorrespondences and solvePose (the calibration of one frame);
 // - BM_Solve:          solvePose alone on the detected correspondences.
 // Run with --benchmark_repetitions=5 and read the medians; tables.py gives the ratios.

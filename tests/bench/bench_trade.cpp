@@ -184,7 +184,7 @@ struct Setting {
 
 std::vector<Setting> makeSettings(const Model& base, const std::vector<int>& budgets) {
   std::vector<Setting> out;
-  for (SweepMode mode : {SweepMode::Accurate})  // the one mode that sweeps (fast is retired: README)
+  for (SweepMode mode : {SweepMode::Accurate})  // the one mode that sweeps (fast is retired: docs/explanation/trade.md)
     for (int budget : budgets) {
       Setting s{mode, budget, variant(base, mode, budget), nullptr};
       s.checker = std::make_unique<Checker>(*s.model);

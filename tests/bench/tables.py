@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Turns the JSON output of bench_gjk / bench_engine / bench_calib into the Markdown tables of the README.
+"""Turns the JSON output of bench_gjk / bench_engine / bench_calib into the Markdown tables of docs/explanation/benchmarks.md.
 
 Usage: tables.py gjk.json engine.json [calib.json]
        tables.py --calib calib.json

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Runs the shell blocks of the documentation's guides, so they cannot drift from the program:
 every fenced block whose language is `sh` in a page, in order, with `bash -e`, in a fresh empty
-folder, with the built `kccd` first on PATH, KCCD_DATA the sample data folder and the built Python
+folder, with the built `kccd` first on PATH and `python3` the interpreter running this script, KCCD_DATA the sample data folder and the built Python
 package on PYTHONPATH. Other blocks (```console, ```text, ```bash, ...) are shown, not run.
 
 Usage: run_guides.py KCCD_BINARY DATA_DIR PYTHONPATH PAGE.md [PAGE.md ...]
@@ -40,7 +40,11 @@ def main() -> int:
         return 2
     kccd, data, pythonpath, pages = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
     env = dict(os.environ)
-    env["PATH"] = os.path.dirname(os.path.abspath(kccd)) + os.pathsep + env.get("PATH", "")
+    # `python3` in a block is this interpreter (the one the package was built for), whatever else
+    # comes first on PATH.
+    shim = tempfile.mkdtemp(prefix="kccd_guide_bin_")
+    os.symlink(sys.executable, os.path.join(shim, "python3"))
+    env["PATH"] = os.pathsep.join([os.path.dirname(os.path.abspath(kccd)), shim, env.get("PATH", "")])
     env["KCCD_DATA"] = os.path.abspath(data)
     env["PYTHONPATH"] = os.path.abspath(pythonpath)
     env["PYTHONDONTWRITEBYTECODE"] = "1"

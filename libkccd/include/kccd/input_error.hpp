@@ -56,7 +56,7 @@ inline std::string messageNumber(double value, int digits = 10) { return formatN
 bool isUtf8(std::string_view text);
 
 /// `text` made safe to quote in a one-line message: control bytes, DEL and bytes that are not
-/// UTF-8 become \xNN, and text longer than `max_bytes` is cut with "...".
+/// UTF-8 become `\xNN`, and text longer than `max_bytes` is cut with "...".
 std::string printable(std::string_view text, std::size_t max_bytes = 80);
 
 }  // namespace kccd

@@ -20,8 +20,8 @@ enum class JointType : std::uint8_t { Fixed, Revolute, Prismatic, Translation3d,
 
 /// How a joint's interval is swept: `Exact` accepts only zero-width intervals; `Accurate` (chords,
 /// with tangent apexes and box splitting in the exact stage) covers any interval. (The chords-only
-/// `fast` mode is retired: model files may still say `fast`, read as `accurate`; README, "Sweep
-/// modes".)
+/// `fast` mode is retired: model files may still say `fast`, read as `accurate`; the measured
+/// reason is in docs/explanation/trade.md.)
 enum class SweepMode : std::uint8_t { Exact, Accurate };
 
 /// One joint. Its motion acts in the joint frame given by `origin` (pose in the parent frame at
@@ -56,7 +56,7 @@ struct Body {
 };
 
 /// How a link looks, for drawing only (never checked for collision): a mesh file or a
-/// primitive, placed in a frame, with a colour. `kccd import` writes them from URDF <visual>s.
+/// primitive, placed in a frame, with a colour. `kccd import` writes them from URDF `<visual>` elements.
 struct Visual {
   enum class Shape : std::uint8_t { Mesh, Box, Cylinder, Sphere };
   int frame = kWorld;

@@ -17,7 +17,7 @@ class UrdfError : public InputError {
 };
 
 /// kccd import's defaults: the tolerance each link's volume meets (mm outside its hull) and the
-/// concavity above which a link splits into pieces (mm); README "Importing a real robot" says why.
+/// concavity above which a link splits into pieces (mm); docs/guides/import-robot.md says why.
 inline constexpr double kDefaultToleranceMm = 2.0;
 inline constexpr double kDefaultConcavityMm = 40.0;
 

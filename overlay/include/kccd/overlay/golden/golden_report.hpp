@@ -26,8 +26,8 @@ struct GoldenRun {
 
 /// Writes the reports and evidence into `folder` (made when missing; files staged then renamed):
 /// results.json, junit.xml, summary.md, report.html, and for each case that did not pass (every
-/// case with `keep_passing`) <id>/<output>.actual.png, .expected.png, .diff.png, .crop.png and
-/// <id>/golden.json (the actual sidecar).
+/// case with `keep_passing`) `<id>/<output>.actual.png`, .expected.png, .diff.png, .crop.png and
+/// `<id>/golden.json` (the actual sidecar).
 void writeGoldenReports(const GoldenRun& run, const std::string& folder, bool keep_passing);
 
 /// The one-line summary of a run: "N cases: P passed, F failed, M missing".
