@@ -18,7 +18,7 @@ def help_of(kccd: str, words: list[str]) -> str:
     return run.stdout.replace(kccd, "kccd")
 
 
-def wrapped(text: str, width: int = 100) -> str:
+def wrapped(text: str, width: int = 82) -> str:
     """The help text with long lines wrapped, each continuation under its description's column
     (the words are the program's own, only the line breaks differ)."""
     out: list[str] = []
