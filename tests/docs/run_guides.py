@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Runs the shell blocks of the documentation's guides, so they cannot drift from the program:
 every fenced block whose language is `sh` in a page, in order, with `bash -e`, in a fresh empty
-folder, with the built `kccd` first on PATH and `python3` the interpreter running this script, KCCD_DATA the sample data folder and the built Python
-package on PYTHONPATH. Other blocks (```console, ```text, ```bash, ...) are shown, not run.
+folder, with the built `kccd` first on PATH and `python3` the interpreter running this script, KCCD_DATA the sample data folder (also linked as `data/` in
+the folder, as in the repository) and the built Python package on PYTHONPATH. Other blocks (```console, ```text, ```bash, ...) are shown, not run.
 
 Usage: run_guides.py KCCD_BINARY DATA_DIR PYTHONPATH PAGE.md [PAGE.md ...]
 Exit 0 when every block of every page ran with status 0; otherwise the failing page, block (its
@@ -57,6 +57,8 @@ def main() -> int:
             continue
         t0 = time.monotonic()
         with tempfile.TemporaryDirectory(prefix="kccd_guide_") as work:
+            # `data/` as in the repository, where a reader runs the commands from.
+            os.symlink(env["KCCD_DATA"], os.path.join(work, "data"))
             for line, text in found:
                 run = subprocess.run(["bash", "-e", "-c", text], cwd=work, env=env, capture_output=True, text=True)
                 if run.returncode != 0:
