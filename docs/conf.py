@@ -20,5 +20,3 @@ breathe_default_project = "kccd"
 breathe_default_members = ("members",)
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"  # the signatures pybind11 writes already name the types
-# Pages link files of the repository (sources, scripts, data) that are not pages of the site.
-suppress_warnings = ["myst.xref_missing"]
