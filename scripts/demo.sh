@@ -28,7 +28,7 @@ step $kccd overlay data/humanoid.yaml --camera $out/camera.yaml --video $rec/vid
 # ... and the braking-interval swept volumes the safety check tests (10 ms latency, 5 rad/s^2).
 step $kccd overlay data/humanoid.yaml --camera $out/camera.yaml --video $rec/video.mkv --states $rec/states.csv \
   --time-offset 0.137 --swept -o $out/overlay_swept.mp4 --report $out/report_swept.json \
-  --contact-sheet $out/contact_sheet_swept.png
+  --contact-sheet $out/contact_sheet_swept.png --timeline $out/timeline_swept.png
 
 # The tour: queries on the bundled robots, a single rendered frame, labelled-point calibration,
 # fitting a CAD part and proving pairs that never meet.
@@ -53,6 +53,7 @@ step $kccd pairs data/demo_arm.yaml -q
 printf '\n\033[1mThe main job wrote, in %s/:\033[0m\n' "$out"
 printf '  overlay.mp4, overlay_swept.mp4     the recording with the static / swept volumes\n'
 printf '  contact_sheet.png, contact_sheet_swept.png   selected frames side by side\n'
+printf '  timeline_swept.png                 the swept run over time: bound, margin, spans and the pairs responsible\n'
 printf '  report.json, report_swept.json     per frame: state match, status, min distance, pairs\n'
 printf '  calib_check.png, camera.yaml       the calibration: check image and camera file\n'
 printf '  recording/                         the synthetic input and its truth (synth.json)\n'
