@@ -46,9 +46,12 @@ Exit runBagInfo(const BagInfoArgs& args) {
     for (const auto& [c, n] : b.chunks) std::cout << " " << n << " " << c;
     std::cout << "\n";
   }
-  std::cout << "\ntopics (skew: log time minus header stamp, min / median / max):\n";
+  std::cout << "\ntopics (log times from the first message's; skew: log time minus header stamp, min / median / max):\n";
   for (const logs::TopicSummary& t : b.topics) {
     std::cout << "  " << t.topic << "  " << (t.type.empty() ? "(no schema)" : t.type) << "  " << t.count << (t.count == 1 ? " message" : " messages");
+    std::cout << (t.count == 1 ? " at " : " from ") << fixed(seconds(t.first_log_time - b.first_log_time), 3);
+    if (t.count > 1) std::cout << " to " << fixed(seconds(t.last_log_time - b.first_log_time), 3);
+    std::cout << " s";
     if (t.count > 1) std::cout << ", " << fixed(t.rate(), t.rate() >= 100 ? 1 : 3) << " Hz";
     if (t.stamped > t.zero_stamps)
       std::cout << ", skew " << fixed(1e3 * t.skew_min, 3) << " / " << fixed(1e3 * t.skew_median, 3) << " / " << fixed(1e3 * t.skew_max, 3) << " ms";
