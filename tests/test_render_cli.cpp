@@ -1,6 +1,8 @@
 // End-to-end: `kccd render` as scripts use it (files written, JSON summary, exit codes, errors).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -98,6 +100,26 @@ TEST_F(RenderCli, SweptVolumesCoverTheStaticOnes) {
   // Every pixel covered at the box's middle state is covered by the swept volumes.
   EXPECT_EQ(cv::countNonZero((s > 0) & (w == 0)), 0);
   EXPECT_GT(cv::countNonZero(w > 0), cv::countNonZero(s > 0));
+}
+
+// Without EGL (glvnd finds no EGL vendor here) the command falls back to OSMesa and says so in one
+// warning line naming EGL's failure; with EGL it says nothing. KCCD_GL=egl makes the same an error.
+TEST_F(RenderCli, AFallBackToOsMesaIsSaid) {
+  const std::string args = base() + " --state 0.3,0.4,0.6 -o ";
+  const Outcome egl = runKccd(args + out("egl.png"));
+  ASSERT_EQ(egl.code, 0) << egl.err;
+  EXPECT_EQ(egl.err, "");
+  const std::string no_egl = "__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent ";
+  const Outcome fallback = kccd::testing::runProgram(no_egl + KCCD_CLI + " " + args + out("osmesa.png"));
+  ASSERT_EQ(fallback.code, 0) << fallback.err;
+  EXPECT_NE(fallback.out.find("/ OSMesa"), std::string::npos) << fallback.out;
+  EXPECT_EQ(fallback.err.rfind("kccd: warning: no EGL context (EGL: ", 0), 0u) << fallback.err;
+  EXPECT_NE(fallback.err.find("rendered with OSMesa"), std::string::npos) << fallback.err;
+  EXPECT_EQ(std::count(fallback.err.begin(), fallback.err.end(), '\n'), 1) << fallback.err;
+  const Outcome pinned = kccd::testing::runProgram(no_egl + "KCCD_GL=egl " + KCCD_CLI + " " + args + out("pinned.png"));
+  EXPECT_NE(pinned.code, 0);
+  EXPECT_NE(pinned.err.find("EGL"), std::string::npos) << pinned.err;
+  EXPECT_FALSE(fs::exists(out("pinned.png")));
 }
 
 TEST_F(RenderCli, BadInputExitsTwoWithOneLine) {

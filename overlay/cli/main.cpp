@@ -68,9 +68,20 @@ int main(int argc, char** argv) {
     help += " --help";
     return fail(Exit::BadInput, kccd::cli::optionMessage(e.what()) + " (see " + help + ")");
   }
+  // A silent change of GL back end changes the renderer string (and may change pixels): said once.
+  const auto say_fallback = [] {
+    const std::string reason = kccd::render::GlContext::lastFallback();
+    if (!reason.empty())
+      std::cerr << "kccd: warning: no EGL context (" << kccd::cli::oneLine(reason)
+                << "): rendered with OSMesa (KCCD_GL=egl makes this an error, KCCD_GL=osmesa chooses OSMesa)\n";
+  };
   try {
     for (auto& [sub, run] : commands)
-      if (sub->parsed()) return static_cast<int>(run());
+      if (sub->parsed()) {
+        const Exit status = run();
+        say_fallback();
+        return static_cast<int>(status);
+      }
   } catch (const kccd::InputError& e) {  // every reader's error and every option error (UsageError)
     return fail(Exit::BadInput, kccd::cli::oneLine(e.what()));
   } catch (const kccd::render::GlContextError& e) {  // no GL context (KCCD_GL, EGL, OSMesa): not an input error

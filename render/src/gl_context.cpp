@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
 #include <string>
 
 #include "gl_backends.hpp"
@@ -54,6 +55,22 @@ std::unique_ptr<GlContext> GlContext::make(GlBackend backend) {
   throw GlContextError("GL: no back end");
 }
 
+namespace {
+std::mutex& fallbackMutex() {
+  static std::mutex m;
+  return m;
+}
+std::string& fallbackReason() {
+  static std::string reason;
+  return reason;
+}
+}  // namespace
+
+std::string GlContext::lastFallback() {
+  const std::lock_guard lock(fallbackMutex());
+  return fallbackReason();
+}
+
 std::unique_ptr<GlContext> GlContext::make() {
   const char* env = std::getenv("KCCD_GL");
   const std::string choice = env == nullptr ? "" : env;
@@ -68,7 +85,12 @@ std::unique_ptr<GlContext> GlContext::make() {
   for (const GlBackend b : {GlBackend::Egl, GlBackend::OsMesa}) {
     if (!compiledIn(b)) continue;
     try {
-      return make(b);
+      std::unique_ptr<GlContext> context = make(b);
+      if (!reasons.empty()) {  // a fallback: kept, for the caller to say so
+        const std::lock_guard lock(fallbackMutex());
+        fallbackReason() = reasons;
+      }
+      return context;
     } catch (const GlContextError& e) {
       reasons += (reasons.empty() ? "" : "; ") + std::string(e.what());
     }

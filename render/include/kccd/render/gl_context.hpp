@@ -46,6 +46,9 @@ class GlContext {
   static std::unique_ptr<GlContext> make();
   /// Creates a context on the given back end (KCCD_GL is not read).
   static std::unique_ptr<GlContext> make(GlBackend backend);
+  /// Why make() last fell back from EGL to OSMesa in this process ("" if it never did): the
+  /// rendered bytes may then differ from EGL's, and the renderer string does. Thread-safe.
+  static std::string lastFallback();
 
  protected:
   explicit GlContext(GlBackend backend) : backend_(backend) {}
