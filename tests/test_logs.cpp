@@ -82,6 +82,17 @@ class McapFixtures : public ::testing::Test {
 
 std::uint64_t ns(const nlohmann::json& s) { return std::stoull(s.get<std::string>()); }
 
+// A 64x48 pinhole camera 2 m in front of the fixtures' seven-joint arms, looking along +y: written
+// to the scratch folder as `name`, its path returned.
+std::string camera64(const std::string& name) {
+  return kccd::testing::writeScratch(
+      "test_logs", name,
+      "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+      "   data: [ 40, 0, 31.5, 0, 40, 23.5, 0, 0, 1 ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n"
+      "   data: [ 0, 0, 0, 0, 0 ]\nrvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 1.5707963267948966, 0, 0 ]\n"
+      "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0, 0.5, 2 ]\n");
+}
+
 TEST_F(McapFixtures, EveryFileReadsAsWritten) {
   for (const char* name : kFiles) {
     SCOPED_TRACE(name);
@@ -754,12 +765,7 @@ TEST_F(McapFixtures, OverlayOfABagIsTheOverlayOfItsExportedFiles) {
   for (int k = 1; k <= 7; ++k)
     model += "  - {name: link" + std::to_string(k) + ", frame: joint" + std::to_string(k) + ", points: [[0, 0, 0], [0.05, 0, 0.1]], radius: 0.03}\n";
   const std::string model_path = kccd::testing::writeScratch("test_logs", "seven.yaml", model);
-  const std::string camera_path = kccd::testing::writeScratch(
-      "test_logs", "cam64.yaml",
-      "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
-      "   data: [ 40, 0, 31.5, 0, 40, 23.5, 0, 0, 1 ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n"
-      "   data: [ 0, 0, 0, 0, 0 ]\nrvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 1.5707963267948966, 0, 0 ]\n"
-      "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0, 0.5, 2 ]\n");
+  const std::string camera_path = camera64("cam64.yaml");
   const std::string base = std::string(KCCD_CLI) + " overlay " + model_path + " --camera " + camera_path + " --quiet";
   auto frames = [&](const fs::path& dir) {
     std::vector<std::string> v;
@@ -859,12 +865,7 @@ TEST_F(McapFixtures, AJointMapRenamesScalesAndFixesStateValues) {
   };
   const std::string plain = kccd::testing::writeScratch("test_logs", "map_plain.yaml", modelText("joint3", "joint7"));
   const std::string renamed = kccd::testing::writeScratch("test_logs", "map_renamed.yaml", modelText("rail", "wrist"));
-  const std::string camera = kccd::testing::writeScratch(
-      "test_logs", "map_cam.yaml",
-      "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
-      "   data: [ 40, 0, 31.5, 0, 40, 23.5, 0, 0, 1 ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n"
-      "   data: [ 0, 0, 0, 0, 0 ]\nrvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 1.5707963267948966, 0, 0 ]\n"
-      "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0, 0.5, 2 ]\n");
+  const std::string camera = camera64("map_cam.yaml");
   const std::string map = kccd::testing::writeScratch("test_logs", "map.yaml",
                                                       "kccd_joint_map: 1\njoints:\n"
                                                       "  wrist: {from: joint7, scale: -2.5, offset: 0.25}\n"
@@ -952,12 +953,7 @@ TEST_F(McapFixtures, AGoldenCaseOnABagFrameIsTheOverlaysFrame) {
       "  - {name: joint7, parent: joint6, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 0, 1], limits: [-3, 3]}\n"
       "bodies:\n  - {name: base, frame: world, points: [[0.3, 0, 0], [0.3, 0, 0.5]], radius: 0.05}\n"
       "  - {name: arm, frame: joint4, points: [[0, 0, 0], [0.3, 0, 0.1]], radius: 0.04}\n");
-  const std::string camera = kccd::testing::writeScratch(
-      "test_logs", "golden_cam.yaml",
-      "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
-      "   data: [ 40, 0, 31.5, 0, 40, 23.5, 0, 0, 1 ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n"
-      "   data: [ 0, 0, 0, 0, 0 ]\nrvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 1.5707963267948966, 0, 0 ]\n"
-      "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0, 0.5, 2 ]\n");
+  const std::string camera = camera64("golden_cam.yaml");
   const std::string manifest = (out / "manifest.yaml").string();
   std::ofstream(manifest) << "kccd_golden: 1\ndefaults: {model: " << model << ", camera: " << camera << ", bag: " << file("joint_zstd.mcap")
                           << ", outputs: [mask, overlay]}\ncases:\n  - {id: mcap-f2, frame: 2}\n  - {id: mcap-f5, frame: 5}\n"

@@ -69,6 +69,13 @@ class Fields {
   const char* record_;
 };
 
+// The little-endian 64-bit number at `p` (record lengths, times).
+std::uint64_t le64(const std::uint8_t* p) {
+  std::uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v |= static_cast<std::uint64_t>(p[i]) << (8 * i);
+  return v;
+}
+
 std::uint32_t crc32Of(std::uint32_t crc, const std::uint8_t* p, std::size_t n) {
   while (n > 0) {  // zlib takes 32-bit lengths
     const std::size_t step = std::min<std::size_t>(n, 1u << 30);
@@ -135,8 +142,7 @@ bool McapReader::readIndex() {
   in_.seekg(static_cast<std::streamoff>(size_ - tail.size()));
   if (!in_.read(reinterpret_cast<char*>(tail.data()), static_cast<std::streamsize>(tail.size()))) return false;
   if (tail[0] != kFooter || std::memcmp(tail.data() + kFooterBytes, kMagic, 8) != 0) return false;
-  std::uint64_t summary_start = 0;
-  for (int i = 0; i < 8; ++i) summary_start |= static_cast<std::uint64_t>(tail[9 + i]) << (8 * i);
+  const std::uint64_t summary_start = le64(tail.data() + 9);
   const std::uint64_t summary_end = size_ - tail.size();
   if (summary_start < 8 || summary_start >= summary_end) return false;
   std::vector<std::uint8_t> summary(static_cast<std::size_t>(summary_end - summary_start));
@@ -151,8 +157,7 @@ bool McapReader::readIndex() {
     for (std::size_t p = 0; p < summary.size();) {
       if (summary.size() - p < 9) return false;
       const std::uint8_t op = summary[p];
-      std::uint64_t len = 0;
-      for (int i = 0; i < 8; ++i) len |= static_cast<std::uint64_t>(summary[p + 1 + i]) << (8 * i);
+      const std::uint64_t len = le64(summary.data() + p + 1);
       if (len > summary.size() - p - 9) return false;
       const std::span<const std::uint8_t> content(summary.data() + p + 9, static_cast<std::size_t>(len));
       const std::uint64_t at = summary_start + p;
@@ -190,8 +195,7 @@ bool McapReader::readIndex() {
     std::uint8_t head[9];
     in_.seekg(static_cast<std::streamoff>(p));
     if (summary_start - p < 9 || !in_.read(reinterpret_cast<char*>(head), 9)) return false;
-    std::uint64_t len = 0;
-    for (int i = 0; i < 8; ++i) len |= static_cast<std::uint64_t>(head[1 + i]) << (8 * i);
+    const std::uint64_t len = le64(head + 1);
     if (len > summary_start - p - 9) return false;
     if (head[0] == kMessage) return false;
     if (head[0] == kSchema || head[0] == kChannel || head[0] == kHeader) {
@@ -230,33 +234,22 @@ bool McapReader::nextMerged(LogMessage& out) {
       in_.seekg(static_cast<std::streamoff>(c.offset));
       if (!in_.read(reinterpret_cast<char*>(record.data()), static_cast<std::streamsize>(record.size())) || record[0] != kChunk)
         fail(c.offset, "the chunk index points at no Chunk record here");
-      std::uint64_t len = 0;
-      for (int i = 0; i < 8; ++i) len |= static_cast<std::uint64_t>(record[1 + i]) << (8 * i);
-      if (len != c.length - 9) fail(c.offset, "the chunk index gives this chunk another length than its record");
+      if (le64(record.data() + 1) != c.length - 9) fail(c.offset, "the chunk index gives this chunk another length than its record");
       try {
         decompressChunk(std::span<const std::uint8_t>(record).subspan(9), c.offset, o->records);
       } catch (const std::out_of_range& e) {
         fail(c.offset, e.what());
       }
       for (std::size_t p = 0; p < o->records.size();) {
-        const std::size_t left = o->records.size() - p;
-        if (left < 9) fail(c.offset, "the chunk ends inside a record's opcode and length");
-        const std::uint8_t op = o->records[p];
-        std::uint64_t n = 0;
-        for (int i = 0; i < 8; ++i) n |= static_cast<std::uint64_t>(o->records[p + 1 + i]) << (8 * i);
-        if (n > left - 9) fail(c.offset, std::string("a ") + opName(op) + " record inside the chunk runs past its end");
-        const std::span<const std::uint8_t> content(o->records.data() + p + 9, static_cast<std::size_t>(n));
+        std::uint8_t op = 0;
+        const std::span<const std::uint8_t> content = chunkRecord(o->records, p, c.offset, op);
         if (op == kMessage) {
-          if (n < 22) fail(c.offset, "the Message record is too short for its header (" + std::to_string(n) + " bytes)");
-          std::uint64_t t = 0;
-          for (int i = 0; i < 8; ++i) t |= static_cast<std::uint64_t>(content[6 + i]) << (8 * i);
-          o->messages.push_back({t, p + 9, static_cast<std::size_t>(n)});
+          if (content.size() < 22) fail(c.offset, "the Message record is too short for its header (" + std::to_string(content.size()) + " bytes)");
+          const std::size_t at = static_cast<std::size_t>(content.data() - o->records.data());
+          o->messages.push_back({le64(content.data() + 6), at, content.size()});
         } else if (op == kSchema || op == kChannel) {
           handle(op, content, c.offset, true);
-        } else if (op <= kDataEnd) {
-          fail(c.offset, std::string("a ") + opName(op) + " record inside a chunk (only schemas, channels and messages belong there)");
         }
-        p += 9 + static_cast<std::size_t>(n);
       }
       std::stable_sort(o->messages.begin(), o->messages.end(), [](const Merge::Entry& a, const Merge::Entry& b) { return a.log_time < b.log_time; });
       if (!o->messages.empty()) g.open.push_back(std::move(o));
@@ -299,8 +292,7 @@ bool McapReader::readRecord(std::uint8_t& opcode, std::vector<std::uint8_t>& con
   std::uint8_t head[9];
   in_.read(reinterpret_cast<char*>(head), 9);
   opcode = head[0];
-  std::uint64_t len = 0;
-  for (int i = 0; i < 8; ++i) len |= static_cast<std::uint64_t>(head[1 + i]) << (8 * i);
+  const std::uint64_t len = le64(head + 1);
   if (len > size_ - pos_ - 9) {  // never allocated beyond what the file holds
     cut(pos_, std::string("inside a ") + opName(opcode) + " record of " + std::to_string(len) + " bytes");
     return false;
@@ -315,6 +307,20 @@ bool McapReader::readRecord(std::uint8_t& opcode, std::vector<std::uint8_t>& con
   }
   pos_ += 9 + len;
   return true;
+}
+
+std::span<const std::uint8_t> McapReader::chunkRecord(const std::vector<std::uint8_t>& records, std::size_t& pos, std::uint64_t at,
+                                                      std::uint8_t& op) const {
+  const std::size_t left = records.size() - pos;
+  if (left < 9) fail(at, "the chunk ends inside a record's opcode and length");
+  op = records[pos];
+  const std::uint64_t len = le64(records.data() + pos + 1);
+  if (len > left - 9) fail(at, std::string("a ") + opName(op) + " record inside the chunk runs past its end");
+  if (op != kSchema && op != kChannel && op != kMessage && op <= kDataEnd)
+    fail(at, std::string("a ") + opName(op) + " record inside a chunk (only schemas, channels and messages belong there)");
+  const std::span<const std::uint8_t> content(records.data() + pos + 9, static_cast<std::size_t>(len));
+  pos += 9 + static_cast<std::size_t>(len);
+  return content;
 }
 
 void McapReader::openChunk(std::span<const std::uint8_t> content, std::uint64_t at) {
@@ -453,16 +459,8 @@ bool McapReader::next(LogMessage& out) {
     }
     // Records of the open chunk first.
     if (chunk_pos_ < chunk_.size()) {
-      const std::size_t left = chunk_.size() - chunk_pos_;
-      if (left < 9) fail(chunk_at_, "the chunk ends inside a record's opcode and length");
-      const std::uint8_t op = chunk_[chunk_pos_];
-      std::uint64_t len = 0;
-      for (int i = 0; i < 8; ++i) len |= static_cast<std::uint64_t>(chunk_[chunk_pos_ + 1 + i]) << (8 * i);
-      if (len > left - 9) fail(chunk_at_, std::string("a ") + opName(op) + " record inside the chunk runs past its end");
-      const std::span<const std::uint8_t> content(chunk_.data() + chunk_pos_ + 9, static_cast<std::size_t>(len));
-      chunk_pos_ += 9 + static_cast<std::size_t>(len);
-      if (op != kSchema && op != kChannel && op != kMessage && op <= kDataEnd)
-        fail(chunk_at_, std::string("a ") + opName(op) + " record inside a chunk (only schemas, channels and messages belong there)");
+      std::uint8_t op = 0;
+      const std::span<const std::uint8_t> content = chunkRecord(chunk_, chunk_pos_, chunk_at_, op);
       handle(op, content, chunk_at_, true);
       continue;
     }

@@ -1,9 +1,5 @@
 #include "calib_frames.hpp"
 
-#include <algorithm>
-#include <iostream>
-#include <map>
-
 #include "cli_args.hpp"
 #include "cli_output.hpp"
 #include "kccd/overlay/bags/bag_recording.hpp"
@@ -33,20 +29,8 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
     // With a model (and no --state) the joint states give each frame's state; else the images alone.
     bag = model && a.states.empty() ? overlay::readBagRecording(bo, *model) : overlay::readBagImages(bo);
     for (const std::string& w : bag->warnings) warnings.push_back("--bag " + a.bag + ": " + w);
-    const int last = *std::max_element(a.video_frames.begin(), a.video_frames.end());
-    if (static_cast<std::size_t>(last) >= bag->frame_times.size())
-      throw UsageError("--frame " + std::to_string(last) + ": " + a.bag + " has " + std::to_string(bag->frame_times.size()) + " images on " +
-                       bag->image_topic + " (frames 0 ... " + std::to_string(bag->frame_times.size() - 1) + ")");
-    // One pass over the image topic, keeping the frames asked for (in the order asked).
-    std::map<int, cv::Mat> kept;
-    for (const int f : a.video_frames) kept[f];
-    const std::unique_ptr<overlay::FrameSource> source = bag->open_frames();
-    cv::Mat frame;
-    for (int i = 0; i <= last && source->read(frame); ++i)
-      if (kept.count(i)) kept[i] = frame.clone();
+    video_pictures = overlay::framesAt(*bag, std::vector<long>(a.video_frames.begin(), a.video_frames.end()), "--frame");
     for (const int f : a.video_frames) {
-      if (kept[f].empty()) throw UsageError("--frame " + std::to_string(f) + ": " + a.bag + ": the image could not be read");
-      video_pictures.push_back(kept[f]);
       picture_names.push_back(a.bag + "#" + std::to_string(f));
       if (bag->log.rows() > 0) times.push_back(bag->frame_times[static_cast<std::size_t>(f)]);
     }

@@ -130,9 +130,7 @@ Exit runOverlay(const OverlayArgs& a) {
         progress.update(expected ? static_cast<double>(n) / static_cast<double>(expected) : 0.0, detail);
       });
   progress.finish();
-  if (bag)
-    r.source = {{"bag", a.bag}, {"image_topic", bag->image_topic}, {"joint_topic", bag->joint_topic}, {"time_source", a.time_source},
-                {"origin_ns", std::to_string(bag->origin_ns)}, {"joint_map", a.joint_map}};
+  if (bag) r.source = bag->source();
 
   nlohmann::json j = overlay::writeOverlayOutputs(outputs, r, model, sink);
   j.erase("frames");  // the summary printed by --json

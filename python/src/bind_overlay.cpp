@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
-#include <map>
 #include <filesystem>
 #include <cmath>
 
@@ -155,9 +154,7 @@ caption. output: a .png, written under a temporary name and renamed when complet
                 last = now;
                 relay(p.frames_done, p.frames_expected, p.frames_per_second);
               });
-          if (rec)
-            r.source = {{"bag", bag}, {"image_topic", rec->image_topic}, {"joint_topic", rec->joint_topic}, {"time_source", time_source},
-                        {"origin_ns", std::to_string(rec->origin_ns)}, {"joint_map", joint_map}};
+          if (rec) r.source = rec->source();
           full = overlay::writeOverlayOutputs(outputs, r, model, sink);
         });
         return toPython(full);
@@ -203,19 +200,8 @@ the run over time (`kccd overlay --timeline`). Raises InputError naming the inpu
           py::gil_scoped_release release;
           info = overlay::bagInfoJson(logs::summarizeBag(path));
           if (h || !frames.empty() || !image_topic.empty()) rec = h ? overlay::readBagRecording(o, *h->model) : overlay::readBagImages(o);
-          if (!frames.empty()) {
-            const long last = *std::max_element(frames.begin(), frames.end());
-            if (static_cast<std::size_t>(last) >= rec.frame_times.size())
-              throw InputError(path + ": frame " + std::to_string(last) + ": the image topic " + rec.image_topic + " has " +
-                               std::to_string(rec.frame_times.size()) + " images");
-            std::map<long, cv::Mat> kept;
-            for (const long f : frames) kept[f];
-            const std::unique_ptr<overlay::FrameSource> source = rec.open_frames();
-            cv::Mat frame;
-            for (long i = 0; i <= last && source->read(frame); ++i)
-              if (kept.count(i)) cv::cvtColor(frame, kept[i], cv::COLOR_BGR2RGB);
-            for (const long f : frames) images.push_back(kept[f]);
-          }
+          images = overlay::framesAt(rec, frames, "frame");
+          for (cv::Mat& image : images) cv::cvtColor(image, image, cv::COLOR_BGR2RGB);
         }
         d["info"] = toPython(info);
         if (rec.frame_times.empty()) return d;

@@ -6,6 +6,7 @@
 #include <deque>
 #include <functional>
 #include <future>
+#include <map>
 #include <mutex>
 #include <thread>
 
@@ -157,6 +158,9 @@ void imageTimes(const BagRecordingOptions& o, const LogSource& images, BagRecord
 // readBagRecording, or with no model only the images (no joint topic chosen, no state log).
 BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
   BagRecording rec;
+  rec.bag = o.bag;
+  rec.time_source = o.time_source;
+  rec.joint_map = o.joint_map.source;
   // One pass: every topic, the images' times, and per joint-state topic its rows for the model's
   // state values (the first problem kept, reported only if that topic is the one used).
   const JointMap map = !model ? JointMap{} : o.joint_map.states.empty() ? identityJointMap(*model) : o.joint_map;
@@ -265,6 +269,37 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
 }  // namespace
 
 BagRecording readBagRecording(const BagRecordingOptions& options, const Model& model) { return readBag(options, &model); }
+
+std::vector<std::pair<std::string, std::string>> BagRecording::source() const {
+  return {{"bag", bag},
+          {"image_topic", image_topic},
+          {"joint_topic", joint_topic},
+          {"time_source", time_source == TimeSource::Log ? "log" : "header"},
+          {"origin_ns", std::to_string(origin_ns)},
+          {"joint_map", joint_map}};
+}
+
+std::vector<cv::Mat> framesAt(const BagRecording& rec, const std::vector<long>& indices, const std::string& option) {
+  if (indices.empty()) return {};
+  const std::size_t n = rec.frame_times.size();
+  for (const long f : indices)
+    if (f < 0 || static_cast<std::size_t>(f) >= n)
+      throw InputError(option + " " + std::to_string(f) + ": " + rec.bag + " has " + std::to_string(n) + " images on " +
+                       printable(rec.image_topic, 60) + (n > 0 ? " (frames 0 ... " + std::to_string(n - 1) + ")" : std::string()));
+  const long last = *std::max_element(indices.begin(), indices.end());
+  std::map<long, cv::Mat> kept;
+  for (const long f : indices) kept[f];
+  const std::unique_ptr<FrameSource> source = rec.open_frames();
+  cv::Mat frame;
+  for (long i = 0; i <= last; ++i) {
+    if (!source->read(frame))
+      throw InputError(option + " " + std::to_string(i) + ": " + rec.bag + ": the image could not be read (the log ends before it)");
+    if (kept.count(i)) kept[i] = frame.clone();
+  }
+  std::vector<cv::Mat> out;
+  for (const long f : indices) out.push_back(kept.at(f));
+  return out;
+}
 
 BagRecording readBagImages(const BagRecordingOptions& options) { return readBag(options, nullptr); }
 

@@ -143,13 +143,8 @@ GoldenRenderer::GoldenRenderer(const GoldenManifest& manifest) : impl_(std::make
         s.logs.emplace(key, std::make_unique<StateLog>(it->second->log));
       }
       const BagRecording& rec = *it->second;
-      if (static_cast<std::size_t>(c.frame) >= rec.frame_times.size())
-        throw InputError(where + ".frame: " + std::to_string(c.frame) + ": " + c.bag + " has " + std::to_string(rec.frame_times.size()) + " images on " +
-                         rec.image_topic);
       LoadedFrame f;
-      const std::unique_ptr<FrameSource> frames = rec.open_frames();
-      for (std::int64_t k = 0; k <= c.frame; ++k)
-        if (!frames->read(f.bgr)) throw InputError(where + ".frame: " + c.bag + ": image " + std::to_string(k) + " could not be read");
+      f.bgr = framesAt(rec, {static_cast<long>(c.frame)}, where + ".frame:").front();
       checkPicture(f.bgr, cam, c.bag + "#" + std::to_string(c.frame), c.camera);
       f.time = rec.frame_times[static_cast<std::size_t>(c.frame)];
       const cv::Mat flat = f.bgr.isContinuous() ? f.bgr : f.bgr.clone();

@@ -58,6 +58,10 @@ class McapReader final : public LogReader {
   bool readRecord(std::uint8_t& opcode, std::vector<std::uint8_t>& content, std::uint64_t& at);
   void handle(std::uint8_t opcode, std::span<const std::uint8_t> content, std::uint64_t at, bool in_chunk);
   void openChunk(std::span<const std::uint8_t> content, std::uint64_t at);
+  // The record at `pos` of a chunk's records (advancing `pos`): its opcode and content; fails
+  // naming the chunk at `at` for one that runs past the end or does not belong in a chunk.
+  std::span<const std::uint8_t> chunkRecord(const std::vector<std::uint8_t>& records, std::size_t& pos, std::uint64_t at,
+                                            std::uint8_t& op) const;
   void decompressChunk(std::span<const std::uint8_t> content, std::uint64_t at, std::vector<std::uint8_t>& out);
   struct Merge;
   bool readIndex();
