@@ -52,6 +52,24 @@ struct LogSource {
   std::int64_t first = std::numeric_limits<std::int64_t>::max();  // the earliest chosen time
 };
 
+// The source of a message's channel: its topic, kind, encoding and (for the kinds read) parsed
+// definitions. Throws InputError naming the place and the definition's line.
+inline LogSource logSourceOf(const std::string& bag, const logs::LogReader& reader, const logs::LogMessage& m) {
+  LogSource s;
+  s.topic = m.channel->topic;
+  s.kind = logKindOf(*m.channel, m.schema);
+  if (s.kind == LogKind::Other) return s;
+  s.cdr = m.channel->message_encoding == "cdr";
+  try {
+    s.types = logs::MessageDefinitions::parse(m.schema->name, m.schema->data, s.cdr ? logs::Dialect::Ros2 : logs::Dialect::Ros1);
+  } catch (const logs::DefinitionError& e) {
+    throw InputError(bag + ": " + reader.place(m.offset) + ": topic " + printable(s.topic, 60) + ": the definition of " +
+                     printable(m.schema->name, 60) + (e.line() ? " (line " + std::to_string(e.line()) + ")" : std::string()) + ": " +
+                     printable(e.what(), 200));
+  }
+  return s;
+}
+
 inline const Value& fieldOf(const Value& v, const char* field, const std::string& where) {
   const Value* f = v.field(field);
   if (!f) throw InputError(where + ": the message has no field '" + field + "'");
@@ -162,20 +180,7 @@ inline std::map<std::uint16_t, LogSource> scanLog(const std::string& bag, TimeSo
   while (reader.next(m)) {
     auto [it, fresh] = sources.try_emplace(m.channel->id);
     LogSource& s = it->second;
-    if (fresh) {
-      s.topic = m.channel->topic;
-      s.kind = logKindOf(*m.channel, m.schema);
-      if (s.kind != LogKind::Other) {
-        s.cdr = m.channel->message_encoding == "cdr";
-        try {
-          s.types = logs::MessageDefinitions::parse(m.schema->name, m.schema->data, s.cdr ? logs::Dialect::Ros2 : logs::Dialect::Ros1);
-        } catch (const logs::DefinitionError& e) {
-          throw InputError(bag + ": " + reader.place(m.offset) + ": topic " + printable(s.topic, 60) + ": the definition of " +
-                           printable(m.schema->name, 60) + (e.line() ? " (line " + std::to_string(e.line()) + ")" : std::string()) + ": " +
-                           printable(e.what(), 200));
-        }
-      }
-    }
+    if (fresh) s = logSourceOf(bag, reader, m);
     if (s.kind == LogKind::Other) continue;
     const std::string at = messagePlace(bag, reader, m, s.count);
     ++s.count;

@@ -96,13 +96,7 @@ class BagFrames final : public FrameSource {
     logs::LogMessage m;
     while (reader_->next(m)) {
       if (m.channel->topic != topic_) continue;
-      if (!source_) {
-        source_.emplace();
-        source_->topic = topic_;
-        source_->kind = logKindOf(*m.channel, m.schema);
-        source_->cdr = m.channel->message_encoding == "cdr";
-        source_->types = logs::MessageDefinitions::parse(m.schema->name, m.schema->data, source_->cdr ? logs::Dialect::Ros2 : logs::Dialect::Ros1);
-      }
+      if (!source_) source_ = logSourceOf(bag_, *reader_, m);
       std::string at = messagePlace(bag_, *reader_, m, seen_++);
       const logs::Value v = decodeMessage(*source_, m, at);
       std::size_t zero = 0;
@@ -132,10 +126,6 @@ class BagFrames final : public FrameSource {
   unsigned workers_;
   OrderedJobs jobs_;  // last: its threads end before the rest goes
 };
-
-}  // namespace
-
-namespace {
 
 // The images' times from the origin (those not after the previous one's left out, with a
 // warning), the nominal rate, and how to open the frames.
