@@ -64,12 +64,9 @@ struct Db3Reader::Db {
 
 namespace {
 
-// The bytes a database file's header declares (page size x the in-header page count, when the
-// count is valid: its version number equals the change counter), or 0 when it declares none.
-std::uint64_t declaredBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  unsigned char h[100] = {};
-  if (!in.read(reinterpret_cast<char*>(h), 100)) return 0;
+// The bytes a database file's 100-byte header `h` declares (page size x the in-header page count,
+// when the count is valid: its version number equals the change counter), or 0 when it declares none.
+std::uint64_t declaredBytes(const unsigned char (&h)[100]) {
   auto be32 = [&](int at) { return (std::uint32_t{h[at]} << 24) | (std::uint32_t{h[at + 1]} << 16) | (std::uint32_t{h[at + 2]} << 8) | h[at + 3]; };
   const std::uint32_t page = h[16] == 0 && h[17] == 1 ? 65536u : (std::uint32_t{h[16]} << 8) | h[17];
   if (page < 512 || (page & (page - 1)) != 0 || be32(24) != be32(92)) return 0;
@@ -179,14 +176,16 @@ void Db3Reader::open(std::size_t index) {
   auto fail = [&](const std::string& problem) -> void {
     throw InputError(InputLocation{path, 0, 0, "sqlite3"}, problem);
   };
+  unsigned char header[100] = {};  // the magic, then what the header declares
+  std::streamsize got = 0;
   {
     std::ifstream in(path, std::ios::binary);
-    char magic[16] = {};
-    if (!in || !in.read(magic, 16) || std::memcmp(magic, "SQLite format 3", 16) != 0)
-      fail(in ? "not an SQLite database (rosbag2 .db3)" : "cannot be opened");
+    if (in) got = in.read(reinterpret_cast<char*>(header), sizeof header).gcount();
+    if (got < 16) fail("cannot be opened");
+    if (std::memcmp(header, "SQLite format 3", 16) != 0) fail("not an SQLite database (rosbag2 .db3)");
   }
   std::error_code size_error;
-  const std::uint64_t size = std::filesystem::file_size(path, size_error), declared = declaredBytes(path);
+  const std::uint64_t size = std::filesystem::file_size(path, size_error), declared = got == 100 ? declaredBytes(header) : 0;
   const bool cut = !size_error && declared > size;
   if (sqlite3_open_v2(path.c_str(), &db_->db, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, cut ? wholePagesVfs() : nullptr) != SQLITE_OK)
     fail(std::string("cannot be opened: ") + (db_->db ? db3Message(db_->db) : "out of memory"));
