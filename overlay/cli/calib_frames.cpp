@@ -23,7 +23,7 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
         .bag = a.bag,
         .joint_topic = a.joint_topic,
         .image_topic = a.image_topic,
-        .time_source = a.time_source == "log" ? overlay::TimeSource::Log : overlay::TimeSource::Header,
+        .time_source = *overlay::timeSourceOf(a.time_source),  // checked by the option
         .joint_map = a.joint_map.empty() || !model ? overlay::JointMap{} : overlay::loadJointMap(a.joint_map, *model)};
     if (!a.joint_map.empty() && !model) throw UsageError("--joint-map: needs --model");
     // With a model (and no --state) the joint states give each frame's state; else the images alone.

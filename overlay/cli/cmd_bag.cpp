@@ -71,7 +71,7 @@ struct BagExportArgs {
 
 Exit runBagExport(const BagExportArgs& args) {
   overlay::BagExportOptions o = args.options;
-  o.time_source = args.time_source == "log" ? overlay::TimeSource::Log : overlay::TimeSource::Header;
+  o.time_source = *overlay::timeSourceOf(args.time_source);  // checked by the option
   const overlay::BagExportReport r = overlay::exportBag(o);
   for (const std::string& w : r.warnings) std::cerr << "kccd bag export: warning: " << w << "\n";
   if (args.quiet) return Exit::Ok;

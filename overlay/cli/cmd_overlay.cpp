@@ -84,7 +84,7 @@ Exit runOverlay(const OverlayArgs& a) {
   std::optional<overlay::BagRecording> bag;
   if (!a.bag.empty()) {
     bag = overlay::readBagRecording({.bag = a.bag, .joint_topic = a.joint_topic, .image_topic = a.image_topic,
-                                     .time_source = a.time_source == "log" ? overlay::TimeSource::Log : overlay::TimeSource::Header,
+                                     .time_source = *overlay::timeSourceOf(a.time_source),  // checked by the option
                                      .joint_map = a.joint_map.empty() ? overlay::JointMap{} : overlay::loadJointMap(a.joint_map, model)},
                                     model);
     for (const std::string& w : bag->warnings) std::cerr << "kccd overlay: warning: --bag " << a.bag << ": " << w << "\n";

@@ -91,11 +91,12 @@ caption. output: a .png, written under a temporary name and renamed when complet
           throw py::value_error("give video and states, or bag (a robot log), not both");
         if (bag.empty() && (!image_topic.empty() || !joint_topic.empty() || !joint_map.empty()))
           throw py::value_error("image_topic, joint_topic and joint_map go with bag");
-        if (time_source != "header" && time_source != "log") throw py::value_error("time_source: expected 'header' or 'log'");
+        const std::optional<overlay::TimeSource> clock = overlay::timeSourceOf(time_source);
+        if (!clock) throw py::value_error("time_source: expected 'header' or 'log'");
         std::optional<overlay::BagRecording> rec;
         if (!bag.empty())
           rec = overlay::readBagRecording({.bag = bag, .joint_topic = joint_topic, .image_topic = image_topic,
-                                           .time_source = time_source == "log" ? overlay::TimeSource::Log : overlay::TimeSource::Header,
+                                           .time_source = *clock,
                                            .joint_map = joint_map.empty() ? overlay::JointMap{} : overlay::loadJointMap(joint_map, model)},
                                           model);
         if (rec)
@@ -184,14 +185,15 @@ the run over time (`kccd overlay --timeline`). Raises InputError naming the inpu
       "read_bag",
       [](const std::string& path, const std::shared_ptr<ModelHandle>& h, const std::string& image_topic, const std::string& joint_topic,
          const std::string& time_source, const std::string& joint_map, const std::vector<long>& frames) {
-        if (time_source != "header" && time_source != "log") throw py::value_error("time_source: expected 'header' or 'log'");
+        const std::optional<overlay::TimeSource> clock = overlay::timeSourceOf(time_source);
+        if (!clock) throw py::value_error("time_source: expected 'header' or 'log'");
         if (!h && (!joint_topic.empty() || !joint_map.empty())) throw py::value_error("joint_topic and joint_map need a model");
         for (const long f : frames)
           if (f < 0) throw py::value_error("frames: indices from 0");
         py::dict d;
         const overlay::BagRecordingOptions o{
             .bag = path, .joint_topic = joint_topic, .image_topic = image_topic,
-            .time_source = time_source == "log" ? overlay::TimeSource::Log : overlay::TimeSource::Header,
+            .time_source = *clock,
             .joint_map = joint_map.empty() || !h ? overlay::JointMap{} : overlay::loadJointMap(joint_map, *h->model)};
         nlohmann::json info;
         overlay::BagRecording rec;

@@ -22,6 +22,14 @@
 #include "bag_messages.hpp"
 
 namespace kccd::overlay {
+
+const char* toString(TimeSource source) { return source == TimeSource::Log ? "log" : "header"; }
+
+std::optional<TimeSource> timeSourceOf(std::string_view word) {
+  if (word == "header") return TimeSource::Header;
+  if (word == "log") return TimeSource::Log;
+  return std::nullopt;
+}
 namespace {
 
 using namespace detail;

@@ -264,7 +264,7 @@ std::vector<std::pair<std::string, std::string>> BagRecording::source() const {
   return {{"bag", bag},
           {"image_topic", image_topic},
           {"joint_topic", joint_topic},
-          {"time_source", time_source == TimeSource::Log ? "log" : "header"},
+          {"time_source", toString(time_source)},
           {"origin_ns", std::to_string(origin_ns)},
           {"joint_map", joint_map}};
 }

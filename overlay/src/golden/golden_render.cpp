@@ -199,7 +199,7 @@ GoldenRendering GoldenRenderer::render(std::size_t index) {
       const BagRecording& rec = *s.bags.at({logKey(c), c.model});
       // A log may be large (or a folder): its frame's pixels are hashed below, not the whole log.
       inputs["bag"] = {{"file", relativeTo(c.bag, s.manifest.folder)}, {"frame", c.frame},
-                       {"image_topic", rec.image_topic}, {"joint_topic", rec.joint_topic}, {"time_source", c.log_time ? "log" : "header"},
+                       {"image_topic", rec.image_topic}, {"joint_topic", rec.joint_topic}, {"time_source", toString(c.log_time ? TimeSource::Log : TimeSource::Header)},
                        {"time_offset", c.time_offset}};
     }
     inputs["video_frame"] = {{"sha256", f.pixels_sha256}};

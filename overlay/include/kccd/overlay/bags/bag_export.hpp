@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -19,6 +20,10 @@ enum class TimeSource {
   Header,  ///< the header stamp (the log time where a stamp is zero, with a warning)
   Log,     ///< the time the recorder logged it
 };
+/// "header" or "log": the words of --time-source and of the reports.
+const char* toString(TimeSource source);
+/// The clock a word names ("header" or "log"), or none.
+std::optional<TimeSource> timeSourceOf(std::string_view word);
 
 /// What to export and where. Outputs left empty are not written; at least one is needed.
 struct BagExportOptions {
