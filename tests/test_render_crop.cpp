@@ -112,6 +112,61 @@ TEST(RenderCrop, TheCroppedLayerIsTheWholeLayerBitForBit) {
             << " % of the images\n";
 }
 
+// One cropped renderer drawing a long run of frames whose looks and requests change from frame to
+// frame (tinted, shaded, with a mask drawn in the same pass or alone, nothing drawn, a volume around
+// the camera) and whose volumes jump across the image: each frame's layer is a fresh whole-image
+// renderer's bit for bit, so what earlier frames left in the GL target (the tinted look clears only
+// the cells it knows were drawn) never shows through.
+TEST(RenderCrop, WhatEarlierFramesDrewNeverShowsThrough) {
+  std::mt19937_64 rng(99);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (const bool distorted : {false, true}) {
+    SCOPED_TRACE(distorted ? "distorting camera" : "plain camera");
+    const Camera c = kccd::testing::randomCamera(rng, distorted, 400, 300);
+    const cv::Vec3d centre = kccd::testing::cameraCentre(c);
+    const Vec3 eye(centre[0], centre[1], centre[2]);
+    RenderOptions cropped, whole;
+    whole.crop = false;
+    Renderer a(c, cropped);
+    int tinted_after_other = 0;
+    Style previous;
+    for (int frame = 0; frame < 40; ++frame) {
+      SCOPED_TRACE("frame " + std::to_string(frame));
+      std::vector<std::vector<Vec3>> clouds;
+      std::vector<Volume> scene;
+      const int n = frame % 9 == 8 ? 0 : 1 + static_cast<int>(rng() % 6);
+      clouds.reserve(static_cast<std::size_t>(n));
+      for (int i = 0; i < n; ++i) {
+        Vec3 at(0.8 * u(rng), 0.8 * u(rng), 0.8 * u(rng));
+        double radius = 0.01 + 0.1 * std::abs(u(rng));
+        if (i == 0 && frame % 13 == 6) at = eye, radius = 0.3;  // around the camera: the whole view
+        const auto cloud = kccd::testing::randomCloud(rng, 1 + static_cast<int>(rng() % 8), at, 0.02 + 0.2 * std::abs(u(rng)));
+        clouds.emplace_back(cloud.begin(), cloud.end());
+        scene.push_back(Volume{clouds.back(), radius, static_cast<SafetyStatus>(i % 4), "body " + std::to_string(i)});
+      }
+      Style style;
+      style.shaded = frame % 5 == 2;
+      style.legend = frame % 4 == 1;
+      style.outline_width = frame % 3 == 0 ? 5.0 : 2.0;
+      const bool mask = frame % 6 == 3;
+      if (!style.shaded && !mask && frame > 0 && (previous.shaded || frame % 6 == 4)) ++tinted_after_other;
+      previous = style;
+      if (frame % 7 == 5) (void)a.render(scene, style, false, true);  // a mask alone in between
+      Renderer b(c, whole);
+      const Frame fa = a.render(scene, style, true, mask);
+      const Frame fb = b.render(scene, style, true, mask);
+      cv::Mat diff;
+      cv::absdiff(fa.bgra, fb.bgra, diff);
+      EXPECT_EQ(cv::countNonZero(diff.reshape(1)), 0);
+      if (mask) {
+        cv::absdiff(fa.mask, fb.mask, diff);
+        EXPECT_EQ(cv::countNonZero(diff), 0);
+      }
+    }
+    EXPECT_GT(tinted_after_other, 3);  // the looks really alternate
+  }
+}
+
 TEST(RenderCrop, RenderOntoRejectsAFrameOfAnotherSizeOrType) {
   std::mt19937_64 rng(7);
   const Camera c = kccd::testing::randomCamera(rng, true, 160, 120);

@@ -136,6 +136,95 @@ void drawShaded(const std::vector<const PreparedVolume*>& order, double ambient)
   glDisable(GL_DEPTH_TEST);
 }
 
+// Zeros the colour of the bound target in every dirty cell of `out` (transparent quads over the
+// whole cells, blending off, camera matrices restored) and marks every cell clean. Cell edges lie
+// on pixel edges, so each quad covers its cells' pixel centres and no other.
+void clearCells(ColourReadBack& out) {
+  constexpr int c = ColourReadBack::kCell;
+  GLint viewport[4] = {0, 0, 0, 0};
+  glGetIntegerv(GL_VIEWPORT, viewport);
+  const double w = viewport[2], h = viewport[3];
+  std::vector<float> quads;
+  for (int cy = 0; cy < out.cells_y; ++cy)
+    for (int cx = 0; cx < out.cells_x;) {
+      if (!out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx)]) {
+        ++cx;
+        continue;
+      }
+      const int first = cx;
+      while (cx < out.cells_x && out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx)]) out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx++)] = 0;
+      // Pixel edges to normalised device coordinates (GL's rows are the image's, see setCamera).
+      const auto nx = [&](int x) { return static_cast<float>(2.0 * std::min<double>(x, w) / w - 1.0); };
+      const auto ny = [&](int y) { return static_cast<float>(2.0 * std::min<double>(y, h) / h - 1.0); };
+      const float x0 = nx(first * c), x1 = nx(cx * c), y0 = ny(cy * c), y1 = ny((cy + 1) * c);
+      quads.insert(quads.end(), {x0, y0, 0, x1, y0, 0, x1, y1, 0, x0, y0, 0, x1, y1, 0, x0, y1, 0});
+    }
+  if (quads.empty()) return;
+  glMatrixMode(GL_PROJECTION);
+  glPushMatrix();
+  glLoadIdentity();
+  glMatrixMode(GL_MODELVIEW);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glColor4f(0, 0, 0, 0);
+  glVertexPointer(3, GL_FLOAT, 0, quads.data());
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(quads.size() / 3));
+  glEnable(GL_CULL_FACE);
+  glMatrixMode(GL_PROJECTION);
+  glPopMatrix();
+  glMatrixMode(GL_MODELVIEW);
+}
+
+// Marks dirty every cell of `out` whose part of the read-back rectangle holds a non-zero byte.
+void markDirtyCells(ColourReadBack& out) {
+  constexpr int c = ColourReadBack::kCell;
+  const cv::Rect& r = out.rect;
+  for (int cy = r.y / c; cy * c < r.y + r.height; ++cy)
+    for (int cx = r.x / c; cx * c < r.x + r.width; ++cx) {
+      unsigned char& cell = out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx)];
+      if (cell) continue;
+      const cv::Rect part = cv::Rect(cx * c, cy * c, c, c) & r;
+      bool any = false;
+      for (int y = part.y; y < part.y + part.height && !any; ++y) {
+        const uchar* row = out.image.ptr<uchar>(y, part.x);
+        uchar bits = 0;
+        for (int k = 0; k < 4 * part.width; ++k) bits |= row[k];
+        any = bits != 0;
+      }
+      cell = any;
+    }
+}
+
+// Volumes' vertices, indices and flat colours gathered for one draw call (drawn in the order added).
+struct OutlineBatch {
+  std::vector<float> vertices, colours;  // xyz and rgba per vertex
+  std::vector<std::uint32_t> indices;
+
+  void add(const std::vector<float>& xyz, const std::vector<std::uint32_t>& index, const std::array<float, 4>& rgba) {
+    const auto base = static_cast<std::uint32_t>(vertices.size() / 3);
+    vertices.insert(vertices.end(), xyz.begin(), xyz.end());
+    for (std::size_t k = 0; k < xyz.size() / 3; ++k) colours.insert(colours.end(), rgba.begin(), rgba.end());
+    for (const std::uint32_t i : index) indices.push_back(base + i);
+  }
+  // Draws the primitives of `mode`. A primitive's vertices share one colour, so interpolating it
+  // gives that colour exactly (its gradients are zero). Not GL_FLAT: on llvmpipe a later smooth
+  // draw of another program then came out flat-shaded.
+  void draw(GLenum mode) const {
+    if (indices.empty()) return;
+    glEnableClientState(GL_COLOR_ARRAY);
+    glColorPointer(4, GL_FLOAT, 0, colours.data());
+    glVertexPointer(3, GL_FLOAT, 0, vertices.data());
+    glDrawElements(mode, static_cast<GLsizei>(indices.size()), GL_UNSIGNED_INT, indices.data());
+    glDisableClientState(GL_COLOR_ARRAY);
+  }
+  void clear() {
+    vertices.clear();
+    colours.clear();
+    indices.clear();
+  }
+};
+
 }  // namespace
 
 std::vector<cv::Rect> colourRects(const Projection& projection, const std::vector<PreparedVolume>& bodies,
@@ -196,9 +285,24 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
     glEnable(GL_SCISSOR_TEST);
     glScissor(rect.x, rect.y, rect.width, rect.height);
   }
-  glClearColor(0, 0, 0, 0);
-  glClearDepth(1.0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (out.cells_x != (w + ColourReadBack::kCell - 1) / ColourReadBack::kCell) {  // the first frame: the target is unknown
+    out.cells_x = (w + ColourReadBack::kCell - 1) / ColourReadBack::kCell;
+    out.cells_y = (h + ColourReadBack::kCell - 1) / ColourReadBack::kCell;
+    out.dirty.assign(static_cast<std::size_t>(out.cells_x) * static_cast<std::size_t>(out.cells_y), 1);
+  }
+  if (!with_labels && !style.shaded && gl.samples <= 1 && options.crop) {
+    // The tinted look tests no depth: only the colour is cleared, and only in the cells that may
+    // hold a pixel (drawn as transparent quads: llvmpipe clears a scissored rectangle several
+    // times slower than it fills one). The target is then zero everywhere, as a clear leaves it.
+    glDisable(GL_SCISSOR_TEST);
+    clearCells(out);
+    glEnable(GL_SCISSOR_TEST);
+  } else {
+    glClearColor(0, 0, 0, 0);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    if (with_labels) std::fill(out.dirty.begin(), out.dirty.end(), 0);  // cleared whole (no scissor)
+  }
   if (with_labels) clearLabels();
   if (style.shaded) {
     std::vector<const PreparedVolume*> all;
@@ -232,17 +336,30 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
   // The tints as premultiplied colours (the blend then multiplies nothing by the source alpha:
   // ~15 % less fill time on llvmpipe than blending straight colours).
   glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  // Consecutive outlined volumes are filled in one draw call (GL blends a call's triangles in
+  // their order, and a colour per volume's vertices is the colour glColor would give: the same
+  // pixels for a fraction of the per-call cost on llvmpipe).
+  OutlineBatch batch;
+  auto flushFills = [&] {
+    if (batch.indices.empty()) return;
+    glDisable(GL_CULL_FACE);  // the outline's winding is the image's, not the mesh's
+    batch.draw(GL_TRIANGLES);
+    glEnable(GL_CULL_FACE);
+    batch.clear();
+  };
   for (const PreparedVolume* p : order) {
     const cv::Scalar c = p->colour;  // BGR, drawn as GL's RGB (see the read-back)
     const double fa = style.fill_alpha;
-    glColor4d(fa * c[0] / 255.0, fa * c[1] / 255.0, fa * c[2] / 255.0, fa);
+    const std::array<float, 4> tint{static_cast<float>(fa * c[0] / 255.0), static_cast<float>(fa * c[1] / 255.0),
+                                    static_cast<float>(fa * c[2] / 255.0), static_cast<float>(fa)};
     if (p->outlined()) {
       ++frame.polygon_fills;
-      glDisable(GL_CULL_FACE);  // the outline's winding is the image's, not the mesh's
-      glVertexPointer(3, GL_FLOAT, 0, p->outline_vertices.data());
-      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(p->outline_fill.size()), GL_UNSIGNED_INT, p->outline_fill.data());
-      glEnable(GL_CULL_FACE);
-    } else if (!p->surface && polygonFill(*p)) {
+      batch.add(p->outline_vertices, p->outline_fill, tint);
+      continue;
+    }
+    flushFills();
+    glColor4f(tint[0], tint[1], tint[2], tint[3]);
+    if (!p->surface && polygonFill(*p)) {
       ++frame.polygon_fills;
       glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
       glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(p->fill.size()), GL_UNSIGNED_INT, p->fill.data());
@@ -250,18 +367,19 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
       drawTriangles(*p->mesh, p->vertices);
     }
   }
+  flushFills();
   glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);  // smoothed lines: coverage in alpha
   glLineWidth(static_cast<float>(style.outline_width * projection.supersample()));
   glEnable(GL_LINE_SMOOTH);  // coverage in alpha, blended like the fill
   glHint(GL_LINE_SMOOTH_HINT, GL_NICEST);
+  // Every volume's outline in one draw call, in the same order, each in its own colour.
   for (const PreparedVolume* p : order) {
     const cv::Scalar c = p->colour * 0.7;
-    glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
     const bool own = p->outlined();
-    glVertexPointer(3, GL_FLOAT, 0, own ? p->outline_vertices.data() : p->vertices.data());
-    const std::vector<std::uint32_t>& lines = own ? p->outline_lines : p->outline;
-    glDrawElements(GL_LINES, static_cast<GLsizei>(lines.size()), GL_UNSIGNED_INT, lines.data());
+    batch.add(own ? p->outline_vertices : p->vertices, own ? p->outline_lines : p->outline,
+              {static_cast<float>(c[0] / 255.0), static_cast<float>(c[1] / 255.0), static_cast<float>(c[2] / 255.0), 1.0f});
   }
+  batch.draw(GL_LINES);
   glDisable(GL_LINE_SMOOTH);
   // Volumes containing the camera tint the whole view, in front of everything else.
   for (const PreparedVolume& p : bodies)
@@ -296,6 +414,8 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
     glReadPixels(out.rect.x, out.rect.y, out.rect.width, out.rect.height, GL_RGBA, GL_UNSIGNED_BYTE,
                  out.image.ptr<uchar>(out.rect.y, out.rect.x));
     glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+    // Without multisampling the target's pixels are the ones read: cells holding one are dirty.
+    if (gl.samples <= 1) markDirtyCells(out);
   }
   if (with_labels) *labels = readLabels(w, h);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -20,6 +20,12 @@ struct ColourReadBack {
   cv::Mat image;
   cv::Rect rect;
   std::vector<cv::Rect> parts;
+  /// Cells of kCell x kCell pinhole pixels (row-major) of the colour target that may hold a
+  /// non-zero pixel: what was read back non-zero, and what an earlier clear did not reach. The
+  /// next tinted frame clears these cells alone (the rest of the target is zero already).
+  static constexpr int kCell = 16;
+  std::vector<unsigned char> dirty;
+  int cells_x = 0, cells_y = 0;
 };
 
 /// Pinhole rectangles that hold every pixel the colour pass draws of `bodies`, one per drawn

@@ -4,8 +4,13 @@
 //   1. the plain transcode: decode -> encode, pipelined on two threads (the baseline),
 //   2. `kccd overlay` with static volumes,
 //   3. `kccd overlay --swept`,
-// and prints frames per second and the ratios. With --baseline OTHER_KCCD (e.g. the previous
-// build) the same two runs of that binary are timed in between, and the ratios to it printed.
+// and prints frames per second and the ratios. Each is also run on a short clip, the first K
+// frames of the same recording (K = frames / 10, at least 10): the difference of the two times
+// is what the frames beyond K cost, so (frames - K) / (T_frames - T_K) is the rate a long
+// recording runs at once started (the overlay's process start, model, log and lens set-up left
+// out; the transcode's opening likewise), and T_K - K / rate the fixed cost. With --baseline
+// OTHER_KCCD (e.g. the previous build) the same two runs of that binary are timed in between,
+// and the ratios to it printed.
 // Usage:
 //   bench_overlay KCCD_BINARY [--frames N] [--jobs J] [--dir WORKDIR] [--codec mp4v|MJPG|FFV1]
 //                 [--baseline OTHER_KCCD] [--repeat R (rounds, each run's fastest kept; default 3)]
@@ -69,11 +74,32 @@ std::string extensionFor(const std::string& codec) {
   return ".mp4";
 }
 
-void makeVideo(const std::string& path, const std::string& codec, int frames, double fps) {
+// The recording (`frames` frames) and a short clip of its first `short_frames` frames.
+void makeVideos(const std::string& path, const std::string& short_path, const std::string& codec, int frames,
+                int short_frames, double fps) {
   cv::VideoWriter vw(path, cv::CAP_FFMPEG, fourcc(codec), fps, cv::Size(1280, 720), true);
+  cv::VideoWriter clip(short_path, cv::CAP_FFMPEG, fourcc(codec), fps, cv::Size(1280, 720), true);
   if (!vw.isOpened()) throw std::runtime_error("cannot write " + path);
+  if (!clip.isOpened()) throw std::runtime_error("cannot write " + short_path);
   cv::RNG rng(7);
-  for (int i = 0; i < frames; ++i) vw.write(kccd::bench::texturedFrame(i, rng));
+  for (int i = 0; i < frames; ++i) {
+    const cv::Mat f = kccd::bench::texturedFrame(i, rng);
+    vw.write(f);
+    if (i < short_frames) clip.write(f);
+  }
+}
+
+// A look's rate once started, from its whole run (n frames) and the short clip's (k frames):
+// frames per second beyond the first k, and the fixed cost (seconds) that rate leaves over.
+struct Steady {
+  double fps = 0.0, fixed = 0.0;
+};
+
+Steady steadyOf(double t_n, int n, double t_k, int k) {
+  Steady s;
+  s.fps = t_n > t_k ? (n - k) / (t_n - t_k) : 0.0;
+  s.fixed = s.fps > 0.0 ? t_k - k / s.fps : 0.0;
+  return s;
 }
 
 // Decode and encode on two threads with a bounded queue: the plain transcode's best.
@@ -175,20 +201,23 @@ int main(int argc, char** argv) {
     const double fps = 30.0;
     const std::string ext = extensionFor(codec);
     const std::string model = std::string(KCCD_DATA_DIR) + "/humanoid.yaml", camera = dir + "/camera.yaml",
-                      video = dir + "/in" + ext, log = dir + "/states.csv";
+                      video = dir + "/in" + ext, clip = dir + "/short" + ext, log = dir + "/states.csv";
+    const int clip_frames = std::max(10, frames / 10);
+    if (frames < 2 * clip_frames) throw std::runtime_error("--frames: at least 20");
     kccd::calib::saveCamera(kccd::bench::benchCamera(), camera);
     kccd::bench::makeLog(log, kccd::loadModel(model), frames / fps + 1.0);
-    makeVideo(video, codec, frames, fps);
+    makeVideos(video, clip, codec, frames, clip_frames, fps);
 
-    int plain_frames = 0;
-    const std::string args = " overlay " + model + " --camera " + camera + " --video " + video + " --states " + log +
-                             " --quiet" + (jobs > 0 ? " --jobs " + std::to_string(jobs) : "");
+    int plain_frames = 0, clip_plain_frames = 0;
+    const std::string common = " --camera " + camera + " --states " + log + " --quiet" + (jobs > 0 ? " --jobs " + std::to_string(jobs) : "");
+    const std::string args = " overlay " + model + " --video " + video + common;
+    const std::string short_args = " overlay " + model + " --video " + clip + common;
     const std::string base = kccd + args;
     // Rounds of: transcode, then per look the baseline's run and this build's (alternating, so a
-    // change in the machine's load falls on all of them); each keeps its fastest round (the least
-    // disturbed by other work on a shared machine).
+    // change in the machine's load falls on all of them), then the short clip's; each keeps its
+    // fastest round (the least disturbed by other work on a shared machine).
     const std::string other = baseline + args;
-    Timed plain, stat_base, stat, swept_base, swept;
+    Timed plain, stat_base, stat, swept_base, swept, clip_plain, clip_stat, clip_swept;
     std::string stat_json, swept_json;
     // A command's wall time, and the CPU its process used (the children's CPU clock moves when it is waited for).
     auto run = [&](Timed& best, const std::string& command, std::string* json) {
@@ -205,7 +234,18 @@ int main(int argc, char** argv) {
       run(stat, base + " --timings --json -o " + dir + "/static" + ext + " --codec " + codec, &stat_json);
       if (!baseline.empty()) run(swept_base, other + " --swept -o " + dir + "/base_swept" + ext + " --codec " + codec, nullptr);
       run(swept, base + " --swept --timings --json -o " + dir + "/swept" + ext + " --codec " + codec, &swept_json);
+      const double c1 = cpuSeconds(RUSAGE_SELF);
+      const double clip_wall = transcode(clip, dir + "/plain_short" + ext, codec, clip_plain_frames);
+      clip_plain.keep(clip_wall, cpuSeconds(RUSAGE_SELF) - c1);
+      run(clip_stat, kccd + short_args + " -o " + dir + "/static_short" + ext + " --codec " + codec, nullptr);
+      run(clip_swept, kccd + short_args + " --swept -o " + dir + "/swept_short" + ext + " --codec " + codec, nullptr);
     }
+    if (clip_plain_frames != clip_frames)
+      throw std::runtime_error("the short clip's transcode saw " + std::to_string(clip_plain_frames) + " frames, not " +
+                               std::to_string(clip_frames));
+    const Steady s_plain = steadyOf(plain.wall, plain_frames, clip_plain.wall, clip_frames);
+    const Steady s_stat = steadyOf(stat.wall, frames, clip_stat.wall, clip_frames);
+    const Steady s_swept = steadyOf(swept.wall, frames, clip_swept.wall, clip_frames);
     const Stages stat_stages = stagesOf(stat_json, frames), swept_stages = stagesOf(swept_json, frames);
 
     const unsigned hw = std::thread::hardware_concurrency();
@@ -220,6 +260,14 @@ int main(int argc, char** argv) {
                 100 * f_static / f_plain, cpu(stat, frames));
     std::printf("  kccd overlay --swept:              %7.1f fps  (%3.0f %% of the transcode)  CPU %5.1f ms per frame\n", f_swept,
                 100 * f_swept / f_plain, cpu(swept, frames));
+    // Once started: what each further frame costs (a long recording's rate), and the fixed cost.
+    std::printf("  once started (frames %d..%d against the first %d alone), frames per second and fixed cost:\n", clip_frames,
+                frames, clip_frames);
+    std::printf("    plain transcode:                 %7.1f fps                          fixed %.3f s\n", s_plain.fps, s_plain.fixed);
+    std::printf("    kccd overlay, static volumes:    %7.1f fps  (%3.0f %% of the transcode)  fixed %.3f s\n", s_stat.fps,
+                100 * s_stat.fps / s_plain.fps, s_stat.fixed);
+    std::printf("    kccd overlay --swept:            %7.1f fps  (%3.0f %% of the transcode)  fixed %.3f s\n", s_swept.fps,
+                100 * s_swept.fps / s_plain.fps, s_swept.fixed);
     // Where the time went (each stage on its own thread: decoding, annotating and encoding overlap).
     std::printf("  per frame, ms        static   swept   (set-up %.3f s and %.3f s)\n", stat_stages.setup, swept_stages.setup);
     for (std::size_t k = 0; k < stat_stages.ms.size(); ++k)
@@ -232,9 +280,13 @@ int main(int argc, char** argv) {
                   baseline.c_str(), frames / swept_base.wall, swept_base.wall / swept.wall, cpu(swept_base, frames));
     }
     std::printf("{\"frames\": %d, \"codec\": \"%s\", \"plain_fps\": %.2f, \"static_fps\": %.2f, \"swept_fps\": %.2f, "
-                "\"static_ratio\": %.3f, \"swept_ratio\": %.3f, \"plain_cpu_ms\": %.2f, \"static_cpu_ms\": %.2f, \"swept_cpu_ms\": %.2f}\n",
+                "\"static_ratio\": %.3f, \"swept_ratio\": %.3f, \"plain_cpu_ms\": %.2f, \"static_cpu_ms\": %.2f, \"swept_cpu_ms\": %.2f, "
+                "\"clip_frames\": %d, \"started_plain_fps\": %.2f, \"started_static_fps\": %.2f, \"started_swept_fps\": %.2f, "
+                "\"started_static_ratio\": %.3f, \"started_swept_ratio\": %.3f, \"fixed_plain_s\": %.3f, \"fixed_static_s\": %.3f, "
+                "\"fixed_swept_s\": %.3f}\n",
                 frames, codec.c_str(), f_plain, f_static, f_swept, f_static / f_plain, f_swept / f_plain, cpu(plain, plain_frames),
-                cpu(stat, frames), cpu(swept, frames));
+                cpu(stat, frames), cpu(swept, frames), clip_frames, s_plain.fps, s_stat.fps, s_swept.fps,
+                s_stat.fps / s_plain.fps, s_swept.fps / s_plain.fps, s_plain.fixed, s_stat.fixed, s_swept.fixed);
     if (plain_frames != frames) std::fprintf(stderr, "bench_overlay: the transcode saw %d frames, not %d\n", plain_frames, frames);
   } catch (const std::exception& e) {
     std::cerr << "bench_overlay: " << e.what() << "\n";
