@@ -196,6 +196,24 @@ void markDirtyCells(ColourReadBack& out) {
     }
 }
 
+// The dirty cells within the read-back rectangle, as runs along each row of cells (clipped to it).
+std::vector<cv::Rect> dirtyRuns(const ColourReadBack& out) {
+  constexpr int c = ColourReadBack::kCell;
+  const cv::Rect& r = out.rect;
+  std::vector<cv::Rect> runs;
+  for (int cy = r.y / c; cy * c < r.y + r.height; ++cy)
+    for (int cx = r.x / c; cx * c < r.x + r.width;) {
+      if (!out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx)]) {
+        ++cx;
+        continue;
+      }
+      const int first = cx;
+      while (cx * c < r.x + r.width && out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx)]) ++cx;
+      runs.push_back(cv::Rect(first * c, cy * c, (cx - first) * c, c) & r);
+    }
+  return runs;
+}
+
 // Volumes' vertices, indices and flat colours gathered for one draw call (drawn in the order added).
 struct OutlineBatch {
   std::vector<float> vertices, colours;  // xyz and rgba per vertex
@@ -414,8 +432,12 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
     glReadPixels(out.rect.x, out.rect.y, out.rect.width, out.rect.height, GL_RGBA, GL_UNSIGNED_BYTE,
                  out.image.ptr<uchar>(out.rect.y, out.rect.x));
     glPixelStorei(GL_PACK_ROW_LENGTH, 0);
-    // Without multisampling the target's pixels are the ones read: cells holding one are dirty.
-    if (gl.samples <= 1) markDirtyCells(out);
+    // Without multisampling the target's pixels are the ones read: cells holding one are dirty,
+    // and only they are handed on to the warp (the read-back is zero in the others).
+    if (gl.samples <= 1) {
+      markDirtyCells(out);
+      out.parts = dirtyRuns(out);
+    }
   }
   if (with_labels) *labels = readLabels(w, h);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -166,14 +166,31 @@ std::vector<cv::Rect> ColourWarp::markTiles(std::span<const cv::Rect> drawn, Til
       }
     }
   }
-  // Every tile whose samples may read a drawn pixel.
+  // Every tile whose samples may read a drawn pixel: the drawn rectangles marked on a grid of
+  // kTile-pixel pinhole cells, asked of each tile's source rectangle through the grid's sums.
+  const int pw = projection_.pinhole().width, ph = projection_.pinhole().height;
+  const int gx = (pw + TileMask::kTile - 1) / TileMask::kTile, gy = (ph + TileMask::kTile - 1) / TileMask::kTile;
+  const cv::Rect pinhole(0, 0, pw, ph);
+  std::vector<int>& sums = grid_sums_;  // (gy + 1) x (gx + 1): cells marked above and left of each corner
+  sums.assign(static_cast<std::size_t>(gx + 1) * static_cast<std::size_t>(gy + 1), 0);
+  const auto at = [&](int x, int y) -> int& { return sums[static_cast<std::size_t>(y) * static_cast<std::size_t>(gx + 1) + static_cast<std::size_t>(x)]; };
+  bool any = false;
+  for (const cv::Rect& d : drawn) {
+    const cv::Rect r = d & pinhole;
+    if (r.empty()) continue;
+    any = true;
+    for (int y = r.y / TileMask::kTile; y <= (r.y + r.height - 1) / TileMask::kTile; ++y)
+      for (int x = r.x / TileMask::kTile; x <= (r.x + r.width - 1) / TileMask::kTile; ++x) at(x + 1, y + 1) = 1;
+  }
+  if (!any) return tiles.runs();
+  for (int y = 1; y <= gy; ++y)
+    for (int x = 1; x <= gx; ++x) at(x, y) += at(x - 1, y) + at(x, y - 1) - at(x - 1, y - 1);
   for (int t = 0; t < tiles.tiles(); ++t) {
-    const cv::Rect& source = tile_source_[static_cast<std::size_t>(t)];
-    for (const cv::Rect& d : drawn)
-      if (!(source & d).empty()) {
-        tiles.mark(t);
-        break;
-      }
+    const cv::Rect source = tile_source_[static_cast<std::size_t>(t)] & pinhole;
+    if (source.empty()) continue;
+    const int x0 = source.x / TileMask::kTile, x1 = (source.x + source.width - 1) / TileMask::kTile + 1;
+    const int y0 = source.y / TileMask::kTile, y1 = (source.y + source.height - 1) / TileMask::kTile + 1;
+    if (at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0) > 0) tiles.mark(t);
   }
   return tiles.runs();
 }

@@ -57,6 +57,7 @@ class ColourWarp {
   const Projection& projection_;
   cv::Mat map_a_, map_b_;              // remap tables in fixed point
   std::vector<cv::Rect> tile_source_;  // per camera tile (TileMask order), the pinhole pixels its warp may read
+  std::vector<int> grid_sums_;         // markTiles' scratch: drawn pinhole cells, summed
 };
 
 /// The labels' way into the camera image through the mask pass's projection (which must outlive it).
