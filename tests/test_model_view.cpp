@@ -188,6 +188,67 @@ TEST(ModelViewBudget, BodyAboveThePointBudgetIsDrawnAsItIs) {
   EXPECT_GT(larger, 1.1 * silhouette);
 }
 
+// A robot standing still: a request drawn onto an image that equals the last one bit for bit
+// reuses the last answer and layer. Over a run of requests (static and swept, held for a few
+// frames, changed in the last bit of one value, a style changed, a query-only request and a mask
+// in between) each frame onto a fresh photo is, pixel for pixel and answer for answer, what a new
+// view draws for that request alone; reuse happens exactly when the request repeats.
+TEST_F(ModelViewTest, ARepeatedRequestReusesTheLastAnswerAndLayer) {
+  const Model& m = *model_;
+  std::mt19937_64 rng(5);
+  ModelView view(m, smallCamera());
+  std::vector<double> q = {0.3, 0.4, 0.6}, lo = q, hi = q;
+  int reused = 0, expected_reused = 0;
+  ModelViewRequest last;
+  bool last_onto = false;
+  for (int frame = 0; frame < 36; ++frame) {
+    SCOPED_TRACE("frame " + std::to_string(frame));
+    const bool swept = frame >= 18;
+    const int step = frame % 6;  // 0: moved; 1, 2: held; 3: the last bit of one value; 4: held; 5: style or request kind changed
+    if (step == 0) {
+      for (std::size_t i = 0; i < q.size(); ++i) q[i] += 0.2 * std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
+      for (std::size_t i = 0; i < q.size(); ++i) lo[i] = q[i] - 0.05, hi[i] = q[i] + 0.08;
+    }
+    if (step == 3) q[1] = std::nextafter(q[1], 10.0), lo[1] = std::nextafter(lo[1], -10.0);
+    ModelViewRequest request;
+    request.state = q;
+    if (swept) request.lower = lo, request.upper = hi;
+    request.mask = false;
+    request.style.legend = step != 5 || frame % 12 != 5;
+    cv::Mat photo(180, 320, CV_8UC3);
+    cv::randu(photo, 0, 256);
+    cv::Mat onto = photo.clone();
+    const bool query_only = step == 5 && frame % 12 == 11;
+    if (query_only) request.colour = false;
+    else request.onto = &onto;
+    if (frame == 20) (void)view.draw(ModelViewRequest{.state = q, .colour = false, .mask = true});  // a mask in between
+    const ModelFrame f = view.draw(request);
+    // The same request to a new view: nothing to reuse.
+    ModelView fresh(m, smallCamera());
+    cv::Mat expected_onto = photo.clone();
+    ModelViewRequest again = request;
+    if (!query_only) again.onto = &expected_onto;
+    const ModelFrame e = fresh.draw(again);
+    EXPECT_FALSE(e.reused);
+    const bool repeats = last_onto && !query_only && frame != 20 && step != 0 && step != 3 && request.style == last.style &&
+                         (swept == !last.lower.empty());
+    EXPECT_EQ(f.reused, repeats);
+    reused += f.reused, expected_reused += repeats;
+    EXPECT_TRUE(sameImage(onto, expected_onto));
+    ASSERT_EQ(f.query.has_value(), e.query.has_value());
+    EXPECT_EQ(f.query->min_distance, e.query->min_distance);
+    EXPECT_EQ(f.query->status, e.query->status);
+    EXPECT_EQ(f.status, e.status);
+    EXPECT_EQ(f.distances, e.distances);
+    EXPECT_EQ(f.images.visibility, e.images.visibility);
+    EXPECT_EQ(f.images.drawn, e.images.drawn);
+    last = request;
+    last_onto = !query_only;
+  }
+  EXPECT_GE(reused, 12);
+  EXPECT_EQ(reused, expected_reused);
+}
+
 TEST_F(ModelViewTest, BoxDrawsTheSweptVolumes) {
   const Model& m = *model_;
   const std::vector<double> lo = {-0.5, 0.0, 0.0}, hi = {0.5, 0.1, 0.2};

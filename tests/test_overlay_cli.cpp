@@ -321,6 +321,40 @@ TEST_F(OverlayCli, SameResultWithOneOrTwoJobs) {
   }
 }
 
+// A robot standing still (the log holds one state from 0.8 s on): each held frame reuses its
+// annotator's last answer and layer, and is the frame a run drawing it alone (nothing to reuse)
+// writes, byte for byte, in the same report. A lower-case FourCC is written without a word.
+TEST_F(OverlayCli, AHeldStateReusesTheLastFrameAndDrawsTheSame) {
+  writeText(log_,
+            "time,shoulder_yaw,shoulder_pitch,elbow\n0.0,-1.0,-0.5,0.5\n0.4,0.0,0.0,0.0\n0.8,-0.6,-0.2,0.2\n"
+            "1.2,-0.6,-0.2,0.2\n1.6,-0.6,-0.2,0.2\n2.0,-0.6,-0.2,0.2\n");
+  for (const std::string look : {"", " --swept"}) {
+    SCOPED_TRACE(look.empty() ? "static" : "swept");
+    fs::remove_all(out("all"));
+    const Outcome r = runKccd(base() + look + " --jobs 1 --timings --json --png-dir " + out("all") + " --report " + out("all.json") +
+                              " -o " + out("all.avi") + " --codec mjpg");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto summary = nlohmann::json::parse(r.out);
+    // Frames 8..19 lie between equal samples; swept, the velocity is zero from 1.2 s on.
+    EXPECT_GE(summary["timings"]["reused"].get<int>(), look.empty() ? 11 : 7) << r.out;
+    EXPECT_EQ(r.err.find("OpenCV"), std::string::npos) << r.err;
+    const auto all = nlohmann::json::parse(readText(out("all.json")))["frames"];
+    for (const int k : {9, 14, 19}) {
+      SCOPED_TRACE("frame " + std::to_string(k));
+      fs::remove_all(out("one"));
+      const Outcome one = runKccd(base() + look + " --jobs 1 --png-dir " + out("one") + " --frames " + std::to_string(k) +
+                                  " --report " + out("one.json"));
+      ASSERT_EQ(one.code, 0) << one.err;
+      char name[32];
+      std::snprintf(name, sizeof name, "/frame_%06d.png", k);
+      EXPECT_EQ(readText(out("all") + name), readText(out("one") + name));
+      nlohmann::json a = all[k], b = nlohmann::json::parse(readText(out("one.json")))["frames"][k];
+      a.erase("written"), b.erase("written");
+      EXPECT_EQ(a, b);
+    }
+  }
+}
+
 TEST_F(OverlayCli, TruncatedVideoIsAnError) {
   const std::string cut = out("input_cut.mkv");
   {

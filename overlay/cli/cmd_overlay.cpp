@@ -157,7 +157,8 @@ Exit runOverlay(const OverlayArgs& a) {
     const overlay::StageTimes& t = r.stages;
     const double n = std::max<double>(1.0, static_cast<double>(frames));
     std::cerr << "overlay timings: set-up " << format(r.setup_seconds, 3) << " s, frames " << format(r.seconds, 3)
-              << " s with " << r.jobs << " jobs; per frame (ms, each on its own thread):\n";
+              << " s with " << r.jobs << " jobs, " << r.reused
+              << " frame(s) reused (the same state as their annotator's last); per frame (ms, each on its own thread):\n";
     const std::pair<const char*, double> rows[] = {{"decode", t.decode},   {"state", t.state},         {"query", t.query},
                                                    {"render", t.render},   {"read_back", t.read_back}, {"warp", t.warp},
                                                    {"composite", t.composite}, {"encode", t.encode}};

@@ -1,5 +1,6 @@
 #include "kccd/render/model_view.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <iterator>
 #include <stdexcept>
@@ -17,7 +18,37 @@ ModelView::ModelView(const Model& model, const Projection& projection, const Ren
                      std::vector<LoadedVisual> visuals)
     : model_(model), checker_(model), renderer_(projection, options), visuals_(std::move(visuals)) {}
 
+bool ModelView::sameAsLastOnto(const ModelViewRequest& r) const {
+  if (!last_onto_ || r.onto == nullptr || !r.colour || r.mask) return false;
+  const LastOnto& l = *last_onto_;
+  // Bit for bit: == on doubles (a NaN is never equal, so never reused).
+  return std::ranges::equal(r.state, l.state) && std::ranges::equal(r.lower, l.lower) &&
+         std::ranges::equal(r.upper, l.upper) && std::ranges::equal(r.status, l.status) &&
+         std::ranges::equal(r.colours, l.colours) && r.radius_scale == l.radius_scale &&
+         r.tight_volumes == l.tight_volumes && r.volumes == l.volumes && r.visuals == l.visuals && r.style == l.style &&
+         renderer_.canRenderOntoAgain(r.style);
+}
+
 ModelFrame ModelView::draw(const ModelViewRequest& request) {
+  if (sameAsLastOnto(request)) {
+    ModelFrame out = last_onto_->frame;
+    out.images = renderer_.renderOntoAgain(*request.onto, request.style);
+    out.query_seconds = 0.0;
+    out.reused = true;
+    return out;
+  }
+  last_onto_.reset();  // the checker and the renderer move on
+  ModelFrame out = drawAnew(request);
+  if (request.onto != nullptr && request.colour && !request.mask && renderer_.canRenderOntoAgain(request.style)) {
+    const ModelViewRequest& r = request;
+    last_onto_ = LastOnto{{r.state.begin(), r.state.end()}, {r.lower.begin(), r.lower.end()}, {r.upper.begin(), r.upper.end()},
+                          {r.status.begin(), r.status.end()}, {r.colours.begin(), r.colours.end()}, r.radius_scale,
+                          r.tight_volumes, r.volumes, r.visuals, r.style, out};
+  }
+  return out;
+}
+
+ModelFrame ModelView::drawAnew(const ModelViewRequest& request) {
   const std::size_t n = model_.bodies.size();
   if (!request.status.empty() && request.status.size() != n)
     throw std::invalid_argument("ModelView: " + std::to_string(request.status.size()) + " statuses for " +

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "gl_targets.hpp"
 #include "kccd/render/composite.hpp"
@@ -78,12 +79,44 @@ Frame Renderer::renderOnto(cv::Mat& bgr, std::span<const Volume> volumes, const 
     frame.bgra.release();
     return frame;
   }
-  return draw(volumes, style, true, false, &bgr);
+  Frame frame = draw(volumes, style, true, false, &bgr);
+  again_style_ = style;
+  again_frame_ = frame;
+  return frame;
+}
+
+bool Renderer::canRenderOntoAgain(const Style& style) const { return again_style_ && *again_style_ == style; }
+
+Frame Renderer::renderOntoAgain(cv::Mat& bgr, const Style& style) {
+  if (!canRenderOntoAgain(style)) throw std::logic_error("Renderer::renderOntoAgain: the last call drew no such layer");
+  const Camera& camera = projection_.camera();
+  if (bgr.type() != CV_8UC3 || bgr.cols != camera.width || bgr.rows != camera.height)
+    throw std::invalid_argument("Renderer::renderOntoAgain: needs a CV_8UC3 image of the camera's size");
+  Frame frame = again_frame_;
+  frame.times = FrameTimes{};
+  frame.meshes_built = 0;
+  blendOnto(bgr, style, frame);
+  return frame;
+}
+
+void Renderer::blendOnto(cv::Mat& bgr, const Style& style, Frame& frame) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point t = Clock::now();
+  detail::TileMask tiles(projection_.camera().width, projection_.camera().height);
+  // Warped, straightened and blended in one pass; the legend's box is the legend's alone.
+  const cv::Rect legend = style.legend ? legend_->legendBox(bgr.size()) : cv::Rect();
+  colour_warp_->blendOnto(bgr, read_back_->image, read_back_->parts, tiles, legend);
+  const Clock::time_point t_warped = Clock::now();
+  if (style.legend) tiles.mark(legend_->compositeLegend(bgr));
+  frame.drawn = tiles.runs();
+  frame.times.warp = std::chrono::duration<double>(t_warped - t).count();
+  frame.times.decorate = std::chrono::duration<double>(Clock::now() - t_warped).count();
 }
 
 Frame Renderer::draw(std::span<const Volume> volumes, const Style& style, bool want_colour, bool want_mask, cv::Mat* onto) {
   if (volumes.size() > 255) throw std::invalid_argument("Renderer: at most 255 volumes (8-bit mask labels)");
   const auto t_start = std::chrono::steady_clock::now();
+  again_style_.reset();  // this draw replaces the layer
   context_->makeCurrent();
   // Outlines from the cores for the tinted look's colour layer; meshes for the labels, the
   // shaded look, and what the outlines cannot draw.
@@ -100,24 +133,20 @@ Frame Renderer::draw(std::span<const Volume> volumes, const Style& style, bool w
   frame.times.prepare = seconds(t_start, t);
   if (want_colour) {
     detail::drawColour(*gl_, projection_, options_, bodies, style, frame, *read_back_, same_pass ? &labels : nullptr);
-    t = Clock::now();
-    detail::TileMask tiles(projection_.camera().width, projection_.camera().height);
-    Clock::time_point t_warped;
-    if (onto) {  // warped, straightened and blended in one pass; the legend's box is the legend's alone
-      const cv::Rect legend = style.legend ? legend_->legendBox(onto->size()) : cv::Rect();
-      colour_warp_->blendOnto(*onto, read_back_->image, read_back_->parts, tiles, legend);
-      t_warped = Clock::now();
-      if (style.legend) tiles.mark(legend_->compositeLegend(*onto));
+    if (onto) {
+      blendOnto(*onto, style, frame);
     } else {
+      t = Clock::now();
+      detail::TileMask tiles(projection_.camera().width, projection_.camera().height);
       frame.bgra = colour_warp_->apply(read_back_->image, read_back_->parts, tiles);
-      t_warped = Clock::now();
+      const Clock::time_point t_warped = Clock::now();
       tiles.mark(legend_->draw(frame.bgra, volumes, frame.visibility, style));
       if (!options_.crop) tiles.mark(cv::Rect(0, 0, frame.bgra.cols, frame.bgra.rows));
+      frame.times.warp = seconds(t, t_warped);
+      frame.drawn = tiles.runs();
+      frame.times.decorate = seconds(t_warped, Clock::now());
     }
-    frame.times.warp = seconds(t, t_warped);
-    frame.drawn = tiles.runs();
     t = Clock::now();
-    frame.times.decorate = seconds(t_warped, t);
   }
   if (want_mask) {
     cv::Mat pinhole_labels = same_pass ? labels : detail::drawMask(*gl_, maskProjection(), bodies, frame.near, frame.far);

@@ -85,6 +85,7 @@ void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
   const render::ModelFrame drawn = view_.draw(request);
   const render::FrameTimes& ft = drawn.images.times;
   rec.times.query = drawn.query_seconds;
+  rec.reused = drawn.reused;
   rec.times.render = ft.prepare + ft.draw;
   rec.times.read_back = ft.read_back;
   rec.times.warp = ft.warp + ft.decorate;

@@ -335,6 +335,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
     report.clear += r.status == SafetyStatus::Clear;
     report.unsafe += r.unsafe();
     report.stages += r.times;
+    report.reused += r.reused;
   }
   if (opt.contact_frames > 0) {
     report.contact_sheet = sheet.compose();

@@ -35,7 +35,7 @@ nlohmann::json reportJson(const OverlayReport& report, const Model& model, bool 
   }
   if (report.timings) {
     const StageTimes& t = report.stages;
-    j["timings"] = {{"setup", report.setup_seconds}, {"frames", report.seconds}, {"jobs", report.jobs},
+    j["timings"] = {{"setup", report.setup_seconds}, {"frames", report.seconds}, {"jobs", report.jobs}, {"reused", report.reused},
                     {"stage_seconds",
                      {{"decode", t.decode}, {"state", t.state}, {"query", t.query}, {"render", t.render},
                       {"read_back", t.read_back}, {"warp", t.warp}, {"composite", t.composite}, {"encode", t.encode}}}};

@@ -1,5 +1,6 @@
 #include "kccd/overlay/recording/video_sink.hpp"
 
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -11,7 +12,18 @@
 namespace kccd::overlay {
 
 int videoFourcc(const std::string& path, const std::string& codec) {
-  if (codec.size() == 4) return cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]);
+  if (codec.size() == 4) {
+    // The usual codecs in their containers' own spelling, whatever the case given: FFmpeg maps a
+    // FourCC to a codec ignoring case, but a muxer that wants another spelling makes OpenCV print
+    // a warning of its own on the way.
+    std::string c = codec;
+    for (const char* known : {"MJPG", "FFV1", "mp4v", "XVID", "DIVX", "avc1", "H264", "hvc1", "HEVC", "VP80", "VP90", "FMP4"}) {
+      bool same = true;
+      for (std::size_t k = 0; k < 4; ++k) same = same && std::tolower(static_cast<unsigned char>(codec[k])) == std::tolower(known[k]);
+      if (same) c = known;
+    }
+    return cv::VideoWriter::fourcc(c[0], c[1], c[2], c[3]);
+  }
   const std::string ext = lowerExtension(path);
   if (ext == ".mkv") return cv::VideoWriter::fourcc('F', 'F', 'V', '1');
   if (ext == ".avi") return cv::VideoWriter::fourcc('M', 'J', 'P', 'G');

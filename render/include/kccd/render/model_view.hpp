@@ -61,6 +61,9 @@ struct ModelFrame {
   /// The query's answer (its pairs view the checker: valid until the next draw); none without a state.
   std::optional<QueryResult> query;
   double query_seconds = 0.0;  ///< the query and the volumes for drawing (images.times has the drawing's)
+  /// The request was the last one's, bit for bit, drawn onto an image: the last query's answer
+  /// and layer were put onto this image (Renderer::renderOntoAgain) instead of being made again.
+  bool reused = false;
 };
 
 /// Draws one model for one camera; owns the checker, the renderer (a GL context: one view per
@@ -78,8 +81,11 @@ class ModelView {
   ModelView& operator=(const ModelView&) = delete;
 
   /// Queries the box (a Distances query from a reset table, so the answer depends on the request
-  /// alone), places and colours the volumes and draws them. Throws std::invalid_argument for
-  /// statuses or colours not one per body, or more than 255 volumes and visuals.
+  /// alone), places and colours the volumes and draws them. A request drawn onto an image that
+  /// equals the last such request bit for bit (state, box, statuses, colours, style, flags) reuses
+  /// the last answer and layer (ModelFrame::reused): the same pixels and answer, without the query
+  /// and the drawing (a robot standing still). Throws std::invalid_argument for statuses or
+  /// colours not one per body, or more than 255 volumes and visuals.
   ModelFrame draw(const ModelViewRequest& request);
 
   /// The model drawn.
@@ -92,6 +98,19 @@ class ModelView {
   Checker checker_;
   Renderer renderer_;
   std::vector<LoadedVisual> visuals_;
+  // The last request drawn onto an image, and what it gave (no images): reused when the next is equal.
+  struct LastOnto {
+    std::vector<double> state, lower, upper;
+    std::vector<SafetyStatus> status;
+    std::vector<cv::Scalar> colours;
+    double radius_scale = 1.0;
+    bool tight_volumes = true, volumes = true, visuals = false;
+    Style style;
+    ModelFrame frame;
+  };
+  std::optional<LastOnto> last_onto_;
+  bool sameAsLastOnto(const ModelViewRequest& request) const;
+  ModelFrame drawAnew(const ModelViewRequest& request);
 };
 
 }  // namespace kccd::render

@@ -68,6 +68,7 @@ struct Style {
   /// shading by a light at the camera's upper left; fill_alpha and outline_width are not used.
   bool shaded = false;
   double ambient = 0.35;       ///< shaded: the unlit fraction of the colour
+  bool operator==(const Style&) const = default;
 };
 
 /// Renderer settings fixed at construction.

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -48,6 +49,13 @@ class Renderer {
   /// std::invalid_argument): the pixels compositeOver(bgr, layer, drawn) gives for render()'s
   /// layer, without making the layer (Frame::bgra stays empty; Frame::drawn says where it drew).
   Frame renderOnto(cv::Mat& bgr, std::span<const Volume> volumes, const Style& style = {});
+  /// Whether the last call drew a layer that renderOntoAgain() can put onto another image: a
+  /// renderOnto() in `style` that blended in the warp's pass (cropped, no names).
+  bool canRenderOntoAgain(const Style& style) const;
+  /// The last renderOnto()'s layer (the same volumes, the same style) onto another `bgr`, without
+  /// drawing it again: the pixels that renderOnto() with those volumes gives, and its Frame (with
+  /// this call's Frame::drawn and times). Throws std::logic_error unless canRenderOntoAgain(style).
+  Frame renderOntoAgain(cv::Mat& bgr, const Style& style);
 
   /// The GL renderer's name (GL_RENDERER), e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
   const std::string& rendererString() const;
@@ -60,6 +68,8 @@ class Renderer {
 
  private:
   Frame draw(std::span<const Volume> volumes, const Style& style, bool want_colour, bool want_mask, cv::Mat* onto);
+  // The read-back layer warped and blended onto `bgr`, the legend's box from the cached legend.
+  void blendOnto(cv::Mat& bgr, const Style& style, Frame& frame);
 
   RenderOptions options_;
   Projection projection_;
@@ -71,6 +81,9 @@ class Renderer {
   std::unique_ptr<detail::ColourReadBack> read_back_;  // the colour target's pixels, kept between frames
   std::unique_ptr<detail::LabelWarp> label_warp_;
   std::unique_ptr<detail::Legend> legend_;
+  // The last renderOnto() that blended in the warp's pass: its style and its Frame (no images).
+  std::optional<Style> again_style_;
+  Frame again_frame_;
 };
 
 }  // namespace kccd::render

@@ -49,6 +49,7 @@ struct FrameRecord {
   std::vector<double> values;             ///< the state used (empty without one)
   bool selected = false;              ///< drawn (and handed to the sink)
   bool written = false;               ///< handed to a sink that keeps frames
+  bool reused = false;                ///< drawn by reusing the annotator's last answer and layer (the same state, bit for bit)
   StageTimes times;                   ///< where its time went
   /// True when the frame's check cannot be trusted: treat the robot as unsafe.
   bool unsafe() const { return query != Status::Ok || braking_failed || not_finite; }

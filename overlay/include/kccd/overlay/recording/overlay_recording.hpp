@@ -96,6 +96,7 @@ struct OverlayReport {
   double seconds = 0.0;             ///< the frame loop's wall time
   double setup_seconds = 0.0;       ///< before the first frame: inputs checked, lens maps, first pass
   StageTimes stages;                ///< every frame's StageTimes summed
+  std::size_t reused = 0;           ///< drawn frames whose state (and box) equalled their annotator's last: answer and layer reused
   bool timings = false;             ///< OverlayOptions::timings: reportJson gives setup_seconds and stages
   cv::Mat contact_sheet;            ///< selected frames, captioned (empty when none was asked or drawn)
   std::vector<std::size_t> contact_sheet_frames;  ///< the indices of the frames on it, in order
