@@ -3,7 +3,8 @@
 // pixel it draws: random scenes through plain and distorting cameras, supersampled or not, with
 // volumes partly outside the view, reaching behind the near plane or containing the camera. And
 // Renderer::renderOnto (the layer blended onto a frame in the warp's pass, without making it)
-// gives the composited frame bit for bit.
+// gives the composited frame bit for bit, as does Renderer::renderOntoAgain (the last layer onto
+// another frame); one renderer drawing many frames never shows an earlier frame's pixels.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -165,6 +166,41 @@ TEST(RenderCrop, WhatEarlierFramesDrewNeverShowsThrough) {
     }
     EXPECT_GT(tinted_after_other, 3);  // the looks really alternate
   }
+}
+
+// The last renderOnto()'s layer onto another picture: what renderOnto() gives there, the same
+// Frame::drawn; only after a renderOnto() in that style, and never after another draw.
+TEST(RenderCrop, RenderOntoAgainIsRenderOntoWithoutTheDrawing) {
+  std::mt19937_64 rng(11);
+  const Camera c = kccd::testing::randomCamera(rng, true, 320, 240);
+  Renderer r(c), fresh(c);
+  std::vector<Vec3> cloud{Vec3(0.05, 0.0, 0.0), Vec3(-0.1, 0.1, 0.05)};
+  const std::vector<Volume> scene{Volume{cloud, 0.15, SafetyStatus::WithinMargin, "arm"}};
+  Style style;
+  cv::Mat first(240, 320, CV_8UC3), second(240, 320, CV_8UC3);
+  cv::randu(first, 0, 256);
+  cv::randu(second, 0, 256);
+  EXPECT_FALSE(r.canRenderOntoAgain(style));
+  EXPECT_THROW(r.renderOntoAgain(second, style), std::logic_error);
+  const Frame drawn = r.renderOnto(first, scene, style);
+  EXPECT_TRUE(r.canRenderOntoAgain(style));
+  Style other = style;
+  other.legend = false;
+  EXPECT_FALSE(r.canRenderOntoAgain(other));
+  cv::Mat again = second.clone(), expected = second.clone();
+  const Frame fa = r.renderOntoAgain(again, style);
+  const Frame fe = fresh.renderOnto(expected, scene, style);
+  cv::Mat diff;
+  cv::absdiff(again, expected, diff);
+  EXPECT_EQ(cv::countNonZero(diff.reshape(1)), 0);
+  EXPECT_GT(cv::countNonZero(cv::Mat(again != second).reshape(1)), 1000);  // something was drawn
+  EXPECT_EQ(fa.drawn, fe.drawn);
+  EXPECT_EQ(fa.visibility, drawn.visibility);
+  cv::Mat grey(240, 320, CV_8UC1, cv::Scalar::all(0));
+  EXPECT_THROW(r.renderOntoAgain(grey, style), std::invalid_argument);
+  (void)r.render(scene, style, true, false);
+  EXPECT_FALSE(r.canRenderOntoAgain(style));
+  EXPECT_THROW(r.renderOntoAgain(again, style), std::logic_error);
 }
 
 TEST(RenderCrop, RenderOntoRejectsAFrameOfAnotherSizeOrType) {
