@@ -136,6 +136,30 @@ void drawShaded(const std::vector<const PreparedVolume*>& order, double ambient)
   glDisable(GL_DEPTH_TEST);
 }
 
+// The dirty cells of `out` within `cells` (in cells), as runs along each row of cells.
+std::vector<cv::Rect> dirtyCellRuns(const ColourReadBack& out, const cv::Rect& cells) {
+  std::vector<cv::Rect> runs;
+  const auto dirty = [&](int cx, int cy) { return out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx)] != 0; };
+  for (int cy = cells.y; cy < cells.y + cells.height; ++cy)
+    for (int cx = cells.x; cx < cells.x + cells.width;) {
+      if (!dirty(cx, cy)) {
+        ++cx;
+        continue;
+      }
+      const int first = cx;
+      while (cx < cells.x + cells.width && dirty(cx, cy)) ++cx;
+      runs.emplace_back(first, cy, cx - first, 1);
+    }
+  return runs;
+}
+
+// The cells (in cells) that meet the pixel rectangle `r`.
+cv::Rect cellsOf(const cv::Rect& r) {
+  constexpr int c = ColourReadBack::kCell;
+  if (r.empty()) return {};
+  return cv::Rect(cv::Point(r.x / c, r.y / c), cv::Point((r.x + r.width - 1) / c + 1, (r.y + r.height - 1) / c + 1));
+}
+
 // Zeros the colour of the bound target in every dirty cell of `out` (transparent quads over the
 // whole cells, blending off, camera matrices restored) and marks every cell clean. Cell edges lie
 // on pixel edges, so each quad covers its cells' pixel centres and no other.
@@ -144,21 +168,15 @@ void clearCells(ColourReadBack& out) {
   GLint viewport[4] = {0, 0, 0, 0};
   glGetIntegerv(GL_VIEWPORT, viewport);
   const double w = viewport[2], h = viewport[3];
+  // Pixel edges to normalised device coordinates (GL's rows are the image's, see setCamera).
+  const auto nx = [&](int x) { return static_cast<float>(2.0 * std::min<double>(x, w) / w - 1.0); };
+  const auto ny = [&](int y) { return static_cast<float>(2.0 * std::min<double>(y, h) / h - 1.0); };
   std::vector<float> quads;
-  for (int cy = 0; cy < out.cells_y; ++cy)
-    for (int cx = 0; cx < out.cells_x;) {
-      if (!out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx)]) {
-        ++cx;
-        continue;
-      }
-      const int first = cx;
-      while (cx < out.cells_x && out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx)]) out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx++)] = 0;
-      // Pixel edges to normalised device coordinates (GL's rows are the image's, see setCamera).
-      const auto nx = [&](int x) { return static_cast<float>(2.0 * std::min<double>(x, w) / w - 1.0); };
-      const auto ny = [&](int y) { return static_cast<float>(2.0 * std::min<double>(y, h) / h - 1.0); };
-      const float x0 = nx(first * c), x1 = nx(cx * c), y0 = ny(cy * c), y1 = ny((cy + 1) * c);
-      quads.insert(quads.end(), {x0, y0, 0, x1, y0, 0, x1, y1, 0, x0, y0, 0, x1, y1, 0, x0, y1, 0});
-    }
+  for (const cv::Rect& run : dirtyCellRuns(out, cv::Rect(0, 0, out.cells_x, out.cells_y))) {
+    const float x0 = nx(run.x * c), x1 = nx((run.x + run.width) * c), y0 = ny(run.y * c), y1 = ny((run.y + 1) * c);
+    quads.insert(quads.end(), {x0, y0, 0, x1, y0, 0, x1, y1, 0, x0, y0, 0, x1, y1, 0, x0, y1, 0});
+  }
+  std::fill(out.dirty.begin(), out.dirty.end(), 0);
   if (quads.empty()) return;
   glMatrixMode(GL_PROJECTION);
   glPushMatrix();
@@ -180,8 +198,9 @@ void clearCells(ColourReadBack& out) {
 void markDirtyCells(ColourReadBack& out) {
   constexpr int c = ColourReadBack::kCell;
   const cv::Rect& r = out.rect;
-  for (int cy = r.y / c; cy * c < r.y + r.height; ++cy)
-    for (int cx = r.x / c; cx * c < r.x + r.width; ++cx) {
+  const cv::Rect cells = cellsOf(r);
+  for (int cy = cells.y; cy < cells.y + cells.height; ++cy)
+    for (int cx = cells.x; cx < cells.x + cells.width; ++cx) {
       unsigned char& cell = out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx)];
       if (cell) continue;
       const cv::Rect part = cv::Rect(cx * c, cy * c, c, c) & r;
@@ -196,25 +215,17 @@ void markDirtyCells(ColourReadBack& out) {
     }
 }
 
-// The dirty cells within the read-back rectangle, as runs along each row of cells (clipped to it).
+// The dirty cells within the read-back rectangle as pixel rectangles (runs along each row of
+// cells, clipped to it).
 std::vector<cv::Rect> dirtyRuns(const ColourReadBack& out) {
   constexpr int c = ColourReadBack::kCell;
-  const cv::Rect& r = out.rect;
   std::vector<cv::Rect> runs;
-  for (int cy = r.y / c; cy * c < r.y + r.height; ++cy)
-    for (int cx = r.x / c; cx * c < r.x + r.width;) {
-      if (!out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx)]) {
-        ++cx;
-        continue;
-      }
-      const int first = cx;
-      while (cx * c < r.x + r.width && out.dirty[static_cast<std::size_t>(cy * out.cells_x + cx)]) ++cx;
-      runs.push_back(cv::Rect(first * c, cy * c, (cx - first) * c, c) & r);
-    }
+  for (const cv::Rect& run : dirtyCellRuns(out, cellsOf(out.rect)))
+    runs.push_back(cv::Rect(run.x * c, run.y * c, run.width * c, c) & out.rect);
   return runs;
 }
 
-// Volumes' vertices, indices and flat colours gathered for one draw call (drawn in the order added).
+// Volumes' vertices, indices and colours (one per volume) gathered for one draw call, drawn in the order added.
 struct OutlineBatch {
   std::vector<float> vertices, colours;  // xyz and rgba per vertex
   std::vector<std::uint32_t> indices;
