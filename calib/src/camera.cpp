@@ -6,7 +6,6 @@
 #include <optional>
 
 #include <opencv2/calib3d.hpp>
-#include <opencv2/core/utility.hpp>
 #include <opencv2/core/eigen.hpp>
 
 #include "kccd/file_reader.hpp"
@@ -171,27 +170,14 @@ void undistortPixels(const Camera& camera, const cv::Mat& pixels, cv::Mat& norma
   const int n = pixels.rows;
   const double fx = camera.camera_matrix(0, 0), fy = camera.camera_matrix(1, 1);
   const double cx = camera.camera_matrix(0, 2), cy = camera.camera_matrix(1, 2);
-  // Each point is inverted, and distorted again, on its own: the work is split over OpenCV's
-  // threads in blocks (the same numbers as in one call; a lens map is a million points).
-  normal.create(n, 1, CV_64FC2);
-  cv::Mat back(n, 1, CV_64FC2);
-  const int blocks = std::max(1, std::min(64, n / 4096));
-  cv::parallel_for_(cv::Range(0, blocks), [&](const cv::Range& range) {
-    for (int k = range.start; k < range.end; ++k) {
-      const int a = static_cast<int>(static_cast<long>(n) * k / blocks), b = static_cast<int>(static_cast<long>(n) * (k + 1) / blocks);
-      if (a == b) continue;
-      cv::Mat part, xyz(b - a, 1, CV_64FC3), again;
-      cv::undistortPoints(pixels.rowRange(a, b), part, camera.camera_matrix, camera.distortion, cv::noArray(), cv::noArray(),
-                          cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-10));
-      for (int i = 0; i < b - a; ++i) {
-        const cv::Vec2d p = part.at<cv::Vec2d>(i);
-        xyz.at<cv::Vec3d>(i) = cv::Vec3d(p[0], p[1], 1.0);
-      }
-      cv::projectPoints(xyz, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.camera_matrix, camera.distortion, again);
-      part.copyTo(normal.rowRange(a, b));
-      again.reshape(2, b - a).copyTo(back.rowRange(a, b));
-    }
-  });
+  cv::undistortPoints(pixels, normal, camera.camera_matrix, camera.distortion, cv::noArray(), cv::noArray(),
+                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-10));
+  cv::Mat xyz(n, 1, CV_64FC3), back;
+  for (int i = 0; i < n; ++i) {
+    const cv::Vec2d p = normal.at<cv::Vec2d>(i);
+    xyz.at<cv::Vec3d>(i) = cv::Vec3d(p[0], p[1], 1.0);
+  }
+  cv::projectPoints(xyz, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.camera_matrix, camera.distortion, back);
   // At most one image width / height of extra field on each side.
   const double x_lo = -(cx + 0.5) / fx - camera.width / fx, x_hi = (camera.width - cx - 0.5) / fx + camera.width / fx;
   const double y_lo = -(cy + 0.5) / fy - camera.height / fy, y_hi = (camera.height - cy - 0.5) / fy + camera.height / fy;

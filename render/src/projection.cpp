@@ -46,8 +46,9 @@ Projection::Projection(const Camera& camera, double supersample)
   const int n = camera.width * camera.height;
   cv::Mat normal(n, 1, CV_64FC2);
   std::vector<unsigned char> valid(n, 0);
-  // The blocks are independent: inverted in parallel (the set-up of a long recording's run).
-  const int block_rows = std::max(1, (1 << 16) / camera.width);
+  // The blocks are independent: inverted in parallel (the set-up of a long recording's run), each
+  // a few thousand pixels, so that the lens's slow corners spread over the threads.
+  const int block_rows = std::max(1, (1 << 12) / camera.width);
   const int blocks = (camera.height + block_rows - 1) / block_rows;
   cv::parallel_for_(cv::Range(0, blocks), [&](const cv::Range& range) {
     for (int b = range.start; b < range.end; ++b) {
