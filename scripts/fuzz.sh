@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang-14, ASan + UBSan, in build-fuzz/) and runs each for a while
 # on a fresh copy of its seed corpus (tests/fuzz/corpus/NAME plus sample files from data/),
-# KCCD_JOBS targets at a time. Any crash, sanitizer report, leak, time-out or memory blow-up fails
-# the run and leaves the input in build-fuzz/artifacts/ and the log in build-fuzz/NAME.log.
+# KCCD_JOBS targets at a time. A crash, sanitizer report, leak, per-input time-out (an input that
+# runs longer than the target's bound: a hang) or memory blow-up fails the run and leaves the
+# input in build-fuzz/artifacts/ and the log in build-fuzz/NAME.log.
 #   scripts/fuzz.sh [--seconds N] [TARGET...]   explore: N seconds each (default 15), a new seed each run
 #   scripts/fuzz.sh --ci [TARGET...]            CI: a fixed seed and a fixed number of inputs per
-#                                               target (15-40 s each here), so a run is repeatable
-# Environment: KCCD_JOBS (default 2).
+#                                               target (15-40 s each here), so runs are comparable
+# In --ci mode a target also stops at a time cap (120 s; KCCD_FUZZ_SECONDS): one that reaches the
+# cap before its count is reported with its rate as a warning, never a failure, since machines
+# differ by 3x. Only what a finding is fails: the speed of the machine does not.
+# Environment: KCCD_JOBS (default 2), KCCD_FUZZ_SECONDS (the --ci cap).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=15
@@ -16,7 +20,7 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds=$2; shift 2 ;;
     --seconds=*) seconds=${1#*=}; shift ;;
-    --ci) ci=1; seconds=120; shift ;;
+    --ci) ci=1; seconds=${KCCD_FUZZ_SECONDS:-120}; shift ;;
     -*) echo "fuzz.sh: unknown option $1" >&2; exit 2 ;;
     *) targets+=("$1"); shift ;;
   esac
@@ -39,7 +43,7 @@ ci_runs() {  # inputs per target in --ci mode (15-40 s each on this project's ma
     fuzz_frame_times) echo 200000 ;;
     fuzz_frame) echo 3000 ;;
     fuzz_video) echo 3000 ;;
-    fuzz_camera) echo 200000 ;;
+    fuzz_camera) echo 100000 ;;  # read by yaml-cpp since OpenCV's parser hung: about 3,800 inputs/s
     fuzz_tags) echo 140000 ;;
     fuzz_labels) echo 130000 ;;
     fuzz_labels_json) echo 100000 ;;
@@ -75,6 +79,13 @@ seeds() {  # extra seed files from data/ per target
     fuzz_joint_map) ;;
   esac
 }
+input_timeout() {  # seconds one input may take before it counts as a hang: far above the slowest
+  # legitimate input measured (tests/reader_bounds, docs/development/fuzzing.md), on a machine 3x slower under ASan
+  case "$1" in
+    fuzz_urdf|fuzz_part|fuzz_video|fuzz_frame) echo 60 ;;
+    *) echo 30 ;;
+  esac
+}
 mkdir -p $out/artifacts
 fuzz_one() {  # target: runs it, then prints its one-line result (and the log's end on failure)
   local t=$1 corpus=$out/corpus/$1
@@ -92,19 +103,29 @@ fuzz_one() {  # target: runs it, then prints its one-line result (and the log's 
   fi
   what="$what from $(ls "$corpus" | wc -l) seeds"
   # An out-of-memory stop under ASan can leave libFuzzer stuck: the outer timeout kills it.
-  if ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 \
-     LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
-     timeout -s KILL $((seconds + 120)) "build-fuzz/tests/fuzz/$t" "${limits[@]}" -timeout=10 \
-       -rss_limit_mb=2048 -malloc_limit_mb=1024 -max_len=65536 -print_final_stats=1 -detect_leaks=$leaks \
-       -artifact_prefix="$out/artifacts/$t-" "$corpus" > "$out/$t.log" 2>&1; then
-    echo "== $t: $what: $(grep -E "stat::number_of_executed_units|stat::new_units_added" "$out/$t.log" | tr '\n' ' ')"
-    local ran; ran=$(grep -oE "stat::number_of_executed_units: *[0-9]+" "$out/$t.log" | grep -oE "[0-9]+$" || echo 0)
-    if [ $ci -eq 1 ] && [ "$ran" -lt "$(ci_runs "$t")" ]; then
-      echo "fuzz.sh: $t stopped at its ${seconds} s limit after $ran of $(ci_runs "$t") inputs: this machine is slow, or the target has become slower (lower its count in ci_runs)"
-    fi
-  else
-    echo "fuzz.sh: $t FAILED, $what (log: $out/$t.log, inputs: $out/artifacts/)"; tail -40 "$out/$t.log"
+  local start=$SECONDS rc=0
+  ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 \
+  LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
+    timeout -s KILL $((seconds + 3 * $(input_timeout "$t"))) "build-fuzz/tests/fuzz/$t" "${limits[@]}" \
+      -timeout="$(input_timeout "$t")" -rss_limit_mb=2048 -malloc_limit_mb=1024 -max_len=65536 -print_final_stats=1 \
+      -detect_leaks=$leaks -artifact_prefix="$out/artifacts/$t-" "$corpus" > "$out/$t.log" 2>&1 || rc=$?
+  local took=$((SECONDS - start))
+  local ran; ran=$(grep -oE "stat::number_of_executed_units: *[0-9]+" "$out/$t.log" | grep -oE "[0-9]+$" || echo 0)
+  local added; added=$(grep -oE "stat::new_units_added: *[0-9]+" "$out/$t.log" | grep -oE "[0-9]+$" || echo 0)
+  if [ $rc -ne 0 ]; then
+    local why="exit $rc"
+    [ $rc -eq 137 ] && why="killed after $took s (stuck past its time cap)"
+    grep -q "ERROR: libFuzzer: timeout" "$out/$t.log" && why="an input ran past the per-input bound of $(input_timeout "$t") s (a hang)"
+    grep -q "ERROR: AddressSanitizer\|ERROR: LeakSanitizer\|runtime error:" "$out/$t.log" && why="a sanitizer report"
+    grep -q "ERROR: libFuzzer: out-of-memory" "$out/$t.log" && why="out of memory"
+    grep -q "deadly signal" "$out/$t.log" && why="a crash"
+    echo "fuzz.sh: $t FAILED: $why, $what (log: $out/$t.log, inputs: $out/artifacts/)"; tail -40 "$out/$t.log"
     return 1
+  fi
+  local rate=$(( ran / (took > 0 ? took : 1) ))
+  echo "== $t: $what: $ran inputs in $took s ($rate/s), $added new units"
+  if [ $ci -eq 1 ] && [ "$ran" -lt "$(ci_runs "$t")" ]; then
+    echo "fuzz.sh: warning: $t reached its ${seconds} s cap after $ran of $(ci_runs "$t") inputs ($rate/s): a slower or busier machine, or a slower target (not a failure)"
   fi
 }
 # KCCD_JOBS targets at a time; each prints its result when it ends.

@@ -234,7 +234,20 @@ TEST_F(CalibCli, BadInputIsOneLineExitTwo) {
   };
   cv::imwrite(out("small.png"), cv::Mat(100, 200, CV_8UC3, cv::Scalar(128, 128, 128)));
   write("not_image.png", "hello");
+  // Cut images of the formats decoded by the suite itself and by OpenCV (whose decoders print
+  // their own lines on stderr): one line of kccd's, naming the damage.
+  std::vector<std::uint8_t> encoded;
+  const cv::Mat picture(240, 320, CV_8UC3, cv::Scalar(40, 90, 200));
+  for (const std::string ext : {".jpg", ".bmp", ".ppm", ".tif", ".webp"}) {
+    cv::imencode(ext, picture, encoded);
+    write("cut" + ext.substr(1) + ".png", std::string(encoded.begin(), encoded.begin() + static_cast<long>(encoded.size() / 2)));
+  }
   const std::vector<Case> cases{
+      {"--intrinsics " + kCamera + " --image " + out("cutjpg.png") + l + " -o " + out("c.yaml"), "image: a damaged JPEG (Premature end of JPEG file)"},
+      {"--intrinsics " + kCamera + " --image " + out("cutbmp.png") + l + " -o " + out("c.yaml"), "image: a damaged image ("},
+      {"--intrinsics " + kCamera + " --image " + out("cutppm.png") + l + " -o " + out("c.yaml"), "image: a damaged image ("},
+      {"--intrinsics " + kCamera + " --image " + out("cuttif.png") + l + " -o " + out("c.yaml"), "image: "},
+      {"--intrinsics " + kCamera + " --image " + out("cutwebp.png") + l + " -o " + out("c.yaml"), "image: "},
       {"--intrinsics " + kCamera + l, "-o CAMERA.yaml is required"},
       {l + " -o " + out("c.yaml"), "--intrinsics CAMERA.yaml is required"},
       {"--intrinsics " + kCamera + " -o " + out("c.yaml"), "give --image FRAME"},

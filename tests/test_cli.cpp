@@ -230,6 +230,17 @@ TEST(Cli, FitJsonContractAndErrors) {
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(e.err.find("top-level parts"), std::string::npos) << e.err;
   EXPECT_EQ(e.out, "");  // nothing half-printed
+  // A coordinate beyond what a model may hold (1e6 m), or not a number, in an ASCII STL: the line
+  // and the vertex, exit 2 (the fit's distances used to overflow into an internal error).
+  const std::string huge = ::testing::TempDir() + "/" + std::to_string(getpid()) + "_huge.stl";
+  for (const std::string value : {"1e308", "inf", "nan", "2e6"}) {
+    std::ofstream(huge) << "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 " << value
+                        << " 0\nendloop\nendfacet\nendsolid s\n";
+    e = runKccd("fit " + huge + " -k 8 --merge");
+    EXPECT_EQ(e.code, 2) << value << ": " << e.err;
+    EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << e.err;
+    EXPECT_NE(e.err.find("_huge.stl:6: vertex 3: "), std::string::npos) << value << ": " << e.err;
+  }
   e = runKccd("fit /nonexistent/part.iv");
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(e.err.find("/nonexistent/part.iv: cannot open the file"), std::string::npos) << e.err;

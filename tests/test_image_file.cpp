@@ -159,3 +159,100 @@ TEST(ImageFile, DamagedPngsAreOneErrorAndNothingOnStderr) {
 }
 
 }  // namespace
+
+namespace {
+
+// `jpeg` with an Exif APP1 segment holding only Orientation = `o` inserted after SOI (as a
+// camera writes it; OpenCV's encoder writes none).
+std::vector<std::uint8_t> withOrientation(const std::vector<std::uint8_t>& jpeg, int o, bool big_endian) {
+  std::vector<std::uint8_t> tiff = big_endian ? std::vector<std::uint8_t>{'M', 'M', 0, 42, 0, 0, 0, 8}
+                                              : std::vector<std::uint8_t>{'I', 'I', 42, 0, 8, 0, 0, 0};
+  const auto u16 = [&](unsigned v) {
+    if (big_endian) tiff.push_back(static_cast<std::uint8_t>(v >> 8)), tiff.push_back(static_cast<std::uint8_t>(v & 0xFF));
+    else tiff.push_back(static_cast<std::uint8_t>(v & 0xFF)), tiff.push_back(static_cast<std::uint8_t>(v >> 8));
+  };
+  u16(1);                                   // one entry
+  u16(0x0112), u16(3), u16(1), u16(0);      // Orientation, SHORT, count 1 (the count's high half)
+  u16(static_cast<unsigned>(o)), u16(0);    // the value, padding
+  u16(0), u16(0);                           // no next IFD
+  std::vector<std::uint8_t> app1 = {'E', 'x', 'i', 'f', 0, 0};
+  app1.insert(app1.end(), tiff.begin(), tiff.end());
+  const std::size_t length = app1.size() + 2;
+  std::vector<std::uint8_t> out(jpeg.begin(), jpeg.begin() + 2);
+  out.insert(out.end(), {0xFF, 0xE1, static_cast<std::uint8_t>(length >> 8), static_cast<std::uint8_t>(length & 0xFF)});
+  out.insert(out.end(), app1.begin(), app1.end());
+  out.insert(out.end(), jpeg.begin() + 2, jpeg.end());
+  return out;
+}
+
+// JPEGs are decoded by the suite (libjpeg-turbo, its messages kept); OpenCV's imdecode is the
+// oracle: the same pixels for colour and grey files, baseline and progressive,
+// optimised tables, restart markers, every Exif orientation in both byte orders, in every colour mode.
+TEST(ImageFile, JpegPixelsAreOpenCvsInEveryMode) {
+  std::mt19937 rng(5);
+  int compared = 0;
+  for (const int type : {CV_8UC3, CV_8UC1}) {
+    cv::Mat m(45, 61, type);
+    cv::randu(m, 0, 256);
+    cv::GaussianBlur(m, m, cv::Size(5, 5), 1.5);  // photo-like, so quantisation keeps structure
+    const std::vector<std::vector<int>> settings = {
+        {cv::IMWRITE_JPEG_QUALITY, 90},
+        {cv::IMWRITE_JPEG_QUALITY, 75, cv::IMWRITE_JPEG_PROGRESSIVE, 1},
+        {cv::IMWRITE_JPEG_QUALITY, 95, cv::IMWRITE_JPEG_OPTIMIZE, 1, cv::IMWRITE_JPEG_CHROMA_QUALITY, 60},
+        {cv::IMWRITE_JPEG_QUALITY, 80, cv::IMWRITE_JPEG_RST_INTERVAL, 2},
+    };
+    for (const auto& params : settings) {
+      std::vector<std::uint8_t> jpeg;
+      ASSERT_TRUE(cv::imencode(".jpg", m, jpeg, params));
+      for (int o = 1; o <= 8; ++o) {
+        for (const bool big : {false, true}) {
+          const std::vector<std::uint8_t> bytes = o == 1 && !big ? jpeg : withOrientation(jpeg, o, big);
+          const cv::Mat buf(1, static_cast<int>(bytes.size()), CV_8U, const_cast<std::uint8_t*>(bytes.data()));
+          for (const auto& [mode, flag] : {std::pair{kc::ImageColour::Bgr, cv::IMREAD_COLOR}, std::pair{kc::ImageColour::Grey, cv::IMREAD_GRAYSCALE},
+                                           std::pair{kc::ImageColour::Unchanged, cv::IMREAD_UNCHANGED}}) {
+            SCOPED_TRACE(std::to_string(type) + " orientation " + std::to_string(o) + (big ? " MM" : " II") + " mode " +
+                         std::to_string(static_cast<int>(mode)));
+            const cv::Mat ours = decoded(bytes, mode), theirs = cv::imdecode(buf, flag);
+            ASSERT_EQ(ours.size(), theirs.size());
+            ASSERT_EQ(ours.type(), theirs.type());
+            EXPECT_EQ(cv::norm(ours, theirs, cv::NORM_INF), 0.0);
+            ++compared;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 2 * 4 * 16 * 3);
+}
+
+// A cut JPEG and one whose entropy-coded data is damaged: one line naming the damage, nothing on
+// stderr (OpenCV decoded both to a grey-filled picture, with libjpeg's warning on stderr).
+TEST(ImageFile, DamagedJpegsAreOneErrorAndNothingOnStderr) {
+  cv::Mat m(64, 64, CV_8UC3);
+  cv::randu(m, 0, 256);
+  std::vector<std::uint8_t> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", m, jpeg));
+  std::vector<std::vector<std::uint8_t>> damaged;
+  for (std::size_t cut = 3; cut + 2 < jpeg.size(); cut += 97) damaged.emplace_back(jpeg.begin(), jpeg.begin() + static_cast<long>(cut));
+  int refused = 0;
+  for (const auto& b : damaged) {
+    std::string problem;
+    const std::string printed = stderrOf([&] {
+      try {
+        (void)decoded(b, kc::ImageColour::Bgr);
+      } catch (const kc::ImageError& e) {
+        problem = e.what();
+      }
+    });
+    EXPECT_EQ(printed, "");
+    EXPECT_FALSE(problem.empty()) << "a cut JPEG of " << b.size() << " of " << jpeg.size() << " bytes decoded";
+    if (!problem.empty()) {
+      ++refused;
+      EXPECT_EQ(problem.rfind("test.png: image: a damaged JPEG (", 0), 0u) << problem;
+      EXPECT_EQ(problem.find('\n'), std::string::npos) << problem;
+    }
+  }
+  EXPECT_EQ(refused, static_cast<int>(damaged.size()));
+}
+
+}  // namespace

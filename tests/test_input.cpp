@@ -197,6 +197,31 @@ TEST(InputErrorLocation, TheYamlReaderPlacesEveryCheck) {
   EXPECT_EQ(r.where(root["none"]), "t.yaml");  // no place: the source alone
 }
 
+// Anchors and aliases share a node: a reader walking the document visits it once per alias.
+// Sharing a little is fine; aliases of aliases that multiply a few hundred bytes into billions of
+// values are refused at the alias that passes the bound, with its place.
+TEST(InputErrorLocation, AliasesThatMultiplyAreRefused) {
+  const YamlReader r("t.yaml", 40);
+  const YAML::Node ok = r.load("a: &p [1, 2, 3]\nb: *p\nc: *p\n");
+  EXPECT_EQ(ok["c"].size(), 3u);
+  std::string bomb = "a0: &a0 [1, 2, 3, 4, 5, 6, 7, 8]\n";
+  for (int i = 1; i < 40; ++i)
+    bomb += "a" + std::to_string(i) + ": &a" + std::to_string(i) + " [*a" + std::to_string(i - 1) + ", *a" + std::to_string(i - 1) +
+            ", *a" + std::to_string(i - 1) + ", *a" + std::to_string(i - 1) + "]\n";
+  try {
+    (void)r.load(bomb);
+    ADD_FAILURE() << "4^39 values accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("aliases expand the document to more than 4194304 values"), std::string::npos) << e.what();
+    // The values through a9 number 3.3 million; a10's first alias (line 11) adds 2.4 million more.
+    EXPECT_EQ(e.location().line, 11u) << e.what();
+  }
+  // The bound is a limit: a lower one refuses the small document above.
+  YamlLimits small;
+  small.max_expanded_nodes = 8;
+  EXPECT_THROW((void)r.load("a: &p [1, 2, 3]\nb: *p\nc: *p\n", small), InputError);
+}
+
 TEST(InputErrorLocation, TheTableReadersFillLineColumnAndField) {
   Model m = parseModel(
       "kccd: 1\njoints:\n  - {name: q, parent: world, type: prismatic, axis: [1, 0, 0]}\n"

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -271,6 +272,32 @@ TEST_F(McapFixtures, DamagedBytesGiveOneLineErrorsOrStillRead) {
   // CRCs and structure catch most damage; bytes inside message payloads may decode to other values.
   EXPECT_GT(errors, read);
   std::cout << "damaged files: " << errors << " rejected, " << read << " read\n";
+}
+
+// A type of two fields of a type of two fields ... of an empty type holds 2^64 values in no bytes:
+// decoding stops at a bound on the messages made per byte, with an error, at once.
+TEST(MessageDecoding, TypesThatTakeNoBytesCannotMultiply) {
+  std::string text = "T1 a\nT1 b\n";
+  for (int k = 1; k < 64; ++k)
+    text += std::string(80, '=') + "\nMSG: fuzz_msgs/T" + std::to_string(k) + "\nT" + std::to_string(k + 1) + " a\nT" +
+            std::to_string(k + 1) + " b\n";
+  text += std::string(80, '=') + "\nMSG: fuzz_msgs/T64\n";
+  for (const Dialect dialect : {Dialect::Ros2, Dialect::Ros1}) {
+    const MessageDefinitions types = MessageDefinitions::parse("fuzz_msgs/Root", text, dialect);
+    const std::vector<std::uint8_t> bytes = {0, 1, 0, 0, 0, 0, 0, 0};
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      (void)(dialect == Dialect::Ros2 ? decodeCdr(types, bytes) : decodeRos1(types, bytes));
+      ADD_FAILURE() << "2^64 values decoded";
+    } catch (const DecodeError& e) {
+      EXPECT_NE(std::string(e.what()).find("types that take no bytes"), std::string::npos) << e.what();
+    }
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
+  }
+  // An empty type a few times over is still read.
+  const MessageDefinitions few = MessageDefinitions::parse("fuzz_msgs/Root", "E[4] e\n" + std::string(80, '=') + "\nMSG: fuzz_msgs/E\n",
+                                                          Dialect::Ros2);
+  EXPECT_EQ(decodeCdr(few, std::vector<std::uint8_t>{0, 1, 0, 0}).items.front().items.size(), 4u);
 }
 
 TEST(McapReader, NotAnMcapFileOrNoFile) {

@@ -147,7 +147,7 @@ TEST_F(RenderCli, BadInputExitsTwoWithOneLine) {
   std::ofstream(out("bad_cam.yaml")) << "%YAML:1.0\n---\nimage_width: 320\nimage_height: 0\n";
   const Outcome r = runKccd("render " + kDemo + " --camera " + out("bad_cam.yaml") + " --state 0,0,0" + o);
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("bad_cam.yaml: image_height"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("bad_cam.yaml:4:15: image_height: 0 is not in"), std::string::npos) << r.err;  // the value's place
   EXPECT_FALSE(fs::exists(out("bad.png")));
   // No partial or temporary files are left behind.
   for (const auto& e : fs::directory_iterator(dir_))
@@ -172,10 +172,12 @@ TEST_F(RenderCli, CameraFileErrorsExitTwoWithOneLine) {
        ":" + std::to_string(std::count(ok.begin(), ok.end(), '\n') + 1) + ":1: document: a second YAML document"},
       {"empty.yaml", "", ": file: empty"},
       {"noheader.yaml", ok.substr(ok.find('\n') + 1), ":1: header"},
-      {"list.yaml", "%YAML:1.0\n---\n- 1\n", ": document: the top level must be a mapping"},
+      {"list.yaml", "%YAML:1.0\n---\n- 1\n", ":3:1: document: the top level must be a mapping"},
       {"binary.yaml", std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10), ":1: file: control byte"},
       {"truncated.yaml", ok.substr(0, ok.find("data:") + 12), ":"},
-      {"height.yaml", height, ": image_height: 20000 is not in 1..8192"},
+      {"height.yaml", height,
+       ":" + std::to_string(std::count(height.begin(), height.begin() + static_cast<long>(height.find("image_height: 20000")), '\n') + 1) +
+           ":15: image_height: 20000 is not in 1..8192"},
       {"dir.yaml", "", ": file: not a regular file"},
       {"fifo.yaml", "", ": file: not a regular file"},
   };

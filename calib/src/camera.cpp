@@ -1,6 +1,8 @@
 #include "kccd/calib/camera.hpp"
 
 #include <algorithm>
+#include <charconv>
+#include <cstdint>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -10,7 +12,7 @@
 
 #include "kccd/file_reader.hpp"
 #include "kccd/format_number.hpp"
-#include "kccd/yaml_document.hpp"
+#include "kccd/yaml_reader.hpp"
 
 namespace kccd::calib {
 namespace {
@@ -36,10 +38,10 @@ std::string readCameraFile(const std::string& path) {
   }
 }
 
-// Structure before OpenCV parses anything: text only, OpenCV's `%YAML:1.x` header, then one YAML
-// document with unique plain keys (the `%YAML:1.0` line is not standard YAML: it is blanked for
-// the check, keeping the line numbers).
-void checkCameraText(const std::string& text, const std::string& path) {
+// Structure before YAML is parsed: text only, OpenCV's `%YAML:1.x` header, and document markers
+// that OpenCV and YAML read alike. Returns the text with the header blanked (`%YAML:1.0` is not
+// standard YAML), keeping the line numbers.
+std::string checkCameraText(const std::string& text, const std::string& path) {
   std::size_t line = 1;
   for (const char ch : text) {
     const auto c = static_cast<unsigned char>(ch);
@@ -48,7 +50,7 @@ void checkCameraText(const std::string& text, const std::string& path) {
       failAt(path, line, "file", "control byte " + printable(std::string_view(&ch, 1)) + " (not a text file)");
   }
   // "---" or "..." at the start of a line with more text right after it is content to YAML but a
-  // document marker to OpenCV (whose parser can then loop forever): neither reading is wanted.
+  // document marker to OpenCV: a file meaning two things to the two readers is refused.
   line = 1;
   for (std::size_t at = 0; at < text.size(); at = text.find('\n', at) + 1, ++line) {
     if (text.compare(at, 3, "---") != 0 && text.compare(at, 3, "...") != 0) {
@@ -72,94 +74,117 @@ void checkCameraText(const std::string& text, const std::string& path) {
     failAt(path, 1, "header", "the first line must be %YAML:1.0 (an OpenCV FileStorage YAML camera file), not '" +
                                   printable(first, 40) + "'");
   std::string yaml = text;
-  std::fill(yaml.begin() + static_cast<std::ptrdiff_t>(start), yaml.begin() + static_cast<std::ptrdiff_t>(eol), ' ');
-  try {
-    checkYamlDocument(yaml, path);
-  } catch (const InputError& e) {
-    throw CameraError(e.location(), e.problem());
+  std::fill(yaml.begin(), yaml.begin() + static_cast<std::ptrdiff_t>(eol), ' ');
+  return yaml;
+}
+
+// The camera file's nodes read by yaml-cpp (which streams a bounded document: no parser here can
+// spin), each failure a CameraError at the node's line and column.
+class CameraNodes {
+ public:
+  explicit CameraNodes(const std::string& path) : reader_(path, 40) {}
+
+  YAML::Node load(const std::string& yaml) const { return reader_.load(yaml); }
+
+  [[noreturn]] void failAtNode(const YAML::Node& node, const std::string& field, const std::string& problem) const {
+    const InputLocation where = reader_.at(node, field);
+    throw CameraError(where, problem);
   }
-}
 
-// OpenCV's parse error text "name(line): problem" as "path:line: yaml: problem" (OpenCV 4.6
-// puts that text in the exception's function name and its own function name in the message).
-[[noreturn]] void failParse(const std::string& path, const cv::Exception& e) {
-  for (const std::string& text : {e.func, e.err}) {
-    const std::size_t close = text.find("): ");
-    const std::size_t open = close == std::string::npos ? std::string::npos : text.rfind('(', close);
-    if (open == std::string::npos) continue;
-    const std::string digits = text.substr(open + 1, close - open - 1);
-    if (digits.empty() || digits.size() > 8 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
-      continue;
-    failAt(path, std::stoul(digits), "yaml", "OpenCV cannot read it: " + printable(text.substr(close + 3), 100));
+  // A plain scalar read as OpenCV reads numbers ("1.", ".5", "-1e-3", ".Inf", ".Nan"); nullopt
+  // when it is no number.
+  static std::optional<double> real(const YAML::Node& n) {
+    if (!n.IsScalar() || n.Tag() != "?") return std::nullopt;  // quoted text is text
+    std::string_view s = n.Scalar();
+    const bool minus = !s.empty() && s.front() == '-';
+    if (!s.empty() && (s.front() == '+' || s.front() == '-')) s.remove_prefix(1);
+    if (s == ".inf" || s == ".Inf" || s == ".INF") return minus ? -HUGE_VAL : HUGE_VAL;
+    if (s == ".nan" || s == ".NaN" || s == ".Nan" || s == ".NAN") return std::nan("");
+    if (s.empty() || !(std::isdigit(static_cast<unsigned char>(s.front())) || s.front() == '.')) return std::nullopt;
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
+    if (end != s.data() + s.size() || (ec != std::errc() && ec != std::errc::result_out_of_range)) return std::nullopt;
+    if (ec == std::errc::result_out_of_range) v = std::abs(v) < 1.0 ? 0.0 : HUGE_VAL;  // as strtod: 0 or inf
+    return minus ? -v : v;
   }
-  fail(path, "yaml", "OpenCV cannot read it: " + printable(e.err, 100));
-}
 
-// A key given twice in a mapping, as OpenCV parsed it (the YAML pre-check names the line; this
-// guards against the two parsers reading keys differently).
-void checkUniqueKeys(const cv::FileNode& map, const std::string& path, const std::string& prefix) {
-  std::vector<std::string> keys;
-  for (cv::FileNodeIterator it = map.begin(); it != map.end(); ++it) keys.push_back((*it).name());
-  std::sort(keys.begin(), keys.end());
-  const auto dup = std::adjacent_find(keys.begin(), keys.end());
-  if (dup != keys.end()) fail(path, prefix + printable(*dup, 40), "duplicate key");
-}
-
-cv::Mat readMatrix(const cv::FileStorage& fs, const std::string& source, const char* field) {
-  const cv::FileNode node = fs[field];
-  if (node.empty()) fail(source, field, "missing");
-  const std::string layout = "not an OpenCV matrix (!!opencv-matrix with rows, cols, dt, data)";
-  if (!node.isMap()) fail(source, field, layout);
-  checkUniqueKeys(node, source, std::string(field) + ".");
-  // Sizes first: OpenCV allocates rows x cols before it compares them with the data.
-  const cv::FileNode rows = node["rows"], cols = node["cols"], dt = node["dt"], data = node["data"];
-  if (!rows.isInt() || !cols.isInt() || !dt.isString() || !data.isSeq()) fail(source, field, layout);
-  const int r = static_cast<int>(rows), c = static_cast<int>(cols);
-  if (r < 1 || r > kMaxMatrixSide || c < 1 || c > kMaxMatrixSide)
-    fail(source, field, std::to_string(r) + "x" + std::to_string(c) + " is not a camera matrix size (rows and cols in 1.." +
-                            std::to_string(kMaxMatrixSide) + ")");
-  const std::string type = static_cast<std::string>(dt);
-  if (type.size() != 1 || std::string("ucwsifd").find(type[0]) == std::string::npos)
-    fail(source, field, "dt '" + printable(type, 20) + "' is not one of u, c, w, s, i, f, d");
-  if (data.size() != static_cast<std::size_t>(r) * static_cast<std::size_t>(c))
-    fail(source, field, "data has " + std::to_string(data.size()) + " values, rows x cols is " + std::to_string(r * c));
-  for (cv::FileNodeIterator it = data.begin(); it != data.end(); ++it)
-    if (!(*it).isInt() && !(*it).isReal()) fail(source, field, "data holds a value that is not a number");
-  cv::Mat m;
-  try {
-    node >> m;
-  } catch (const cv::Exception&) {
-    m.release();
+  // A plain integer scalar ("640"), nullopt otherwise (also beyond int).
+  static std::optional<long long> integer(const YAML::Node& n) {
+    if (!n.IsScalar() || n.Tag() != "?") return std::nullopt;
+    std::string_view s = n.Scalar();
+    if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+    long long v = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (s.empty() || end != s.data() + s.size() || ec != std::errc()) return std::nullopt;
+    return v;
   }
-  if (m.empty() || m.channels() != 1) fail(source, field, layout);
-  m.convertTo(m, CV_64F);
-  return m;
-}
 
-int readSize(const cv::FileStorage& fs, const std::string& source, const char* field) {
-  const cv::FileNode node = fs[field];
-  if (node.empty()) fail(source, field, "missing");
-  if (!node.isInt()) fail(source, field, "not an integer");
-  const int v = static_cast<int>(node);
-  if (v <= 0 || v > kMaxImageSide) fail(source, field, std::to_string(v) + " is not in 1.." + std::to_string(kMaxImageSide));
-  return v;
-}
+  cv::Mat matrix(const YAML::Node& root, const char* field) const {
+    const YAML::Node node = root[field];
+    if (!node.IsDefined() || node.IsNull()) fail(reader_.source(), field, "missing");
+    const std::string layout = "not an OpenCV matrix (!!opencv-matrix with rows, cols, dt, data)";
+    if (!node.IsMap()) failAtNode(node, field, layout);
+    const YAML::Node rows = node["rows"], cols = node["cols"], dt = node["dt"], data = node["data"];
+    const std::optional<long long> r = integer(rows), c = integer(cols);
+    if (!r || !c || !dt.IsScalar() || !data.IsSequence()) failAtNode(node, field, layout);
+    if (*r < 1 || *r > kMaxMatrixSide || *c < 1 || *c > kMaxMatrixSide)
+      failAtNode(node, field, std::to_string(*r) + "x" + std::to_string(*c) +
+                                  " is not a camera matrix size (rows and cols in 1.." + std::to_string(kMaxMatrixSide) + ")");
+    const std::string type = dt.Scalar();
+    if (type.size() != 1 || std::string("ucwsifd").find(type[0]) == std::string::npos)
+      failAtNode(dt, field, "dt '" + printable(type, 20) + "' is not one of u, c, w, s, i, f, d");
+    if (data.size() != static_cast<std::size_t>(*r * *c))
+      failAtNode(data, field, "data has " + std::to_string(data.size()) + " values, rows x cols is " + std::to_string(*r * *c));
+    cv::Mat m(static_cast<int>(*r), static_cast<int>(*c), CV_64F);
+    for (std::size_t i = 0; i < data.size(); ++i) {
+      const std::optional<double> v = real(data[i]);
+      if (!v) failAtNode(data[i], field, "data holds a value that is not a number");
+      m.at<double>(static_cast<int>(i)) = asType(*v, type[0]);
+    }
+    return m;
+  }
 
-// An optional quality figure: absent, or a finite number >= 0.
-std::optional<double> readQuality(const cv::FileStorage& fs, const std::string& source, const char* field) {
-  const cv::FileNode node = fs[field];
-  if (node.empty()) return std::nullopt;
-  if (!node.isInt() && !node.isReal()) fail(source, field, "not a number");
-  const double v = static_cast<double>(node);
-  if (!std::isfinite(v) || v < 0.0) fail(source, field, "must be a finite number >= 0");
-  return v;
-}
+  int size(const YAML::Node& root, const char* field) const {
+    const YAML::Node node = root[field];
+    if (!node.IsDefined() || node.IsNull()) fail(reader_.source(), field, "missing");
+    const std::optional<long long> v = integer(node);
+    if (!v) failAtNode(node, field, "not an integer");
+    if (*v <= 0 || *v > kMaxImageSide) failAtNode(node, field, std::to_string(*v) + " is not in 1.." + std::to_string(kMaxImageSide));
+    return static_cast<int>(*v);
+  }
 
-cv::Vec3d readVec3(const cv::FileStorage& fs, const std::string& source, const char* field) {
-  const cv::Mat m = readMatrix(fs, source, field);
-  if (m.total() != 3) fail(source, field, "needs 3 values, has " + std::to_string(m.total()));
-  return {m.at<double>(0), m.at<double>(1), m.at<double>(2)};
-}
+  // An optional quality figure: absent, or a finite number >= 0.
+  std::optional<double> quality(const YAML::Node& root, const char* field) const {
+    const YAML::Node node = root[field];
+    if (!node.IsDefined() || node.IsNull()) return std::nullopt;
+    const std::optional<double> v = real(node);
+    if (!v) failAtNode(node, field, "not a number");
+    if (!std::isfinite(*v) || *v < 0.0) failAtNode(node, field, "must be a finite number >= 0");
+    return v;
+  }
+
+  cv::Vec3d vec3(const YAML::Node& root, const char* field) const {
+    const cv::Mat m = matrix(root, field);
+    if (m.total() != 3) failAtNode(root[field], field, "needs 3 values, has " + std::to_string(m.total()));
+    return {m.at<double>(0), m.at<double>(1), m.at<double>(2)};
+  }
+
+ private:
+  // `v` stored as OpenCV stores a value of element type `dt` (rounded and saturated for integers).
+  static double asType(double v, char dt) {
+    switch (dt) {
+      case 'u': return cv::saturate_cast<std::uint8_t>(v);
+      case 'c': return cv::saturate_cast<std::int8_t>(v);
+      case 'w': return cv::saturate_cast<std::uint16_t>(v);
+      case 's': return cv::saturate_cast<std::int16_t>(v);
+      case 'i': return cv::saturate_cast<int>(v);
+      case 'f': return static_cast<double>(static_cast<float>(v));
+      default: return v;
+    }
+  }
+
+  YamlReader reader_;
+};
 
 }  // namespace
 
@@ -272,43 +297,34 @@ void Camera::validate(const std::string& source) const {
 
 Camera loadCamera(const std::string& path, CameraPose pose) {
   const std::string text = readCameraFile(path);
-  checkCameraText(text, path);
-  cv::FileStorage fs;
-  try {
-    if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML))
-      fail(path, "yaml", "OpenCV cannot read it");
-  } catch (const cv::Exception& e) {
-    failParse(path, e);
-  } catch (const std::exception& e) {  // OpenCV 4.6 lets std::length_error out of some malformed keys
-    fail(path, "yaml", "OpenCV cannot read it (" + printable(e.what(), 60) + ")");
-  }
+  const CameraNodes nodes(path);
   Camera c;
   try {
-    const cv::FileNode root = fs.root();
-    if (!root.isMap()) fail(path, "document", "the top level must be a mapping of camera fields (image_width: ...)");
-    checkUniqueKeys(root, path, "");
-    c.width = readSize(fs, path, "image_width");
-    c.height = readSize(fs, path, "image_height");
-    const cv::Mat k = readMatrix(fs, path, "camera_matrix");
-    if (k.rows != 3 || k.cols != 3) fail(path, "camera_matrix", "must be 3x3");
+    const YAML::Node root = nodes.load(checkCameraText(text, path));
+    if (!root.IsMap()) nodes.failAtNode(root, "document", "the top level must be a mapping of camera fields (image_width: ...)");
+    c.width = nodes.size(root, "image_width");
+    c.height = nodes.size(root, "image_height");
+    const cv::Mat k = nodes.matrix(root, "camera_matrix");
+    if (k.rows != 3 || k.cols != 3) nodes.failAtNode(root["camera_matrix"], "camera_matrix", "must be 3x3");
     c.camera_matrix = cv::Matx33d(k);
-    const cv::Mat d = readMatrix(fs, path, "distortion_coefficients");
-    if (d.rows != 1 && d.cols != 1) fail(path, "distortion_coefficients", "must be a row or a column");
+    const cv::Mat d = nodes.matrix(root, "distortion_coefficients");
+    if (d.rows != 1 && d.cols != 1)
+      nodes.failAtNode(root["distortion_coefficients"], "distortion_coefficients", "must be a row or a column");
     c.distortion.assign(d.begin<double>(), d.end<double>());
-    const bool has_pose = !fs["rvec"].empty() || !fs["tvec"].empty();
+    const bool has_pose = root["rvec"].IsDefined() || root["tvec"].IsDefined();
     if (has_pose || pose == CameraPose::Required) {
-      c.rvec = readVec3(fs, path, "rvec");
-      c.tvec = readVec3(fs, path, "tvec");
+      c.rvec = nodes.vec3(root, "rvec");
+      c.tvec = nodes.vec3(root, "tvec");
     }
-    c.reprojection_rms_px = readQuality(fs, path, "reprojection_rms_px");
-    c.rotation_sigma_deg = readQuality(fs, path, "rotation_sigma_deg");
-    c.position_sigma_m = readQuality(fs, path, "position_sigma_m");
-  } catch (const cv::Exception& e) {
-    failParse(path, e);
+    c.reprojection_rms_px = nodes.quality(root, "reprojection_rms_px");
+    c.rotation_sigma_deg = nodes.quality(root, "rotation_sigma_deg");
+    c.position_sigma_m = nodes.quality(root, "position_sigma_m");
   } catch (const CameraError&) {
     throw;
-  } catch (const std::exception& e) {
-    fail(path, "yaml", "OpenCV cannot read it (" + printable(e.what(), 60) + ")");
+  } catch (const InputError& e) {  // the YAML checks: syntax, documents, repeated keys, nesting
+    throw CameraError(e.location(), e.problem());
+  } catch (const YAML::Exception& e) {
+    fail(path, "yaml", "cannot read it (" + printable(e.msg, 60) + ")");
   }
   c.validate(path);
   return c;

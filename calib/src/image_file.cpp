@@ -5,13 +5,17 @@
 #include <algorithm>
 #include <cstring>
 #include <functional>
+#include <iostream>
 #include <memory>
+#include <mutex>
+#include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/file_reader.hpp"
+#include "jpeg_decode.hpp"
 
 namespace kccd::calib {
 
@@ -102,18 +106,49 @@ cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& sour
       fail("a PNG too large to decode in the memory available");
     }
   }
-  cv::Mat img;
-  try {
-    const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
-    img = cv::imdecode(encoded, colour == ImageColour::Grey  ? cv::IMREAD_GRAYSCALE
-                                : colour == ImageColour::Bgr ? cv::IMREAD_COLOR
-                                                             : cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception&) {
-    img.release();
-  } catch (const std::bad_alloc&) {
-    img.release();
+  const auto checkSize = [&](int width, int height) {
+    if (const std::string problem = tooLarge(width, height); !problem.empty()) fail(problem);
+  };
+  if (detail::looksLikeJpeg(bytes)) {
+    cv::Mat jpeg;
+    try {
+      jpeg = detail::decodeJpeg(bytes, colour, checkSize, fail);
+    } catch (const std::bad_alloc&) {
+      fail("a JPEG too large to decode in the memory available");
+    }
+    if (!jpeg.empty()) return jpeg;
   }
-  if (img.empty()) fail("not an image OpenCV can decode (PNG, JPEG, TIFF, BMP, ...)");
+  // Other formats (BMP, TIFF, WebP, PNM, ...) through OpenCV, whose imdecode prints a decoder's
+  // exception on std::cerr: that text is caught (under a lock: the stream is the process's) and
+  // becomes part of the one-line error.
+  cv::Mat img;
+  std::string said;
+  {
+    static std::mutex cerr_lock;
+    const std::lock_guard<std::mutex> lock(cerr_lock);
+    std::ostringstream caught;
+    std::streambuf* const was = std::cerr.rdbuf(caught.rdbuf());
+    try {
+      const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
+      img = cv::imdecode(encoded, colour == ImageColour::Grey  ? cv::IMREAD_GRAYSCALE
+                                  : colour == ImageColour::Bgr ? cv::IMREAD_COLOR
+                                                               : cv::IMREAD_UNCHANGED);
+    } catch (const cv::Exception&) {
+      img.release();
+    } catch (const std::bad_alloc&) {
+      img.release();
+    }
+    std::cerr.rdbuf(was);
+    said = caught.str();
+  }
+  if (img.empty()) {
+    // OpenCV's words after its "imdecode_(''): can't read data: " prefix, first line only.
+    std::string why = said.substr(0, said.find('\n'));
+    if (const std::size_t colon = why.find("): "); colon != std::string::npos) why = why.substr(colon + 3);
+    if (const std::size_t err = why.find("error: ("); err != std::string::npos) why = why.substr(err);
+    fail(why.empty() ? "not an image OpenCV can decode (PNG, JPEG, TIFF, BMP, ...)"
+                     : "a damaged image (" + printable(why, 120) + ")");
+  }
   if (const std::string problem = tooLarge(img.cols, img.rows); !problem.empty()) fail(problem);
   return img;
 }

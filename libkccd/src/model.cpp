@@ -58,9 +58,9 @@ void Model::finalize(bool check_all, const std::vector<std::array<int, 2>>& igno
     state_size_ += j.dof;
   }
   auto key = [](int a, int b) { return std::array<int, 2>{std::min(a, b), std::max(a, b)}; };
+  // Sorted lists searched by halves: a model of thousands of bodies and pair lists stays quick.
   auto listed = [&](const std::vector<std::array<int, 2>>& list, int a, int b) {
-    return std::find(list.begin(), list.end(), key(a, b)) != list.end() ||
-           std::find(list.begin(), list.end(), key(b, a)) != list.end();
+    return std::binary_search(list.begin(), list.end(), key(a, b));
   };
   std::vector<std::array<int, 2>> ign, inc;
   for (const auto& p : ignore) ign.push_back(key(p[0], p[1]));
@@ -70,6 +70,8 @@ void Model::finalize(bool check_all, const std::vector<std::array<int, 2>>& igno
                        "' are in the same frame and can never move relative to each other");
     inc.push_back(key(p[0], p[1]));
   }
+  std::sort(ign.begin(), ign.end());
+  std::sort(inc.begin(), inc.end());
   pairs.clear();
   const int n = static_cast<int>(bodies.size());
   for (int a = 0; a < n; ++a) {

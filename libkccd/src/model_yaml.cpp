@@ -128,6 +128,8 @@ void parseJoints(const Reader& r, const YAML::Node& list, Model& m) {
 
 void parseBodies(const Reader& r, const YAML::Node& list, Model& m) {
   if (!list.IsSequence()) r.fail(list, "bodies", "expected a list");
+  if (list.size() > kMaxModelBodies)
+    r.fail(list, "bodies", std::to_string(list.size()) + " bodies, more than a model may hold (" + std::to_string(kMaxModelBodies) + ")");
   std::map<std::string, int> links;  // link name -> its first piece (body index)
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YAML::Node n = list[i];

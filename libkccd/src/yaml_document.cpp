@@ -32,16 +32,27 @@ class Checker final : public YAML::EventHandler {
     if (++documents_ > 1) fail(mark, "document", "a second YAML document ('---' or '...' followed by more): the file must hold exactly one");
   }
   void OnDocumentEnd() override {}
-  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { leaf(mark, "~", true); }
-  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { leaf(mark, "", false); }
-  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string& value) override {
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    count(mark, 1);
+    named(anchor, 1);
+    leaf(mark, "~", true);
+  }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    count(mark, anchor < sizes_.size() ? sizes_[anchor] : 1);
+    leaf(mark, "", false);
+  }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, const std::string& value) override {
+    count(mark, 1);
+    named(anchor, 1);
     leaf(mark, value, true);
   }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
-    open(mark, false);
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    count(mark, 1);
+    open(mark, false, anchor);
   }
-  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
-    open(mark, true);
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    count(mark, 1);
+    open(mark, true, anchor);
   }
   void OnSequenceEnd() override { close(); }
   void OnMapEnd() override { close(); }
@@ -53,7 +64,24 @@ class Checker final : public YAML::EventHandler {
     std::size_t index = 0;   // sequences: index of the next item
     std::string key;         // maps: the key of the value being read
     std::set<std::string> keys;
+    YAML::anchor_t anchor = 0;   // the anchor naming this node (0: none)
+    std::size_t first_node = 0;  // expanded_ when it opened
   };
+
+  // `nodes` more nodes read (an alias: as many as the node it names holds).
+  void count(const YAML::Mark& mark, std::size_t nodes) {
+    expanded_ += nodes;
+    if (expanded_ > limits_.max_expanded_nodes)
+      fail(mark, path(), "aliases expand the document to more than " + std::to_string(limits_.max_expanded_nodes) +
+                             " values (anchors and aliases are for sharing a little, not for multiplying)");
+  }
+
+  // Remembers the size of the node an anchor names.
+  void named(YAML::anchor_t anchor, std::size_t nodes) {
+    if (anchor == 0) return;
+    if (sizes_.size() <= anchor) sizes_.resize(anchor + 1, 1);
+    sizes_[anchor] = nodes;
+  }
 
   [[noreturn]] void fail(const YAML::Mark& mark, const std::string& field, const std::string& problem) const {
     throw InputError(at(source_, mark, field.empty() ? std::string("document") : field), problem);
@@ -101,17 +129,22 @@ class Checker final : public YAML::EventHandler {
     if (!key(mark, value, plain)) done();
   }
 
-  void open(const YAML::Mark& mark, bool map) {
+  void open(const YAML::Mark& mark, bool map, YAML::anchor_t anchor) {
     key(mark, "", false);  // a list or mapping as a key fails there
     if (static_cast<int>(stack_.size()) >= limits_.max_depth)
       fail(mark, path(), "nested deeper than " + std::to_string(limits_.max_depth) + " levels");
     Frame f;
     f.map = map;
+    f.anchor = anchor;
+    f.first_node = expanded_ - 1;
     stack_.push_back(std::move(f));
   }
 
   void close() {
-    if (!stack_.empty()) stack_.pop_back();
+    if (!stack_.empty()) {
+      named(stack_.back().anchor, expanded_ - stack_.back().first_node);
+      stack_.pop_back();
+    }
     done();
   }
 
@@ -119,6 +152,8 @@ class Checker final : public YAML::EventHandler {
   const YamlLimits& limits_;
   int documents_ = 0;
   std::vector<Frame> stack_;
+  std::size_t expanded_ = 0;        // nodes read, aliases counted as copies
+  std::vector<std::size_t> sizes_;  // per anchor, the nodes its node holds
 };
 
 }  // namespace

@@ -55,6 +55,14 @@ struct Db3Reader::Db {
   std::size_t next = 0;
   sqlite3_stmt* row_by_id = nullptr;
   std::string cut;  // what the header declares against what the file holds
+  // The work budget (sqlite3's progress handler, in thousands of VM steps): far above what the
+  // file's own rows need, so only a crafted schema can exhaust it.
+  std::uint64_t ticks = 0, max_ticks = 0;
+  static int onProgress(void* self) {
+    auto* db = static_cast<Db*>(self);
+    return ++db->ticks > db->max_ticks ? 1 : 0;
+  }
+  bool exhausted() const { return ticks > max_ticks; }
   ~Db() {
     if (rows) sqlite3_finalize(rows);
     if (row_by_id) sqlite3_finalize(row_by_id);
@@ -189,6 +197,13 @@ void Db3Reader::open(std::size_t index) {
   const bool cut = !size_error && declared > size;
   if (sqlite3_open_v2(path.c_str(), &db_->db, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, cut ? wholePagesVfs() : nullptr) != SQLITE_OK)
     fail(std::string("cannot be opened: ") + (db_->db ? db3Message(db_->db) : "out of memory"));
+  // Nothing in the file's schema runs as trusted code; no value is longer than the file could
+  // hold; the work of every query is bounded by the file's size.
+  sqlite3_db_config(db_->db, SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0, nullptr);
+  const std::uint64_t bytes = size_error ? 0 : size;
+  sqlite3_limit(db_->db, SQLITE_LIMIT_LENGTH, static_cast<int>(std::min<std::uint64_t>(bytes + (1u << 20), 1000000000u)));
+  db_->max_ticks = (256 * bytes + 200'000'000) / 1000;
+  sqlite3_progress_handler(db_->db, 1000, &Db::onProgress, db_.get());
   {
     // A file shorter than its header declares was cut short (a recorder killed, a copy stopped):
     // sqlite3 then refuses its schema, whose later tables' pages are gone. Reading with the schema
@@ -208,6 +223,16 @@ void Db3Reader::open(std::size_t index) {
     }
     return std::make_pair(st, std::string());
   };
+  // rosbag2 writes tables: a view (which can compute rows without end) in their place is refused.
+  if (sqlite3_stmt* st = query("SELECT name, type FROM sqlite_master WHERE name IN ('messages', 'topics', 'message_definitions')").first) {
+    while (sqlite3_step(st) == SQLITE_ROW)
+      if (columnText(st, 1) != "table") {
+        const std::string what = columnText(st, 0) + "' is a " + columnText(st, 1);
+        sqlite3_finalize(st);
+        fail("'" + printable(what, 60) + ", not a table (a rosbag2 file holds tables)");
+      }
+    sqlite3_finalize(st);
+  }
   // The stored definitions (rosbag2 Jazzy and later: message_definitions), by type.
   std::map<std::string, std::pair<std::string, std::string>> stored;  // type -> (encoding, text)
   if (sqlite3_stmt* st = query("SELECT topic_type, encoding, encoded_message_definition FROM message_definitions").first) {
@@ -316,7 +341,9 @@ bool Db3Reader::next(LogMessage& out) {
     }
     if (rc != SQLITE_DONE) {
       // A file cut short or damaged: what was read stands, with the damage named.
-      damage_ = filePrefix() + db3Message(db_->db) + " (after " + std::to_string(row_) + " messages)";
+      damage_ = filePrefix() + (db_->exhausted() ? std::string("reading stopped: far more work than a file of this size needs")
+                                                 : db3Message(db_->db)) +
+                " (after " + std::to_string(row_) + " messages)";
       db_.reset();
       return false;
     }

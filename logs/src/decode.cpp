@@ -63,6 +63,12 @@ class Decoder {
 
   Value message(const MessageType& t, int depth) {
     if (depth > 64) throw DecodeError(pos_, "types nested more than 64 deep");
+    // Fields of types that take no bytes are not counted against the data: the values made are
+    // (a message type whose fields are two of a type of two of a type ... of an empty type holds
+    // 2^64 values in no bytes at all).
+    if (++values_ > 4 * data_.size() + 4096)
+      throw DecodeError(pos_, "more than " + std::to_string(4 * data_.size() + 4096) +
+                                  " nested messages for " + std::to_string(data_.size()) + " bytes (types that take no bytes, multiplied)");
     Value v;
     v.kind = Value::Kind::Struct;
     v.type = &t;
@@ -202,6 +208,7 @@ class Decoder {
   std::span<const std::uint8_t> data_;
   std::size_t pos_, origin_;
   bool cdr_, big_;
+  std::size_t values_ = 0;  // messages decoded so far
 };
 
 }  // namespace

@@ -8,6 +8,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "kccd/file_reader.hpp"
+#include "kccd/yaml_reader.hpp"
+
 #include "kccd/input_error.hpp"
 #include "kccd/logs/db3_reader.hpp"
 #include "kccd/logs/mcap_reader.hpp"
@@ -20,13 +23,12 @@ namespace {
 // A rosbag2 folder: its metadata.yaml lists the storage and the files in order.
 std::vector<std::string> folderFiles(const std::string& dir) {
   const std::filesystem::path meta = std::filesystem::path(dir) / "metadata.yaml";
-  if (!std::filesystem::exists(meta)) throw InputError(InputLocation{dir, 0, 0, "folder"}, "not a rosbag2 folder (no metadata.yaml)");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(meta.string());
-  } catch (const YAML::Exception& e) {
-    throw InputError(InputLocation{meta.string(), static_cast<std::size_t>(e.mark.line + 1), 0, "yaml"}, printable(e.msg, 120));
-  }
+  std::error_code ec;
+  if (!std::filesystem::exists(meta, ec)) throw InputError(InputLocation{dir, 0, 0, "folder"}, "not a rosbag2 folder (no metadata.yaml)");
+  // A bounded regular file (a FIFO or /dev/zero in its place is refused without reading), then
+  // one checked YAML document (bounded nesting and aliases) before yaml-cpp builds nodes.
+  const YamlReader reader(meta.string());
+  const YAML::Node root = reader.load(readRegularFile(meta.string(), 16u << 20, "rosbag2 metadata file"));
   const YAML::Node info = root["rosbag2_bagfile_information"];
   if (!info || !info.IsMap()) throw InputError(InputLocation{meta.string(), 0, 0, "rosbag2_bagfile_information"}, "missing");
   std::string storage;
@@ -62,6 +64,9 @@ std::unique_ptr<LogReader> openLog(const std::string& path) {
     if (mcaps > 0) throw InputError(InputLocation{path, 0, 0, "folder"}, "a bag split into several MCAP files: give them one at a time");
     return std::make_unique<Db3Reader>(files, path);
   }
+  // Only a regular file is opened: a FIFO would block the open itself.
+  if (const auto st = std::filesystem::status(path, ec); std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
+    throw InputError(InputLocation{path, 0, 0, "file"}, "not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     const int error = errno;

@@ -95,6 +95,7 @@ McapReader::McapReader(const std::string& path) : path_(path) {
   in_.seekg(0);
   if (end < 0) throw InputError(InputLocation{path, 0, 0, "file"}, "cannot be read");
   size_ = static_cast<std::uint64_t>(end);
+  decompress_left_ = detail::decompressBudget(size_);
   std::uint8_t magic[8] = {};
   if (size_ < 8 || !in_.read(reinterpret_cast<char*>(magic), 8) || std::memcmp(magic, kMagic, 8) != 0)
     throw InputError(InputLocation{path, 0, 0, "byte 0"}, "not an MCAP file (its first 8 bytes are not the MCAP magic)");
@@ -340,6 +341,7 @@ void McapReader::decompressChunk(std::span<const std::uint8_t> content, std::uin
   const std::span<const std::uint8_t> records = f.bytes64("records");
   if (size > kMaxChunk) fail(at, "a chunk of " + std::to_string(size) + " bytes uncompressed, more than this reader takes (2 GiB)");
   chunk_.clear();
+  if (const std::string problem = detail::takeFromBudget(decompress_left_, size); !problem.empty()) fail(at, problem);
   if (compression.empty()) {
     if (records.size() != size) fail(at, "an uncompressed chunk of " + std::to_string(records.size()) + " bytes says it holds " + std::to_string(size));
     chunk_.assign(records.begin(), records.end());

@@ -58,6 +58,7 @@ Ros1Reader::Ros1Reader(const std::string& path) : path_(path) {
   if (!in_) throw InputError(InputLocation{path, 0, 0, "file"}, "cannot be opened");
   in_.seekg(0, std::ios::end);
   size_ = static_cast<std::uint64_t>(std::max<std::streamoff>(in_.tellg(), 0));
+  decompress_left_ = detail::decompressBudget(size_);
   in_.seekg(0);
   char magic[13] = {};
   if (size_ < 13 || !in_.read(magic, 13) || std::memcmp(magic, kRos1Magic, 13) != 0)
@@ -128,6 +129,7 @@ bool Ros1Reader::record(std::span<const std::uint8_t> header, std::span<const st
       const auto comp = f.find("compression");
       if (comp == f.end() || !numberOf(f, "size", size)) fail(at, "a chunk record without compression and size");
       if (size > kMaxRos1Chunk) fail(at, "a chunk of " + std::to_string(size) + " bytes");
+      if (const std::string problem = detail::takeFromBudget(decompress_left_, size); !problem.empty()) fail(at, problem);
       if (comp->second == "none") {
         if (data.size() != size) fail(at, "an uncompressed chunk of " + std::to_string(data.size()) + " bytes says it holds " + std::to_string(size));
         chunk_.assign(data.begin(), data.end());

@@ -14,12 +14,20 @@
 
 namespace kccd::fuzz {
 
+/// This process's id in ten digits: the input's path, which error messages quote, then has the
+/// same length in every run (a pid of another length changed the messages' lengths, so the
+/// coverage libFuzzer steers by, and runs with the same seed and count did not repeat).
+inline std::string fixedWidthPid() {
+  const std::string pid = std::to_string(getpid());
+  return std::string(pid.size() < 10 ? 10 - pid.size() : 0, '0') + pid;
+}
+
 /// Writes `size` bytes to `name` in a folder of this process's own (created once, under the
 /// system's temporary folder, named after `target`) and returns the file's path.
 inline std::string writeInput(const char* target, const std::string& name, const std::uint8_t* data, std::size_t size) {
   static const std::filesystem::path dir = [target] {
     const std::filesystem::path d =
-        std::filesystem::temp_directory_path() / (std::string("kccd_") + target + "_" + std::to_string(getpid()));
+        std::filesystem::temp_directory_path() / (std::string("kccd_") + target + "_" + fixedWidthPid());
     std::filesystem::create_directories(d);
     return d;
   }();

@@ -103,6 +103,10 @@ class ModelError : public InputError {
 /// metres, far beyond any robot cell, and small enough that squares and sums stay exact to ~1e-7 m.
 inline constexpr double kMaxModelLength = 1e6;
 
+/// Most bodies a model file may hold (the checked pairs grow with their square: 8 million at this
+/// bound); a cell of a few robots has tens to hundreds.
+inline constexpr std::size_t kMaxModelBodies = 4096;
+
 /// The immutable model. Build it with loadModel() / parseModel() or assemble it and call
 /// finalize(); a Checker then holds every mutable buffer.
 class Model {

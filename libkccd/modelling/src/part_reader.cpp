@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <utility>
+#include <algorithm>
 
 #include <Inventor/SbMatrix.h>
 #include <Inventor/SoDB.h>
@@ -53,9 +54,12 @@
 #include <Inventor/nodes/SoSeparator.h>
 #include <Inventor/nodes/SoShape.h>
 #include <Inventor/nodes/SoSphere.h>
+#include <Inventor/nodes/SoArray.h>
+#include <Inventor/nodes/SoMultipleCopy.h>
 
 #include "kccd/file_reader.hpp"
 #include "kccd/format_number.hpp"
+#include "kccd/model.hpp"
 #include "kccd/modelling/part.hpp"
 #include "large_stack.hpp"
 #include "mesh_reader.hpp"
@@ -385,12 +389,27 @@ Part readStl(const std::string& data, const std::string& path, const Vec3& scale
     std::istringstream text(data);
     std::string word;
     int line_vertices = 0;
+    std::size_t line = 1, counted = 0;  // the line of the text's position `counted`
+    const auto lineAt = [&](std::streamoff at) {
+      const auto end = static_cast<std::size_t>(std::max<std::streamoff>(at, 0));
+      line += static_cast<std::size_t>(std::count(data.begin() + static_cast<std::ptrdiff_t>(counted),
+                                                  data.begin() + static_cast<std::ptrdiff_t>(std::min(end, data.size())), '\n'));
+      counted = std::max(counted, std::min(end, data.size()));
+      return line;
+    };
     while (text >> word) {
       if (word != "vertex") continue;
+      const std::size_t at = lineAt(text.tellg());
       Vec3 v;
       if (!(text >> v.x() >> v.y() >> v.z()))
-        throw PartError(path + ": malformed vertex after " + std::to_string(part.points.size()) +
-                                 " vertices");
+        throw PartError(InputLocation{path, at, 0, "vertex " + std::to_string(part.points.size() + 1)},
+                        "malformed (three numbers expected)");
+      const Vec3 scaled = v.cwiseProduct(scale);
+      if (!scaled.allFinite() || scaled.cwiseAbs().maxCoeff() > kMaxModelLength)
+        throw PartError(InputLocation{path, at, 0, "vertex " + std::to_string(part.points.size() + 1)},
+                        formatNumber(v.x(), 9) + " " + formatNumber(v.y(), 9) + " " + formatNumber(v.z(), 9) +
+                            (scale == Vec3::Ones() ? "" : " (scaled)") +
+                            " is beyond the largest length a model may give (1e6 m)");
       add(v);
       if (++line_vertices % 3 == 0) {
         const int n = static_cast<int>(part.points.size());
@@ -405,6 +424,8 @@ Part readStl(const std::string& data, const std::string& path, const Vec3& scale
 
 // An ASCII Open Inventor or VRML text before Coin reads it: nesting of braces and brackets
 // (outside strings and comments) at most kMaxNesting, and no node that includes another file.
+constexpr std::size_t kMaxWordBytes = 4096;
+
 void scanText(const std::string& data, const std::string& path) {
   int depth = 0, line = 1;
   std::string token, previous;
@@ -449,6 +470,11 @@ void scanText(const std::string& data, const std::string& path) {
       endToken();
       if (ch == '\n') ++line;
     } else {
+      // Coin's reader crashes (a double free) on a word of about a megabyte (found by the
+      // reader-bound test); names and numbers are short.
+      if (token.size() >= kMaxWordBytes)
+        throw PartError(path + ":" + std::to_string(line) + ": a word longer than " + std::to_string(kMaxWordBytes) +
+                        " bytes ('" + kccd::printable(token, 20) + "')");
       token += ch;
     }
   }
@@ -461,17 +487,40 @@ struct RefGuard {
   ~RefGuard() { node->unref(); }
 };
 
-// Group nesting of a scene read from a binary file, without recursion.
+// Group nesting of a scene, without recursion, and the nodes a traversal visits: a node used
+// again (DEF/USE) is visited once per use and an Array or MultipleCopy visits its children once
+// per copy, so a few hundred bytes can stand for 10^10 visits of every later action. Both are
+// bounded before any action runs.
 void checkNesting(SoNode* root, const std::string& path) {
-  std::vector<std::pair<SoNode*, int>> stack{{root, 0}};
+  constexpr double kMaxVisits = 1e6;
+  struct Entry {
+    SoNode* node;
+    int depth;
+    double copies;  // visits of this node per traversal
+  };
+  std::vector<Entry> stack{{root, 0, 1.0}};
+  double visits = 0.0;
   while (!stack.empty()) {
-    const auto [node, depth] = stack.back();
+    const Entry e = stack.back();
     stack.pop_back();
-    if (depth > kMaxNesting)
+    if (e.depth > kMaxNesting)
       throw PartError(path + ": nested deeper than " + std::to_string(kMaxNesting) + " levels");
-    if (!node->isOfType(SoGroup::getClassTypeId())) continue;
-    auto* group = static_cast<SoGroup*>(node);
-    for (int i = 0; i < group->getNumChildren(); ++i) stack.emplace_back(group->getChild(i), depth + 1);
+    visits += e.copies;
+    if (visits > kMaxVisits)
+      throw PartError(path + ": the scene expands to more than 1000000 nodes (nodes used again with USE, or Array and "
+                             "MultipleCopy nodes, multiply): write the geometry out");
+    if (!e.node->isOfType(SoGroup::getClassTypeId())) continue;
+    auto* group = static_cast<SoGroup*>(e.node);
+    double copies = e.copies;
+    if (e.node->isOfType(SoArray::getClassTypeId())) {
+      const auto* array = static_cast<SoArray*>(e.node);
+      copies *= std::max(1.0, static_cast<double>(array->numElements1.getValue())) *
+                std::max(1.0, static_cast<double>(array->numElements2.getValue())) *
+                std::max(1.0, static_cast<double>(array->numElements3.getValue()));
+    } else if (e.node->isOfType(SoMultipleCopy::getClassTypeId())) {
+      copies *= std::max(1, static_cast<SoMultipleCopy*>(e.node)->matrix.getNum());
+    }
+    for (int i = 0; i < group->getNumChildren(); ++i) stack.push_back({group->getChild(i), e.depth + 1, copies});
   }
 }
 
@@ -682,11 +731,22 @@ Part readPart(const std::string& path, const ReadOptions& options) {
   if (part.triangles == 0 && part.primitives == 0)
     throw PartError(name + (options.part.empty() ? "" : " (part " + printable(options.part) + ")") +
                              ": no triangles or solid primitives (nothing to fit)");
-  for (const Vec3& p : part.points)
-    if (!p.allFinite()) throw PartError(name + ": non-finite vertex coordinates");
-  for (const Sphere& b : part.balls)
+  // Every coordinate within what a model may hold (the fit's distances stay finite then).
+  for (std::size_t i = 0; i < part.points.size(); ++i) {
+    const Vec3& p = part.points[i];
+    if (!p.allFinite()) throw PartError(name + ": vertex " + std::to_string(i + 1) + ": non-finite coordinates");
+    if (p.cwiseAbs().maxCoeff() > kMaxModelLength)
+      throw PartError(name + ": vertex " + std::to_string(i + 1) + ": " + formatNumber(p.x(), 9) + " " +
+                      formatNumber(p.y(), 9) + " " + formatNumber(p.z(), 9) +
+                      " is beyond the largest length a model may give (1e6 m)");
+  }
+  for (const Sphere& b : part.balls) {
     if (!b.center.allFinite() || !std::isfinite(b.radius))
       throw PartError(name + ": non-finite sphere (a scale or radius overflows)");
+    if (b.center.cwiseAbs().maxCoeff() + b.radius > kMaxModelLength)
+      throw PartError(name + ": a sphere of radius " + formatNumber(b.radius, 9) +
+                      " reaches beyond the largest length a model may give (1e6 m)");
+  }
   double max_abs = 0.0;
   for (const Vec3& p : part.points) max_abs = std::max(max_abs, p.cwiseAbs().maxCoeff());
   for (const Sphere& b : part.balls) max_abs = std::max(max_abs, b.center.cwiseAbs().maxCoeff() + b.radius);

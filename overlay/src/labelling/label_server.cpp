@@ -1,5 +1,6 @@
 #include "kccd/overlay/labelling/label_server.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -15,6 +16,27 @@
 
 namespace kccd::overlay {
 namespace {
+
+// The deepest nesting of arrays and objects in a JSON text (strings skipped): the parsed
+// document's copies and destruction recurse once per level.
+int jsonDepth(const std::string& text) {
+  int depth = 0, deepest = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
 
 constexpr const char* kJson = "application/json";
 
@@ -90,6 +112,16 @@ struct LabelServer::Impl {
       sendError(res, 415, "writes are JSON: send Content-Type: application/json");
       return httplib::Server::HandlerResponse::Handled;
     }
+    // The body's size is bounded by its Content-Length only: a chunked or compressed body (which
+    // the library would read or inflate without that bound) is refused before it is read.
+    if (req.has_header("Transfer-Encoding") || !req.has_header("Content-Length")) {
+      sendError(res, 411, "writes give their Content-Length (no chunked transfer)");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (req.has_header("Content-Encoding")) {
+      sendError(res, 415, "writes are plain JSON (no Content-Encoding)");
+      return httplib::Server::HandlerResponse::Handled;
+    }
     return httplib::Server::HandlerResponse::Unhandled;
   }
 
@@ -130,6 +162,7 @@ struct LabelServer::Impl {
         if (i < 0) return sendError(res, 400, "frame: expected a frame index, got '" + f + "'");
         frame = static_cast<std::size_t>(i);
       }
+      if (jsonDepth(req.body) > 64) return sendError(res, 400, "request body: JSON nested deeper than 64 levels");
       nlohmann::json document;
       try {
         document = nlohmann::json::parse(req.body);

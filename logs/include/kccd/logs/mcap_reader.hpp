@@ -72,6 +72,7 @@ class McapReader final : public LogReader {
   std::string path_;
   std::ifstream in_;
   std::uint64_t size_ = 0, pos_ = 0;
+  std::uint64_t decompress_left_ = 0;  // what chunks may still decompress to (a bound on bombs)
   std::uint32_t data_crc_ = 0;        // CRC-32 of every byte read before the Data End record
   bool data_crc_on_ = true;
   std::uint32_t summary_crc_ = 0;     // CRC-32 from the summary section's start

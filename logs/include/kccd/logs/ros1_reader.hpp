@@ -34,6 +34,7 @@ class Ros1Reader final : public LogReader {
   std::string path_, damage_;
   std::ifstream in_;
   std::uint64_t size_ = 0, pos_ = 0;
+  std::uint64_t decompress_left_ = 0;  // what chunks may still decompress to (a bound on bombs)
   std::vector<std::uint8_t> header_, data_, chunk_;
   std::size_t chunk_pos_ = 0;
   std::uint64_t chunk_at_ = 0;
