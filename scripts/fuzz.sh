@@ -26,7 +26,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 # The slowest first, so that the jobs end together.
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_urdf fuzz_part fuzz_model fuzz_states fuzz_frame_times fuzz_camera fuzz_tags fuzz_labels fuzz_labels_json fuzz_golden_manifest fuzz_frame fuzz_video fuzz_mcap fuzz_ros_message fuzz_ros1_bag fuzz_db3 fuzz_joint_map)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_urdf fuzz_part fuzz_model fuzz_states fuzz_frame_times fuzz_camera fuzz_tags fuzz_labels fuzz_labels_json fuzz_golden_manifest fuzz_frame fuzz_mask fuzz_video fuzz_mcap fuzz_ros_message fuzz_ros1_bag fuzz_db3 fuzz_joint_map)
 bash scripts/install-deps.sh --fuzz
 # -O1 with line tables only: the fuzzers' stacks keep files and lines, and the build is much shorter.
 CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -43,6 +43,7 @@ ci_runs() {  # inputs per target in --ci mode (15-40 s each on this project's ma
     fuzz_frame_times) echo 200000 ;;
     fuzz_frame) echo 3000 ;;
     fuzz_video) echo 3000 ;;
+    fuzz_mask) echo 20000 ;;
     fuzz_camera) echo 100000 ;;  # read by yaml-cpp since OpenCV's parser hung: about 3,800 inputs/s
     fuzz_tags) echo 140000 ;;
     fuzz_labels) echo 130000 ;;
@@ -70,6 +71,7 @@ seeds() {  # extra seed files from data/ per target
     fuzz_golden_manifest) ;;
     fuzz_frame) ;;
     fuzz_video) ;;
+    fuzz_mask) ;;
     fuzz_part) ls data/parts/* ;;
     fuzz_urdf) ls tests/data/urdf/*.urdf ;;
     fuzz_mcap) ;;

@@ -24,6 +24,7 @@
 #include "support/cameras.hpp"
 #include "support/golden.hpp"
 #include "support/run_program.hpp"
+#include "support/silhouette.hpp"
 
 namespace {
 
@@ -225,6 +226,133 @@ TEST_F(CalibCli, NotSolvableWritesNothingAndSaysWhatToAdd) {
   EXPECT_FALSE(fs::exists(out("cam.yaml")));
 }
 
+// --masks: the pose refined to robot masks, from four rough clicks (8 px off) on two frames. The
+// masks are drawn by tests/support/silhouette.hpp, which shares no code with the refinement.
+class CalibMasks : public CalibCli {
+ protected:
+  void SetUp() override {
+    CalibCli::SetUp();
+    cam_ = truth_;  // the sample camera at half size: 640 x 360
+    cam_.width /= 2, cam_.height /= 2;
+    cam_.camera_matrix(0, 0) /= 2, cam_.camera_matrix(1, 1) /= 2;
+    cam_.camera_matrix(0, 2) = (cam_.camera_matrix(0, 2) + 0.5) / 2 - 0.5;
+    cam_.camera_matrix(1, 2) = (cam_.camera_matrix(1, 2) + 0.5) / 2 - 0.5;
+    kccd::calib::saveCamera(cam_, out("cam.yaml"));
+    states_ = {{0.6, -0.3, 0.9}, {-0.5, 0.4, -0.7}};
+    for (std::size_t f = 0; f < states_.size(); ++f) cv::imwrite(out("mask" + std::to_string(f) + ".png"), mask(states_[f]));
+  }
+  cv::Mat mask(const std::vector<double>& state) const {
+    std::vector<kccd::Pose> poses(model_.joints.size());
+    EXPECT_TRUE(kccd::framePoses(model_, state, poses));
+    cv::Mat m = cv::Mat::zeros(cam_.height, cam_.width, CV_8UC1);
+    for (const int b : kRobot) {
+      std::vector<kccd::Vec3> pts;
+      for (const kccd::Vec3& p : model_.bodies[static_cast<std::size_t>(b)].points)
+        pts.push_back(kccd::framePose(poses, model_.bodies[static_cast<std::size_t>(b)].frame) * p);
+      m |= kccd::testing::cpuSilhouette(cam_, pts, model_.bodies[static_cast<std::size_t>(b)].radius);
+    }
+    return m * 255;
+  }
+  // Two clicks on the arm in frame f, each 8 px off.
+  std::string roughClicks(std::size_t f) const {
+    std::vector<kccd::Pose> poses(model_.joints.size());
+    EXPECT_TRUE(kccd::framePoses(model_, states_[f], poses));
+    std::string t = "labels:\n";
+    const std::pair<const char*, cv::Point2d> picks[] = {{f == 0 ? "forearm" : "upper_arm", {8, 0}}, {"gripper", {0, -8}}};
+    for (const auto& [body, off] : picks) {
+      const kccd::Body& b = model_.bodies[static_cast<std::size_t>(model_.bodyIndex(body))];
+      const kccd::Vec3 w = kccd::framePose(poses, b.frame) * b.points[0];
+      const cv::Point2d px = project(cam_, {w.x(), w.y(), w.z()}) + off;
+      t += std::string("  - {name: ") + body + std::to_string(f) + ", pixel: [" + fmt(px.x) + ", " + fmt(px.y) + "], body: " + body +
+           ", point: [" + fmt(b.points[0].x()) + ", " + fmt(b.points[0].y()) + ", " + fmt(b.points[0].z()) + "]}\n";
+    }
+    return t;
+  }
+  std::string frameArgs(bool labels) const {
+    std::string a;
+    for (std::size_t f = 0; f < states_.size(); ++f) {
+      std::string st;
+      for (double v : states_[f]) st += (st.empty() ? "" : ",") + fmt(v);
+      a += (labels ? " --labels " + out("l" + std::to_string(f) + ".yaml") : std::string()) + " --state " + st + " --masks " +
+           out("mask" + std::to_string(f) + ".png");
+    }
+    return a + " --model " + kDemo + " --mask-bodies pedestal,shoulder,upper_arm,forearm,gripper";
+  }
+  const std::vector<int> kRobot = {0, 3, 4, 5, 6};
+  kccd::calib::Camera cam_;
+  std::vector<std::vector<double>> states_;
+};
+
+TEST_F(CalibMasks, FourRoughClicksAndMasksGiveTheCamera) {
+  for (std::size_t f = 0; f < states_.size(); ++f) write("l" + std::to_string(f) + ".yaml", roughClicks(f));
+  const Outcome r = runKccd("calib --intrinsics " + out("cam.yaml") + frameArgs(true) + " -o " + out("c.yaml") + " --json --check " +
+                            out("check.png"));
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j["refinement"]["improved"].get<bool>()) << r.out;
+  EXPECT_EQ(j["refinement"]["start"], "points");  // four clicks are too few for the gated solve
+  for (const auto& fr : j["refinement"]["frames"]) EXPECT_GT(fr["iou_after"].get<double>(), 0.95) << r.out;
+  const kccd::calib::Camera c = kccd::calib::loadCamera(out("c.yaml"));
+  EXPECT_LT(rotationErrorDeg(c.rvec, cam_.rvec), 0.2);
+  EXPECT_LT(cv::norm(centre(c) - centre(cam_)), 0.01);
+  std::printf("4 clicks 8 px off + 2 masks: %.3f deg, %.2f mm from the truth\n", rotationErrorDeg(c.rvec, cam_.rvec),
+              1e3 * cv::norm(centre(c) - centre(cam_)));
+  // The check image draws both outlines (mask: yellow, drawn robot: magenta) on the frame.
+  const cv::Mat check = cv::imread(out("check.png"));
+  ASSERT_FALSE(check.empty());
+  cv::Mat magenta, yellow;
+  cv::inRange(check, cv::Scalar(200, 0, 200), cv::Scalar(255, 60, 255), magenta);
+  cv::inRange(check, cv::Scalar(0, 170, 200), cv::Scalar(60, 255, 255), yellow);
+  EXPECT_GT(cv::countNonZero(magenta), 100);
+  EXPECT_GT(cv::countNonZero(yellow), 100);
+}
+
+TEST_F(CalibMasks, BadMasksAreOneLineExitTwoAndNothingWritten) {
+  for (std::size_t f = 0; f < states_.size(); ++f) write("l" + std::to_string(f) + ".yaml", roughClicks(f));
+  cv::imwrite(out("small.png"), cv::Mat(100, 200, CV_8UC1, cv::Scalar(255)));
+  cv::imwrite(out("empty.png"), cv::Mat::zeros(cam_.height, cam_.width, CV_8UC1));
+  cv::imwrite(out("full.png"), cv::Mat(cam_.height, cam_.width, CV_8UC1, cv::Scalar(7)));
+  write("broken.png", "\x89PNG\r\n\x1a\nnot really");
+  const std::string base = "calib --intrinsics " + out("cam.yaml") + " -o " + out("c.yaml");
+  const std::string state = " --state 0,0,0";
+  const struct {
+    std::string args, expect;
+  } cases[] = {
+      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("small.png"), "small.png: mask: 200x100, but the camera"},
+      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("empty.png"), "empty.png: mask: no robot in it"},
+      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("full.png"), "full.png: mask: nothing but robot"},
+      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("broken.png"), "broken.png: mask: "},
+      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("mask0.png") + " " + out("mask1.png"),
+       "--masks: 2 mask(s) for 1 frame(s)"},
+      {" --labels " + out("l0.yaml") + state + " --masks " + out("mask0.png"), "--masks: needs --model"},
+      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("mask0.png") + " --mask-bodies arm",
+       "--mask-bodies: 'arm' is not a body"},
+      {" --labels " + out("l0.yaml") + " --camera " + kCamera, "--camera: a start for --masks"},
+  };
+  for (const auto& c : cases) {
+    const Outcome r = runKccd(base + c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out("c.yaml")));
+  }
+}
+
+// Masks of other states than the frames' from a rough camera alone: the masks cannot confirm any
+// pose, so nothing is written and the exit is 4 with what to add.
+TEST_F(CalibMasks, MasksThatCannotBeMatchedExitFourWithWhatToAdd) {
+  cv::imwrite(out("wrong.png"), mask({-2.5, 1.5, 2.0}));
+  kccd::calib::Camera far = cam_;
+  far.tvec[0] += 0.6;  // a rough camera far off
+  kccd::calib::saveCamera(far, out("rough.yaml"));
+  cv::imwrite(out("frame.png"), cv::Mat(cam_.height, cam_.width, CV_8UC3, cv::Scalar(90, 90, 90)));
+  const Outcome r = runKccd("calib --intrinsics " + out("cam.yaml") + " --image " + out("frame.png") + " --masks " + out("wrong.png") +
+                            " --state 0.6,-0.3,0.9 --model " + kDemo + " --camera " + out("rough.yaml") + " -o " + out("c.yaml"));
+  EXPECT_EQ(r.code, 4) << r.err << r.out;
+  EXPECT_NE(r.err.find("add labels of the robot or tags"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out("c.yaml")));
+}
+
 TEST_F(CalibCli, BadInputIsOneLineExitTwo) {
   std::mt19937_64 rng(9);
   write("l.yaml", worldLabels(rng, 8));
@@ -258,7 +386,7 @@ TEST_F(CalibCli, BadInputIsOneLineExitTwo) {
       {"--intrinsics " + kCamera + " --labels " + out("missing.yaml") + " -o " + out("c.yaml"), out("missing.yaml")},
       {"--intrinsics " + kCamera + " --image " + out("small.png") + l + " -o " + out("c.yaml"), "the image is 200x100 but the camera"},
       {"--intrinsics " + kCamera + " --image " + out("not_image.png") + l + " -o " + out("c.yaml"), "image: not an image OpenCV can decode"},
-      {"--intrinsics " + kCamera + " --image " + out("small.png") + " -o " + out("c.yaml"), "give --tags LAYOUT and/or --labels"},
+      {"--intrinsics " + kCamera + " --image " + out("small.png") + " -o " + out("c.yaml"), "give --tags LAYOUT, --labels LABELS and/or --masks MASK"},
       {"--intrinsics " + kCamera + l + " --tags " + kCamera + " -o " + out("c.yaml"), "--tags: needs --image"},
       {"--intrinsics " + kCamera + l + " --state 0,0,0 -o " + out("c.yaml"), "--state: needs --model"},
       {"--intrinsics " + kCamera + l + " --model " + kDemo + " --state 0,0 -o " + out("c.yaml"), "has 2 values"},

@@ -128,41 +128,46 @@ bool looksLikeJpeg(std::span<const std::uint8_t> bytes) {
   return bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
 }
 
+namespace {
+
+// The two libjpeg phases, each in a function of its own around its setjmp: no local of the caller
+// lives across a longjmp. Each returns false when libjpeg gave up (the error is in d.errors).
+bool readHeader(Decompressor& d, std::span<const std::uint8_t> bytes, bool keep_exif) {
+  if (setjmp(d.errors.jump) != 0) return false;
+  jpeg_mem_src(&d.info, bytes.data(), static_cast<unsigned long>(bytes.size()));
+  if (keep_exif) jpeg_save_markers(&d.info, JPEG_APP0 + 1, 0xFFFF);
+  jpeg_read_header(&d.info, TRUE);
+  return true;
+}
+
+bool readPixels(Decompressor& d, JSAMPROW* rows, bool grey) {
+  if (setjmp(d.errors.jump) != 0) return false;
+  d.info.out_color_space = grey ? JCS_GRAYSCALE : JCS_EXT_BGR;
+  d.info.out_color_components = grey ? 1 : 3;
+  jpeg_start_decompress(&d.info);
+  while (d.info.output_scanline < d.info.output_height)
+    jpeg_read_scanlines(&d.info, rows + d.info.output_scanline, d.info.output_height - d.info.output_scanline);
+  jpeg_finish_decompress(&d.info);
+  return true;
+}
+
+}  // namespace
+
 cv::Mat decodeJpeg(std::span<const std::uint8_t> bytes, ImageColour colour,
                    const std::function<void(int width, int height)>& check_size,
                    const std::function<void(const std::string&)>& fail) {
-  // Everything that owns memory lives outside the setjmp scope: a longjmp skips no destructor.
   Decompressor d;
-  cv::Mat img;
-  std::vector<JSAMPROW> rows;
-  bool checked = false;
   const bool orient = colour != ImageColour::Unchanged;
-  if (setjmp(d.errors.jump) == 0) {
-    jpeg_mem_src(&d.info, bytes.data(), static_cast<unsigned long>(bytes.size()));
-    if (orient) jpeg_save_markers(&d.info, JPEG_APP0 + 1, 0xFFFF);
-    jpeg_read_header(&d.info, TRUE);
-    checked = true;  // the size is checked outside the jump scope, below
-  }
-  if (!d.errors.error.empty()) fail("a damaged JPEG (" + d.errors.error + ")");
-  if (!checked) fail("a damaged JPEG");
+  if (!readHeader(d, bytes, orient)) fail("a damaged JPEG (" + d.errors.error + ")");
   check_size(static_cast<int>(d.info.image_width), static_cast<int>(d.info.image_height));
   // Read now: the saved markers are freed with the image's memory by jpeg_finish_decompress.
   const int orientation = orient ? exifOrientation(d.info.marker_list) : 1;
   if (d.info.num_components == 4) return {};  // CMYK: left to OpenCV
   const bool grey = colour == ImageColour::Grey || (colour == ImageColour::Unchanged && d.info.num_components == 1);
-  const int channels = grey ? 1 : 3;
-  img.create(static_cast<int>(d.info.image_height), static_cast<int>(d.info.image_width), CV_8UC(channels));
-  rows.resize(static_cast<std::size_t>(img.rows));
+  cv::Mat img(static_cast<int>(d.info.image_height), static_cast<int>(d.info.image_width), CV_8UC(grey ? 1 : 3));
+  std::vector<JSAMPROW> rows(static_cast<std::size_t>(img.rows));
   for (int r = 0; r < img.rows; ++r) rows[static_cast<std::size_t>(r)] = img.ptr<JSAMPLE>(r);
-  if (setjmp(d.errors.jump) == 0) {
-    d.info.out_color_space = grey ? JCS_GRAYSCALE : JCS_EXT_BGR;
-    d.info.out_color_components = channels;
-    jpeg_start_decompress(&d.info);
-    while (d.info.output_scanline < d.info.output_height)
-      jpeg_read_scanlines(&d.info, rows.data() + d.info.output_scanline, d.info.output_height - d.info.output_scanline);
-    jpeg_finish_decompress(&d.info);
-  }
-  if (!d.errors.error.empty()) fail("a damaged JPEG (" + d.errors.error + ")");
+  if (!readPixels(d, rows.data(), grey)) fail("a damaged JPEG (" + d.errors.error + ")");
   if (!d.errors.damage.empty()) fail("a damaged JPEG (" + d.errors.damage + ")");
   orientImage(img, orientation);
   return img;

@@ -174,6 +174,24 @@ const char* toString(PoseStatus status) {
   return "unknown";
 }
 
+std::pair<double, double> poseSigmas(const cv::Vec3d& rvec, const cv::Vec3d& tvec, const cv::Matx66d& covariance) {
+  // Jacobians of the rotation increment and of the centre with respect to (rvec, tvec), by central differences.
+  cv::Matx<double, 3, 6> a = cv::Matx<double, 3, 6>::zeros(), g = cv::Matx<double, 3, 6>::zeros();
+  const double h = 1e-6;
+  for (int c = 0; c < 3; ++c) {
+    cv::Vec3d d(0, 0, 0);
+    d[c] = h;
+    const cv::Vec3d da = (rotationDelta(rvec, d) - rotationDelta(rvec, -d)) / (2 * h);
+    const cv::Vec3d dg = (centre(rvec + d, tvec) - centre(rvec - d, tvec)) / (2 * h);
+    for (int r = 0; r < 3; ++r) a(r, c) = da[r], g(r, c) = dg[r];
+  }
+  cv::Matx33d rmat;
+  cv::Rodrigues(rvec, rmat);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) g(r, 3 + c) = -rmat(c, r);
+  return {std::sqrt(largestEigen(a * covariance * a.t())) * 180.0 / std::numbers::pi, std::sqrt(largestEigen(g * covariance * g.t()))};
+}
+
 PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>& points, const PoseOptions& options) {
   // ---- input
   const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
@@ -424,24 +442,7 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   cv::Mat(jtj.inv(cv::DECOMP_SVD)).copyTo(inv);
   const cv::Matx66d cov = sigma2 * inv;
 
-  // Jacobians of the rotation increment and of the centre with respect to (rvec, tvec), by central differences.
-  cv::Matx<double, 3, 6> a = cv::Matx<double, 3, 6>::zeros(), g = cv::Matx<double, 3, 6>::zeros();
-  const double h = 1e-6;
-  for (int c = 0; c < 3; ++c) {
-    cv::Vec3d d(0, 0, 0);
-    d[c] = h;
-    const cv::Vec3d da = (rotationDelta(rvec, d) - rotationDelta(rvec, -d)) / (2 * h);
-    const cv::Vec3d dg = (centre(rvec + d, tvec) - centre(rvec - d, tvec)) / (2 * h);
-    for (int r = 0; r < 3; ++r) a(r, c) = da[r], g(r, c) = dg[r];
-  }
-  cv::Matx33d rmat;
-  cv::Rodrigues(rvec, rmat);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) g(r, 3 + c) = -rmat(c, r);
-  const auto sigmas = [&](const cv::Matx66d& s) {
-    return std::pair<double, double>(std::sqrt(largestEigen(a * s * a.t())) * 180.0 / std::numbers::pi,
-                                     std::sqrt(largestEigen(g * s * g.t())));
-  };
+  const auto sigmas = [&](const cv::Matx66d& s) { return poseSigmas(rvec, tvec, s); };
   const auto [rot_sigma, pos_sigma] = sigmas(cov);
   const double gate2 = std::max(sigma2, options.noise_floor_px * options.noise_floor_px);
   const auto [rot_gate, pos_gate] = sigmas(gate2 * inv);

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 
 #include "calib_frames.hpp"
 #include "cli_args.hpp"
@@ -14,6 +15,7 @@
 #include "commands.hpp"
 #include "kccd/overlay/calibration/calib_check.hpp"
 #include "kccd/overlay/calibration/calib_gather.hpp"
+#include "kccd/overlay/calibration/calib_refine.hpp"
 #include "kccd/overlay/calibration/calib_report.hpp"
 #include "kccd/overlay/calibration/calib_solve.hpp"
 #include "kccd/state_log.hpp"
@@ -22,8 +24,8 @@ namespace kccd::cli {
 namespace {
 
 struct CalibArgs : FrameOptions {
-  std::string intrinsics, tags, model, output, check, truth;
-  std::vector<std::string> labels;
+  std::string intrinsics, tags, model, output, check, truth, rough_camera, mask_bodies;
+  std::vector<std::string> labels, masks;
   double threshold = 8.0, magnify = 20.0;
   int min_inliers = 6;
   bool json = false, quiet = false;
@@ -44,7 +46,7 @@ void checkBodyLabels(const calib::Labels& labels, const std::optional<Model>& mo
 // The gathering inputs the options describe: the frames (calib_frames.hpp), the labels and the
 // tag layout.
 overlay::GatherInputs gatherInputs(const CalibArgs& a, const calib::Camera& cam, const std::optional<Model>& model) {
-  const GivenFrames given = givenFrames(a, a.labels.size(), !a.tags.empty(), model);
+  const GivenFrames given = givenFrames(a, a.labels.size(), !a.tags.empty(), model, !a.masks.empty());
   for (const std::string& w : given.warnings) std::cerr << "kccd calib: warning: " << w << "\n";
   overlay::GatherInputs in;
   in.camera = cam;
@@ -62,6 +64,31 @@ overlay::GatherInputs gatherInputs(const CalibArgs& a, const calib::Camera& cam,
       checkBodyLabels(*fr.labels, model, fr.state.has_value());
     }
   }
+  return in;
+}
+
+// The masks (read and checked before anything else is), the bodies they show and a rough start.
+std::optional<overlay::MaskInputs> maskInputs(const CalibArgs& a, const calib::Camera& cam, const std::optional<Model>& model) {
+  if (a.masks.empty()) {
+    if (!a.rough_camera.empty()) throw UsageError("--camera: a start for --masks (give --masks)");
+    if (!a.mask_bodies.empty()) throw UsageError("--mask-bodies: goes with --masks");
+    return std::nullopt;
+  }
+  if (!model) throw UsageError("--masks: needs --model (the robot drawn to match the masks)");
+  overlay::MaskInputs in;
+  for (const std::string& m : a.masks) {
+    in.masks.push_back(calib::readMask(m, cam.width, cam.height));
+    in.mask_names.push_back(m);
+  }
+  if (!a.mask_bodies.empty()) {
+    std::stringstream list(a.mask_bodies);
+    for (std::string name; std::getline(list, name, ',');) {
+      const int b = model->bodyIndex(name);
+      if (b < 0) throw UsageError("--mask-bodies: '" + name + "' is not a body of " + a.model + " (kccd info lists them)");
+      in.bodies.push_back(b);
+    }
+  }
+  if (!a.rough_camera.empty()) in.rough = calib::loadCamera(a.rough_camera);
   return in;
 }
 
@@ -83,29 +110,49 @@ Exit runCalib(const CalibArgs& a) {
   if (!a.truth.empty()) truth = calib::loadCamera(a.truth);
   std::optional<Model> model;
   if (!a.model.empty()) model = loadOrExplain(a.model);
+  const std::optional<overlay::MaskInputs> mask_inputs = maskInputs(a, intrinsics, model);
   const overlay::Gathered g = overlay::gatherCorrespondences(gatherInputs(a, intrinsics, model));
 
   calib::PoseOptions options;
   options.ransac_threshold_px = a.threshold;
   options.min_inliers = a.min_inliers;
-  const overlay::CalibSolution s =
+  overlay::CalibSolution s =
       overlay::solveCalibration(intrinsics, g, options, model ? &*model : nullptr, truth ? &*truth : nullptr);
+  std::optional<overlay::MaskRefinement> refinement;
+  if (mask_inputs) {
+    refinement = overlay::refineCalibrationToMasks(s, g, intrinsics, *model, *mask_inputs, truth ? &*truth : nullptr);
+    if (!refinement->result.improved && !s.solved())
+      s.pose.message = refinement->result.message + " and the points do not solve (" + s.pose.message +
+                       "): add labels of the robot or tags, or start from --camera ROUGH.yaml";
+  }
   const calib::PoseResult& r = s.pose;
   std::string renderer_name;
   if (s.solved()) {
-    writeFileAtomically(a.output, calib::cameraText(r.camera));
+    writeFileAtomically(a.output, calib::cameraText(r.camera) + (refinement ? overlay::refinementText(*refinement) : std::string()));
     for (std::size_t f = 0; !a.check.empty() && f < g.frames.size(); ++f) {
-      const overlay::CheckImage check =
+      overlay::CheckImage check =
           overlay::checkImage(g, s, f, model ? &*model : nullptr, {.magnify = a.magnify, .camera_name = a.intrinsics});
       if (!check.renderer.empty()) renderer_name = check.renderer;
+      if (refinement)
+        overlay::drawMaskAgreement(check.bgr, r.camera, mask_inputs->masks[f],
+                                   calib::placeVolumes(*model, g.frames[f].state, mask_inputs->bodies));
       writePngAtomically(checkPath(a.check, f), check.bgr, "--check");
     }
   }
 
   if (a.json) {
-    std::cout << overlay::calibReport(g, s, {.camera = a.output, .check = a.check, .renderer = renderer_name}).dump(2)
-              << "\n";
+    nlohmann::json report = overlay::calibReport(g, s, {.camera = a.output, .check = a.check, .renderer = renderer_name});
+    if (refinement) report["refinement"] = overlay::refinementJson(*refinement);
+    std::cout << report.dump(2) << "\n";
   } else if (!a.quiet) {
+    if (refinement) {
+      for (std::size_t f = 0; f < refinement->result.frames.size(); ++f) {
+        const calib::FrameAgreement& fa = refinement->result.frames[f];
+        std::cout << "mask " << a.masks[f] << ": IoU " << format(fa.iou_before, 4) << " -> " << format(fa.iou_after, 4)
+                  << ", outline " << format(fa.rms_px, 3) << " px rms over " << fa.outline_points << " points\n";
+      }
+      if (!refinement->result.improved && s.solved()) std::cout << refinement->result.message << "\n";
+    }
     std::cout << (s.solved() ? "" : "not solved: ") << r.message << "\n";
     if (s.truth_error)
       std::cout << "against " << a.truth << ": rotation " << format(s.truth_error->rotation_deg, 3) << " deg ("
@@ -180,6 +227,15 @@ Runner addCalib(CLI::App& app) {
   sub->add_option("--magnify", a->magnify, "Residual vectors in the check image are drawn this many times longer")
       ->check(finiteIn(1, 1000))
       ->capture_default_str();
+  sub->add_option("--masks", a->masks,
+                  "Robot masks, one per frame in the same order (PNG or any image; non-zero = robot, e.g. a segmentation "
+                  "tool's output): the pose is refined so the model's drawn robot matches them over all frames; needs "
+                  "--model and each frame's state")
+      ->expected(1, -1);
+  sub->add_option("--camera", a->rough_camera,
+                  "A rough camera file to start --masks from when no labels or tags give a start (its pose is used)");
+  sub->add_option("--mask-bodies", a->mask_bodies,
+                  "Comma-separated bodies of the model that the masks show (default: all bodies)");
   sub->add_flag("--json", a->json, "Print the result as JSON (status, sigmas, rejected, residuals)");
   sub->add_flag("-q,--quiet", a->quiet, "Print nothing but errors");
 

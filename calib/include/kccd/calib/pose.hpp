@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -71,6 +72,10 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
 /// to rvec, tvec; C: the pose covariance), in pixels; the largest over the points (points behind
 /// the camera are skipped; 0 when none is in front).
 double projectedSigmaPx(const Camera& camera, const cv::Matx66d& covariance, const std::vector<cv::Point3d>& world);
+
+/// The 1-sigma rotation (degrees, largest over axes) and camera-centre position (metres, largest
+/// over directions) of a pose (rvec, tvec) whose covariance is `covariance`.
+std::pair<double, double> poseSigmas(const cv::Vec3d& rvec, const cv::Vec3d& tvec, const cv::Matx66d& covariance);
 
 /// Name of a status ("solved", "too few points", ...).
 const char* toString(PoseStatus status);

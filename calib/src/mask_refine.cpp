@@ -1,0 +1,343 @@
+#include "kccd/calib/mask_refine.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "kccd/calib/image_file.hpp"
+#include "kccd/calib/pose.hpp"
+#include "kccd/format_number.hpp"
+
+namespace kccd::calib {
+namespace {
+
+// A frame's target: the cleaned mask and its signed distance field (px; < 0 inside the robot).
+struct Target {
+  cv::Mat mask;
+  cv::Mat sdf;  // CV_32F
+};
+
+// Specks that are not near the drawn robot dropped, holes smaller than a few percent of the
+// image's side filled: what segmentation leaves that no pose can explain.
+cv::Mat cleanMask(const cv::Mat& mask, const cv::Mat& drawn) {
+  const double diagonal = std::hypot(mask.cols, mask.rows);
+  // Near: within a fifth of the image's diagonal of the drawing (a distance transform, not a
+  // dilation by a kernel of hundreds of pixels).
+  cv::Mat away, near;
+  cv::distanceTransform(drawn == 0, away, cv::DIST_L2, cv::DIST_MASK_3);
+  near = away <= static_cast<float>(std::max(3.0, 0.2 * diagonal));
+  cv::Mat labels;
+  const int n = cv::connectedComponents(mask, labels, 8, CV_32S);
+  std::vector<char> keep(static_cast<std::size_t>(n), 0);
+  for (int y = 0; y < mask.rows; ++y)
+    for (int x = 0; x < mask.cols; ++x)
+      if (const int l = labels.at<int>(y, x); l > 0 && near.at<unsigned char>(y, x)) keep[static_cast<std::size_t>(l)] = 1;
+  cv::Mat out = cv::Mat::zeros(mask.size(), CV_8UC1);
+  for (int y = 0; y < mask.rows; ++y)
+    for (int x = 0; x < mask.cols; ++x)
+      if (keep[static_cast<std::size_t>(labels.at<int>(y, x))] && labels.at<int>(y, x) > 0) out.at<unsigned char>(y, x) = 255;
+  if (cv::countNonZero(out) == 0) out = mask.clone();  // nothing near: keep all, the fit says what it can
+  // Holes: background components that do not touch the border and are small.
+  cv::Mat background = out == 0, holes;
+  const int m = cv::connectedComponents(background, holes, 4, CV_32S);
+  std::vector<int> area(static_cast<std::size_t>(m), 0);
+  std::vector<char> border(static_cast<std::size_t>(m), 0);
+  for (int y = 0; y < out.rows; ++y)
+    for (int x = 0; x < out.cols; ++x) {
+      const int l = holes.at<int>(y, x);
+      ++area[static_cast<std::size_t>(l)];
+      if (x == 0 || y == 0 || x == out.cols - 1 || y == out.rows - 1) border[static_cast<std::size_t>(l)] = 1;
+    }
+  const double small = std::pow(0.03 * std::min(out.cols, out.rows), 2);
+  for (int y = 0; y < out.rows; ++y)
+    for (int x = 0; x < out.cols; ++x) {
+      const int l = holes.at<int>(y, x);
+      if (l > 0 && !border[static_cast<std::size_t>(l)] && area[static_cast<std::size_t>(l)] < small) out.at<unsigned char>(y, x) = 255;
+    }
+  return out;
+}
+
+cv::Mat signedDistance(const cv::Mat& mask) {
+  cv::Mat inside, outside;
+  cv::distanceTransform(mask, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::distanceTransform(mask == 0, outside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::Mat sdf(mask.size(), CV_32F);
+  for (int y = 0; y < mask.rows; ++y)
+    for (int x = 0; x < mask.cols; ++x) {
+      const float i = inside.at<float>(y, x), o = outside.at<float>(y, x);
+      sdf.at<float>(y, x) = (o > 0 ? o - 0.5f : 0.0f) - (i > 0 ? i - 0.5f : 0.0f);
+    }
+  return sdf;
+}
+
+// Bilinear sample of `f` at (x, y) (clamped to the image).
+double sample(const cv::Mat& f, double x, double y) {
+  x = std::clamp(x, 0.0, f.cols - 1.001);
+  y = std::clamp(y, 0.0, f.rows - 1.001);
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const double ax = x - x0, ay = y - y0;
+  const float* r0 = f.ptr<float>(y0);
+  const float* r1 = f.ptr<float>(y0 + 1);
+  return (1 - ay) * ((1 - ax) * r0[x0] + ax * r0[x0 + 1]) + ay * ((1 - ax) * r1[x0] + ax * r1[x0 + 1]);
+}
+
+struct Sample {
+  std::size_t frame;
+  cv::Point3d world;
+  cv::Point2d normal;
+};
+
+// The outline points of every frame at `camera` that lie inside the image (away from its border).
+std::vector<Sample> samplesAt(const Camera& camera, std::span<const MaskFrame> frames, double spacing,
+                              std::vector<cv::Mat>* drawn = nullptr) {
+  std::vector<Sample> out;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    const Silhouette s = drawSilhouette(camera, frames[f].volumes, spacing);
+    if (drawn) drawn->push_back(s.mask);
+    for (const OutlinePoint& p : s.outline)
+      if (p.pixel.x >= 2 && p.pixel.y >= 2 && p.pixel.x <= camera.width - 3 && p.pixel.y <= camera.height - 3)
+        out.push_back({f, cv::Point3d(p.world.x(), p.world.y(), p.world.z()), p.normal});
+  }
+  return out;
+}
+
+struct Evaluation {
+  double cost = 0.0;
+  cv::Matx66d jtj = cv::Matx66d::zeros();
+  cv::Vec6d jtr = cv::Vec6d::all(0);
+  double weight_sum = 0.0, weighted_sq = 0.0;
+};
+
+// The robust cost of the samples at (rvec, tvec) with Cauchy scale `c`, and its normal equations.
+Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const std::vector<Sample>& samples,
+                    const std::vector<Target>& targets, double c, bool normal_equations) {
+  Evaluation e;
+  std::vector<cv::Point3d> world(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) world[i] = samples[i].world;
+  std::vector<cv::Point2d> px;
+  cv::Mat jac;
+  if (world.empty()) return e;
+  cv::projectPoints(world, rvec, tvec, cam.camera_matrix, cam.distortion, px, normal_equations ? jac : cv::noArray());
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const cv::Mat& sdf = targets[samples[i].frame].sdf;
+    const double r = sample(sdf, px[i].x, px[i].y);
+    double w = 1.0 / (1.0 + (r / c) * (r / c));
+    const double gx = 0.5 * (sample(sdf, px[i].x + 1, px[i].y) - sample(sdf, px[i].x - 1, px[i].y));
+    const double gy = 0.5 * (sample(sdf, px[i].x, px[i].y + 1) - sample(sdf, px[i].x, px[i].y - 1));
+    // The field should grow outward along the drawn outline's normal; where it does not (a hole's
+    // edge, another object's outline), the point counts little.
+    if (gx * samples[i].normal.x + gy * samples[i].normal.y < 0) w *= 0.1;
+    e.cost += 0.5 * c * c * std::log1p((r / c) * (r / c)) * (w < 0.5 / (1.0 + (r / c) * (r / c)) ? 0.1 : 1.0);
+    e.weight_sum += w;
+    e.weighted_sq += w * r * r;
+    if (!normal_equations) continue;
+    cv::Vec6d j;
+    for (int k = 0; k < 6; ++k)
+      j[k] = gx * jac.at<double>(static_cast<int>(2 * i), k) + gy * jac.at<double>(static_cast<int>(2 * i + 1), k);
+    e.jtj += w * (j * j.t());
+    e.jtr += w * r * j;
+  }
+  return e;
+}
+
+// Pre-alignment, for a start far off (10 degrees is a robot's width in the image): the camera
+// turned so the drawn robot's centroid lands on the mask's, and moved along its axis so their
+// areas match, over all frames together. Rotation shows first as a shift of the whole image,
+// distance as a change of size; the fit then starts where the outlines overlap.
+Camera preAlign(const Camera& start, std::span<const MaskFrame> frames, const std::vector<Target>& targets, double spacing) {
+  Camera cam = start;
+  const double fx = cam.camera_matrix(0, 0), fy = cam.camera_matrix(1, 1);
+  for (int round = 0; round < 6; ++round) {
+    std::vector<cv::Mat> drawn;
+    (void)samplesAt(cam, frames, spacing, &drawn);
+    double du = 0, dv = 0, drawn_area = 0, mask_area = 0, depth = 0;
+    int used = 0, depth_points = 0;
+    const Pose w2c = cam.worldToCamera();
+    for (std::size_t f = 0; f < frames.size(); ++f) {
+      const cv::Moments a = cv::moments(drawn[f], true), b = cv::moments(targets[f].mask, true);
+      if (a.m00 < 1 || b.m00 < 1) continue;
+      du += b.m10 / b.m00 - a.m10 / a.m00;
+      dv += b.m01 / b.m00 - a.m01 / a.m00;
+      drawn_area += a.m00;
+      mask_area += b.m00;
+      ++used;
+      for (const PlacedVolume& v : frames[f].volumes)
+        for (const Vec3& p : v.points) {
+          const double z = (w2c * p).z();
+          if (z > 0) depth += z, ++depth_points;
+        }
+    }
+    if (used == 0 || depth_points == 0) break;
+    du /= used, dv /= used;
+    // A turn about the camera's y and x axes moves the image by fx * angle, fy * angle.
+    const cv::Vec3d turn(-std::atan(dv / fy), std::atan(du / fx), 0.0);
+    cv::Matx33d d, r;
+    cv::Rodrigues(turn, d);
+    cv::Rodrigues(cam.rvec, r);
+    cv::Rodrigues(d * r, cam.rvec);
+    cam.tvec = d * cam.tvec;
+    // Size: the image of the robot scales with 1 / depth, its area with 1 / depth^2.
+    const double z = depth / depth_points;
+    const double ratio = std::clamp(std::sqrt(drawn_area / mask_area), 0.5, 2.0);
+    cam.tvec[2] += z * (ratio - 1.0);
+    if (std::hypot(du, dv) < 0.5 && std::abs(ratio - 1.0) < 1e-3) break;
+  }
+  return cam;
+}
+
+}  // namespace
+
+cv::Mat readMask(const std::string& path, int width, int height) {
+  cv::Mat img;
+  try {
+    img = readImageFile(path, ImageColour::Unchanged);
+  } catch (const ImageError& e) {
+    throw MaskError(InputLocation{path, 0, 0, "mask"}, e.problem());
+  }
+  if (img.cols != width || img.rows != height)
+    throw MaskError(InputLocation{path, 0, 0, "mask"}, std::to_string(img.cols) + "x" + std::to_string(img.rows) +
+                                                         ", but the camera's images are " + std::to_string(width) + "x" +
+                                                         std::to_string(height));
+  std::vector<cv::Mat> channels;
+  cv::split(img, channels);
+  cv::Mat mask = cv::Mat::zeros(img.size(), CV_8UC1);
+  for (const cv::Mat& c : channels) mask |= (c != 0);
+  const int robot = cv::countNonZero(mask);
+  if (robot == 0) throw MaskError(InputLocation{path, 0, 0, "mask"}, "no robot in it (every pixel is 0)");
+  if (robot == width * height) throw MaskError(InputLocation{path, 0, 0, "mask"}, "nothing but robot (no pixel is 0)");
+  return mask;
+}
+
+RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frames, const RefineOptions& options) {
+  if (frames.empty()) throw InputError("masks: no frame to refine the pose with");
+  for (const MaskFrame& f : frames)
+    if (f.mask.cols != start.width || f.mask.rows != start.height || f.mask.type() != CV_8UC1)
+      throw InputError("masks: a mask of " + std::to_string(f.mask.cols) + "x" + std::to_string(f.mask.rows) + " for a camera of " +
+                       std::to_string(start.width) + "x" + std::to_string(start.height));
+  RefineResult result;
+  result.camera = start;
+  // Targets: each mask cleaned against the start's drawing.
+  std::vector<cv::Mat> drawn_start;
+  (void)samplesAt(start, frames, options.spacing_px, &drawn_start);
+  std::vector<Target> targets(frames.size());
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    targets[f].mask = cleanMask(frames[f].mask != 0, drawn_start[f]);
+    targets[f].sdf = signedDistance(targets[f].mask);
+  }
+  result.frames.resize(frames.size());
+  for (std::size_t f = 0; f < frames.size(); ++f) result.frames[f].iou_before = maskIou(drawn_start[f], targets[f].mask);
+
+  // Pre-aligned by centroid and size, the masks cleaned again against that drawing; kept only
+  // if it overlaps the masks better than the start.
+  Camera cam = preAlign(start, frames, targets, options.spacing_px);
+  {
+    std::vector<cv::Mat> drawn;
+    (void)samplesAt(cam, frames, options.spacing_px, &drawn);
+    double before = 0, after = 0;
+    for (std::size_t f = 0; f < frames.size(); ++f) {
+      before += result.frames[f].iou_before;
+      after += maskIou(drawn[f], targets[f].mask);
+    }
+    if (after > before) {
+      for (std::size_t f = 0; f < frames.size(); ++f) {
+        targets[f].mask = cleanMask(frames[f].mask != 0, drawn[f]);
+        targets[f].sdf = signedDistance(targets[f].mask);
+      }
+    } else {
+      cam = start;
+    }
+  }
+  const double diagonal = std::hypot(start.width, start.height);
+  for (const double scale : {0.08, 0.03, 0.01, 0.004}) {
+    const double c = std::max(1.5, scale * diagonal);
+    double lambda = 1e-3;
+    for (int it = 0; it < options.max_iterations; ++it) {
+      const std::vector<Sample> samples = samplesAt(cam, frames, options.spacing_px);
+      if (samples.size() < 12) break;
+      const Evaluation e = evaluate(cam, cam.rvec, cam.tvec, samples, targets, c, true);
+      bool stepped = false;
+      while (lambda < 1e8) {
+        cv::Matx66d a = e.jtj;
+        for (int k = 0; k < 6; ++k) a(k, k) += lambda * std::max(e.jtj(k, k), 1e-12);
+        cv::Vec6d delta;
+        if (!cv::solve(a, -e.jtr, delta, cv::DECOMP_CHOLESKY)) {
+          lambda *= 10;
+          continue;
+        }
+        const cv::Vec3d r2 = cam.rvec + cv::Vec3d(delta[0], delta[1], delta[2]);
+        const cv::Vec3d t2 = cam.tvec + cv::Vec3d(delta[3], delta[4], delta[5]);
+        const Evaluation next = evaluate(cam, r2, t2, samples, targets, c, false);
+        if (next.cost < e.cost) {
+          cam.rvec = r2, cam.tvec = t2;
+          lambda = std::max(1e-7, lambda / 3);
+          stepped = cv::norm(delta) > 1e-7;
+          break;
+        }
+        lambda *= 4;
+      }
+      ++result.iterations;
+      if (!stepped) break;
+    }
+  }
+
+  // Agreement at the result, and whether it is kept.
+  std::vector<cv::Mat> drawn_after;
+  const std::vector<Sample> final_samples = samplesAt(cam, frames, options.spacing_px, &drawn_after);
+  double before = 0.0, after = 0.0, worst_drop = 0.0;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    FrameAgreement& a = result.frames[f];
+    a.iou_after = maskIou(drawn_after[f], targets[f].mask);
+    before += a.iou_before;
+    after += a.iou_after;
+    worst_drop = std::max(worst_drop, a.iou_before - a.iou_after);
+  }
+  before /= static_cast<double>(frames.size());
+  after /= static_cast<double>(frames.size());
+  const double c_final = std::max(1.5, 0.004 * diagonal);
+  const Evaluation e = evaluate(cam, cam.rvec, cam.tvec, final_samples, targets, c_final, true);
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    std::vector<Sample> mine;
+    for (const Sample& s : final_samples)
+      if (s.frame == f) mine.push_back(s);
+    const Evaluation ef = evaluate(cam, cam.rvec, cam.tvec, mine, targets, c_final, false);
+    result.frames[f].outline_points = static_cast<int>(mine.size());
+    result.frames[f].rms_px = ef.weight_sum > 0 ? std::sqrt(ef.weighted_sq / ef.weight_sum) : 0.0;
+  }
+  if (!(after > before + 1e-4) || worst_drop > 0.02) {
+    for (FrameAgreement& a : result.frames) a.iou_after = a.iou_before;
+    result.message = "the masks did not improve the pose (mean IoU " + formatNumber(before, 4) + " at the start, " +
+                     formatNumber(after, 4) + " refined" +
+                     (worst_drop > 0.02 ? ", one frame " + formatNumber(worst_drop, 3) + " worse" : std::string()) +
+                     "): the start is kept";
+    return result;
+  }
+  // The pose's covariance from the normal equations: sigma^2 (J^T W J)^-1, with the outline
+  // samples' correlation (neighbours about `spacing` apart see the same edge) counted by a factor
+  // of 5 on the variance.
+  const double dof = std::max(1.0, e.weight_sum - 6.0);
+  const double sigma2 = e.weighted_sq / dof * 5.0;
+  cv::Matx66d inv;
+  cv::invert(e.jtj, inv, cv::DECOMP_SVD);
+  result.covariance = sigma2 * inv;
+  const auto [rotation_sigma, position_sigma] = poseSigmas(cam.rvec, cam.tvec, result.covariance);
+  cam.rotation_sigma_deg = rotation_sigma;
+  cam.position_sigma_m = position_sigma;
+  if (after < options.min_iou || !(*cam.rotation_sigma_deg <= options.max_rotation_sigma_deg)) {
+    for (FrameAgreement& a : result.frames) a.iou_after = a.iou_before;
+    result.covariance = cv::Matx66d::zeros();
+    result.message = "the drawn robot and the masks agree too little (mean IoU " + formatNumber(after, 3) + ", at least " +
+                     formatNumber(options.min_iou, 3) + " needed; rotation +-" + formatNumber(*cam.rotation_sigma_deg, 3) +
+                     " deg): check each frame's state, the clock, and which bodies the masks show (--mask-bodies); the start is kept";
+    return result;
+  }
+  result.camera = cam;
+  result.improved = true;
+  result.message = "refined to the masks: mean IoU " + formatNumber(before, 4) + " -> " + formatNumber(after, 4) + " over " +
+                   std::to_string(frames.size()) + " frame(s), rotation +-" + formatNumber(*cam.rotation_sigma_deg, 3) +
+                   " deg, position +-" + formatNumber(*cam.position_sigma_m, 3) + " m";
+  return result;
+}
+
+}  // namespace kccd::calib

@@ -1,0 +1,172 @@
+#include "kccd/overlay/calibration/calib_refine.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "kccd/calib/pose_difference.hpp"
+#include "kccd/format_number.hpp"
+
+namespace kccd::overlay {
+namespace {
+
+// A pose from four or more points without the solve's gates (rough clicks give one the solve
+// refuses): SQPnP on all of them.
+std::optional<calib::Camera> roughPose(const calib::Camera& intrinsics, const Gathered& g) {
+  if (g.points.size() < 4) return std::nullopt;
+  std::vector<cv::Point3d> world;
+  std::vector<cv::Point2d> pixels;
+  for (const calib::Correspondence& c : g.points) world.push_back(c.world), pixels.push_back(c.pixel);
+  cv::Vec3d rvec, tvec;
+  try {
+    if (!cv::solvePnP(world, pixels, intrinsics.camera_matrix, intrinsics.distortion, rvec, tvec, false, cv::SOLVEPNP_SQPNP))
+      return std::nullopt;
+  } catch (const cv::Exception&) {
+    return std::nullopt;
+  }
+  if (!std::isfinite(cv::norm(rvec)) || !std::isfinite(cv::norm(tvec))) return std::nullopt;
+  calib::Camera c = intrinsics;
+  c.rvec = rvec, c.tvec = tvec;
+  c.reprojection_rms_px.reset(), c.rotation_sigma_deg.reset(), c.position_sigma_m.reset();
+  return c;
+}
+
+}  // namespace
+
+MaskRefinement refineCalibrationToMasks(CalibSolution& solution, const Gathered& g, const calib::Camera& intrinsics,
+                                        const Model& model, const MaskInputs& in, const calib::Camera* truth) {
+  if (in.masks.size() != g.frames.size())
+    throw CalibInputError("--masks: " + std::to_string(in.masks.size()) + " mask(s) for " + std::to_string(g.frames.size()) +
+                          " frame(s): give one mask per frame, in the same order");
+  MaskRefinement out;
+  out.drawn = "collision volumes";
+  calib::Camera start;
+  if (solution.solved()) {
+    start = solution.pose.camera, out.start = "solve";
+  } else if (const std::optional<calib::Camera> rough = roughPose(intrinsics, g)) {
+    start = *rough, out.start = "points";
+  } else if (in.rough) {
+    start = intrinsics;
+    start.rvec = in.rough->rvec, start.tvec = in.rough->tvec;
+    out.start = "camera";
+  } else {
+    throw CalibInputError("--masks: no start for the pose: give 4 or more labels or tag corners, or --camera ROUGH.yaml");
+  }
+  std::vector<calib::MaskFrame> frames;
+  for (std::size_t f = 0; f < g.frames.size(); ++f) {
+    const std::vector<double>& state = g.frames[f].state;
+    if (static_cast<int>(state.size()) != model.stateSize())
+      throw CalibInputError("--masks: frame " + std::to_string(f + 1) + " has no state of the model's " +
+                            std::to_string(model.stateSize()) + " values: give --state, or --states with --time");
+    frames.push_back({in.masks[f], calib::placeVolumes(model, state, in.bodies)});
+  }
+  out.result = calib::refineToMasks(start, frames);
+  if (!out.result.improved) return out;
+  // A solved start is a strong prior: a refined pose far outside its uncertainty (3 sigma) for a
+  // small gain in agreement says the masks and the volumes differ (a robot thinner than its
+  // volumes, masks that are too wide), not that the points were wrong: the solve is kept.
+  if (out.start == "solve" && start.rotation_sigma_deg && start.position_sigma_m) {
+    const calib::PoseDifference d = calib::poseDifference(out.result.camera, start);
+    double gain = 0.0;
+    for (const calib::FrameAgreement& a : out.result.frames) gain += a.iou_after - a.iou_before;
+    gain /= static_cast<double>(out.result.frames.size());
+    const double rot_sigmas = d.rotation_deg / std::max(*start.rotation_sigma_deg, 1e-9);
+    const double pos_sigmas = d.position_m / std::max(*start.position_sigma_m, 1e-12);
+    if ((rot_sigmas > 3.0 || pos_sigmas > 3.0) && gain < 0.02) {
+      for (calib::FrameAgreement& a : out.result.frames) a.iou_after = a.iou_before;
+      out.result.improved = false;
+      out.result.camera = start;
+      out.result.covariance = cv::Matx66d::zeros();
+      out.result.message = "the masks' best pose lies " + formatNumber(d.rotation_deg, 3) + " deg and " +
+                           formatNumber(d.position_m * 1000, 3) + " mm from the points' solve (" +
+                           formatNumber(std::max(rot_sigmas, pos_sigmas), 3) + " sigma) for a mean IoU gain of " +
+                           formatNumber(gain, 3) + ": the solve is kept (are the volumes wider or the masks narrower than the robot?)";
+      return out;
+    }
+  }
+
+  calib::PoseResult& pose = solution.pose;
+  pose.camera = out.result.camera;
+  pose.covariance = out.result.covariance;
+  pose.status = calib::PoseStatus::Solved;
+  // Every point's residual under the refined pose; those far off are named.
+  double outline_rms = 0.0;
+  for (const calib::FrameAgreement& a : out.result.frames) outline_rms = std::max(outline_rms, a.rms_px);
+  const double limit = std::max(4.0, 3.0 * outline_rms);
+  pose.residuals.clear();
+  pose.rejected.clear();
+  if (!g.points.empty()) {
+    std::vector<cv::Point3d> world;
+    for (const calib::Correspondence& c : g.points) world.push_back(c.world);
+    std::vector<cv::Point2d> px;
+    cv::projectPoints(world, pose.camera.rvec, pose.camera.tvec, pose.camera.camera_matrix, pose.camera.distortion, px);
+    for (std::size_t i = 0; i < g.points.size(); ++i) {
+      const double d = std::hypot(px[i].x - g.points[i].pixel.x, px[i].y - g.points[i].pixel.y);
+      const bool agrees = std::isfinite(d) && d <= limit;
+      pose.residuals.push_back({g.points[i].name, d, agrees});
+      if (!agrees) out.disagreeing.push_back(g.points[i].name), pose.rejected.push_back(g.points[i].name);
+    }
+  }
+  pose.inliers = static_cast<int>(g.points.size() - out.disagreeing.size());
+  // The points' RMS under the refined pose, over those the image agrees with (none: unknown).
+  double sse = 0.0;
+  for (const calib::Residual& res : pose.residuals)
+    if (res.inlier) sse += res.px * res.px;
+  if (pose.inliers > 0) pose.camera.reprojection_rms_px = std::sqrt(sse / pose.inliers);
+  else pose.camera.reprojection_rms_px.reset();
+  pose.message = out.result.message;
+  if (!out.disagreeing.empty()) {
+    pose.message += "; the image disagrees with";
+    for (const std::string& n : out.disagreeing) pose.message += " " + n;
+  }
+  if (truth) solution.truth_error = calib::poseDifference(pose.camera, *truth);
+  solution.volume_sigma_px.reset();
+  return out;
+}
+
+std::string refinementText(const MaskRefinement& m) {
+  std::string before = "[", after = "[";
+  for (std::size_t f = 0; f < m.result.frames.size(); ++f) {
+    before += (f ? ", " : " ") + formatNumber(m.result.frames[f].iou_before, 6);
+    after += (f ? ", " : " ") + formatNumber(m.result.frames[f].iou_after, 6);
+  }
+  return std::string("refinement: ") + (m.result.improved ? "masks" : "none") + "\nrefinement_start: " + m.start +
+         "\nrefinement_drawn: \"" + m.drawn + "\"\nmask_iou_before: " + before + " ]\nmask_iou_after: " + after + " ]\n";
+}
+
+nlohmann::json refinementJson(const MaskRefinement& m) {
+  nlohmann::json j;
+  j["improved"] = m.result.improved;
+  j["message"] = m.result.message;
+  j["start"] = m.start;
+  j["drawn"] = m.drawn;
+  j["iterations"] = m.result.iterations;
+  j["frames"] = nlohmann::json::array();
+  for (const calib::FrameAgreement& a : m.result.frames)
+    j["frames"].push_back({{"iou_before", a.iou_before}, {"iou_after", a.iou_after}, {"rms_px", a.rms_px}, {"outline_points", a.outline_points}});
+  j["disagreeing"] = m.disagreeing;
+  if (m.result.improved) {
+    j["rotation_sigma_deg"] = *m.result.camera.rotation_sigma_deg;
+    j["position_sigma_m"] = *m.result.camera.position_sigma_m;
+  }
+  return j;
+}
+
+void drawMaskAgreement(cv::Mat& bgr, const calib::Camera& camera, const cv::Mat& mask, std::span<const calib::PlacedVolume> volumes) {
+  if (bgr.empty()) return;
+  const double sx = static_cast<double>(bgr.cols) / camera.width, sy = static_cast<double>(bgr.rows) / camera.height;
+  const int thick = std::max(1, static_cast<int>(std::lround(std::min(sx, sy) * std::max(camera.width, camera.height) / 640.0)));
+  auto outline = [&](const cv::Mat& m, const cv::Scalar& colour) {
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(m.clone(), contours, cv::RETR_LIST, cv::CHAIN_APPROX_NONE);
+    for (auto& c : contours)
+      for (cv::Point& p : c) p = cv::Point(static_cast<int>(std::lround(p.x * sx)), static_cast<int>(std::lround(p.y * sy)));
+    cv::polylines(bgr, contours, true, colour, thick, cv::LINE_AA);
+  };
+  outline(mask != 0, cv::Scalar(0, 220, 255));
+  outline(calib::drawSilhouette(camera, volumes).mask, cv::Scalar(255, 0, 255));
+}
+
+}  // namespace kccd::overlay
