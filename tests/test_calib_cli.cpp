@@ -372,10 +372,10 @@ TEST_F(CalibCli, BadInputIsOneLineExitTwo) {
   }
   const std::vector<Case> cases{
       {"--intrinsics " + kCamera + " --image " + out("cutjpg.png") + l + " -o " + out("c.yaml"), "image: a damaged JPEG (Premature end of JPEG file)"},
-      {"--intrinsics " + kCamera + " --image " + out("cutbmp.png") + l + " -o " + out("c.yaml"), "image: a damaged image ("},
-      {"--intrinsics " + kCamera + " --image " + out("cutppm.png") + l + " -o " + out("c.yaml"), "image: a damaged image ("},
-      {"--intrinsics " + kCamera + " --image " + out("cuttif.png") + l + " -o " + out("c.yaml"), "image: "},
-      {"--intrinsics " + kCamera + " --image " + out("cutwebp.png") + l + " -o " + out("c.yaml"), "image: "},
+      {"--intrinsics " + kCamera + " --image " + out("cutbmp.png") + l + " -o " + out("c.yaml"), "image: a damaged image (Unexpected end of input stream)"},
+      {"--intrinsics " + kCamera + " --image " + out("cutppm.png") + l + " -o " + out("c.yaml"), "image: a damaged image (Unexpected end of input stream)"},
+      {"--intrinsics " + kCamera + " --image " + out("cuttif.png") + l + " -o " + out("c.yaml"), "image: not an image OpenCV can decode"},
+      {"--intrinsics " + kCamera + " --image " + out("cutwebp.png") + l + " -o " + out("c.yaml"), "image: not an image OpenCV can decode"},
       {"--intrinsics " + kCamera + l, "-o CAMERA.yaml is required"},
       {l + " -o " + out("c.yaml"), "--intrinsics CAMERA.yaml is required"},
       {"--intrinsics " + kCamera + " -o " + out("c.yaml"), "give --image FRAME"},

@@ -93,6 +93,11 @@ cv::Mat decodePng(std::span<const std::uint8_t> bytes, ImageColour colour, const
 
 }  // namespace
 
+std::mutex& stderrLock() {
+  static std::mutex lock;
+  return lock;
+}
+
 cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& source, ImageColour colour) {
   const auto fail = [&](const std::string& problem) {
     throw ImageError(InputLocation{source, 0, 0, "image"}, problem);
@@ -124,28 +129,38 @@ cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& sour
   cv::Mat img;
   std::string said;
   {
-    static std::mutex cerr_lock;
-    const std::lock_guard<std::mutex> lock(cerr_lock);
+    const std::lock_guard<std::mutex> lock(stderrLock());
     std::ostringstream caught;
-    std::streambuf* const was = std::cerr.rdbuf(caught.rdbuf());
-    try {
-      const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
-      img = cv::imdecode(encoded, colour == ImageColour::Grey  ? cv::IMREAD_GRAYSCALE
-                                  : colour == ImageColour::Bgr ? cv::IMREAD_COLOR
-                                                               : cv::IMREAD_UNCHANGED);
-    } catch (const cv::Exception&) {
-      img.release();
-    } catch (const std::bad_alloc&) {
-      img.release();
+    struct Swap {  // std::cerr's buffer swapped, and restored however the decode ends
+      std::streambuf* was;
+      explicit Swap(std::streambuf* to) : was(std::cerr.rdbuf(to)) {}
+      ~Swap() { std::cerr.rdbuf(was); }
+      Swap(const Swap&) = delete;
+      Swap& operator=(const Swap&) = delete;
+    };
+    {
+      const Swap swap(caught.rdbuf());
+      try {
+        const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
+        img = cv::imdecode(encoded, colour == ImageColour::Grey  ? cv::IMREAD_GRAYSCALE
+                                    : colour == ImageColour::Bgr ? cv::IMREAD_COLOR
+                                                                 : cv::IMREAD_UNCHANGED);
+      } catch (const cv::Exception&) {
+        img.release();
+      } catch (const std::bad_alloc&) {
+        img.release();
+      }
     }
-    std::cerr.rdbuf(was);
     said = caught.str();
   }
   if (img.empty()) {
     // OpenCV's words after its "imdecode_(''): can't read data: " prefix, first line only.
     std::string why = said.substr(0, said.find('\n'));
     if (const std::size_t colon = why.find("): "); colon != std::string::npos) why = why.substr(colon + 3);
-    if (const std::size_t err = why.find("error: ("); err != std::string::npos) why = why.substr(err);
+    // "error: (-2:Unspecified error) Unexpected end of input stream in function 'readBlock'": the words only.
+    if (const std::size_t err = why.find("error: ("); err != std::string::npos)
+      if (const std::size_t close = why.find(") ", err); close != std::string::npos) why = why.substr(close + 2);
+    if (const std::size_t in = why.rfind(" in function "); in != std::string::npos) why = why.substr(0, in);
     fail(why.empty() ? "not an image OpenCV can decode (PNG, JPEG, TIFF, BMP, ...)"
                      : "a damaged image (" + printable(why, 120) + ")");
   }

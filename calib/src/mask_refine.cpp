@@ -203,7 +203,14 @@ cv::Mat readMask(const std::string& path, int width, int height) {
   std::vector<cv::Mat> channels;
   cv::split(img, channels);
   cv::Mat mask = cv::Mat::zeros(img.size(), CV_8UC1);
-  for (const cv::Mat& c : channels) mask |= (c != 0);
+  // With alpha: a cut-out (transparent background) is its alpha; an opaque image its colours.
+  double alpha_min = 1.0;
+  if (channels.size() == 4) cv::minMaxLoc(channels[3], &alpha_min);
+  if (channels.size() == 4 && alpha_min == 0.0) {
+    mask = channels[3] != 0;
+  } else {
+    for (std::size_t k = 0; k < std::min<std::size_t>(channels.size(), 3); ++k) mask |= (channels[k] != 0);
+  }
   const int robot = cv::countNonZero(mask);
   if (robot == 0) throw MaskError(InputLocation{path, 0, 0, "mask"}, "no robot in it (every pixel is 0)");
   if (robot == width * height) throw MaskError(InputLocation{path, 0, 0, "mask"}, "nothing but robot (no pixel is 0)");
@@ -304,6 +311,12 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
     const Evaluation ef = evaluate(cam, cam.rvec, cam.tvec, mine, targets, c_final, false);
     result.frames[f].outline_points = static_cast<int>(mine.size());
     result.frames[f].rms_px = ef.weight_sum > 0 ? std::sqrt(ef.weighted_sq / ef.weight_sum) : 0.0;
+  }
+  if (final_samples.size() < 12) {
+    for (FrameAgreement& a : result.frames) a.iou_after = a.iou_before;
+    result.message = "the drawn robot's outline is not in the images (" + std::to_string(final_samples.size()) +
+                     " points): the start is kept";
+    return result;
   }
   if (!(after > before + 1e-4) || worst_drop > 0.02) {
     for (FrameAgreement& a : result.frames) a.iou_after = a.iou_before;

@@ -14,6 +14,7 @@ namespace {
 
 constexpr int kRimSamples = 32;  // per sphere; the polygon's radius is set between inscribed and circumscribed
 constexpr int kSubpixel = 8;     // fill precision: 1/256 px (cv::fillConvexPoly's shift)
+constexpr double kNearPlane = 0.01;  // m: a volume reaching closer to the camera is left out
 
 // The 3-D rim of the sphere (centre c, radius r) seen from `eye`, appended to `rim` (nothing when
 // the eye is inside the sphere).
@@ -85,7 +86,7 @@ Silhouette drawSilhouette(const Camera& camera, std::span<const PlacedVolume> vo
     bool front = true;
     for (const Vec3& x : rim) {
       const Vec3 c = w2c * x;
-      if (!(c.z() > 1e-6)) front = false;
+      if (!(c.z() > kNearPlane)) front = false;
       flat.emplace_back(static_cast<float>(c.x() / c.z()), static_cast<float>(c.y() / c.z()));
     }
     if (!front) continue;
@@ -100,7 +101,9 @@ Silhouette drawSilhouette(const Camera& camera, std::span<const PlacedVolume> vo
       const int a = hull[i], b = hull[(i + 1) % hull.size()];
       const double du = (flat[static_cast<std::size_t>(b)].x - flat[static_cast<std::size_t>(a)].x) * fx;
       const double dv = (flat[static_cast<std::size_t>(b)].y - flat[static_cast<std::size_t>(a)].y) * fy;
-      const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(du, dv) / spacing_px)));
+      // At most a few times the image's perimeter of samples per edge (an edge can reach far outside).
+      const double cap = 4.0 * (camera.width + camera.height) / spacing_px;
+      const int n = static_cast<int>(std::clamp(std::ceil(std::hypot(du, dv) / spacing_px), 1.0, cap));
       for (int k = 0; k < n; ++k) {
         const double t = static_cast<double>(k) / n;
         const Vec3 x = (1.0 - t) * rim[static_cast<std::size_t>(a)] + t * rim[static_cast<std::size_t>(b)];

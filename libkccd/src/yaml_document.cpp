@@ -38,6 +38,8 @@ class Checker final : public YAML::EventHandler {
     leaf(mark, "~", true);
   }
   void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    for (const Frame& f : stack_)
+      if (f.anchor == anchor && anchor != 0) fail(mark, path(), "an alias inside the node it names (a cycle)");
     count(mark, anchor < sizes_.size() ? sizes_[anchor] : 1);
     leaf(mark, "", false);
   }

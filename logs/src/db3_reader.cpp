@@ -224,7 +224,7 @@ void Db3Reader::open(std::size_t index) {
     return std::make_pair(st, std::string());
   };
   // rosbag2 writes tables: a view (which can compute rows without end) in their place is refused.
-  if (sqlite3_stmt* st = query("SELECT name, type FROM sqlite_master WHERE name IN ('messages', 'topics', 'message_definitions')").first) {
+  if (sqlite3_stmt* st = query("SELECT name, type FROM sqlite_master WHERE lower(name) IN ('messages', 'topics', 'message_definitions')").first) {
     while (sqlite3_step(st) == SQLITE_ROW)
       if (columnText(st, 1) != "table") {
         const std::string what = columnText(st, 0) + "' is a " + columnText(st, 1);

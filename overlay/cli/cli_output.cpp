@@ -7,7 +7,9 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <mutex>
 
+#include "kccd/calib/image_file.hpp"
 #include "kccd/input_error.hpp"
 
 namespace kccd::cli {
@@ -49,9 +51,13 @@ void Progress::update(double fraction, const std::string& detail) {
     const std::size_t len = line.size();
     if (len < shown_width_) line += std::string(shown_width_ - len, ' ');
     shown_width_ = std::max(shown_width_, len);
-    std::cerr << "\r" << line << std::flush;
+    {
+      const std::lock_guard<std::mutex> lock(calib::stderrLock());  // frames may be decoded meanwhile
+      std::cerr << "\r" << line << std::flush;
+    }
     shown_ = true;
   } else if (t - last_time_ >= 5.0) {
+    const std::lock_guard<std::mutex> lock(calib::stderrLock());
     std::cerr << what_ << ": " << static_cast<int>(fraction * 100) << "%" << (detail.empty() ? "" : " " + detail) << "\n";
     last_time_ = t;
   }
@@ -61,7 +67,9 @@ void Progress::update(double fraction, const std::string& detail) {
 void Progress::finish() {
   if (finished_) return;
   finished_ = true;
-  if (shown_) std::cerr << "\r" << std::string(std::max(what_.size() + 40, shown_width_), ' ') << "\r" << std::flush;
+  if (!shown_) return;
+  const std::lock_guard<std::mutex> lock(calib::stderrLock());
+  std::cerr << "\r" << std::string(std::max(what_.size() + 40, shown_width_), ' ') << "\r" << std::flush;
 }
 
 }  // namespace kccd::cli

@@ -117,7 +117,7 @@ struct Watchdog {
 }  // namespace
 
 int main(int argc, char** argv) {
-  double bound = 20.0;
+  double bound = 60.0;
   std::vector<std::string> paths;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];

@@ -54,6 +54,7 @@
 #include <Inventor/nodes/SoSeparator.h>
 #include <Inventor/nodes/SoShape.h>
 #include <Inventor/nodes/SoSphere.h>
+#include <Inventor/misc/SoChildList.h>
 #include <Inventor/nodes/SoArray.h>
 #include <Inventor/nodes/SoMultipleCopy.h>
 
@@ -391,7 +392,8 @@ Part readStl(const std::string& data, const std::string& path, const Vec3& scale
     int line_vertices = 0;
     std::size_t line = 1, counted = 0;  // the line of the text's position `counted`
     const auto lineAt = [&](std::streamoff at) {
-      const auto end = static_cast<std::size_t>(std::max<std::streamoff>(at, 0));
+      // tellg() is -1 once the stream hit the end: the line of the text's end then.
+      const auto end = std::max(counted, at < 0 ? data.size() : static_cast<std::size_t>(at));
       line += static_cast<std::size_t>(std::count(data.begin() + static_cast<std::ptrdiff_t>(counted),
                                                   data.begin() + static_cast<std::ptrdiff_t>(std::min(end, data.size())), '\n'));
       counted = std::max(counted, std::min(end, data.size()));
@@ -509,8 +511,9 @@ void checkNesting(SoNode* root, const std::string& path) {
     if (visits > kMaxVisits)
       throw PartError(path + ": the scene expands to more than 1000000 nodes (nodes used again with USE, or Array and "
                              "MultipleCopy nodes, multiply): write the geometry out");
-    if (!e.node->isOfType(SoGroup::getClassTypeId())) continue;
-    auto* group = static_cast<SoGroup*>(e.node);
+    // Groups and node kits alike: every node with children (a kit's parts are traversed too).
+    const SoChildList* children = e.node->getChildren();
+    if (!children) continue;
     double copies = e.copies;
     if (e.node->isOfType(SoArray::getClassTypeId())) {
       const auto* array = static_cast<SoArray*>(e.node);
@@ -520,7 +523,7 @@ void checkNesting(SoNode* root, const std::string& path) {
     } else if (e.node->isOfType(SoMultipleCopy::getClassTypeId())) {
       copies *= std::max(1, static_cast<SoMultipleCopy*>(e.node)->matrix.getNum());
     }
-    for (int i = 0; i < group->getNumChildren(); ++i) stack.push_back({group->getChild(i), e.depth + 1, copies});
+    for (int i = 0; i < children->getLength(); ++i) stack.push_back({(*children)[i], e.depth + 1, copies});
   }
 }
 

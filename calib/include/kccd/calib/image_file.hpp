@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <mutex>
 #include <span>
 #include <string>
 
@@ -30,6 +31,11 @@ enum class ImageColour : std::uint8_t { Bgr, Grey, Unchanged };
 /// and fit a camera (Camera::validate's bounds: kMaxImageSide a side, kMaxImagePixels). Throws
 /// ImageError, never anything else for any bytes.
 cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& source, ImageColour colour);
+
+/// The lock decodeImage holds while one of OpenCV's decoders (formats other than PNG and JPEG) may
+/// write to std::cerr, whose buffer it swaps for that time to keep the text for its message: a
+/// thread that writes to std::cerr while images may be decoded on others takes it too.
+std::mutex& stderrLock();
 
 /// Reads a regular file of at most kMaxImageFileBytes (a FIFO or device is refused without
 /// blocking) and decodes it with decodeImage. Throws ImageError.
