@@ -8,6 +8,7 @@
 
 #include "kccd/calib/image_file.hpp"
 #include "kccd/calib/pose.hpp"
+#include "kccd/calib/pose_difference.hpp"
 #include "kccd/format_number.hpp"
 
 namespace kccd::calib {
@@ -304,27 +305,47 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   after /= static_cast<double>(frames.size());
   const double c_final = std::max(1.5, 0.004 * diagonal);
   const Evaluation e = evaluate(cam, cam.rvec, cam.tvec, final_samples, targets, c_final, true);
-  for (std::size_t f = 0; f < frames.size(); ++f) {
-    std::vector<Sample> mine;
-    for (const Sample& s : final_samples)
-      if (s.frame == f) mine.push_back(s);
-    const Evaluation ef = evaluate(cam, cam.rvec, cam.tvec, mine, targets, c_final, false);
-    result.frames[f].outline_points = static_cast<int>(mine.size());
-    result.frames[f].rms_px = ef.weight_sum > 0 ? std::sqrt(ef.weighted_sq / ef.weight_sum) : 0.0;
-  }
-  if (final_samples.size() < 12) {
+  // Each frame's outline rms and point count at `at` (the refined pose, or the start when kept).
+  const auto outlineAgreement = [&](const Camera& at, const std::vector<Sample>& samples) {
+    for (std::size_t f = 0; f < frames.size(); ++f) {
+      std::vector<Sample> mine;
+      for (const Sample& s : samples)
+        if (s.frame == f) mine.push_back(s);
+      const Evaluation ef = evaluate(at, at.rvec, at.tvec, mine, targets, c_final, false);
+      result.frames[f].outline_points = static_cast<int>(mine.size());
+      result.frames[f].rms_px = ef.weight_sum > 0 ? std::sqrt(ef.weighted_sq / ef.weight_sum) : 0.0;
+    }
+  };
+  outlineAgreement(cam, final_samples);
+  // The start is returned: its figures, not the refined pose's.
+  const auto keepStart = [&](std::string message) {
     for (FrameAgreement& a : result.frames) a.iou_after = a.iou_before;
-    result.message = "the drawn robot's outline is not in the images (" + std::to_string(final_samples.size()) +
-                     " points): the start is kept";
+    outlineAgreement(start, samplesAt(start, frames, options.spacing_px));
+    result.covariance = cv::Matx66d::zeros();
+    result.message = std::move(message);
     return result;
-  }
-  if (!(after > before + 1e-4) || worst_drop > 0.02) {
-    for (FrameAgreement& a : result.frames) a.iou_after = a.iou_before;
-    result.message = "the masks did not improve the pose (mean IoU " + formatNumber(before, 4) + " at the start, " +
+  };
+  if (final_samples.size() < 12)
+    return keepStart("the drawn robot's outline is not in the images (" + std::to_string(final_samples.size()) +
+                     " points): the start is kept");
+  if (!(after > before + 1e-4) || worst_drop > 0.02)
+    return keepStart("the masks did not improve the pose (mean IoU " + formatNumber(before, 4) + " at the start, " +
                      formatNumber(after, 4) + " refined" +
                      (worst_drop > 0.02 ? ", one frame " + formatNumber(worst_drop, 3) + " worse" : std::string()) +
-                     "): the start is kept";
-    return result;
+                     "): the start is kept");
+  // A start with known uncertainty is a strong prior: a refined pose far outside it (3 sigma) for a
+  // small gain in agreement says the masks and the volumes differ (a robot thinner than its
+  // volumes, masks that are too wide), not that the start was wrong.
+  if (options.start_is_prior && start.rotation_sigma_deg && start.position_sigma_m) {
+    const PoseDifference d = poseDifference(cam, start);
+    const double gain = after - before;
+    const double rot_sigmas = d.rotation_deg / std::max(*start.rotation_sigma_deg, 1e-9);
+    const double pos_sigmas = d.position_m / std::max(*start.position_sigma_m, 1e-12);
+    if ((rot_sigmas > 3.0 || pos_sigmas > 3.0) && gain < 0.02)
+      return keepStart("the masks' best pose lies " + formatNumber(d.rotation_deg, 3) + " deg and " +
+                       formatNumber(d.position_m * 1000, 3) + " mm from the start (" +
+                       formatNumber(std::max(rot_sigmas, pos_sigmas), 3) + " sigma) for a mean IoU gain of " +
+                       formatNumber(gain, 3) + ": the start is kept (are the volumes wider or the masks narrower than the robot?)");
   }
   // The pose's covariance from the normal equations: sigma^2 (J^T W J)^-1, with the outline
   // samples' correlation (neighbours about `spacing` apart see the same edge) counted by a factor
@@ -337,14 +358,10 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   const auto [rotation_sigma, position_sigma] = poseSigmas(cam.rvec, cam.tvec, result.covariance);
   cam.rotation_sigma_deg = rotation_sigma;
   cam.position_sigma_m = position_sigma;
-  if (after < options.min_iou || !(*cam.rotation_sigma_deg <= options.max_rotation_sigma_deg)) {
-    for (FrameAgreement& a : result.frames) a.iou_after = a.iou_before;
-    result.covariance = cv::Matx66d::zeros();
-    result.message = "the drawn robot and the masks agree too little (mean IoU " + formatNumber(after, 3) + ", at least " +
+  if (after < options.min_iou || !(*cam.rotation_sigma_deg <= options.max_rotation_sigma_deg))
+    return keepStart("the drawn robot and the masks agree too little (mean IoU " + formatNumber(after, 3) + ", at least " +
                      formatNumber(options.min_iou, 3) + " needed; rotation +-" + formatNumber(*cam.rotation_sigma_deg, 3) +
-                     " deg): check each frame's state, the clock, and which bodies the masks show (--mask-bodies); the start is kept";
-    return result;
-  }
+                     " deg): check each frame's state, the clock, and which bodies the masks show (--mask-bodies); the start is kept");
   result.camera = cam;
   result.improved = true;
   result.message = "refined to the masks: mean IoU " + formatNumber(before, 4) + " -> " + formatNumber(after, 4) + " over " +

@@ -148,8 +148,10 @@ Exit runCalib(const CalibArgs& a) {
     if (refinement) {
       for (std::size_t f = 0; f < refinement->result.frames.size(); ++f) {
         const calib::FrameAgreement& fa = refinement->result.frames[f];
-        std::cout << "mask " << a.masks[f] << ": IoU " << format(fa.iou_before, 4) << " -> " << format(fa.iou_after, 4)
-                  << ", outline " << format(fa.rms_px, 3) << " px rms over " << fa.outline_points << " points\n";
+        std::cout << "mask " << a.masks[f] << ": IoU " << format(fa.iou_before, 4);
+        if (refinement->result.improved) std::cout << " -> " << format(fa.iou_after, 4);
+        std::cout << ", outline " << format(fa.rms_px, 3) << " px rms over " << fa.outline_points << " points"
+                  << (refinement->result.improved ? "" : " (the start, kept)") << "\n";
       }
       if (!refinement->result.improved && s.solved()) std::cout << refinement->result.message << "\n";
     }

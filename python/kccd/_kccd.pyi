@@ -1,6 +1,7 @@
 """Types of the C++ extension kccd._kccd (re-exported by the kccd package)."""
 
 import enum
+import os
 from collections.abc import Callable, Sequence
 from typing import Any, Literal, TypedDict
 
@@ -166,6 +167,7 @@ class Camera:
     @staticmethod
     def load(path: str, require_pose: bool = True) -> Camera: ...
     def save(self, path: str) -> None: ...
+    def with_pose(self, rvec: _ArrayLike, tvec: _ArrayLike) -> Camera: ...
     @property
     def width(self) -> int: ...
     @property
@@ -416,6 +418,29 @@ class _Pose(TypedDict):
     rotation_sigma_deg: float | None
     position_sigma_m: float | None
 
+class _MaskFrame(TypedDict):
+    iou_before: float
+    iou_after: float
+    rms_px: float
+    outline_points: int
+
+class _Refinement(TypedDict):
+    improved: bool
+    message: str
+    camera: Camera
+    frames: list[_MaskFrame]
+    iterations: int
+    covariance: npt.NDArray[np.float64] | None
+    drawn: str
+
+def refine_to_masks(
+    camera: Camera,
+    model: Model,
+    masks: Sequence[str | os.PathLike[str] | _ArrayLike],
+    states: _ArrayLike,
+    *,
+    bodies: Sequence[str] | None = None,
+) -> _Refinement: ...
 def solve_pose(
     intrinsics: Camera,
     pixels: _ArrayLike,

@@ -1,6 +1,6 @@
 // Calibration from Python: images and recording frames as NumPy arrays, AprilTag detection, tag
-// layouts and the correspondences they give, and the camera pose solved from correspondences with
-// the statuses and quality figures of `kccd calib`.
+// layouts and the correspondences they give, the camera pose solved from correspondences with
+// the statuses and quality figures of `kccd calib`, and the pose refined to robot masks.
 #include <pybind11/stl.h>
 
 #include <opencv2/imgproc.hpp>
@@ -10,7 +10,9 @@
 #include "bindings.hpp"
 #include "kccd/calib/camera.hpp"
 #include "kccd/calib/image_file.hpp"
+#include "kccd/calib/mask_refine.hpp"
 #include "kccd/calib/pose.hpp"
+#include "kccd/calib/silhouette.hpp"
 #include "kccd/calib/tag_detect.hpp"
 #include "kccd/calib/tag_layout.hpp"
 #include "kccd/overlay/calibration/calib_gather.hpp"
@@ -50,6 +52,34 @@ cv::Mat greyOf(const py::handle& image) {
   if (channels == 3) cv::cvtColor(view, grey, cv::COLOR_RGB2GRAY);
   if (channels == 4) cv::cvtColor(view, grey, cv::COLOR_RGBA2GRAY);
   return grey;
+}
+
+// Mask `index` of a refinement: a path (read by calib::readMask) or a 2-D uint8 or bool array,
+// non-zero = robot, of the camera's size, with both robot and background in it.
+cv::Mat maskOf(const py::handle& value, std::size_t index, const calib::Camera& camera) {
+  const std::string name = "masks[" + std::to_string(index) + "]";
+  if (py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__"))
+    return calib::readMask(py::str(py::module_::import("os").attr("fspath")(value)).cast<std::string>(), camera.width,
+                           camera.height);
+  py::array a = py::array::ensure(value);
+  if (!a) {
+    PyErr_Clear();
+    throw py::type_error(name + ": expected a path or a NumPy array");
+  }
+  const char kind = a.dtype().kind();
+  if (!((kind == 'u' && a.dtype().itemsize() == 1) || kind == 'b'))
+    throw py::type_error(name + ": expected dtype uint8 or bool, got dtype " + py::str(a.dtype()).cast<std::string>());
+  if (a.ndim() != 2) throw py::value_error(name + ": expected shape (H, W)");
+  if (a.shape(0) != camera.height || a.shape(1) != camera.width)
+    throw py::value_error(name + ": " + std::to_string(a.shape(1)) + "x" + std::to_string(a.shape(0)) + " for a camera of " +
+                          std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  const auto c = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(a);
+  const cv::Mat view(camera.height, camera.width, CV_8UC1, const_cast<std::uint8_t*>(c.data()));
+  cv::Mat mask = (view != 0);
+  const int robot = cv::countNonZero(mask);
+  if (robot == 0) throw py::value_error(name + ": no robot in it (every pixel is 0)");
+  if (robot == mask.rows * mask.cols) throw py::value_error(name + ": nothing but robot (no pixel is 0)");
+  return mask;
 }
 
 py::array_t<double> rows(const std::vector<std::array<double, 3>>& v, int cols) {
@@ -257,6 +287,73 @@ quality, SOLVED only, else None), 'residuals_px' float64 (N,) and 'inlier' bool 
 (empty when none), 'rejected' (names), 'inliers', 'covariance' float64 (6, 6) of (rvec, tvec) or None, and
 'reprojection_rms_px', 'rotation_sigma_deg', 'position_sigma_m' (None unless SOLVED). Raises InputError for a
 non-finite coordinate, an empty or repeated name, or invalid intrinsics.)doc");
+
+  m.def(
+      "refine_to_masks",
+      [](const calib::Camera& camera, const std::shared_ptr<ModelHandle>& h, const py::sequence& masks,
+         const py::handle& states, const std::optional<std::vector<std::string>>& bodies) {
+        const Model& model = *h->model;
+        const int n = model.stateSize();
+        const auto st = stateMatrix(states, "states", n);
+        if (static_cast<std::size_t>(st.shape(0)) != masks.size())
+          throw py::value_error("masks, states: " + std::to_string(masks.size()) + " masks but " + std::to_string(st.shape(0)) +
+                                " states");
+        if (masks.size() == 0) throw py::value_error("masks: give at least one");
+        std::vector<int> indices;
+        if (bodies)
+          for (const std::string& b : *bodies) {
+            const int i = model.bodyIndex(b);
+            if (i < 0) throw py::value_error("bodies: the model has no body '" + b + "'");
+            indices.push_back(i);
+          }
+        std::vector<calib::MaskFrame> frames;
+        for (std::size_t f = 0; f < masks.size(); ++f) {
+          const double* row = st.data(static_cast<py::ssize_t>(f), 0);
+          frames.push_back({maskOf(masks[f], f, camera), calib::placeVolumes(model, std::span<const double>(row, static_cast<std::size_t>(n)), indices)});
+        }
+        calib::RefineResult r;
+        {
+          py::gil_scoped_release release;
+          r = calib::refineToMasks(camera, frames);
+        }
+        py::list per_frame;
+        for (const calib::FrameAgreement& a : r.frames) {
+          py::dict d;
+          d["iou_before"] = a.iou_before;
+          d["iou_after"] = a.iou_after;
+          d["rms_px"] = a.rms_px;
+          d["outline_points"] = a.outline_points;
+          per_frame.append(d);
+        }
+        py::dict out;
+        out["improved"] = r.improved;
+        out["message"] = r.message;
+        out["camera"] = r.camera;
+        out["frames"] = per_frame;
+        out["iterations"] = r.iterations;
+        if (r.improved) {
+          py::array_t<double> cov({6, 6});
+          for (int i = 0; i < 6; ++i)
+            for (int j = 0; j < 6; ++j) cov.mutable_at(i, j) = r.covariance(i, j);
+          out["covariance"] = cov;
+        } else {
+          out["covariance"] = py::none();
+        }
+        out["drawn"] = "collision volumes";
+        return out;
+      },
+      py::arg("camera"), py::arg("model"), py::arg("masks"), py::arg("states"), py::kw_only(), py::arg("bodies") = py::none(),
+      R"doc(The camera's pose refined so that the model's volumes, drawn through the lens at each frame's state,
+match robot masks of the frames, as `kccd calib --masks`: camera, a Camera with a start pose (a solve, or a rough
+pose some 10 deg / 10 cm off); masks, one per frame, each a path to an image (non-zero = robot) or a uint8 or
+bool (H, W) array of the camera's size; states float64 (frames, state_size); bodies, the names of the bodies
+that are the robot in the masks (default all). Returns a dict: 'improved' (the pose was refined; else 'camera'
+is the start), 'message' (one line: what happened, or why the start was kept), 'camera' (with the refinement's
+pose sigmas when improved), 'frames' (per frame 'iou_before', 'iou_after', 'rms_px', 'outline_points'),
+'iterations', 'covariance' float64 (6, 6) of (rvec, tvec) or None, 'drawn' (what stands for the robot:
+'collision volumes'). Raises InputError for an unreadable mask file (naming it), ValueError for a mask of
+another size, with no robot or nothing but robot, a count that does not match the states, or an unknown body.
+The GIL is released while refining.)doc");
 }
 
 }  // namespace kccd::python

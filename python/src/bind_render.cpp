@@ -2,6 +2,8 @@
 // them, off-screen, as NumPy images.
 #include <pybind11/stl.h>
 
+#include <cmath>
+
 #include <opencv2/imgproc.hpp>
 
 #include "arrays.hpp"
@@ -47,6 +49,25 @@ metres), as `kccd calib` writes it. Load with Camera.load(path).)doc")
                              "float64 (3,): world -> camera rotation (Rodrigues vector, radians)")
       .def_property_readonly("tvec", [](const calib::Camera& c) { return floatArray(c.tvec.val); },
                              "float64 (3,): world -> camera translation (metres)")
+      .def(
+          "with_pose",
+          [](const calib::Camera& c, const py::handle& rvec, const py::handle& tvec) {
+            const std::vector<double> r = stateVector(rvec, "rvec", 3), t = stateVector(tvec, "tvec", 3);
+            for (double v : r)
+              if (!std::isfinite(v)) throw py::value_error("rvec: must be finite");
+            for (double v : t)
+              if (!std::isfinite(v)) throw py::value_error("tvec: must be finite");
+            calib::Camera out = c;
+            out.rvec = cv::Vec3d(r[0], r[1], r[2]);
+            out.tvec = cv::Vec3d(t[0], t[1], t[2]);
+            out.reprojection_rms_px.reset();
+            out.rotation_sigma_deg.reset();
+            out.position_sigma_m.reset();
+            return out;
+          },
+          py::arg("rvec"), py::arg("tvec"),
+          "A copy with the pose (world -> camera) set to rvec, tvec (float64 (3,) each; a rough start for "
+          "refine_to_masks, say) and no quality figures.")
       .def_readonly("reprojection_rms_px", &calib::Camera::reprojection_rms_px)
       .def_readonly("rotation_sigma_deg", &calib::Camera::rotation_sigma_deg)
       .def_readonly("position_sigma_m", &calib::Camera::position_sigma_m)

@@ -4,18 +4,30 @@
 // - BM_DetectTags:     AprilTag detection alone (the baseline docs/explanation/benchmarks.md compares against);
 // - BM_DetectAndSolve: detection, tagCorrespondences and solvePose (the calibration of one frame);
 // - BM_Solve:          solvePose alone on the detected correspondences.
+// And the robot-mask refinement (mask_refine.hpp) on 10 frames of 960x540 of the demo arm, masks
+// by the tests' independent rasteriser (support/silhouette.hpp), against the label-only solve it
+// starts from, in the same run:
+// - BM_SolveLabels:           solvePose on 12 body labels over 3 frames, 8 px click error;
+// - BM_RefineFromLabels:      refineToMasks from that solve (kccd calib --labels --masks);
+// - BM_RefineFromTenDegrees:  refineToMasks from a pose 10 deg and 10 cm off (--camera ROUGH --masks).
 // Run with --benchmark_repetitions=5 and read the medians; tables.py gives the ratios.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <random>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <opencv2/calib3d.hpp>
 
 #include "support/cameras.hpp"
+#include "kccd/calib/mask_refine.hpp"
 #include "kccd/calib/pose.hpp"
+#include "kccd/calib/silhouette.hpp"
 #include "kccd/calib/tag_detect.hpp"
+#include "kccd/model.hpp"
+#include "support/silhouette.hpp"
 #include "support/tag_scene.hpp"
 
 namespace {
@@ -117,9 +129,98 @@ void BM_Solve(benchmark::State& state) {
   addErrors(state, f, r);
 }
 
+// The mask scene: demo_arm's pedestal, shoulder, upper arm, forearm and gripper in 10 random
+// states, seen at 960x540 (f 780 px, mild distortion) from 1.6 m.
+struct MaskScene {
+  Model model = loadModel(std::string(KCCD_DATA_DIR) + "/demo_arm.yaml");
+  std::vector<int> bodies = {0, 3, 4, 5, 6};
+  Camera truth = testing::lookAt(Vec3(1.25, -0.95, 0.9), Vec3(0.2, 0.0, 0.35), 960, 540, 780.0, {-0.08, 0.03, 0.0005, -0.0003, 0.0});
+  std::vector<MaskFrame> frames;
+  std::vector<Correspondence> labels;  // 4 per frame on the first 3 frames, 8 px off
+  Camera rough;                        // 10 deg and 10 cm from the truth
+
+  MaskScene() {
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::normal_distribution<double> click(0.0, 8.0);
+    for (int f = 0; f < 10; ++f) {
+      const std::vector<double> state = {1.2 * u(rng), 0.6 * u(rng), 1.0 * u(rng)};
+      MaskFrame frame{cv::Mat::zeros(truth.height, truth.width, CV_8UC1), placeVolumes(model, state, bodies)};
+      for (const PlacedVolume& v : frame.volumes) frame.mask |= testing::cpuSilhouette(truth, v.points, v.radius);
+      frame.mask *= 255;
+      if (f < 3)
+        for (std::size_t b = 1; b < frame.volumes.size(); ++b) {  // a click on each moving body's first core point
+          const Vec3& p = frame.volumes[b].points.front();
+          const cv::Point2d px = testing::cvProject(truth, p);
+          labels.push_back({"f" + std::to_string(f) + "b" + std::to_string(b), px + cv::Point2d(click(rng), click(rng)),
+                            cv::Point3d(p.x(), p.y(), p.z())});
+        }
+      frames.push_back(std::move(frame));
+    }
+    // 10 deg about a fixed skew axis through the camera, 10 cm along another.
+    cv::Matx33d r, d;
+    cv::Rodrigues(truth.rvec, r);
+    cv::Rodrigues(cv::Vec3d(0.6, -0.5, 0.62) * (10.0 * kPi / 180.0 / cv::norm(cv::Vec3d(0.6, -0.5, 0.62))), d);
+    const cv::Vec3d centre = testing::cameraCentre(truth) + cv::Vec3d(-0.5, 0.7, 0.5) * (0.10 / cv::norm(cv::Vec3d(-0.5, 0.7, 0.5)));
+    rough = truth;
+    cv::Rodrigues(d * r, rough.rvec);
+    rough.tvec = -((d * r) * centre);
+  }
+};
+
+const MaskScene& maskScene() {
+  static const MaskScene s;
+  return s;
+}
+
+void addMaskErrors(benchmark::State& state, const Camera& truth, const Camera& got) {
+  state.counters["rotation_error_deg"] = testing::rotationErrorDeg(got.rvec, truth.rvec);
+  state.counters["position_error_mm"] = 1000 * cv::norm(testing::cameraCentre(got) - testing::cameraCentre(truth));
+}
+
+void BM_SolveLabels(benchmark::State& state) {
+  const MaskScene& s = maskScene();
+  PoseResult r;
+  for (auto _ : state) {
+    r = solvePose(s.truth, s.labels);
+    benchmark::DoNotOptimize(r.camera.rvec);
+  }
+  if (r.status != PoseStatus::Solved) return state.SkipWithError(r.message.c_str());
+  addMaskErrors(state, s.truth, r.camera);
+  state.counters["labels"] = static_cast<double>(s.labels.size());
+}
+
+void refine(benchmark::State& state, const Camera& start) {
+  const MaskScene& s = maskScene();
+  RefineResult r;
+  for (auto _ : state) {
+    r = refineToMasks(start, s.frames);
+    benchmark::DoNotOptimize(r.camera.rvec);
+  }
+  if (!r.improved) return state.SkipWithError(r.message.c_str());
+  addMaskErrors(state, s.truth, r.camera);
+  double iou = 0.0;
+  for (const FrameAgreement& a : r.frames) iou += a.iou_after / static_cast<double>(r.frames.size());
+  state.counters["mean_iou"] = iou;
+  state.counters["frames"] = static_cast<double>(r.frames.size());
+  state.counters["iterations"] = r.iterations;
+}
+
+void BM_RefineFromLabels(benchmark::State& state) {
+  const MaskScene& s = maskScene();
+  const PoseResult start = solvePose(s.truth, s.labels);
+  if (start.status != PoseStatus::Solved) return state.SkipWithError(start.message.c_str());
+  refine(state, start.camera);
+}
+
+void BM_RefineFromTenDegrees(benchmark::State& state) { refine(state, maskScene().rough); }
+
 BENCHMARK(BM_DetectTags)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_DetectAndSolve)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Solve)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_SolveLabels)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_RefineFromLabels)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_RefineFromTenDegrees)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 }  // namespace
 

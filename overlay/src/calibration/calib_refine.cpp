@@ -62,30 +62,10 @@ MaskRefinement refineCalibrationToMasks(CalibSolution& solution, const Gathered&
                             std::to_string(model.stateSize()) + " values: give --state, or --states with --time");
     frames.push_back({in.masks[f], calib::placeVolumes(model, state, in.bodies)});
   }
-  out.result = calib::refineToMasks(start, frames);
+  calib::RefineOptions options;
+  options.start_is_prior = out.start == "solve";
+  out.result = calib::refineToMasks(start, frames, options);
   if (!out.result.improved) return out;
-  // A solved start is a strong prior: a refined pose far outside its uncertainty (3 sigma) for a
-  // small gain in agreement says the masks and the volumes differ (a robot thinner than its
-  // volumes, masks that are too wide), not that the points were wrong: the solve is kept.
-  if (out.start == "solve" && start.rotation_sigma_deg && start.position_sigma_m) {
-    const calib::PoseDifference d = calib::poseDifference(out.result.camera, start);
-    double gain = 0.0;
-    for (const calib::FrameAgreement& a : out.result.frames) gain += a.iou_after - a.iou_before;
-    gain /= static_cast<double>(out.result.frames.size());
-    const double rot_sigmas = d.rotation_deg / std::max(*start.rotation_sigma_deg, 1e-9);
-    const double pos_sigmas = d.position_m / std::max(*start.position_sigma_m, 1e-12);
-    if ((rot_sigmas > 3.0 || pos_sigmas > 3.0) && gain < 0.02) {
-      for (calib::FrameAgreement& a : out.result.frames) a.iou_after = a.iou_before;
-      out.result.improved = false;
-      out.result.camera = start;
-      out.result.covariance = cv::Matx66d::zeros();
-      out.result.message = "the masks' best pose lies " + formatNumber(d.rotation_deg, 3) + " deg and " +
-                           formatNumber(d.position_m * 1000, 3) + " mm from the points' solve (" +
-                           formatNumber(std::max(rot_sigmas, pos_sigmas), 3) + " sigma) for a mean IoU gain of " +
-                           formatNumber(gain, 3) + ": the solve is kept (are the volumes wider or the masks narrower than the robot?)";
-      return out;
-    }
-  }
 
   calib::PoseResult& pose = solution.pose;
   pose.camera = out.result.camera;

@@ -38,6 +38,9 @@ struct RefineOptions {
   int max_iterations = 40;  ///< per stage of the robust scale
   double min_iou = 0.6;     ///< a refined pose whose mean IoU stays below this is not a camera
   double max_rotation_sigma_deg = 3.0;  ///< nor one this uncertain (the points' solve has the same gate)
+  /// The start's sigmas (when it has them) are a prior: a pose more than 3 sigma from it for a mean
+  /// IoU gain below 0.02 keeps the start (the masks and the volumes differ, not the start).
+  bool start_is_prior = false;
 };
 
 /// The agreement of one frame before and after.
@@ -45,7 +48,7 @@ struct FrameAgreement {
   double iou_before = 0.0;  ///< mask IoU at the start pose
   double iou_after = 0.0;   ///< at the returned pose
   double rms_px = 0.0;      ///< outline points' distance to the mask's outline at the returned pose (robust rms)
-  int outline_points = 0;   ///< points of the drawn outline inside the image
+  int outline_points = 0;   ///< points of the drawn outline inside the image at the returned pose
 };
 
 /// The result; `camera` is the refined pose only when `improved`, else the start.
