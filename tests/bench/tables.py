@@ -98,6 +98,20 @@ def calib_table(rows):
             continue
         ratio = f"{ms(r) / ms(base):.2f}" if base else "-"
         out.append(f"| {label} | {ms(r):.1f} | {ratio} |")
+    # The mask refinement against the label-only solve it starts from (the same run).
+    labels = med.get("BM_SolveLabels")
+    if labels:
+        out += ["", "| step (10 frames of 960x540) | ms | ratio to the label solve | rotation error (deg) | position error (mm) |",
+                "|---|---|---|---|---|"]
+        refine = {"BM_SolveLabels": "solvePose on 12 labels, 8 px off (baseline)",
+                  "BM_RefineFromLabels": "refineToMasks from that solve",
+                  "BM_RefineFromTenDegrees": "refineToMasks from 10 deg / 10 cm off"}
+        for key, label in refine.items():
+            r = med.get(key)
+            if r is None:
+                continue
+            out.append(f"| {label} | {ms(r):.1f} | {ms(r) / ms(labels):.1f} | {r.get('rotation_error_deg', float('nan')):.3f} | "
+                       f"{r.get('position_error_mm', float('nan')):.2f} |")
     return "\n".join(out)
 
 
