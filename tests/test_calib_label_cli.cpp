@@ -86,6 +86,10 @@ TEST_F(CalibLabelCli, MistakesAreOneLineAndExit2) {
       {"--labels " + (dir_ / "bad.yaml").string(), (dir_ / "bad.yaml").string() + ":2:"},
       {"--labels " + labels + " --image " + (dir_ / "small.png").string(), "--labels: given 1 times for 2"},
       {"--labels " + labels + " --web-root " + (dir_ / "nothing").string(), "--web-root " + (dir_ / "nothing").string() + ": not a folder"},
+      // Snap to the robot: a mask per frame, of the camera's size, with robot in it.
+      {"--labels " + labels + " --masks " + (dir_ / "small.png").string(), "small.png: mask: 10x10, but the camera"},
+      {"--labels " + labels + " --masks " + frame_ + " " + frame_, "--masks: 2 mask(s) for 1 frame(s)"},
+      {"--labels " + labels + " --mask-bodies arm", "--mask-bodies: goes with --masks"},
   };
   for (const Case& c : cases) {
     const Outcome o = kccd::testing::runProgram(base() + " " + c.args + " -q");

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -22,6 +23,8 @@
 #include "kccd/overlay/calibration/calib_solve.hpp"
 #include "kccd/overlay/labelling/label_server.hpp"
 #include "kccd/overlay/labelling/labels_document.hpp"
+#include "kccd/render/model_view.hpp"
+#include "support/cameras.hpp"
 #include "support/files.hpp"
 
 // Last: the OpenSSL headers it pulls in define names that clash with Eigen's when they come first.
@@ -59,8 +62,12 @@ class LabelServerTest : public ::testing::Test {
     fs::remove_all(dir_);
   }
 
-  void start(const std::string& camera_output = "") {
+  void start(const std::string& camera_output = "", const cv::Mat& mask = {}) {
     LabelSessionInputs in;
+    if (!mask.empty()) {
+      in.masks = {mask};
+      in.mask_names = {"mask.png"};
+    }
     in.intrinsics = intrinsicsOf(calib::loadCamera(kData + "/demo_camera.yaml"));
     in.intrinsics_name = "demo_camera.yaml";
     in.model = model_.get();
@@ -377,6 +384,84 @@ TEST_F(LabelServerTest, NewAndBadLabelsFiles) {
   session_.reset();
   std::ofstream(labels_) << "labels: [{name: a, pixel: [1, 2]}]\n";
   EXPECT_THROW(start(), calib::LabelsError);
+}
+
+// Snap to the robot: four clicks 6 px off and a misclick do not solve (at least 6 are needed); with a robot mask
+// (drawn by the GL renderer at the sample camera, not by calib's silhouette) the snap refines the rough
+// pose from the four to the camera, the overlay draws both outlines, unchecking goes back, and a
+// save writes the snapped camera with its refinement figures.
+TEST_F(LabelServerTest, SnapToTheRobotFromFourRoughClicksAndAMisclick) {
+  const calib::Camera truth = calib::loadCamera(kData + "/demo_camera.yaml");
+  render::ModelView view(*model_, truth);
+  render::ModelViewRequest request;
+  request.state = kState;
+  request.mask = true;
+  const cv::Mat mask = view.draw(request).images.mask != 0;
+  std::ofstream(labels_) << "labels:\n"
+                            "  - {name: pedestal_0, pixel: [554.6, 444.3], world: [0, 0, 0]}\n"
+                            "  - {name: table_1, pixel: [704.6, 650.5], world: [0.95, -0.4, 0.1]}\n"
+                            "  - {name: upper_arm_1, pixel: [671.0, 368.5], body: upper_arm, point: [0.4, 0, 0]}\n"
+                            "  - {name: gripper_3, pixel: [767.9, 525.5], body: gripper, point: [0.42, 0.04, 0]}\n"
+                            "  - {name: post_misclick, pixel: [758.1, 538.7], world: [0.6, 0, 0]}\n";  // 40 px off
+  const std::string camera = (dir_ / "camera.yaml").string();
+  start(camera, mask);
+  nlohmann::json s = getJson("/api/session");
+  EXPECT_EQ(s["solve"]["snap"]["available"], true);
+  EXPECT_EQ(s["solve"]["snap"]["on"], false);
+  EXPECT_NE(s["solve"]["status"], "solved");
+
+  auto on = client_->Post("/api/snap", R"({"on": true})", "application/json");
+  ASSERT_TRUE(on);
+  ASSERT_EQ(on->status, 200) << on->body;
+  const nlohmann::json snapped = nlohmann::json::parse(on->body);
+  ASSERT_EQ(snapped["status"], "solved") << snapped.dump(1);
+  EXPECT_EQ(snapped["snap"]["on"], true);
+  EXPECT_EQ(snapped["refinement"]["start"], "points");
+  EXPECT_GT(snapped["refinement"]["frames"][0]["iou_after"].get<double>(), 0.95);
+  EXPECT_EQ(snapped["revision"], 1);
+  // The rough clicks agree with the snapped pose; the misclick is named.
+  EXPECT_EQ(snapped["rejected"], nlohmann::json({"post_misclick"})) << snapped.dump(1);
+  // The overlay carries the mask's outline (yellow) and the drawn robot's (magenta), opaque.
+  const auto png = client_->Get("/overlay/0.png");
+  ASSERT_TRUE(png);
+  const cv::Mat layer = cv::imdecode(std::vector<unsigned char>(png->body.begin(), png->body.end()), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(layer.type(), CV_8UC4);
+  cv::Mat magenta, yellow;
+  cv::inRange(layer, cv::Scalar(200, 0, 200, 255), cv::Scalar(255, 60, 255, 255), magenta);
+  cv::inRange(layer, cv::Scalar(0, 170, 200, 255), cv::Scalar(60, 255, 255, 255), yellow);
+  EXPECT_GT(cv::countNonZero(magenta), 200);
+  EXPECT_GT(cv::countNonZero(yellow), 10);  // where the outlines agree, the drawn one covers the mask's
+
+  // Saved: the snapped camera, near the true one, with the refinement's figures.
+  const auto saved = client_->Post("/api/save", "{}", "application/json");
+  ASSERT_TRUE(saved);
+  ASSERT_EQ(saved->status, 200) << saved->body;
+  const calib::Camera written = calib::loadCamera(camera);
+  const double rot = kccd::testing::rotationErrorDeg(written.rvec, truth.rvec);
+  const double pos = cv::norm(kccd::testing::cameraCentre(written) - kccd::testing::cameraCentre(truth));
+  std::printf("4 clicks 6 px off, snapped: %.3f deg, %.2f mm from the sample camera\n", rot, pos * 1e3);
+  EXPECT_LT(rot, 0.2);
+  EXPECT_LT(pos, 0.01);
+  EXPECT_NE(readText(camera).find("refinement: masks"), std::string::npos);
+
+  // Unchecked: back to the points' solve (not solved), the overlay without outlines.
+  auto off = client_->Post("/api/snap", R"({"on": false})", "application/json");
+  ASSERT_TRUE(off);
+  ASSERT_EQ(off->status, 200) << off->body;
+  EXPECT_NE(nlohmann::json::parse(off->body)["status"], "solved");
+  EXPECT_FALSE(nlohmann::json::parse(off->body).contains("refinement"));
+  const auto bad = client_->Post("/api/snap", R"({"on": "yes"})", "application/json");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+}
+
+TEST_F(LabelServerTest, SnapWithoutMasksIsRefused) {
+  start();
+  EXPECT_EQ(getJson("/api/session")["solve"]["snap"]["available"], false);
+  const auto r = client_->Post("/api/snap", R"({"on": true})", "application/json");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 409);
+  EXPECT_NE(r->body.find("--masks"), std::string::npos) << r->body;
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <thread>
 
 #include "calib_frames.hpp"
@@ -17,14 +18,15 @@
 #include "commands.hpp"
 #include "kccd/calib/image_file.hpp"
 #include "kccd/overlay/calibration/calib_gather.hpp"
+#include "kccd/calib/mask_refine.hpp"
 #include "kccd/overlay/labelling/label_server.hpp"
 
 namespace kccd::cli {
 namespace {
 
 struct LabelArgs : FrameOptions {
-  std::string intrinsics, tags, model, output, host = "127.0.0.1", web_root;
-  std::vector<std::string> labels;
+  std::string intrinsics, tags, model, output, host = "127.0.0.1", web_root, mask_bodies;
+  std::vector<std::string> labels, masks;
   int port = 0, min_inliers = 6;
   double threshold = 8.0;
   bool open = false, no_browser = false, quiet = false;
@@ -76,6 +78,24 @@ Exit runLabel(LabelArgs a) {
   in.pose.ransac_threshold_px = a.threshold;
   in.pose.min_inliers = a.min_inliers;
   in.camera_output = a.output;
+  if (!a.masks.empty()) {
+    if (!model) throw UsageError("--masks: needs --model (the robot drawn to match the masks)");
+    if (a.masks.size() != given.count)
+      throw UsageError("--masks: " + std::to_string(a.masks.size()) + " mask(s) for " + std::to_string(given.count) +
+                       " frame(s): give one per frame, in the same order");
+    for (const std::string& m : a.masks) {
+      in.masks.push_back(calib::readMask(m, in.intrinsics.width, in.intrinsics.height));
+      in.mask_names.push_back(m);
+    }
+    std::stringstream list(a.mask_bodies);
+    for (std::string name; std::getline(list, name, ',');) {
+      const int b = model->bodyIndex(name);
+      if (b < 0) throw UsageError("--mask-bodies: '" + name + "' is not a body of " + a.model + " (kccd info lists them)");
+      in.mask_bodies.push_back(b);
+    }
+  } else if (!a.mask_bodies.empty()) {
+    throw UsageError("--mask-bodies: goes with --masks");
+  }
   for (std::size_t f = 0; f < given.count; ++f) {
     overlay::LabelFrame frame;
     frame.name = given.names[f];
@@ -154,6 +174,11 @@ Runner addCalibLabel(CLI::App& calib) {
   sub->add_option("--max-gap", a->max_gap, "No state when the log has no sample this close (s)")->check(finiteIn(0, 1e300));
   sub->add_option("--ignore-columns", a->ignore_columns, "Comma-separated state log columns to skip");
   sub->add_option("-o,--output", a->output, "Camera file Save writes when the pose is solved");
+  sub->add_option("--masks", a->masks,
+                  "Robot masks, one per frame in the same order (non-zero = robot): the page's Snap to the robot refines the "
+                  "pose so the model's drawn robot matches them, as kccd calib --masks; needs --model and each frame's state")
+      ->expected(1, -1);
+  sub->add_option("--mask-bodies", a->mask_bodies, "Comma-separated bodies of the model that the masks show (default: all bodies)");
   sub->add_option("--threshold", a->threshold, "RANSAC threshold (px), as kccd calib")->check(finiteIn(0.1, 1000))->capture_default_str();
   sub->add_option("--min-inliers", a->min_inliers, "Fewer agreeing points: not solvable, as kccd calib")
       ->check(CLI::Range(4, 1000000))

@@ -265,7 +265,38 @@ function renderSolve() {
   // the volumes may be off in the image, and who was rejected.
   if (solved && s.volume_sigma_px != null) text += `\nthe volumes: ±${n(s.volume_sigma_px)} px (1 σ, worst core point)`;
   if (s.rejected && s.rejected.length) text += `\nrejected: ${s.rejected.join(", ")}`;
+  // Snapping to the robot masks: whether it is on, and what it did (IoU per frame before -> after).
+  const snap = s.snap || { available: false, on: false };
+  $("snapbox").hidden = !snap.available;
+  $("snap").checked = snap.on;
+  if (snap.on) {
+    const r = s.refinement;
+    if (r && r.improved)
+      text += `\nsnapped to the masks: IoU ${r.frames.map((f) => `${n(f.iou_before)} → ${n(f.iou_after)}`).join(", ")}` +
+        `\n(yellow: the mask's outline, magenta: the drawn robot's)`;
+    else text += `\nnot snapped: ${snap.message}`;
+  }
   $("figures").textContent = text;
+}
+
+async function setSnap(on) {
+  if (inflight) await inflight.catch(() => {});
+  $("stale").hidden = false;
+  $("snap").disabled = true;
+  try {
+    state.solve = await api("POST", "/api/snap", { on });
+    state.revision = state.solve.revision;
+    message("");
+    await refreshOverlay(state.frame);
+  } catch (e) {
+    message(e.message, true);
+  } finally {
+    $("stale").hidden = true;
+    $("snap").disabled = false;
+    renderSolve();
+    renderLabels();
+    draw();
+  }
 }
 
 function renderLabels() {
@@ -588,6 +619,7 @@ function showRecovered() {
   $("recovered").hidden = !r;
   if (r) $("recovered-text").textContent = `${r.file} holds ${r.labels.labels.length} label(s) autosaved after the labels file was last saved.`;
 }
+$("snap").onchange = () => setSnap($("snap").checked);
 $("restore").onclick = () => {
   const f = state.session.frames[state.frame];
   if (!f.recovered) return;

@@ -2,7 +2,10 @@
 // playwright-core, headless) labels the demo's points as an operator would (a world point typed
 // in, a body point found by search, then a click on the frame), a click on the drawn volumes offers
 // that body's nearest point first, saves, and the residual table the page shows must match
-// `kccd calib --json` on the saved file. A screenshot is kept.
+// `kccd calib --json` on the saved file. A screenshot is kept. Then "snap to the robot": four
+// rough clicks that do not solve, a robot mask drawn by `kccd render --mask`, the box ticked: the
+// page shows the snapped pose and both outlines (screenshot label_page_snap.png), unticked it goes
+// back.
 //   node label_page.mjs KCCD DATA_DIR OUT_DIR
 // Exit 0 passed, 1 failed (also when no browser can start: never skipped).
 import { spawn, execFileSync } from "node:child_process";
@@ -23,18 +26,44 @@ const fail = (why) => {
   process.exitCode = 1;
 };
 
+// `kccd calib label ARGS` started, and the address it prints first.
+async function serve(args) {
+  const server = spawn(kccd, ["calib", "label", ...args], { stdio: ["ignore", "pipe", "inherit"] });
+  const url = await new Promise((resolve, reject) => {
+    createInterface({ input: server.stdout }).once("line", resolve);
+    server.once("exit", (code) => reject(new Error(`kccd calib label exited with ${code} before printing its URL`)));
+  });
+  return { server, url };
+}
+
+// Headless chromium on `url`, the page ready; its uncaught errors collected in `errors`.
+async function openPage(url) {
+  const browser = await chromium.launch({ executablePath: "/usr/bin/chromium", headless: true,
+    args: ["--no-sandbox", "--disable-background-networking", "--disable-gpu"] });
+  // bypassCSP: the page's policy forbids eval, which Playwright's waitForFunction uses.
+  const context = await browser.newContext({ viewport: { width: 1600, height: 900 }, bypassCSP: true });
+  const page = await context.newPage();
+  const errors = [];
+  page.on("pageerror", (e) => errors.push(e.message));
+  await page.goto(url);
+  await page.waitForSelector("body[data-ready='1']", { timeout: 20000 });
+  return { browser, page, errors };
+}
+
+// The server's exit status once it has stopped (it is sent SIGTERM half a second from now).
+async function stopped(server) {
+  setTimeout(() => server.kill("SIGTERM"), 500);
+  return server.exitCode !== null ? server.exitCode : await new Promise((resolve) => server.once("exit", (c) => resolve(c)));
+}
+
 // The frame: the demo arm rendered at the labels' state (what the camera sees, on grey).
 const frame = join(out, "frame.png");
 execFileSync(kccd, ["render", join(data, "demo_arm.yaml"), "--camera", join(data, "demo_camera.yaml"), "--state", "0.3,0.4,0.6",
   "--no-legend", "-o", frame]);
 const labels = join(out, "labels.yaml");
 const camera = join(out, "camera.yaml");
-const server = spawn(kccd, ["calib", "label", "--intrinsics", join(data, "demo_camera.yaml"), "--image", frame, "--labels", labels,
-  "--model", join(data, "demo_arm.yaml"), "--state", "0.3,0.4,0.6", "-o", camera, "-q"], { stdio: ["ignore", "pipe", "inherit"] });
-const url = await new Promise((resolve, reject) => {
-  createInterface({ input: server.stdout }).once("line", resolve);
-  server.once("exit", (code) => reject(new Error(`kccd calib label exited with ${code} before printing its URL`)));
-});
+const { server, url } = await serve(["--intrinsics", join(data, "demo_camera.yaml"), "--image", frame, "--labels", labels,
+  "--model", join(data, "demo_arm.yaml"), "--state", "0.3,0.4,0.6", "-o", camera, "-q"]);
 if (!/^http:\/\/127\.0\.0\.1:\d+\/$/.test(url)) fail(`first line is not the URL: ${url}`);
 
 // The demo's labels (data/demo_labels.yaml): world points typed in; the shoulder's core point
@@ -51,15 +80,8 @@ const wanted = [
 
 let browser;
 try {
-  browser = await chromium.launch({ executablePath: "/usr/bin/chromium", headless: true,
-    args: ["--no-sandbox", "--disable-background-networking", "--disable-gpu"] });
-  // bypassCSP: the page's policy forbids eval, which Playwright's waitForFunction uses.
-  const context = await browser.newContext({ viewport: { width: 1600, height: 900 }, bypassCSP: true });
-  const page = await context.newPage();
-  const errors = [];
-  page.on("pageerror", (e) => errors.push(e.message));
-  await page.goto(url);
-  await page.waitForSelector("body[data-ready='1']", { timeout: 20000 });
+  let page, errors;
+  ({ browser, page, errors } = await openPage(url));
   const settle = () => page.waitForFunction(() => !window.kccdPage.pending(), null, { timeout: 20000 });
   for (const w of wanted) {
     await page.click("#worldform summary").catch(() => {});
@@ -135,7 +157,49 @@ try {
   fail(e.stack || String(e));
 } finally {
   if (browser) await browser.close();
-  setTimeout(() => server.kill("SIGTERM"), 500);
 }
-const code = server.exitCode !== null ? server.exitCode : await new Promise((resolve) => server.once("exit", (c) => resolve(c)));
+const code = await stopped(server);
 if (code !== 0) fail(`kccd calib label exited with ${code}`);
+
+// Snap to the robot.
+const mask = join(out, "mask.png");
+execFileSync(kccd, ["render", join(data, "demo_arm.yaml"), "--camera", join(data, "demo_camera.yaml"), "--state", "0.3,0.4,0.6",
+  "--mask", "-o", mask]);
+const rough = join(out, "rough.yaml");
+execFileSync("sh", ["-c", `cat > '${rough}' <<'EOF'
+labels:
+  - {name: pedestal_0, pixel: [554.6, 444.3], world: [0, 0, 0]}
+  - {name: table_1, pixel: [704.6, 650.5], world: [0.95, -0.4, 0.1]}
+  - {name: upper_arm_1, pixel: [671.0, 368.5], body: upper_arm, point: [0.4, 0, 0]}
+  - {name: gripper_3, pixel: [767.9, 525.5], body: gripper, point: [0.42, 0.04, 0]}
+EOF`]);
+const { server: snapServer, url: snapUrl } = await serve(["--intrinsics", join(data, "demo_camera.yaml"), "--image", frame,
+  "--labels", rough, "--model", join(data, "demo_arm.yaml"), "--state", "0.3,0.4,0.6", "--masks", mask, "-q"]);
+let browser2;
+try {
+  let page, errors;
+  ({ browser: browser2, page, errors } = await openPage(snapUrl));
+  if (await page.$eval("#snapbox", (e) => e.hidden)) fail("with --masks the page offers no snap");
+  const before = await page.evaluate(() => window.kccdPage.solve().status);
+  if (before === "solved") fail("four clicks solved without the snap: the test shows nothing");
+  await page.check("#snap");
+  await page.waitForFunction(() => window.kccdPage.solve().snap.on && !document.getElementById("snap").disabled, null, { timeout: 60000 });
+  const snapped = await page.evaluate(() => window.kccdPage.solve());
+  if (snapped.status !== "solved") fail(`snapped: status ${snapped.status} (${snapped.snap.message})`);
+  const figures = await page.$eval("#figures", (e) => e.textContent);
+  if (!figures.includes("snapped to the masks: IoU")) fail(`the figures do not say the snap: ${figures}`);
+  await page.screenshot({ path: join(out, "label_page_snap.png") });
+  await page.uncheck("#snap");
+  await page.waitForFunction(() => !window.kccdPage.solve().snap.on && !document.getElementById("snap").disabled, null, { timeout: 60000 });
+  if ((await page.evaluate(() => window.kccdPage.solve().status)) !== before) fail("unticked, the solve is not the points' again");
+  if (errors.length) fail(`errors in the page: ${errors.join("; ")}`);
+  console.log(`label_page: snapped from 4 clicks: IoU ${snapped.refinement.frames[0].iou_before.toFixed(3)} -> ` +
+    `${snapped.refinement.frames[0].iou_after.toFixed(3)}; screenshot ${join(out, "label_page_snap.png")}`);
+  await page.click("#quit");
+} catch (e) {
+  fail(e.stack || String(e));
+} finally {
+  if (browser2) await browser2.close();
+}
+const code2 = await stopped(snapServer);
+if (code2 !== 0) fail(`kccd calib label --masks exited with ${code2}`);

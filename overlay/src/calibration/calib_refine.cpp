@@ -71,10 +71,11 @@ MaskRefinement refineCalibrationToMasks(CalibSolution& solution, const Gathered&
   pose.camera = out.result.camera;
   pose.covariance = out.result.covariance;
   pose.status = calib::PoseStatus::Solved;
-  // Every point's residual under the refined pose; those far off are named.
+  // Every point's residual under the refined pose; those far off are named: farther than 3 times
+  // the outline's rms, 3 times the clicks' median residual (rough clicks are all a few pixels off:
+  // a misclick is off by much more than the others) and 4 px.
   double outline_rms = 0.0;
   for (const calib::FrameAgreement& a : out.result.frames) outline_rms = std::max(outline_rms, a.rms_px);
-  const double limit = std::max(4.0, 3.0 * outline_rms);
   pose.residuals.clear();
   pose.rejected.clear();
   if (!g.points.empty()) {
@@ -82,10 +83,21 @@ MaskRefinement refineCalibrationToMasks(CalibSolution& solution, const Gathered&
     for (const calib::Correspondence& c : g.points) world.push_back(c.world);
     std::vector<cv::Point2d> px;
     cv::projectPoints(world, pose.camera.rvec, pose.camera.tvec, pose.camera.camera_matrix, pose.camera.distortion, px);
+    std::vector<double> d(g.points.size());
+    for (std::size_t i = 0; i < g.points.size(); ++i) d[i] = std::hypot(px[i].x - g.points[i].pixel.x, px[i].y - g.points[i].pixel.y);
+    std::vector<double> finite;
+    for (double v : d)
+      if (std::isfinite(v)) finite.push_back(v);
+    double median = 0.0;
+    if (!finite.empty()) {
+      std::sort(finite.begin(), finite.end());
+      const std::size_t n = finite.size();
+      median = n % 2 ? finite[n / 2] : 0.5 * (finite[n / 2 - 1] + finite[n / 2]);
+    }
+    const double limit = std::max({4.0, 3.0 * outline_rms, 3.0 * median});
     for (std::size_t i = 0; i < g.points.size(); ++i) {
-      const double d = std::hypot(px[i].x - g.points[i].pixel.x, px[i].y - g.points[i].pixel.y);
-      const bool agrees = std::isfinite(d) && d <= limit;
-      pose.residuals.push_back({g.points[i].name, d, agrees});
+      const bool agrees = std::isfinite(d[i]) && d[i] <= limit;
+      pose.residuals.push_back({g.points[i].name, d[i], agrees});
       if (!agrees) out.disagreeing.push_back(g.points[i].name), pose.rejected.push_back(g.points[i].name);
     }
   }

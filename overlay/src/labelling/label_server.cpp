@@ -194,6 +194,24 @@ struct LabelServer::Impl {
       if (i < 0 || static_cast<std::size_t>(i) >= session.frameCount()) return sendError(res, 404, "no such frame");
       sendJson(res, 200, session.pick(static_cast<std::size_t>(i), at[0], at[1]));
     });
+    server.Post("/api/snap", [this](const httplib::Request& req, httplib::Response& res) {
+      nlohmann::json body;
+      try {
+        body = nlohmann::json::parse(req.body);
+      } catch (const nlohmann::json::parse_error& e) {
+        return sendError(res, 400, "request body: not JSON (" + std::string(e.what()) + ")");
+      }
+      if (!body.is_object() || !body.contains("on") || !body["on"].is_boolean())
+        return sendError(res, 400, "request body: expected {\"on\": true|false}");
+      const std::lock_guard<std::mutex> lock(mutex);
+      if (!session.session()["solve"]["snap"]["available"].get<bool>())
+        return sendError(res, 409, "no robot masks to snap to: start kccd calib label with --masks");
+      try {
+        sendJson(res, 200, session.setSnap(body["on"].get<bool>()));
+      } catch (const InputError& e) {
+        sendError(res, 400, e.what());
+      }
+    });
     server.Post("/api/save", [this](const httplib::Request&, httplib::Response& res) {
       const std::lock_guard<std::mutex> lock(mutex);
       const LabelSaved saved = session.save();

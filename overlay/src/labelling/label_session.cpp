@@ -84,6 +84,14 @@ std::vector<unsigned char> encodePng(const cv::Mat& image) {
 
 LabelSession::LabelSession(LabelSessionInputs inputs) : in_(std::move(inputs)) {
   if (in_.frames.empty()) throw std::invalid_argument("LabelSession: no frames");
+  if (!in_.masks.empty()) {
+    if (in_.masks.size() != in_.frames.size() || !in_.model)
+      throw std::invalid_argument("LabelSession: masks need a model and one mask per frame");
+    for (std::size_t i = 0; i < in_.frames.size(); ++i)
+      if (!in_.frames[i].state)
+        throw CalibInputError("--masks: frame " + std::to_string(i + 1) + " (" + in_.frames[i].name +
+                              ") has no state: the masks are matched by the model drawn at each frame's state");
+  }
   frames_.resize(in_.frames.size());
   for (std::size_t i = 0; i < in_.frames.size(); ++i) {
     const LabelFrame& f = in_.frames[i];
@@ -125,8 +133,25 @@ void LabelSession::resolve() {
     g.frames.push_back(std::move(f));
   }
   const Gathered gathered = gatherCorrespondences(g);
-  const CalibSolution s = solveCalibration(in_.intrinsics, gathered, in_.pose, in_.model);
+  CalibSolution s = solveCalibration(in_.intrinsics, gathered, in_.pose, in_.model);
+  // Snapping: the solve refined to the masks; without a start (fewer than 4 points), said.
+  refinement_.reset();
+  std::string snap_message;
+  if (snap_) {
+    MaskInputs masks;
+    masks.masks = in_.masks;
+    masks.mask_names = in_.mask_names;
+    masks.bodies = in_.mask_bodies;
+    try {
+      refinement_ = refineCalibrationToMasks(s, gathered, in_.intrinsics, *in_.model, masks);
+      snap_message = refinement_->result.message;
+    } catch (const CalibInputError& e) {
+      snap_message = e.what();
+    }
+  }
   nlohmann::json report = calibReport(gathered, s, {.camera = s.solved() ? in_.camera_output : std::string()});
+  report["snap"] = {{"available", !in_.masks.empty()}, {"on", snap_}, {"message", snap_message}};
+  if (refinement_) report["refinement"] = refinementJson(*refinement_);
   report["rms_px"] = s.solved() && s.pose.camera.reprojection_rms_px ? nlohmann::json(*s.pose.camera.reprojection_rms_px)
                                                                         : nlohmann::json(nullptr);
   report["revision"] = revision_;
@@ -224,6 +249,21 @@ nlohmann::json LabelSession::putLabels(std::size_t frame, const nlohmann::json& 
   return solve_json_;
 }
 
+nlohmann::json LabelSession::setSnap(bool on) {
+  if (in_.masks.empty()) throw std::logic_error("the session has no robot masks to snap to (kccd calib label --masks)");
+  const bool old = snap_;
+  snap_ = on;
+  ++revision_;
+  try {
+    resolve();
+  } catch (...) {
+    snap_ = old;
+    --revision_;
+    throw;
+  }
+  return solve_json_;
+}
+
 nlohmann::json LabelSession::modelPoints(std::size_t frame) const {
   const LabelFrame& f = in_.frames.at(frame);
   if (!solved_ || !in_.model || !f.state) return nlohmann::json::array();
@@ -279,6 +319,19 @@ const std::vector<unsigned char>& LabelSession::overlayPng(std::size_t frame) {
     render::ModelFrame drawn = view.draw(request);
     layer = std::move(drawn.images.bgra);
     f.mask = std::move(drawn.images.mask);
+    if (refinement_ && frame < in_.masks.size()) {
+      // The mask's outline and the drawn robot's, opaque over the volumes.
+      cv::Mat lines = cv::Mat::zeros(layer.rows, layer.cols, CV_8UC3);
+      drawMaskAgreement(lines, *solved_, in_.masks[frame], calib::placeVolumes(*in_.model, *in.state, in_.mask_bodies));
+      for (int y = 0; y < lines.rows; ++y)
+        for (int x = 0; x < lines.cols; ++x)
+          if (const cv::Vec3b c = lines.at<cv::Vec3b>(y, x); c != cv::Vec3b(0, 0, 0)) {
+            // Anti-aliased edges: the colour at full strength, its coverage as alpha.
+            const int a = std::max({c[0], c[1], c[2]});
+            const auto full = [a](unsigned char v) { return static_cast<unsigned char>(v * 255 / a); };
+            layer.at<cv::Vec4b>(y, x) = cv::Vec4b(full(c[0]), full(c[1]), full(c[2]), static_cast<unsigned char>(a));
+          }
+    }
   } else {
     layer = cv::Mat(in.bgr.rows, in.bgr.cols, CV_8UC4, cv::Scalar(0, 0, 0, 0));
     f.mask = cv::Mat();
@@ -308,7 +361,7 @@ LabelSaved LabelSession::save() {
     saved.labels.push_back(path);
   }
   if (solved_ && !in_.camera_output.empty()) {
-    writeFileAtomically(in_.camera_output, calib::cameraText(*solved_));
+    writeFileAtomically(in_.camera_output, calib::cameraText(*solved_) + (refinement_ ? refinementText(*refinement_) : std::string()));
     saved.camera = in_.camera_output;
   }
   dirty_ = false;

@@ -17,6 +17,7 @@
 #include "kccd/calib/pose.hpp"
 #include "kccd/calib/tag_layout.hpp"
 #include "kccd/model.hpp"
+#include "kccd/overlay/calibration/calib_refine.hpp"
 
 namespace kccd::overlay {
 
@@ -38,6 +39,11 @@ struct LabelSessionInputs {
   calib::PoseOptions pose;               ///< as `kccd calib` takes them
   std::string camera_output;             ///< the camera file save() writes when solved; empty: none
   int corners = 40;                      ///< strong corners offered per frame
+  /// Robot masks, one per frame (CV_8UC1 of the camera's size, non-zero = robot), or none: with
+  /// them the page can snap the pose to the robot (setSnap). Every frame then needs a state.
+  std::vector<cv::Mat> masks;
+  std::vector<std::string> mask_names;  ///< one per mask, as messages name them
+  std::vector<int> mask_bodies;         ///< the bodies the masks show (empty: all)
 };
 
 /// Where save() wrote.
@@ -76,6 +82,13 @@ class LabelSession {
   /// LABELS.yaml.bak is newer than LABELS.yaml and differs offers it as frames[i].recovered.
   nlohmann::json putLabels(std::size_t frame, const nlohmann::json& document);
 
+  /// Snaps the pose to the robot masks (on) or goes back to the points' solve (off), then solves
+  /// again; returns solve(). While on, every solve is refined to the masks as `kccd calib --masks`
+  /// refines it (from the points' solve, or a rough pose from 4 or more points), solve() carries
+  /// `refinement` (refinementJson) and the overlay draws the mask's outline (yellow) and the drawn
+  /// robot's (magenta). std::logic_error when the session has no masks.
+  nlohmann::json setSnap(bool on);
+
   /// Frame `frame`'s picture as PNG bytes. std::out_of_range for a bad frame.
   const std::vector<unsigned char>& framePng(std::size_t frame) const;
 
@@ -107,6 +120,8 @@ class LabelSession {
   std::vector<Frame> frames_;
   nlohmann::json solve_json_;
   std::optional<calib::Camera> solved_;
+  bool snap_ = false;
+  std::optional<MaskRefinement> refinement_;  ///< the last solve's refinement while snapping
   int revision_ = 0;
   bool dirty_ = false;
 };
