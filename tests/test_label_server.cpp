@@ -444,7 +444,22 @@ TEST_F(LabelServerTest, SnapToTheRobotFromFourRoughClicksAndAMisclick) {
   EXPECT_LT(pos, 0.01);
   EXPECT_NE(readText(camera).find("refinement: masks"), std::string::npos);
 
-  // Unchecked: back to the points' solve (not solved), the overlay without outlines.
+  // An edit while snapping is snapped again; with fewer than 4 points there is no start, said.
+  nlohmann::json two = getJson("/api/session")["labels"];
+  two["labels"] = nlohmann::json::array({two["labels"][0], two["labels"][1]});
+  const auto few = putLabels(two);
+  ASSERT_TRUE(few);
+  ASSERT_EQ(few->status, 200) << few->body;
+  const nlohmann::json unsnapped = nlohmann::json::parse(few->body);
+  EXPECT_NE(unsnapped["status"], "solved");
+  EXPECT_EQ(unsnapped["snap"]["on"], true);
+  EXPECT_FALSE(unsnapped["snap"]["message"].get<std::string>().empty()) << unsnapped.dump(1);
+  EXPECT_FALSE(unsnapped.contains("refinement"));
+  const auto back = putLabels(s["labels"]);
+  ASSERT_TRUE(back);
+  EXPECT_EQ(nlohmann::json::parse(back->body)["status"], "solved") << back->body;
+
+  // Unchecked: back to the points' solve (not solved).
   auto off = client_->Post("/api/snap", R"({"on": false})", "application/json");
   ASSERT_TRUE(off);
   ASSERT_EQ(off->status, 200) << off->body;

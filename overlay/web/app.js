@@ -279,23 +279,32 @@ function renderSolve() {
   $("figures").textContent = text;
 }
 
+// Snap on or off: one request at a time with the label edits (an edit made meanwhile is sent
+// after it, as resolve() does), the box disabled until the answer is shown.
 async function setSnap(on) {
-  if (inflight) await inflight.catch(() => {});
-  $("stale").hidden = false;
   $("snap").disabled = true;
+  while (inflight) await inflight.catch(() => {});
+  $("stale").hidden = false;
+  inflight = api("POST", "/api/snap", { on });
   try {
-    state.solve = await api("POST", "/api/snap", { on });
+    state.solve = await inflight;
     state.revision = state.solve.revision;
+    state.dirty = true;  // Save writes another camera now
     message("");
     await refreshOverlay(state.frame);
   } catch (e) {
     message(e.message, true);
   } finally {
+    inflight = null;
     $("stale").hidden = true;
     $("snap").disabled = false;
     renderSolve();
     renderLabels();
     draw();
+    if (again) {
+      again = false;
+      resolve();
+    }
   }
 }
 

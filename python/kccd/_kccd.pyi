@@ -440,6 +440,7 @@ def refine_to_masks(
     states: _ArrayLike,
     *,
     bodies: Sequence[str] | None = None,
+    start_is_prior: bool | None = None,
 ) -> _Refinement: ...
 def solve_pose(
     intrinsics: Camera,

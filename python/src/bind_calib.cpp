@@ -291,7 +291,9 @@ non-finite coordinate, an empty or repeated name, or invalid intrinsics.)doc");
   m.def(
       "refine_to_masks",
       [](const calib::Camera& camera, const std::shared_ptr<ModelHandle>& h, const py::sequence& masks,
-         const py::handle& states, const std::optional<std::vector<std::string>>& bodies) {
+         const py::handle& states, const std::optional<std::vector<std::string>>& bodies, const std::optional<bool>& start_is_prior) {
+        if (py::isinstance<py::str>(masks) || py::isinstance<py::bytes>(masks))
+          throw py::type_error("masks: a list of masks (one per frame), not one path");
         const Model& model = *h->model;
         const int n = model.stateSize();
         const auto st = stateMatrix(states, "states", n);
@@ -311,10 +313,13 @@ non-finite coordinate, an empty or repeated name, or invalid intrinsics.)doc");
           const double* row = st.data(static_cast<py::ssize_t>(f), 0);
           frames.push_back({maskOf(masks[f], f, camera), calib::placeVolumes(model, std::span<const double>(row, static_cast<std::size_t>(n)), indices)});
         }
+        calib::RefineOptions options;
+        // As kccd calib: a start with sigmas (a solve) is a prior unless told otherwise.
+        options.start_is_prior = start_is_prior.value_or(camera.rotation_sigma_deg && camera.position_sigma_m);
         calib::RefineResult r;
         {
           py::gil_scoped_release release;
-          r = calib::refineToMasks(camera, frames);
+          r = calib::refineToMasks(camera, frames, options);
         }
         py::list per_frame;
         for (const calib::FrameAgreement& a : r.frames) {
@@ -343,11 +348,14 @@ non-finite coordinate, an empty or repeated name, or invalid intrinsics.)doc");
         return out;
       },
       py::arg("camera"), py::arg("model"), py::arg("masks"), py::arg("states"), py::kw_only(), py::arg("bodies") = py::none(),
+      py::arg("start_is_prior") = py::none(),
       R"doc(The camera's pose refined so that the model's volumes, drawn through the lens at each frame's state,
 match robot masks of the frames, as `kccd calib --masks`: camera, a Camera with a start pose (a solve, or a rough
 pose some 10 deg / 10 cm off); masks, one per frame, each a path to an image (non-zero = robot) or a uint8 or
 bool (H, W) array of the camera's size; states float64 (frames, state_size); bodies, the names of the bodies
-that are the robot in the masks (default all). Returns a dict: 'improved' (the pose was refined; else 'camera'
+that are the robot in the masks (default all); start_is_prior: the start's sigmas are a prior, so a pose more than
+3 sigma from it for a mean IoU gain below 0.02 keeps the start (default: when the camera has sigmas, i.e. a solve
+such as solve_pose's, as kccd calib does). Returns a dict: 'improved' (the pose was refined; else 'camera'
 is the start), 'message' (one line: what happened, or why the start was kept), 'camera' (with the refinement's
 pose sigmas when improved), 'frames' (per frame 'iou_before', 'iou_after', 'rms_px', 'outline_points'),
 'iterations', 'covariance' float64 (6, 6) of (rvec, tvec) or None, 'drawn' (what stands for the robot:

@@ -9,7 +9,7 @@
 //   node label_page.mjs KCCD DATA_DIR OUT_DIR
 // Exit 0 passed, 1 failed (also when no browser can start: never skipped).
 import { spawn, execFileSync } from "node:child_process";
-import { mkdirSync, rmSync, existsSync, readFileSync } from "node:fs";
+import { mkdirSync, rmSync, existsSync, readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
 import { createInterface } from "node:readline";
 import { chromium } from "playwright-core";
@@ -45,6 +45,7 @@ async function openPage(url) {
   const page = await context.newPage();
   const errors = [];
   page.on("pageerror", (e) => errors.push(e.message));
+  page.on("dialog", (d) => d.accept());  // "Quit without saving?": yes
   await page.goto(url);
   await page.waitForSelector("body[data-ready='1']", { timeout: 20000 });
   return { browser, page, errors };
@@ -166,13 +167,12 @@ const mask = join(out, "mask.png");
 execFileSync(kccd, ["render", join(data, "demo_arm.yaml"), "--camera", join(data, "demo_camera.yaml"), "--state", "0.3,0.4,0.6",
   "--mask", "-o", mask]);
 const rough = join(out, "rough.yaml");
-execFileSync("sh", ["-c", `cat > '${rough}' <<'EOF'
-labels:
+writeFileSync(rough, `labels:
   - {name: pedestal_0, pixel: [554.6, 444.3], world: [0, 0, 0]}
   - {name: table_1, pixel: [704.6, 650.5], world: [0.95, -0.4, 0.1]}
   - {name: upper_arm_1, pixel: [671.0, 368.5], body: upper_arm, point: [0.4, 0, 0]}
   - {name: gripper_3, pixel: [767.9, 525.5], body: gripper, point: [0.42, 0.04, 0]}
-EOF`]);
+`);
 const { server: snapServer, url: snapUrl } = await serve(["--intrinsics", join(data, "demo_camera.yaml"), "--image", frame,
   "--labels", rough, "--model", join(data, "demo_arm.yaml"), "--state", "0.3,0.4,0.6", "--masks", mask, "-q"]);
 let browser2;

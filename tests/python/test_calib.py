@@ -210,6 +210,8 @@ def test_refine_to_masks_bad_input(arm: kccd.Model, camera: kccd.Camera, tmp_pat
         kccd.refine_to_masks(camera, arm, [np.ones_like(good)], states)
     with pytest.raises(TypeError, match="uint8 or bool"):
         kccd.refine_to_masks(camera, arm, [good.astype(np.float32)], states)
+    with pytest.raises(TypeError, match="not one path"):
+        kccd.refine_to_masks(camera, arm, "mask.png", states)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="2 masks but 1 states"):
         kccd.refine_to_masks(camera, arm, [good, good], states)
     with pytest.raises(ValueError, match="no body 'wing'"):

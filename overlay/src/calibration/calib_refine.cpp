@@ -72,8 +72,8 @@ MaskRefinement refineCalibrationToMasks(CalibSolution& solution, const Gathered&
   pose.covariance = out.result.covariance;
   pose.status = calib::PoseStatus::Solved;
   // Every point's residual under the refined pose; those far off are named: farther than 3 times
-  // the outline's rms, 3 times the clicks' median residual (rough clicks are all a few pixels off:
-  // a misclick is off by much more than the others) and 4 px.
+  // the outline's rms, 3 times the other clicks' median residual (rough clicks are all a few
+  // pixels off: a misclick is off by much more than the others) and 4 px.
   double outline_rms = 0.0;
   for (const calib::FrameAgreement& a : out.result.frames) outline_rms = std::max(outline_rms, a.rms_px);
   pose.residuals.clear();
@@ -85,17 +85,18 @@ MaskRefinement refineCalibrationToMasks(CalibSolution& solution, const Gathered&
     cv::projectPoints(world, pose.camera.rvec, pose.camera.tvec, pose.camera.camera_matrix, pose.camera.distortion, px);
     std::vector<double> d(g.points.size());
     for (std::size_t i = 0; i < g.points.size(); ++i) d[i] = std::hypot(px[i].x - g.points[i].pixel.x, px[i].y - g.points[i].pixel.y);
-    std::vector<double> finite;
-    for (double v : d)
-      if (std::isfinite(v)) finite.push_back(v);
-    double median = 0.0;
-    if (!finite.empty()) {
-      std::sort(finite.begin(), finite.end());
-      const std::size_t n = finite.size();
-      median = n % 2 ? finite[n / 2] : 0.5 * (finite[n / 2 - 1] + finite[n / 2]);
-    }
-    const double limit = std::max({4.0, 3.0 * outline_rms, 3.0 * median});
+    // The median of the other points' residuals: a misclick does not raise its own limit.
+    const auto othersMedian = [&d](std::size_t skip) {
+      std::vector<double> others;
+      for (std::size_t k = 0; k < d.size(); ++k)
+        if (k != skip && std::isfinite(d[k])) others.push_back(d[k]);
+      if (others.empty()) return 0.0;
+      std::sort(others.begin(), others.end());
+      const std::size_t n = others.size();
+      return n % 2 ? others[n / 2] : 0.5 * (others[n / 2 - 1] + others[n / 2]);
+    };
     for (std::size_t i = 0; i < g.points.size(); ++i) {
+      const double limit = std::max({4.0, 3.0 * outline_rms, 3.0 * othersMedian(i)});
       const bool agrees = std::isfinite(d[i]) && d[i] <= limit;
       pose.residuals.push_back({g.points[i].name, d[i], agrees});
       if (!agrees) out.disagreeing.push_back(g.points[i].name), pose.rejected.push_back(g.points[i].name);

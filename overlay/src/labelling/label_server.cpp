@@ -195,6 +195,7 @@ struct LabelServer::Impl {
       sendJson(res, 200, session.pick(static_cast<std::size_t>(i), at[0], at[1]));
     });
     server.Post("/api/snap", [this](const httplib::Request& req, httplib::Response& res) {
+      if (jsonDepth(req.body) > 64) return sendError(res, 400, "request body: JSON nested deeper than 64 levels");
       nlohmann::json body;
       try {
         body = nlohmann::json::parse(req.body);
@@ -204,7 +205,7 @@ struct LabelServer::Impl {
       if (!body.is_object() || !body.contains("on") || !body["on"].is_boolean())
         return sendError(res, 400, "request body: expected {\"on\": true|false}");
       const std::lock_guard<std::mutex> lock(mutex);
-      if (!session.session()["solve"]["snap"]["available"].get<bool>())
+      if (!session.solve()["snap"]["available"].get<bool>())
         return sendError(res, 409, "no robot masks to snap to: start kccd calib label with --masks");
       try {
         sendJson(res, 200, session.setSnap(body["on"].get<bool>()));

@@ -85,8 +85,11 @@ std::vector<unsigned char> encodePng(const cv::Mat& image) {
 LabelSession::LabelSession(LabelSessionInputs inputs) : in_(std::move(inputs)) {
   if (in_.frames.empty()) throw std::invalid_argument("LabelSession: no frames");
   if (!in_.masks.empty()) {
-    if (in_.masks.size() != in_.frames.size() || !in_.model)
-      throw std::invalid_argument("LabelSession: masks need a model and one mask per frame");
+    if (in_.masks.size() != in_.frames.size() || in_.mask_names.size() != in_.masks.size() || !in_.model)
+      throw std::invalid_argument("LabelSession: masks need a model, and one mask and one name per frame");
+    for (const cv::Mat& m : in_.masks)
+      if (m.type() != CV_8UC1 || m.cols != in_.intrinsics.width || m.rows != in_.intrinsics.height)
+        throw std::invalid_argument("LabelSession: a mask is not 8-bit one-channel of the camera's size");
     for (std::size_t i = 0; i < in_.frames.size(); ++i)
       if (!in_.frames[i].state)
         throw CalibInputError("--masks: frame " + std::to_string(i + 1) + " (" + in_.frames[i].name +
@@ -134,8 +137,9 @@ void LabelSession::resolve() {
   }
   const Gathered gathered = gatherCorrespondences(g);
   CalibSolution s = solveCalibration(in_.intrinsics, gathered, in_.pose, in_.model);
-  // Snapping: the solve refined to the masks; without a start (fewer than 4 points), said.
-  refinement_.reset();
+  // Snapping: the solve refined to the masks; without a start (fewer than 4 points), said. Kept
+  // in a local until everything else has been computed, so a throw leaves the last solve whole.
+  std::optional<MaskRefinement> refinement;
   std::string snap_message;
   if (snap_) {
     MaskInputs masks;
@@ -143,15 +147,15 @@ void LabelSession::resolve() {
     masks.mask_names = in_.mask_names;
     masks.bodies = in_.mask_bodies;
     try {
-      refinement_ = refineCalibrationToMasks(s, gathered, in_.intrinsics, *in_.model, masks);
-      snap_message = refinement_->result.message;
+      refinement = refineCalibrationToMasks(s, gathered, in_.intrinsics, *in_.model, masks);
+      snap_message = refinement->result.message;
     } catch (const CalibInputError& e) {
       snap_message = e.what();
     }
   }
   nlohmann::json report = calibReport(gathered, s, {.camera = s.solved() ? in_.camera_output : std::string()});
   report["snap"] = {{"available", !in_.masks.empty()}, {"on", snap_}, {"message", snap_message}};
-  if (refinement_) report["refinement"] = refinementJson(*refinement_);
+  if (refinement) report["refinement"] = refinementJson(*refinement);
   report["rms_px"] = s.solved() && s.pose.camera.reprojection_rms_px ? nlohmann::json(*s.pose.camera.reprojection_rms_px)
                                                                         : nlohmann::json(nullptr);
   report["revision"] = revision_;
@@ -175,6 +179,7 @@ void LabelSession::resolve() {
   }
   solve_json_ = std::move(report);
   solved_ = s.solved() ? std::optional<calib::Camera>(s.pose.camera) : std::nullopt;
+  refinement_ = std::move(refinement);
 }
 
 nlohmann::json LabelSession::session() const {
@@ -251,6 +256,7 @@ nlohmann::json LabelSession::putLabels(std::size_t frame, const nlohmann::json& 
 
 nlohmann::json LabelSession::setSnap(bool on) {
   if (in_.masks.empty()) throw std::logic_error("the session has no robot masks to snap to (kccd calib label --masks)");
+  if (on == snap_) return solve_json_;
   const bool old = snap_;
   snap_ = on;
   ++revision_;
@@ -261,6 +267,7 @@ nlohmann::json LabelSession::setSnap(bool on) {
     --revision_;
     throw;
   }
+  dirty_ = true;  // what Save writes has changed
   return solve_json_;
 }
 
@@ -326,10 +333,14 @@ const std::vector<unsigned char>& LabelSession::overlayPng(std::size_t frame) {
       for (int y = 0; y < lines.rows; ++y)
         for (int x = 0; x < lines.cols; ++x)
           if (const cv::Vec3b c = lines.at<cv::Vec3b>(y, x); c != cv::Vec3b(0, 0, 0)) {
-            // Anti-aliased edges: the colour at full strength, its coverage as alpha.
-            const int a = std::max({c[0], c[1], c[2]});
-            const auto full = [a](unsigned char v) { return static_cast<unsigned char>(v * 255 / a); };
-            layer.at<cv::Vec4b>(y, x) = cv::Vec4b(full(c[0]), full(c[1]), full(c[2]), static_cast<unsigned char>(a));
+            // Anti-aliased edges: the line's colour at full strength over the volumes with its
+            // coverage (straight alpha both).
+            const double a = std::max({c[0], c[1], c[2]}) / 255.0;
+            cv::Vec4b& under = layer.at<cv::Vec4b>(y, x);
+            const double ua = under[3] / 255.0, out_a = a + (1.0 - a) * ua;
+            for (int k = 0; k < 3; ++k)
+              under[k] = cv::saturate_cast<unsigned char>((c[k] / std::max(a, 1e-9) * a + under[k] * ua * (1.0 - a)) / out_a);
+            under[3] = cv::saturate_cast<unsigned char>(255.0 * out_a);
           }
     }
   } else {

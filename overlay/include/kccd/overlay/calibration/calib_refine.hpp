@@ -32,7 +32,7 @@ struct MaskRefinement {
   std::string drawn;       ///< what was drawn: "collision volumes"
   calib::RefineResult result;
   /// Labelled points the refined pose puts farther from their click than 3 times the outline's
-  /// robust rms, 3 times the clicks' median residual and 4 px: the image disagrees with them.
+  /// robust rms, 3 times the other clicks' median residual and 4 px: the image disagrees with them.
   std::vector<std::string> disagreeing;
 };
 

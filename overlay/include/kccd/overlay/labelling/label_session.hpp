@@ -84,7 +84,8 @@ class LabelSession {
 
   /// Snaps the pose to the robot masks (on) or goes back to the points' solve (off), then solves
   /// again; returns solve(). While on, every solve is refined to the masks as `kccd calib --masks`
-  /// refines it (from the points' solve, or a rough pose from 4 or more points), solve() carries
+  /// refines it (from the points' solve, or a rough pose from 4 or more points; with fewer,
+  /// solve()'s snap.message says so and the points' solve stands), solve() carries
   /// `refinement` (refinementJson) and the overlay draws the mask's outline (yellow) and the drawn
   /// robot's (magenta). std::logic_error when the session has no masks.
   nlohmann::json setSnap(bool on);
@@ -109,7 +110,7 @@ class LabelSession {
   LabelSaved save();
 
   std::size_t frameCount() const;  ///< the frames of the session
-  int revision() const { return revision_; }  ///< counts the accepted label edits
+  int revision() const { return revision_; }  ///< counts the accepted label edits and snap changes
   bool dirty() const { return dirty_; }        ///< edits not saved yet
 
  private:
