@@ -295,16 +295,8 @@ async function setSnap(on) {
   } catch (e) {
     message(e.message, true);
   } finally {
-    inflight = null;
-    $("stale").hidden = true;
     $("snap").disabled = false;
-    renderSolve();
-    renderLabels();
-    draw();
-    if (again) {
-      again = false;
-      resolve();
-    }
+    settled();
   }
 }
 
@@ -384,15 +376,21 @@ async function resolve() {
   } catch (e) {
     message(e.message, true);
   } finally {
-    inflight = null;
-    $("stale").hidden = true;
-    renderSolve();
-    renderLabels();
-    draw();
-    if (again) {
-      again = false;
-      resolve();
-    }
+    settled();
+  }
+}
+
+// A request to the server has ended (answered or not): the page shows the solve it has, and the
+// edit made meanwhile, if any, is sent now.
+function settled() {
+  inflight = null;
+  $("stale").hidden = true;
+  renderSolve();
+  renderLabels();
+  draw();
+  if (again) {
+    again = false;
+    resolve();
   }
 }
 

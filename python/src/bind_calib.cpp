@@ -82,6 +82,14 @@ cv::Mat maskOf(const py::handle& value, std::size_t index, const calib::Camera& 
   return mask;
 }
 
+// A pose covariance (of rvec, tvec) as a float64 (6, 6) array.
+py::array_t<double> covarianceArray(const cv::Matx66d& c) {
+  py::array_t<double> out({6, 6});
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) out.mutable_at(i, j) = c(i, j);
+  return out;
+}
+
 py::array_t<double> rows(const std::vector<std::array<double, 3>>& v, int cols) {
   py::array_t<double> out({static_cast<py::ssize_t>(v.size()), static_cast<py::ssize_t>(cols)});
   auto o = out.mutable_unchecked<2>();
@@ -262,14 +270,7 @@ void bindCalib(py::module_& m) {
         out["inlier"] = inlier;
         out["rejected"] = r.rejected;
         out["inliers"] = r.inliers;
-        if (solved) {
-          py::array_t<double> cov({6, 6});
-          for (int i = 0; i < 6; ++i)
-            for (int j = 0; j < 6; ++j) cov.mutable_at(i, j) = r.covariance(i, j);
-          out["covariance"] = cov;
-        } else {
-          out["covariance"] = py::none();
-        }
+        out["covariance"] = solved ? py::object(covarianceArray(r.covariance)) : py::object(py::none());
         out["reprojection_rms_px"] = solved ? py::cast(r.camera.reprojection_rms_px) : py::object(py::none());
         out["rotation_sigma_deg"] = solved ? py::cast(r.camera.rotation_sigma_deg) : py::object(py::none());
         out["position_sigma_m"] = solved ? py::cast(r.camera.position_sigma_m) : py::object(py::none());
@@ -336,14 +337,7 @@ non-finite coordinate, an empty or repeated name, or invalid intrinsics.)doc");
         out["camera"] = r.camera;
         out["frames"] = per_frame;
         out["iterations"] = r.iterations;
-        if (r.improved) {
-          py::array_t<double> cov({6, 6});
-          for (int i = 0; i < 6; ++i)
-            for (int j = 0; j < 6; ++j) cov.mutable_at(i, j) = r.covariance(i, j);
-          out["covariance"] = cov;
-        } else {
-          out["covariance"] = py::none();
-        }
+        out["covariance"] = r.improved ? py::object(covarianceArray(r.covariance)) : py::object(py::none());
         out["drawn"] = "collision volumes";
         return out;
       },
