@@ -1,6 +1,7 @@
 #include "kccd/overlay/labelling/label_server.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -71,6 +72,9 @@ struct LabelServer::Impl {
   LabelSession& session;
   LabelServerOptions options;
   httplib::Server server;
+  // stop() may come before run() listens (a signal right after the address is printed): it is
+  // remembered, and repeated until run() has returned.
+  std::atomic<bool> stop_requested{false}, started{false}, finished{false};
   std::mutex mutex;  // one request at a time touches the session
   int port = 0;
   std::set<std::string> hosts;  // the Host values this server answers
@@ -277,9 +281,21 @@ int LabelServer::port() const { return impl_->port; }
 
 std::string LabelServer::url() const { return "http://" + *impl_->hosts.begin() + "/"; }
 
-void LabelServer::run() { impl_->server.listen_after_bind(); }
+void LabelServer::run() {
+  impl_->started = true;
+  if (!impl_->stop_requested) impl_->server.listen_after_bind();
+  impl_->finished = true;
+}
 
-void LabelServer::stop() { impl_->server.stop(); }
+void LabelServer::stop() {
+  impl_->stop_requested = true;
+  impl_->server.stop();
+  // Not listening yet: run() is about to; stop it once it does.
+  while (impl_->started && !impl_->finished) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    impl_->server.stop();
+  }
+}
 
 void LabelServer::onRequest(std::function<void(const std::string&, const std::string&, int)> log) { impl_->log = std::move(log); }
 
