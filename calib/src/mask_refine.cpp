@@ -10,6 +10,7 @@
 #include "kccd/calib/pose.hpp"
 #include "kccd/calib/pose_difference.hpp"
 #include "kccd/format_number.hpp"
+#include "outline_fit.hpp"
 
 namespace kccd::calib {
 namespace {
@@ -73,74 +74,26 @@ cv::Mat signedDistance(const cv::Mat& mask) {
   return sdf;
 }
 
-// Bilinear sample of `f` at (x, y) (clamped to the image).
-double sample(const cv::Mat& f, double x, double y) {
-  x = std::clamp(x, 0.0, f.cols - 1.001);
-  y = std::clamp(y, 0.0, f.rows - 1.001);
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const double ax = x - x0, ay = y - y0;
-  const float* r0 = f.ptr<float>(y0);
-  const float* r1 = f.ptr<float>(y0 + 1);
-  return (1 - ay) * ((1 - ax) * r0[x0] + ax * r0[x0 + 1]) + ay * ((1 - ax) * r1[x0] + ax * r1[x0 + 1]);
-}
-
-struct Sample {
-  std::size_t frame;
-  cv::Point3d world;
-  cv::Point2d normal;
-};
-
-// The outline points of every frame at `camera` that lie inside the image (away from its border).
-std::vector<Sample> samplesAt(const Camera& camera, std::span<const MaskFrame> frames, double spacing,
-                              std::vector<cv::Mat>* drawn = nullptr) {
-  std::vector<Sample> out;
-  for (std::size_t f = 0; f < frames.size(); ++f) {
-    const Silhouette s = drawSilhouette(camera, frames[f].volumes, spacing);
-    if (drawn) drawn->push_back(s.mask);
-    for (const OutlinePoint& p : s.outline)
-      if (p.pixel.x >= 2 && p.pixel.y >= 2 && p.pixel.x <= camera.width - 3 && p.pixel.y <= camera.height - 3)
-        out.push_back({f, cv::Point3d(p.world.x(), p.world.y(), p.world.z()), p.normal});
-  }
+// Each frame's volumes, as the outline fit takes them.
+std::vector<std::span<const PlacedVolume>> volumesOf(std::span<const MaskFrame> frames) {
+  std::vector<std::span<const PlacedVolume>> out;
+  for (const MaskFrame& f : frames) out.emplace_back(f.volumes);
   return out;
 }
 
-struct Evaluation {
-  double cost = 0.0;
-  cv::Matx66d jtj = cv::Matx66d::zeros();
-  cv::Vec6d jtr = cv::Vec6d::all(0);
-  double weight_sum = 0.0, weighted_sq = 0.0;
-};
-
-// The robust cost of the samples at (rvec, tvec) with Cauchy scale `c`, and its normal equations.
-Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const std::vector<Sample>& samples,
-                    const std::vector<Target>& targets, double c, bool normal_equations) {
-  Evaluation e;
-  std::vector<cv::Point3d> world(samples.size());
-  for (std::size_t i = 0; i < samples.size(); ++i) world[i] = samples[i].world;
-  std::vector<cv::Point2d> px;
-  cv::Mat jac;
-  if (world.empty()) return e;
-  cv::projectPoints(world, rvec, tvec, cam.camera_matrix, cam.distortion, px, normal_equations ? jac : cv::noArray());
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    const cv::Mat& sdf = targets[samples[i].frame].sdf;
-    const double r = sample(sdf, px[i].x, px[i].y);
-    double w = 1.0 / (1.0 + (r / c) * (r / c));
-    const double gx = 0.5 * (sample(sdf, px[i].x + 1, px[i].y) - sample(sdf, px[i].x - 1, px[i].y));
-    const double gy = 0.5 * (sample(sdf, px[i].x, px[i].y + 1) - sample(sdf, px[i].x, px[i].y - 1));
-    // The field should grow outward along the drawn outline's normal; where it does not (a hole's
-    // edge, another object's outline), the point counts little.
-    if (gx * samples[i].normal.x + gy * samples[i].normal.y < 0) w *= 0.1;
-    e.cost += 0.5 * c * c * std::log1p((r / c) * (r / c)) * (w < 0.5 / (1.0 + (r / c) * (r / c)) ? 0.1 : 1.0);
-    e.weight_sum += w;
-    e.weighted_sq += w * r * r;
-    if (!normal_equations) continue;
-    cv::Vec6d j;
-    for (int k = 0; k < 6; ++k)
-      j[k] = gx * jac.at<double>(static_cast<int>(2 * i), k) + gy * jac.at<double>(static_cast<int>(2 * i + 1), k);
-    e.jtj += w * (j * j.t());
-    e.jtr += w * r * j;
-  }
-  return e;
+// The masks' field: an outline point's signed distance to the mask's outline. The field should
+// grow outward along the drawn outline's normal; where it does not (a hole's edge, another
+// object's outline), the point counts little.
+detail::Field maskField(const std::vector<Target>& targets) {
+  return [&targets](const detail::OutlineSample& s, const cv::Point2d& p) {
+    const cv::Mat& sdf = targets[s.frame].sdf;
+    detail::FieldValue v;
+    v.r = detail::sampleField(sdf, p.x, p.y);
+    v.gx = 0.5 * (detail::sampleField(sdf, p.x + 1, p.y) - detail::sampleField(sdf, p.x - 1, p.y));
+    v.gy = 0.5 * (detail::sampleField(sdf, p.x, p.y + 1) - detail::sampleField(sdf, p.x, p.y - 1));
+    if (v.gx * s.normal.x + v.gy * s.normal.y < 0) v.trust = 0.1;
+    return v;
+  };
 }
 
 // Pre-alignment, for a start far off (10 degrees is a robot's width in the image): the camera
@@ -148,11 +101,12 @@ Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& t
 // areas match, over all frames together. Rotation shows first as a shift of the whole image,
 // distance as a change of size; the fit then starts where the outlines overlap.
 Camera preAlign(const Camera& start, std::span<const MaskFrame> frames, const std::vector<Target>& targets, double spacing) {
+  const std::vector<std::span<const PlacedVolume>> volumes = volumesOf(frames);
   Camera cam = start;
   const double fx = cam.camera_matrix(0, 0), fy = cam.camera_matrix(1, 1);
   for (int round = 0; round < 6; ++round) {
     std::vector<cv::Mat> drawn;
-    (void)samplesAt(cam, frames, spacing, &drawn);
+    (void)detail::outlineSamples(cam, volumes, spacing, &drawn);
     double du = 0, dv = 0, drawn_area = 0, mask_area = 0, depth = 0;
     int used = 0, depth_points = 0;
     const Pose w2c = cam.worldToCamera();
@@ -226,9 +180,13 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
                        std::to_string(start.width) + "x" + std::to_string(start.height));
   RefineResult result;
   result.camera = start;
+  const std::vector<std::span<const PlacedVolume>> volumes = volumesOf(frames);
+  const auto samplesAt = [&](const Camera& at, std::vector<cv::Mat>* drawn = nullptr) {
+    return detail::outlineSamples(at, volumes, options.spacing_px, drawn);
+  };
   // Targets: each mask cleaned against the start's drawing.
   std::vector<cv::Mat> drawn_start;
-  (void)samplesAt(start, frames, options.spacing_px, &drawn_start);
+  (void)samplesAt(start, &drawn_start);
   std::vector<Target> targets(frames.size());
   for (std::size_t f = 0; f < frames.size(); ++f) {
     targets[f].mask = cleanMask(frames[f].mask != 0, drawn_start[f]);
@@ -242,7 +200,7 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   Camera cam = preAlign(start, frames, targets, options.spacing_px);
   {
     std::vector<cv::Mat> drawn;
-    (void)samplesAt(cam, frames, options.spacing_px, &drawn);
+    (void)samplesAt(cam, &drawn);
     double before = 0, after = 0;
     for (std::size_t f = 0; f < frames.size(); ++f) {
       before += result.frames[f].iou_before;
@@ -258,41 +216,15 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
     }
   }
   const double diagonal = std::hypot(start.width, start.height);
-  for (const double scale : {0.08, 0.03, 0.01, 0.004}) {
-    const double c = std::max(1.5, scale * diagonal);
-    double lambda = 1e-3;
-    for (int it = 0; it < options.max_iterations; ++it) {
-      const std::vector<Sample> samples = samplesAt(cam, frames, options.spacing_px);
-      if (samples.size() < 12) break;
-      const Evaluation e = evaluate(cam, cam.rvec, cam.tvec, samples, targets, c, true);
-      bool stepped = false;
-      while (lambda < 1e8) {
-        cv::Matx66d a = e.jtj;
-        for (int k = 0; k < 6; ++k) a(k, k) += lambda * std::max(e.jtj(k, k), 1e-12);
-        cv::Vec6d delta;
-        if (!cv::solve(a, -e.jtr, delta, cv::DECOMP_CHOLESKY)) {
-          lambda *= 10;
-          continue;
-        }
-        const cv::Vec3d r2 = cam.rvec + cv::Vec3d(delta[0], delta[1], delta[2]);
-        const cv::Vec3d t2 = cam.tvec + cv::Vec3d(delta[3], delta[4], delta[5]);
-        const Evaluation next = evaluate(cam, r2, t2, samples, targets, c, false);
-        if (next.cost < e.cost) {
-          cam.rvec = r2, cam.tvec = t2;
-          lambda = std::max(1e-7, lambda / 3);
-          stepped = cv::norm(delta) > 1e-7;
-          break;
-        }
-        lambda *= 4;
-      }
-      ++result.iterations;
-      if (!stepped) break;
-    }
-  }
+  std::vector<double> scales;
+  for (const double scale : {0.08, 0.03, 0.01, 0.004}) scales.push_back(std::max(1.5, scale * diagonal));
+  const detail::Field field = maskField(targets);
+  cam = detail::fitPose(cam, [&](const Camera& at) { return samplesAt(at); }, field, scales, options.max_iterations,
+                        result.iterations);
 
   // Agreement at the result, and whether it is kept.
   std::vector<cv::Mat> drawn_after;
-  const std::vector<Sample> final_samples = samplesAt(cam, frames, options.spacing_px, &drawn_after);
+  const std::vector<detail::OutlineSample> final_samples = samplesAt(cam, &drawn_after);
   double before = 0.0, after = 0.0, worst_drop = 0.0;
   for (std::size_t f = 0; f < frames.size(); ++f) {
     FrameAgreement& a = result.frames[f];
@@ -304,14 +236,14 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   before /= static_cast<double>(frames.size());
   after /= static_cast<double>(frames.size());
   const double c_final = std::max(1.5, 0.004 * diagonal);
-  const Evaluation e = evaluate(cam, cam.rvec, cam.tvec, final_samples, targets, c_final, true);
+  const detail::Evaluation e = detail::evaluate(cam, cam.rvec, cam.tvec, final_samples, field, c_final, true);
   // Each frame's outline rms and point count at `at` (the refined pose, or the start when kept).
-  const auto outlineAgreement = [&](const Camera& at, const std::vector<Sample>& samples) {
+  const auto outlineAgreement = [&](const Camera& at, const std::vector<detail::OutlineSample>& samples) {
     for (std::size_t f = 0; f < frames.size(); ++f) {
-      std::vector<Sample> mine;
-      for (const Sample& s : samples)
+      std::vector<detail::OutlineSample> mine;
+      for (const detail::OutlineSample& s : samples)
         if (s.frame == f) mine.push_back(s);
-      const Evaluation ef = evaluate(at, at.rvec, at.tvec, mine, targets, c_final, false);
+      const detail::Evaluation ef = detail::evaluate(at, at.rvec, at.tvec, mine, field, c_final, false);
       result.frames[f].outline_points = static_cast<int>(mine.size());
       result.frames[f].rms_px = ef.weight_sum > 0 ? std::sqrt(ef.weighted_sq / ef.weight_sum) : 0.0;
     }
@@ -320,7 +252,7 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   // The start is returned: its figures, not the refined pose's.
   const auto keepStart = [&](std::string message) {
     for (FrameAgreement& a : result.frames) a.iou_after = a.iou_before;
-    outlineAgreement(start, samplesAt(start, frames, options.spacing_px));
+    outlineAgreement(start, samplesAt(start));
     result.covariance = cv::Matx66d::zeros();
     result.message = std::move(message);
     return result;
@@ -347,14 +279,7 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
                        formatNumber(std::max(rot_sigmas, pos_sigmas), 3) + " sigma) for a mean IoU gain of " +
                        formatNumber(gain, 3) + ": the start is kept (are the volumes wider or the masks narrower than the robot?)");
   }
-  // The pose's covariance from the normal equations: sigma^2 (J^T W J)^-1, with the outline
-  // samples' correlation (neighbours about `spacing` apart see the same edge) counted by a factor
-  // of 5 on the variance.
-  const double dof = std::max(1.0, e.weight_sum - 6.0);
-  const double sigma2 = e.weighted_sq / dof * 5.0;
-  cv::Matx66d inv;
-  cv::invert(e.jtj, inv, cv::DECOMP_SVD);
-  result.covariance = sigma2 * inv;
+  result.covariance = detail::poseCovariance(e);
   const auto [rotation_sigma, position_sigma] = poseSigmas(cam.rvec, cam.tvec, result.covariance);
   cam.rotation_sigma_deg = rotation_sigma;
   cam.position_sigma_m = position_sigma;

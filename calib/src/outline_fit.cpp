@@ -1,0 +1,101 @@
+#include "outline_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/calib3d.hpp>
+
+namespace kccd::calib::detail {
+
+std::vector<OutlineSample> outlineSamples(const Camera& camera, std::span<const std::span<const PlacedVolume>> frames,
+                                          double spacing, std::vector<cv::Mat>* drawn) {
+  std::vector<OutlineSample> out;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    const Silhouette s = drawSilhouette(camera, frames[f], spacing);
+    if (drawn) drawn->push_back(s.mask);
+    for (const OutlinePoint& p : s.outline)
+      if (p.pixel.x >= 2 && p.pixel.y >= 2 && p.pixel.x <= camera.width - 3 && p.pixel.y <= camera.height - 3)
+        out.push_back({f, cv::Point3d(p.world.x(), p.world.y(), p.world.z()), p.normal});
+  }
+  return out;
+}
+
+double sampleField(const cv::Mat& f, double x, double y) {
+  x = std::clamp(x, 0.0, f.cols - 1.001);
+  y = std::clamp(y, 0.0, f.rows - 1.001);
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const double ax = x - x0, ay = y - y0;
+  const float* r0 = f.ptr<float>(y0);
+  const float* r1 = f.ptr<float>(y0 + 1);
+  return (1 - ay) * ((1 - ax) * r0[x0] + ax * r0[x0 + 1]) + ay * ((1 - ax) * r1[x0] + ax * r1[x0 + 1]);
+}
+
+Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& tvec, std::span<const OutlineSample> samples,
+                    const Field& field, double c, bool normal_equations) {
+  Evaluation e;
+  if (samples.empty()) return e;
+  std::vector<cv::Point3d> world(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) world[i] = samples[i].world;
+  std::vector<cv::Point2d> px;
+  cv::Mat jac;
+  cv::projectPoints(world, rvec, tvec, cam.camera_matrix, cam.distortion, px, normal_equations ? jac : cv::noArray());
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const FieldValue v = field(samples[i], px[i]);
+    const double u = v.r / c;
+    const double w = v.trust / (1.0 + u * u);
+    e.cost += v.trust * 0.5 * c * c * std::log1p(u * u);
+    e.weight_sum += w;
+    e.weighted_sq += w * v.r * v.r;
+    if (!normal_equations) continue;
+    cv::Vec6d j;
+    for (int k = 0; k < 6; ++k)
+      j[k] = v.gx * jac.at<double>(static_cast<int>(2 * i), k) + v.gy * jac.at<double>(static_cast<int>(2 * i + 1), k);
+    e.jtj += w * (j * j.t());
+    e.jtr += w * v.r * j;
+  }
+  return e;
+}
+
+Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const Camera&)>& samples_at, const Field& field,
+               std::span<const double> scales_px, int max_iterations, int& iterations) {
+  for (const double c : scales_px) {
+    double lambda = 1e-3;
+    for (int it = 0; it < max_iterations; ++it) {
+      const std::vector<OutlineSample> samples = samples_at(cam);
+      if (samples.size() < 12) break;
+      const Evaluation e = evaluate(cam, cam.rvec, cam.tvec, samples, field, c, true);
+      bool stepped = false;
+      while (lambda < 1e8) {
+        cv::Matx66d a = e.jtj;
+        for (int k = 0; k < 6; ++k) a(k, k) += lambda * std::max(e.jtj(k, k), 1e-12);
+        cv::Vec6d delta;
+        if (!cv::solve(a, -e.jtr, delta, cv::DECOMP_CHOLESKY)) {
+          lambda *= 10;
+          continue;
+        }
+        const cv::Vec3d r2 = cam.rvec + cv::Vec3d(delta[0], delta[1], delta[2]);
+        const cv::Vec3d t2 = cam.tvec + cv::Vec3d(delta[3], delta[4], delta[5]);
+        if (evaluate(cam, r2, t2, samples, field, c, false).cost < e.cost) {
+          cam.rvec = r2, cam.tvec = t2;
+          lambda = std::max(1e-7, lambda / 3);
+          stepped = cv::norm(delta) > 1e-7;
+          break;
+        }
+        lambda *= 4;
+      }
+      ++iterations;
+      if (!stepped) break;
+    }
+  }
+  return cam;
+}
+
+cv::Matx66d poseCovariance(const Evaluation& e) {
+  const double dof = std::max(1.0, e.weight_sum - 6.0);
+  const double sigma2 = e.weighted_sq / dof * 5.0;
+  cv::Matx66d inv;
+  cv::invert(e.jtj, inv, cv::DECOMP_SVD);
+  return sigma2 * inv;
+}
+
+}  // namespace kccd::calib::detail
