@@ -28,6 +28,7 @@ using namespace kccd;
 using namespace kccd::calib;
 using kccd::testing::cameraCentre;
 using kccd::testing::rotationErrorDeg;
+using kccd::testing::perturbed;
 
 const std::string kData = KCCD_DATA_DIR;
 const std::vector<int> kRobot = {0, 3, 4, 5, 6};  // demo_arm: pedestal, shoulder, upper arm, forearm, gripper
@@ -37,24 +38,6 @@ cv::Mat trueMask(const Model& model, const Camera& cam, const std::vector<double
   cv::Mat mask = cv::Mat::zeros(cam.height, cam.width, CV_8UC1);
   for (const PlacedVolume& v : placeVolumes(model, state, kRobot)) mask |= kccd::testing::cpuSilhouette(cam, v.points, v.radius);
   return mask * 255;
-}
-
-// `c` turned by `deg` about a random axis through its centre and moved `m` in a random direction.
-Camera perturbed(const Camera& c, double deg, double m, std::mt19937_64& rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  cv::Vec3d axis(n(rng), n(rng), n(rng));
-  axis *= (deg * M_PI / 180.0) / cv::norm(axis);
-  cv::Vec3d dir(n(rng), n(rng), n(rng));
-  dir *= m / cv::norm(dir);
-  cv::Matx33d r, d;
-  cv::Rodrigues(c.rvec, r);
-  cv::Rodrigues(axis, d);
-  const cv::Vec3d centre = -(r.t() * c.tvec) + dir;
-  const cv::Matx33d r2 = d * r;
-  Camera out = c;
-  cv::Rodrigues(r2, out.rvec);
-  out.tvec = -(r2 * centre);
-  return out;
 }
 
 struct Scene {

@@ -103,13 +103,11 @@ detail::Field maskField(const std::vector<Target>& targets) {
 Camera preAlign(const Camera& start, std::span<const MaskFrame> frames, const std::vector<Target>& targets, double spacing) {
   const std::vector<std::span<const PlacedVolume>> volumes = volumesOf(frames);
   Camera cam = start;
-  const double fx = cam.camera_matrix(0, 0), fy = cam.camera_matrix(1, 1);
   for (int round = 0; round < 6; ++round) {
     std::vector<cv::Mat> drawn;
     (void)detail::outlineSamples(cam, volumes, spacing, &drawn);
-    double du = 0, dv = 0, drawn_area = 0, mask_area = 0, depth = 0;
-    int used = 0, depth_points = 0;
-    const Pose w2c = cam.worldToCamera();
+    double du = 0, dv = 0, drawn_area = 0, mask_area = 0;
+    int used = 0;
     for (std::size_t f = 0; f < frames.size(); ++f) {
       const cv::Moments a = cv::moments(drawn[f], true), b = cv::moments(targets[f].mask, true);
       if (a.m00 < 1 || b.m00 < 1) continue;
@@ -118,26 +116,14 @@ Camera preAlign(const Camera& start, std::span<const MaskFrame> frames, const st
       drawn_area += a.m00;
       mask_area += b.m00;
       ++used;
-      for (const PlacedVolume& v : frames[f].volumes)
-        for (const Vec3& p : v.points) {
-          const double z = (w2c * p).z();
-          if (z > 0) depth += z, ++depth_points;
-        }
     }
-    if (used == 0 || depth_points == 0) break;
+    const double depth = detail::meanDepth(cam, volumes);
+    if (used == 0 || depth <= 0) break;
     du /= used, dv /= used;
-    // A turn about the camera's y and x axes moves the image by fx * angle, fy * angle.
-    const cv::Vec3d turn(-std::atan(dv / fy), std::atan(du / fx), 0.0);
-    cv::Matx33d d, r;
-    cv::Rodrigues(turn, d);
-    cv::Rodrigues(cam.rvec, r);
-    cv::Rodrigues(d * r, cam.rvec);
-    cam.tvec = d * cam.tvec;
-    // Size: the image of the robot scales with 1 / depth, its area with 1 / depth^2.
-    const double z = depth / depth_points;
-    const double ratio = std::clamp(std::sqrt(drawn_area / mask_area), 0.5, 2.0);
-    cam.tvec[2] += z * (ratio - 1.0);
-    if (std::hypot(du, dv) < 0.5 && std::abs(ratio - 1.0) < 1e-3) break;
+    // Size: the image of the robot's area grows with the square of its size.
+    const double growth = std::clamp(std::sqrt(mask_area / drawn_area), 0.5, 2.0);
+    cam = detail::turnedAndMoved(cam, du, dv, growth, depth);
+    if (std::hypot(du, dv) < 0.5 && std::abs(growth - 1.0) < 1e-3) break;
   }
   return cam;
 }

@@ -20,6 +20,31 @@ std::vector<OutlineSample> outlineSamples(const Camera& camera, std::span<const 
   return out;
 }
 
+Camera turnedAndMoved(const Camera& cam, double du, double dv, double growth, double depth) {
+  Camera out = cam;
+  // A turn about the camera's y and x axes moves the image by fx * angle, fy * angle.
+  const cv::Vec3d turn(-std::atan(dv / cam.camera_matrix(1, 1)), std::atan(du / cam.camera_matrix(0, 0)), 0.0);
+  cv::Matx33d d, r;
+  cv::Rodrigues(turn, d);
+  cv::Rodrigues(cam.rvec, r);
+  cv::Rodrigues(d * r, out.rvec);
+  out.tvec = d * cam.tvec;
+  // The image of a thing scales with 1 / depth.
+  out.tvec[2] += depth * (1.0 / growth - 1.0);
+  return out;
+}
+
+double meanDepth(const Camera& cam, std::span<const std::span<const PlacedVolume>> frames) {
+  const Pose w2c = cam.worldToCamera();
+  double depth = 0.0;
+  int n = 0;
+  for (const std::span<const PlacedVolume>& f : frames)
+    for (const PlacedVolume& v : f)
+      for (const Vec3& p : v.points)
+        if (const double z = (w2c * p).z(); z > 0) depth += z, ++n;
+  return n ? depth / n : 0.0;
+}
+
 double sampleField(const cv::Mat& f, double x, double y) {
   x = std::clamp(x, 0.0, f.cols - 1.001);
   y = std::clamp(y, 0.0, f.rows - 1.001);
@@ -31,8 +56,25 @@ double sampleField(const cv::Mat& f, double x, double y) {
 }
 
 Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& tvec, std::span<const OutlineSample> samples,
-                    const Field& field, double c, bool normal_equations) {
+                    const Field& field, double c, bool normal_equations, const Anchors* anchors) {
   Evaluation e;
+  if (anchors && !anchors->world.empty()) {
+    std::vector<cv::Point2d> px;
+    cv::Mat jac;
+    cv::projectPoints(anchors->world, rvec, tvec, cam.camera_matrix, cam.distortion, px, normal_equations ? jac : cv::noArray());
+    const double a = anchors->scale_px;
+    for (std::size_t i = 0; i < px.size(); ++i)
+      for (int k = 0; k < 2; ++k) {
+        const double r = k == 0 ? px[i].x - anchors->pixel[i].x : px[i].y - anchors->pixel[i].y;
+        const double u = r / a, w = 1.0 / (1.0 + u * u);
+        e.cost += 0.5 * a * a * std::log1p(u * u);
+        if (!normal_equations) continue;
+        cv::Vec6d j;
+        for (int m = 0; m < 6; ++m) j[m] = jac.at<double>(static_cast<int>(2 * i) + k, m);
+        e.jtj += w * (j * j.t());
+        e.jtr += w * r * j;
+      }
+  }
   if (samples.empty()) return e;
   std::vector<cv::Point3d> world(samples.size());
   for (std::size_t i = 0; i < samples.size(); ++i) world[i] = samples[i].world;
@@ -57,13 +99,13 @@ Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& t
 }
 
 Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const Camera&)>& samples_at, const Field& field,
-               std::span<const double> scales_px, int max_iterations, int& iterations) {
+               std::span<const double> scales_px, int max_iterations, int& iterations, const Anchors* anchors) {
   for (const double c : scales_px) {
     double lambda = 1e-3;
     for (int it = 0; it < max_iterations; ++it) {
       const std::vector<OutlineSample> samples = samples_at(cam);
       if (samples.size() < 12) break;
-      const Evaluation e = evaluate(cam, cam.rvec, cam.tvec, samples, field, c, true);
+      const Evaluation e = evaluate(cam, cam.rvec, cam.tvec, samples, field, c, true, anchors);
       bool stepped = false;
       while (lambda < 1e8) {
         cv::Matx66d a = e.jtj;
@@ -75,7 +117,7 @@ Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const 
         }
         const cv::Vec3d r2 = cam.rvec + cv::Vec3d(delta[0], delta[1], delta[2]);
         const cv::Vec3d t2 = cam.tvec + cv::Vec3d(delta[3], delta[4], delta[5]);
-        if (evaluate(cam, r2, t2, samples, field, c, false).cost < e.cost) {
+        if (evaluate(cam, r2, t2, samples, field, c, false, anchors).cost < e.cost) {
           cam.rvec = r2, cam.tvec = t2;
           lambda = std::max(1e-7, lambda / 3);
           stepped = cv::norm(delta) > 1e-7;

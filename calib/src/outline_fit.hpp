@@ -27,6 +27,13 @@ struct OutlineSample {
 std::vector<OutlineSample> outlineSamples(const Camera& camera, std::span<const std::span<const PlacedVolume>> frames,
                                           double spacing, std::vector<cv::Mat>* drawn = nullptr);
 
+/// `cam` turned so its image moves by (du, dv) px (about its own x and y axes), then moved along
+/// its axis so the image of things at `depth` grows by `growth` (> 0).
+Camera turnedAndMoved(const Camera& cam, double du, double dv, double growth, double depth);
+
+/// The mean depth in front of `cam` of the frames' volumes' core points (0 when none is in front).
+double meanDepth(const Camera& cam, std::span<const std::span<const PlacedVolume>> frames);
+
 /// Bilinear sample of a CV_32F field at (x, y), clamped to the field.
 double sampleField(const cv::Mat& field, double x, double y);
 
@@ -37,7 +44,16 @@ struct FieldValue {
 };
 using Field = std::function<FieldValue(const OutlineSample&, const cv::Point2d& pixel)>;
 
-/// The robust cost of `samples` at (rvec, tvec) with Cauchy scale `c`, and its normal equations.
+/// Points seen in the image (clicks, tag corners) that hold the fit near them: each a robust 2-D
+/// residual with its own Cauchy scale.
+struct Anchors {
+  std::vector<cv::Point3d> world;
+  std::vector<cv::Point2d> pixel;
+  double scale_px = 8.0;
+};
+
+/// The robust cost of `samples` (and `anchors`, when given) at (rvec, tvec) with Cauchy scale `c`,
+/// and its normal equations.
 struct Evaluation {
   double cost = 0.0;
   cv::Matx66d jtj = cv::Matx66d::zeros();
@@ -45,12 +61,12 @@ struct Evaluation {
   double weight_sum = 0.0, weighted_sq = 0.0;  ///< sum of w, sum of w r^2 (a robust rms)
 };
 Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& tvec, std::span<const OutlineSample> samples,
-                    const Field& field, double c, bool normal_equations);
+                    const Field& field, double c, bool normal_equations, const Anchors* anchors = nullptr);
 
 /// Levenberg-Marquardt from `cam` for each Cauchy scale in turn (px), outline samples redrawn
 /// every iteration; `samples_at` gives them at a pose. Returns the pose, counts iterations.
 Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const Camera&)>& samples_at, const Field& field,
-               std::span<const double> scales_px, int max_iterations, int& iterations);
+               std::span<const double> scales_px, int max_iterations, int& iterations, const Anchors* anchors = nullptr);
 
 /// The pose's covariance from the normal equations at the optimum: sigma^2 (J^T W J)^-1, with the
 /// outline samples' correlation (neighbours a spacing apart see the same edge) counted by a factor

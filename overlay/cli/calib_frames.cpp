@@ -8,7 +8,7 @@
 
 namespace kccd::cli {
 
-GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, const std::optional<Model>& model, bool masks) {
+GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, const std::optional<Model>& model, bool refined) {
   std::vector<std::string> picture_names = a.images;
   std::vector<cv::Mat> video_pictures;
   std::vector<double> times = a.times;
@@ -57,8 +57,8 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
     throw UsageError("--labels: given " + std::to_string(labels) + " times for " + std::to_string(picture_names.size()) +
                      " images: give one labels file per --image, in the same order");
   if (tags && picture_names.empty()) throw UsageError("--tags: needs --image (tags are detected in the images)");
-  if (!picture_names.empty() && !tags && labels == 0 && !masks)
-    throw UsageError("--image: give --tags LAYOUT, --labels LABELS and/or --masks MASK to say what the image shows");
+  if (!picture_names.empty() && !tags && labels == 0 && !refined)
+    throw UsageError("--image: give --tags LAYOUT, --labels LABELS and/or --masks MASK (or --refine edges) to say what the image shows");
   if (!a.states.empty() && a.states.size() != 1 && a.states.size() != n)
     throw UsageError("--state: given " + std::to_string(a.states.size()) + " times for " + std::to_string(n) +
                      " frames: give it once (all frames) or once per frame");

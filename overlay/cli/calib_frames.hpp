@@ -39,7 +39,8 @@ struct GivenFrames {
 void addBagOptions(CLI::App& command, FrameOptions& o);
 
 /// Checks the options against each other (`labels` labels files and `tags` a tag layout given)
-/// and reads the recording's frames and the state log. Throws UsageError, or the readers' errors.
-GivenFrames givenFrames(const FrameOptions& o, std::size_t labels, bool tags, const std::optional<Model>& model, bool masks = false);
+/// and reads the recording's frames and the state log; `refined`: masks or edges say what the
+/// pictures show. Throws UsageError, or the readers' errors.
+GivenFrames givenFrames(const FrameOptions& o, std::size_t labels, bool tags, const std::optional<Model>& model, bool refined = false);
 
 }  // namespace kccd::cli

@@ -24,7 +24,7 @@ namespace kccd::cli {
 namespace {
 
 struct CalibArgs : FrameOptions {
-  std::string intrinsics, tags, model, output, check, truth, rough_camera, mask_bodies;
+  std::string intrinsics, tags, model, output, check, truth, rough_camera, mask_bodies, refine;
   std::vector<std::string> labels, masks;
   double threshold = 8.0, magnify = 20.0;
   int min_inliers = 6;
@@ -46,7 +46,7 @@ void checkBodyLabels(const calib::Labels& labels, const std::optional<Model>& mo
 // The gathering inputs the options describe: the frames (calib_frames.hpp), the labels and the
 // tag layout.
 overlay::GatherInputs gatherInputs(const CalibArgs& a, const calib::Camera& cam, const std::optional<Model>& model) {
-  const GivenFrames given = givenFrames(a, a.labels.size(), !a.tags.empty(), model, !a.masks.empty());
+  const GivenFrames given = givenFrames(a, a.labels.size(), !a.tags.empty(), model, !a.masks.empty() || a.refine == "edges");
   for (const std::string& w : given.warnings) std::cerr << "kccd calib: warning: " << w << "\n";
   overlay::GatherInputs in;
   in.camera = cam;
@@ -59,7 +59,7 @@ overlay::GatherInputs gatherInputs(const CalibArgs& a, const calib::Camera& cam,
     fr.state = given.states[f];
     if (!given.names.empty()) fr.image = given.names[f];
     if (!given.pictures.empty()) fr.bgr = given.pictures[f];
-    if (!a.labels.empty()) {
+    if (!a.labels.empty() && a.labels[f] != "none") {
       fr.labels = calib::loadLabels(a.labels[f]);
       checkBodyLabels(*fr.labels, model, fr.state.has_value());
     }
@@ -67,15 +67,22 @@ overlay::GatherInputs gatherInputs(const CalibArgs& a, const calib::Camera& cam,
   return in;
 }
 
-// The masks (read and checked before anything else is), the bodies they show and a rough start.
-std::optional<overlay::MaskInputs> maskInputs(const CalibArgs& a, const calib::Camera& cam, const std::optional<Model>& model) {
-  if (a.masks.empty()) {
-    if (!a.rough_camera.empty()) throw UsageError("--camera: a start for --masks (give --masks)");
-    if (!a.mask_bodies.empty()) throw UsageError("--mask-bodies: goes with --masks");
+// What the pose is refined to: the masks (read and checked before anything else is) or the
+// pictures' edges, the bodies they show and a rough start.
+std::optional<overlay::RefineInputs> refineInputs(const CalibArgs& a, const calib::Camera& cam, const std::optional<Model>& model) {
+  const bool edges = a.refine == "edges";
+  if (edges && !a.masks.empty()) throw UsageError("--refine edges: refines to the pictures themselves; --masks goes with --refine masks");
+  if (a.refine == "masks" && a.masks.empty()) throw UsageError("--refine masks: give the masks with --masks M1.png ...");
+  if (a.masks.empty() && !edges) {
+    if (!a.rough_camera.empty()) throw UsageError("--camera: a start for --masks or --refine edges (give one)");
+    if (!a.mask_bodies.empty()) throw UsageError("--mask-bodies: goes with --masks or --refine edges");
     return std::nullopt;
   }
-  if (!model) throw UsageError("--masks: needs --model (the robot drawn to match the masks)");
-  overlay::MaskInputs in;
+  if (!model)
+    throw UsageError(edges ? "--refine edges: needs --model (the robot drawn to match the pictures)"
+                           : "--masks: needs --model (the robot drawn to match the masks)");
+  overlay::RefineInputs in;
+  if (edges) in.source = calib::RefineSource::Edges;
   for (const std::string& m : a.masks) {
     in.masks.push_back(calib::readMask(m, cam.width, cam.height));
     in.mask_names.push_back(m);
@@ -110,7 +117,7 @@ Exit runCalib(const CalibArgs& a) {
   if (!a.truth.empty()) truth = calib::loadCamera(a.truth);
   std::optional<Model> model;
   if (!a.model.empty()) model = loadOrExplain(a.model);
-  const std::optional<overlay::MaskInputs> mask_inputs = maskInputs(a, intrinsics, model);
+  const std::optional<overlay::RefineInputs> refine_inputs = refineInputs(a, intrinsics, model);
   const overlay::Gathered g = overlay::gatherCorrespondences(gatherInputs(a, intrinsics, model));
 
   calib::PoseOptions options;
@@ -118,9 +125,9 @@ Exit runCalib(const CalibArgs& a) {
   options.min_inliers = a.min_inliers;
   overlay::CalibSolution s =
       overlay::solveCalibration(intrinsics, g, options, model ? &*model : nullptr, truth ? &*truth : nullptr);
-  std::optional<overlay::MaskRefinement> refinement;
-  if (mask_inputs) {
-    refinement = overlay::refineCalibrationToMasks(s, g, intrinsics, *model, *mask_inputs, truth ? &*truth : nullptr);
+  std::optional<overlay::Refinement> refinement;
+  if (refine_inputs) {
+    refinement = overlay::refineCalibration(s, g, intrinsics, *model, *refine_inputs, truth ? &*truth : nullptr);
     if (!refinement->result.improved && !s.solved())
       s.pose.message = refinement->result.message + " and the points do not solve (" + s.pose.message +
                        "): add labels of the robot or tags, or start from --camera ROUGH.yaml";
@@ -131,11 +138,13 @@ Exit runCalib(const CalibArgs& a) {
     writeFileAtomically(a.output, calib::cameraText(r.camera) + (refinement ? overlay::refinementText(*refinement) : std::string()));
     for (std::size_t f = 0; !a.check.empty() && f < g.frames.size(); ++f) {
       overlay::CheckImage check =
-          overlay::checkImage(g, s, f, model ? &*model : nullptr, {.magnify = a.magnify, .camera_name = a.intrinsics});
+          overlay::checkImage(g, s, f, model ? &*model : nullptr, {.magnify = a.magnify,
+                              .camera_name = a.intrinsics,
+                              .pose_source = a.refine == "edges" ? "the pictures' edges" : "the robot's masks"});
       if (!check.renderer.empty()) renderer_name = check.renderer;
       if (refinement)
-        overlay::drawMaskAgreement(check.bgr, r.camera, mask_inputs->masks[f],
-                                   calib::placeVolumes(*model, g.frames[f].state, mask_inputs->bodies));
+        overlay::drawMaskAgreement(check.bgr, r.camera, refine_inputs->masks.empty() ? cv::Mat() : refine_inputs->masks[f],
+                                   calib::placeVolumes(*model, g.frames[f].state, refine_inputs->bodies));
       writePngAtomically(checkPath(a.check, f), check.bgr, "--check");
     }
   }
@@ -148,8 +157,13 @@ Exit runCalib(const CalibArgs& a) {
     if (refinement) {
       for (std::size_t f = 0; f < refinement->result.frames.size(); ++f) {
         const calib::FrameAgreement& fa = refinement->result.frames[f];
-        std::cout << "mask " << a.masks[f] << ": IoU " << format(fa.iou_before, 4);
-        if (refinement->result.improved) std::cout << " -> " << format(fa.iou_after, 4);
+        if (refine_inputs->masks.empty()) {
+          std::cout << "frame " << f + 1 << ": outline on edges " << format(100 * fa.matched_before, 3) << "%";
+          if (refinement->result.improved) std::cout << " -> " << format(100 * fa.matched_after, 3) << "%";
+        } else {
+          std::cout << "mask " << a.masks[f] << ": IoU " << format(fa.iou_before, 4);
+          if (refinement->result.improved) std::cout << " -> " << format(fa.iou_after, 4);
+        }
         std::cout << ", outline " << format(fa.rms_px, 3) << " px rms over " << fa.outline_points << " points"
                   << (refinement->result.improved ? "" : " (the start, kept)") << "\n";
       }
@@ -201,7 +215,8 @@ Runner addCalib(CLI::App& app) {
       ->check(CLI::Range(0, 100000000));
   addBagOptions(*sub, *a);
   sub->add_option("--tags", a->tags, "Tag layout: where the AprilTags are in the world");
-  sub->add_option("--labels", a->labels, "Labelled points (repeat: one file per --image, same order)")->allow_extra_args(false);
+  sub->add_option("--labels", a->labels, "Labelled points (repeat: one file per --image, same order; none for a frame without labels, e.g. 4 labels on "
+                  "one frame and the others used by --masks or --refine edges only)")->allow_extra_args(false);
   sub->add_option("--model", a->model, "Model file placing the body labels (and drawn in the check image)");
   sub->add_option("--state", a->states,
                   "The robot's state in the frames (comma-separated; once for all frames, or once per frame) for body labels "
@@ -234,10 +249,15 @@ Runner addCalib(CLI::App& app) {
                   "tool's output): the pose is refined so the model's drawn robot matches them over all frames; needs "
                   "--model and each frame's state")
       ->expected(1, -1);
+  sub->add_option("--refine", a->refine,
+                  "What the pose is refined to: masks (the default with --masks) or edges (no masks: the robot's drawn outline is "
+                  "pulled onto the pictures' own edges of its direction, coarse to fine; needs --model, each frame's picture and "
+                  "state, and a start a few degrees off at most, e.g. from 4 rough labels)")
+      ->check(CLI::IsMember({"masks", "edges"}));
   sub->add_option("--camera", a->rough_camera,
-                  "A rough camera file to start --masks from when no labels or tags give a start (its pose is used)");
+                  "A rough camera file to start --masks or --refine edges from when no labels or tags give a start (its pose is used)");
   sub->add_option("--mask-bodies", a->mask_bodies,
-                  "Comma-separated bodies of the model that the masks show (default: all bodies)");
+                  "Comma-separated bodies of the model that the masks (or, with --refine edges, the pictures) show (default: all bodies)");
   sub->add_flag("--json", a->json, "Print the result as JSON (status, sigmas, rejected, residuals)");
   sub->add_flag("-q,--quiet", a->quiet, "Print nothing but errors");
 

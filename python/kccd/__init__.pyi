@@ -25,6 +25,7 @@ from ._kccd import read_bag as read_bag
 from ._kccd import read_frame as read_frame
 from ._kccd import read_frames as read_frames
 from ._kccd import read_image as read_image
+from ._kccd import refine_to_edges as refine_to_edges
 from ._kccd import refine_to_masks as refine_to_masks
 from ._kccd import render as render
 from ._kccd import solve_pose as solve_pose
@@ -57,6 +58,7 @@ __all__ = [
     "read_frame",
     "read_frames",
     "read_image",
+    "refine_to_edges",
     "refine_to_masks",
     "render",
     "solve_pose",

@@ -433,6 +433,31 @@ class _Refinement(TypedDict):
     covariance: npt.NDArray[np.float64] | None
     drawn: str
 
+class _EdgeFrame(TypedDict):
+    edge_share_before: float
+    edge_share_after: float
+    rms_px: float
+    outline_points: int
+
+class _EdgeRefinement(TypedDict):
+    improved: bool
+    message: str
+    camera: Camera
+    frames: list[_EdgeFrame]
+    iterations: int
+    covariance: npt.NDArray[np.float64] | None
+    drawn: str
+
+def refine_to_edges(
+    camera: Camera,
+    model: Model,
+    pictures: Sequence[str | os.PathLike[str] | _ArrayLike],
+    states: _ArrayLike,
+    *,
+    bodies: Sequence[str] | None = None,
+    start_is_prior: bool | None = None,
+) -> _EdgeRefinement: ...
+
 def refine_to_masks(
     camera: Camera,
     model: Model,

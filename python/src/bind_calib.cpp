@@ -9,6 +9,7 @@
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "kccd/calib/camera.hpp"
+#include "kccd/calib/edge_refine.hpp"
 #include "kccd/calib/image_file.hpp"
 #include "kccd/calib/mask_refine.hpp"
 #include "kccd/calib/pose.hpp"
@@ -87,6 +88,74 @@ py::array_t<double> covarianceArray(const cv::Matx66d& c) {
   py::array_t<double> out({6, 6});
   for (int i = 0; i < 6; ++i)
     for (int j = 0; j < 6; ++j) out.mutable_at(i, j) = c(i, j);
+  return out;
+}
+
+// pictures[index] of `camera`'s size as 8-bit grey: an image file's path, or a uint8 (H, W) or
+// (H, W, 3) array (either channel order: edges do not depend on it).
+cv::Mat pictureOf(const py::handle& value, std::size_t index, const calib::Camera& camera) {
+  const std::string name = "pictures[" + std::to_string(index) + "]";
+  cv::Mat grey;
+  if (py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__")) {
+    grey = calib::readImageFile(py::str(py::module_::import("os").attr("fspath")(value)).cast<std::string>(), calib::ImageColour::Grey);
+  } else {
+    py::array a = py::array::ensure(value);
+    if (!a) {
+      PyErr_Clear();
+      throw py::type_error(name + ": expected a path or a NumPy array");
+    }
+    if (!(a.dtype().kind() == 'u' && a.dtype().itemsize() == 1))
+      throw py::type_error(name + ": expected dtype uint8, got dtype " + py::str(a.dtype()).cast<std::string>());
+    if (!(a.ndim() == 2 || (a.ndim() == 3 && a.shape(2) == 3))) throw py::value_error(name + ": expected shape (H, W) or (H, W, 3)");
+    const auto c = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(a);
+    const cv::Mat view(static_cast<int>(a.shape(0)), static_cast<int>(a.shape(1)), a.ndim() == 2 ? CV_8UC1 : CV_8UC3,
+                       const_cast<std::uint8_t*>(c.data()));
+    if (a.ndim() == 3) cv::cvtColor(view, grey, cv::COLOR_BGR2GRAY);
+    else grey = view.clone();
+  }
+  if (grey.cols != camera.width || grey.rows != camera.height)
+    throw py::value_error(name + ": " + std::to_string(grey.cols) + "x" + std::to_string(grey.rows) + " for a camera of " +
+                          std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  return grey;
+}
+
+// The model's body indices of `bodies` (none: all).
+std::vector<int> bodyIndices(const Model& model, const std::optional<std::vector<std::string>>& bodies) {
+  std::vector<int> indices;
+  if (bodies)
+    for (const std::string& b : *bodies) {
+      const int i = model.bodyIndex(b);
+      if (i < 0) throw py::value_error("bodies: the model has no body '" + b + "'");
+      indices.push_back(i);
+    }
+  return indices;
+}
+
+// A refinement's result as refine_to_masks and refine_to_edges return it.
+py::dict refinementDict(const calib::RefineResult& r) {
+  const bool edges = r.source == calib::RefineSource::Edges;
+  py::list per_frame;
+  for (const calib::FrameAgreement& a : r.frames) {
+    py::dict d;
+    if (edges) {
+      d["edge_share_before"] = a.matched_before;
+      d["edge_share_after"] = a.matched_after;
+    } else {
+      d["iou_before"] = a.iou_before;
+      d["iou_after"] = a.iou_after;
+    }
+    d["rms_px"] = a.rms_px;
+    d["outline_points"] = a.outline_points;
+    per_frame.append(d);
+  }
+  py::dict out;
+  out["improved"] = r.improved;
+  out["message"] = r.message;
+  out["camera"] = r.camera;
+  out["frames"] = per_frame;
+  out["iterations"] = r.iterations;
+  out["covariance"] = r.improved ? py::object(covarianceArray(r.covariance)) : py::object(py::none());
+  out["drawn"] = "collision volumes";
   return out;
 }
 
@@ -302,13 +371,7 @@ non-finite coordinate, an empty or repeated name, or invalid intrinsics.)doc");
           throw py::value_error("masks, states: " + std::to_string(masks.size()) + " masks but " + std::to_string(st.shape(0)) +
                                 " states");
         if (masks.size() == 0) throw py::value_error("masks: give at least one");
-        std::vector<int> indices;
-        if (bodies)
-          for (const std::string& b : *bodies) {
-            const int i = model.bodyIndex(b);
-            if (i < 0) throw py::value_error("bodies: the model has no body '" + b + "'");
-            indices.push_back(i);
-          }
+        const std::vector<int> indices = bodyIndices(model, bodies);
         std::vector<calib::MaskFrame> frames;
         for (std::size_t f = 0; f < masks.size(); ++f) {
           const double* row = st.data(static_cast<py::ssize_t>(f), 0);
@@ -322,24 +385,7 @@ non-finite coordinate, an empty or repeated name, or invalid intrinsics.)doc");
           py::gil_scoped_release release;
           r = calib::refineToMasks(camera, frames, options);
         }
-        py::list per_frame;
-        for (const calib::FrameAgreement& a : r.frames) {
-          py::dict d;
-          d["iou_before"] = a.iou_before;
-          d["iou_after"] = a.iou_after;
-          d["rms_px"] = a.rms_px;
-          d["outline_points"] = a.outline_points;
-          per_frame.append(d);
-        }
-        py::dict out;
-        out["improved"] = r.improved;
-        out["message"] = r.message;
-        out["camera"] = r.camera;
-        out["frames"] = per_frame;
-        out["iterations"] = r.iterations;
-        out["covariance"] = r.improved ? py::object(covarianceArray(r.covariance)) : py::object(py::none());
-        out["drawn"] = "collision volumes";
-        return out;
+        return refinementDict(r);
       },
       py::arg("camera"), py::arg("model"), py::arg("masks"), py::arg("states"), py::kw_only(), py::arg("bodies") = py::none(),
       py::arg("start_is_prior") = py::none(),
@@ -356,6 +402,46 @@ pose sigmas when improved), 'frames' (per frame 'iou_before', 'iou_after', 'rms_
 'collision volumes'). Raises InputError for an unreadable mask file (naming it), ValueError for a mask of
 another size, with no robot or nothing but robot, a count that does not match the states, or an unknown body.
 The GIL is released while refining.)doc");
-}
+
+  m.def(
+      "refine_to_edges",
+      [](const calib::Camera& camera, const std::shared_ptr<ModelHandle>& h, const py::sequence& pictures,
+         const py::handle& states, const std::optional<std::vector<std::string>>& bodies, const std::optional<bool>& start_is_prior) {
+        if (py::isinstance<py::str>(pictures) || py::isinstance<py::bytes>(pictures))
+          throw py::type_error("pictures: a list of pictures (one per frame), not one path");
+        const Model& model = *h->model;
+        const int n = model.stateSize();
+        const auto st = stateMatrix(states, "states", n);
+        if (static_cast<std::size_t>(st.shape(0)) != pictures.size())
+          throw py::value_error("pictures, states: " + std::to_string(pictures.size()) + " pictures but " +
+                                std::to_string(st.shape(0)) + " states");
+        if (pictures.size() == 0) throw py::value_error("pictures: give at least one");
+        const std::vector<int> indices = bodyIndices(model, bodies);
+        std::vector<calib::EdgeFrame> frames;
+        for (std::size_t f = 0; f < pictures.size(); ++f) {
+          const double* row = st.data(static_cast<py::ssize_t>(f), 0);
+          frames.push_back({pictureOf(pictures[f], f, camera),
+                            calib::placeVolumes(model, std::span<const double>(row, static_cast<std::size_t>(n)), indices)});
+        }
+        calib::EdgeOptions options;
+        options.start_is_prior = start_is_prior.value_or(camera.rotation_sigma_deg && camera.position_sigma_m);
+        calib::RefineResult r;
+        {
+          py::gil_scoped_release release;
+          r = calib::refineToEdges(camera, frames, options);
+        }
+        return refinementDict(r);
+      },
+      py::arg("camera"), py::arg("model"), py::arg("pictures"), py::arg("states"), py::kw_only(), py::arg("bodies") = py::none(),
+      py::arg("start_is_prior") = py::none(),
+      R"doc(The camera's pose refined so that the model's volumes' outline, drawn through the lens at each frame's
+state, lies on the pictures' own edges, as `kccd calib --refine edges` (no masks needed): camera, a Camera with a
+start pose a few degrees off at most (e.g. a solve from 4 rough labels); pictures, one per frame, each a path to
+an image or a uint8 (H, W) or (H, W, 3) array of the camera's size; states float64 (frames, state_size); bodies,
+the bodies in view (default all); start_is_prior as refine_to_masks (for a gain below 5 points of the outline on
+edges). Returns the dict of refine_to_masks, with per frame 'edge_share_before' and 'edge_share_after' (the share
+of the drawn outline within 2 px of an image edge of its direction) in place of the IoUs. Raises InputError for an
+unreadable picture file (naming it), ValueError for a picture of another size, a count that does not match the
+states, or an unknown body. The GIL is released while refining.)doc");}
 
 }  // namespace kccd::python

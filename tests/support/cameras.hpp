@@ -86,4 +86,22 @@ inline Camera randomCamera(std::mt19937_64& rng, bool distorted, int w = 320, in
   return lookAt(dist * dir, Vec3(0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng)), w, h, 0.9 * w * (1.0 + 0.2 * u(rng)), d);
 }
 
+// `c` turned by `deg` about a random axis through its centre and moved `m` in a random direction.
+inline Camera perturbed(const Camera& c, double deg, double m, std::mt19937_64& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  cv::Vec3d axis(n(rng), n(rng), n(rng));
+  axis *= (deg * M_PI / 180.0) / cv::norm(axis);
+  cv::Vec3d dir(n(rng), n(rng), n(rng));
+  dir *= m / cv::norm(dir);
+  cv::Matx33d r, d;
+  cv::Rodrigues(c.rvec, r);
+  cv::Rodrigues(axis, d);
+  const cv::Vec3d centre = -(r.t() * c.tvec) + dir;
+  const cv::Matx33d r2 = d * r;
+  Camera out = c;
+  cv::Rodrigues(r2, out.rvec);
+  out.tvec = -(r2 * centre);
+  return out;
+}
+
 }  // namespace kccd::testing

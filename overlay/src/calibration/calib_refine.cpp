@@ -35,12 +35,13 @@ std::optional<calib::Camera> roughPose(const calib::Camera& intrinsics, const Ga
 
 }  // namespace
 
-MaskRefinement refineCalibrationToMasks(CalibSolution& solution, const Gathered& g, const calib::Camera& intrinsics,
-                                        const Model& model, const MaskInputs& in, const calib::Camera* truth) {
-  if (in.masks.size() != g.frames.size())
+Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const calib::Camera& intrinsics,
+                                        const Model& model, const RefineInputs& in, const calib::Camera* truth) {
+  const bool edges = in.source == calib::RefineSource::Edges;
+  if (!edges && in.masks.size() != g.frames.size())
     throw CalibInputError("--masks: " + std::to_string(in.masks.size()) + " mask(s) for " + std::to_string(g.frames.size()) +
                           " frame(s): give one mask per frame, in the same order");
-  MaskRefinement out;
+  Refinement out;
   out.drawn = "collision volumes";
   calib::Camera start;
   if (solution.solved()) {
@@ -52,19 +53,31 @@ MaskRefinement refineCalibrationToMasks(CalibSolution& solution, const Gathered&
     start.rvec = in.rough->rvec, start.tvec = in.rough->tvec;
     out.start = "camera";
   } else {
-    throw CalibInputError("--masks: no start for the pose: give 4 or more labels or tag corners, or --camera ROUGH.yaml");
+    throw CalibInputError(std::string(edges ? "--refine edges" : "--masks") +
+                          ": no start for the pose: give 4 or more labels or tag corners, or --camera ROUGH.yaml");
   }
-  std::vector<calib::MaskFrame> frames;
+  std::vector<calib::MaskFrame> mask_frames;
+  std::vector<calib::EdgeFrame> edge_frames;
   for (std::size_t f = 0; f < g.frames.size(); ++f) {
     const std::vector<double>& state = g.frames[f].state;
+    const std::string what = edges ? "--refine edges" : "--masks";
     if (static_cast<int>(state.size()) != model.stateSize())
-      throw CalibInputError("--masks: frame " + std::to_string(f + 1) + " has no state of the model's " +
+      throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no state of the model's " +
                             std::to_string(model.stateSize()) + " values: give --state, or --states with --time");
-    frames.push_back({in.masks[f], calib::placeVolumes(model, state, in.bodies)});
+    if (edges && g.frames[f].bgr.empty())
+      throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no picture to find edges in: give --image or --video");
+    if (edges) edge_frames.push_back({g.frames[f].bgr, calib::placeVolumes(model, state, in.bodies)});
+    else mask_frames.push_back({in.masks[f], calib::placeVolumes(model, state, in.bodies)});
   }
-  calib::RefineOptions options;
-  options.start_is_prior = out.start == "solve";
-  out.result = calib::refineToMasks(start, frames, options);
+  if (edges) {
+    calib::EdgeOptions options;
+    options.start_is_prior = out.start == "solve";
+    out.result = calib::refineToEdges(start, edge_frames, options, g.points);
+  } else {
+    calib::RefineOptions options;
+    options.start_is_prior = out.start == "solve";
+    out.result = calib::refineToMasks(start, mask_frames, options);
+  }
   if (!out.result.improved) return out;
 
   calib::PoseResult& pose = solution.pose;
@@ -119,26 +132,35 @@ MaskRefinement refineCalibrationToMasks(CalibSolution& solution, const Gathered&
   return out;
 }
 
-std::string refinementText(const MaskRefinement& m) {
+std::string refinementText(const Refinement& m) {
+  const bool edges = m.result.source == calib::RefineSource::Edges;
   std::string before = "[", after = "[";
   for (std::size_t f = 0; f < m.result.frames.size(); ++f) {
-    before += (f ? ", " : " ") + formatNumber(m.result.frames[f].iou_before, 6);
-    after += (f ? ", " : " ") + formatNumber(m.result.frames[f].iou_after, 6);
+    const calib::FrameAgreement& a = m.result.frames[f];
+    before += (f ? ", " : " ") + formatNumber(edges ? a.matched_before : a.iou_before, 6);
+    after += (f ? ", " : " ") + formatNumber(edges ? a.matched_after : a.iou_after, 6);
   }
-  return std::string("refinement: ") + (m.result.improved ? "masks" : "none") + "\nrefinement_start: " + m.start +
-         "\nrefinement_drawn: \"" + m.drawn + "\"\nmask_iou_before: " + before + " ]\nmask_iou_after: " + after + " ]\n";
+  const std::string key = edges ? "edge_share" : "mask_iou";
+  return std::string("refinement: ") + (m.result.improved ? (edges ? "edges" : "masks") : "none") + "\nrefinement_start: " + m.start +
+         "\nrefinement_drawn: \"" + m.drawn + "\"\n" + key + "_before: " + before + " ]\n" + key + "_after: " + after + " ]\n";
 }
 
-nlohmann::json refinementJson(const MaskRefinement& m) {
+nlohmann::json refinementJson(const Refinement& m) {
   nlohmann::json j;
+  const bool edges = m.result.source == calib::RefineSource::Edges;
+  j["source"] = edges ? "edges" : "masks";
   j["improved"] = m.result.improved;
   j["message"] = m.result.message;
   j["start"] = m.start;
   j["drawn"] = m.drawn;
   j["iterations"] = m.result.iterations;
   j["frames"] = nlohmann::json::array();
-  for (const calib::FrameAgreement& a : m.result.frames)
-    j["frames"].push_back({{"iou_before", a.iou_before}, {"iou_after", a.iou_after}, {"rms_px", a.rms_px}, {"outline_points", a.outline_points}});
+  for (const calib::FrameAgreement& a : m.result.frames) {
+    nlohmann::json f = {{"rms_px", a.rms_px}, {"outline_points", a.outline_points}};
+    if (edges) f["edge_share_before"] = a.matched_before, f["edge_share_after"] = a.matched_after;
+    else f["iou_before"] = a.iou_before, f["iou_after"] = a.iou_after;
+    j["frames"].push_back(f);
+  }
   j["disagreeing"] = m.disagreeing;
   if (m.result.improved) {
     j["rotation_sigma_deg"] = *m.result.camera.rotation_sigma_deg;
@@ -158,7 +180,7 @@ void drawMaskAgreement(cv::Mat& bgr, const calib::Camera& camera, const cv::Mat&
       for (cv::Point& p : c) p = cv::Point(static_cast<int>(std::lround(p.x * sx)), static_cast<int>(std::lround(p.y * sy)));
     cv::polylines(bgr, contours, true, colour, thick, cv::LINE_AA);
   };
-  outline(mask != 0, cv::Scalar(0, 220, 255));
+  if (!mask.empty()) outline(mask != 0, cv::Scalar(0, 220, 255));
   outline(calib::drawSilhouette(camera, volumes).mask, cv::Scalar(255, 0, 255));
 }
 

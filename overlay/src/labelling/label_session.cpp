@@ -139,15 +139,15 @@ void LabelSession::resolve() {
   CalibSolution s = solveCalibration(in_.intrinsics, gathered, in_.pose, in_.model);
   // Snapping: the solve refined to the masks; without a start (fewer than 4 points), said. Kept
   // in a local until everything else has been computed, so a throw leaves the last solve whole.
-  std::optional<MaskRefinement> refinement;
+  std::optional<Refinement> refinement;
   std::string snap_message;
   if (snap_) {
-    MaskInputs masks;
+    RefineInputs masks;
     masks.masks = in_.masks;
     masks.mask_names = in_.mask_names;
     masks.bodies = in_.mask_bodies;
     try {
-      refinement = refineCalibrationToMasks(s, gathered, in_.intrinsics, *in_.model, masks);
+      refinement = refineCalibration(s, gathered, in_.intrinsics, *in_.model, masks);
       snap_message = refinement->result.message;
     } catch (const CalibInputError& e) {
       snap_message = e.what();

@@ -43,16 +43,23 @@ struct RefineOptions {
   bool start_is_prior = false;
 };
 
-/// The agreement of one frame before and after.
+/// The agreement of one frame before and after (a refinement to masks fills the IoUs, one to
+/// edges the matched fractions).
 struct FrameAgreement {
   double iou_before = 0.0;  ///< mask IoU at the start pose
   double iou_after = 0.0;   ///< at the returned pose
-  double rms_px = 0.0;      ///< outline points' distance to the mask's outline at the returned pose (robust rms)
+  double matched_before = 0.0;  ///< share of the drawn outline on an image edge of its direction, at the start
+  double matched_after = 0.0;   ///< at the returned pose
+  double rms_px = 0.0;      ///< outline points' distance to the mask's outline (or the edges) at the returned pose (robust rms)
   int outline_points = 0;   ///< points of the drawn outline inside the image at the returned pose
 };
 
+/// What a refinement was made to.
+enum class RefineSource { Masks, Edges };
+
 /// The result; `camera` is the refined pose only when `improved`, else the start.
 struct RefineResult {
+  RefineSource source = RefineSource::Masks;
   bool improved = false;
   std::string message;  ///< one line: what happened, and why the start was kept when it was
   Camera camera;        ///< with the refinement's pose sigmas when improved

@@ -18,6 +18,7 @@ namespace kccd::overlay {
 struct CheckImageOptions {
   double magnify = 20.0;    ///< inliers' residual vectors are drawn this many times longer
   std::string camera_name;  ///< names the camera in messages
+  std::string pose_source = "the robot's masks";  ///< what gave the pose when no points did
 };
 
 /// A check image and what drew its volumes.

@@ -1,7 +1,8 @@
-// A calibration's pose refined to robot masks of its frames (calib::refineToMasks): the start
-// chosen (the points' solve, else a rough pose from four or more points, else a given camera),
-// the model's volumes placed at each frame's state, the result put into the solution with each
-// labelled point's residual under the refined pose. The command line and Python build the inputs.
+// A calibration's pose refined to robot masks of its frames (calib::refineToMasks) or to its
+// pictures' edges (calib::refineToEdges): the start chosen (the points' solve, else a rough pose
+// from four or more points, else a given camera), the model's volumes placed at each frame's
+// state, the result put into the solution with each labelled point's residual under the refined
+// pose. The command line, the labelling page and Python build the inputs.
 #pragma once
 
 #include <optional>
@@ -12,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "kccd/calib/edge_refine.hpp"
 #include "kccd/calib/mask_refine.hpp"
 #include "kccd/overlay/calibration/calib_gather.hpp"
 #include "kccd/overlay/calibration/calib_solve.hpp"
@@ -19,15 +21,16 @@
 namespace kccd::overlay {
 
 /// What the refinement is given beside the gathered frames.
-struct MaskInputs {
-  std::vector<cv::Mat> masks;          ///< one per gathered frame (calib::readMask)
+struct RefineInputs {
+  calib::RefineSource source = calib::RefineSource::Masks;  ///< Edges: the gathered frames' pictures
+  std::vector<cv::Mat> masks;          ///< with Masks: one per gathered frame (calib::readMask)
   std::vector<std::string> mask_names; ///< as messages name them
   std::vector<int> bodies;             ///< the model's bodies that are the robot (empty: all)
   std::optional<calib::Camera> rough;  ///< a start when the points do not give one
 };
 
 /// What the refinement did.
-struct MaskRefinement {
+struct Refinement {
   std::string start;       ///< "solve" (the points' solve), "points" (a rough pose from them), "camera" (the given one)
   std::string drawn;       ///< what was drawn: "collision volumes"
   calib::RefineResult result;
@@ -36,24 +39,26 @@ struct MaskRefinement {
   std::vector<std::string> disagreeing;
 };
 
-/// Refines `solution`'s pose to the masks. When the result improves the agreement, the solution
+/// Refines `solution`'s pose to the masks or the edges. When the result improves the agreement, the solution
 /// holds the refined camera (status solved, the covariance and sigmas of the refinement, the
 /// residuals of every point under it, the truth error when `truth` is given); otherwise it is left
 /// as it was. Throws CalibInputError when no start can be had, a frame has no state of the model's
-/// size, or the masks do not match the frames.
-MaskRefinement refineCalibrationToMasks(CalibSolution& solution, const Gathered& gathered, const calib::Camera& intrinsics,
-                                        const Model& model, const MaskInputs& inputs, const calib::Camera* truth = nullptr);
+/// size, the masks do not match the frames, or (edges) a frame has no picture.
+Refinement refineCalibration(CalibSolution& solution, const Gathered& gathered, const calib::Camera& intrinsics,
+                                        const Model& model, const RefineInputs& inputs, const calib::Camera* truth = nullptr);
 
 /// The refinement's figures as lines the camera file ends with (keys OpenCV and the camera reader
-/// skip): refinement, refinement_start, refinement_drawn, mask_iou_before, mask_iou_after.
-std::string refinementText(const MaskRefinement& refinement);
+/// skip): refinement (masks, edges or none), refinement_start, refinement_drawn, then
+/// mask_iou_before and mask_iou_after, or edge_share_before and edge_share_after.
+std::string refinementText(const Refinement& refinement);
 
-/// The refinement as the JSON report gives it: improved, message, start, drawn, frames
-/// (iou_before, iou_after, rms_px, outline_points), disagreeing.
-nlohmann::json refinementJson(const MaskRefinement& refinement);
+/// The refinement as the JSON report gives it: source, improved, message, start, drawn, frames
+/// (iou_before and iou_after, or edge_share_before and edge_share_after; rms_px,
+/// outline_points), disagreeing.
+nlohmann::json refinementJson(const Refinement& refinement);
 
-/// Draws onto a check image of the camera's frame the mask's outline (yellow) and the robot's
-/// drawn outline at `camera` (magenta), so where they part shows.
+/// Draws onto a check image of the camera's frame the mask's outline (yellow; none for an empty
+/// mask) and the robot's drawn outline at `camera` (magenta), so where they part shows.
 void drawMaskAgreement(cv::Mat& bgr, const calib::Camera& camera, const cv::Mat& mask, std::span<const calib::PlacedVolume> volumes);
 
 }  // namespace kccd::overlay

@@ -122,7 +122,7 @@ class LabelSession {
   nlohmann::json solve_json_;
   std::optional<calib::Camera> solved_;
   bool snap_ = false;
-  std::optional<MaskRefinement> refinement_;  ///< the last solve's refinement while snapping
+  std::optional<Refinement> refinement_;  ///< the last solve's refinement while snapping
   int revision_ = 0;
   bool dirty_ = false;
 };
