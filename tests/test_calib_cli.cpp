@@ -22,6 +22,7 @@
 #include "kccd/kinematics.hpp"
 #include "kccd/model.hpp"
 #include "support/cameras.hpp"
+#include "support/files.hpp"
 #include "support/golden.hpp"
 #include "support/run_program.hpp"
 #include "support/silhouette.hpp"
@@ -328,6 +329,67 @@ TEST_F(CalibMasks, BadMasksAreOneLineExitTwoAndNothingWritten) {
       {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("mask0.png") + " --mask-bodies arm",
        "--mask-bodies: 'arm' is not a body"},
       {" --labels " + out("l0.yaml") + " --camera " + kCamera, "--camera: a start for --masks"},
+  };
+  for (const auto& c : cases) {
+    const Outcome r = runKccd(base + c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out("c.yaml")));
+  }
+}
+
+// --refine edges: no masks; the frames are pictures of the robot (each body painted by the
+// independent rasteriser) on a background with boxes, from the same four rough clicks.
+TEST_F(CalibMasks, FourRoughClicksAndThePicturesEdgesGiveTheCamera) {
+  std::string args;
+  for (std::size_t f = 0; f < states_.size(); ++f) {
+    write("l" + std::to_string(f) + ".yaml", roughClicks(f));
+    cv::Mat grey(cam_.height, cam_.width, CV_8UC1, cv::Scalar(90));
+    cv::rectangle(grey, {40, 200}, {200, 330}, cv::Scalar(160), cv::FILLED);
+    cv::rectangle(grey, {480, 40}, {600, 120}, cv::Scalar(30), cv::FILLED);
+    grey.setTo(cv::Scalar(210), mask(states_[f]));
+    cv::GaussianBlur(grey, grey, cv::Size(5, 5), 0.8);
+    cv::Mat bgr;
+    cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
+    cv::imwrite(out("pic" + std::to_string(f) + ".png"), bgr);
+    std::string st;
+    for (double v : states_[f]) st += (st.empty() ? "" : ",") + fmt(v);
+    args += " --image " + out("pic" + std::to_string(f) + ".png") + " --labels " + out("l" + std::to_string(f) + ".yaml") + " --state " + st;
+  }
+  const Outcome r = runKccd("calib --intrinsics " + out("cam.yaml") + args + " --model " + kDemo +
+                            " --mask-bodies pedestal,shoulder,upper_arm,forearm,gripper --refine edges -o " + out("c.yaml") +
+                            " --json --check " + out("check.png"));
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j["refinement"]["improved"].get<bool>()) << r.out;
+  EXPECT_EQ(j["refinement"]["source"], "edges");
+  for (const auto& fr : j["refinement"]["frames"]) EXPECT_GT(fr["edge_share_after"].get<double>(), 0.8) << r.out;
+  const kccd::calib::Camera c = kccd::calib::loadCamera(out("c.yaml"));
+  EXPECT_LT(rotationErrorDeg(c.rvec, cam_.rvec), 0.2);
+  EXPECT_LT(cv::norm(centre(c) - centre(cam_)), 0.01);
+  std::printf("4 clicks 8 px off + the edges of 2 pictures: %.3f deg, %.2f mm from the truth\n", rotationErrorDeg(c.rvec, cam_.rvec),
+              1e3 * cv::norm(centre(c) - centre(cam_)));
+  EXPECT_NE(kccd::testing::readText(out("c.yaml")).find("refinement: edges"), std::string::npos);
+  // The check image draws the drawn robot's outline (magenta) on the frame.
+  const cv::Mat check = cv::imread(out("check.png"));
+  ASSERT_FALSE(check.empty());
+  cv::Mat magenta;
+  cv::inRange(check, cv::Scalar(200, 0, 200), cv::Scalar(255, 60, 255), magenta);
+  EXPECT_GT(cv::countNonZero(magenta), 100);
+}
+
+TEST_F(CalibMasks, BadRefineOptionsAreOneLineExitTwo) {
+  write("l0.yaml", roughClicks(0));
+  const std::string base = "calib --intrinsics " + out("cam.yaml") + " -o " + out("c.yaml") + " --labels " + out("l0.yaml") + " --state 0,0,0";
+  const struct {
+    std::string args, expect;
+  } cases[] = {
+      {" --model " + kDemo + " --refine edges --masks " + out("mask0.png"), "--refine edges: refines to the pictures themselves"},
+      {" --refine edges", "--refine edges: needs --model"},
+      {" --model " + kDemo + " --refine masks", "--refine masks: give the masks"},
+      {" --model " + kDemo + " --refine lines", "--refine"},
+      {" --model " + kDemo + " --refine edges", "frame 1 has no picture to find edges in"},
   };
   for (const auto& c : cases) {
     const Outcome r = runKccd(base + c.args);

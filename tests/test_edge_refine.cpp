@@ -129,9 +129,10 @@ TEST(EdgeRefine, ClutterASecondArmAndAShadowDoNotPullItAway) {
 // Four clicks 8 px off, one body's centre on each of four pictures (on one picture this planar
 // arm's four bodies lie in a plane, which four points cannot pin down), a rough pose from them
 // alone (SQPnP), then the edges with the clicks holding the fit near them. Such starts are 2-15
-// degrees and 8-30 cm off; the edges do not find the camera from every one (measured: 3 of 6 click
-// sets within 0.05 deg / 1.5 mm, two stuck 3 degrees off nearer than their start, one refused as
-// the clicks disagree), but a refined pose is never farther from the truth than its start.
+// (and once 165) degrees and 8-30 cm off; the edges do not find the camera from every one
+// (measured: 3 of 6 click sets within 0.04 deg / 1.2 mm, one stuck 3 degrees off nearer than its
+// start, one refused as the clicks disagree, the flipped one not improved), but a refined pose is
+// never farther from the truth than its start.
 TEST(EdgeRefine, FourRoughClicksAreEnoughToStartMostly) {
   const Scene scene(kccd::testing::casesFor(6, 5), 11, true);
   std::mt19937_64 rng(12);

@@ -30,21 +30,21 @@ py::array_t<std::uint8_t> rgbArray(const cv::Mat& bgr) {
 }
 
 // `image` (uint8 (H, W) grey, (H, W, 3) RGB or (H, W, 4) RGBA) as an 8-bit grey cv::Mat of its own,
-// converted with the weights `kccd calib` uses on its BGR frames.
-cv::Mat greyOf(const py::handle& image) {
+// converted with the weights `kccd calib` uses on its BGR frames; `name` names it in errors.
+cv::Mat greyOf(const py::handle& image, const std::string& name = "image") {
   py::array a = py::array::ensure(image);
   if (!a) {
     PyErr_Clear();
-    throw py::type_error("image: expected a NumPy array of uint8 pixels");
+    throw py::type_error(name + ": expected a NumPy array of uint8 pixels");
   }
   if (a.dtype().kind() != 'u' || a.dtype().itemsize() != 1)
-    throw py::type_error("image: expected dtype uint8, got dtype " + py::str(a.dtype()).cast<std::string>());
+    throw py::type_error(name + ": expected dtype uint8, got dtype " + py::str(a.dtype()).cast<std::string>());
   const int channels = a.ndim() == 2 ? 1 : (a.ndim() == 3 ? static_cast<int>(a.shape(2)) : 0);
   if (channels != 1 && channels != 3 && channels != 4)
-    throw py::value_error("image: expected shape (H, W) grey, (H, W, 3) RGB or (H, W, 4) RGBA");
-  if (a.shape(0) < 1 || a.shape(1) < 1) throw py::value_error("image: is empty");
+    throw py::value_error(name + ": expected shape (H, W) grey, (H, W, 3) RGB or (H, W, 4) RGBA");
+  if (a.shape(0) < 1 || a.shape(1) < 1) throw py::value_error(name + ": is empty");
   if (a.shape(0) > calib::kMaxImageSide || a.shape(1) > calib::kMaxImageSide)
-    throw py::value_error("image: larger than " + std::to_string(calib::kMaxImageSide) + " pixels a side");
+    throw py::value_error(name + ": larger than " + std::to_string(calib::kMaxImageSide) + " pixels a side");
   const auto c = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(a);
   const cv::Mat view(static_cast<int>(c.shape(0)), static_cast<int>(c.shape(1)), CV_8UC(channels),
                      const_cast<std::uint8_t*>(c.data()));
@@ -91,28 +91,14 @@ py::array_t<double> covarianceArray(const cv::Matx66d& c) {
   return out;
 }
 
-// pictures[index] of `camera`'s size as 8-bit grey: an image file's path, or a uint8 (H, W) or
-// (H, W, 3) array (either channel order: edges do not depend on it).
+// pictures[index] of `camera`'s size as 8-bit grey: an image file's path, or an array as greyOf
+// takes it.
 cv::Mat pictureOf(const py::handle& value, std::size_t index, const calib::Camera& camera) {
   const std::string name = "pictures[" + std::to_string(index) + "]";
-  cv::Mat grey;
-  if (py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__")) {
-    grey = calib::readImageFile(py::str(py::module_::import("os").attr("fspath")(value)).cast<std::string>(), calib::ImageColour::Grey);
-  } else {
-    py::array a = py::array::ensure(value);
-    if (!a) {
-      PyErr_Clear();
-      throw py::type_error(name + ": expected a path or a NumPy array");
-    }
-    if (!(a.dtype().kind() == 'u' && a.dtype().itemsize() == 1))
-      throw py::type_error(name + ": expected dtype uint8, got dtype " + py::str(a.dtype()).cast<std::string>());
-    if (!(a.ndim() == 2 || (a.ndim() == 3 && a.shape(2) == 3))) throw py::value_error(name + ": expected shape (H, W) or (H, W, 3)");
-    const auto c = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(a);
-    const cv::Mat view(static_cast<int>(a.shape(0)), static_cast<int>(a.shape(1)), a.ndim() == 2 ? CV_8UC1 : CV_8UC3,
-                       const_cast<std::uint8_t*>(c.data()));
-    if (a.ndim() == 3) cv::cvtColor(view, grey, cv::COLOR_BGR2GRAY);
-    else grey = view.clone();
-  }
+  const cv::Mat grey = py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__")
+                           ? calib::readImageFile(py::str(py::module_::import("os").attr("fspath")(value)).cast<std::string>(),
+                                                  calib::ImageColour::Grey)
+                           : greyOf(value, name);
   if (grey.cols != camera.width || grey.rows != camera.height)
     throw py::value_error(name + ": " + std::to_string(grey.cols) + "x" + std::to_string(grey.rows) + " for a camera of " +
                           std::to_string(camera.width) + "x" + std::to_string(camera.height));
@@ -437,7 +423,7 @@ The GIL is released while refining.)doc");
       R"doc(The camera's pose refined so that the model's volumes' outline, drawn through the lens at each frame's
 state, lies on the pictures' own edges, as `kccd calib --refine edges` (no masks needed): camera, a Camera with a
 start pose a few degrees off at most (e.g. a solve from 4 rough labels); pictures, one per frame, each a path to
-an image or a uint8 (H, W) or (H, W, 3) array of the camera's size; states float64 (frames, state_size); bodies,
+an image or a uint8 (H, W) grey, (H, W, 3) RGB or (H, W, 4) RGBA array of the camera's size; states float64 (frames, state_size); bodies,
 the bodies in view (default all); start_is_prior as refine_to_masks (for a gain below 5 points of the outline on
 edges). Returns the dict of refine_to_masks, with per frame 'edge_share_before' and 'edge_share_after' (the share
 of the drawn outline within 2 px of an image edge of its direction) in place of the IoUs. Raises InputError for an

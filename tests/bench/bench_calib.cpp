@@ -9,7 +9,9 @@
 // starts from, in the same run:
 // - BM_SolveLabels:           solvePose on 12 body labels over 3 frames, 8 px click error;
 // - BM_RefineFromLabels:      refineToMasks from that solve (kccd calib --labels --masks);
-// - BM_RefineFromTenDegrees:  refineToMasks from a pose 10 deg and 10 cm off (--camera ROUGH --masks).
+// - BM_RefineFromTenDegrees:  refineToMasks from a pose 10 deg and 10 cm off (--camera ROUGH --masks);
+// - BM_RefineEdgesFromLabels: refineToEdges from that solve, the labels as clicks, on pictures of the
+//                             masks' robot (one shade) on a background with boxes (--refine edges).
 // Run with --benchmark_repetitions=5 and read the medians; tables.py gives the ratios.
 #include <benchmark/benchmark.h>
 
@@ -22,6 +24,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "support/cameras.hpp"
+#include "kccd/calib/edge_refine.hpp"
 #include "kccd/calib/mask_refine.hpp"
 #include "kccd/calib/pose.hpp"
 #include "kccd/calib/silhouette.hpp"
@@ -136,11 +139,12 @@ struct MaskScene {
   std::vector<int> bodies = {0, 3, 4, 5, 6};
   Camera truth = testing::lookAt(Vec3(1.25, -0.95, 0.9), Vec3(0.2, 0.0, 0.35), 960, 540, 780.0, {-0.08, 0.03, 0.0005, -0.0003, 0.0});
   std::vector<MaskFrame> frames;
+  std::vector<EdgeFrame> pictures;     // the robot in one shade on grey with boxes, blurred
   std::vector<Correspondence> labels;  // 4 per frame on the first 3 frames, 8 px off
   Camera rough;                        // 10 deg and 10 cm from the truth
 
   MaskScene() {
-    std::mt19937_64 rng(7);
+    std::mt19937_64 rng(7), boxes(8);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     std::normal_distribution<double> click(0.0, 8.0);
     for (int f = 0; f < 10; ++f) {
@@ -155,6 +159,14 @@ struct MaskScene {
           labels.push_back({"f" + std::to_string(f) + "b" + std::to_string(b), px + cv::Point2d(click(rng), click(rng)),
                             cv::Point3d(p.x(), p.y(), p.z())});
         }
+      cv::Mat grey(truth.height, truth.width, CV_8UC1, cv::Scalar(90));
+      for (int k = 0; k < 8; ++k) {
+        const cv::Point a(static_cast<int>(480 + 450 * u(boxes)), static_cast<int>(270 + 250 * u(boxes)));
+        cv::rectangle(grey, a, a + cv::Point(60, 40), cv::Scalar(128 + 100 * u(boxes)), cv::FILLED);
+      }
+      grey.setTo(cv::Scalar(200), frame.mask);
+      cv::GaussianBlur(grey, grey, cv::Size(5, 5), 0.8);
+      pictures.push_back({grey, frame.volumes});
       frames.push_back(std::move(frame));
     }
     // 10 deg about a fixed skew axis through the camera, 10 cm along another.
@@ -215,12 +227,31 @@ void BM_RefineFromLabels(benchmark::State& state) {
 
 void BM_RefineFromTenDegrees(benchmark::State& state) { refine(state, maskScene().rough); }
 
+void BM_RefineEdgesFromLabels(benchmark::State& state) {
+  const MaskScene& s = maskScene();
+  const PoseResult start = solvePose(s.truth, s.labels);
+  if (start.status != PoseStatus::Solved) return state.SkipWithError(start.message.c_str());
+  RefineResult r;
+  for (auto _ : state) {
+    r = refineToEdges(start.camera, s.pictures, {}, s.labels);
+    benchmark::DoNotOptimize(r.camera.rvec);
+  }
+  if (!r.improved) return state.SkipWithError(r.message.c_str());
+  addMaskErrors(state, s.truth, r.camera);
+  double share = 0.0;
+  for (const FrameAgreement& a : r.frames) share += a.matched_after / static_cast<double>(r.frames.size());
+  state.counters["edge_share"] = share;
+  state.counters["frames"] = static_cast<double>(r.frames.size());
+  state.counters["iterations"] = r.iterations;
+}
+
 BENCHMARK(BM_DetectTags)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_DetectAndSolve)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Solve)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_SolveLabels)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_RefineFromLabels)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_RefineFromTenDegrees)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_RefineEdgesFromLabels)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 }  // namespace
 

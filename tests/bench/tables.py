@@ -98,14 +98,15 @@ def calib_table(rows):
             continue
         ratio = f"{ms(r) / ms(base):.2f}" if base else "-"
         out.append(f"| {label} | {ms(r):.1f} | {ratio} |")
-    # The mask refinement against the label-only solve it starts from (the same run).
+    # The refinements (masks, edges) against the label-only solve they start from (the same run).
     labels = med.get("BM_SolveLabels")
     if labels:
         out += ["", "| step (10 frames of 960x540) | ms | ratio to the label solve | rotation error (deg) | position error (mm) |",
                 "|---|---|---|---|---|"]
         refine = {"BM_SolveLabels": "solvePose on 12 labels, 8 px off (baseline)",
                   "BM_RefineFromLabels": "refineToMasks from that solve",
-                  "BM_RefineFromTenDegrees": "refineToMasks from 10 deg / 10 cm off"}
+                  "BM_RefineFromTenDegrees": "refineToMasks from 10 deg / 10 cm off",
+                  "BM_RefineEdgesFromLabels": "refineToEdges from that solve (no masks; the labels as clicks)"}
         for key, label in refine.items():
             r = med.get(key)
             if r is None:

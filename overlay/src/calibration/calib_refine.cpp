@@ -35,14 +35,27 @@ std::optional<calib::Camera> roughPose(const calib::Camera& intrinsics, const Ga
 
 }  // namespace
 
-Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const calib::Camera& intrinsics,
-                                        const Model& model, const RefineInputs& in, const calib::Camera* truth) {
+Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const calib::Camera& intrinsics, const Model& model,
+                             const RefineInputs& in, const calib::Camera* truth) {
   const bool edges = in.source == calib::RefineSource::Edges;
   if (!edges && in.masks.size() != g.frames.size())
     throw CalibInputError("--masks: " + std::to_string(in.masks.size()) + " mask(s) for " + std::to_string(g.frames.size()) +
                           " frame(s): give one mask per frame, in the same order");
   Refinement out;
   out.drawn = "collision volumes";
+  std::vector<calib::MaskFrame> mask_frames;
+  std::vector<calib::EdgeFrame> edge_frames;
+  const std::string what = edges ? "--refine edges" : "--masks";
+  for (std::size_t f = 0; f < g.frames.size(); ++f) {
+    const std::vector<double>& state = g.frames[f].state;
+    if (static_cast<int>(state.size()) != model.stateSize())
+      throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no state of the model's " +
+                            std::to_string(model.stateSize()) + " values: give --state, or --states with --time");
+    if (edges && g.frames[f].bgr.empty())
+      throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no picture to find edges in: give --image or --video");
+    if (edges) edge_frames.push_back({g.frames[f].bgr, calib::placeVolumes(model, state, in.bodies)});
+    else mask_frames.push_back({in.masks[f], calib::placeVolumes(model, state, in.bodies)});
+  }
   calib::Camera start;
   if (solution.solved()) {
     start = solution.pose.camera, out.start = "solve";
@@ -53,21 +66,7 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
     start.rvec = in.rough->rvec, start.tvec = in.rough->tvec;
     out.start = "camera";
   } else {
-    throw CalibInputError(std::string(edges ? "--refine edges" : "--masks") +
-                          ": no start for the pose: give 4 or more labels or tag corners, or --camera ROUGH.yaml");
-  }
-  std::vector<calib::MaskFrame> mask_frames;
-  std::vector<calib::EdgeFrame> edge_frames;
-  for (std::size_t f = 0; f < g.frames.size(); ++f) {
-    const std::vector<double>& state = g.frames[f].state;
-    const std::string what = edges ? "--refine edges" : "--masks";
-    if (static_cast<int>(state.size()) != model.stateSize())
-      throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no state of the model's " +
-                            std::to_string(model.stateSize()) + " values: give --state, or --states with --time");
-    if (edges && g.frames[f].bgr.empty())
-      throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no picture to find edges in: give --image or --video");
-    if (edges) edge_frames.push_back({g.frames[f].bgr, calib::placeVolumes(model, state, in.bodies)});
-    else mask_frames.push_back({in.masks[f], calib::placeVolumes(model, state, in.bodies)});
+    throw CalibInputError(what + ": no start for the pose: give 4 or more labels or tag corners, or --camera ROUGH.yaml");
   }
   if (edges) {
     calib::EdgeOptions options;

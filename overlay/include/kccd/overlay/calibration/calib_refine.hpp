@@ -44,8 +44,8 @@ struct Refinement {
 /// residuals of every point under it, the truth error when `truth` is given); otherwise it is left
 /// as it was. Throws CalibInputError when no start can be had, a frame has no state of the model's
 /// size, the masks do not match the frames, or (edges) a frame has no picture.
-Refinement refineCalibration(CalibSolution& solution, const Gathered& gathered, const calib::Camera& intrinsics,
-                                        const Model& model, const RefineInputs& inputs, const calib::Camera* truth = nullptr);
+Refinement refineCalibration(CalibSolution& solution, const Gathered& gathered, const calib::Camera& intrinsics, const Model& model,
+                             const RefineInputs& inputs, const calib::Camera* truth = nullptr);
 
 /// The refinement's figures as lines the camera file ends with (keys OpenCV and the camera reader
 /// skip): refinement (masks, edges or none), refinement_start, refinement_drawn, then
