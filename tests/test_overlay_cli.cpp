@@ -429,6 +429,28 @@ TEST_F(OverlayCli, BadOptions) {
   EXPECT_EQ(readVideo(video_).size(), static_cast<std::size_t>(kFrames));  // the input is untouched
 }
 
+TEST_F(OverlayCli, BadMaskOptionsAreOneLineExitTwoAndNothingWritten) {
+  fs::create_directories(out("input_empty_masks"));
+  fs::create_directories(out("input_masks"));
+  cv::imwrite(out("input_masks/frame_000000.png"), cv::Mat(kH + 1, kW, CV_8UC1, cv::Scalar(255)));  // another size
+  const struct {
+    std::string extra, expect;
+  } cases[] = {
+      {" --masks " + out("input_none"), "--masks " + out("input_none") + ": not a folder"},
+      {" --masks " + out("input_empty_masks"), ": no mask in the folder (expected frame_000000.png"},
+      {" --mask-bodies arm", "--mask-bodies: goes with --masks"},
+      {" --masks " + out("input_masks") + " --mask-bodies wing", "--mask-bodies: 'wing' is not a body"},
+      {" --masks " + out("input_masks"), "frame_000000.png: mask: " + std::to_string(kW) + "x" + std::to_string(kH + 1)},
+  };
+  for (const auto& c : cases) {
+    const Outcome r = runKccd(base() + " --report " + out("r.json") + c.extra);
+    EXPECT_EQ(r.code, 2) << c.extra << "\n" << r.err;
+    EXPECT_EQ(lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << r.err;
+    EXPECT_TRUE(outputs().empty()) << c.extra;
+  }
+}
+
 TEST_F(OverlayCli, UnsafeQueryStatusExitsThreeAndWritesEverything) {
   // `sweep: exact` on the elbow: a swept box that moves the elbow is an unsafe status (ExactNeedsPoint).
   std::string model = readText(kDemo);

@@ -308,6 +308,34 @@ TEST_F(Synth, ARecordingAsABagCalibratesAndOverlaysAsItsFiles) {
 
 // Two runs with one seed write the same bytes: a short recording each (the fixture's is long
 // enough for a collision; determinism does not need one), so the check costs little.
+// kccd overlay --masks: the recording's own masks (drawn by the GL renderer at 0.8 of the volumes'
+// radius; the IoU is computed from calib's CPU silhouette of the volumes, which shares no code with
+// it) agree evenly with the logged states at the true clock offset; 0.2 s off, the agreement drops
+// and the frames where the robot moves fast stand out as low.
+TEST_F(Synth, OverlayMasksAgreeAtTheTrueClockAndNotAtAWrongOne) {
+  const double offset = summary()["state_log"]["time_offset"].get<double>();
+  const auto agreement = [&](double t, const std::string& name) {
+    const Outcome r = runKccd("overlay " + kHumanoid + " --camera " + dir("a") + "/camera_true.yaml --video " + dir("a") +
+                              "/video.mkv --states " + dir("a") + "/states.csv --masks " + dir("a") + "/masks --time-offset " +
+                              kccd::formatNumber(t, 17) + " --report " + dir(name) + ".json --timeline " + dir(name) + ".png -q");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return json::parse(kccd::testing::readText(dir(name) + ".json"));
+  };
+  const json right = agreement(offset, "agree_right"), wrong = agreement(offset + 0.2, "agree_wrong");
+  const json& a = right["mask_agreement"];
+  const json& b = wrong["mask_agreement"];
+  std::printf("true clock: mean IoU %.3f (smallest %.3f, %d low); 0.2 s off: %.3f (smallest %.3f, %d low)\n", a["mean_iou"].get<double>(),
+              a["min_iou"].get<double>(), a["low_frames"].get<int>(), b["mean_iou"].get<double>(), b["min_iou"].get<double>(),
+              b["low_frames"].get<int>());
+  EXPECT_EQ(a["frames"].get<int>(), static_cast<int>(std::lround(kSeconds * kFps)));
+  EXPECT_GT(a["min_iou"].get<double>(), 0.7);
+  EXPECT_EQ(a["low_frames"].get<int>(), 0);
+  EXPECT_LT(b["mean_iou"].get<double>(), a["mean_iou"].get<double>() - 0.05);
+  EXPECT_GT(b["low_frames"].get<int>(), 3);
+  for (const json& f : right["frames"]) EXPECT_TRUE(f.contains("mask_iou")) << f.dump();
+  EXPECT_TRUE(fs::exists(dir("agree_wrong") + ".png"));
+}
+
 TEST_F(Synth, SameSeedSameFiles) {
   for (const char* name : {"b1", "b2"}) {
     const Outcome r = runKccd("synth " + kHumanoid + " -o " + dir(name) + " --seconds 0.6 --fps 10 --seed 3 -q");

@@ -130,7 +130,7 @@ Camera preAlign(const Camera& start, std::span<const MaskFrame> frames, const st
 
 }  // namespace
 
-cv::Mat readMask(const std::string& path, int width, int height) {
+cv::Mat readMask(const std::string& path, int width, int height, bool robot_and_background) {
   cv::Mat img;
   try {
     img = readImageFile(path, ImageColour::Unchanged);
@@ -152,6 +152,7 @@ cv::Mat readMask(const std::string& path, int width, int height) {
   } else {
     for (std::size_t k = 0; k < std::min<std::size_t>(channels.size(), 3); ++k) mask |= (channels[k] != 0);
   }
+  if (!robot_and_background) return mask;
   const int robot = cv::countNonZero(mask);
   if (robot == 0) throw MaskError(InputLocation{path, 0, 0, "mask"}, "no robot in it (every pixel is 0)");
   if (robot == width * height) throw MaskError(InputLocation{path, 0, 0, "mask"}, "nothing but robot (no pixel is 0)");

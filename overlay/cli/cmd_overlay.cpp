@@ -24,7 +24,7 @@ namespace {
 
 struct OverlayArgs {
   std::string model, camera, video, states, output, png_dir, report, frames, frame_times, ignore_columns, codec, contact_sheet, timeline;
-  std::string bag, image_topic, joint_topic, joint_map, time_source = "header";
+  std::string bag, image_topic, joint_topic, joint_map, time_source = "header", masks, mask_bodies;
   int contact_frames = 12;
   std::string time_offset_text = "0";  // seconds, or auto:A:B
   double max_gap = 0.0, fps = 0.0;
@@ -102,6 +102,19 @@ Exit runOverlay(const OverlayArgs& a) {
     } catch (const overlay::FrameTimesError& e) {
       throw UsageError(std::string("--frame-times ") + e.what());
     }
+  std::optional<overlay::MaskAgreement> masks;
+  if (!a.masks.empty()) {
+    std::vector<int> bodies;
+    for (const std::string& name : splitCommas(a.mask_bodies)) {
+      const int b = model.bodyIndex(name);
+      if (b < 0) throw UsageError("--mask-bodies: '" + name + "' is not a body of " + a.model + " (kccd info lists them)");
+      bodies.push_back(b);
+    }
+    masks.emplace(a.masks, camera, model, std::move(bodies), "--masks " + a.masks);
+    in.masks = &*masks;
+  } else if (!a.mask_bodies.empty()) {
+    throw UsageError("--mask-bodies: goes with --masks");
+  }
   if (a.visuals && model.visuals.empty()) throw UsageError("--visuals: " + a.model + " has no visuals:");
   if (a.visuals && model.visuals.size() + model.bodies.size() > 255)
     throw UsageError("--visuals: " + a.model + ": more than 255 bodies and visuals to draw");
@@ -152,6 +165,14 @@ Exit runOverlay(const OverlayArgs& a) {
                                              format(r.time_offset_found.correlation, 3) + "); "
                                        : "")
               << format(frames / std::max(r.seconds, 1e-9), 3) << " frames/s with " << r.jobs << " jobs\n";
+    if (const overlay::AgreementSummary m = overlay::summariseAgreement(r.frames); m.frames > 0) {
+      std::cout << "masks: IoU with the drawn robot over " << m.frames << " frames: mean " << format(m.mean, 3) << ", smallest "
+                << format(m.min, 3) << "; " << m.low.size() << " frame(s) below " << format(m.low_below, 3)
+                << " (0.8 x the median)";
+      for (std::size_t k = 0; k < std::min<std::size_t>(m.low.size(), 5); ++k)
+        std::cout << (k ? ", " : ": lowest ") << m.low[k] << " (" << format(*r.frames[m.low[k]].mask_iou, 3) << ")";
+      std::cout << "\n";
+    }
   }
   if (a.timings) {
     const overlay::StageTimes& t = r.stages;
@@ -232,6 +253,12 @@ Runner addOverlay(CLI::App& app) {
   sub->add_flag("--visuals", a->visuals,
                 "Also draw the model's visual geometry (visuals:) at the logged state, tinted in its own colours: "
                 "where it misses the robot in the video, the camera, the log's clock or the model is off");
+  sub->add_option("--masks", a->masks,
+                  "Folder of robot masks, frame_000000.png ... (one per frame, any segmentation tool's output, non-zero = robot; "
+                  "frames without a file are skipped): each frame's IoU with the robot drawn at its logged state goes into the "
+                  "report, the summary, the timeline and the contact sheet's captions; frames far below the run's median stand "
+                  "out (a wrong clock offset, a joint offset, a moved camera)");
+  sub->add_option("--mask-bodies", a->mask_bodies, "Comma-separated bodies of the model that the masks show (default: all bodies)");
   sub->add_option("--codec", a->codec, "FourCC of the output video (default by extension)");
   sub->add_option("-j,--jobs", a->jobs, "Worker threads (each with its own GL context; default: hardware threads)")->check(CLI::Range(1, 256));
   sub->add_flag("--json", a->json, "Print the summary as JSON");

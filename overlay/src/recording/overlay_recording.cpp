@@ -266,6 +266,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
             todo.pop_front();
           }
           annotator->annotate(job.bgr, job.record);
+          if (in.masks) job.record.mask_iou = in.masks->at(job.index, job.record.values);
           std::lock_guard lock(mu);
           done.emplace(job.index, std::move(job));
           cv.notify_all();
@@ -302,6 +303,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
         if (opt.contact_frames > 0) {
           std::string caption = "#" + count(job.index) + "  " + messageNumber(r.time, 4) + " s  " + toString(r.status);
           if (std::isfinite(r.min_distance)) caption += "  " + messageNumber(r.min_distance * 1000, 3) + " mm";
+          if (r.mask_iou) caption += "  IoU " + messageNumber(*r.mask_iou, 3);
           // The most critical frame is always on the sheet: colliding first, then the nearest.
           const double priority = r.unsafe() || r.status == SafetyStatus::Colliding ? -1.0
                                   : std::isfinite(r.min_distance)                   ? r.min_distance

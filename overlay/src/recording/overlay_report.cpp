@@ -1,4 +1,5 @@
 // The overlay report as JSON (docs/formats.md section 9).
+#include <algorithm>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -40,6 +41,12 @@ nlohmann::json reportJson(const OverlayReport& report, const Model& model, bool 
                      {{"decode", t.decode}, {"state", t.state}, {"query", t.query}, {"render", t.render},
                       {"read_back", t.read_back}, {"warp", t.warp}, {"composite", t.composite}, {"encode", t.encode}}}};
   }
+  if (const AgreementSummary a = summariseAgreement(report.frames); a.frames > 0) {
+    nlohmann::json low = nlohmann::json::array();
+    for (std::size_t i = 0; i < std::min<std::size_t>(a.low.size(), 20); ++i) low.push_back(a.low[i]);
+    j["mask_agreement"] = {{"frames", a.frames}, {"mean_iou", a.mean},  {"median_iou", a.median}, {"min_iou", a.min},
+                           {"low_below", a.low_below}, {"low_frames", a.low.size()}, {"lowest", low}};
+  }
   if (!with_frames) return j;
   nlohmann::json frames = nlohmann::json::array();
   for (std::size_t i = 0; i < report.frames.size(); ++i) {
@@ -58,6 +65,7 @@ nlohmann::json reportJson(const OverlayReport& report, const Model& model, bool 
     f["links_within_margin"] = nlohmann::json::array();
     for (const auto& l : linkPairs(model, r.pairs)) f["links_within_margin"].push_back({l[0], l[1]});
     if (r.match != StateMatch::None) f["query_status"] = r.queryStatusText();
+    if (r.mask_iou) f["mask_iou"] = *r.mask_iou;
     f["written"] = r.written;
     frames.push_back(std::move(f));
   }

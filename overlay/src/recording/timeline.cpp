@@ -51,6 +51,42 @@ int textWidth(const std::string& s, double scale, int thickness = 1) {
   return cv::getTextSize(s, kFont, scale, thickness, &base).width;
 }
 
+// The agreement row under the spans' list: each frame's mask IoU over time (0 to 1), the low frames
+// (below 0.8 x the median) marked. Draws into rows [y, y + kAgreementHeight) of `img`.
+constexpr int kAgreementHeight = 150;
+const cv::Scalar kAgreement(60, 140, 40), kLow(40, 40, 220);
+template <typename ToX>
+void drawAgreement(cv::Mat& img, const std::vector<FrameRecord>& frames, const AgreementSummary& a, ToX X, int x0, int x1, int y) {
+  const int p0 = y + 34, p1 = y + kAgreementHeight - 16;
+  auto Y = [&](double v) { return p1 - static_cast<int>(std::lround(std::clamp(v, 0.0, 1.0) * (p1 - p0))); };
+  text(img, "Robot masks: IoU with the drawn robot over " + std::to_string(a.frames) + " frames, mean " + formatNumber(a.mean, 3) +
+                ", smallest " + formatNumber(a.min, 3) + "; " + std::to_string(a.low.size()) + " frames below " +
+                formatNumber(a.low_below, 3) + " (0.8 x the median: the state and the video disagree there)",
+       {x0, y + 18}, 0.45, kInk);
+  for (double v : {0.0, 0.5, 1.0}) {
+    cv::line(img, {x0, Y(v)}, {x1, Y(v)}, kGrid, 1);
+    const std::string label = formatNumber(v, 2);
+    text(img, label, {x0 - 8 - textWidth(label, 0.42), Y(v) + 5}, 0.42, kInk);
+  }
+  text(img, "IoU", {8, p0 + 10}, 0.42, kInk);
+  for (const std::size_t i : a.low) cv::line(img, {X(frames[i].time), p0}, {X(frames[i].time), p1}, kLow, 1);
+  std::vector<cv::Point> run;
+  auto flush = [&] {
+    if (run.size() == 1) cv::circle(img, run[0], 2, kAgreement, cv::FILLED, cv::LINE_AA);
+    if (run.size() > 1) cv::polylines(img, run, false, kAgreement, 2, cv::LINE_AA);
+    run.clear();
+  };
+  for (const FrameRecord& f : frames) {
+    if (!f.mask_iou) {
+      flush();
+      continue;
+    }
+    run.emplace_back(X(f.time), Y(*f.mask_iou));
+  }
+  flush();
+  cv::rectangle(img, {x0, p0}, {x1, p1}, kInk, 1);
+}
+
 struct Span {
   std::size_t first = 0, last = 0;  // frame positions in the report
   int shade = 0;
@@ -105,7 +141,8 @@ cv::Mat drawTimeline(const OverlayReport& report, const Model& model, const std:
 
   const int left = 86, right = 24, head = 74, plot_h = 300, axis_h = 62;
   const int list_h = 30 + static_cast<int>(shown) * 22 + (listed.size() > shown ? 22 : 0) + (spans.empty() ? 0 : 8);
-  const int height = head + plot_h + axis_h + list_h;
+  const AgreementSummary agreement = summariseAgreement(frames);
+  const int height = head + plot_h + axis_h + list_h + (agreement.frames > 0 ? kAgreementHeight : 0);
   cv::Mat img(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
   const int x0 = left, x1 = width - right, y0 = head, y1 = head + plot_h;
   auto X = [&](double t) { return x0 + static_cast<int>(std::lround((t - t0) / (t1 - t0) * (x1 - x0))); };
@@ -213,6 +250,7 @@ cv::Mat drawTimeline(const OverlayReport& report, const Model& model, const std:
       text(img, "... and " + std::to_string(listed.size() - shown) + " more spans (see the report)", {x0 + 22, ly}, 0.45, kInk);
     }
   }
+  if (agreement.frames > 0) drawAgreement(img, frames, agreement, X, x0, x1, head + plot_h + axis_h + list_h);
   return img;
 }
 

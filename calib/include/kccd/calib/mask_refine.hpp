@@ -21,10 +21,11 @@ class MaskError : public InputError {
   using InputError::InputError;
 };
 
-/// A robot mask read from an image file (PNG, JPEG, ...): 255 where any channel is non-zero, else
-/// 0. Throws MaskError for an unreadable file, another size than width x height, and a mask with
-/// no robot or nothing but robot.
-cv::Mat readMask(const std::string& path, int width, int height);
+/// A robot mask read from an image file (PNG, JPEG, ...): 255 where any channel is non-zero (for
+/// a cut-out with transparency: its alpha), else 0. Throws MaskError for an unreadable file,
+/// another size than width x height, and, when `robot_and_background`, a mask with no robot or
+/// nothing but robot (a frame's mask in a recording may be either: the robot out of view).
+cv::Mat readMask(const std::string& path, int width, int height, bool robot_and_background = true);
 
 /// One frame to fit: its robot mask and the model's volumes placed at its state.
 struct MaskFrame {

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -51,6 +52,7 @@ struct FrameRecord {
   bool written = false;               ///< handed to a sink that keeps frames
   bool reused = false;                ///< drawn by reusing the annotator's last answer and layer (the same state, bit for bit)
   StageTimes times;                   ///< where its time went
+  std::optional<double> mask_iou;     ///< agreement with the frame's robot mask (OverlayInputs::masks), when it has one
   /// True when the frame's check cannot be trusted: treat the robot as unsafe.
   bool unsafe() const { return query != Status::Ok || braking_failed || not_finite; }
   /// The report's "query_status": "no_braking_box", "volume_not_finite" or the query's status word.

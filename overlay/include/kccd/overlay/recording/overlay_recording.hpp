@@ -19,6 +19,7 @@
 #include "kccd/model.hpp"
 #include "kccd/overlay/recording/frame_source.hpp"
 #include "kccd/overlay/recording/frame_annotator.hpp"
+#include "kccd/overlay/recording/mask_agreement.hpp"
 #include "kccd/overlay/recording/time_offset.hpp"
 #include "kccd/overlay/recording/video_sink.hpp"
 #include "kccd/state_log.hpp"
@@ -49,6 +50,8 @@ struct OverlayInputs {
   /// Opens the frames instead of `video` (e.g. a robot log's image topic, see bag_recording.hpp);
   /// called once per pass over the frames.
   std::function<std::unique_ptr<FrameSource>()> open_frames;
+  /// Robot masks of the frames: each frame's FrameRecord::mask_iou, computed by the annotating threads.
+  const MaskAgreement* masks = nullptr;
 };
 
 /// How a run checks and draws.

@@ -1,7 +1,7 @@
 // A run's timeline: what an operator reads first about a long recording. The smallest distance
 // bound over the frames' times with the safety margin, the spans within the margin, colliding,
 // unsafe or without a state shaded, the link pairs responsible for each span named, and the
-// contact sheet's frames marked.
+// contact sheet's frames marked; with robot masks, each frame's agreement with them below.
 #pragma once
 
 #include <string>

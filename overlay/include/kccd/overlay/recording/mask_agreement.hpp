@@ -1,0 +1,56 @@
+// A recording's robot masks (one image per frame, any segmentation tool's output) and each frame's
+// agreement with the robot drawn at its logged state: the IoU of the mask with the model's
+// silhouette through the camera. A frame whose logged state does not match the video (a wrong
+// clock offset, a joint offset, a moved camera) stands out as low agreement.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "kccd/calib/camera.hpp"
+#include "kccd/model.hpp"
+#include "kccd/overlay/recording/frame_annotator.hpp"
+
+namespace kccd::overlay {
+
+/// The masks of a recording's frames: a folder holding frame_NNNNNN.png (frame index from 0, six
+/// digits, as kccd synth writes them); a frame without a file has no agreement. Non-zero = robot.
+class MaskAgreement {
+ public:
+  /// Checks the folder (it exists and holds at least one frame_NNNNNN.png) and the bodies drawn
+  /// (model body indices; empty: all). `label` names the folder in errors (e.g. "--masks m/").
+  /// Throws InputError.
+  MaskAgreement(const std::string& folder, const calib::Camera& camera, const Model& model, std::vector<int> bodies,
+                std::string label);
+
+  /// The IoU of frame `index`'s mask with the robot drawn at `state`; none when the frame has no
+  /// mask file or `state` is empty. Safe to call from several threads. Throws calib::MaskError for
+  /// a mask that cannot be read or is not the camera's size.
+  std::optional<double> at(std::size_t index, std::span<const double> state) const;
+
+  /// How many frames have a mask file.
+  std::size_t count() const { return indices_.size(); }
+  const std::string& label() const { return label_; }
+
+ private:
+  std::string folder_, label_;
+  const calib::Camera& camera_;
+  const Model& model_;
+  std::vector<int> bodies_;
+  std::vector<std::size_t> indices_;  // sorted frame indices with a file
+};
+
+/// The run's agreement in summary: frames with an IoU, their mean and smallest, and the frames
+/// below `low_share` x the median IoU ("low": the state and the video disagree there), lowest first.
+struct AgreementSummary {
+  std::size_t frames = 0;
+  double mean = 0.0, median = 0.0, min = 0.0;
+  double low_below = 0.0;        ///< the IoU under which a frame is low
+  std::vector<std::size_t> low;  ///< report positions of the low frames, the lowest first
+};
+AgreementSummary summariseAgreement(std::span<const FrameRecord> frames, double low_share = 0.8);
+
+}  // namespace kccd::overlay
