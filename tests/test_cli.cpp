@@ -356,6 +356,30 @@ TEST(Cli, FitWritesIntoAModel) {
   EXPECT_NE(bad.err.find("no body named 'nobody'"), std::string::npos) << bad.err;
 }
 
+// The body's tolerance is the new fit's bound, never the old geometry's (kccd info prints it).
+TEST(Cli, FitIntoAModelReplacesTheBodysTolerance) {
+  const std::string model = scratchCopy(kDemo, "fit_tolerance.yaml");
+  std::string text = kccd::testing::readText(model);
+  const std::string radius = "    radius: 0.045\n";
+  ASSERT_NE(text.find(radius), std::string::npos);
+  text.replace(text.find(radius), radius.size(), radius + "    tolerance: 0.123\n");  // a stale bound
+  std::ofstream(model, std::ios::binary) << text;
+  const Outcome fit = runKccd("fit " + kModels + "simple/cone.iv --tolerance 2 --json --model " + model + " --body forearm");
+  ASSERT_EQ(fit.code, 0) << fit.err;
+  const double bound = nlohmann::json::parse(fit.out)["tolerance"].get<double>();
+  EXPECT_LE(bound, 0.002);
+  const Outcome info = runKccd("info " + model + " --json");
+  ASSERT_EQ(info.code, 0) << info.err;
+  bool seen = false;
+  const auto j = nlohmann::json::parse(info.out);
+  for (const auto& b : j["bodies"])
+    if (b["name"] == "forearm") {
+      seen = true;
+      EXPECT_EQ(b["tolerance"].get<double>(), bound) << info.out;
+    }
+  EXPECT_TRUE(seen) << info.out;
+}
+
 // Edits of one model by concurrent runs all land (a lock serialises them); a symbolic link stays
 // a link, the file keeps its mode, and no temporary file is left behind.
 TEST(Cli, ConcurrentEditsOfOneModelAreNotLost) {

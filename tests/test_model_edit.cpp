@@ -41,6 +41,46 @@ TEST(YamlEdit, BodyGeometryKeepsEverythingElse) {
   EXPECT_THROW(km::withBodyGeometry(text, "demo_arm.yaml", "forearm", "[]", "0.1"), km::EditError);
 }
 
+// A body's tolerance is the bound its old geometry met: the new geometry's replaces it, or it goes
+// when none is given; a body without one gains it. Block and flow style, comments kept.
+TEST(YamlEdit, NewGeometryNeverKeepsTheOldTolerance) {
+  const std::string text =
+      "kccd: 1\nname: t\njoints:\n  - {name: j, parent: world, type: revolute, axis: [0, 0, 1]}\nbodies:\n"
+      "  - name: a   # the base\n    frame: world\n    points: [[0, 0, 0], [1, 0, 0]]\n    radius: 0.1  # metres\n"
+      "    tolerance: 0.004   # as fitted\n"
+      "  - {name: b, frame: j, points: [[0, 0, 2]], radius: 0.2, tolerance: 0.003}\n"
+      "  - name: c\n    frame: j\n    points: [[0, 0, 4]]\n    radius: 0.3\n"
+      "  - {name: d, frame: j, points: [[0, 0, 6]], radius: 0.3}\n";
+  const auto tolerance = [](const std::string& t, const char* body) {
+    const Model m = kccd::parseModel(t, "edited");
+    return m.bodies[static_cast<std::size_t>(m.bodyIndex(body))].tolerance;
+  };
+  for (const char* body : {"a", "b"}) {
+    const std::string replaced = km::withBodyGeometry(text, "t", body, "[[5, 5, 5]]", "0.5", "0.002");
+    EXPECT_EQ(tolerance(replaced, body), 0.002) << body << "\n" << replaced;
+    const std::string dropped = km::withBodyGeometry(text, "t", body, "[[5, 5, 5]]", "0.5");
+    EXPECT_LT(tolerance(dropped, body), 0.0) << body << "\n" << dropped;  // not said
+    EXPECT_EQ(tolerance(dropped, body == std::string("a") ? "b" : "a"), body == std::string("a") ? 0.003 : 0.004);
+    EXPECT_NE(dropped.find("# metres"), std::string::npos);
+  }
+  EXPECT_EQ(km::withBodyGeometry(text, "t", "a", "[[5, 5, 5]]", "0.5").find("as fitted"), std::string::npos);
+  for (const char* body : {"c", "d"}) {
+    const std::string added = km::withBodyGeometry(text, "t", body, "[[5, 5, 5]]", "0.5", "0.001");
+    EXPECT_EQ(tolerance(added, body), 0.001) << body << "\n" << added;
+    EXPECT_LT(tolerance(km::withBodyGeometry(text, "t", body, "[[5, 5, 5]]", "0.5"), body), 0.0);
+  }
+}
+
+// Names that need quoting are quoted with '"' and '\\' escaped (a pair list that loads back).
+TEST(YamlEdit, QuotedNamesEscapeQuotesAndBackslashes) {
+  const std::string text =
+      "kccd: 1\nname: t\njoints:\n  - {name: j, parent: world, type: revolute, axis: [0, 0, 1]}\nbodies:\n"
+      "  - {name: 'say \"hi\"', frame: world, points: [[0, 0, 0]], radius: 0.1}\n"
+      "  - {name: 'back\\slash', frame: j, points: [[0, 0, 2]], radius: 0.2}\n";
+  const std::string edited = km::withIgnoreList(text, "t", {{"say \"hi\"", "back\\slash"}});
+  EXPECT_TRUE(kccd::parseModel(edited, "edited").pairs.empty()) << edited;
+}
+
 TEST(YamlEdit, BlockAndFlowStyles) {
   const std::string block =
       "kccd: 1\nname: t\njoints:\n  - {name: j, parent: world, type: revolute, axis: [0, 0, 1]}\nbodies:\n"

@@ -82,7 +82,7 @@ Exit runFit(const FitArgs& args) {
     const modelling::FitResult& r = fitted[0].fit;
     editFile(args.model, [&](const std::string& text) {
       return modelling::withBodyGeometry(text, args.model, args.body, modelling::flowPoints(r.points),
-                                         modelling::yamlNumber(r.radius, true));
+                                         modelling::yamlNumber(r.radius, true), toleranceYaml(r));
     });
   }
   if (args.json) {

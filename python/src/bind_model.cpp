@@ -148,8 +148,8 @@ Pickles through its YAML text (and the file it came from, against which mesh pat
           py::arg("body"), py::arg("points"), py::arg("radius"),
           R"doc(A new Model with body `body`'s core points (float64 (K, 3), in its frame, metres) and radius
 (metres, written rounded up to 10 significant digits, never smaller) replaced, everything else in the text kept
-(comments, order, layout), as `kccd fit --model --body` does. Raises InputError when the body is missing or the
-edited model does not load.)doc")
+(comments, order, layout), as `kccd fit --model --body` does; the body's `tolerance` (its old geometry's bound) is
+removed. Raises InputError when the body is missing or the edited model does not load.)doc")
       .def("__repr__",
            [](const ModelHandle& h) {
              return "<kccd.Model '" + h.model->name + "': " + std::to_string(h.model->joints.size()) + " joints, " +

@@ -1,6 +1,8 @@
 #include "kccd/modelling/yaml_edit.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
@@ -110,11 +112,18 @@ std::string replaceValue(const std::string& t, const Found& f, const std::string
   return t.substr(0, colon + 1) + " " + text + t.substr(end);
 }
 
+// A name as a YAML scalar: bare when safe, else double-quoted with '"' and '\\' escaped.
 std::string quoted(const std::string& name) {
+  bool bare = !name.empty();
   for (char c : name)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.' && c != '/')
-      return "\"" + name + "\"";
-  return name;
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.' && c != '/') bare = false;
+  if (bare) return name;
+  std::string out = "\"";
+  for (char c : name) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
 }
 
 void check(const std::string& text, const std::string& source) {
@@ -168,25 +177,55 @@ std::string flowPairs(const std::vector<IgnoreEntry>& pairs, int indent) {
 }
 
 std::string withBodyGeometry(const std::string& text, const std::string& source, const std::string& body,
-                             const std::string& points_yaml, const std::string& radius_yaml) {
+                             const std::string& points_yaml, const std::string& radius_yaml, const std::string& tolerance_yaml) {
   const YAML::Node root = load(text, source);
   const YAML::Node bodies = root["bodies"];
   if (!bodies || !bodies.IsSequence()) throw EditError(source + ": no bodies list");
   for (const YAML::Node& b : bodies) {
     if (!b.IsMap() || !b["name"] || b["name"].Scalar() != body) continue;
-    // Edit the later of the two values first so the earlier positions stay valid.
-    Found points, radius;
+    Found points, radius, tolerance;
     if (!findKey(b, "points", points) || !findKey(b, "radius", radius))
       throw EditError(source + ":" + std::to_string(b.Mark().line + 1) + ": body " + body +
                                " has no points/radius to replace");
-    std::string out = text;
-    if (points.key.Mark().pos > radius.key.Mark().pos) {
-      out = replaceValue(out, points, points_yaml);
-      out = replaceValue(out, radius, radius_yaml);
-    } else {
-      out = replaceValue(out, radius, radius_yaml);
-      out = replaceValue(out, points, points_yaml);
+    const bool has_tolerance = findKey(b, "tolerance", tolerance);
+    const bool flow = text[static_cast<std::size_t>(b.Mark().pos)] == '{';
+    // The edits as (start, end, new text), made from the last to the first so earlier positions
+    // stay valid. The old tolerance is the old geometry's bound: replaced, or dropped when none is given.
+    struct Edit {
+      std::size_t start, end;
+      std::string text;
+    };
+    std::vector<Edit> edits;
+    const auto valueEdit = [&](const Found& f, const std::string& value) {
+      const std::size_t colon = text.find(':', static_cast<std::size_t>(f.key.Mark().pos));
+      return Edit{colon + 1, valueEnd(text, f.value), " " + value};
+    };
+    edits.push_back(valueEdit(points, points_yaml));
+    edits.push_back(valueEdit(radius, radius_yaml));
+    if (has_tolerance && !tolerance_yaml.empty()) {
+      edits.push_back(valueEdit(tolerance, tolerance_yaml));
+    } else if (has_tolerance) {
+      const std::size_t key = static_cast<std::size_t>(tolerance.key.Mark().pos), end = valueEnd(text, tolerance.value);
+      const std::size_t line = lineStart(text, key);
+      if (flow) {
+        std::size_t comma = key;
+        while (comma > 0 && text[comma - 1] != ',' && text[comma - 1] != '{') --comma;
+        edits.push_back({comma > 0 && text[comma - 1] == ',' ? comma - 1 : key, end, ""});
+      } else if (text.find_first_not_of(' ', line) == key) {  // a line of its own
+        const std::size_t eol = text.find('\n', end);
+        edits.push_back({line, eol == std::string::npos ? text.size() : eol + 1, ""});
+      } else {
+        throw EditError(source + ":" + std::to_string(tolerance.key.Mark().line + 1) + ": body " + body +
+                        ": its tolerance is not on a line of its own; remove it by hand");
+      }
+    } else if (!tolerance_yaml.empty()) {
+      const std::size_t at = valueEnd(text, radius.value);
+      const int column = static_cast<int>(radius.key.Mark().column);
+      edits.push_back({at, at, flow ? ", tolerance: " + tolerance_yaml : "\n" + std::string(static_cast<std::size_t>(column), ' ') + "tolerance: " + tolerance_yaml});
     }
+    std::sort(edits.begin(), edits.end(), [](const Edit& x, const Edit& y) { return x.start > y.start; });
+    std::string out = text;
+    for (const Edit& e : edits) out = out.substr(0, e.start) + e.text + out.substr(e.end);
     check(out, source);
     return out;
   }

@@ -27,10 +27,13 @@ struct IgnoreEntry {
 };
 
 /// Replaces the `points` and `radius` of body `body` in model text (`source` names it in
-/// messages) with the given YAML texts and returns the edited text. Throws EditError
-/// when the body is missing or the edited model would not load.
+/// messages) with the given YAML texts and returns the edited text. The body's `tolerance` (the
+/// bound its old geometry met) becomes `tolerance_yaml`, or is removed when that is empty (the
+/// new geometry's bound unknown). Throws EditError when the body is missing or the edited model
+/// would not load.
 std::string withBodyGeometry(const std::string& text, const std::string& source, const std::string& body,
-                             const std::string& points_yaml, const std::string& radius_yaml);
+                             const std::string& points_yaml, const std::string& radius_yaml,
+                             const std::string& tolerance_yaml = "");
 /// Sets `pairs: ignore:` of model text to `pairs` (creating the keys if needed); same errors.
 std::string withIgnoreList(const std::string& text, const std::string& source,
                            const std::vector<IgnoreEntry>& pairs);
