@@ -376,10 +376,12 @@ TEST_F(Synth, NoCollisionOption) {
 
 // A model with visuals: the recording shows the visual meshes (an OBJ for the upper arm, boxes
 // and a cylinder), the masks label them with the body in their frame, and synth.json says so.
-TEST_F(Synth, DrawsTheModelsVisualGeometry) {
+// The demo arm with three visuals (a cylinder, an OBJ mesh, a box), written as `path`, its mesh
+// as upper_arm.obj beside it.
+void writeVisualArm(const std::string& path) {
   std::string model = kccd::testing::readText(kData + "/demo_arm.yaml");
   {
-    std::ofstream obj(dir("upper_arm.obj"));
+    std::ofstream obj(fs::path(path).parent_path() / "upper_arm.obj");
     for (int i = 0; i < 8; ++i)
       obj << "v " << (i & 1 ? 0.4 : 0.0) << " " << (i & 2 ? 0.04 : -0.04) << " " << (i & 4 ? 0.04 : -0.04) << "\n";
     obj << "f 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\nf 1 2 6\nf 1 6 5\nf 3 7 8\nf 3 8 4\nf 1 5 7\nf 1 7 3\nf 2 4 8\nf 2 8 6\n";
@@ -388,7 +390,44 @@ TEST_F(Synth, DrawsTheModelsVisualGeometry) {
            "  - frame: world\n    cylinder: {radius: 0.08, length: 0.35}\n    origin: {xyz: [0, 0, 0.175]}\n"
            "  - frame: shoulder_pitch\n    mesh: upper_arm.obj\n    colour: [0.9, 0.4, 0.1]\n"
            "  - frame: elbow\n    box: [0.4, 0.07, 0.07]\n    origin: {xyz: [0.2, 0, 0]}\n";
-  std::ofstream(dir("visual_arm.yaml")) << model;
+  std::ofstream(path) << model;
+}
+
+// kccd calib --masks draws what the robot looks like: masks of the visual geometry (drawn by the
+// GL renderer in synth) give the true camera back from the visuals (a CPU raster of the same
+// meshes, sharing no code with it), closer than from the volumes, which are wider than the visuals.
+TEST_F(Synth, MaskRefinementDrawsTheModelsVisuals) {
+  writeVisualArm(dir("visual_arm_masks.yaml"));
+  const Outcome r = runKccd("synth " + dir("visual_arm_masks.yaml") + " -o " + dir("vm") + " --seconds 0.4 --fps 10 --seed 4 --no-collision -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const double offset = summary("vm")["state_log"]["time_offset"].get<double>();
+  kccd::calib::Camera rough = kccd::calib::loadCamera(dir("vm") + "/camera_true.yaml");
+  rough.tvec[0] += 0.05;
+  rough.tvec[1] -= 0.03;
+  kccd::calib::saveCamera(rough, dir("vm_rough.yaml"));
+  const auto calib = [&](const std::string& draw, const std::string& bodies) {
+    const Outcome c = runKccd("calib --intrinsics " + dir("vm") + "/intrinsics.yaml --video " + dir("vm") + "/video.mkv --frame 0 --frame 3" +
+                              " --time " + kccd::formatNumber(offset, 17) + " --time " + kccd::formatNumber(offset + 0.3, 17) +
+                              " --model " + dir("visual_arm_masks.yaml") + " --states " + dir("vm") + "/states.csv --masks " + dir("vm") +
+                              "/masks/frame_000000.png " + dir("vm") + "/masks/frame_000003.png --camera " + dir("vm_rough.yaml") +
+                              " --truth " + dir("vm") + "/camera_true.yaml --draw " + draw + bodies + " -o " + dir("vm_" + draw + ".yaml") + " --json");
+    EXPECT_EQ(c.code, 0) << c.err << c.out;
+    return json::parse(c.out);
+  };
+  const json visuals = calib("visuals", ""), volumes = calib("volumes", " --mask-bodies pedestal,upper_arm,forearm");
+  EXPECT_EQ(visuals["refinement"]["drawn"], "visual meshes");
+  EXPECT_EQ(volumes["refinement"]["drawn"], "collision volumes (asked for)");
+  const double vis_deg = visuals["truth_error"]["rotation_deg"].get<double>(), vis_m = visuals["truth_error"]["position_m"].get<double>();
+  const double vol_deg = volumes["truth_error"]["rotation_deg"].get<double>(), vol_m = volumes["truth_error"]["position_m"].get<double>();
+  std::printf("drawn visuals: %.3f deg, %.2f mm; volumes: %.3f deg, %.2f mm from the true camera\n", vis_deg, vis_m * 1e3, vol_deg, vol_m * 1e3);
+  EXPECT_LT(vis_deg, 0.1);
+  EXPECT_LT(vis_m, 0.004);
+  EXPECT_LT(vis_m, vol_m);
+  for (const json& f : visuals["refinement"]["frames"]) EXPECT_GT(f["iou_after"].get<double>(), 0.95);
+}
+
+TEST_F(Synth, DrawsTheModelsVisualGeometry) {
+  writeVisualArm(dir("visual_arm.yaml"));
   const Outcome info = runKccd("info " + dir("visual_arm.yaml") + " --json");
   ASSERT_EQ(info.code, 0) << info.err;
   const json ij = json::parse(info.out);

@@ -176,7 +176,7 @@ class ShiftSearch {
 // frames shifted over the image (up to 8% of its diagonal) and scaled (0.8 to 1.25) at the
 // coarsest level, the best share on edges of the outline's direction taken, and the camera turned
 // and moved to match; the start when nothing scores better.
-Camera preAlign(const Camera& start, std::span<const std::span<const PlacedVolume>> volumes,
+Camera preAlign(const Camera& start, std::span<const detail::FrameShape> volumes,
                 const std::vector<std::vector<EdgeLevel>>& levels) {
   const ShiftSearch search(levels, 2);
   std::vector<ShiftSearch::Point> points;
@@ -221,7 +221,7 @@ RefineResult refineToEdges(const Camera& start, std::span<const EdgeFrame> frame
                            std::span<const Correspondence> clicks) {
   if (frames.empty()) throw InputError("edges: no frame to refine the pose with");
   std::vector<std::vector<EdgeLevel>> levels;
-  std::vector<std::span<const PlacedVolume>> volumes;
+  std::vector<detail::FrameShape> shapes, volumes;  // with meshes when given; the volumes alone
   for (const EdgeFrame& f : frames) {
     if (f.image.cols != start.width || f.image.rows != start.height || f.image.depth() != CV_8U ||
         (f.image.channels() != 1 && f.image.channels() != 3))
@@ -232,13 +232,16 @@ RefineResult refineToEdges(const Camera& start, std::span<const EdgeFrame> frame
     if (f.image.channels() == 3) cv::cvtColor(f.image, grey, cv::COLOR_BGR2GRAY);
     else grey = f.image;
     levels.push_back({edgesOf(grey, 0), edgesOf(grey, 1), edgesOf(grey, 2)});
-    volumes.emplace_back(f.volumes);
+    shapes.push_back({f.volumes, f.meshes});
+    volumes.push_back({f.volumes, {}});
   }
   RefineResult result;
   result.source = RefineSource::Edges;
   result.camera = start;
   result.frames.resize(frames.size());
-  const auto samplesAt = [&](const Camera& at) { return detail::outlineSamples(at, volumes, options.spacing_px); };
+  const auto samplesAt = [&](const Camera& at) { return detail::outlineSamples(at, shapes, options.spacing_px); };
+  const auto volumeSamplesAt = [&](const Camera& at) { return detail::outlineSamples(at, volumes, options.spacing_px); };
+  const bool meshes = std::any_of(frames.begin(), frames.end(), [](const EdgeFrame& f) { return !f.meshes.empty(); });
 
   // Coarse to fine: (level, Cauchy scale as a share of the diagonal); the search reaches 3 scales.
   // The coarsest level is for the pre-alignment only: a fit there is pulled by what a quarter of
@@ -251,12 +254,20 @@ RefineResult refineToEdges(const Camera& start, std::span<const EdgeFrame> frame
   detail::Anchors anchors;
   anchors.scale_px = options.click_px;
   for (const Correspondence& c : clicks) anchors.world.push_back(c.world), anchors.pixel.push_back(c.pixel);
+  // Meshes are slower to draw: the half-resolution stages draw the volumes (the caller gives those
+  // of the bodies the meshes show), the full-resolution ones the meshes, whose outline is traced on
+  // pixels: a stage with them ends at steps below 1e-5 or gains below 1e-4 of the cost.
   const auto fitFrom = [&](Camera cam) {
     for (const auto& stage : stages) {
       const double c = std::max(1.5, stage.scale * diagonal);
       const double scales[] = {c};
-      cam = detail::fitPose(cam, samplesAt, edgeField(levels, stage.level, 3.0 * c), scales, options.max_iterations,
-                            result.iterations, &anchors);
+      const bool fine = meshes && stage.level == 0;
+      if (fine)
+        cam = detail::fitPose(cam, samplesAt, edgeField(levels, stage.level, 3.0 * c), scales, options.max_iterations,
+                              result.iterations, &anchors, 1e-5, 1e-4);
+      else
+        cam = detail::fitPose(cam, volumeSamplesAt, edgeField(levels, stage.level, 3.0 * c), scales, options.max_iterations,
+                              result.iterations, &anchors);
     }
     return cam;
   };

@@ -74,10 +74,10 @@ cv::Mat signedDistance(const cv::Mat& mask) {
   return sdf;
 }
 
-// Each frame's volumes, as the outline fit takes them.
-std::vector<std::span<const PlacedVolume>> volumesOf(std::span<const MaskFrame> frames) {
-  std::vector<std::span<const PlacedVolume>> out;
-  for (const MaskFrame& f : frames) out.emplace_back(f.volumes);
+// Each frame's shape, as the outline fit takes it.
+std::vector<detail::FrameShape> shapesOf(std::span<const MaskFrame> frames) {
+  std::vector<detail::FrameShape> out;
+  for (const MaskFrame& f : frames) out.push_back({f.volumes, f.meshes});
   return out;
 }
 
@@ -101,7 +101,7 @@ detail::Field maskField(const std::vector<Target>& targets) {
 // areas match, over all frames together. Rotation shows first as a shift of the whole image,
 // distance as a change of size; the fit then starts where the outlines overlap.
 Camera preAlign(const Camera& start, std::span<const MaskFrame> frames, const std::vector<Target>& targets, double spacing) {
-  const std::vector<std::span<const PlacedVolume>> volumes = volumesOf(frames);
+  const std::vector<detail::FrameShape> volumes = shapesOf(frames);
   Camera cam = start;
   for (int round = 0; round < 6; ++round) {
     std::vector<cv::Mat> drawn;
@@ -167,9 +167,9 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
                        std::to_string(start.width) + "x" + std::to_string(start.height));
   RefineResult result;
   result.camera = start;
-  const std::vector<std::span<const PlacedVolume>> volumes = volumesOf(frames);
+  const std::vector<detail::FrameShape> shapes = shapesOf(frames);
   const auto samplesAt = [&](const Camera& at, std::vector<cv::Mat>* drawn = nullptr) {
-    return detail::outlineSamples(at, volumes, options.spacing_px, drawn);
+    return detail::outlineSamples(at, shapes, options.spacing_px, drawn);
   };
   // Targets: each mask cleaned against the start's drawing.
   std::vector<cv::Mat> drawn_start;
@@ -202,12 +202,15 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
       cam = start;
     }
   }
+  // Coarse to fine. Meshes are slower to draw, and their outline is traced on pixels: their
+  // stages end at steps below 1e-5 (0.0006 deg, 0.01 mm) or gains below 1e-4 of the cost.
   const double diagonal = std::hypot(start.width, start.height);
   std::vector<double> scales;
   for (const double scale : {0.08, 0.03, 0.01, 0.004}) scales.push_back(std::max(1.5, scale * diagonal));
   const detail::Field field = maskField(targets);
-  cam = detail::fitPose(cam, [&](const Camera& at) { return samplesAt(at); }, field, scales, options.max_iterations,
-                        result.iterations);
+  const bool meshes = std::any_of(frames.begin(), frames.end(), [](const MaskFrame& f) { return !f.meshes.empty(); });
+  cam = detail::fitPose(cam, [&](const Camera& at) { return samplesAt(at); }, field, scales, options.max_iterations, result.iterations,
+                        nullptr, meshes ? 1e-5 : 1e-7, meshes ? 1e-4 : 0.0);
 
   // Agreement at the result, and whether it is kept.
   std::vector<cv::Mat> drawn_after;

@@ -7,11 +7,12 @@
 
 namespace kccd::calib::detail {
 
-std::vector<OutlineSample> outlineSamples(const Camera& camera, std::span<const std::span<const PlacedVolume>> frames,
-                                          double spacing, std::vector<cv::Mat>* drawn) {
+std::vector<OutlineSample> outlineSamples(const Camera& camera, std::span<const FrameShape> frames, double spacing,
+                                          std::vector<cv::Mat>* drawn) {
   std::vector<OutlineSample> out;
   for (std::size_t f = 0; f < frames.size(); ++f) {
-    const Silhouette s = drawSilhouette(camera, frames[f], spacing);
+    const Silhouette s = frames[f].meshes.empty() ? drawSilhouette(camera, frames[f].volumes, spacing)
+                                                  : drawMeshSilhouette(camera, frames[f].meshes, spacing);
     if (drawn) drawn->push_back(s.mask);
     for (const OutlinePoint& p : s.outline)
       if (p.pixel.x >= 2 && p.pixel.y >= 2 && p.pixel.x <= camera.width - 3 && p.pixel.y <= camera.height - 3)
@@ -34,12 +35,12 @@ Camera turnedAndMoved(const Camera& cam, double du, double dv, double growth, do
   return out;
 }
 
-double meanDepth(const Camera& cam, std::span<const std::span<const PlacedVolume>> frames) {
+double meanDepth(const Camera& cam, std::span<const FrameShape> frames) {
   const Pose w2c = cam.worldToCamera();
   double depth = 0.0;
   int n = 0;
-  for (const std::span<const PlacedVolume>& f : frames)
-    for (const PlacedVolume& v : f)
+  for (const FrameShape& f : frames)
+    for (const PlacedVolume& v : f.volumes)
       for (const Vec3& p : v.points)
         if (const double z = (w2c * p).z(); z > 0) depth += z, ++n;
   return n ? depth / n : 0.0;
@@ -99,7 +100,8 @@ Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& t
 }
 
 Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const Camera&)>& samples_at, const Field& field,
-               std::span<const double> scales_px, int max_iterations, int& iterations, const Anchors* anchors) {
+               std::span<const double> scales_px, int max_iterations, int& iterations, const Anchors* anchors, double tiny,
+               double min_gain) {
   for (const double c : scales_px) {
     double lambda = 1e-3;
     for (int it = 0; it < max_iterations; ++it) {
@@ -117,10 +119,10 @@ Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const 
         }
         const cv::Vec3d r2 = cam.rvec + cv::Vec3d(delta[0], delta[1], delta[2]);
         const cv::Vec3d t2 = cam.tvec + cv::Vec3d(delta[3], delta[4], delta[5]);
-        if (evaluate(cam, r2, t2, samples, field, c, false, anchors).cost < e.cost) {
+        if (const double cost = evaluate(cam, r2, t2, samples, field, c, false, anchors).cost; cost < e.cost) {
           cam.rvec = r2, cam.tvec = t2;
           lambda = std::max(1e-7, lambda / 3);
-          stepped = cv::norm(delta) > 1e-7;
+          stepped = cv::norm(delta) > tiny && e.cost - cost > min_gain * e.cost;
           break;
         }
         lambda *= 4;

@@ -22,17 +22,23 @@ struct OutlineSample {
   cv::Point2d normal;
 };
 
-/// The outline points of every frame's volumes at `camera` that lie inside the image (2 px from its
+/// What is drawn of one frame: its meshes when it has them, else its volumes.
+struct FrameShape {
+  std::span<const PlacedVolume> volumes;
+  std::span<const PlacedMesh> meshes;
+};
+
+/// The outline points of every frame's shape at `camera` that lie inside the image (2 px from its
 /// border); the frames' filled silhouettes into `drawn` when given.
-std::vector<OutlineSample> outlineSamples(const Camera& camera, std::span<const std::span<const PlacedVolume>> frames,
-                                          double spacing, std::vector<cv::Mat>* drawn = nullptr);
+std::vector<OutlineSample> outlineSamples(const Camera& camera, std::span<const FrameShape> frames, double spacing,
+                                          std::vector<cv::Mat>* drawn = nullptr);
 
 /// `cam` turned so its image moves by (du, dv) px (about its own x and y axes), then moved along
 /// its axis so the image of things at `depth` grows by `growth` (> 0).
 Camera turnedAndMoved(const Camera& cam, double du, double dv, double growth, double depth);
 
 /// The mean depth in front of `cam` of the frames' volumes' core points (0 when none is in front).
-double meanDepth(const Camera& cam, std::span<const std::span<const PlacedVolume>> frames);
+double meanDepth(const Camera& cam, std::span<const FrameShape> frames);
 
 /// Bilinear sample of a CV_32F field at (x, y), clamped to the field.
 double sampleField(const cv::Mat& field, double x, double y);
@@ -64,9 +70,12 @@ Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& t
                     const Field& field, double c, bool normal_equations, const Anchors* anchors = nullptr);
 
 /// Levenberg-Marquardt from `cam` for each Cauchy scale in turn (px), outline samples redrawn
-/// every iteration; `samples_at` gives them at a pose. Returns the pose, counts iterations.
+/// every iteration; `samples_at` gives them at a pose. A stage ends when a step changes (rvec,
+/// tvec) by less than `tiny` (norm) or lowers the cost by less than `min_gain` of it (a drawing
+/// quantised to pixels never settles to `tiny`). Returns the pose, counts iterations.
 Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const Camera&)>& samples_at, const Field& field,
-               std::span<const double> scales_px, int max_iterations, int& iterations, const Anchors* anchors = nullptr);
+               std::span<const double> scales_px, int max_iterations, int& iterations, const Anchors* anchors = nullptr,
+               double tiny = 1e-7, double min_gain = 0.0);
 
 /// The pose's covariance from the normal equations at the optimum: sigma^2 (J^T W J)^-1, with the
 /// outline samples' correlation (neighbours a spacing apart see the same edge) counted by a factor

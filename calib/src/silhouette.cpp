@@ -147,6 +147,98 @@ Silhouette drawSilhouette(const Camera& camera, std::span<const PlacedVolume> vo
   return s;
 }
 
+Silhouette drawMeshSilhouette(const Camera& camera, std::span<const PlacedMesh> meshes, double spacing_px) {
+  Silhouette s;
+  // Each pixel's covering triangle (an index over all meshes' triangles; -1: none).
+  cv::Mat id(camera.height, camera.width, CV_32S, cv::Scalar(-1));
+  const Pose w2c = camera.worldToCamera();
+  struct Projected {
+    const PlacedMesh* mesh;
+    std::vector<cv::Point2d> pixel;  // per vertex
+    std::vector<char> front;         // per vertex
+    int first = 0;                   // the index of its first triangle
+  };
+  std::vector<Projected> projected;
+  int next = 0;
+  for (const PlacedMesh& m : meshes) {
+    Projected p{&m, {}, std::vector<char>(m.vertices.size(), 0), next};
+    std::vector<cv::Point3d> normalised(m.vertices.size());
+    for (std::size_t i = 0; i < m.vertices.size(); ++i) {
+      const Vec3 c = w2c * m.vertices[i];
+      p.front[i] = c.z() > kNearPlane;
+      normalised[i] = p.front[i] ? cv::Point3d(c.x() / c.z(), c.y() / c.z(), 1.0) : cv::Point3d(0, 0, 1);
+    }
+    if (!normalised.empty())
+      cv::projectPoints(normalised, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.camera_matrix, camera.distortion, p.pixel);
+    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+      const auto& tri = m.triangles[t];
+      if (!p.front[tri[0]] || !p.front[tri[1]] || !p.front[tri[2]]) continue;
+      cv::Point corners[3];
+      bool inside = true;
+      for (int k = 0; k < 3; ++k) {
+        const cv::Point2d& q = p.pixel[tri[static_cast<std::size_t>(k)]];
+        if (!(std::abs(q.x) < 1e5 && std::abs(q.y) < 1e5)) inside = false;
+        corners[k] = cv::Point(static_cast<int>(std::lround(q.x * (1 << kSubpixel))), static_cast<int>(std::lround(q.y * (1 << kSubpixel))));
+      }
+      if (inside) cv::fillConvexPoly(id, corners, 3, cv::Scalar(next + static_cast<int>(t)), cv::LINE_8, kSubpixel);
+    }
+    next += static_cast<int>(m.triangles.size());
+    projected.push_back(std::move(p));
+  }
+  s.mask = id >= 0;
+  // The outer outline, sampled every spacing_px along it; each sample is moved half a pixel
+  // outward on its triangle's plane (barycentric coordinates extend beyond the triangle).
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(s.mask.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  const int step = std::max(1, static_cast<int>(std::lround(spacing_px)));
+  for (const std::vector<cv::Point>& c : contours) {
+    const int n = static_cast<int>(c.size());
+    if (n < 3) continue;
+    for (int i = 0; i < n; i += step) {
+      const cv::Point2d t = cv::Point2d(c[static_cast<std::size_t>((i + 2) % n)] - c[static_cast<std::size_t>((i + n - 2) % n)]);
+      const double len = std::hypot(t.x, t.y);
+      if (!(len > 0)) continue;
+      cv::Point2d normal(t.y / len, -t.x / len);
+      const cv::Point at = c[static_cast<std::size_t>(i)];
+      const cv::Point probe(static_cast<int>(std::lround(at.x + 1.5 * normal.x)), static_cast<int>(std::lround(at.y + 1.5 * normal.y)));
+      if (probe.x >= 0 && probe.y >= 0 && probe.x < camera.width && probe.y < camera.height && s.mask.at<unsigned char>(probe) != 0)
+        normal = -normal;  // pointed inward
+      const int tri = id.at<int>(at);
+      if (tri < 0) continue;
+      const auto owner = std::upper_bound(projected.begin(), projected.end(), tri, [](int v, const Projected& p) { return v < p.first; }) - 1;
+      const auto& corners = owner->mesh->triangles[static_cast<std::size_t>(tri - owner->first)];
+      const cv::Point2d a = owner->pixel[corners[0]], b = owner->pixel[corners[1]], d = owner->pixel[corners[2]];
+      // Where the ray from the pixel's centre along the normal leaves the triangle: the outline
+      // (not the fill's rounding), half a pixel out when that cannot be found.
+      const cv::Point2d q0(at.x, at.y);
+      double exit = 0.5;
+      {
+        double best = -HUGE_VAL;  // the exit: the farthest crossing along the normal
+        const cv::Point2d corner[3] = {a, b, d};
+        for (int k = 0; k < 3; ++k) {
+          const cv::Point2d e0 = corner[k], e = corner[(k + 1) % 3] - corner[k];
+          const double den = normal.x * e.y - normal.y * e.x;
+          if (std::abs(den) < 1e-12) continue;
+          const double t = ((e0.x - q0.x) * e.y - (e0.y - q0.y) * e.x) / den;       // along the normal
+          const double u = ((e0.x - q0.x) * normal.y - (e0.y - q0.y) * normal.x) / den;  // along the edge
+          if (t > -1.0 && t < 1.5 && u >= -0.01 && u <= 1.01 && t > best) best = t;
+        }
+        if (std::isfinite(best)) exit = best;
+      }
+      const cv::Point2d q = q0 + exit * normal;
+      const double det = (b.x - a.x) * (d.y - a.y) - (d.x - a.x) * (b.y - a.y);
+      if (!(std::abs(det) > 1e-12)) continue;
+      const double u = ((q.x - a.x) * (d.y - a.y) - (d.x - a.x) * (q.y - a.y)) / det;
+      const double v = ((b.x - a.x) * (q.y - a.y) - (q.x - a.x) * (b.y - a.y)) / det;
+      const Vec3& A = owner->mesh->vertices[corners[0]];
+      const Vec3& B = owner->mesh->vertices[corners[1]];
+      const Vec3& D = owner->mesh->vertices[corners[2]];
+      s.outline.push_back({A + std::clamp(u, -2.0, 3.0) * (B - A) + std::clamp(v, -2.0, 3.0) * (D - A), q, normal});
+    }
+  }
+  return s;
+}
+
 double maskIou(const cv::Mat& a, const cv::Mat& b) {
   CV_Assert(a.size() == b.size() && a.type() == CV_8UC1 && b.type() == CV_8UC1);
   cv::Mat both, either;

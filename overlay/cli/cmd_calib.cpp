@@ -24,7 +24,7 @@ namespace kccd::cli {
 namespace {
 
 struct CalibArgs : FrameOptions {
-  std::string intrinsics, tags, model, output, check, truth, rough_camera, mask_bodies, refine;
+  std::string intrinsics, tags, model, output, check, truth, rough_camera, mask_bodies, refine, draw = "auto";
   std::vector<std::string> labels, masks;
   double threshold = 8.0, magnify = 20.0;
   int min_inliers = 6;
@@ -83,6 +83,7 @@ std::optional<overlay::RefineInputs> refineInputs(const CalibArgs& a, const cali
                            : "--masks: needs --model (the robot drawn to match the masks)");
   overlay::RefineInputs in;
   if (edges) in.source = calib::RefineSource::Edges;
+  in.draw = a.draw;
   for (const std::string& m : a.masks) {
     in.masks.push_back(calib::readMask(m, cam.width, cam.height));
     in.mask_names.push_back(m);
@@ -144,7 +145,8 @@ Exit runCalib(const CalibArgs& a) {
       if (!check.renderer.empty()) renderer_name = check.renderer;
       if (refinement)
         overlay::drawMaskAgreement(check.bgr, r.camera, refine_inputs->masks.empty() ? cv::Mat() : refine_inputs->masks[f],
-                                   calib::placeVolumes(*model, g.frames[f].state, refine_inputs->bodies));
+                                   calib::placeVolumes(*model, g.frames[f].state, refine_inputs->bodies),
+                                   f < refinement->meshes.size() ? refinement->meshes[f] : std::vector<calib::PlacedMesh>{});
       writePngAtomically(checkPath(a.check, f), check.bgr, "--check");
     }
   }
@@ -254,6 +256,11 @@ Runner addCalib(CLI::App& app) {
                   "pulled onto the pictures' own edges of its direction, coarse to fine; needs --model, each frame's picture and "
                   "state, and a start a few degrees off at most, e.g. from 4 rough labels)")
       ->check(CLI::IsMember({"masks", "edges"}));
+  sub->add_option("--draw", a->draw,
+                  "What --masks or --refine edges draws of the robot: auto (the model's visuals, what the robot looks like, when "
+                  "it has them and they can be read; else its collision volumes), visuals, or volumes")
+      ->check(CLI::IsMember({"auto", "visuals", "volumes"}))
+      ->capture_default_str();
   sub->add_option("--camera", a->rough_camera,
                   "A rough camera file to start --masks or --refine edges from when no labels or tags give a start (its pose is used)");
   sub->add_option("--mask-bodies", a->mask_bodies,

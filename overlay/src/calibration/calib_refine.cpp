@@ -8,6 +8,8 @@
 
 #include "kccd/calib/pose_difference.hpp"
 #include "kccd/format_number.hpp"
+#include "kccd/kinematics.hpp"
+#include "kccd/render/visuals.hpp"
 
 namespace kccd::overlay {
 namespace {
@@ -33,6 +35,41 @@ std::optional<calib::Camera> roughPose(const calib::Camera& intrinsics, const Ga
   return c;
 }
 
+// The visuals of the frames that carry `bodies` (all when empty) placed at `state`, as meshes.
+std::vector<calib::PlacedMesh> placedVisuals(const Model& model, std::span<const render::LoadedVisual> visuals,
+                                             std::span<const double> state, std::span<const int> bodies) {
+  std::vector<Pose> poses(model.joints.size());
+  if (!framePoses(model, state, poses)) return {};
+  std::vector<calib::PlacedMesh> out;
+  for (const render::LoadedVisual& v : visuals) {
+    const bool shown = bodies.empty() || std::any_of(bodies.begin(), bodies.end(), [&](int b) {
+                         return model.bodies[static_cast<std::size_t>(b)].frame == v.frame;
+                       });
+    if (!shown || !v.mesh) continue;
+    const Pose& at = framePose(poses, v.frame);
+    calib::PlacedMesh m;
+    m.vertices.reserve(v.mesh->vertices.size());
+    for (const Vec3& p : v.mesh->vertices) m.vertices.push_back(at * p);
+    m.triangles = v.mesh->triangles;
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+// The bodies (of `bodies`, all when empty) whose frames carry a visual: the volumes that stand for
+// the visuals where a fit draws volumes first. All of `bodies` without visuals.
+std::vector<int> visualBodies(const Model& model, std::span<const render::LoadedVisual> visuals, std::span<const int> bodies) {
+  std::vector<int> chosen(bodies.begin(), bodies.end());
+  if (chosen.empty())
+    for (std::size_t b = 0; b < model.bodies.size(); ++b) chosen.push_back(static_cast<int>(b));
+  if (visuals.empty()) return chosen;
+  std::vector<int> out;
+  for (const int b : chosen)
+    if (std::any_of(visuals.begin(), visuals.end(), [&](const render::LoadedVisual& v) { return v.frame == model.bodies[static_cast<std::size_t>(b)].frame; }))
+      out.push_back(b);
+  return out.empty() ? chosen : out;
+}
+
 }  // namespace
 
 Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const calib::Camera& intrinsics, const Model& model,
@@ -43,6 +80,21 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
                           " frame(s): give one mask per frame, in the same order");
   Refinement out;
   out.drawn = "collision volumes";
+  // What the robot looks like, when the model says and it can be read.
+  std::vector<render::LoadedVisual> visuals;
+  if (in.draw != "volumes" && !model.visuals.empty()) {
+    try {
+      visuals = render::loadVisuals(model);
+      out.drawn = "visual meshes";
+    } catch (const render::VisualError& e) {
+      if (in.draw == "visuals") throw;
+      out.drawn = std::string("collision volumes (the visuals could not be read: ") + e.what() + ")";
+    }
+  } else if (in.draw == "visuals") {
+    throw CalibInputError("--draw visuals: the model has no visuals: (draw its collision volumes with --draw volumes)");
+  } else if (!model.visuals.empty()) {
+    out.drawn = "collision volumes (asked for)";
+  }
   std::vector<calib::MaskFrame> mask_frames;
   std::vector<calib::EdgeFrame> edge_frames;
   const std::string what = edges ? "--refine edges" : "--masks";
@@ -53,8 +105,10 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
                             std::to_string(model.stateSize()) + " values: give --state, or --states with --time");
     if (edges && g.frames[f].bgr.empty())
       throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no picture to find edges in: give --image or --video");
-    if (edges) edge_frames.push_back({g.frames[f].bgr, calib::placeVolumes(model, state, in.bodies)});
-    else mask_frames.push_back({in.masks[f], calib::placeVolumes(model, state, in.bodies)});
+    std::vector<calib::PlacedMesh> meshes = placedVisuals(model, visuals, state, in.bodies);
+    out.meshes.push_back(meshes);
+    if (edges) edge_frames.push_back({g.frames[f].bgr, calib::placeVolumes(model, state, visualBodies(model, visuals, in.bodies)), std::move(meshes)});
+    else mask_frames.push_back({in.masks[f], calib::placeVolumes(model, state, in.bodies), std::move(meshes)});
   }
   calib::Camera start;
   if (solution.solved()) {
@@ -168,7 +222,8 @@ nlohmann::json refinementJson(const Refinement& m) {
   return j;
 }
 
-void drawMaskAgreement(cv::Mat& bgr, const calib::Camera& camera, const cv::Mat& mask, std::span<const calib::PlacedVolume> volumes) {
+void drawMaskAgreement(cv::Mat& bgr, const calib::Camera& camera, const cv::Mat& mask, std::span<const calib::PlacedVolume> volumes,
+                       std::span<const calib::PlacedMesh> meshes) {
   if (bgr.empty()) return;
   const double sx = static_cast<double>(bgr.cols) / camera.width, sy = static_cast<double>(bgr.rows) / camera.height;
   const int thick = std::max(1, static_cast<int>(std::lround(std::min(sx, sy) * std::max(camera.width, camera.height) / 640.0)));
@@ -180,7 +235,8 @@ void drawMaskAgreement(cv::Mat& bgr, const calib::Camera& camera, const cv::Mat&
     cv::polylines(bgr, contours, true, colour, thick, cv::LINE_AA);
   };
   if (!mask.empty()) outline(mask != 0, cv::Scalar(0, 220, 255));
-  outline(calib::drawSilhouette(camera, volumes).mask, cv::Scalar(255, 0, 255));
+  outline(meshes.empty() ? calib::drawSilhouette(camera, volumes).mask : calib::drawMeshSilhouette(camera, meshes).mask,
+          cv::Scalar(255, 0, 255));
 }
 
 }  // namespace kccd::overlay

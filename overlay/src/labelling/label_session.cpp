@@ -329,7 +329,8 @@ const std::vector<unsigned char>& LabelSession::overlayPng(std::size_t frame) {
     if (refinement_ && frame < in_.masks.size()) {
       // The mask's outline and the drawn robot's, opaque over the volumes.
       cv::Mat lines = cv::Mat::zeros(layer.rows, layer.cols, CV_8UC3);
-      drawMaskAgreement(lines, *solved_, in_.masks[frame], calib::placeVolumes(*in_.model, *in.state, in_.mask_bodies));
+      drawMaskAgreement(lines, *solved_, in_.masks[frame], calib::placeVolumes(*in_.model, *in.state, in_.mask_bodies),
+                        frame < refinement_->meshes.size() ? refinement_->meshes[frame] : std::vector<calib::PlacedMesh>{});
       for (int y = 0; y < lines.rows; ++y)
         for (int x = 0; x < lines.cols; ++x)
           if (const cv::Vec3b c = lines.at<cv::Vec3b>(y, x); c != cv::Vec3b(0, 0, 0)) {

@@ -19,6 +19,9 @@ namespace kccd::calib {
 struct EdgeFrame {
   cv::Mat image;                      ///< 8-bit grey or BGR, the camera's size
   std::vector<PlacedVolume> volumes;  ///< world coordinates
+  /// What the robot looks like (visual meshes): drawn instead of the volumes at full resolution
+  /// when given (the coarse stages draw the volumes: give those of the bodies the meshes show).
+  std::vector<PlacedMesh> meshes;
 };
 
 /// How the edge refinement runs.

@@ -27,10 +27,11 @@ class MaskError : public InputError {
 /// nothing but robot (a frame's mask in a recording may be either: the robot out of view).
 cv::Mat readMask(const std::string& path, int width, int height, bool robot_and_background = true);
 
-/// One frame to fit: its robot mask and the model's volumes placed at its state.
+/// One frame to fit: its robot mask and the model placed at its state.
 struct MaskFrame {
   cv::Mat mask;                       ///< CV_8UC1, the camera's size; non-zero = robot
   std::vector<PlacedVolume> volumes;  ///< world coordinates
+  std::vector<PlacedMesh> meshes;     ///< what the robot looks like (visual meshes); drawn instead of the volumes when given
 };
 
 /// How the refinement runs.

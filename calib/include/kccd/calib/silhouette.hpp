@@ -3,6 +3,8 @@
 // robot, so a pose can be fitted to an image's outline of the robot (mask_refine.hpp).
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -17,6 +19,13 @@ namespace kccd::calib {
 struct PlacedVolume {
   std::vector<Vec3> points;  ///< world coordinates
   double radius = 0.0;
+};
+
+/// A triangle mesh placed in the world: what part of the robot looks like (a visual mesh at one
+/// state).
+struct PlacedMesh {
+  std::vector<Vec3> vertices;                          ///< world coordinates
+  std::vector<std::array<std::uint32_t, 3>> triangles;  ///< indices into vertices
 };
 
 /// The volumes of `bodies` (indices into model.bodies; all when empty) at `state`. Throws
@@ -42,6 +51,13 @@ struct Silhouette {
 /// then distorted; volumes reaching behind the camera are left out. Never throws for a valid
 /// camera.
 Silhouette drawSilhouette(const Camera& camera, std::span<const PlacedVolume> volumes, double spacing_px = 2.0);
+
+/// The silhouette of `meshes` through `camera` (lens included): every triangle in front of the
+/// camera filled (its corners projected through the lens: exact for triangles of a few pixels),
+/// the union's outer outline traced and sampled, each outline point the mesh point half a pixel
+/// outside the outline pixel's triangle (on its plane), so the outline is not drawn half a pixel
+/// thin. Triangles reaching behind the camera are left out. Never throws for a valid camera.
+Silhouette drawMeshSilhouette(const Camera& camera, std::span<const PlacedMesh> meshes, double spacing_px = 2.0);
 
 /// Intersection over union of two masks of the same size (non-zero = in); 1 when both are empty.
 double maskIou(const cv::Mat& a, const cv::Mat& b);

@@ -26,14 +26,18 @@ struct RefineInputs {
   std::vector<cv::Mat> masks;          ///< with Masks: one per gathered frame (calib::readMask)
   std::vector<std::string> mask_names; ///< as messages name them
   std::vector<int> bodies;             ///< the model's bodies that are the robot (empty: all)
+  /// What is drawn: the model's visuals (what the robot looks like) when it has them and they can
+  /// be read ("auto"), only the collision volumes ("volumes"), or the visuals or an error ("visuals").
+  std::string draw = "auto";
   std::optional<calib::Camera> rough;  ///< a start when the points do not give one
 };
 
 /// What the refinement did.
 struct Refinement {
   std::string start;       ///< "solve" (the points' solve), "points" (a rough pose from them), "camera" (the given one)
-  std::string drawn;       ///< what was drawn: "collision volumes"
+  std::string drawn;       ///< what was drawn: "visual meshes", or "collision volumes" (and why, when the model has visuals)
   calib::RefineResult result;
+  std::vector<std::vector<calib::PlacedMesh>> meshes;  ///< per frame, the visuals drawn (empty: the volumes were)
   /// Labelled points the refined pose puts farther from their click than 3 times the outline's
   /// robust rms, 3 times the other clicks' median residual and 4 px: the image disagrees with them.
   std::vector<std::string> disagreeing;
@@ -43,7 +47,8 @@ struct Refinement {
 /// holds the refined camera (status solved, the covariance and sigmas of the refinement, the
 /// residuals of every point under it, the truth error when `truth` is given); otherwise it is left
 /// as it was. Throws CalibInputError when no start can be had, a frame has no state of the model's
-/// size, the masks do not match the frames, or (edges) a frame has no picture.
+/// size, the masks do not match the frames, (edges) a frame has no picture, or (draw "visuals") the
+/// model has no visuals or they cannot be read.
 Refinement refineCalibration(CalibSolution& solution, const Gathered& gathered, const calib::Camera& intrinsics, const Model& model,
                              const RefineInputs& inputs, const calib::Camera* truth = nullptr);
 
@@ -58,7 +63,9 @@ std::string refinementText(const Refinement& refinement);
 nlohmann::json refinementJson(const Refinement& refinement);
 
 /// Draws onto a check image of the camera's frame the mask's outline (yellow; none for an empty
-/// mask) and the robot's drawn outline at `camera` (magenta), so where they part shows.
-void drawMaskAgreement(cv::Mat& bgr, const calib::Camera& camera, const cv::Mat& mask, std::span<const calib::PlacedVolume> volumes);
+/// mask) and the robot's drawn outline at `camera` (magenta: the meshes when given, else the
+/// volumes), so where they part shows.
+void drawMaskAgreement(cv::Mat& bgr, const calib::Camera& camera, const cv::Mat& mask, std::span<const calib::PlacedVolume> volumes,
+                       std::span<const calib::PlacedMesh> meshes = {});
 
 }  // namespace kccd::overlay
