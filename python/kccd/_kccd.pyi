@@ -456,6 +456,7 @@ def refine_to_edges(
     *,
     bodies: Sequence[str] | None = None,
     start_is_prior: bool | None = None,
+    draw: str = "auto",
 ) -> _EdgeRefinement: ...
 
 def refine_to_masks(
@@ -466,6 +467,7 @@ def refine_to_masks(
     *,
     bodies: Sequence[str] | None = None,
     start_is_prior: bool | None = None,
+    draw: str = "auto",
 ) -> _Refinement: ...
 def solve_pose(
     intrinsics: Camera,

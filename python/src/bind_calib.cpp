@@ -17,6 +17,7 @@
 #include "kccd/calib/tag_detect.hpp"
 #include "kccd/calib/tag_layout.hpp"
 #include "kccd/overlay/calibration/calib_gather.hpp"
+#include "kccd/overlay/calibration/calib_refine.hpp"
 
 namespace kccd::python {
 
@@ -105,6 +106,12 @@ cv::Mat pictureOf(const py::handle& value, std::size_t index, const calib::Camer
   return grey;
 }
 
+// `draw` checked: what a refinement draws of the robot.
+const std::string& drawOf(const std::string& draw) {
+  if (draw != "auto" && draw != "visuals" && draw != "volumes") throw py::value_error("draw: expected 'auto', 'visuals' or 'volumes'");
+  return draw;
+}
+
 // The model's body indices of `bodies` (none: all).
 std::vector<int> bodyIndices(const Model& model, const std::optional<std::vector<std::string>>& bodies) {
   std::vector<int> indices;
@@ -117,8 +124,9 @@ std::vector<int> bodyIndices(const Model& model, const std::optional<std::vector
   return indices;
 }
 
-// A refinement's result as refine_to_masks and refine_to_edges return it.
-py::dict refinementDict(const calib::RefineResult& r) {
+// A refinement's result as refine_to_masks and refine_to_edges return it; `drawn` says what stood
+// for the robot.
+py::dict refinementDict(const calib::RefineResult& r, const std::string& drawn) {
   const bool edges = r.source == calib::RefineSource::Edges;
   py::list per_frame;
   for (const calib::FrameAgreement& a : r.frames) {
@@ -141,7 +149,7 @@ py::dict refinementDict(const calib::RefineResult& r) {
   out["frames"] = per_frame;
   out["iterations"] = r.iterations;
   out["covariance"] = r.improved ? py::object(covarianceArray(r.covariance)) : py::object(py::none());
-  out["drawn"] = "collision volumes";
+  out["drawn"] = drawn;
   return out;
 }
 
@@ -347,7 +355,8 @@ non-finite coordinate, an empty or repeated name, or invalid intrinsics.)doc");
   m.def(
       "refine_to_masks",
       [](const calib::Camera& camera, const std::shared_ptr<ModelHandle>& h, const py::sequence& masks,
-         const py::handle& states, const std::optional<std::vector<std::string>>& bodies, const std::optional<bool>& start_is_prior) {
+         const py::handle& states, const std::optional<std::vector<std::string>>& bodies, const std::optional<bool>& start_is_prior,
+         const std::string& draw) {
         if (py::isinstance<py::str>(masks) || py::isinstance<py::bytes>(masks))
           throw py::type_error("masks: a list of masks (one per frame), not one path");
         const Model& model = *h->model;
@@ -357,11 +366,11 @@ non-finite coordinate, an empty or repeated name, or invalid intrinsics.)doc");
           throw py::value_error("masks, states: " + std::to_string(masks.size()) + " masks but " + std::to_string(st.shape(0)) +
                                 " states");
         if (masks.size() == 0) throw py::value_error("masks: give at least one");
-        const std::vector<int> indices = bodyIndices(model, bodies);
+        const overlay::RobotDrawing robot(model, bodyIndices(model, bodies), drawOf(draw));
         std::vector<calib::MaskFrame> frames;
         for (std::size_t f = 0; f < masks.size(); ++f) {
-          const double* row = st.data(static_cast<py::ssize_t>(f), 0);
-          frames.push_back({maskOf(masks[f], f, camera), calib::placeVolumes(model, std::span<const double>(row, static_cast<std::size_t>(n)), indices)});
+          const std::span<const double> state(st.data(static_cast<py::ssize_t>(f), 0), static_cast<std::size_t>(n));
+          frames.push_back({maskOf(masks[f], f, camera), robot.volumes(state), robot.meshes(state)});
         }
         calib::RefineOptions options;
         // As kccd calib: a start with sigmas (a solve) is a prior unless told otherwise.
@@ -371,10 +380,10 @@ non-finite coordinate, an empty or repeated name, or invalid intrinsics.)doc");
           py::gil_scoped_release release;
           r = calib::refineToMasks(camera, frames, options);
         }
-        return refinementDict(r);
+        return refinementDict(r, robot.drawn());
       },
       py::arg("camera"), py::arg("model"), py::arg("masks"), py::arg("states"), py::kw_only(), py::arg("bodies") = py::none(),
-      py::arg("start_is_prior") = py::none(),
+      py::arg("start_is_prior") = py::none(), py::arg("draw") = "auto",
       R"doc(The camera's pose refined so that the model's volumes, drawn through the lens at each frame's state,
 match robot masks of the frames, as `kccd calib --masks`: camera, a Camera with a start pose (a solve, or a rough
 pose some 10 deg / 10 cm off); masks, one per frame, each a path to an image (non-zero = robot) or a uint8 or
@@ -384,15 +393,17 @@ that are the robot in the masks (default all); start_is_prior: the start's sigma
 such as solve_pose's, as kccd calib does). Returns a dict: 'improved' (the pose was refined; else 'camera'
 is the start), 'message' (one line: what happened, or why the start was kept), 'camera' (with the refinement's
 pose sigmas when improved), 'frames' (per frame 'iou_before', 'iou_after', 'rms_px', 'outline_points'),
-'iterations', 'covariance' float64 (6, 6) of (rvec, tvec) or None, 'drawn' (what stands for the robot:
-'collision volumes'). Raises InputError for an unreadable mask file (naming it), ValueError for a mask of
+'iterations', 'covariance' float64 (6, 6) of (rvec, tvec) or None, 'drawn' (what stood for the robot: 'visual
+meshes', or 'collision volumes' with the reason when the model has visuals). draw: 'auto' (the model's visuals when
+it has them and they can be read, else its collision volumes), 'visuals' or 'volumes', as kccd calib --draw. Raises InputError for an unreadable mask file (naming it), ValueError for a mask of
 another size, with no robot or nothing but robot, a count that does not match the states, or an unknown body.
 The GIL is released while refining.)doc");
 
   m.def(
       "refine_to_edges",
       [](const calib::Camera& camera, const std::shared_ptr<ModelHandle>& h, const py::sequence& pictures,
-         const py::handle& states, const std::optional<std::vector<std::string>>& bodies, const std::optional<bool>& start_is_prior) {
+         const py::handle& states, const std::optional<std::vector<std::string>>& bodies, const std::optional<bool>& start_is_prior,
+         const std::string& draw) {
         if (py::isinstance<py::str>(pictures) || py::isinstance<py::bytes>(pictures))
           throw py::type_error("pictures: a list of pictures (one per frame), not one path");
         const Model& model = *h->model;
@@ -402,12 +413,11 @@ The GIL is released while refining.)doc");
           throw py::value_error("pictures, states: " + std::to_string(pictures.size()) + " pictures but " +
                                 std::to_string(st.shape(0)) + " states");
         if (pictures.size() == 0) throw py::value_error("pictures: give at least one");
-        const std::vector<int> indices = bodyIndices(model, bodies);
+        const overlay::RobotDrawing robot(model, bodyIndices(model, bodies), drawOf(draw));
         std::vector<calib::EdgeFrame> frames;
         for (std::size_t f = 0; f < pictures.size(); ++f) {
-          const double* row = st.data(static_cast<py::ssize_t>(f), 0);
-          frames.push_back({pictureOf(pictures[f], f, camera),
-                            calib::placeVolumes(model, std::span<const double>(row, static_cast<std::size_t>(n)), indices)});
+          const std::span<const double> state(st.data(static_cast<py::ssize_t>(f), 0), static_cast<std::size_t>(n));
+          frames.push_back({pictureOf(pictures[f], f, camera), robot.volumes(state), robot.meshes(state)});
         }
         calib::EdgeOptions options;
         options.start_is_prior = start_is_prior.value_or(camera.rotation_sigma_deg && camera.position_sigma_m);
@@ -416,16 +426,16 @@ The GIL is released while refining.)doc");
           py::gil_scoped_release release;
           r = calib::refineToEdges(camera, frames, options);
         }
-        return refinementDict(r);
+        return refinementDict(r, robot.drawn());
       },
       py::arg("camera"), py::arg("model"), py::arg("pictures"), py::arg("states"), py::kw_only(), py::arg("bodies") = py::none(),
-      py::arg("start_is_prior") = py::none(),
+      py::arg("start_is_prior") = py::none(), py::arg("draw") = "auto",
       R"doc(The camera's pose refined so that the model's volumes' outline, drawn through the lens at each frame's
 state, lies on the pictures' own edges, as `kccd calib --refine edges` (no masks needed): camera, a Camera with a
 start pose a few degrees off at most (e.g. a solve from 4 rough labels); pictures, one per frame, each a path to
 an image or a uint8 (H, W) grey, (H, W, 3) RGB or (H, W, 4) RGBA array of the camera's size; states float64 (frames, state_size); bodies,
 the bodies in view (default all); start_is_prior as refine_to_masks (for a gain below 5 points of the outline on
-edges). Returns the dict of refine_to_masks, with per frame 'edge_share_before' and 'edge_share_after' (the share
+edges); draw as refine_to_masks. Returns the dict of refine_to_masks, with per frame 'edge_share_before' and 'edge_share_after' (the share
 of the drawn outline within 2 px of an image edge of its direction) in place of the IoUs. Raises InputError for an
 unreadable picture file (naming it), ValueError for a picture of another size, a count that does not match the
 states, or an unknown body. The GIL is released while refining.)doc");}

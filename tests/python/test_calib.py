@@ -240,6 +240,10 @@ def test_refine_to_edges_bad_input(arm: kccd.Model, camera: kccd.Camera, tmp_pat
         kccd.refine_to_edges(camera, arm, [good], states, bodies=["wing"])
     with pytest.raises(kccd.InputError, match="missing.png"):
         kccd.refine_to_edges(camera, arm, [tmp_path / "missing.png"], states)
+    with pytest.raises(ValueError, match="draw: expected"):
+        kccd.refine_to_edges(camera, arm, [good], states, draw="mesh")
+    with pytest.raises(kccd.InputError, match="no visuals"):
+        kccd.refine_to_edges(camera, arm, [good], states, draw="visuals")
 
 
 def test_refine_to_masks_bad_input(arm: kccd.Model, camera: kccd.Camera, tmp_path: pathlib.Path) -> None:

@@ -35,15 +35,51 @@ std::optional<calib::Camera> roughPose(const calib::Camera& intrinsics, const Ga
   return c;
 }
 
-// The visuals of the frames that carry `bodies` (all when empty) placed at `state`, as meshes.
-std::vector<calib::PlacedMesh> placedVisuals(const Model& model, std::span<const render::LoadedVisual> visuals,
-                                             std::span<const double> state, std::span<const int> bodies) {
-  std::vector<Pose> poses(model.joints.size());
-  if (!framePoses(model, state, poses)) return {};
+}  // namespace
+
+RobotDrawing::RobotDrawing(const Model& model, std::vector<int> bodies, const std::string& draw)
+    : model_(model), bodies_(std::move(bodies)), drawn_("collision volumes") {
+  if (draw != "auto" && draw != "visuals" && draw != "volumes")
+    throw CalibInputError("draw: '" + draw + "' is not auto, visuals or volumes");
+  if (draw != "volumes" && !model.visuals.empty()) {
+    try {
+      visuals_ = render::loadVisuals(model);
+      drawn_ = "visual meshes";
+    } catch (const render::VisualError& e) {
+      if (draw == "visuals") throw;
+      drawn_ = std::string("collision volumes (the visuals could not be read: ") + e.what() + ")";
+    }
+  } else if (draw == "visuals") {
+    throw CalibInputError("draw visuals: the model has no visuals: (draw its collision volumes instead)");
+  } else if (!model.visuals.empty()) {
+    drawn_ = "collision volumes (asked for)";
+  }
+  // With visuals, the volumes that stand for them: the bodies in frames that carry one.
+  volume_bodies_ = bodies_;
+  if (volume_bodies_.empty())
+    for (std::size_t b = 0; b < model.bodies.size(); ++b) volume_bodies_.push_back(static_cast<int>(b));
+  if (!visuals_.empty()) {
+    std::vector<int> shown;
+    for (const int b : volume_bodies_)
+      if (std::any_of(visuals_.begin(), visuals_.end(),
+                      [&](const render::LoadedVisual& v) { return v.frame == model.bodies[static_cast<std::size_t>(b)].frame; }))
+        shown.push_back(b);
+    if (!shown.empty()) volume_bodies_ = std::move(shown);
+  }
+}
+
+std::vector<calib::PlacedVolume> RobotDrawing::volumes(std::span<const double> state) const {
+  return calib::placeVolumes(model_, state, volume_bodies_);
+}
+
+std::vector<calib::PlacedMesh> RobotDrawing::meshes(std::span<const double> state) const {
+  if (visuals_.empty()) return {};
+  std::vector<Pose> poses(model_.joints.size());
+  if (!framePoses(model_, state, poses)) return {};
   std::vector<calib::PlacedMesh> out;
-  for (const render::LoadedVisual& v : visuals) {
-    const bool shown = bodies.empty() || std::any_of(bodies.begin(), bodies.end(), [&](int b) {
-                         return model.bodies[static_cast<std::size_t>(b)].frame == v.frame;
+  for (const render::LoadedVisual& v : visuals_) {
+    const bool shown = bodies_.empty() || std::any_of(bodies_.begin(), bodies_.end(), [&](int b) {
+                         return model_.bodies[static_cast<std::size_t>(b)].frame == v.frame;
                        });
     if (!shown || !v.mesh) continue;
     const Pose& at = framePose(poses, v.frame);
@@ -56,22 +92,6 @@ std::vector<calib::PlacedMesh> placedVisuals(const Model& model, std::span<const
   return out;
 }
 
-// The bodies (of `bodies`, all when empty) whose frames carry a visual: the volumes that stand for
-// the visuals where a fit draws volumes first. All of `bodies` without visuals.
-std::vector<int> visualBodies(const Model& model, std::span<const render::LoadedVisual> visuals, std::span<const int> bodies) {
-  std::vector<int> chosen(bodies.begin(), bodies.end());
-  if (chosen.empty())
-    for (std::size_t b = 0; b < model.bodies.size(); ++b) chosen.push_back(static_cast<int>(b));
-  if (visuals.empty()) return chosen;
-  std::vector<int> out;
-  for (const int b : chosen)
-    if (std::any_of(visuals.begin(), visuals.end(), [&](const render::LoadedVisual& v) { return v.frame == model.bodies[static_cast<std::size_t>(b)].frame; }))
-      out.push_back(b);
-  return out.empty() ? chosen : out;
-}
-
-}  // namespace
-
 Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const calib::Camera& intrinsics, const Model& model,
                              const RefineInputs& in, const calib::Camera* truth) {
   const bool edges = in.source == calib::RefineSource::Edges;
@@ -79,22 +99,8 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
     throw CalibInputError("--masks: " + std::to_string(in.masks.size()) + " mask(s) for " + std::to_string(g.frames.size()) +
                           " frame(s): give one mask per frame, in the same order");
   Refinement out;
-  out.drawn = "collision volumes";
-  // What the robot looks like, when the model says and it can be read.
-  std::vector<render::LoadedVisual> visuals;
-  if (in.draw != "volumes" && !model.visuals.empty()) {
-    try {
-      visuals = render::loadVisuals(model);
-      out.drawn = "visual meshes";
-    } catch (const render::VisualError& e) {
-      if (in.draw == "visuals") throw;
-      out.drawn = std::string("collision volumes (the visuals could not be read: ") + e.what() + ")";
-    }
-  } else if (in.draw == "visuals") {
-    throw CalibInputError("--draw visuals: the model has no visuals: (draw its collision volumes with --draw volumes)");
-  } else if (!model.visuals.empty()) {
-    out.drawn = "collision volumes (asked for)";
-  }
+  const RobotDrawing robot(model, in.bodies, in.draw);
+  out.drawn = robot.drawn();
   std::vector<calib::MaskFrame> mask_frames;
   std::vector<calib::EdgeFrame> edge_frames;
   const std::string what = edges ? "--refine edges" : "--masks";
@@ -105,10 +111,10 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
                             std::to_string(model.stateSize()) + " values: give --state, or --states with --time");
     if (edges && g.frames[f].bgr.empty())
       throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no picture to find edges in: give --image or --video");
-    std::vector<calib::PlacedMesh> meshes = placedVisuals(model, visuals, state, in.bodies);
+    std::vector<calib::PlacedMesh> meshes = robot.meshes(state);
     out.meshes.push_back(meshes);
-    if (edges) edge_frames.push_back({g.frames[f].bgr, calib::placeVolumes(model, state, visualBodies(model, visuals, in.bodies)), std::move(meshes)});
-    else mask_frames.push_back({in.masks[f], calib::placeVolumes(model, state, in.bodies), std::move(meshes)});
+    if (edges) edge_frames.push_back({g.frames[f].bgr, robot.volumes(state), std::move(meshes)});
+    else mask_frames.push_back({in.masks[f], robot.volumes(state), std::move(meshes)});
   }
   calib::Camera start;
   if (solution.solved()) {

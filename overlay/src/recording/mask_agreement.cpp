@@ -23,11 +23,16 @@ std::optional<std::size_t> frameIndexOf(const std::string& name) {
   return index;
 }
 
+void checkBodies(const Model& model, const std::vector<int>& bodies, const std::string& label) {
+  for (const int b : bodies)
+    if (b < 0 || b >= static_cast<int>(model.bodies.size())) throw InputError(label + ": body index " + std::to_string(b) + " out of range");
+}
+
 }  // namespace
 
 MaskAgreement::MaskAgreement(const std::string& folder, const calib::Camera& camera, const Model& model, std::vector<int> bodies,
                              std::string label)
-    : folder_(folder), label_(std::move(label)), camera_(camera), model_(model), bodies_(std::move(bodies)) {
+    : folder_(folder), label_(std::move(label)), camera_(camera), robot_((checkBodies(model, bodies, label_), model), bodies) {
   std::error_code ec;
   if (!std::filesystem::is_directory(folder, ec))
     throw InputError(label_ + ": not a folder (give the folder holding frame_000000.png, frame_000001.png, ...)");
@@ -36,8 +41,6 @@ MaskAgreement::MaskAgreement(const std::string& folder, const calib::Camera& cam
   if (ec) throw InputError(label_ + ": cannot list the folder (" + ec.message() + ")");
   if (indices_.empty()) throw InputError(label_ + ": no mask in the folder (expected frame_000000.png, frame_000001.png, ...: one per frame, from 0)");
   std::sort(indices_.begin(), indices_.end());
-  for (const int b : bodies_)
-    if (b < 0 || b >= static_cast<int>(model_.bodies.size())) throw InputError(label_ + ": body index " + std::to_string(b) + " out of range");
 }
 
 std::optional<double> MaskAgreement::at(std::size_t index, std::span<const double> state) const {
@@ -45,7 +48,9 @@ std::optional<double> MaskAgreement::at(std::size_t index, std::span<const doubl
   char name[32];
   std::snprintf(name, sizeof name, "frame_%06zu.png", index);
   const cv::Mat mask = calib::readMask((std::filesystem::path(folder_) / name).string(), camera_.width, camera_.height, false);
-  const calib::Silhouette drawn = calib::drawSilhouette(camera_, calib::placeVolumes(model_, state, bodies_));
+  const std::vector<calib::PlacedMesh> meshes = robot_.meshes(state);
+  const calib::Silhouette drawn =
+      meshes.empty() ? calib::drawSilhouette(camera_, robot_.volumes(state)) : calib::drawMeshSilhouette(camera_, meshes);
   return calib::maskIou(drawn.mask, mask);
 }
 

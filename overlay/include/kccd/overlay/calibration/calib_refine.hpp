@@ -17,8 +17,32 @@
 #include "kccd/calib/mask_refine.hpp"
 #include "kccd/overlay/calibration/calib_gather.hpp"
 #include "kccd/overlay/calibration/calib_solve.hpp"
+#include "kccd/render/visuals.hpp"
 
 namespace kccd::overlay {
+
+/// What a refinement draws of the robot at a state: the model's visuals (what it looks like,
+/// loaded once) when `draw` is "auto" and the model has visuals that can be read, or "visuals";
+/// else (or "volumes") the collision volumes. `bodies`: those the pictures show (empty: all).
+class RobotDrawing {
+ public:
+  /// Throws CalibInputError for another `draw` or "visuals" without visuals, render::VisualError
+  /// for "visuals" that cannot be read.
+  RobotDrawing(const Model& model, std::vector<int> bodies, const std::string& draw = "auto");
+  /// The volumes at `state`: with visuals, those of the bodies in frames that carry one (they
+  /// stand for the visuals where a fit draws volumes first).
+  std::vector<calib::PlacedVolume> volumes(std::span<const double> state) const;
+  /// The visuals at `state` as meshes (none without visuals or for an invalid state).
+  std::vector<calib::PlacedMesh> meshes(std::span<const double> state) const;
+  /// "visual meshes", or "collision volumes" with the reason in brackets when the model has visuals.
+  const std::string& drawn() const { return drawn_; }
+
+ private:
+  const Model& model_;
+  std::vector<int> bodies_, volume_bodies_;
+  std::vector<render::LoadedVisual> visuals_;
+  std::string drawn_;
+};
 
 /// What the refinement is given beside the gathered frames.
 struct RefineInputs {

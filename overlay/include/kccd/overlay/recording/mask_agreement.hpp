@@ -1,6 +1,6 @@
 // A recording's robot masks (one image per frame, any segmentation tool's output) and each frame's
 // agreement with the robot drawn at its logged state: the IoU of the mask with the model's
-// silhouette through the camera. A frame whose logged state does not match the video (a wrong
+// silhouette through the camera (its visuals when it has them, as calibration draws it). A frame whose logged state does not match the video (a wrong
 // clock offset, a joint offset, a moved camera) stands out as low agreement.
 #pragma once
 
@@ -12,6 +12,7 @@
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/model.hpp"
+#include "kccd/overlay/calibration/calib_refine.hpp"
 #include "kccd/overlay/recording/frame_annotator.hpp"
 
 namespace kccd::overlay {
@@ -34,12 +35,13 @@ class MaskAgreement {
   /// How many frames have a mask file.
   std::size_t count() const { return indices_.size(); }
   const std::string& label() const { return label_; }
+  /// What is drawn: "visual meshes" or "collision volumes" (RobotDrawing::drawn).
+  const std::string& drawn() const { return robot_.drawn(); }
 
  private:
   std::string folder_, label_;
   const calib::Camera& camera_;
-  const Model& model_;
-  std::vector<int> bodies_;
+  RobotDrawing robot_;
   std::vector<std::size_t> indices_;  // sorted frame indices with a file
 };
 
