@@ -18,9 +18,9 @@ namespace kccd::testing {
 // each ball's rim sampled densely, projected, and its convex outline filled at 7x resolution
 // (pixel (x, y) is the 7x pixel (7x + 3, 7y + 3)), so the fill follows pixel centres to ~0.1 px.
 // This is the 7x image itself (kSilhouetteScale); cpuSilhouette below samples it at pixel centres.
+// A smaller `k` (odd) is faster and follows pixel centres to about 0.5 / k px.
 constexpr int kSilhouetteScale = 7;
-inline cv::Mat cpuSilhouetteFine(const calib::Camera& c, const std::vector<Vec3>& pts, double radius) {
-  const int k = kSilhouetteScale;
+inline cv::Mat cpuSilhouetteFine(const calib::Camera& c, const std::vector<Vec3>& pts, double radius, int k = kSilhouetteScale) {
   cv::Mat big = cv::Mat::zeros(c.height * k, c.width * k, CV_8UC1);
   std::vector<Vec3> centres = pts;
   const double step = radius / 6.0;
@@ -60,9 +60,8 @@ inline cv::Mat cpuSilhouetteFine(const calib::Camera& c, const std::vector<Vec3>
 }
 
 // The silhouette at pixel centres (1 inside, 0 outside).
-inline cv::Mat cpuSilhouette(const calib::Camera& c, const std::vector<Vec3>& pts, double radius) {
-  const int k = kSilhouetteScale;
-  const cv::Mat big = cpuSilhouetteFine(c, pts, radius);
+inline cv::Mat cpuSilhouette(const calib::Camera& c, const std::vector<Vec3>& pts, double radius, int k = kSilhouetteScale) {
+  const cv::Mat big = cpuSilhouetteFine(c, pts, radius, k);
   cv::Mat out(c.height, c.width, CV_8UC1);
   for (int y = 0; y < c.height; ++y)
     for (int x = 0; x < c.width; ++x) out.at<uchar>(y, x) = big.at<uchar>(y * k + k / 2, x * k + k / 2);
