@@ -125,7 +125,7 @@ detail::Field edgeField(const std::vector<std::vector<EdgeLevel>>& levels, int l
 // at one pyramid level.
 class ShiftSearch {
  public:
-  ShiftSearch(const std::vector<std::vector<EdgeLevel>>& levels, int level) : level_(level) {
+  ShiftSearch(const std::vector<std::vector<EdgeLevel>>& levels, int level) {
     for (const std::vector<EdgeLevel>& frame : levels) {
       const EdgeLevel& e = frame[static_cast<std::size_t>(level)];
       scale_ = e.scale;
@@ -167,7 +167,6 @@ class ShiftSearch {
   double scale() const { return scale_; }
 
  private:
-  int level_;
   double scale_ = 1.0;
   std::vector<std::array<cv::Mat, 8>> fields_;
 };
@@ -273,43 +272,18 @@ RefineResult refineToEdges(const Camera& start, std::span<const EdgeFrame> frame
   };
   const double c_final = std::max(1.5, 0.002 * diagonal);
   const detail::Field fine = edgeField(levels, 0, 3.0 * c_final);
-  // The mean share over the frames of the outline on edges at `at`, the outline moved by `shift` px.
-  const auto shareAt = [&](const Camera& at, const cv::Point2d& shift) {
-    const std::vector<detail::OutlineSample> samples = samplesAt(at);
-    std::vector<cv::Point3d> world;
-    for (const detail::OutlineSample& s : samples) world.push_back(s.world);
-    std::vector<cv::Point2d> px;
-    if (!world.empty()) cv::projectPoints(world, at.rvec, at.tvec, at.camera_matrix, at.distortion, px);
-    std::vector<int> on(frames.size(), 0), all(frames.size(), 0);
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-      ++all[samples[i].frame];
-      if (std::abs(fine(samples[i], px[i] + shift).r) <= options.match_px) ++on[samples[i].frame];
-    }
+  // Per frame at `at`: the share of the outline within match_px of an edge of its direction, the
+  // outline points' robust rms and their count; and the mean share over the frames.
+  struct Shares {
+    std::vector<FrameAgreement> frames;  // matched_after, rms_px, outline_points
     double mean = 0.0;
-    for (std::size_t f = 0; f < frames.size(); ++f)
-      if (all[f]) mean += static_cast<double>(on[f]) / all[f] / static_cast<double>(frames.size());
-    return mean;
+    std::vector<detail::OutlineSample> samples;
   };
-  // From the start and from its pre-alignment (clicks, when given, hold both near them); the fit
-  // with more of its outline on edges is taken.
-  Camera cam = fitFrom(start);
-  {
-    const Camera other = fitFrom(preAlign(start, volumes, levels));
-    if (shareAt(other, {0, 0}) > shareAt(cam, {0, 0})) cam = other;
-  }
-  // The clicks' rms distance from where the fit puts their points.
-  double clicks_rms = 0.0;
-  if (!clicks.empty()) {
-    std::vector<cv::Point2d> px;
-    cv::projectPoints(anchors.world, cam.rvec, cam.tvec, cam.camera_matrix, cam.distortion, px);
-    for (std::size_t i = 0; i < px.size(); ++i) clicks_rms += std::pow(cv::norm(px[i] - anchors.pixel[i]), 2) / static_cast<double>(px.size());
-    clicks_rms = std::sqrt(clicks_rms);
-  }
-
-  // Agreement at a pose: per frame the share of outline points on an edge and their robust rms.
-  const auto agreement = [&](const Camera& at, bool after) {
-    const std::vector<detail::OutlineSample> samples = samplesAt(at);
-    double mean = 0.0;
+  const auto sharesAt = [&](const Camera& at) {
+    Shares out;
+    out.samples = samplesAt(at);
+    const std::vector<detail::OutlineSample>& samples = out.samples;
+    out.frames.resize(frames.size());
     for (std::size_t f = 0; f < frames.size(); ++f) {
       std::vector<detail::OutlineSample> mine;
       for (const detail::OutlineSample& s : samples)
@@ -321,29 +295,52 @@ RefineResult refineToEdges(const Camera& start, std::span<const EdgeFrame> frame
       int on = 0;
       for (std::size_t i = 0; i < mine.size(); ++i)
         if (std::abs(fine(mine[i], px[i]).r) <= options.match_px) ++on;
-      const double share = mine.empty() ? 0.0 : static_cast<double>(on) / static_cast<double>(mine.size());
       const detail::Evaluation e = detail::evaluate(at, at.rvec, at.tvec, mine, fine, c_final, false);
-      FrameAgreement& a = result.frames[f];
-      (after ? a.matched_after : a.matched_before) = share;
+      FrameAgreement& a = out.frames[f];
+      a.matched_after = mine.empty() ? 0.0 : static_cast<double>(on) / static_cast<double>(mine.size());
       a.rms_px = e.weight_sum > 0 ? std::sqrt(e.weighted_sq / e.weight_sum) : 0.0;
       a.outline_points = static_cast<int>(mine.size());
-      mean += share / static_cast<double>(frames.size());
+      out.mean += a.matched_after / static_cast<double>(frames.size());
     }
-    return std::pair{mean, samples};
+    return out;
   };
-  const double before = agreement(start, false).first;
-  const auto [after, final_samples] = agreement(cam, true);
+  // From the start and from its pre-alignment (clicks, when given, hold both near them); the fit
+  // with more of its outline on edges is taken.
+  Camera cam = fitFrom(start);
+  {
+    const Camera other = fitFrom(preAlign(start, volumes, levels));
+    if (sharesAt(other).mean > sharesAt(cam).mean) cam = other;
+  }
+  // The clicks' rms distance from where the fit puts their points.
+  double clicks_rms = 0.0;
+  if (!clicks.empty()) {
+    std::vector<cv::Point2d> px;
+    cv::projectPoints(anchors.world, cam.rvec, cam.tvec, cam.camera_matrix, cam.distortion, px);
+    for (std::size_t i = 0; i < px.size(); ++i) clicks_rms += std::pow(cv::norm(px[i] - anchors.pixel[i]), 2) / static_cast<double>(px.size());
+    clicks_rms = std::sqrt(clicks_rms);
+  }
+
+  // The agreement before and after (the figures of the returned pose: the start's when it is kept).
+  const Shares at_start = sharesAt(start), at_end = sharesAt(cam);
+  const double before = at_start.mean, after = at_end.mean;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    result.frames[f] = at_end.frames[f];
+    result.frames[f].matched_before = at_start.frames[f].matched_after;
+  }
   double worst_drop = 0.0;
   for (const FrameAgreement& a : result.frames) worst_drop = std::max(worst_drop, a.matched_before - a.matched_after);
 
   const auto keepStart = [&](std::string message) {
-    (void)agreement(start, true);
+    for (std::size_t f = 0; f < frames.size(); ++f) {
+      result.frames[f] = at_start.frames[f];
+      result.frames[f].matched_before = at_start.frames[f].matched_after;
+    }
     result.covariance = cv::Matx66d::zeros();
     result.message = std::move(message);
     return result;
   };
-  if (final_samples.size() < 12)
-    return keepStart("the drawn robot's outline is not in the pictures (" + std::to_string(final_samples.size()) +
+  if (at_end.samples.size() < 12)
+    return keepStart("the drawn robot's outline is not in the pictures (" + std::to_string(at_end.samples.size()) +
                      " points): the start is kept");
   if (!(after > before + 1e-3) || worst_drop > 0.05)
     return keepStart("the edges did not improve the pose (" + formatNumber(100 * before, 3) + "% of the outline on edges at the start, " +
@@ -354,16 +351,13 @@ RefineResult refineToEdges(const Camera& start, std::span<const EdgeFrame> frame
     return keepStart("the edges' best pose leaves the clicks " + formatNumber(clicks_rms, 3) + " px rms from their points (more than 3 x " +
                      formatNumber(options.click_px, 3) + " px): the edges and the clicks disagree, the start is kept (check the clicks, "
                      "or start closer)");
-  if (options.start_is_prior && start.rotation_sigma_deg && start.position_sigma_m) {
-    const PoseDifference d = poseDifference(cam, start);
-    const double sigmas = std::max(d.rotation_deg / std::max(*start.rotation_sigma_deg, 1e-9),
-                                   d.position_m / std::max(*start.position_sigma_m, 1e-12));
-    if (sigmas > 3.0 && after - before < 0.05)
-      return keepStart("the edges' best pose lies " + formatNumber(d.rotation_deg, 3) + " deg and " +
-                       formatNumber(d.position_m * 1000, 3) + " mm from the start (" + formatNumber(sigmas, 3) +
+  if (const std::optional<detail::FromStart> d = detail::fromStart(cam, start); options.start_is_prior && d) {
+    if (d->sigmas > 3.0 && after - before < 0.05)
+      return keepStart("the edges' best pose lies " + formatNumber(d->difference.rotation_deg, 3) + " deg and " +
+                       formatNumber(d->difference.position_m * 1000, 3) + " mm from the start (" + formatNumber(d->sigmas, 3) +
                        " sigma) for " + formatNumber(100 * (after - before), 3) + " points more of the outline on edges: the start is kept");
   }
-  const detail::Evaluation e = detail::evaluate(cam, cam.rvec, cam.tvec, final_samples, fine, c_final, true);
+  const detail::Evaluation e = detail::evaluate(cam, cam.rvec, cam.tvec, at_end.samples, fine, c_final, true);
   result.covariance = detail::poseCovariance(e);
   const auto [rotation_sigma, position_sigma] = poseSigmas(cam.rvec, cam.tvec, result.covariance);
   cam.rotation_sigma_deg = rotation_sigma;

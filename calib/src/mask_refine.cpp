@@ -258,16 +258,13 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   // A start with known uncertainty is a strong prior: a refined pose far outside it (3 sigma) for a
   // small gain in agreement says the masks and the volumes differ (a robot thinner than its
   // volumes, masks that are too wide), not that the start was wrong.
-  if (options.start_is_prior && start.rotation_sigma_deg && start.position_sigma_m) {
-    const PoseDifference d = poseDifference(cam, start);
+  if (const std::optional<detail::FromStart> d = detail::fromStart(cam, start); options.start_is_prior && d) {
     const double gain = after - before;
-    const double rot_sigmas = d.rotation_deg / std::max(*start.rotation_sigma_deg, 1e-9);
-    const double pos_sigmas = d.position_m / std::max(*start.position_sigma_m, 1e-12);
-    if ((rot_sigmas > 3.0 || pos_sigmas > 3.0) && gain < 0.02)
-      return keepStart("the masks' best pose lies " + formatNumber(d.rotation_deg, 3) + " deg and " +
-                       formatNumber(d.position_m * 1000, 3) + " mm from the start (" +
-                       formatNumber(std::max(rot_sigmas, pos_sigmas), 3) + " sigma) for a mean IoU gain of " +
-                       formatNumber(gain, 3) + ": the start is kept (are the volumes wider or the masks narrower than the robot?)");
+    if (d->sigmas > 3.0 && gain < 0.02)
+      return keepStart("the masks' best pose lies " + formatNumber(d->difference.rotation_deg, 3) + " deg and " +
+                       formatNumber(d->difference.position_m * 1000, 3) + " mm from the start (" + formatNumber(d->sigmas, 3) +
+                       " sigma) for a mean IoU gain of " + formatNumber(gain, 3) +
+                       ": the start is kept (are the volumes wider or the masks narrower than the robot?)");
   }
   result.covariance = detail::poseCovariance(e);
   const auto [rotation_sigma, position_sigma] = poseSigmas(cam.rvec, cam.tvec, result.covariance);

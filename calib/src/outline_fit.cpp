@@ -134,6 +134,13 @@ Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const 
   return cam;
 }
 
+std::optional<FromStart> fromStart(const Camera& cam, const Camera& start) {
+  if (!start.rotation_sigma_deg || !start.position_sigma_m) return std::nullopt;
+  const PoseDifference d = poseDifference(cam, start);
+  return FromStart{d, std::max(d.rotation_deg / std::max(*start.rotation_sigma_deg, 1e-9),
+                               d.position_m / std::max(*start.position_sigma_m, 1e-12))};
+}
+
 cv::Matx66d poseCovariance(const Evaluation& e) {
   const double dof = std::max(1.0, e.weight_sum - 6.0);
   const double sigma2 = e.weighted_sq / dof * 5.0;

@@ -5,12 +5,14 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "kccd/calib/camera.hpp"
+#include "kccd/calib/pose_difference.hpp"
 #include "kccd/calib/silhouette.hpp"
 
 namespace kccd::calib::detail {
@@ -76,6 +78,14 @@ Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& t
 Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const Camera&)>& samples_at, const Field& field,
                std::span<const double> scales_px, int max_iterations, int& iterations, const Anchors* anchors = nullptr,
                double tiny = 1e-7, double min_gain = 0.0);
+
+/// How far `cam` lies from `start` in the start's own sigmas (the larger of rotation and position),
+/// and the difference; none when the start has no sigmas.
+struct FromStart {
+  PoseDifference difference;
+  double sigmas = 0.0;
+};
+std::optional<FromStart> fromStart(const Camera& cam, const Camera& start);
 
 /// The pose's covariance from the normal equations at the optimum: sigma^2 (J^T W J)^-1, with the
 /// outline samples' correlation (neighbours a spacing apart see the same edge) counted by a factor

@@ -16,6 +16,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <functional>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -202,20 +203,26 @@ void BM_SolveLabels(benchmark::State& state) {
   state.counters["labels"] = static_cast<double>(s.labels.size());
 }
 
-void refine(benchmark::State& state, const Camera& start) {
-  const MaskScene& s = maskScene();
+// Times `run` (a refinement of the mask scene) and counts its errors and agreement (mean_iou for
+// masks, edge_share for edges).
+void refine(benchmark::State& state, const std::function<RefineResult()>& run) {
   RefineResult r;
   for (auto _ : state) {
-    r = refineToMasks(start, s.frames);
+    r = run();
     benchmark::DoNotOptimize(r.camera.rvec);
   }
   if (!r.improved) return state.SkipWithError(r.message.c_str());
-  addMaskErrors(state, s.truth, r.camera);
-  double iou = 0.0;
-  for (const FrameAgreement& a : r.frames) iou += a.iou_after / static_cast<double>(r.frames.size());
-  state.counters["mean_iou"] = iou;
+  addMaskErrors(state, maskScene().truth, r.camera);
+  const bool edges = r.source == RefineSource::Edges;
+  double agreement = 0.0;
+  for (const FrameAgreement& a : r.frames) agreement += (edges ? a.matched_after : a.iou_after) / static_cast<double>(r.frames.size());
+  state.counters[edges ? "edge_share" : "mean_iou"] = agreement;
   state.counters["frames"] = static_cast<double>(r.frames.size());
   state.counters["iterations"] = r.iterations;
+}
+
+void refine(benchmark::State& state, const Camera& start) {
+  refine(state, [&] { return refineToMasks(start, maskScene().frames); });
 }
 
 void BM_RefineFromLabels(benchmark::State& state) {
@@ -231,18 +238,7 @@ void BM_RefineEdgesFromLabels(benchmark::State& state) {
   const MaskScene& s = maskScene();
   const PoseResult start = solvePose(s.truth, s.labels);
   if (start.status != PoseStatus::Solved) return state.SkipWithError(start.message.c_str());
-  RefineResult r;
-  for (auto _ : state) {
-    r = refineToEdges(start.camera, s.pictures, {}, s.labels);
-    benchmark::DoNotOptimize(r.camera.rvec);
-  }
-  if (!r.improved) return state.SkipWithError(r.message.c_str());
-  addMaskErrors(state, s.truth, r.camera);
-  double share = 0.0;
-  for (const FrameAgreement& a : r.frames) share += a.matched_after / static_cast<double>(r.frames.size());
-  state.counters["edge_share"] = share;
-  state.counters["frames"] = static_cast<double>(r.frames.size());
-  state.counters["iterations"] = r.iterations;
+  refine(state, [&] { return refineToEdges(start.camera, s.pictures, {}, s.labels); });
 }
 
 BENCHMARK(BM_DetectTags)->Unit(benchmark::kMillisecond)->MinTime(1.0);

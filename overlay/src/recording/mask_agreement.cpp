@@ -23,16 +23,18 @@ std::optional<std::size_t> frameIndexOf(const std::string& name) {
   return index;
 }
 
-void checkBodies(const Model& model, const std::vector<int>& bodies, const std::string& label) {
+// `bodies`, each checked to be one of the model's.
+std::vector<int> checkedBodies(const Model& model, std::vector<int> bodies, const std::string& label) {
   for (const int b : bodies)
     if (b < 0 || b >= static_cast<int>(model.bodies.size())) throw InputError(label + ": body index " + std::to_string(b) + " out of range");
+  return bodies;
 }
 
 }  // namespace
 
 MaskAgreement::MaskAgreement(const std::string& folder, const calib::Camera& camera, const Model& model, std::vector<int> bodies,
                              std::string label)
-    : folder_(folder), label_(std::move(label)), camera_(camera), robot_((checkBodies(model, bodies, label_), model), bodies) {
+    : folder_(folder), label_(std::move(label)), camera_(camera), robot_(model, checkedBodies(model, std::move(bodies), label_)) {
   std::error_code ec;
   if (!std::filesystem::is_directory(folder, ec))
     throw InputError(label_ + ": not a folder (give the folder holding frame_000000.png, frame_000001.png, ...)");
