@@ -15,10 +15,22 @@
 namespace kccd::calib {
 namespace {
 
+cv::Mat signedDistance(const cv::Mat& mask);
+
 // A frame's target: the cleaned mask and its signed distance field (px; < 0 inside the robot).
+// Where the mask is unknown it counts as robot (what such a region mostly holds, so the known
+// part's outline does not end there), and the drawn outline's points in it count for nothing.
 struct Target {
   cv::Mat mask;
-  cv::Mat sdf;  // CV_32F
+  cv::Mat sdf;    // CV_32F
+  cv::Mat known;  // empty: everywhere
+  // `m` (a drawing, or the mask) where the mask is known.
+  cv::Mat inKnown(const cv::Mat& m) const { return known.empty() ? m : (m & known); }
+  void set(cv::Mat cleaned) {
+    mask = cleaned;
+    sdf = signedDistance(known.empty() ? cleaned : (cleaned | (known == 0)));
+  }
+  double iou(const cv::Mat& drawn) const { return maskIou(inKnown(drawn), inKnown(mask)); }
 };
 
 // Specks that are not near the drawn robot dropped, holes smaller than a few percent of the
@@ -92,6 +104,11 @@ detail::Field maskField(const std::vector<Target>& targets) {
     v.gx = 0.5 * (detail::sampleField(sdf, p.x + 1, p.y) - detail::sampleField(sdf, p.x - 1, p.y));
     v.gy = 0.5 * (detail::sampleField(sdf, p.x, p.y + 1) - detail::sampleField(sdf, p.x, p.y - 1));
     if (v.gx * s.normal.x + v.gy * s.normal.y < 0) v.trust = 0.1;
+    const cv::Mat& known = targets[s.frame].known;
+    if (!known.empty()) {
+      const int x = static_cast<int>(std::lround(p.x)), y = static_cast<int>(std::lround(p.y));
+      if (x < 0 || y < 0 || x >= known.cols || y >= known.rows || !known.at<unsigned char>(y, x)) v.trust = 0.0;
+    }
     return v;
   };
 }
@@ -109,7 +126,7 @@ Camera preAlign(const Camera& start, std::span<const MaskFrame> frames, const st
     double du = 0, dv = 0, drawn_area = 0, mask_area = 0;
     int used = 0;
     for (std::size_t f = 0; f < frames.size(); ++f) {
-      const cv::Moments a = cv::moments(drawn[f], true), b = cv::moments(targets[f].mask, true);
+      const cv::Moments a = cv::moments(targets[f].inKnown(drawn[f]), true), b = cv::moments(targets[f].inKnown(targets[f].mask), true);
       if (a.m00 < 1 || b.m00 < 1) continue;
       du += b.m10 / b.m00 - a.m10 / a.m00;
       dv += b.m01 / b.m00 - a.m01 / a.m00;
@@ -161,10 +178,13 @@ cv::Mat readMask(const std::string& path, int width, int height, bool robot_and_
 
 RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frames, const RefineOptions& options) {
   if (frames.empty()) throw InputError("masks: no frame to refine the pose with");
-  for (const MaskFrame& f : frames)
+  for (const MaskFrame& f : frames) {
     if (f.mask.cols != start.width || f.mask.rows != start.height || f.mask.type() != CV_8UC1)
       throw InputError("masks: a mask of " + std::to_string(f.mask.cols) + "x" + std::to_string(f.mask.rows) + " for a camera of " +
                        std::to_string(start.width) + "x" + std::to_string(start.height));
+    if (!f.known.empty() && (f.known.size() != f.mask.size() || f.known.type() != CV_8UC1))
+      throw InputError("masks: a known region that is not an 8-bit mask of the mask's size");
+  }
   RefineResult result;
   result.camera = start;
   const std::vector<detail::FrameShape> shapes = shapesOf(frames);
@@ -176,11 +196,11 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   (void)samplesAt(start, &drawn_start);
   std::vector<Target> targets(frames.size());
   for (std::size_t f = 0; f < frames.size(); ++f) {
-    targets[f].mask = cleanMask(frames[f].mask != 0, drawn_start[f]);
-    targets[f].sdf = signedDistance(targets[f].mask);
+    if (!frames[f].known.empty()) targets[f].known = frames[f].known != 0;
+    targets[f].set(cleanMask(targets[f].inKnown(frames[f].mask != 0), drawn_start[f]));
   }
   result.frames.resize(frames.size());
-  for (std::size_t f = 0; f < frames.size(); ++f) result.frames[f].iou_before = maskIou(drawn_start[f], targets[f].mask);
+  for (std::size_t f = 0; f < frames.size(); ++f) result.frames[f].iou_before = targets[f].iou(drawn_start[f]);
 
   // Pre-aligned by centroid and size, the masks cleaned again against that drawing; kept only
   // if it overlaps the masks better than the start.
@@ -191,13 +211,10 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
     double before = 0, after = 0;
     for (std::size_t f = 0; f < frames.size(); ++f) {
       before += result.frames[f].iou_before;
-      after += maskIou(drawn[f], targets[f].mask);
+      after += targets[f].iou(drawn[f]);
     }
     if (after > before) {
-      for (std::size_t f = 0; f < frames.size(); ++f) {
-        targets[f].mask = cleanMask(frames[f].mask != 0, drawn[f]);
-        targets[f].sdf = signedDistance(targets[f].mask);
-      }
+      for (std::size_t f = 0; f < frames.size(); ++f) targets[f].set(cleanMask(targets[f].inKnown(frames[f].mask != 0), drawn[f]));
     } else {
       cam = start;
     }
@@ -218,7 +235,7 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   double before = 0.0, after = 0.0, worst_drop = 0.0;
   for (std::size_t f = 0; f < frames.size(); ++f) {
     FrameAgreement& a = result.frames[f];
-    a.iou_after = maskIou(drawn_after[f], targets[f].mask);
+    a.iou_after = targets[f].iou(drawn_after[f]);
     before += a.iou_before;
     after += a.iou_after;
     worst_drop = std::max(worst_drop, a.iou_before - a.iou_after);
@@ -250,10 +267,10 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   if (final_samples.size() < 12)
     return keepStart("the drawn robot's outline is not in the images (" + std::to_string(final_samples.size()) +
                      " points): the start is kept");
-  if (!(after > before + 1e-4) || worst_drop > 0.02)
+  if (!(after > before + 1e-4) || worst_drop > options.max_frame_drop)
     return keepStart("the masks did not improve the pose (mean IoU " + formatNumber(before, 4) + " at the start, " +
                      formatNumber(after, 4) + " refined" +
-                     (worst_drop > 0.02 ? ", one frame " + formatNumber(worst_drop, 3) + " worse" : std::string()) +
+                     (worst_drop > options.max_frame_drop ? ", one frame " + formatNumber(worst_drop, 3) + " worse" : std::string()) +
                      "): the start is kept");
   // A start with known uncertainty is a strong prior: a refined pose far outside it (3 sigma) for a
   // small gain in agreement says the masks and the volumes differ (a robot thinner than its

@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 
 #include "kccd/model.hpp"
+#include "kccd/overlay/calibration/calib_refine.hpp"
 
 namespace kccd::cli {
 
@@ -24,6 +25,7 @@ struct FrameOptions {
   std::vector<double> times;
   std::vector<int> video_frames;
   double max_gap = 0.0;  ///< 0: 1.5 x the log's median period
+  std::size_t recording_samples = 0;  ///< > 0: also about this many frames spread over the --video or --bag, with their states
 };
 
 /// The frames the options give, in order.
@@ -33,6 +35,7 @@ struct GivenFrames {
   std::vector<std::optional<std::vector<double>>> states;  ///< one per frame
   std::size_t count = 0;            ///< frames (pictures, or labels files when there are none)
   std::vector<std::string> warnings;  ///< one line each (e.g. a bag cut short)
+  std::vector<overlay::RecordingSample> recording;  ///< with recording_samples: those of them the log has a state for
 };
 
 /// Adds --bag, --image-topic, --joint-topic, --time-source and --joint-map to `command`.
@@ -40,7 +43,8 @@ void addBagOptions(CLI::App& command, FrameOptions& o);
 
 /// Checks the options against each other (`labels` labels files and `tags` a tag layout given)
 /// and reads the recording's frames and the state log; `refined`: masks or edges say what the
-/// pictures show. Throws UsageError, or the readers' errors.
+/// pictures show. Throws UsageError (also for recording_samples without a recording and a state
+/// log, or with fewer than 8 of its frames in the log), or the readers' errors.
 GivenFrames givenFrames(const FrameOptions& o, std::size_t labels, bool tags, const std::optional<Model>& model, bool refined = false);
 
 }  // namespace kccd::cli

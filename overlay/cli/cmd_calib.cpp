@@ -43,10 +43,16 @@ void checkBodyLabels(const calib::Labels& labels, const std::optional<Model>& mo
   }
 }
 
+bool autoMasks(const CalibArgs& a) { return a.masks.size() == 1 && a.masks.front() == "auto"; }
+
 // The gathering inputs the options describe: the frames (calib_frames.hpp), the labels and the
-// tag layout.
-overlay::GatherInputs gatherInputs(const CalibArgs& a, const calib::Camera& cam, const std::optional<Model>& model) {
-  const GivenFrames given = givenFrames(a, a.labels.size(), !a.tags.empty(), model, !a.masks.empty() || a.refine == "edges");
+// tag layout; with --masks auto, frames spread over the recording into `recording`.
+overlay::GatherInputs gatherInputs(const CalibArgs& a, const calib::Camera& cam, const std::optional<Model>& model,
+                                   std::vector<overlay::RecordingSample>& recording) {
+  FrameOptions frames = a;
+  if (autoMasks(a)) frames.recording_samples = 40;
+  GivenFrames given = givenFrames(frames, a.labels.size(), !a.tags.empty(), model, !a.masks.empty() || a.refine == "edges");
+  recording = std::move(given.recording);
   for (const std::string& w : given.warnings) std::cerr << "kccd calib: warning: " << w << "\n";
   overlay::GatherInputs in;
   in.camera = cam;
@@ -85,6 +91,8 @@ std::optional<overlay::RefineInputs> refineInputs(const CalibArgs& a, const cali
   if (edges) in.source = calib::RefineSource::Edges;
   in.draw = a.draw;
   for (const std::string& m : a.masks) {
+    if (autoMasks(a)) break;
+    if (m == "auto") throw UsageError("--masks auto: makes every frame's mask from the recording: give it alone, not with mask files");
     in.masks.push_back(calib::readMask(m, cam.width, cam.height));
     in.mask_names.push_back(m);
   }
@@ -118,8 +126,10 @@ Exit runCalib(const CalibArgs& a) {
   if (!a.truth.empty()) truth = calib::loadCamera(a.truth);
   std::optional<Model> model;
   if (!a.model.empty()) model = loadOrExplain(a.model);
-  const std::optional<overlay::RefineInputs> refine_inputs = refineInputs(a, intrinsics, model);
-  const overlay::Gathered g = overlay::gatherCorrespondences(gatherInputs(a, intrinsics, model));
+  std::optional<overlay::RefineInputs> refine_inputs = refineInputs(a, intrinsics, model);
+  std::vector<overlay::RecordingSample> recording;
+  const overlay::Gathered g = overlay::gatherCorrespondences(gatherInputs(a, intrinsics, model, recording));
+  if (refine_inputs) refine_inputs->recording = std::move(recording);
 
   calib::PoseOptions options;
   options.ransac_threshold_px = a.threshold;
@@ -144,8 +154,11 @@ Exit runCalib(const CalibArgs& a) {
                               .pose_source = a.refine == "edges" ? "the pictures' edges" : "the robot's masks"});
       if (!check.renderer.empty()) renderer_name = check.renderer;
       if (refinement)
-        overlay::drawMaskAgreement(check.bgr, r.camera, refine_inputs->masks.empty() ? cv::Mat() : refine_inputs->masks[f],
-                                   calib::placeVolumes(*model, g.frames[f].state, refine_inputs->bodies),
+        overlay::drawMaskAgreement(check.bgr, r.camera,
+                                   !refinement->masks.empty()      ? refinement->masks[f]
+                                   : refine_inputs->masks.empty() ? cv::Mat()
+                                                                  : refine_inputs->masks[f],
+                                   calib::placeVolumes(*model, g.frames[f].state, refinement->bodies),
                                    f < refinement->meshes.size() ? refinement->meshes[f] : std::vector<calib::PlacedMesh>{});
       writePngAtomically(checkPath(a.check, f), check.bgr, "--check");
     }
@@ -159,16 +172,18 @@ Exit runCalib(const CalibArgs& a) {
     if (refinement) {
       for (std::size_t f = 0; f < refinement->result.frames.size(); ++f) {
         const calib::FrameAgreement& fa = refinement->result.frames[f];
-        if (refine_inputs->masks.empty()) {
+        if (refinement->result.source == calib::RefineSource::Edges) {
           std::cout << "frame " << f + 1 << ": outline on edges " << format(100 * fa.matched_before, 3) << "%";
           if (refinement->result.improved) std::cout << " -> " << format(100 * fa.matched_after, 3) << "%";
         } else {
-          std::cout << "mask " << a.masks[f] << ": IoU " << format(fa.iou_before, 4);
+          std::cout << (autoMasks(a) ? "frame " + std::to_string(f + 1) + " (mask from the recording)" : "mask " + a.masks[f]) << ": IoU "
+                    << format(fa.iou_before, 4);
           if (refinement->result.improved) std::cout << " -> " << format(fa.iou_after, 4);
         }
         std::cout << ", outline " << format(fa.rms_px, 3) << " px rms over " << fa.outline_points << " points"
                   << (refinement->result.improved ? "" : " (the start, kept)") << "\n";
       }
+      if (!refinement->masks_from.empty()) std::cout << refinement->masks_from << "\n";
       if (!refinement->result.improved && s.solved()) std::cout << refinement->result.message << "\n";
     }
     std::cout << (s.solved() ? "" : "not solved: ") << r.message << "\n";
@@ -249,7 +264,10 @@ Runner addCalib(CLI::App& app) {
   sub->add_option("--masks", a->masks,
                   "Robot masks, one per frame in the same order (PNG or any image; non-zero = robot, e.g. a segmentation "
                   "tool's output): the pose is refined so the model's drawn robot matches them over all frames; needs "
-                  "--model and each frame's state")
+                  "--model and each frame's state. --masks auto: made from the recording itself (--video with --states, or "
+                  "--bag; a fixed camera): the robot is what differs from the background, estimated over 40 frames spread over "
+                  "the recording, each pixel from the frames in which the drawn robot is away from it; people moving, lighting "
+                  "changes and the robot's shadows are foreground too")
       ->expected(1, -1);
   sub->add_option("--refine", a->refine,
                   "What the pose is refined to: masks (the default with --masks) or edges (no masks: the robot's drawn outline is "

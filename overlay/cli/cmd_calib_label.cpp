@@ -84,6 +84,7 @@ Exit runLabel(LabelArgs a) {
       throw UsageError("--masks: " + std::to_string(a.masks.size()) + " mask(s) for " + std::to_string(given.count) +
                        " frame(s): give one per frame, in the same order");
     for (const std::string& m : a.masks) {
+      if (m == "auto") throw UsageError("--masks auto: only kccd calib makes masks from a recording; the page takes mask files");
       in.masks.push_back(calib::readMask(m, in.intrinsics.width, in.intrinsics.height));
       in.mask_names.push_back(m);
     }

@@ -6,6 +6,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "kccd/calib/background.hpp"
 #include "kccd/calib/pose_difference.hpp"
 #include "kccd/format_number.hpp"
 #include "kccd/kinematics.hpp"
@@ -33,6 +34,108 @@ std::optional<calib::Camera> roughPose(const calib::Camera& intrinsics, const Ga
   c.rvec = rvec, c.tvec = tvec;
   c.reprojection_rms_px.reset(), c.rotation_sigma_deg.reset(), c.position_sigma_m.reset();
   return c;
+}
+
+// The bodies of `bodies` (empty: all) that move with a joint: what differs from a background.
+std::vector<int> movingBodies(const Model& model, std::span<const int> bodies) {
+  std::vector<int> out;
+  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
+    if (!bodies.empty() && std::find(bodies.begin(), bodies.end(), static_cast<int>(b)) == bodies.end()) continue;
+    bool moves = false;
+    for (int j = model.bodies[b].frame; j != kWorld && !moves; j = model.joints[static_cast<std::size_t>(j)].parent)
+      moves = model.joints[static_cast<std::size_t>(j)].dof > 0;
+    if (moves) out.push_back(static_cast<int>(b));
+  }
+  return out;
+}
+
+// Where the robot may be in a picture at `cam`: its volumes' drawing widened by `widen` px.
+cv::Mat robotRegion(const calib::Camera& cam, std::span<const calib::PlacedVolume> volumes, double widen) {
+  const cv::Mat drawn = calib::drawSilhouette(cam, volumes).mask;
+  cv::Mat away;
+  cv::distanceTransform(drawn == 0, away, cv::DIST_L2, cv::DIST_MASK_3);
+  return away <= static_cast<float>(widen);
+}
+
+// The refinement to masks made from the recording, remade around the pose as it is refined: the
+// robot's drawing widened by a tenth of the image's diagonal first (a start 10 degrees off moves
+// the robot about that far), then by 3 % and 1.5 % of it around the refined pose. Each round's
+// background comes from the samples away from the robot at that pose, and the fit runs over the
+// gathered frames and 16 of the samples together (many poses pin the camera better than a few). The
+// rounds before the last are kept on any gain (their masks are rough); the last is held to the
+// refinement's gates. The result is the last round that improved the pose, with the gathered
+// frames' figures (IoUs before at `start`) and their masks in `out`.
+calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<calib::MaskFrame> frames, const Gathered& g,
+                                      std::span<const RecordingSample> recording, const RobotDrawing& robot, std::span<const int> bodies,
+                                      const Model& model, const calib::RefineOptions& options, Refinement& out) {
+  const std::size_t gathered = frames.size();
+  std::vector<const cv::Mat*> pictures;
+  for (const GatheredFrame& f : g.frames) pictures.push_back(&f.bgr);
+  std::vector<std::vector<calib::PlacedVolume>> region_volumes;
+  for (const GatheredFrame& f : g.frames) region_volumes.push_back(calib::placeVolumes(model, f.state, bodies));
+  const std::size_t fitted = std::min<std::size_t>(recording.size(), 16);
+  for (std::size_t k = 0; k < recording.size(); ++k) {
+    const RecordingSample& s = recording[k];
+    if (s.bgr.type() != CV_8UC3 || s.bgr.cols != start.width || s.bgr.rows != start.height)
+      throw CalibInputError("--masks auto: the recording's frames are not 8-bit colour pictures of the camera's " +
+                            std::to_string(start.width) + "x" + std::to_string(start.height));
+    if (static_cast<int>(s.state.size()) != model.stateSize())
+      throw CalibInputError("--masks auto: a frame of the recording without a state of the model's " + std::to_string(model.stateSize()) +
+                            " values");
+  }
+  // The samples fitted with the gathered frames: 16 spread over the recording.
+  for (std::size_t i = 0; i < fitted; ++i) {
+    const RecordingSample& s = recording[i * recording.size() / fitted];
+    pictures.push_back(&s.bgr);
+    region_volumes.push_back(calib::placeVolumes(model, s.state, bodies));
+    frames.push_back({cv::Mat(), robot.volumes(s.state), robot.meshes(s.state)});
+  }
+  std::vector<std::vector<calib::PlacedVolume>> sample_volumes;
+  for (const RecordingSample& s : recording) sample_volumes.push_back(calib::placeVolumes(model, s.state, bodies));
+  const double diagonal = std::hypot(start.width, start.height);
+  const std::vector<double> widths = {0.10, 0.03, 0.015};
+  calib::Camera cam = start;
+  std::optional<calib::RefineResult> kept;
+  calib::RefineResult last;
+  cv::Mat known;  // the kept round's
+  for (std::size_t round = 0; round < widths.size(); ++round) {
+    std::vector<cv::Mat> regions;
+    for (const auto& v : region_volumes) regions.push_back(robotRegion(cam, v, widths[round] * diagonal));
+    std::vector<calib::BackgroundSample> samples;
+    for (std::size_t k = 0; k < recording.size(); ++k)
+      samples.push_back({recording[k].bgr, robotRegion(cam, sample_volumes[k], widths[round] * diagonal)});
+    const calib::Background background = calib::estimateBackground(samples);
+    for (std::size_t f = 0; f < frames.size(); ++f) {
+      frames[f].mask = calib::foregroundMask({*pictures[f], regions[f]}, background);
+      frames[f].known = background.known;
+    }
+    calib::RefineOptions o = options;
+    if (round + 1 < widths.size()) o.min_iou = 0.0, o.max_rotation_sigma_deg = 90.0, o.max_frame_drop = 1.0;
+    if (round > 0) o.start_is_prior = false;  // the masks were remade around a refined pose
+    last = calib::refineToMasks(cam, frames, o);
+    if (!last.improved) break;
+    kept = last, cam = last.camera;
+    out.masks.clear();
+    for (std::size_t f = 0; f < gathered; ++f) out.masks.push_back(frames[f].mask);
+    known = background.known;
+  }
+  out.masks_from = "masks from the recording's background over " + std::to_string(recording.size()) + " frames, " +
+                   std::to_string(fitted) + " of them fitted too";
+  if (!kept) {
+    for (std::size_t f = 0; f < gathered; ++f) out.masks.push_back(frames[f].mask);
+    last.frames.resize(gathered);
+    return last;
+  }
+  out.masks_from += " (the background known over " + formatNumber(100.0 * cv::countNonZero(known) / static_cast<double>(known.total()), 3) +
+                    " % of the image)";
+  // The agreement before: the start's drawing against the masks the result was made to.
+  kept->frames.resize(gathered);
+  for (std::size_t f = 0; f < gathered; ++f) {
+    const cv::Mat drawn = frames[f].meshes.empty() ? calib::drawSilhouette(start, frames[f].volumes).mask
+                                                   : calib::drawMeshSilhouette(start, frames[f].meshes).mask;
+    kept->frames[f].iou_before = calib::maskIou(drawn & known, out.masks[f] & known);
+  }
+  return *kept;
 }
 
 }  // namespace
@@ -95,26 +198,34 @@ std::vector<calib::PlacedMesh> RobotDrawing::meshes(std::span<const double> stat
 Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const calib::Camera& intrinsics, const Model& model,
                              const RefineInputs& in, const calib::Camera* truth) {
   const bool edges = in.source == calib::RefineSource::Edges;
-  if (!edges && in.masks.size() != g.frames.size())
+  const bool from_recording = !edges && in.masks.empty() && !in.recording.empty();
+  if (!edges && !from_recording && in.masks.size() != g.frames.size())
     throw CalibInputError("--masks: " + std::to_string(in.masks.size()) + " mask(s) for " + std::to_string(g.frames.size()) +
                           " frame(s): give one mask per frame, in the same order");
   Refinement out;
-  const RobotDrawing robot(model, in.bodies, in.draw);
+  // Masks made from a recording hold only what moves.
+  std::vector<int> bodies = in.bodies;
+  if (from_recording) {
+    bodies = movingBodies(model, in.bodies);
+    if (bodies.empty()) throw CalibInputError("--masks auto: no body of the model (of those the masks show) moves with a joint");
+  }
+  const RobotDrawing robot(model, bodies, in.draw);
+  out.bodies = bodies;
   out.drawn = robot.drawn();
   std::vector<calib::MaskFrame> mask_frames;
   std::vector<calib::EdgeFrame> edge_frames;
-  const std::string what = edges ? "--refine edges" : "--masks";
+  const std::string what = edges ? "--refine edges" : from_recording ? "--masks auto" : "--masks";
   for (std::size_t f = 0; f < g.frames.size(); ++f) {
     const std::vector<double>& state = g.frames[f].state;
     if (static_cast<int>(state.size()) != model.stateSize())
       throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no state of the model's " +
                             std::to_string(model.stateSize()) + " values: give --state, or --states with --time");
-    if (edges && g.frames[f].bgr.empty())
+    if ((edges || from_recording) && g.frames[f].bgr.empty())
       throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no picture to find edges in: give --image or --video");
     std::vector<calib::PlacedMesh> meshes = robot.meshes(state);
     out.meshes.push_back(meshes);
     if (edges) edge_frames.push_back({g.frames[f].bgr, robot.volumes(state), std::move(meshes)});
-    else mask_frames.push_back({in.masks[f], robot.volumes(state), std::move(meshes)});
+    else mask_frames.push_back({from_recording ? cv::Mat() : in.masks[f], robot.volumes(state), std::move(meshes)});
   }
   calib::Camera start;
   if (solution.solved()) {
@@ -135,7 +246,8 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
   } else {
     calib::RefineOptions options;
     options.start_is_prior = out.start == "solve";
-    out.result = calib::refineToMasks(start, mask_frames, options);
+    out.result = from_recording ? refineToRecording(start, mask_frames, g, in.recording, robot, bodies, model, options, out)
+                                : calib::refineToMasks(start, mask_frames, options);
   }
   if (!out.result.improved) return out;
 
@@ -201,7 +313,9 @@ std::string refinementText(const Refinement& m) {
   }
   const std::string key = edges ? "edge_share" : "mask_iou";
   return std::string("refinement: ") + (m.result.improved ? (edges ? "edges" : "masks") : "none") + "\nrefinement_start: " + m.start +
-         "\nrefinement_drawn: \"" + m.drawn + "\"\n" + key + "_before: " + before + " ]\n" + key + "_after: " + after + " ]\n";
+         "\nrefinement_drawn: \"" + m.drawn + "\"\n" +
+         (m.masks_from.empty() ? std::string() : "refinement_masks: \"" + m.masks_from + "\"\n") + key + "_before: " + before +
+         " ]\n" + key + "_after: " + after + " ]\n";
 }
 
 nlohmann::json refinementJson(const Refinement& m) {
@@ -212,6 +326,7 @@ nlohmann::json refinementJson(const Refinement& m) {
   j["message"] = m.result.message;
   j["start"] = m.start;
   j["drawn"] = m.drawn;
+  if (!m.masks_from.empty()) j["masks_from"] = m.masks_from;
   j["iterations"] = m.result.iterations;
   j["frames"] = nlohmann::json::array();
   for (const calib::FrameAgreement& a : m.result.frames) {

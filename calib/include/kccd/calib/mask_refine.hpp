@@ -32,6 +32,9 @@ struct MaskFrame {
   cv::Mat mask;                       ///< CV_8UC1, the camera's size; non-zero = robot
   std::vector<PlacedVolume> volumes;  ///< world coordinates
   std::vector<PlacedMesh> meshes;     ///< what the robot looks like (visual meshes); drawn instead of the volumes when given
+  /// CV_8UC1: non-zero where the mask says anything (empty: everywhere). Elsewhere (e.g. where a
+  /// background estimate never saw the scene) outline points do not count and IoUs are not taken.
+  cv::Mat known;
 };
 
 /// How the refinement runs.
@@ -40,6 +43,7 @@ struct RefineOptions {
   int max_iterations = 40;  ///< per stage of the robust scale
   double min_iou = 0.6;     ///< a refined pose whose mean IoU stays below this is not a camera
   double max_rotation_sigma_deg = 3.0;  ///< nor one this uncertain (the points' solve has the same gate)
+  double max_frame_drop = 0.02;  ///< nor one that lowers a frame's IoU by more than this
   /// The start's sigmas (when it has them) are a prior: a pose more than 3 sigma from it for a mean
   /// IoU gain below 0.02 keeps the start (the masks and the volumes differ, not the start).
   bool start_is_prior = false;
@@ -76,7 +80,7 @@ struct RefineResult {
 /// Levenberg-Marquardt over (rvec, tvec), with a robust (Cauchy) loss whose scale shrinks from a
 /// tenth of the image to a few pixels; outline points at the image border, and those whose
 /// field points the other way (a hole's edge, another object's), count little. The result is
-/// kept only if the mean IoU grows and no frame's falls by more than 0.02 (never a worse camera),
+/// kept only if the mean IoU grows and no frame's falls by more than max_frame_drop (never a worse camera),
 /// and if it is a camera at all: a mean IoU of at least min_iou, a rotation sigma within bounds.
 /// Throws InputError for masks of another size than the camera's or no frame.
 RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frames, const RefineOptions& options = {});

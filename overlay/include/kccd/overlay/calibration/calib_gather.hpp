@@ -48,6 +48,11 @@ struct RecordingFrames {
 RecordingFrames readRecordingFrames(const std::string& path, const std::vector<int>& wanted,
                                     const std::string& label = "");
 
+/// About `count` frames spread evenly over a whole recording (all of them when it has fewer), in
+/// order, with their indices in `indices`; one pass. Throws VideoError as readRecordingFrames.
+RecordingFrames sampleRecordingFrames(const std::string& path, std::size_t count, std::vector<int>& indices,
+                                      const std::string& label = "");
+
 /// One frame of a calibration: its picture, what is labelled in it and the robot's state in it.
 struct CalibFrame {
   /// The image file, read when `bgr` is empty; with `bgr`, the picture's name (e.g.

@@ -44,10 +44,21 @@ class RobotDrawing {
   std::string drawn_;
 };
 
+/// A frame of a fixed camera's recording and the robot's state in it.
+struct RecordingSample {
+  cv::Mat bgr;                 ///< 8-bit BGR, the camera's size
+  std::vector<double> state;   ///< the model's state size
+};
+
 /// What the refinement is given beside the gathered frames.
 struct RefineInputs {
   calib::RefineSource source = calib::RefineSource::Masks;  ///< Edges: the gathered frames' pictures
-  std::vector<cv::Mat> masks;          ///< with Masks: one per gathered frame (calib::readMask)
+  std::vector<cv::Mat> masks;          ///< with Masks: one per gathered frame (calib::readMask), or none with `recording`
+  /// With Masks and no masks: frames of the recording the gathered frames are from (a fixed
+  /// camera), spread over it; the masks are the gathered frames' pictures against the background
+  /// estimated from these away from the drawn robot (calib/background.hpp), remade as the pose is
+  /// refined.
+  std::vector<RecordingSample> recording;
   std::vector<std::string> mask_names; ///< as messages name them
   std::vector<int> bodies;             ///< the model's bodies that are the robot (empty: all)
   /// What is drawn: the model's visuals (what the robot looks like) when it has them and they can
@@ -59,9 +70,12 @@ struct RefineInputs {
 /// What the refinement did.
 struct Refinement {
   std::string start;       ///< "solve" (the points' solve), "points" (a rough pose from them), "camera" (the given one)
+  std::vector<int> bodies; ///< the bodies drawn (with masks from a recording: those that move)
   std::string drawn;       ///< what was drawn: "visual meshes", or "collision volumes" (and why, when the model has visuals)
   calib::RefineResult result;
   std::vector<std::vector<calib::PlacedMesh>> meshes;  ///< per frame, the visuals drawn (empty: the volumes were)
+  std::vector<cv::Mat> masks;  ///< masks made from the recording: per frame, as last used (none with given masks or edges)
+  std::string masks_from;      ///< how they were made, one line (empty with given masks or edges)
   /// Labelled points the refined pose puts farther from their click than 3 times the outline's
   /// robust rms, 3 times the other clicks' median residual and 4 px: the image disagrees with them.
   std::vector<std::string> disagreeing;
@@ -71,17 +85,20 @@ struct Refinement {
 /// holds the refined camera (status solved, the covariance and sigmas of the refinement, the
 /// residuals of every point under it, the truth error when `truth` is given); otherwise it is left
 /// as it was. Throws CalibInputError when no start can be had, a frame has no state of the model's
-/// size, the masks do not match the frames, (edges) a frame has no picture, or (draw "visuals") the
+/// size, the masks do not match the frames, (edges, masks from the recording) a frame has no
+/// picture, a recording's sample is not of the camera's size or state, or (draw "visuals") the
 /// model has no visuals or they cannot be read.
 Refinement refineCalibration(CalibSolution& solution, const Gathered& gathered, const calib::Camera& intrinsics, const Model& model,
                              const RefineInputs& inputs, const calib::Camera* truth = nullptr);
 
 /// The refinement's figures as lines the camera file ends with (keys OpenCV and the camera reader
-/// skip): refinement (masks, edges or none), refinement_start, refinement_drawn, then
+/// skip): refinement (masks, edges or none), refinement_start, refinement_drawn, refinement_masks
+/// (with masks from the recording), then
 /// mask_iou_before and mask_iou_after, or edge_share_before and edge_share_after.
 std::string refinementText(const Refinement& refinement);
 
-/// The refinement as the JSON report gives it: source, improved, message, start, drawn, frames
+/// The refinement as the JSON report gives it: source, improved, message, start, drawn, masks_from
+/// (with masks from the recording), frames
 /// (iou_before and iou_after, or edge_share_before and edge_share_after; rms_px,
 /// outline_points), disagreeing.
 nlohmann::json refinementJson(const Refinement& refinement);
