@@ -431,10 +431,11 @@ TEST_F(CalibMasks, FourRoughClicksAndThePicturesEdgesGiveTheCamera) {
 
 // --masks auto: a fixed camera's recording (FFV1) of the arm, resting in one pose in half of its
 // frames and moving about in the others, on a background of coloured boxes; its state log; a rough
-// camera 6 degrees and 6 cm off, no clicks. The masks are made from the recording itself.
+// camera 6 degrees and 6 cm off, no clicks. The masks are made from the recording itself, its
+// frames' times on the log's clock as the given frames' --time say (0.25 s after frame / fps).
 TEST_F(CalibMasks, MasksFromTheRecordingItselfGiveTheCamera) {
   constexpr int kFrames = 48;
-  constexpr double kFps = 8.0;
+  constexpr double kFps = 8.0, kClock = 0.25;  // the log's clock runs 0.25 s ahead of frame / fps
   std::mt19937_64 rng(12);
   cv::Mat scene(cam_.height, cam_.width, CV_8UC3, cv::Scalar(95, 105, 100));
   for (int k = 0; k < 30; ++k) {
@@ -449,7 +450,7 @@ TEST_F(CalibMasks, MasksFromTheRecordingItselfGiveTheCamera) {
   for (int f = 0; f < kFrames; ++f) {
     const std::vector<double> state =
         f % 2 == 0 ? rest : std::vector<double>{uniform(rng, -1.2, 1.2), uniform(rng, -0.6, 0.6), uniform(rng, -1.0, 1.0)};
-    log += fmt(f / kFps) + "," + fmt(state[0]) + "," + fmt(state[1]) + "," + fmt(state[2]) + "\n";
+    log += fmt(f / kFps + kClock) + "," + fmt(state[0]) + "," + fmt(state[1]) + "," + fmt(state[2]) + "\n";
     cv::Mat picture = scene.clone();
     picture.setTo(cv::Scalar(215, 210, 205), quickMask(state));
     cv::Mat noise(picture.size(), CV_16SC3), wide;
@@ -462,7 +463,9 @@ TEST_F(CalibMasks, MasksFromTheRecordingItselfGiveTheCamera) {
   write("rec.csv", log);
   std::mt19937_64 turn(5);
   kccd::calib::saveCamera(kccd::testing::perturbed(cam_, 6.0, 0.06, turn), out("rough.yaml"));
-  const Outcome r = runKccd("calib --intrinsics " + out("cam.yaml") + " --video " + out("rec.mkv") + " --frame 3 --frame 17 --frame 31" +
+  std::string frames;
+  for (const int f : {3, 17, 31}) frames += " --frame " + std::to_string(f) + " --time " + fmt(f / kFps + kClock);
+  const Outcome r = runKccd("calib --intrinsics " + out("cam.yaml") + " --video " + out("rec.mkv") + frames +
                             " --states " + out("rec.csv") + " --model " + kDemo + " --masks auto --camera " + out("rough.yaml") + " -o " +
                             out("c.yaml") + " --json --check " + out("check.png"));
   ASSERT_EQ(r.code, 0) << r.err << r.out;

@@ -95,7 +95,9 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
       overlay::RecordingFrames r = overlay::sampleRecordingFrames(a.video, a.recording_samples, indices, "--video " + a.video);
       if (!(r.fps > 0.0)) throw UsageError("--masks auto: --video " + a.video + " declares no frame rate, so its frames have no times");
       pictures = std::move(r.frames);
-      for (const int i : indices) sample_times.push_back(i / r.fps);
+      // The frames' --time, when given, says where the log's clock stands against frame / fps.
+      const double offset = a.times.empty() ? 0.0 : a.times.front() - a.video_frames.front() / r.fps;
+      for (const int i : indices) sample_times.push_back(i / r.fps + offset);
     }
     for (std::size_t k = 0; k < pictures.size(); ++k) {
       std::vector<double> state(static_cast<std::size_t>(model->stateSize()), 0.0);

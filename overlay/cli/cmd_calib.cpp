@@ -266,7 +266,8 @@ Runner addCalib(CLI::App& app) {
                   "tool's output): the pose is refined so the model's drawn robot matches them over all frames; needs "
                   "--model and each frame's state. --masks auto: made from the recording itself (--video with --states, or "
                   "--bag; a fixed camera): the robot is what differs from the background, estimated over 40 frames spread over "
-                  "the recording, each pixel from the frames in which the drawn robot is away from it; people moving, lighting "
+                  "the recording (at frame / fps on the log's clock, shifted as the first --time says when given), each pixel from "
+                  "the frames in which the drawn robot is away from it; people moving, lighting "
                   "changes and the robot's shadows are foreground too")
       ->expected(1, -1);
   sub->add_option("--refine", a->refine,

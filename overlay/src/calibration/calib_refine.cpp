@@ -96,6 +96,7 @@ calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<ca
   const std::vector<double> widths = {0.10, 0.03, 0.015};
   calib::Camera cam = start;
   std::optional<calib::RefineResult> kept;
+  std::size_t kept_round = 0;
   calib::RefineResult last;
   cv::Mat known;  // the kept round's
   for (std::size_t round = 0; round < widths.size(); ++round) {
@@ -114,28 +115,46 @@ calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<ca
     if (round > 0) o.start_is_prior = false;  // the masks were remade around a refined pose
     last = calib::refineToMasks(cam, frames, o);
     if (!last.improved) break;
-    kept = last, cam = last.camera;
+    kept = last, kept_round = round, cam = last.camera;
     out.masks.clear();
     for (std::size_t f = 0; f < gathered; ++f) out.masks.push_back(frames[f].mask);
     known = background.known;
   }
   out.masks_from = "masks from the recording's background over " + std::to_string(recording.size()) + " frames, " +
                    std::to_string(fitted) + " of them fitted too";
-  if (!kept) {
-    for (std::size_t f = 0; f < gathered; ++f) out.masks.push_back(frames[f].mask);
-    last.frames.resize(gathered);
-    return last;
+  // A round before the last was kept on any gain: it is a camera only if it passes the gates the
+  // last round would have held it to.
+  if (kept && kept_round + 1 < widths.size()) {
+    double mean = 0.0;
+    for (const calib::FrameAgreement& a : kept->frames) mean += a.iou_after / static_cast<double>(kept->frames.size());
+    if (mean < options.min_iou || !(kept->camera.rotation_sigma_deg.value_or(90.0) <= options.max_rotation_sigma_deg)) {
+      last.message = "the drawn robot and the masks made from the recording agree too little (mean IoU " + formatNumber(mean, 3) +
+                     ", at least " + formatNumber(options.min_iou, 3) + " needed; rotation +-" +
+                     formatNumber(kept->camera.rotation_sigma_deg.value_or(90.0), 3) +
+                     " deg): is the camera fixed, and does the robot move over the recording? The start is kept";
+      kept.reset();
+    }
   }
-  out.masks_from += " (the background known over " + formatNumber(100.0 * cv::countNonZero(known) / static_cast<double>(known.total()), 3) +
-                    " % of the image)";
+  if (!kept) {
+    // The start's figures against the masks of the first round (made around it).
+    last.improved = false, last.camera = start, last.covariance = cv::Matx66d::zeros();
+    if (out.masks.empty())
+      for (std::size_t f = 0; f < gathered; ++f) out.masks.push_back(frames[f].mask);
+    if (known.empty()) known = frames.front().known;
+  }
+  calib::RefineResult result = kept ? *kept : last;
+  result.frames.resize(gathered);
   // The agreement before: the start's drawing against the masks the result was made to.
-  kept->frames.resize(gathered);
   for (std::size_t f = 0; f < gathered; ++f) {
     const cv::Mat drawn = frames[f].meshes.empty() ? calib::drawSilhouette(start, frames[f].volumes).mask
                                                    : calib::drawMeshSilhouette(start, frames[f].meshes).mask;
-    kept->frames[f].iou_before = calib::maskIou(drawn & known, out.masks[f] & known);
+    result.frames[f].iou_before = calib::maskIou(drawn & known, out.masks[f] & known);
+    if (!kept) result.frames[f].iou_after = result.frames[f].iou_before;
   }
-  return *kept;
+  if (kept)
+    out.masks_from += " (the background known over " + formatNumber(100.0 * cv::countNonZero(known) / static_cast<double>(known.total()), 3) +
+                      " % of the image)";
+  return result;
 }
 
 }  // namespace
