@@ -304,6 +304,38 @@ class CalibMasks : public CalibCli {
     m = m >= 128;
     return m;
   }
+  // A fixed camera's recording (FFV1, rec.mkv) of the arm and its log (rec.csv): 48 frames at 8 fps,
+  // the arm resting in one pose in every other frame and elsewhere in the others, on a background
+  // of coloured boxes with noise; the log's clock runs kClock ahead of frame / fps.
+  static constexpr double kFps = 8.0, kClock = 0.25;
+  void writeRecording() const {
+    std::mt19937_64 rng(12);
+    cv::Mat scene(cam_.height, cam_.width, CV_8UC3, cv::Scalar(95, 105, 100));
+    for (int k = 0; k < 30; ++k) {
+      const cv::Point a(static_cast<int>(uniform(rng, 0, cam_.width)), static_cast<int>(uniform(rng, 0, cam_.height)));
+      const cv::Scalar colour(uniform(rng, 20, 200), uniform(rng, 20, 200), uniform(rng, 20, 200));
+      cv::rectangle(scene, a, a + cv::Point(static_cast<int>(uniform(rng, 10, 70)), static_cast<int>(uniform(rng, 10, 50))), colour,
+                    cv::FILLED);
+    }
+    const std::vector<double> rest = {0.3, -0.2, 0.6};
+    std::string log = "time,shoulder_yaw,shoulder_pitch,elbow\n";
+    cv::VideoWriter video(out("rec.mkv"), cv::VideoWriter::fourcc('F', 'F', 'V', '1'), kFps, cv::Size(cam_.width, cam_.height));
+    ASSERT_TRUE(video.isOpened());
+    for (int f = 0; f < 48; ++f) {
+      const std::vector<double> state =
+          f % 2 == 0 ? rest : std::vector<double>{uniform(rng, -1.2, 1.2), uniform(rng, -0.6, 0.6), uniform(rng, -1.0, 1.0)};
+      log += fmt(f / kFps + kClock) + "," + fmt(state[0]) + "," + fmt(state[1]) + "," + fmt(state[2]) + "\n";
+      cv::Mat picture = scene.clone();
+      picture.setTo(cv::Scalar(215, 210, 205), quickMask(state));
+      cv::Mat noise(picture.size(), CV_16SC3), wide;
+      cv::RNG(static_cast<std::uint64_t>(f) + 1).fill(noise, cv::RNG::NORMAL, 0, 3);
+      picture.convertTo(wide, CV_16SC3);
+      cv::Mat(wide + noise).convertTo(picture, CV_8UC3);
+      video.write(picture);
+    }
+    video.release();
+    write("rec.csv", log);
+  }
   // Two clicks on the arm in frame f, each 8 px off.
   std::string roughClicks(std::size_t f) const {
     std::vector<kccd::Pose> poses(model_.joints.size());
@@ -429,38 +461,11 @@ TEST_F(CalibMasks, FourRoughClicksAndThePicturesEdgesGiveTheCamera) {
   EXPECT_GT(cv::countNonZero(magenta), 100);
 }
 
-// --masks auto: a fixed camera's recording (FFV1) of the arm, resting in one pose in half of its
-// frames and moving about in the others, on a background of coloured boxes; its state log; a rough
-// camera 6 degrees and 6 cm off, no clicks. The masks are made from the recording itself, its
-// frames' times on the log's clock as the given frames' --time say (0.25 s after frame / fps).
+// --masks auto: the fixture's recording (writeRecording) and a rough camera 6 degrees and 6 cm
+// off, no clicks. The masks are made from the recording itself, its frames' times on the log's
+// clock as the given frames' --time say.
 TEST_F(CalibMasks, MasksFromTheRecordingItselfGiveTheCamera) {
-  constexpr int kFrames = 48;
-  constexpr double kFps = 8.0, kClock = 0.25;  // the log's clock runs 0.25 s ahead of frame / fps
-  std::mt19937_64 rng(12);
-  cv::Mat scene(cam_.height, cam_.width, CV_8UC3, cv::Scalar(95, 105, 100));
-  for (int k = 0; k < 30; ++k) {
-    const cv::Point a(static_cast<int>(uniform(rng, 0, cam_.width)), static_cast<int>(uniform(rng, 0, cam_.height)));
-    const cv::Scalar colour(uniform(rng, 20, 200), uniform(rng, 20, 200), uniform(rng, 20, 200));
-    cv::rectangle(scene, a, a + cv::Point(static_cast<int>(uniform(rng, 10, 70)), static_cast<int>(uniform(rng, 10, 50))), colour, cv::FILLED);
-  }
-  const std::vector<double> rest = {0.3, -0.2, 0.6};
-  std::string log = "time,shoulder_yaw,shoulder_pitch,elbow\n";
-  cv::VideoWriter video(out("rec.mkv"), cv::VideoWriter::fourcc('F', 'F', 'V', '1'), kFps, cv::Size(cam_.width, cam_.height));
-  ASSERT_TRUE(video.isOpened());
-  for (int f = 0; f < kFrames; ++f) {
-    const std::vector<double> state =
-        f % 2 == 0 ? rest : std::vector<double>{uniform(rng, -1.2, 1.2), uniform(rng, -0.6, 0.6), uniform(rng, -1.0, 1.0)};
-    log += fmt(f / kFps + kClock) + "," + fmt(state[0]) + "," + fmt(state[1]) + "," + fmt(state[2]) + "\n";
-    cv::Mat picture = scene.clone();
-    picture.setTo(cv::Scalar(215, 210, 205), quickMask(state));
-    cv::Mat noise(picture.size(), CV_16SC3), wide;
-    cv::RNG(static_cast<std::uint64_t>(f) + 1).fill(noise, cv::RNG::NORMAL, 0, 3);
-    picture.convertTo(wide, CV_16SC3);
-    cv::Mat(wide + noise).convertTo(picture, CV_8UC3);
-    video.write(picture);
-  }
-  video.release();
-  write("rec.csv", log);
+  writeRecording();
   std::mt19937_64 turn(5);
   kccd::calib::saveCamera(kccd::testing::perturbed(cam_, 6.0, 0.06, turn), out("rough.yaml"));
   std::string frames;
@@ -506,6 +511,46 @@ TEST_F(CalibMasks, MasksFromTheRecordingItselfGiveTheCamera) {
     EXPECT_NE(e.err.find(k.expect), std::string::npos) << k.args << "\n" << e.err;
     EXPECT_FALSE(fs::exists(out("d.yaml")));
   }
+}
+
+// kccd overlay --masks auto: the same recording against its log at the true camera. At the log's
+// true clock the frames agree; one frame late (the arm rests in every other frame) the mean falls;
+// frames whose logged shoulder is off are named low.
+TEST_F(CalibMasks, OverlayAgreementWithMasksFromTheRecording) {
+  writeRecording();
+  // The log with the shoulder 0.3 rad off in rows 20-29: those frames disagree with the video.
+  std::string bad;
+  {
+    std::istringstream rows(kccd::testing::readText(out("rec.csv")));
+    int row = -1;
+    for (std::string line; std::getline(rows, line); ++row) {
+      if (row >= 20 && row < 30) {
+        const std::size_t a = line.find(','), b = line.find(',', a + 1);
+        line = line.substr(0, a + 1) + fmt(std::stod(line.substr(a + 1, b - a - 1)) + 0.3) + line.substr(b);
+      }
+      bad += line + "\n";
+    }
+  }
+  write("bad.csv", bad);
+  const auto agreement = [&](const std::string& log, double offset) {
+    const Outcome r = runKccd("overlay " + kDemo + " --camera " + out("cam.yaml") + " --video " + out("rec.mkv") + " --states " + out(log) +
+                              " --time-offset " + fmt(offset) + " --masks auto --report " + out("r.json") + " -q");
+    EXPECT_EQ(r.code, 0) << r.err << r.out;
+    return nlohmann::json::parse(kccd::testing::readText(out("r.json")))["mask_agreement"];
+  };
+  const nlohmann::json right = agreement("rec.csv", kClock), late = agreement("rec.csv", kClock + 1 / kFps),
+                       offset = agreement("bad.csv", kClock);
+  std::printf("masks from the recording: IoU at the log's clock mean %.3f (smallest %.3f, %d low); a frame late %.3f; "
+              "shoulder 0.3 rad off in 10 frames: %d low\n",
+              right["mean_iou"].get<double>(), right["min_iou"].get<double>(), right["low_frames"].get<int>(), late["mean_iou"].get<double>(),
+              offset["low_frames"].get<int>());
+  EXPECT_GE(right["frames"].get<int>(), 40);
+  EXPECT_GT(right["mean_iou"].get<double>(), 0.9);
+  EXPECT_LE(right["low_frames"].get<int>(), 1) << right.dump();
+  EXPECT_LT(late["mean_iou"].get<double>(), right["mean_iou"].get<double>() - 0.2);
+  int named = 0;
+  for (const auto& f : offset["lowest"]) named += f.get<int>() >= 20 && f.get<int>() < 30;
+  EXPECT_GE(named, 7) << offset.dump();
 }
 
 TEST_F(CalibMasks, BadRefineOptionsAreOneLineExitTwo) {

@@ -71,6 +71,13 @@ Background estimateBackground(std::span<const BackgroundSample> samples, int min
   return out;
 }
 
+cv::Mat robotRegion(const Camera& camera, std::span<const PlacedVolume> volumes, double widen_px) {
+  const cv::Mat drawn = drawSilhouette(camera, volumes).mask;
+  cv::Mat away;
+  cv::distanceTransform(drawn == 0, away, cv::DIST_L2, cv::DIST_MASK_3);
+  return away <= static_cast<float>(widen_px);
+}
+
 cv::Mat foregroundMask(const BackgroundSample& frame, const Background& background, const ForegroundOptions& options) {
   const cv::Size size = background.bgr.size();
   checkSample(frame, size, "foreground");

@@ -110,7 +110,8 @@ Exit runOverlay(const OverlayArgs& a) {
       if (b < 0) throw UsageError("--mask-bodies: '" + name + "' is not a body of " + a.model + " (kccd info lists them)");
       bodies.push_back(b);
     }
-    masks.emplace(a.masks, camera, model, std::move(bodies), "--masks " + a.masks);
+    if (a.masks == "auto") masks.emplace(camera, model, std::move(bodies), "--masks auto");
+    else masks.emplace(a.masks, camera, model, std::move(bodies), "--masks " + a.masks);
     in.masks = &*masks;
   } else if (!a.mask_bodies.empty()) {
     throw UsageError("--mask-bodies: goes with --masks");
@@ -257,7 +258,10 @@ Runner addOverlay(CLI::App& app) {
                   "Folder of robot masks, frame_000000.png ... (one per frame, any segmentation tool's output, non-zero = robot; "
                   "frames without a file are skipped): each frame's IoU with the robot drawn at its logged state goes into the "
                   "report, the summary, the timeline and the contact sheet's captions; frames far below the run's median stand "
-                  "out (a wrong clock offset, a joint offset, a moved camera)");
+                  "out (a wrong clock offset, a joint offset, a moved camera). --masks auto: each frame's mask made from the "
+                  "recording itself (a fixed camera): what differs from its background, learnt over 40 frames spread over it "
+                  "away from the robot drawn at their logged states, taken where the background is known (not where the robot "
+                  "never moves away); only the bodies that move are drawn");
   sub->add_option("--mask-bodies", a->mask_bodies, "Comma-separated bodies of the model that the masks show (default: all bodies)");
   sub->add_option("--codec", a->codec, "FourCC of the output video (default by extension)");
   sub->add_option("-j,--jobs", a->jobs, "Worker threads (each with its own GL context; default: hardware threads)")->check(CLI::Range(1, 256));

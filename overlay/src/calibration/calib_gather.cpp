@@ -56,29 +56,10 @@ RecordingFrames sampleRecordingFrames(const std::string& path, std::size_t count
   RecordingFrames out;
   out.fps = video.fps();
   indices.clear();
-  count = std::max<std::size_t>(count, 1);
-  // Every stride-th frame kept; at twice the count, every other one dropped and the stride doubled.
-  std::size_t stride = 1;
-  cv::Mat frame;
-  for (int i = 0; video.read(frame); ++i) {
-    if (static_cast<std::size_t>(i) % stride != 0) continue;
-    if (frame.type() != CV_8UC3) throw VideoError(name + ": frames are not 8-bit colour images");
-    out.frames.push_back(frame.clone());
-    indices.push_back(i);
-    if (out.frames.size() == 2 * count) {
-      for (std::size_t k = 0; k < count; ++k) out.frames[k] = out.frames[2 * k], indices[k] = indices[2 * k];
-      out.frames.resize(count), indices.resize(count);
-      stride *= 2;
-    }
-  }
-  if (out.frames.size() > count) {  // between count and 2 count: every other one, evenly
-    std::vector<cv::Mat> frames;
-    std::vector<int> kept;
-    for (std::size_t k = 0; k < count; ++k) {
-      const std::size_t at = k * out.frames.size() / count;
-      frames.push_back(out.frames[at]), kept.push_back(indices[at]);
-    }
-    out.frames = std::move(frames), indices = std::move(kept);
+  for (SampledFrame& f : sampleFrames(video, count)) {
+    if (f.bgr.type() != CV_8UC3) throw VideoError(name + ": frames are not 8-bit colour images");
+    indices.push_back(static_cast<int>(f.index));
+    out.frames.push_back(std::move(f.bgr));
   }
   return out;
 }

@@ -36,27 +36,6 @@ std::optional<calib::Camera> roughPose(const calib::Camera& intrinsics, const Ga
   return c;
 }
 
-// The bodies of `bodies` (empty: all) that move with a joint: what differs from a background.
-std::vector<int> movingBodies(const Model& model, std::span<const int> bodies) {
-  std::vector<int> out;
-  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
-    if (!bodies.empty() && std::find(bodies.begin(), bodies.end(), static_cast<int>(b)) == bodies.end()) continue;
-    bool moves = false;
-    for (int j = model.bodies[b].frame; j != kWorld && !moves; j = model.joints[static_cast<std::size_t>(j)].parent)
-      moves = model.joints[static_cast<std::size_t>(j)].dof > 0;
-    if (moves) out.push_back(static_cast<int>(b));
-  }
-  return out;
-}
-
-// Where the robot may be in a picture at `cam`: its volumes' drawing widened by `widen` px.
-cv::Mat robotRegion(const calib::Camera& cam, std::span<const calib::PlacedVolume> volumes, double widen) {
-  const cv::Mat drawn = calib::drawSilhouette(cam, volumes).mask;
-  cv::Mat away;
-  cv::distanceTransform(drawn == 0, away, cv::DIST_L2, cv::DIST_MASK_3);
-  return away <= static_cast<float>(widen);
-}
-
 // The refinement to masks made from the recording, remade around the pose as it is refined: the
 // robot's drawing widened by a tenth of the image's diagonal first (a start 10 degrees off moves
 // the robot about that far), then by 3 % and 1.5 % of it around the refined pose. Each round's
@@ -101,10 +80,10 @@ calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<ca
   cv::Mat known;  // the kept round's
   for (std::size_t round = 0; round < widths.size(); ++round) {
     std::vector<cv::Mat> regions;
-    for (const auto& v : region_volumes) regions.push_back(robotRegion(cam, v, widths[round] * diagonal));
+    for (const auto& v : region_volumes) regions.push_back(calib::robotRegion(cam, v, widths[round] * diagonal));
     std::vector<calib::BackgroundSample> samples;
     for (std::size_t k = 0; k < recording.size(); ++k)
-      samples.push_back({recording[k].bgr, robotRegion(cam, sample_volumes[k], widths[round] * diagonal)});
+      samples.push_back({recording[k].bgr, calib::robotRegion(cam, sample_volumes[k], widths[round] * diagonal)});
     const calib::Background background = calib::estimateBackground(samples);
     for (std::size_t f = 0; f < frames.size(); ++f) {
       frames[f].mask = calib::foregroundMask({*pictures[f], regions[f]}, background);
@@ -158,6 +137,18 @@ calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<ca
 }
 
 }  // namespace
+
+std::vector<int> movingBodies(const Model& model, std::span<const int> bodies) {
+  std::vector<int> out;
+  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
+    if (!bodies.empty() && std::find(bodies.begin(), bodies.end(), static_cast<int>(b)) == bodies.end()) continue;
+    bool moves = false;
+    for (int j = model.bodies[b].frame; j != kWorld && !moves; j = model.joints[static_cast<std::size_t>(j)].parent)
+      moves = model.joints[static_cast<std::size_t>(j)].dof > 0;
+    if (moves) out.push_back(static_cast<int>(b));
+  }
+  return out;
+}
 
 RobotDrawing::RobotDrawing(const Model& model, std::vector<int> bodies, const std::string& draw)
     : model_(model), bodies_(std::move(bodies)), drawn_("collision volumes") {

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "kccd/calib/mask_refine.hpp"
+#include "kccd/kinematics.hpp"
 #include "kccd/calib/silhouette.hpp"
 #include "kccd/input_error.hpp"
 
@@ -45,14 +46,56 @@ MaskAgreement::MaskAgreement(const std::string& folder, const calib::Camera& cam
   std::sort(indices_.begin(), indices_.end());
 }
 
-std::optional<double> MaskAgreement::at(std::size_t index, std::span<const double> state) const {
-  if (state.empty() || !std::binary_search(indices_.begin(), indices_.end(), index)) return std::nullopt;
-  char name[32];
-  std::snprintf(name, sizeof name, "frame_%06zu.png", index);
-  const cv::Mat mask = calib::readMask((std::filesystem::path(folder_) / name).string(), camera_.width, camera_.height, false);
+MaskAgreement::MaskAgreement(const calib::Camera& camera, const Model& model, std::vector<int> bodies, std::string label)
+    : label_(std::move(label)), camera_(camera), robot_(model, movingBodies(model, checkedBodies(model, bodies, label_))),
+      region_bodies_(movingBodies(model, bodies)) {
+  if (region_bodies_.empty()) throw InputError(label_ + ": no body of the model (of those the masks show) moves with a joint");
+}
+
+void MaskAgreement::learnBackground(FrameSource& frames, const std::function<double(std::size_t)>& log_time, const StateLog& log,
+                                    double max_gap) {
+  const Model& model = robot_.model();
+  const double widen = 0.015 * std::hypot(camera_.width, camera_.height);
+  std::vector<calib::BackgroundSample> samples;
+  indices_.clear();
+  std::size_t read = 0;
+  for (SampledFrame& f : sampleFrames(frames, 40)) {
+    ++read;
+    if (f.bgr.type() != CV_8UC3 || f.bgr.cols != camera_.width || f.bgr.rows != camera_.height)
+      throw InputError(label_ + ": frame " + std::to_string(f.index) + " is not an 8-bit colour picture of the camera's " +
+                       std::to_string(camera_.width) + "x" + std::to_string(camera_.height));
+    std::vector<double> state(static_cast<std::size_t>(model.stateSize()), 0.0);
+    const double t = log_time(f.index);
+    if (!std::isfinite(t) || stateAt(log, t, max_gap, state) == StateMatch::None) continue;
+    samples.push_back({std::move(f.bgr), calib::robotRegion(camera_, calib::placeVolumes(model, state, region_bodies_), widen)});
+    indices_.push_back(f.index);
+  }
+  if (samples.size() < 8)
+    throw InputError(label_ + ": only " + std::to_string(samples.size()) + " of " + std::to_string(read) +
+                     " frames spread over the recording have a logged state (8 or more needed to learn its background)");
+  background_ = calib::estimateBackground(samples);
+}
+
+std::optional<double> MaskAgreement::at(std::size_t index, std::span<const double> state, const cv::Mat& picture) const {
+  if (state.empty()) return std::nullopt;
   const std::vector<calib::PlacedMesh> meshes = robot_.meshes(state);
   const calib::Silhouette drawn =
       meshes.empty() ? calib::drawSilhouette(camera_, robot_.volumes(state)) : calib::drawMeshSilhouette(camera_, meshes);
+  if (fromRecording()) {
+    if (!background_ || picture.empty()) return std::nullopt;
+    const double widen = 0.015 * std::hypot(camera_.width, camera_.height);
+    const cv::Mat region = calib::robotRegion(camera_, calib::placeVolumes(robot_.model(), state, region_bodies_), widen);
+    const cv::Mat mask = calib::foregroundMask({picture, region}, *background_);
+    // Where the background is unknown (the robot never leaves), nothing is said: a frame whose
+    // drawn robot lies mostly there has no agreement.
+    const cv::Mat seen = drawn.mask & background_->known;
+    if (cv::countNonZero(seen) < 0.25 * cv::countNonZero(drawn.mask) || cv::countNonZero(seen) == 0) return std::nullopt;
+    return calib::maskIou(seen, mask);
+  }
+  if (!std::binary_search(indices_.begin(), indices_.end(), index)) return std::nullopt;
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06zu.png", index);
+  const cv::Mat mask = calib::readMask((std::filesystem::path(folder_) / name).string(), camera_.width, camera_.height, false);
   return calib::maskIou(drawn.mask, mask);
 }
 

@@ -162,6 +162,14 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
     report.time_offset = report.time_offset_found.offset;
   }
   settings.time_offset = report.time_offset;
+  // Masks made from the recording: its background learnt first (another pass over the frames).
+  std::optional<MaskAgreement> learnt;
+  if (in.masks && in.masks->fromRecording()) {
+    learnt.emplace(*in.masks);
+    const std::unique_ptr<FrameSource> sampling = open();
+    learnt->learnBackground(*sampling, [&](std::size_t i) { return clock(i) + report.time_offset; }, in.log, report.max_gap);
+  }
+  const MaskAgreement* masks = learnt ? &*learnt : in.masks;
   const std::size_t expected = video.declaredFrames();
   if (sink) sink->begin(clock.nominalFps(), camera.width, camera.height);
 
@@ -265,8 +273,9 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
             job = std::move(todo.front());
             todo.pop_front();
           }
+          const cv::Mat picture = masks && masks->fromRecording() ? job.bgr.clone() : cv::Mat();  // before anything is drawn
           annotator->annotate(job.bgr, job.record);
-          if (in.masks) job.record.mask_iou = in.masks->at(job.index, job.record.values);
+          if (masks) job.record.mask_iou = masks->at(job.index, job.record.values, picture);
           std::lock_guard lock(mu);
           done.emplace(job.index, std::move(job));
           cv.notify_all();

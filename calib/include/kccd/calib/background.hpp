@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "kccd/calib/silhouette.hpp"
 #include "kccd/input_error.hpp"
 
 namespace kccd::calib {
@@ -32,6 +33,10 @@ struct Background {
 /// unknown. Throws InputError for no sample, or samples not all 8-bit BGR of one size with robot
 /// masks of that size.
 Background estimateBackground(std::span<const BackgroundSample> samples, int min_samples = 3);
+
+/// Where the robot may be in a picture through `camera`: its volumes' drawing widened by `widen_px`
+/// (CV_8UC1, 255 there): a BackgroundSample's robot.
+cv::Mat robotRegion(const Camera& camera, std::span<const PlacedVolume> volumes, double widen_px);
 
 /// How a frame's pixels are told from the background.
 struct ForegroundOptions {

@@ -36,6 +36,7 @@ class RobotDrawing {
   std::vector<calib::PlacedMesh> meshes(std::span<const double> state) const;
   /// "visual meshes", or "collision volumes" with the reason in brackets when the model has visuals.
   const std::string& drawn() const { return drawn_; }
+  const Model& model() const { return model_; }
 
  private:
   const Model& model_;
@@ -43,6 +44,10 @@ class RobotDrawing {
   std::vector<render::LoadedVisual> visuals_;
   std::string drawn_;
 };
+
+/// The bodies of `bodies` (empty: all of the model's) that move with a joint: what differs from a
+/// fixed camera's background.
+std::vector<int> movingBodies(const Model& model, std::span<const int> bodies);
 
 /// A frame of a fixed camera's recording and the robot's state in it.
 struct RecordingSample {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -22,5 +23,16 @@ class FrameSource {
   /// Index of the next frame read() returns (0 before the first).
   virtual std::size_t nextIndex() const = 0;
 };
+
+/// A frame of a recording and its index (from 0).
+struct SampledFrame {
+  std::size_t index = 0;
+  cv::Mat bgr;
+};
+
+/// About `count` (>= 1) frames spread evenly over what is left of `source` (all of them when it has
+/// fewer), in order; one pass to its end, holding at most 2 x count frames. Throws what read()
+/// throws.
+std::vector<SampledFrame> sampleFrames(FrameSource& source, std::size_t count);
 
 }  // namespace kccd::overlay
