@@ -148,16 +148,16 @@ TEST(CalibTagLayout, EveryMistakeIsOneLineNamingThePlaceAndField) {
 
 TEST(CalibTagLayout, FilesThatAreNotRegularOrTooLarge) {
   const std::string missing = ::testing::TempDir() + "/kccd_no_such_layout.yaml";
-  EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(missing); }), missing + ": file: cannot open the tag layout (no such file)");
+  EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(missing); }), missing + ": cannot open the tag layout (no such file)");
   const std::string dir = ::testing::TempDir();
-  EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(dir); }), dir + ": file: not a regular file");
+  EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(dir); }), dir + ": a folder, not a tag layout");
   const std::string fifo = ::testing::TempDir() + "/kccd_layout_fifo";
   std::filesystem::remove(fifo);
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(fifo); }), fifo + ": file: not a regular file");
+  EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(fifo); }), fifo + ": not a regular file (a device, FIFO or socket)");
   std::filesystem::remove(fifo);
   const std::string big = writeTemp("kccd_layout_big.yaml", "# " + std::string(kMaxTagLayoutBytes, 'x') + "\n");
-  EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(big); }), big + ": file: larger than 1024 KiB");
+  EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(big); }), big + ": larger than 1 MiB");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -299,7 +299,7 @@ TEST(CalibLabels, EveryMistakeIsOneLineNamingThePlaceAndField) {
     EXPECT_EQ(m.rfind(c.expected, 0), 0u) << "got:      " << m << "\nexpected: " << c.expected << "\nfor:\n" << c.text;
   }
   const std::string missing = ::testing::TempDir() + "/kccd_no_such_labels.yaml";
-  EXPECT_EQ(errorOf<LabelsError>([&] { loadLabels(missing); }), missing + ": file: cannot open the labels file (no such file)");
+  EXPECT_EQ(errorOf<LabelsError>([&] { loadLabels(missing); }), missing + ": cannot open the labels file (no such file)");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -80,11 +80,11 @@ TEST_F(IntrinsicsCli, BadInputIsOneLineNamingTheFile) {
     std::string args, expect;
   } cases[] = {
       {"--image " + a + " " + b + " " + small + kGrid, small + ": image: 160x120 differs from " + a},
-      {"--image " + a + " " + path("missing.png") + kGrid, path("missing.png") + ": image: no such file"},
+      {"--image " + a + " " + path("missing.png") + kGrid, path("missing.png") + ": image: cannot open the image (no such file)"},
       {"--image " + a + " " + path("text.png") + kGrid, path("text.png") + ": image: not an image"},
       {"--image " + a + " " + path("cut.png") + kGrid, path("cut.png") + ": image: a damaged PNG ("},
       {"--image " + a + " " + path("wide.png") + kGrid, path("wide.png") + ": image: a damaged PNG ("},
-      {"--image " + a + " " + dir_.string() + kGrid, dir_.string() + ": image: not a regular file"},
+      {"--image " + a + " " + dir_.string() + kGrid, dir_.string() + ": image: a folder, not an image"},
       {"--image " + a + " " + a + kGrid, a + ": image: given twice"},
       {"--image " + a + " --grid 6x4", "--grid needs --tag-size"},
       {"--image " + a + " --grid 6by4 --tag-size 0.04 --spacing 0.01", "--grid 6by4: expected COLSxROWS"},

@@ -63,11 +63,11 @@ TEST(FrameTimes, FilesAreRegularAndBounded) {
     }
     return std::string("(no error)");
   };
-  EXPECT_EQ(error((dir / "missing.csv").string()), (dir / "missing.csv").string() + ": no such file");
-  EXPECT_EQ(error(dir.string()), dir.string() + ": not a regular file");
+  EXPECT_EQ(error((dir / "missing.csv").string()), (dir / "missing.csv").string() + ": cannot open the frame-times file (no such file)");
+  EXPECT_EQ(error(dir.string()), dir.string() + ": a folder, not a frame-times file");
   const std::string fifo = (dir / "fifo").string();
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  EXPECT_EQ(error(fifo), fifo + ": not a regular file");  // refused without blocking
+  EXPECT_EQ(error(fifo), fifo + ": not a regular file (a device, FIFO or socket)");  // refused without blocking
   std::filesystem::remove_all(dir);
 }
 

@@ -67,13 +67,13 @@ TEST_F(FileReader, RefusesAFileOverTheBound) {
   EXPECT_EQ(e.size(), 1001u);
   EXPECT_EQ(e.maxBytes(), 1000u);
   const FileError kib = errorOf(write("big2.txt", std::string(3000, 'x')), 2048, "tag layout");
-  EXPECT_EQ(std::string(kib.what()), (dir_ / "big2.txt").string() + ": file: larger than 2 KiB");
+  EXPECT_EQ(std::string(kib.what()), (dir_ / "big2.txt").string() + ": larger than 2 KiB");
 }
 
 TEST_F(FileReader, RefusesFoldersDevicesAndFifosWithoutBlocking) {
   const FileError folder = errorOf(dir_.string());
   EXPECT_EQ(folder.kind(), FileProblem::Directory);
-  EXPECT_EQ(std::string(folder.what()), dir_.string() + ": file: not a regular file");
+  EXPECT_EQ(std::string(folder.what()), dir_.string() + ": a folder, not a file");
   EXPECT_EQ(errorOf("/dev/zero").kind(), FileProblem::NotRegular);  // would never end if read
   const std::string fifo = (dir_ / "fifo").string();
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
@@ -86,9 +86,9 @@ TEST_F(FileReader, NamesAMissingFileAndItsSource) {
   EXPECT_EQ(e.kind(), FileProblem::Missing);
   EXPECT_EQ(e.systemError(), ENOENT);
   EXPECT_EQ(e.systemReason(), "no such file");
-  EXPECT_EQ(std::string(e.what()), missing + ": file: cannot open the camera file (no such file)");
+  EXPECT_EQ(std::string(e.what()), missing + ": cannot open the camera file (no such file)");
   EXPECT_EQ(e.location().source, missing);
-  EXPECT_EQ(e.location().field, "file");
+  EXPECT_EQ(e.location().field, "");
   EXPECT_EQ(e.location().line, 0u);
   EXPECT_EQ(e.problem(), "cannot open the camera file (no such file)");
   // A part of the path that is not a folder: no such file either way.

@@ -320,7 +320,7 @@ TEST(MeshFormats, UrdfMixingEveryFormatImports) {
   }
   urdf << "</robot>\n";
   km::ImportOptions options;
-  options.points = 4;
+  options.fit.points = 4;
   const kccd::Model m = kccd::parseModel(km::importUrdf(write("mix.urdf", urdf.str()), options), "imported");
   ASSERT_EQ(m.bodies.size(), 5u);
   // The base link's two <visual>s: the DAE with its scale, origin and material colour, a cylinder.

@@ -222,7 +222,7 @@ TEST_F(OverlayCli, FrameTimesAndImageSequence) {
   const Outcome dir = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_seq/frame_%06d.png") +
                               " --states " + log_ + " -q --frame-times " + out("input_seq") + " --report " + out("r3.json"));
   EXPECT_EQ(dir.code, 2);
-  EXPECT_NE(dir.err.find("not a regular file"), std::string::npos) << dir.err;
+  EXPECT_NE(dir.err.find("a folder, not a frame-times file"), std::string::npos) << dir.err;
   EXPECT_FALSE(fs::exists(out("r3.json")));
 }
 

@@ -213,9 +213,7 @@ std::string reasonOf(const Model& m, const std::string& a, const std::string& b)
 
 Model gripperArm(bool keep_adjacent) {
   km::ImportOptions opt;
-  opt.points = 4;  // fixed K = 4 fits, whole links: the rules under test, on the geometry they were written for
-  opt.tolerance = 0.0;
-  opt.max_pieces = 1;
+  opt.fit = {.method = km::FitMethod::Points, .points = 4, .max_pieces = 1};  // fixed K = 4 fits, whole links: the rules under test, on the geometry they were written for
   opt.keep_adjacent = keep_adjacent;
   return kccd::parseModel(km::importUrdf(std::string(KCCD_TEST_DATA_DIR) + "/urdf/gripper_arm.urdf", opt), "gripper");
 }

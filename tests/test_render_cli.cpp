@@ -178,8 +178,8 @@ TEST_F(RenderCli, CameraFileErrorsExitTwoWithOneLine) {
       {"height.yaml", height,
        ":" + std::to_string(std::count(height.begin(), height.begin() + static_cast<long>(height.find("image_height: 20000")), '\n') + 1) +
            ":15: image_height: 20000 is not in 1..8192"},
-      {"dir.yaml", "", ": file: not a regular file"},
-      {"fifo.yaml", "", ": file: not a regular file"},
+      {"dir.yaml", "", ": a folder, not a camera file"},
+      {"fifo.yaml", "", ": not a regular file (a device, FIFO or socket)"},
   };
   for (const auto& c : cases) {
     if (c.name != "dir.yaml" && c.name != "fifo.yaml") std::ofstream(out(c.name), std::ios::binary) << c.text;

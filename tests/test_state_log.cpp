@@ -477,7 +477,7 @@ TEST_F(StateLogFile, LoadsAndNamesTheFile) {
 TEST_F(StateLogFile, OnlyRegularFiles) {
   const std::string missing = (dir_ / "missing.csv").string();
   EXPECT_EQ(loadError(missing), missing + ": cannot open the state log (no such file)");
-  EXPECT_EQ(loadError(dir_.string()), dir_.string() + ": a directory, not a state log file");
+  EXPECT_EQ(loadError(dir_.string()), dir_.string() + ": a folder, not a state log");
   const std::string fifo = (dir_ / "fifo.csv").string();
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
   EXPECT_EQ(loadError(fifo), fifo + ": not a regular file (a device, FIFO or socket)");  // without blocking

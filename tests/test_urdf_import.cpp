@@ -26,7 +26,7 @@ TEST(UrdfImport, TestRobot) {
   const std::string dir = std::string(KCCD_TEST_DATA_DIR) + "/urdf";
   km::ImportOptions opt;
   opt.srdf = dir + "/two_link.srdf";
-  opt.points = 4;
+  opt.fit.points = 4;
   opt.packages["kccd_test"] = dir;
   const std::string text = km::importUrdf(dir + "/two_link.urdf", opt);
   const Model m = kccd::parseModel(text, "imported");
@@ -153,7 +153,7 @@ TEST(UrdfImport, MobileBasesBecomeJointChains) {
       << "<joint name=\"wall\" type=\"planar\"><parent link=\"cart\"/><child link=\"slider\"/>"
          "<axis xyz=\"2 0 0\"/></joint></robot>";
   km::ImportOptions opt;
-  opt.points = 4;
+  opt.fit.points = 4;
   const Model m = kccd::parseModel(km::importUrdf((dir / "mobile.urdf").string(), opt), "imported");
   ASSERT_EQ(m.joints.size(), 8u);
   const kccd::Joint& x = m.joints[m.jointIndex("base_x")];
@@ -218,7 +218,7 @@ TEST(UrdfImport, HullBodiesAreTheLinksConvexHulls) {
   const std::string dir = std::string(KCCD_TEST_DATA_DIR) + "/urdf";
   km::ImportOptions opt;
   opt.packages["kccd_test"] = dir;
-  opt.hulls = true;
+  opt.fit.method = km::FitMethod::Hull;
   const Model hull = kccd::parseModel(km::importUrdf(dir + "/two_link.urdf", opt), "hull");
   const kccd::Body& base = hull.bodies[hull.bodyIndex("base")];
   ASSERT_EQ(base.points.size(), 8u);
@@ -237,8 +237,8 @@ TEST(UrdfImport, HullBodiesAreTheLinksConvexHulls) {
                                                                              slider.points)),
                 slider.radius + 1e-12)
           << d.transpose();
-  opt.hulls = false;
-  opt.points = 4;
+  opt.fit.method = km::FitMethod::Tolerance;
+  opt.fit.points = 4;
   const Model fitted = kccd::parseModel(km::importUrdf(dir + "/two_link.urdf", opt), "fitted");
   for (const kccd::Body& b : hull.bodies) {
     if (b.name == "slider") continue;  // its sphere is a circumscribed polytope there, an exact ball in the fit
@@ -301,7 +301,7 @@ TEST(UrdfImport, ConcaveLinkInPiecesClearsWhatItsHullHolds) {
   km::ImportOptions opt;
   opt.safety_margin = 0.001;
   opt.visuals = false;
-  opt.concavity = 0.01;
+  opt.fit.concavity = 0.01;
   const std::string text = km::importUrdf(urdf, opt);
   const Model m = kccd::parseModel(text, "fork (imported)");
   std::vector<int> pieces;
@@ -311,14 +311,14 @@ TEST(UrdfImport, ConcaveLinkInPiecesClearsWhatItsHullHolds) {
   std::size_t most = 0;
   for (const kccd::Body& b : m.bodies) {
     EXPECT_GE(b.tolerance, 0.0) << b.name;
-    EXPECT_LE(b.tolerance, opt.tolerance) << b.name;
+    EXPECT_LE(b.tolerance, opt.fit.tolerance) << b.name;
     most = std::max(most, b.points.size());
   }
   EXPECT_GE(static_cast<std::size_t>(m.point_budget), most);
   EXPECT_EQ(m.bodies[pieces[0]].name, "forearm/1");
   // The wrist is clear of every piece at the zero state, and (the pitch joint turns it) in a
   // band of states; the forearm's one hull holds it.
-  opt.max_pieces = 1;
+  opt.fit.max_pieces = 1;
   const Model whole = kccd::parseModel(km::importUrdf(urdf, opt), "fork (whole)");
   ASSERT_EQ(whole.bodies.size(), 2u);
   kccd::Checker in_pieces(m), in_one(whole);

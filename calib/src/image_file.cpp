@@ -172,17 +172,8 @@ cv::Mat readImageFile(const std::string& path, ImageColour colour) {
   std::string bytes;
   try {
     bytes = readRegularFile(path, kMaxImageFileBytes, "image");
-  } catch (const FileError& e) {  // said as "path: image: problem"
-    const InputLocation where{path, 0, 0, "image"};
-    switch (e.kind()) {
-      case FileProblem::Missing:
-        throw ImageError(where, "no such file");
-      case FileProblem::Directory:
-      case FileProblem::NotRegular:
-        throw ImageError(where, "not a regular file");
-      default:
-        throw ImageError(where, e.problem());
-    }
+  } catch (const FileError& e) {  // said as "path: image: problem", as every image error is
+    throw ImageError(InputLocation{e.location().source, 0, 0, "image"}, e.problem());
   }
   return decodeImage({reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()}, path, colour);
 }

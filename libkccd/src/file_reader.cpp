@@ -8,6 +8,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <string_view>
 
 namespace kccd {
 namespace {
@@ -17,7 +18,7 @@ std::string reasonOf(int system_error) {
   return system_error == ENOENT ? std::string("no such file") : std::string(std::strerror(system_error));
 }
 
-// The message of a FileError (the calibration inputs' wording).
+// The message of a FileError: every reader's wording.
 std::string describe(const std::string& label, FileProblem kind, int system_error, std::uintmax_t max_bytes) {
   const std::string reason = reasonOf(system_error);
   switch (kind) {
@@ -25,10 +26,14 @@ std::string describe(const std::string& label, FileProblem kind, int system_erro
     case FileProblem::CannotOpen:
       return "cannot open the " + label + " (" + reason + ")";
     case FileProblem::Directory:
+      return std::string("a folder, not ") + (std::string_view("aeiou").find(label.empty() ? 'x' : label[0]) == std::string_view::npos ? "a " : "an ") + label;
     case FileProblem::NotRegular:
-      return "not a regular file";
+      return "not a regular file (a device, FIFO or socket)";
     case FileProblem::TooLarge:
-      return "larger than " + std::to_string(max_bytes >> 10) + " KiB";
+      if (max_bytes >= (std::uintmax_t{1} << 20) && max_bytes % (std::uintmax_t{1} << 20) == 0)
+        return "larger than " + std::to_string(max_bytes >> 20) + " MiB";
+      if (max_bytes >= 1024 && max_bytes % 1024 == 0) return "larger than " + std::to_string(max_bytes >> 10) + " KiB";
+      return "larger than " + std::to_string(max_bytes) + " bytes";
     case FileProblem::CannotRead:
       return "cannot read the " + label + " (" + reason + ")";
   }
@@ -39,7 +44,7 @@ std::string describe(const std::string& label, FileProblem kind, int system_erro
 
 FileError::FileError(const std::string& path, const std::string& label, FileProblem kind, int system_error,
                      std::uintmax_t size, std::uintmax_t max_bytes)
-    : InputError(InputLocation{path, 0, 0, "file"}, describe(label, kind, system_error, max_bytes)),
+    : InputError(InputLocation{printable(path, 1024), 0, 0, {}}, describe(label, kind, system_error, max_bytes)),
       kind_(kind),
       system_error_(system_error),
       size_(size),

@@ -335,21 +335,7 @@ std::string readModelText(const std::string& path) {
   try {
     return readRegularFile(path, kMaxBytes, "model file");
   } catch (const FileError& e) {
-    const InputLocation where{path, 0, 0, {}};
-    switch (e.kind()) {
-      case FileProblem::Missing:
-        throw ModelError(where, "cannot open the model file (no such file)");
-      case FileProblem::Directory:
-      case FileProblem::NotRegular:
-        throw ModelError(where, "not a regular file");
-      case FileProblem::CannotOpen:
-        throw ModelError(where, "cannot open the model file");
-      case FileProblem::TooLarge:
-        throw ModelError(where, "larger than " + std::to_string(kMaxBytes >> 20) + " MiB");
-      case FileProblem::CannotRead:
-        break;
-    }
-    throw ModelError(where, "cannot read the model file (" + e.systemReason() + ")");
+    throw ModelError(e.location(), e.problem());
   }
 }
 

@@ -285,21 +285,7 @@ StateLog loadStateLog(const std::string& path, const Model& model, std::span<con
   try {
     text = readRegularFile(path, kMaxStateLogBytes, "state log");
   } catch (const FileError& e) {
-    const InputLocation where{printable(path, 1024), 0, 0, {}};
-    switch (e.kind()) {
-      case FileProblem::Missing:
-      case FileProblem::CannotOpen:
-        throw StateLogError(where, "cannot open the state log (" + e.systemReason() + ")");
-      case FileProblem::Directory:
-        throw StateLogError(where, "a directory, not a state log file");
-      case FileProblem::NotRegular:
-        throw StateLogError(where, "not a regular file (a device, FIFO or socket)");
-      case FileProblem::TooLarge:
-        throw StateLogError(where, "larger than " + std::to_string(kMaxStateLogBytes >> 20) + " MiB");
-      case FileProblem::CannotRead:
-        break;
-    }
-    throw StateLogError(where, "cannot read the state log (" + e.systemReason() + ")");
+    throw StateLogError(e.location(), e.problem());
   }
   return parseStateLog(text, path, model, ignore_columns);
 }

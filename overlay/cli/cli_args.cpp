@@ -1,7 +1,9 @@
 #include "cli_args.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <map>
 #include <cstdlib>
 #include <regex>
 #include <sstream>
@@ -114,10 +116,21 @@ StateBox parseStateBox(const Model& m, const std::string& state, const std::stri
   return box;
 }
 
-void checkCorePoints(int k) {
-  if (k < 1 || k > modelling::kMaxCorePoints)
-    throw UsageError("--points: the number of core points K must be 1 ... " +
-                     std::to_string(modelling::kMaxCorePoints) + " (got " + std::to_string(k) + ")");
+void rethrowAsOption(const InputError& e, const std::map<std::string, std::string>& spelling) {
+  const InputLocation& at = e.location();
+  if (!at.source.empty() || at.field.empty() || at.line != 0) throw;
+  std::string option = "--" + at.field;
+  std::replace(option.begin(), option.end(), '_', '-');
+  if (const auto s = spelling.find(at.field); s != spelling.end()) option = s->second;
+  throw UsageError(option + ": " + e.problem());
+}
+
+void checkFitOptions(const modelling::FitRequest& request) {
+  try {
+    modelling::checkFitRequest(request);
+  } catch (const modelling::FitRequestError& e) {
+    rethrowAsOption(e, {{"max_evaluations", "--evaluations"}});
+  }
 }
 
 std::vector<std::string> splitCommas(const std::string& text) {

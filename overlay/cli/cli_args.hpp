@@ -2,6 +2,7 @@
 // parser messages, number lists and interval boxes.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -9,6 +10,7 @@
 
 #include "kccd/input_error.hpp"
 #include "kccd/model.hpp"
+#include "kccd/modelling/fit_request.hpp"
 
 namespace kccd::cli {
 
@@ -41,8 +43,14 @@ struct StateBox {
 StateBox parseStateBox(const Model& m, const std::string& state, const std::string& lower, const std::string& upper,
                        const std::string& missing, bool finite);
 
-/// Checks a `--points` value (the number of core points of a fit).
-void checkCorePoints(int k);
+/// Called in a catch block with the library's error `e`: when it is about a field of a request
+/// ("fps: ...": a field, no source), a UsageError with the field as this command line spells it
+/// (`spelling[field]`, else --field with dashes for underscores); otherwise the error rethrown.
+[[noreturn]] void rethrowAsOption(const InputError& e, const std::map<std::string, std::string>& spelling = {});
+
+/// Checks a fit request built from the options; a field out of range is a UsageError naming its
+/// option (--points, --tolerance, --pieces, --concavity, --evaluations, --seed).
+void checkFitOptions(const modelling::FitRequest& request);
 
 /// `--pieces auto|N`: the most convex pieces a concave link may split into (auto: 8); N in 1 ... 64.
 int piecesOption(const std::string& text);

@@ -1,18 +1,19 @@
 // `kccd fit PART --points K`: a conservative SSCH for one rigid part from a CAD file.
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <vector>
 
 #include "cli_args.hpp"
 #include "cli_files.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/modelling/convex_hull.hpp"
-#include "kccd/modelling/convex_pieces.hpp"
-#include "kccd/modelling/fit.hpp"
-#include "kccd/modelling/urdf_import.hpp"
+#include "kccd/modelling/fit_request.hpp"
 #include "kccd/modelling/yaml_edit.hpp"
 
 namespace kccd::cli {
@@ -24,103 +25,65 @@ struct FitArgs {
   std::string part, name, frame = "world", model, body;
   bool merge = false, json = false, quiet = false, hull = false;
   int evaluations = 4000;
+  std::uint64_t seed = 1;
+  std::vector<double> scale = {1.0, 1.0, 1.0};
   double tolerance_mm = 0.0;  // > 0: the fewest points meeting it (--tolerance)
   std::string pieces = "1";
   double concavity_mm = modelling::kDefaultConcavityMm;
 };
 
-// One fitted piece (or the whole part) as a body snippet.
-struct FittedBody {
-  modelling::FitResult fit;
-  double concavity = 0.0;
-};
+// The request the options make (checked, options named).
+modelling::FitRequest fitRequest(const FitArgs& args) {
+  const modelling::FitRequest r{.method = args.hull                ? modelling::FitMethod::Hull
+                                          : args.tolerance_mm > 0 ? modelling::FitMethod::Tolerance
+                                                                  : modelling::FitMethod::Points,
+                                .points = args.points,
+                                .tolerance = args.tolerance_mm * 1e-3,
+                                .max_pieces = piecesOption(args.pieces),
+                                .concavity = args.concavity_mm * 1e-3,
+                                .max_evaluations = args.evaluations,
+                                .seed = args.seed};
+  checkFitOptions(r);
+  return r;
+}
 
 Exit runFit(const FitArgs& args) {
-  checkCorePoints(args.points);
+  const modelling::FitRequest request = fitRequest(args);
   if (args.model.empty() != args.body.empty()) throw UsageError("--model and --body go together");
-  const int max_pieces = piecesOption(args.pieces);
-  const auto t0 = std::chrono::steady_clock::now();
-  modelling::Part part;
-  part = modelling::readPart(args.part_file, {.part = args.part, .merge = args.merge});
-  modelling::PieceSplit split;
-  if (max_pieces > 1) {
-    split = modelling::splitConcave(part, {.max_pieces = max_pieces, .concavity = args.concavity_mm * 1e-3});
+  if (args.scale.size() == 1 || args.scale.size() == 3) {
+    for (const double v : args.scale)
+      if (!std::isfinite(v) || v == 0.0) throw UsageError("--scale: each factor must be a finite number other than 0");
   } else {
-    split.pieces.push_back(part);
-    split.concavity.push_back(0.0);
+    throw UsageError("--scale: give one factor or three (X,Y,Z)");
   }
-  const int count = static_cast<int>(split.pieces.size());
+  const Vec3 scale = args.scale.size() == 1 ? Vec3::Constant(args.scale[0]) : Vec3(args.scale[0], args.scale[1], args.scale[2]);
+  const auto t0 = std::chrono::steady_clock::now();
+  const modelling::Part part = modelling::readPart(args.part_file, {.part = args.part, .merge = args.merge, .scale = scale});
+  modelling::FittedPart fitted;
+  {
+    Progress progress("fitting " + std::filesystem::path(args.part_file).filename().string(), args.quiet || args.json || args.hull);
+    fitted = modelling::fitPart(part, request, [&](double f) { progress.update(f); });
+  }
+  const int count = static_cast<int>(fitted.pieces.size());
   if (count > 1 && !args.model.empty())
     throw UsageError("--model replaces one body, but " + args.part_file + " splits into " + std::to_string(count) +
                      " pieces (--pieces 1 fits it whole; kccd import writes a link's pieces)");
-  std::vector<FittedBody> fitted;
-  {
-    Progress progress("fitting " + std::filesystem::path(args.part_file).filename().string(),
-                      args.quiet || args.json || args.hull);
-    for (int k = 0; k < count; ++k) {
-      const modelling::FitOptions options{.points = args.points,
-                                          .max_evaluations = args.evaluations,
-                                          .progress = [&](double f) { progress.update((k + f) / count); }};
-      const modelling::Part& piece = split.pieces[k];
-      FittedBody b;
-      b.fit = args.hull                ? modelling::exactHull(piece)
-              : args.tolerance_mm > 0 ? modelling::fitToTolerance(piece, args.tolerance_mm * 1e-3, options)
-                                      : modelling::fit(piece, options);
-      b.concavity = split.concavity[k];
-      fitted.push_back(std::move(b));
-    }
-  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const std::string stem =
       args.name.empty() ? (args.body.empty() ? std::filesystem::path(args.part_file).stem().string() : args.body)
                         : args.name;
-  auto nameOf = [&](int k) { return count > 1 ? stem + "/" + std::to_string(k + 1) : stem; };
-  // The bound each body meets, rounded up to a micrometre as the model file records it.
-  auto toleranceYaml = [](const modelling::FitResult& r) { return modelling::yamlNumber(std::ceil(r.outside * 1e6) / 1e6); };
+  auto nameOf = [&](int k) { return modelling::pieceName(stem, k, count); };
+  const auto fitOf = [&](int k) -> const modelling::FitResult& { return fitted.pieces[static_cast<std::size_t>(k)].fit; };
 
   if (!args.model.empty()) {
-    const modelling::FitResult& r = fitted[0].fit;
+    const modelling::FitResult& r = fitOf(0);
     editFile(args.model, [&](const std::string& text) {
       return modelling::withBodyGeometry(text, args.model, args.body, modelling::flowPoints(r.points),
-                                         modelling::yamlNumber(r.radius, true), toleranceYaml(r));
+                                         modelling::yamlNumber(r.radius, true), modelling::toleranceYaml(r));
     });
   }
   if (args.json) {
-    auto describe = [&](const modelling::FitResult& r) {
-      nlohmann::json j;
-      const double hull = r.hull_volume;
-      auto ratio = [&](double v) { return hull > 0 ? v / hull : std::numeric_limits<double>::infinity(); };
-      j["points"] = nlohmann::json::array();
-      for (const Vec3& v : r.points) j["points"].push_back(vec3(v));
-      j["radius"] = std::stod(modelling::yamlNumber(r.radius, true));
-      j["volume"] = r.volume;
-      j["hull_volume"] = hull;
-      j["volume_ratio"] = number(ratio(r.volume));
-      if (!args.hull)
-        j["baselines"] = {{"sphere_volume", r.sphere_volume}, {"sphere_ratio", number(ratio(r.sphere_volume))},
-                          {"capsule_volume", r.capsule_volume}, {"capsule_ratio", number(ratio(r.capsule_volume))}};
-      j["k"] = static_cast<int>(r.points.size());
-      j["hull_vertices"] = r.hull_vertices;
-      j["evaluations"] = r.evaluations;
-      j["outside"] = r.outside;
-      j["tolerance"] = std::stod(toleranceYaml(r));
-      j["method"] = r.method;
-      return j;
-    };
-    nlohmann::json j = count == 1 ? describe(fitted[0].fit) : nlohmann::json::object();
-    if (count > 1) {
-      j["pieces"] = nlohmann::json::array();
-      for (int k = 0; k < count; ++k) {
-        nlohmann::json p = describe(fitted[k].fit);
-        p["name"] = nameOf(k);
-        p["concavity"] = fitted[k].concavity;
-        j["pieces"].push_back(std::move(p));
-      }
-    }
-    if (split.measured) j["concavity"] = split.whole_concavity;
-    j["exact_hull"] = args.hull;
-    j["triangles"] = part.triangles;
-    j["primitives"] = part.primitives;
+    nlohmann::json j = nlohmann::json::parse(modelling::fitJson(part, request, fitted, stem));
     j["time_s"] = seconds;
     if (!args.model.empty()) j["written"] = {{"model", args.model}, {"body", args.body}};
     std::cout << j.dump(2) << "\n";
@@ -129,13 +92,13 @@ Exit runFit(const FitArgs& args) {
   std::ostringstream out;
   out << "# kccd fit " << args.part_file << ": " << part.triangles << " triangles, " << part.primitives
       << " analytic primitives, "
-      << (count == 1 ? fitted[0].fit.hull_vertices : static_cast<int>(modelling::convexHull(part.samples()).vertices.size()))
+      << (count == 1 ? fitOf(0).hull_vertices : static_cast<int>(modelling::convexHull(part.samples()).vertices.size()))
       << " hull vertices, " << seconds << " s\n";
-  if (split.measured)
-    out << "# concavity " << formatNumber(split.whole_concavity * 1e3, 3) << " mm"
+  if (fitted.measured)
+    out << "# concavity " << formatNumber(fitted.whole_concavity * 1e3, 3) << " mm"
         << (count > 1 ? ": " + std::to_string(count) + " convex pieces" : std::string(", one piece")) << "\n";
   for (int k = 0; k < count; ++k) {
-    const modelling::FitResult& r = fitted[k].fit;
+    const modelling::FitResult& r = fitOf(k);
     const double hull = r.hull_volume;
     auto ratio = [&](double v) { return hull > 0 ? v / hull : std::numeric_limits<double>::infinity(); };
     out << "# " << (count > 1 ? nameOf(k) + ": " : "")
@@ -149,15 +112,8 @@ Exit runFit(const FitArgs& args) {
           << " x hull, PCA capsule (K = 2) " << formatNumber(ratio(r.capsule_volume), 4) << " x hull\n";
   }
   if (!args.model.empty()) out << "# written into " << args.model << ", body " << args.body << "\n";
-  for (int k = 0; k < count; ++k) {
-    const modelling::FitResult& r = fitted[k].fit;
-    out << "- name: " << nameOf(k) << "\n";
-    if (count > 1) out << "  link: " << stem << "\n";
-    out << "  frame: " << args.frame << "\n"
-        << "  points: " << modelling::flowPoints(r.points) << "\n"
-        << "  radius: " << modelling::yamlNumber(r.radius, true) << "\n"
-        << "  tolerance: " << toleranceYaml(r) << "\n";
-  }
+  for (int k = 0; k < count; ++k)
+    out << modelling::bodyYaml({.name = nameOf(k), .link = count > 1 ? stem : std::string(), .frame = args.frame, .fit = &fitOf(k)});
   std::cout << out.str();
   return Exit::Ok;
 }
@@ -185,6 +141,13 @@ Runner addFit(CLI::App& app) {
                       "Optimiser budget per start (volume evaluations; three starts are refined)")
           ->capture_default_str()
           ->check(CLI::Range(1, 10000000));
+  sub->add_option("--seed", args->seed, "Seed of the optimiser's random search directions")->capture_default_str();
+  sub->add_option("--scale", args->scale,
+                  "Scale of the part in its file's frame: one factor, or three (X,Y,Z), as a URDF mesh's scale (e.g. 0.001 for a "
+                  "part drawn in millimetres)")
+      ->delimiter(',')
+      ->expected(1, 3)
+      ->default_str("1");
   sub->add_flag("--hull", args->hull,
                 "No fit: the part's exact convex hull (every hull vertex a core point): no looseness, a query "
                 "costs more the more vertices (for the links of pairs that work close together)")

@@ -57,17 +57,19 @@ std::string withProvenPairs(const std::string& text, const ImportArgs& args) {
 }
 
 Exit runImport(const ImportArgs& args) {
-  checkCorePoints(args.points);
   modelling::ImportOptions opt;
   opt.srdf = args.srdf;
-  opt.points = args.points;
-  opt.tolerance = args.fixed_k ? 0.0 : args.tolerance_mm * 1e-3;
-  opt.max_pieces = piecesOption(args.pieces);
-  opt.concavity = args.concavity_mm * 1e-3;
+  opt.fit = {.method = args.hulls     ? modelling::FitMethod::Hull
+                       : args.fixed_k ? modelling::FitMethod::Points
+                                      : modelling::FitMethod::Tolerance,
+             .points = args.points,
+             .tolerance = args.tolerance_mm * 1e-3,
+             .max_pieces = piecesOption(args.pieces),
+             .concavity = args.concavity_mm * 1e-3};
+  checkFitOptions(opt.fit);
   opt.safety_margin = args.margin;
   opt.visuals = !args.no_visuals;
   opt.keep_adjacent = args.keep_adjacent;
-  opt.hulls = args.hulls;
   for (const std::string& p : args.packages) {
     const std::size_t eq = p.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == p.size())

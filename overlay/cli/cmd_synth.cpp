@@ -23,7 +23,12 @@ struct SynthArgs {
 
 Exit runSynth(const overlay::SynthOptions& o, bool quiet) {
   Progress progress("synth", quiet);
-  const overlay::SynthResult r = overlay::synthesizeRecording(o, [&progress](double f) { progress.update(f); });
+  overlay::SynthResult r;
+  try {
+    r = overlay::synthesizeRecording(o, [&progress](double f) { progress.update(f); });
+  } catch (const overlay::SynthError& e) {
+    rethrowAsOption(e);
+  }
   progress.finish();
   if (!quiet) {
     std::cout << "wrote " << o.output << ": " << r.frames << " frames " << r.width << "x" << r.height << " at " << r.fps

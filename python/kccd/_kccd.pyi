@@ -250,6 +250,12 @@ def synthesize_recording(
     codec: str = "ffv1",
     collision: bool = True,
     replace: bool = False,
+    width: int | None = None,
+    height: int | None = None,
+    appearance: str = "auto",
+    visible_scale: float | None = None,
+    blur: float = 0.7,
+    noise: float = 2.5,
     progress: Callable[[float], object] | None = None,
 ) -> dict[str, Any]: ...
 
@@ -276,20 +282,34 @@ def explain(
     seed: int = 1,
 ) -> list[_Explanation]: ...
 
-class _Fit(TypedDict):
+class _FitBaselines(TypedDict):
+    sphere_volume: float
+    sphere_ratio: float | None
+    capsule_volume: float
+    capsule_ratio: float | None
+
+class _FitPiece(TypedDict, total=False):
     points: npt.NDArray[np.float64]
     radius: float
     volume: float
     hull_volume: float
-    sphere_volume: float
-    capsule_volume: float
+    volume_ratio: float | None
+    baselines: _FitBaselines
+    k: int
     hull_vertices: int
     evaluations: int
-    triangles: int
-    primitives: int
     outside: float
+    tolerance: float
     method: str
     yaml: str
+    name: str
+    concavity: float
+
+class _Fit(_FitPiece, total=False):
+    pieces: list[_FitPiece]
+    exact_hull: bool
+    triangles: int
+    primitives: int
 
 def fit(
     part_path: str,
@@ -302,6 +322,8 @@ def fit(
     seed: int = 1,
     exact_hull: bool = False,
     tolerance: float | None = None,
+    pieces: int | str = 1,
+    concavity: float = 40.0,
     progress: Callable[[float], object] | None = None,
 ) -> _Fit: ...
 def import_urdf(

@@ -2,12 +2,14 @@
 // to model text) and kccd.prove_pairs (which pairs can never meet, and the ignore list that follows).
 #include <pybind11/stl.h>
 
+#include <filesystem>
 #include <optional>
 #include <string>
 
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "kccd/modelling/fit.hpp"
+#include "kccd/modelling/fit_request.hpp"
 #include "kccd/modelling/pair_proof.hpp"
 #include "kccd/modelling/part.hpp"
 #include "kccd/modelling/urdf_import.hpp"
@@ -24,10 +26,24 @@ py::list entries(const std::vector<modelling::IgnoreEntry>& list) {
   return out;
 }
 
-void checkPoints(int k) {
-  if (k < 1 || k > modelling::kMaxCorePoints)
-    throw py::value_error("points: must be 1 ... " + std::to_string(modelling::kMaxCorePoints) + ", got " +
-                          std::to_string(k));
+// A fit request's check, as ValueError naming the argument (the request's fields are named as
+// these functions' arguments are).
+void checkRequest(const modelling::FitRequest& request) {
+  try {
+    modelling::checkFitRequest(request);
+  } catch (const modelling::FitRequestError& e) {
+    throw py::value_error(e.what());
+  }
+}
+
+// pieces='auto' (8) or a number.
+int piecesArgument(const py::object& pieces) {
+  if (py::isinstance<py::str>(pieces)) {
+    if (pieces.cast<std::string>() != "auto") throw py::value_error("pieces: 'auto' or a number 1 ... 64");
+    return 8;
+  }
+  if (!py::isinstance<py::int_>(pieces)) throw py::value_error("pieces: 'auto' or a number 1 ... 64");
+  return pieces.cast<int>();  // its range checked with the request
 }
 
 }  // namespace
@@ -36,68 +52,59 @@ void bindModelling(py::module_& m) {
   m.def(
       "fit",
       [](const std::string& path, int k, const std::string& part_name, bool merge, const std::array<double, 3>& scale,
-         int max_evaluations, std::uint64_t seed, bool exact_hull, const std::optional<double>& tolerance,
-         const py::object& progress) {
-        checkPoints(k);
-        if (max_evaluations < 1) throw py::value_error("max_evaluations: must be >= 1");
-        if (tolerance && !(*tolerance >= 1e-6 && *tolerance <= 1e6))
-          throw py::value_error("tolerance: must be a number of millimetres in 1e-6 ... 1e6");
+         int max_evaluations, std::uint64_t seed, bool exact_hull, const std::optional<double>& tolerance, const py::object& pieces,
+         double concavity, const py::object& progress) {
         if (tolerance && exact_hull) throw py::value_error("tolerance: not with exact_hull (the hull has none)");
+        const modelling::FitRequest request{.method = exact_hull  ? modelling::FitMethod::Hull
+                                                      : tolerance ? modelling::FitMethod::Tolerance
+                                                                  : modelling::FitMethod::Points,
+                                            .points = k,
+                                            .tolerance = tolerance.value_or(modelling::kDefaultToleranceMm) * 1e-3,
+                                            .max_pieces = piecesArgument(pieces),
+                                            .concavity = concavity * 1e-3,
+                                            .max_evaluations = max_evaluations,
+                                            .seed = seed};
+        checkRequest(request);
         ProgressRelay relay{progress, {}};
-        modelling::Part part;
-        modelling::FitResult r;
+        std::string text;
         relay.run([&] {
-          part = modelling::readPart(path, {.part = part_name, .merge = merge, .scale = {scale[0], scale[1], scale[2]}});
-          if (exact_hull) {
-            r = modelling::exactHull(part);
-          } else if (tolerance) {
-            r = modelling::fitToTolerance(part, *tolerance * 1e-3,
-                                          {.points = k,
-                                           .max_evaluations = max_evaluations,
-                                           .seed = seed,
-                                           .progress = [&](double f) { relay(f); }});
-          } else {
-            r = modelling::fit(part, {.points = k,
-                                      .max_evaluations = max_evaluations,
-                                      .seed = seed,
-                                      .progress = [&](double f) { relay(f); }});
-          }
+          const modelling::Part part =
+              modelling::readPart(path, {.part = part_name, .merge = merge, .scale = {scale[0], scale[1], scale[2]}});
+          const modelling::FittedPart fitted = modelling::fitPart(part, request, [&](double f) { relay(f); });
+          text = modelling::fitJson(part, request, fitted, std::filesystem::path(path).stem().string());
         });
-        const std::string points_yaml = modelling::flowPoints(r.points);
-        const std::string radius_yaml = modelling::yamlNumber(r.radius, true);
-        py::dict d;
-        d["points"] = pointRows(r.points);
-        d["radius"] = std::stod(radius_yaml);
-        d["volume"] = r.volume;
-        d["hull_volume"] = r.hull_volume;
-        d["sphere_volume"] = r.sphere_volume;
-        d["capsule_volume"] = r.capsule_volume;
-        d["hull_vertices"] = r.hull_vertices;
-        d["evaluations"] = r.evaluations;
-        d["triangles"] = part.triangles;
-        d["primitives"] = part.primitives;
-        d["outside"] = r.outside;
-        d["method"] = std::string(r.method);
-        d["yaml"] = "{points: " + points_yaml + ", radius: " + radius_yaml + "}";
+        py::dict d = py::module_::import("json").attr("loads")(text).cast<py::dict>();
+        const auto asArray = [](py::dict body) { body["points"] = py::module_::import("numpy").attr("array")(body["points"], "float64").attr("reshape")(-1, 3); };
+        if (d.contains("pieces"))
+          for (py::handle p : d["pieces"]) asArray(p.cast<py::dict>());
+        else
+          asArray(d);
         return d;
       },
       py::arg("part_path"), py::arg("points") = 8, py::kw_only(), py::arg("part") = "", py::arg("merge") = false,
       py::arg("scale") = std::array<double, 3>{1.0, 1.0, 1.0}, py::arg("max_evaluations") = 4000, py::arg("seed") = 1,
-      py::arg("exact_hull") = false, py::arg("tolerance") = py::none(), py::arg("progress") = py::none(),
+      py::arg("exact_hull") = false, py::arg("tolerance") = py::none(), py::arg("pieces") = 1,
+      py::arg("concavity") = modelling::kDefaultConcavityMm, py::arg("progress") = py::none(),
       R"doc(Fits a conservative SSCH (`points` core points, 1 ... 16, and a radius) to a rigid part, as `kccd fit`:
 every point of the part lies inside it, and its volume is as small as the search finds. part_path: Open Inventor
 (.iv), VRML (.wrl), STL or any mesh Assimp reads (OBJ, COLLADA, PLY, glTF, ...). part: one DEF'd node alone;
-merge: accept several top-level parts as one body; scale: per axis, in the file's frame; exact_hull: no fit,
-the part's own convex hull (every hull vertex a core point); tolerance: millimetres the volume may reach outside
-the part's hull, as `kccd fit --tolerance` (the K = points fit when it meets it, else the fewest hull vertices
-that do). progress(fraction) is called with the GIL held.
-Returns a dict: 'points' float64 (K, 3) in the part's frame (metres, 10 significant digits), 'radius' (rounded
-up: the SSCH still covers the part when written as printed), 'volume', 'hull_volume', 'sphere_volume',
-'capsule_volume' (m^3: the fit, the part's hull, and the one-sphere and principal-axis-capsule baselines),
-'hull_vertices', 'evaluations', 'triangles', 'primitives', 'outside' (metres: how far the volume may reach
-outside the part's hull, an upper bound), 'method' ('fit', 'hull' or 'simplified hull'), and 'yaml' (the body's geometry as a model file
-writes it: {points: [...], radius: ...}; see Model.with_body_geometry). Raises InputError naming the file and
-place for a part that cannot be read. The GIL is released while fitting.)doc");
+merge: accept several top-level parts as one body; scale: per axis, in the file's frame; seed: of the optimiser's
+search directions; exact_hull: no fit, the part's own convex hull (every hull vertex a core point); tolerance:
+millimetres the volume may reach outside the part's hull, as `kccd fit --tolerance` (the K = points fit when it
+meets it, else the fewest hull vertices that do); pieces: 1 (whole), 'auto' (up to 8) or N: a concave part whose
+concavity exceeds `concavity` millimetres splits into convex pieces, as `kccd fit --pieces`. progress(fraction)
+is called with the GIL held.
+Returns the record `kccd fit --json` prints (docs/formats.md), as a dict: 'points' float64 (K, 3) in the part's
+frame (metres, 10 significant digits), 'radius' (rounded up: the SSCH still covers the part when written as
+printed), 'volume', 'hull_volume' (m^3), 'volume_ratio', 'baselines' (the one-sphere and principal-axis-capsule
+volumes and ratios; not with exact_hull), 'k', 'hull_vertices', 'evaluations', 'outside' (metres: how far the
+volume may reach outside the part's hull, an upper bound), 'tolerance' (that bound rounded up to a micrometre,
+as a model file records it), 'method' ('fit', 'hull' or 'simplified hull'), 'yaml' (the body's geometry as a
+model file writes it: {points: [...], radius: ...}; see Model.with_body_geometry), then 'exact_hull',
+'triangles', 'primitives' and, with pieces, 'concavity' (metres). A part split into several pieces has 'pieces':
+one such record per piece with its 'name' (FILE/1, FILE/2, ...) and 'concavity', in place of 'points' ... 'yaml'.
+Raises ValueError naming the argument out of range, InputError naming the file and place for a part that cannot
+be read. The GIL is released while fitting.)doc");
 
   m.def(
       "import_urdf",
@@ -105,33 +112,24 @@ place for a part that cannot be read. The GIL is released while fitting.)doc");
          const py::object& pieces, double concavity, double safety_margin,
          const std::map<std::string, std::string>& packages, bool visuals, bool hulls, bool keep_adjacent,
          const py::object& progress) {
-        if (k) checkPoints(*k);
-        if (!(tolerance >= 1e-6 && tolerance <= 1e6))
-          throw py::value_error("tolerance: must be a number of millimetres in 1e-6 ... 1e6");
-        if (!(concavity >= 1e-3 && concavity <= 1e6))
-          throw py::value_error("concavity: must be a number of millimetres in 1e-3 ... 1e6");
-        int max_pieces = 8;
-        if (py::isinstance<py::str>(pieces)) {
-          if (pieces.cast<std::string>() != "auto") throw py::value_error("pieces: 'auto' or a number 1 ... 64");
-        } else {
-          max_pieces = pieces.cast<int>();
-          if (max_pieces < 1 || max_pieces > 64) throw py::value_error("pieces: 'auto' or a number 1 ... 64");
-        }
+        modelling::ImportOptions options;
+        options.srdf = srdf;
+        options.fit = {.method = hulls ? modelling::FitMethod::Hull : k ? modelling::FitMethod::Points : modelling::FitMethod::Tolerance,
+                       .points = k.value_or(8),
+                       .tolerance = tolerance * 1e-3,
+                       .max_pieces = piecesArgument(pieces),
+                       .concavity = concavity * 1e-3};
+        checkRequest(options.fit);
         if (!(safety_margin >= 0.0)) throw py::value_error("safety_margin: must be a number >= 0 (metres)");
+        options.safety_margin = safety_margin;
+        options.packages = packages;
+        options.visuals = visuals;
+        options.keep_adjacent = keep_adjacent;
         ProgressRelay relay{progress, {}};
         std::string text;
         relay.run([&] {
-          text = modelling::importUrdf(path, {.srdf = srdf,
-                                              .points = k ? *k : 8,
-                                              .tolerance = k ? 0.0 : tolerance * 1e-3,
-                                              .max_pieces = max_pieces,
-                                              .concavity = concavity * 1e-3,
-                                              .safety_margin = safety_margin,
-                                              .packages = packages,
-                                              .visuals = visuals,
-                                              .hulls = hulls,
-                                              .keep_adjacent = keep_adjacent,
-                                              .progress = [&](double f) { relay(f); }});
+          options.progress = [&](double f) { relay(f); };
+          text = modelling::importUrdf(path, options);
         });
         return text;
       },

@@ -245,8 +245,14 @@ naming the file, topic and place.)doc");
       "synthesize_recording",
       [](const std::string& model, const std::string& output, const std::string& camera, double seconds, double fps,
          double log_rate, double time_offset, std::uint64_t seed, const std::string& codec, bool collision, bool replace,
-         const py::object& progress) {
+         const std::optional<int>& width, const std::optional<int>& height, const std::string& appearance,
+         const std::optional<double>& visible_scale, double blur, double noise, const py::object& progress) {
         overlay::SynthOptions o;
+        o.width = width, o.height = height, o.visible_scale = visible_scale, o.blur = blur, o.noise = noise;
+        if (appearance == "auto") o.appearance = overlay::SynthAppearance::Auto;
+        else if (appearance == "volumes") o.appearance = overlay::SynthAppearance::Volumes;
+        else if (appearance == "visuals") o.appearance = overlay::SynthAppearance::Visuals;
+        else throw py::value_error("appearance: 'auto', 'volumes' or 'visuals', got '" + appearance + "'");
         o.model = model;
         o.output = output;
         o.camera = camera;
@@ -282,10 +288,15 @@ naming the file, topic and place.)doc");
       },
       py::arg("model"), py::arg("output"), py::kw_only(), py::arg("camera") = "", py::arg("seconds") = 5.0,
       py::arg("fps") = 25.0, py::arg("log_rate") = 125.0, py::arg("time_offset") = 0.137, py::arg("seed") = 1,
-      py::arg("codec") = "ffv1", py::arg("collision") = true, py::arg("replace") = false, py::arg("progress") = py::none(),
+      py::arg("codec") = "ffv1", py::arg("collision") = true, py::arg("replace") = false, py::arg("width") = py::none(),
+      py::arg("height") = py::none(), py::arg("appearance") = "auto", py::arg("visible_scale") = py::none(), py::arg("blur") = 0.7,
+      py::arg("noise") = 2.5, py::arg("progress") = py::none(),
       R"doc(A synthetic recording with ground truth, as `kccd synth`: in the new folder `output`, the video, the state
 log states.csv, the true camera camera_true.yaml, tags, masks and synth.json (the folder appears only when
-complete). model: a model file. progress(fraction) is called after each frame with the GIL held. Returns
+complete). model: a model file. Every option of `kccd synth` under its own name: width and height (the default
+camera's image size, not with camera), appearance ('auto', 'volumes' or 'visuals'), visible_scale (the volumes'
+drawn radius fraction), blur and noise (sigmas). An option out of range raises InputError naming it ("fps: must be
+1 ... 240"). progress(fraction) is called after each frame with the GIL held. Returns
 a dict with the files' paths and the truth: per-frame 'min_distance' (metres), 'colliding_frames',
 'near_frames', 'collision_intervals' ([first, last] frames).)doc");
 }

@@ -214,10 +214,7 @@ void BM_PairLooseness(benchmark::State& state, const char* urdf) {
   const int k = static_cast<int>(state.range(0));
   auto load = [&](bool hulls) {
     km::ImportOptions o;
-    o.points = k;
-    o.tolerance = 0.0;  // K points per link, whole
-    o.max_pieces = 1;
-    o.hulls = hulls;
+    o.fit = {.method = hulls ? km::FitMethod::Hull : km::FitMethod::Points, .points = k, .max_pieces = 1};  // K points per link, whole
     o.visuals = false;
     o.packages["herb_description"] = std::filesystem::path(path).parent_path().string();
     kccd::Model m = kccd::parseModel(km::importUrdf(path, o), path);
@@ -312,10 +309,10 @@ const kccd::Model& importedModel(const std::string& robot, int mode) {
     km::ImportOptions o;
     o.visuals = false;
     o.packages = r.packages;
-    if (const char* t = std::getenv("KCCD_BENCH_TOLERANCE_MM")) o.tolerance = std::atof(t) * 1e-3;  // other defaults
-    if (const char* c = std::getenv("KCCD_BENCH_CONCAVITY_MM")) o.concavity = std::atof(c) * 1e-3;
-    if (mode == kEight) o.tolerance = 0.0, o.max_pieces = 1;
-    if (mode == kHulls) o.hulls = true, o.max_pieces = 1;
+    if (const char* t = std::getenv("KCCD_BENCH_TOLERANCE_MM")) o.fit.tolerance = std::atof(t) * 1e-3;  // other defaults
+    if (const char* c = std::getenv("KCCD_BENCH_CONCAVITY_MM")) o.fit.concavity = std::atof(c) * 1e-3;
+    if (mode == kEight) o.fit.method = km::FitMethod::Points, o.fit.max_pieces = 1;
+    if (mode == kHulls) o.fit.method = km::FitMethod::Hull, o.fit.max_pieces = 1;
     const std::string text = km::importUrdf(r.urdf, o);
     slot = std::make_unique<kccd::Model>(kccd::parseModel(text, r.urdf));
     if (const char* budget = std::getenv("KCCD_BENCH_BUDGET")) slot->point_budget = std::atoi(budget);

@@ -5,6 +5,7 @@ distance by enumerating faces, point queries at the witnesses), and bad input na
 import itertools
 import json
 import pathlib
+import re
 import subprocess
 
 import numpy as np
@@ -133,6 +134,84 @@ def test_import_urdf_to_a_tolerance_equals_cli(cli) -> None:
     assert bodies and all(0 <= float(b["tolerance"]) <= 1e-3 for b in bodies)  # YAML 1.1 reads 1e-06 as text
     with pytest.raises(ValueError, match="pieces"):
         kccd.import_urdf(str(URDF / "two_link.urdf"), pieces="many")
+
+
+# Each option of `kccd fit` and `kccd import` that shapes the fit has its argument in kccd.fit and
+# kccd.import_urdf, under the name the library's checks use, with the same default; the rest shape
+# the command line's own output. A new option on either side fails here until the other has it.
+FIT_OPTIONS = {"--points": "points", "--part": "part", "--merge": "merge", "--scale": "scale", "--evaluations": "max_evaluations",
+               "--seed": "seed", "--hull": "exact_hull", "--tolerance": "tolerance", "--pieces": "pieces",
+               "--concavity": "concavity"}
+FIT_CLI_ONLY = {"--help", "--name", "--frame", "--model", "--body", "--json", "--quiet"}
+IMPORT_OPTIONS = {"--srdf": "srdf", "--points": "points", "--tolerance": "tolerance", "--pieces": "pieces",
+                  "--concavity": "concavity", "--margin": "safety_margin", "--package-path": "packages",
+                  "--no-visuals": "visuals", "--hulls": "hulls", "--keep-adjacent": "keep_adjacent"}
+IMPORT_CLI_ONLY = {"--help", "--output", "--quiet", "--pairs", "--max-boxes"}  # kccd.prove_pairs proves pairs in Python
+
+
+def cli_options(cli: pathlib.Path, command: str) -> dict[str, str | None]:
+    """The long options of `kccd COMMAND --help` and their shown defaults (None: none shown)."""
+    text = subprocess.run([str(cli), command, "--help"], check=True, capture_output=True, text=True).stdout
+    out: dict[str, str | None] = {}
+    for line in text.splitlines():
+        m = re.match(r"^\s+(?:-\w,)?(--[\w-]+)(?:,-\w)?(?:\s+\S+?(?:=(\S+))?)?(?:\s|$)", line)
+        if m:
+            out[m.group(1)] = m.group(2)
+    return out
+
+
+def python_arguments(function) -> dict[str, str]:
+    """The arguments of a bound function and their defaults, from its signature line."""
+    signature = function.__doc__.splitlines()[0]
+    out = {}
+    for name, default in re.findall(r"(\w+): [^,=()]+?(?: = ([^,()]+|\[[^]]*\]))?(?=[,)])", signature):
+        out[name] = default.strip() if default else ""
+    return out
+
+
+@pytest.mark.parametrize("command,function,options,cli_only", [
+    ("fit", kccd.fit, FIT_OPTIONS, FIT_CLI_ONLY), ("import", kccd.import_urdf, IMPORT_OPTIONS, IMPORT_CLI_ONLY)])
+def test_every_fit_option_has_its_python_argument(cli, command, function, options, cli_only) -> None:
+    shown = cli_options(cli, command)
+    assert set(shown) == set(options) | cli_only, f"kccd {command} --help: {sorted(shown)}"
+    args = python_arguments(function)
+    assert set(options.values()) <= set(args), f"{function.__name__}{sorted(args)}"
+    for flag, name in options.items():
+        default = shown[flag]
+        if default is None or name in ("pieces", "visuals"):
+            continue
+        assert float(default) == float(args[name].strip("[]").split(",")[0]), f"{flag}={default} but {name}={args[name]}"
+
+
+def test_fit_request_errors_name_each_front_ends_spelling(cli) -> None:
+    gripper = str(DATA / "parts" / "gripper.iv")
+    for args, flag, keyword in [(["-k", "17"], "--points", {"points": 17}),
+                                (["--pieces", "99"], "--pieces", {"pieces": 99}),
+                                (["--pieces", "2", "--concavity", "1e-4"], "--concavity", {"pieces": 2, "concavity": 1e-4})]:
+        run = subprocess.run([str(cli), "fit", gripper, *args], capture_output=True, text=True)
+        assert run.returncode == 2 and run.stderr.count("\n") == 1 and f"{flag}:" in run.stderr, run.stderr
+        name = next(iter(keyword)) if len(keyword) == 1 else "concavity"
+        with pytest.raises(ValueError, match=f"^{name}:"):
+            kccd.fit(gripper, **{"points": 8, **keyword})
+
+
+def test_fit_in_pieces_equals_cli(cli, tmp_path: pathlib.Path) -> None:
+    # An L of two boxes: concave, it splits into two pieces.
+    boxes = []
+    for lo, hi in [((0, 0, 0), (0.3, 0.05, 0.05)), ((0, 0, 0), (0.05, 0.3, 0.05))]:
+        c = np.array(list(itertools.product(*zip(lo, hi))), dtype=float)
+        for a, b, d in [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6), (0, 2, 6),
+                        (0, 6, 4), (1, 5, 7), (1, 7, 3)]:
+            boxes.append(c[[a, b, d]])
+    part = tmp_path / "ell.stl"
+    write_stl(part, np.array(boxes))
+    f = kccd.fit(str(part), 4, pieces="auto", concavity=10, max_evaluations=300)
+    j = json.loads(subprocess.run([str(cli), "fit", str(part), "-k", "4", "--pieces", "auto", "--concavity", "10", "--evaluations", "300",
+                                   "--json"], check=True, capture_output=True, text=True).stdout)
+    assert len(f["pieces"]) == len(j["pieces"]) >= 2 and f["concavity"] == j["concavity"]
+    for a, b in zip(f["pieces"], j["pieces"]):
+        assert a["name"] == b["name"] and a["points"].tolist() == b["points"] and a["radius"] == b["radius"]
+        assert a["yaml"] == b["yaml"]
 
 
 def test_with_body_geometry(arm: kccd.Model) -> None:

@@ -3,6 +3,7 @@ short synthetic recording equal to `kccd overlay`'s report, progress callbacks, 
 
 import json
 import pathlib
+import re
 import subprocess
 
 import numpy as np
@@ -152,3 +153,31 @@ def test_overlay_braking_is_the_commands() -> None:
     assert (b.latency, b.deceleration, b.max_acceleration, b.position_error, b.velocity_error) == (0.01, 5.0, 0, 0, 0)
     b.latency = 1.0
     assert kccd.overlay_braking().latency == 0.01, "each call is a fresh copy"
+
+
+# Every option of `kccd synth` has its argument in kccd.synthesize_recording, under its field's name;
+# an option out of range is named in each front end's spelling.
+SYNTH_OPTIONS = {"--camera": "camera", "--seconds": "seconds", "--fps": "fps", "--width": "width", "--height": "height",
+                 "--seed": "seed", "--codec": "codec", "--log-rate": "log_rate", "--time-offset": "time_offset",
+                 "--visible-scale": "visible_scale", "--appearance": "appearance", "--blur": "blur", "--noise": "noise",
+                 "--no-collision": "collision", "--force": "replace", "--output": "output"}
+
+
+def test_every_synth_option_has_its_python_argument(cli, tmp_path: pathlib.Path) -> None:
+    text = subprocess.run([str(cli), "synth", "--help"], check=True, capture_output=True, text=True).stdout
+    shown = set(re.findall(r"^\s+(?:-\w,)?(--[\w-]+)", text, re.M)) - {"--help", "--quiet"}
+    assert shown == set(SYNTH_OPTIONS), sorted(shown)
+    signature = kccd.synthesize_recording.__doc__.splitlines()[0]
+    for name in SYNTH_OPTIONS.values():
+        assert re.search(rf"\b{name}:", signature), f"synthesize_recording has no {name}"
+    model = str(DATA / "demo_arm.yaml")
+    run = subprocess.run([str(cli), "synth", model, "-o", str(tmp_path / "a"), "--fps", "25", "--log-rate", "25"],
+                         capture_output=True, text=True)
+    assert run.returncode == 2 and run.stderr.startswith("kccd: --log-rate: must differ from the frame rate"), run.stderr
+    with pytest.raises(kccd.InputError, match="^log_rate: must differ from the frame rate"):
+        kccd.synthesize_recording(model, str(tmp_path / "b"), fps=25, log_rate=25)
+    with pytest.raises(kccd.InputError, match=r"^blur: must be in \[0, 10\]"):
+        kccd.synthesize_recording(model, str(tmp_path / "b"), blur=11)
+    s = kccd.synthesize_recording(model, str(tmp_path / "c"), seconds=0.2, width=640, height=400, appearance="volumes",
+                                  visible_scale=0.5, noise=0)
+    assert s["width"] == 640 and s["height"] == 400

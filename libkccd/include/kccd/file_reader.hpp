@@ -18,10 +18,11 @@ enum class FileProblem : std::uint8_t {
   CannotRead,  ///< reading failed part way
 };
 
-/// A file that cannot be read, with why as data. Its message, "path: file: problem" (location:
-/// the path, field "file"), reads "cannot open the <label> (no such file)", "not a regular file",
-/// "larger than N KiB" or "cannot read the <label> (reason)"; readers with their own words build
-/// them from the data.
+/// A file that cannot be read, with why as data. Its message, "path: problem" (location: the path,
+/// made printable), is every reader's wording: "cannot open the <label> (no such file)" (or the
+/// system's reason), "a folder, not a <label>", "not a regular file (a device, FIFO or socket)",
+/// "larger than N MiB" (or KiB) or "cannot read the <label> (reason)". A reader throws its own
+/// error type from location() and problem().
 class FileError : public InputError {
  public:
   /// The error of reading `path`, a `label` ("camera file"), that failed with `kind`.

@@ -23,7 +23,9 @@ struct InputLocation {
 };
 
 /// Input that cannot be used. The message is one line: "file[:line[:column]]: field: problem";
-/// the location and the problem are kept as data beside it.
+/// the location and the problem are kept as data beside it. A request's field out of range (an
+/// option, an argument) has a field and no source: a front end says the field in its own spelling
+/// (`--fps` on the command line, `fps=` in Python).
 class InputError : public std::runtime_error {
  public:
   /// An error whose message is `message` as given: the location is unknown, the problem is the message.

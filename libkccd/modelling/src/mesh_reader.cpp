@@ -63,7 +63,7 @@ std::string assimpMessage(const char* text, const std::string& path) {
     if (c == '\n' || c == '\r' || c == '\t') c = ' ';
   while (!s.empty() && s.back() == ' ') s.pop_back();
   if (s.size() > 200) s = s.substr(0, 200) + "...";
-  return printable(s.empty() ? "unknown format or empty file" : s);
+  return printable(s.empty() ? "unknown format or empty file" : s, 300);
 }
 
 bool hasTriangles(const aiScene& scene, const aiNode& node) {

@@ -106,7 +106,7 @@ struct Messages {
     while (!s.empty() && s.back() == ' ') s.pop_back();
     if (s.find("non-valid floating point number") != std::string::npos)
       s = "a number is out of single-precision range";  // Coin would read it as 0
-    self->first = printable(s);
+    self->first = printable(s, 300);
   }
   void clear() {
     first.clear();
@@ -679,47 +679,16 @@ Part readScene(const std::string& data, const std::string& path, const ReadOptio
 
 }  // namespace
 
-std::string printable(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char ch : text) {
-    const auto u = static_cast<unsigned char>(ch);
-    if (u < 0x20 || u == 0x7f) {
-      char buffer[5];
-      std::snprintf(buffer, sizeof buffer, "\\x%02x", u);
-      out += buffer;
-    } else {
-      out += ch;
-    }
-  }
-  return out;
-}
-
 std::string readInputFile(const std::string& path, std::uintmax_t max_bytes) {
   try {
     return readRegularFile(path, max_bytes);
   } catch (const FileError& e) {
-    const InputLocation where{printable(path), 0, 0, {}};
-    switch (e.kind()) {
-      case FileProblem::Missing:
-      case FileProblem::CannotOpen:
-        throw InputError(where, "cannot open the file (" + std::string(std::strerror(e.systemError())) + ")");
-      case FileProblem::Directory:
-        throw InputError(where, "is a directory, not a file");
-      case FileProblem::NotRegular:
-        throw InputError(where, "not a regular file (a device, FIFO or socket)");
-      case FileProblem::TooLarge:
-        throw InputError(where, std::to_string(e.size()) + " bytes is more than the limit of " +
-                                    std::to_string(max_bytes >> 20) + " MiB");
-      case FileProblem::CannotRead:
-        break;
-    }
-    throw InputError(where, "cannot read the file (" + std::string(std::strerror(e.systemError())) + ")");
+    throw InputError(e.location(), e.problem());
   }
 }
 
 Part readPart(const std::string& path, const ReadOptions& options) {
-  const std::string name = printable(path);
+  const std::string name = printable(path, 1024);
   if (!options.scale.allFinite() || (options.scale.array() == 0.0).any())
     throw PartError(name + ": scale " + formatNumber(options.scale.x(), 9) + " " + formatNumber(options.scale.y(), 9) +
                     " " + formatNumber(options.scale.z(), 9) + ": factors must be finite and non-zero");

@@ -99,25 +99,6 @@ Part linkPart(const std::string& urdf_path, const urdf::Link& link, const Import
   return part;
 }
 
-// A YAML double-quoted string.
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (const char ch : text) {
-    const auto u = static_cast<unsigned char>(ch);
-    if (ch == '"' || ch == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (u < 0x20 || u == 0x7f) {
-      char buffer[5];
-      std::snprintf(buffer, sizeof buffer, "\\x%02x", u);
-      out += buffer;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
-
 // The link's <visual> elements as `visuals:` entries in `frame` (mesh files resolved like the
 // collision meshes, written as absolute paths; the material's colour when it has one).
 void writeVisuals(std::ostringstream& out, const std::string& urdf_path, const urdf::Link& link, const std::string& frame,
@@ -152,9 +133,9 @@ void writeVisuals(std::ostringstream& out, const std::string& urdf_path, const u
         }
         std::error_code ec;
         if (!std::filesystem::is_regular_file(file, ec))
-          throw UrdfError(urdf_path + ": link " + link.name + ": visual mesh " + printable(mesh.filename) + ": " +
-                          printable(file) + " is not a file (or import with --no-visuals)");
-        out << "    mesh: " << quoted(std::filesystem::absolute(file).lexically_normal().string()) << "\n";
+          throw UrdfError(urdf_path + ": link " + link.name + ": visual mesh " + printable(mesh.filename, 1024) + ": " +
+                          printable(file, 1024) + " is not a file (or import with --no-visuals)");
+        out << "    mesh: " << yamlQuoted(std::filesystem::absolute(file).lexically_normal().string()) << "\n";
         if (mesh.scale.x != 1 || mesh.scale.y != 1 || mesh.scale.z != 1)
           out << "    scale: " << vec(mesh.scale.x, mesh.scale.y, mesh.scale.z) << "\n";
         break;
@@ -183,7 +164,7 @@ class CaptureLog : public console_bridge::OutputHandler {
  public:
   std::string first;
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR && first.empty()) first = printable(text);
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR && first.empty()) first = printable(text, 300);
   }
 };
 
@@ -473,44 +454,26 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     if (link->collision_array.empty()) continue;
     const Part part = linkPart(path, *link, options);
     if (part.empty()) continue;
-    PieceSplit split;
-    if (options.max_pieces > 1) {
-      split = splitConcave(part, {.max_pieces = options.max_pieces, .concavity = options.concavity});
-    } else {
-      split.pieces.push_back(part);
-      split.concavity.push_back(0.0);
-    }
-    const int count = static_cast<int>(split.pieces.size());
+    const FittedPart f = fitPart(part, options.fit, [&](double d) {
+      if (options.progress) options.progress((fitted + d) / std::max(1, with_geometry));
+    });
+    const int count = static_cast<int>(f.pieces.size());
     for (int k = 0; k < count; ++k) {
-      const Part& piece = split.pieces[k];
-      FitOptions fo;
-      fo.points = options.points;
-      if (options.progress)
-        fo.progress = [&](double f) { options.progress((fitted + (k + f) / count) / std::max(1, with_geometry)); };
-      const std::string name = count > 1 ? link->name + "/" + std::to_string(k + 1) : link->name;
-      bodies << "  - name: " << name << "\n";
-      if (count > 1)
-        bodies << "    link: " << link->name << "   # piece " << k + 1 << " of " << count << ", concavity about "
-               << yamlNumber(std::round(split.concavity[k] * 1e4) / 1e4) << " m (the link's: "
-               << yamlNumber(std::round(split.whole_concavity * 1e4) / 1e4) << " m)\n";
-      bodies << "    frame: " << frame_of.at(link->name) << "\n";
-      FitResult r;
-      std::string how;
-      if (options.hulls) {  // the hull's vertices (balls by circumscribed polytopes), no fit
-        r = exactHull(piece);
-        how = "the convex hull of the collision geometry";
-      } else if (options.tolerance > 0.0) {
-        r = fitToTolerance(piece, options.tolerance, fo);
-        how = std::string(r.method) + ", " + std::to_string(r.points.size()) + " points";
-      } else {
-        r = fit(piece, fo);
-        how = "K = " + std::to_string(r.points.size()) + " fit";
-      }
-      bodies << "    points: " << flowPoints(r.points) << "\n"
-             << "    radius: " << yamlNumber(r.radius, true) << "   # " << how << ": volume " << yamlNumber(r.volume)
-             << " m^3, hull " << yamlNumber(r.hull_volume) << " m^3\n"
-             << "    tolerance: " << yamlNumber(std::ceil(r.outside * 1e6) / 1e6)
-             << "   # at most this far outside the link's convex hull (m)\n";
+      const FitResult& r = f.pieces[static_cast<std::size_t>(k)].fit;
+      const std::string name = pieceName(link->name, k, count);
+      const std::string how = options.fit.method == FitMethod::Hull        ? "the convex hull of the collision geometry"
+                              : options.fit.method == FitMethod::Tolerance ? std::string(r.method) + ", " + std::to_string(r.points.size()) + " points"
+                                                                           : "K = " + std::to_string(r.points.size()) + " fit";
+      bodies << bodyYaml({.name = name,
+                          .link = count > 1 ? link->name : std::string(),
+                          .frame = frame_of.at(link->name),
+                          .fit = &r,
+                          .link_comment = "piece " + std::to_string(k + 1) + " of " + std::to_string(count) + ", concavity about " +
+                                          yamlNumber(std::round(f.pieces[static_cast<std::size_t>(k)].concavity * 1e4) / 1e4) +
+                                          " m (the link's: " + yamlNumber(std::round(f.whole_concavity * 1e4) / 1e4) + " m)",
+                          .radius_comment = how + ": volume " + yamlNumber(r.volume) + " m^3, hull " + yamlNumber(r.hull_volume) + " m^3",
+                          .tolerance_comment = "at most this far outside the link's convex hull (m)"},
+                         "  ");
       body_names.insert(name);
       pieces_of[link->name].push_back(name);
       most_points = std::max(most_points, r.points.size());
@@ -528,12 +491,12 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     out << "# Imported from " << std::filesystem::path(path).filename().string()
         << (options.srdf.empty() ? "" : " and " + std::filesystem::path(options.srdf).filename().string())
         << " by kccd import ("
-        << (options.hulls              ? std::string("convex hulls, no fit")
-            : options.tolerance > 0.0 ? "each link within " + yamlNumber(options.tolerance * 1e3) + " mm of its hull"
-                                      : std::to_string(options.points) + " core points per link")
-        << (options.max_pieces > 1
-                ? ", concave links in up to " + std::to_string(options.max_pieces) + " pieces (concavity above " +
-                      yamlNumber(options.concavity * 1e3) + " mm)"
+        << (options.fit.method == FitMethod::Hull        ? std::string("convex hulls, no fit")
+            : options.fit.method == FitMethod::Tolerance ? "each link within " + yamlNumber(options.fit.tolerance * 1e3) + " mm of its hull"
+                                                         : std::to_string(options.fit.points) + " core points per link")
+        << (options.fit.max_pieces > 1
+                ? ", concave links in up to " + std::to_string(options.fit.max_pieces) + " pieces (concavity above " +
+                      yamlNumber(options.fit.concavity * 1e3) + " mm)"
                 : std::string())
         << ")\n"
         << "kccd: 1\n"

@@ -1,6 +1,7 @@
 #include "kccd/modelling/yaml_edit.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <vector>
 #include <stdexcept>
@@ -112,20 +113,6 @@ std::string replaceValue(const std::string& t, const Found& f, const std::string
   return t.substr(0, colon + 1) + " " + text + t.substr(end);
 }
 
-// A name as a YAML scalar: bare when safe, else double-quoted with '"' and '\\' escaped.
-std::string quoted(const std::string& name) {
-  bool bare = !name.empty();
-  for (char c : name)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.' && c != '/') bare = false;
-  if (bare) return name;
-  std::string out = "\"";
-  for (char c : name) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
 void check(const std::string& text, const std::string& source) {
   try {
     (void)parseModel(text, source + " (edited)");
@@ -135,6 +122,28 @@ void check(const std::string& text, const std::string& source) {
 }
 
 }  // namespace
+
+std::string yamlQuoted(const std::string& text, bool bare_when_safe) {
+  bool bare = bare_when_safe && !text.empty();
+  for (const char c : text)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.' && c != '/') bare = false;
+  if (bare) return text;
+  std::string out = "\"";
+  for (const char ch : text) {
+    const auto u = static_cast<unsigned char>(ch);
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (u < 0x20 || u == 0x7f) {
+      char buffer[5];
+      std::snprintf(buffer, sizeof buffer, "\\x%02x", u);
+      out += buffer;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
 
 std::string yamlNumber(double value, bool up) {
   const auto print = [](double v) { return formatNumber(v == 0.0 ? 0.0 : v, 10); };  // no "-0"
@@ -157,7 +166,7 @@ std::string flowPairs(const std::vector<IgnoreEntry>& pairs, int indent) {
   std::string s = "[", line;
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     std::string item = "[";
-    item.append(quoted(pairs[i].a)).append(", ").append(quoted(pairs[i].b));
+    item.append(yamlQuoted(pairs[i].a, true)).append(", ").append(yamlQuoted(pairs[i].b, true));
     if (pairs[i].reason != IgnoreReason::User) item.append(", ").append(toString(pairs[i].reason));
     item.append("]");
     if (i > 0) {

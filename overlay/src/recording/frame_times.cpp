@@ -75,20 +75,7 @@ std::vector<double> loadFrameTimes(const std::string& path) {
   try {
     text = readRegularFile(path, kMaxFrameTimesBytes, "frame-times file");
   } catch (const FileError& e) {
-    const InputLocation where{printable(path, 400), 0, 0, {}};
-    switch (e.kind()) {
-      case FileProblem::Missing:
-        throw FrameTimesError(where, "no such file");
-      case FileProblem::Directory:
-      case FileProblem::NotRegular:
-        throw FrameTimesError(where, "not a regular file");
-      case FileProblem::TooLarge:
-        throw FrameTimesError(where, "larger than 1 GiB");
-      case FileProblem::CannotOpen:
-      case FileProblem::CannotRead:
-        break;
-    }
-    throw FrameTimesError(where, "cannot read the file");
+    throw FrameTimesError(e.location(), e.problem());
   }
   return parseFrameTimes(text, path);
 }

@@ -35,6 +35,46 @@
 namespace kccd::overlay {
 namespace {
 
+// FFmpeg's and OpenCV's own log lines silenced while runs are under way (errors are reported once,
+// by the caller; set OPENCV_FFMPEG_LOGLEVEL to see FFmpeg's), the process's settings restored when
+// the last run in it ends. FFmpeg reads videos, OpenCV's image reader sequences.
+class QuietOpenCv {
+ public:
+  QuietOpenCv() {
+    const std::lock_guard lock(mu());
+    if (users()++ > 0) return;
+    level() = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+    set_env() = std::getenv("OPENCV_FFMPEG_LOGLEVEL") == nullptr;
+    if (set_env()) setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
+  }
+  ~QuietOpenCv() {
+    const std::lock_guard lock(mu());
+    if (--users() > 0) return;
+    cv::utils::logging::setLogLevel(level());
+    if (set_env()) unsetenv("OPENCV_FFMPEG_LOGLEVEL");
+  }
+  QuietOpenCv(const QuietOpenCv&) = delete;
+  QuietOpenCv& operator=(const QuietOpenCv&) = delete;
+
+ private:
+  static std::mutex& mu() {
+    static std::mutex m;
+    return m;
+  }
+  static int& users() {
+    static int n = 0;
+    return n;
+  }
+  static cv::utils::logging::LogLevel& level() {
+    static cv::utils::logging::LogLevel l = cv::utils::logging::LOG_LEVEL_INFO;
+    return l;
+  }
+  static bool& set_env() {
+    static bool b = false;
+    return b;
+  }
+};
+
 struct FrameJob {
   std::size_t index = 0;
   cv::Mat bgr;
@@ -129,10 +169,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   settings.plain = opt.plain;
   if (opt.swept) settings.braking.assign(static_cast<std::size_t>(model.stateSize()), opt.braking);
 
-  // Errors are reported once, by the caller: FFmpeg's and OpenCV's own log lines are silenced (set
-  // OPENCV_FFMPEG_LOGLEVEL to see FFmpeg's). FFmpeg reads videos, OpenCV's image reader sequences.
-  setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
-  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  const QuietOpenCv quiet;
   // No mask is drawn: its finer pinhole image (and its per-pixel distortion map) is not built. The
   // colour pass's map is built once here for every annotator.
   render::RenderOptions render_options;

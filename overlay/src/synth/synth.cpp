@@ -28,11 +28,13 @@ using Clock = std::chrono::steady_clock;
 
 double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
-// A number option within [lo, hi] (NaN refused), as `kccd synth` checks it.
-void checkRange(double value, double lo, double hi, const char* option) {
+// An error about one of the options' fields (a front end names it in its own spelling).
+SynthError fieldError(const std::string& field, const std::string& problem) { return SynthError(InputLocation{{}, 0, 0, field}, problem); }
+
+// A number option within [lo, hi] (NaN refused).
+void checkRange(double value, double lo, double hi, const char* field) {
   if (!(value >= lo && value <= hi))
-    throw SynthError(std::string(option) + ": must be in [" + messageNumber(lo) + ", " + messageNumber(hi) + "], got " +
-                     messageNumber(value));
+    throw fieldError(field, "must be in [" + messageNumber(lo) + ", " + messageNumber(hi) + "], got " + messageNumber(value));
 }
 
 // Every option that does not need the model's motion, in the order `kccd synth` has always checked
@@ -40,16 +42,16 @@ void checkRange(double value, double lo, double hi, const char* option) {
 void checkOptions(const SynthOptions& o, const Model& m) {
   if (m.bodies.size() > 255) throw SynthError(o.model + ": more than 255 bodies do not fit an 8-bit mask");
   videoFormat(o.codec);
-  if (!(o.fps >= 1 && o.fps <= 240)) throw SynthError("--fps: must be 1 ... 240");
-  checkRange(o.seconds, 0.04, 600, "--seconds");
-  if (std::floor(o.seconds * o.fps) < 1) throw SynthError("--seconds: too short for one frame at --fps");
+  if (!(o.fps >= 1 && o.fps <= 240)) throw fieldError("fps", "must be 1 ... 240");
+  checkRange(o.seconds, 0.04, 600, "seconds");
+  if (std::floor(o.seconds * o.fps) < 1) throw fieldError("seconds", "too short for one frame at the frame rate");
   if (!(o.log_rate > 0) || std::abs(o.log_rate - o.fps) < 1e-9)
-    throw SynthError("--log-rate: must differ from --fps (a real log runs on its own clock)");
-  checkRange(o.log_rate, 1, 10000, "--log-rate");
-  checkRange(o.time_offset, 0, 10, "--time-offset");
-  checkRange(o.blur, 0, 10, "--blur");
-  checkRange(o.noise, 0, 50, "--noise");
-  if (o.visible_scale) checkRange(*o.visible_scale, 0.1, 0.95, "--visible-scale");
+    throw fieldError("log_rate", "must differ from the frame rate (a real log runs on its own clock)");
+  checkRange(o.log_rate, 1, 10000, "log_rate");
+  checkRange(o.time_offset, 0, 10, "time_offset");
+  checkRange(o.blur, 0, 10, "blur");
+  checkRange(o.noise, 0, 50, "noise");
+  if (o.visible_scale) checkRange(*o.visible_scale, 0.1, 0.95, "visible_scale");
   const fs::path out = fs::path(o.output).lexically_normal();
   if (out.empty() || out.filename().empty() || out.filename() == "." || out.filename() == "..")
     throw SynthError("-o " + o.output + ": give a folder name");
@@ -65,10 +67,10 @@ void checkOptions(const SynthOptions& o, const Model& m) {
 std::vector<render::LoadedVisual> appearanceOf(const SynthOptions& o, const Model& m) {
   const bool use_visuals =
       o.appearance == SynthAppearance::Visuals || (o.appearance == SynthAppearance::Auto && !m.visuals.empty());
-  if (use_visuals && m.visuals.empty()) throw SynthError("--appearance visuals: " + o.model + " has no visuals:");
+  if (use_visuals && m.visuals.empty()) throw fieldError("appearance", "visuals: " + o.model + " has no visuals:");
   if (use_visuals && m.visuals.size() > 255)
     throw SynthError(o.model + ": " + std::to_string(m.visuals.size()) + " visuals: at most 255 can be drawn");
-  if (use_visuals && o.visible_scale) throw SynthError("--visible-scale: applies to --appearance volumes only");
+  if (use_visuals && o.visible_scale) throw fieldError("visible_scale", "applies to the appearance volumes only");
   return use_visuals ? render::loadVisuals(m) : std::vector<render::LoadedVisual>{};
 }
 
@@ -87,10 +89,10 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
   const int height = o.height.value_or(SynthOptions::kDefaultHeight);
   if (!o.camera.empty()) {
     if (o.width || o.height)
-      throw SynthError("--width/--height shape the default camera; the camera file " + o.camera + " fixes the size");
+      throw fieldError(o.width ? "width" : "height", "shapes the default camera; the camera file " + o.camera + " fixes the size");
     given = calib::loadCamera(o.camera);
   } else if (width < 64 || height < 64 || width > 4096 || height > 4096) {
-    throw SynthError("--width/--height: must be 64 ... 4096 pixels");
+    throw fieldError(width < 64 || width > 4096 ? "width" : "height", "must be 64 ... 4096 pixels");
   }
 
   const int frames = static_cast<int>(std::floor(o.seconds * o.fps + 1e-9));
@@ -134,7 +136,7 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
   cv::VideoWriter video;
   video.open((dir / format.file).string(), cv::CAP_FFMPEG, format.fourcc, o.fps,
              cv::Size(scene.camera.width, scene.camera.height), true);
-  if (!video.isOpened()) throw SynthError("--codec " + o.codec + ": OpenCV cannot write this video here");
+  if (!video.isOpened()) throw fieldError("codec", o.codec + ": OpenCV cannot write this video here");
 
   SynthRun run;
   run.video_file = format.file;

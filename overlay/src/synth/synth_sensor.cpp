@@ -32,7 +32,7 @@ VideoFormat videoFormat(const std::string& codec) {
   if (codec == "ffv1") return {"video.mkv", cv::VideoWriter::fourcc('F', 'F', 'V', '1')};
   if (codec == "mjpg") return {"video.avi", cv::VideoWriter::fourcc('M', 'J', 'P', 'G')};
   if (codec == "mp4v") return {"video.mp4", cv::VideoWriter::fourcc('m', 'p', '4', 'v')};
-  throw SynthError("--codec: expected ffv1, mjpg or mp4v, got '" + codec + "'");
+  throw SynthError(InputLocation{{}, 0, 0, "codec"}, "expected ffv1, mjpg or mp4v, got '" + codec + "'");
 }
 
 cv::Scalar bodyColour(const Model& m, std::size_t i) {

@@ -84,9 +84,6 @@ inline constexpr int kMaxNesting = 256;                                  ///< br
 /// at most `max_bytes`. Throws InputError naming the file.
 std::string readInputFile(const std::string& path, std::uintmax_t max_bytes = kMaxInputBytes);
 
-/// `text` fit for a one-line message: control bytes and DEL written as \xNN.
-std::string printable(std::string_view text);
-
 /// Vertices of a polyhedron that contains the unit ball (its faces touch the ball from outside).
 const std::vector<Vec3>& circumscribedUnitSphere();
 

@@ -40,6 +40,9 @@ std::string withIgnoreList(const std::string& text, const std::string& source,
 /// A number as written into model files: 10 significant digits, rounded up when `up` (for radii,
 /// which must not shrink).
 std::string yamlNumber(double value, bool up = false);
+/// `text` as a YAML scalar: double-quoted, with '"' and '\\' escaped and control bytes as \xNN; bare
+/// when `bare_when_safe` and it holds only letters, digits and _ - . /.
+std::string yamlQuoted(const std::string& text, bool bare_when_safe = false);
 /// Points as a YAML flow list [[x, y, z], ...] with yamlNumber digits.
 std::string flowPoints(std::span<const Vec3> points);
 

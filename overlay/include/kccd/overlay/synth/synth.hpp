@@ -21,8 +21,10 @@
 namespace kccd::overlay {
 
 /// Input that cannot make a recording: a bad option, a model that cannot collide, no trajectory
-/// found, a camera that sees too few tags, an output folder that exists. One line; options are
-/// named as `kccd synth` spells them ("--fps: ...", "-o DIR: ...").
+/// found, a camera that sees too few tags, an output folder that exists. One line. An option out
+/// of range is named by its SynthOptions field (location().field, no source: "fps: must be 1 ...
+/// 240"), for a front end to say in its own spelling; the output folder as `kccd synth` says it
+/// ("-o DIR: ...").
 class SynthError : public InputError {
  public:
   using InputError::InputError;
