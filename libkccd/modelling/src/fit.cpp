@@ -331,7 +331,18 @@ FitResult exactHull(const Part& part) {
   return result;
 }
 
-FitResult fit(const Part& part, const FitOptions& options) {
+namespace {
+
+// fit() with the part's outside hull `h` (outsideHull) given: fitToTolerance has built it already.
+FitResult fitWithHull(const Part& part, const FitOptions& options, const OutsideHull& h);
+
+}  // namespace
+
+FitResult fit(const Part& part, const FitOptions& options) { return fitWithHull(part, options, outsideHull(part)); }
+
+namespace {
+
+FitResult fitWithHull(const Part& part, const FitOptions& options, const OutsideHull& h) {
   if (options.points < 1 || options.points > kMaxCorePoints)
     throw std::invalid_argument("the number of core points must be 1 ... " + std::to_string(kMaxCorePoints) +
                                 " (got " + std::to_string(options.points) + ")");
@@ -474,10 +485,12 @@ FitResult fit(const Part& part, const FitOptions& options) {
     for (int i = 0; i < 3; ++i) p(i) = std::stod(yamlNumber(p(i)));
   result.radius = coverRadius(result.points, cover);
   result.volume = sschVolume(result.points, result.radius);
-  result.outside = outsideDistance(result.points, result.radius, part);
+  result.outside = outsideOf(result.points, result.radius, h);
   if (options.progress) options.progress(1.0);
   return result;
 }
+
+}  // namespace
 
 double outsideDistance(std::span<const Vec3> core, double radius, const Part& part) {
   return outsideOf(core, radius, outsideHull(part));
@@ -616,7 +629,7 @@ FitResult fitToTolerance(const Part& part, double tolerance, const FitOptions& o
     if (options.progress) options.progress(1.0);
     return hull;
   }
-  FitResult fitted = fit(part, options);  // sets fitted.outside
+  FitResult fitted = fitWithHull(part, options, h);  // sets fitted.outside
   if (fitted.outside <= tolerance) return fitted;
   hull.evaluations = fitted.evaluations;
   hull.sphere_volume = fitted.sphere_volume;
