@@ -9,6 +9,43 @@
 #include "kccd/state_log.hpp"
 
 namespace kccd::cli {
+namespace {
+
+// About `a.recording_samples` frames spread over the recording (`bag`, else --video) with their
+// states in `log` (for masks made from the recording); those without a state left out.
+std::vector<overlay::RecordingSample> recordingSamples(const FrameOptions& a, const overlay::BagRecording* bag, const StateLog* log,
+                                                       const Model& model, double max_gap, const std::string& log_name) {
+  std::vector<overlay::RecordingSample> out;
+  if (a.video.empty() && !bag) throw UsageError("--masks auto: makes the masks from a recording: give --video (with --states) or --bag");
+  if (!log) throw UsageError("--masks auto: needs each frame's state: give --states LOG.csv (or --bag with joint states)");
+  std::vector<int> indices;
+  std::vector<cv::Mat> pictures;
+  std::vector<double> sample_times;
+  if (bag) {
+    const std::size_t frames = bag->frame_times.size();
+    for (std::size_t k = 0; k < std::min(frames, a.recording_samples); ++k)
+      indices.push_back(static_cast<int>(k * frames / std::min(frames, a.recording_samples)));
+    pictures = overlay::framesAt(*bag, std::vector<long>(indices.begin(), indices.end()), "--masks auto");
+    for (const int i : indices) sample_times.push_back(bag->frame_times[static_cast<std::size_t>(i)]);
+  } else {
+    overlay::RecordingFrames r = overlay::sampleRecordingFrames(a.video, a.recording_samples, indices, "--video " + a.video);
+    if (!(r.fps > 0.0)) throw UsageError("--masks auto: --video " + a.video + " declares no frame rate, so its frames have no times");
+    pictures = std::move(r.frames);
+    // The frames' --time, when given, says where the log's clock stands against frame / fps.
+    const double offset = a.times.empty() ? 0.0 : a.times.front() - a.video_frames.front() / r.fps;
+    for (const int i : indices) sample_times.push_back(i / r.fps + offset);
+  }
+  for (std::size_t k = 0; k < pictures.size(); ++k) {
+    std::vector<double> state(static_cast<std::size_t>(model.stateSize()), 0.0);
+    if (stateAt(*log, sample_times[k], max_gap, state) != StateMatch::None) out.push_back({pictures[k], std::move(state)});
+  }
+  if (out.size() < 8)
+    throw UsageError("--masks auto: only " + std::to_string(out.size()) + " of " + std::to_string(pictures.size()) +
+                     " frames spread over the recording have a state in " + log_name + " (8 or more needed)");
+  return out;
+}
+
+}  // namespace
 
 GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, const std::optional<Model>& model, bool refined) {
   std::vector<std::string> picture_names = a.images;
@@ -79,34 +116,7 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
   const std::string log_name = bag ? "--bag " + a.bag : a.state_log;
 
   GivenFrames out;
-  if (a.recording_samples > 0) {
-    if (a.video.empty() && !bag) throw UsageError("--masks auto: makes the masks from a recording: give --video (with --states) or --bag");
-    if (!log) throw UsageError("--masks auto: needs each frame's state: give --states LOG.csv (or --bag with joint states)");
-    std::vector<int> indices;
-    std::vector<cv::Mat> pictures;
-    std::vector<double> sample_times;
-    if (bag) {
-      const std::size_t frames = bag->frame_times.size();
-      for (std::size_t k = 0; k < std::min(frames, a.recording_samples); ++k)
-        indices.push_back(static_cast<int>(k * frames / std::min(frames, a.recording_samples)));
-      pictures = overlay::framesAt(*bag, std::vector<long>(indices.begin(), indices.end()), "--masks auto");
-      for (const int i : indices) sample_times.push_back(bag->frame_times[static_cast<std::size_t>(i)]);
-    } else {
-      overlay::RecordingFrames r = overlay::sampleRecordingFrames(a.video, a.recording_samples, indices, "--video " + a.video);
-      if (!(r.fps > 0.0)) throw UsageError("--masks auto: --video " + a.video + " declares no frame rate, so its frames have no times");
-      pictures = std::move(r.frames);
-      // The frames' --time, when given, says where the log's clock stands against frame / fps.
-      const double offset = a.times.empty() ? 0.0 : a.times.front() - a.video_frames.front() / r.fps;
-      for (const int i : indices) sample_times.push_back(i / r.fps + offset);
-    }
-    for (std::size_t k = 0; k < pictures.size(); ++k) {
-      std::vector<double> state(static_cast<std::size_t>(model->stateSize()), 0.0);
-      if (stateAt(*log, sample_times[k], max_gap, state) != StateMatch::None) out.recording.push_back({pictures[k], std::move(state)});
-    }
-    if (out.recording.size() < 8)
-      throw UsageError("--masks auto: only " + std::to_string(out.recording.size()) + " of " + std::to_string(pictures.size()) +
-                       " frames spread over the recording have a state in " + log_name + " (8 or more needed)");
-  }
+  if (a.recording_samples > 0) out.recording = recordingSamples(a, bag ? &*bag : nullptr, log ? &*log : nullptr, *model, max_gap, log_name);
   out.names = std::move(picture_names);
   out.pictures = std::move(video_pictures);
   out.count = n;

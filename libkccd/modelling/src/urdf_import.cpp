@@ -343,6 +343,54 @@ std::vector<IgnoreEntry> readSrdf(const tinyxml2::XMLDocument& doc, const std::s
   return out;
 }
 
+// Each link's collision geometry fitted as requested: the bodies' entries, each link's bodies
+// (the SRDF's pairs name links) and the largest body's point count.
+struct FittedLinks {
+  std::string yaml;
+  std::map<std::string, std::vector<std::string>> pieces_of;  // link -> its bodies
+  std::size_t most_points = 0;
+};
+
+FittedLinks fitLinks(const std::string& path, const std::vector<urdf::LinkConstSharedPtr>& order,
+                     const std::map<std::string, std::string>& frame_of, const ImportOptions& options) {
+  FittedLinks out;
+  std::string bodies;
+  int done = 0, with_geometry = 0;
+  for (const auto& link : order)
+    if (!link->collision_array.empty()) ++with_geometry;
+  for (const auto& link : order) {
+    if (link->collision_array.empty()) continue;
+    const Part part = linkPart(path, *link, options);
+    if (part.empty()) continue;
+    const FittedPart f = fitPart(part, options.fit, [&](double d) {
+      if (options.progress) options.progress((done + d) / std::max(1, with_geometry));
+    });
+    const int count = static_cast<int>(f.pieces.size());
+    for (int k = 0; k < count; ++k) {
+      const FitResult& r = f.pieces[static_cast<std::size_t>(k)].fit;
+      const std::string name = pieceName(link->name, k, count);
+      const std::string how = options.fit.method == FitMethod::Hull        ? "the convex hull of the collision geometry"
+                              : options.fit.method == FitMethod::Tolerance ? std::string(r.method) + ", " + std::to_string(r.points.size()) + " points"
+                                                                           : "K = " + std::to_string(r.points.size()) + " fit";
+      bodies += bodyYaml({.name = name,
+                          .link = count > 1 ? link->name : std::string(),
+                          .frame = frame_of.at(link->name),
+                          .fit = &r,
+                          .link_comment = "piece " + std::to_string(k + 1) + " of " + std::to_string(count) + ", concavity about " +
+                                          yamlNumber(std::round(f.pieces[static_cast<std::size_t>(k)].concavity * 1e4) / 1e4) +
+                                          " m (the link's: " + yamlNumber(std::round(f.whole_concavity * 1e4) / 1e4) + " m)",
+                          .radius_comment = how + ": volume " + yamlNumber(r.volume) + " m^3, hull " + yamlNumber(r.hull_volume) + " m^3",
+                          .tolerance_comment = "at most this far outside the link's convex hull (m)"},
+                         "  ");
+      out.pieces_of[link->name].push_back(name);
+      out.most_points = std::max(out.most_points, r.points.size());
+    }
+    ++done;
+  }
+  out.yaml = std::move(bodies);
+  return out;
+}
+
 }  // namespace
 
 std::string importUrdf(const std::string& path, const ImportOptions& options) {
@@ -371,7 +419,7 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
   }
 
   std::ostringstream joints, bodies;
-  std::set<std::string> link_names, body_names;
+  std::set<std::string> link_names;
   std::set<std::string> urdf_joint_names, joint_names;  // the URDF's; the model's
   for (const auto& [name, joint] : urdf->joints_) urdf_joint_names.insert(name);
   std::map<std::string, std::string> frame_of;  // link -> KCCD frame name
@@ -445,41 +493,10 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
       if (child) queue.push_back(child);
     }
   }
-  std::map<std::string, std::vector<std::string>> pieces_of;  // link -> its bodies (SRDF pairs)
-  int fitted = 0, with_geometry = 0;
-  std::size_t most_points = 0;  // the largest body's core points
-  for (const auto& link : order)
-    if (!link->collision_array.empty()) ++with_geometry;
-  for (const auto& link : order) {
-    if (link->collision_array.empty()) continue;
-    const Part part = linkPart(path, *link, options);
-    if (part.empty()) continue;
-    const FittedPart f = fitPart(part, options.fit, [&](double d) {
-      if (options.progress) options.progress((fitted + d) / std::max(1, with_geometry));
-    });
-    const int count = static_cast<int>(f.pieces.size());
-    for (int k = 0; k < count; ++k) {
-      const FitResult& r = f.pieces[static_cast<std::size_t>(k)].fit;
-      const std::string name = pieceName(link->name, k, count);
-      const std::string how = options.fit.method == FitMethod::Hull        ? "the convex hull of the collision geometry"
-                              : options.fit.method == FitMethod::Tolerance ? std::string(r.method) + ", " + std::to_string(r.points.size()) + " points"
-                                                                           : "K = " + std::to_string(r.points.size()) + " fit";
-      bodies << bodyYaml({.name = name,
-                          .link = count > 1 ? link->name : std::string(),
-                          .frame = frame_of.at(link->name),
-                          .fit = &r,
-                          .link_comment = "piece " + std::to_string(k + 1) + " of " + std::to_string(count) + ", concavity about " +
-                                          yamlNumber(std::round(f.pieces[static_cast<std::size_t>(k)].concavity * 1e4) / 1e4) +
-                                          " m (the link's: " + yamlNumber(std::round(f.whole_concavity * 1e4) / 1e4) + " m)",
-                          .radius_comment = how + ": volume " + yamlNumber(r.volume) + " m^3, hull " + yamlNumber(r.hull_volume) + " m^3",
-                          .tolerance_comment = "at most this far outside the link's convex hull (m)"},
-                         "  ");
-      body_names.insert(name);
-      pieces_of[link->name].push_back(name);
-      most_points = std::max(most_points, r.points.size());
-    }
-    ++fitted;
-  }
+  const FittedLinks fitted = fitLinks(path, order, frame_of, options);
+  const std::map<std::string, std::vector<std::string>>& pieces_of = fitted.pieces_of;
+  const std::size_t most_points = fitted.most_points;
+  bodies << fitted.yaml;
   std::ostringstream visuals;
   if (options.visuals)
     for (const auto& link : order) writeVisuals(visuals, path, *link, frame_of.at(link->name), options);
