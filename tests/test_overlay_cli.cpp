@@ -21,7 +21,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "kccd/calib/camera.hpp"
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/render/composite.hpp"
 #include "support/golden.hpp"
 #include "support/run_program.hpp"

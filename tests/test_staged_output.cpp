@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 #include "support/files.hpp"
 
 namespace fs = std::filesystem;

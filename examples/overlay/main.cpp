@@ -9,7 +9,7 @@
 #include <kccd/calib/camera.hpp>
 #include <kccd/model.hpp>
 #include <kccd/overlay/recording/overlay_recording.hpp>
-#include <kccd/overlay/recording/staged_output.hpp>
+#include <kccd/overlay/common/staged_output.hpp>
 #include <kccd/overlay/recording/video_sink.hpp>
 #include <kccd/state_log.hpp>
 #include <nlohmann/json.hpp>

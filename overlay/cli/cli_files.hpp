@@ -8,7 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "kccd/model.hpp"
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 
 namespace kccd::cli {
 

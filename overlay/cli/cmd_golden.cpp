@@ -19,7 +19,7 @@
 #include "kccd/overlay/golden/golden_manifest.hpp"
 #include "kccd/overlay/golden/golden_render.hpp"
 #include "kccd/overlay/golden/golden_report.hpp"
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/render/gl_context.hpp"
 
 namespace kccd::cli {

@@ -22,7 +22,7 @@
 #include "kccd/overlay/bags/bag_recording.hpp"
 #include "kccd/overlay/recording/contact_sheet.hpp"
 #include "kccd/overlay/recording/overlay_recording.hpp"
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/synth/synth.hpp"
 #include "kccd/overlay/recording/video_sink.hpp"
 #include "kccd/state_log.hpp"

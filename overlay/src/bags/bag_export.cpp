@@ -17,7 +17,7 @@
 #include "kccd/logs/decode.hpp"
 #include "kccd/logs/log_reader.hpp"
 #include "kccd/logs/message_definition.hpp"
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/recording/video_sink.hpp"
 
 #include "bag_messages.hpp"

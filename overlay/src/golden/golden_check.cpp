@@ -4,7 +4,7 @@
 
 #include "kccd/calib/image_file.hpp"
 #include "kccd/file_reader.hpp"
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 
 namespace kccd::overlay {
 namespace {

@@ -6,7 +6,7 @@
 #include <openssl/evp.h>
 
 #include "kccd/format_number.hpp"
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 
 namespace kccd::overlay {
 namespace {

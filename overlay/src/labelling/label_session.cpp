@@ -15,7 +15,7 @@
 #include "kccd/overlay/calibration/calib_solve.hpp"
 #include "kccd/overlay/labelling/labelling_candidates.hpp"
 #include "kccd/overlay/labelling/labels_document.hpp"
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/render/model_view.hpp"
 
 namespace kccd::overlay {

@@ -28,7 +28,7 @@
 #include "kccd/input_error.hpp"
 #include "kccd/overlay/recording/contact_sheet.hpp"
 #include "kccd/overlay/recording/timeline.hpp"
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/recording/video_source.hpp"
 #include "kccd/render/projection.hpp"
 

@@ -12,7 +12,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "kccd/calib/camera.hpp"
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/synth/synth_scene.hpp"
 #include "kccd/overlay/synth/synth_sensor.hpp"
 #include "kccd/overlay/synth/synth_trajectory.hpp"

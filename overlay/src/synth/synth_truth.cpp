@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core/persistence.hpp>
 
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/safety_status.hpp"
 
 namespace kccd::overlay {

@@ -9,7 +9,7 @@
 
 #include <opencv2/core/mat.hpp>
 
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 
 namespace cv {
 class VideoWriter;

@@ -1,4 +1,4 @@
-#include "kccd/overlay/recording/staged_output.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
