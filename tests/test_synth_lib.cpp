@@ -198,7 +198,9 @@ TEST_F(SynthLib, BadOptionsAreSynthErrors) {
     } catch (const SynthError& e) {
       EXPECT_NE(std::string(e.what()).find(c.says), std::string::npos) << e.what();
       // An option out of range is named by its field (no source), for each front end to spell.
-      if (std::string(c.says) != "-o") EXPECT_TRUE(e.location().source.empty() && e.location().field == c.says) << e.what();
+      if (std::string(c.says) != "-o") {
+        EXPECT_TRUE(e.location().source.empty() && e.location().field == c.says) << e.what();
+      }
     }
     EXPECT_FALSE(fs::exists(*root_ / "bad")) << c.says;
   }
