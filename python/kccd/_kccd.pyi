@@ -226,6 +226,8 @@ def overlay_recording(
     time_source: str = "header",
     joint_map: str = "",
     timeline: str = "",
+    masks: str = "",
+    mask_bodies: Sequence[str] = (),
 ) -> dict[str, Any]: ...
 def read_bag(
     path: str,

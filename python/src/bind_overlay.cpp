@@ -21,6 +21,7 @@
 #include "kccd/overlay/bags/bag_info.hpp"
 #include "kccd/overlay/bags/bag_recording.hpp"
 #include "kccd/overlay/recording/contact_sheet.hpp"
+#include "kccd/overlay/recording/mask_agreement.hpp"
 #include "kccd/overlay/recording/overlay_recording.hpp"
 #include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/synth/synth.hpp"
@@ -83,7 +84,8 @@ caption. output: a .png, written under a temporary name and renamed when complet
          const std::string& states, const std::string& output, const std::string& report, const std::string& contact_sheet,
          double time_offset, bool swept, const std::optional<BrakingParams>& braking, int jobs, const std::string& frames,
          int contact_frames, const py::object& progress, double progress_every, const std::string& bag, const std::string& image_topic,
-         const std::string& joint_topic, const std::string& time_source, const std::string& joint_map, const std::string& timeline) {
+         const std::string& joint_topic, const std::string& time_source, const std::string& joint_map, const std::string& timeline,
+         const std::string& masks, const std::vector<std::string>& mask_bodies) {
         const Model& model = *h->model;
         if (!(progress_every >= 0.0) || !std::isfinite(progress_every))
           throw py::value_error("progress_every: must be a finite number of seconds >= 0");
@@ -108,6 +110,20 @@ caption. output: a .png, written under a temporary name and renamed when complet
         if (rec) {
           in.frame_times = rec->frame_times;
           in.open_frames = rec->open_frames;
+        }
+        std::optional<overlay::MaskAgreement> agreement;
+        if (!masks.empty()) {
+          std::vector<int> bodies;
+          for (const std::string& name : mask_bodies) {
+            const int b = model.bodyIndex(name);
+            if (b < 0) throw py::value_error("mask_bodies: '" + name + "' is not a body of the model");
+            bodies.push_back(b);
+          }
+          if (masks == "auto") agreement.emplace(camera, model, std::move(bodies), "masks auto");
+          else agreement.emplace(masks, camera, model, std::move(bodies), "masks " + masks);
+          in.masks = &*agreement;
+        } else if (!mask_bodies.empty()) {
+          throw py::value_error("mask_bodies: goes with masks");
         }
         overlay::OverlayOptions o;
         o.time_offset = time_offset;
@@ -164,7 +180,8 @@ caption. output: a .png, written under a temporary name and renamed when complet
       py::arg("report") = "", py::arg("contact_sheet") = "", py::arg("time_offset") = 0.0, py::arg("swept") = false,
       py::arg("braking") = py::none(), py::arg("jobs") = 0, py::arg("frames") = "", py::arg("contact_frames") = 12, py::arg("progress") = py::none(),
       py::arg("progress_every") = 0.0, py::arg("bag") = "", py::arg("image_topic") = "", py::arg("joint_topic") = "",
-      py::arg("time_source") = "header", py::arg("joint_map") = "", py::arg("timeline") = "",
+      py::arg("time_source") = "header", py::arg("joint_map") = "", py::arg("timeline") = "", py::arg("masks") = "",
+      py::arg("mask_bodies") = std::vector<std::string>{},
       R"doc(The main job, as `kccd overlay`: every frame of `video` (a file or an image-sequence pattern) checked at
 the state the log `states` (CSV) gives at its time (log time = frame time + time_offset, seconds), the
 volumes drawn and composited. Outputs, checked before any frame is decoded (extension, an existing
@@ -179,7 +196,10 @@ per-frame records under 'frames'). Instead of video and states, bag: a robot log
 folder, ROS 1 .bag) whose image topic gives the frames at their own times and whose joint states give
 the states, as `kccd overlay --bag` (image_topic, joint_topic: default the only one of the type;
 time_source 'header' or 'log'; joint_map: a joint map file; warnings as UserWarning). timeline: a .png of
-the run over time (`kccd overlay --timeline`). Raises InputError naming the input and place.)doc");
+the run over time (`kccd overlay --timeline`). masks: a folder of robot masks (frame_000000.png, ...) or
+'auto' (made from the recording's own background), as `kccd overlay --masks`: each frame's 'mask_iou' and the
+report's 'mask_agreement'; mask_bodies: the bodies the masks show (default all). Raises InputError naming the
+input and place.)doc");
 
   m.def(
       "read_bag",
