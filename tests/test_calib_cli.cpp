@@ -111,6 +111,21 @@ class CalibCli : public ::testing::Test {
     return t;
   }
 
+  // A bad invocation: the arguments after a base command line, and what its one error line says.
+  struct ErrorCase {
+    std::string args, expect;
+  };
+  // Each case exits 2 with one line saying its `expect`, and `output` is not written.
+  void expectOneLineErrors(const std::string& base, const std::vector<ErrorCase>& cases, const std::string& output) const {
+    for (const ErrorCase& c : cases) {
+      const Outcome r = runKccd(base + c.args);
+      EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << "\n" << r.err;
+      EXPECT_FALSE(fs::exists(output));
+    }
+  }
+
   fs::path dir_;
   kccd::calib::Camera truth_;
   kccd::Model model_;
@@ -398,9 +413,7 @@ TEST_F(CalibMasks, BadMasksAreOneLineExitTwoAndNothingWritten) {
   write("broken.png", "\x89PNG\r\n\x1a\nnot really");
   const std::string base = "calib --intrinsics " + out("cam.yaml") + " -o " + out("c.yaml");
   const std::string state = " --state 0,0,0";
-  const struct {
-    std::string args, expect;
-  } cases[] = {
+  const std::vector<ErrorCase> cases = {
       {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("small.png"), "small.png: mask: 200x100, but the camera"},
       {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("empty.png"), "empty.png: mask: no robot in it"},
       {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("full.png"), "full.png: mask: nothing but robot"},
@@ -412,13 +425,7 @@ TEST_F(CalibMasks, BadMasksAreOneLineExitTwoAndNothingWritten) {
        "--mask-bodies: 'arm' is not a body"},
       {" --labels " + out("l0.yaml") + " --camera " + kCamera, "--camera: a start for --masks"},
   };
-  for (const auto& c : cases) {
-    const Outcome r = runKccd(base + c.args);
-    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << "\n" << r.err;
-    EXPECT_FALSE(fs::exists(out("c.yaml")));
-  }
+  expectOneLineErrors(base, cases, out("c.yaml"));
 }
 
 // --refine edges: no masks; the frames are pictures of the robot (each body painted by the
@@ -497,20 +504,12 @@ TEST_F(CalibMasks, MasksFromTheRecordingItselfGiveTheCamera) {
 
   // What --masks auto needs, said in one line each.
   const std::string base = "calib --intrinsics " + out("cam.yaml") + " --model " + kDemo + " --camera " + out("rough.yaml") + " -o " + out("d.yaml");
-  const struct {
-    std::string args, expect;
-  } cases[] = {
+  const std::vector<ErrorCase> cases = {
       {" --image " + out("check.png") + " --state 0,0,0 --masks auto", "--masks auto: makes the masks from a recording"},
       {" --video " + out("rec.mkv") + " --frame 3 --state 0,0,0 --masks auto", "--masks auto: needs each frame's state"},
       {" --video " + out("rec.mkv") + " --frame 3 --states " + out("rec.csv") + " --masks auto " + out("mask0.png"), "give it alone"},
   };
-  for (const auto& k : cases) {
-    const Outcome e = runKccd(base + k.args);
-    EXPECT_EQ(e.code, 2) << k.args << "\n" << e.err;
-    EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << e.err;
-    EXPECT_NE(e.err.find(k.expect), std::string::npos) << k.args << "\n" << e.err;
-    EXPECT_FALSE(fs::exists(out("d.yaml")));
-  }
+  expectOneLineErrors(base, cases, out("d.yaml"));
 }
 
 // kccd overlay --masks auto: the same recording against its log at the true camera. At the log's
@@ -556,22 +555,14 @@ TEST_F(CalibMasks, OverlayAgreementWithMasksFromTheRecording) {
 TEST_F(CalibMasks, BadRefineOptionsAreOneLineExitTwo) {
   write("l0.yaml", roughClicks(0));
   const std::string base = "calib --intrinsics " + out("cam.yaml") + " -o " + out("c.yaml") + " --labels " + out("l0.yaml") + " --state 0,0,0";
-  const struct {
-    std::string args, expect;
-  } cases[] = {
+  const std::vector<ErrorCase> cases = {
       {" --model " + kDemo + " --refine edges --masks " + out("mask0.png"), "--refine edges: refines to the pictures themselves"},
       {" --refine edges", "--refine edges: needs --model"},
       {" --model " + kDemo + " --refine masks", "--refine masks: give the masks"},
       {" --model " + kDemo + " --refine lines", "--refine"},
       {" --model " + kDemo + " --refine edges", "frame 1 has no picture to find edges in"},
   };
-  for (const auto& c : cases) {
-    const Outcome r = runKccd(base + c.args);
-    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << "\n" << r.err;
-    EXPECT_FALSE(fs::exists(out("c.yaml")));
-  }
+  expectOneLineErrors(base, cases, out("c.yaml"));
 }
 
 // Masks of other states than the frames' from a rough camera alone: the masks cannot confirm any

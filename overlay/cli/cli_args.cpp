@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <map>
 #include <cstdlib>
+#include <map>
 #include <regex>
 #include <sstream>
 
@@ -156,7 +156,7 @@ void addPieceOptions(CLI::App& sub, std::string& pieces, double& concavity_mm, c
 }
 
 int piecesOption(const std::string& text) {
-  if (text == "auto") return 8;
+  if (text == "auto") return modelling::kAutoPieces;
   int n = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
   if (ec != std::errc() || end != text.data() + text.size() || n < 1 || n > 64)

@@ -36,11 +36,11 @@ void checkRequest(const modelling::FitRequest& request) {
   }
 }
 
-// pieces='auto' (8) or a number.
+// pieces='auto' (kAutoPieces) or a number.
 int piecesArgument(const py::object& pieces) {
   if (py::isinstance<py::str>(pieces)) {
     if (pieces.cast<std::string>() != "auto") throw py::value_error("pieces: 'auto' or a number 1 ... 64");
-    return 8;
+    return modelling::kAutoPieces;
   }
   if (!py::isinstance<py::int_>(pieces)) throw py::value_error("pieces: 'auto' or a number 1 ... 64");
   return pieces.cast<int>();  // its range checked with the request
@@ -74,7 +74,9 @@ void bindModelling(py::module_& m) {
           text = modelling::fitJson(part, request, fitted, std::filesystem::path(path).stem().string());
         });
         py::dict d = py::module_::import("json").attr("loads")(text).cast<py::dict>();
-        const auto asArray = [](py::dict body) { body["points"] = py::module_::import("numpy").attr("array")(body["points"], "float64").attr("reshape")(-1, 3); };
+        const auto asArray = [](py::dict body) {
+          body["points"] = py::module_::import("numpy").attr("array")(body["points"], "float64").attr("reshape")(-1, 3);
+        };
         if (d.contains("pieces"))
           for (py::handle p : d["pieces"]) asArray(p.cast<py::dict>());
         else

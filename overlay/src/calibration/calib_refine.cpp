@@ -50,27 +50,26 @@ calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<ca
   const std::size_t gathered = frames.size();
   std::vector<const cv::Mat*> pictures;
   for (const GatheredFrame& f : g.frames) pictures.push_back(&f.bgr);
-  std::vector<std::vector<calib::PlacedVolume>> region_volumes;
-  for (const GatheredFrame& f : g.frames) region_volumes.push_back(calib::placeVolumes(model, f.state, bodies));
-  const std::size_t fitted = std::min<std::size_t>(recording.size(), 16);
-  for (std::size_t k = 0; k < recording.size(); ++k) {
-    const RecordingSample& s = recording[k];
+  std::vector<std::vector<calib::PlacedVolume>> frame_volumes, sample_volumes;  // all the bodies, for the regions
+  for (const GatheredFrame& f : g.frames) frame_volumes.push_back(calib::placeVolumes(model, f.state, bodies));
+  for (const RecordingSample& s : recording) {
     if (s.bgr.type() != CV_8UC3 || s.bgr.cols != start.width || s.bgr.rows != start.height)
       throw CalibInputError("--masks auto: the recording's frames are not 8-bit colour pictures of the camera's " +
                             std::to_string(start.width) + "x" + std::to_string(start.height));
     if (static_cast<int>(s.state.size()) != model.stateSize())
       throw CalibInputError("--masks auto: a frame of the recording without a state of the model's " + std::to_string(model.stateSize()) +
                             " values");
+    sample_volumes.push_back(calib::placeVolumes(model, s.state, bodies));
   }
   // The samples fitted with the gathered frames: 16 spread over the recording.
+  const std::size_t fitted = std::min<std::size_t>(recording.size(), 16);
+  std::vector<std::size_t> fitted_sample;
   for (std::size_t i = 0; i < fitted; ++i) {
-    const RecordingSample& s = recording[i * recording.size() / fitted];
-    pictures.push_back(&s.bgr);
-    region_volumes.push_back(calib::placeVolumes(model, s.state, bodies));
-    frames.push_back({cv::Mat(), robot.volumes(s.state), robot.meshes(s.state)});
+    const std::size_t k = i * recording.size() / fitted;
+    fitted_sample.push_back(k);
+    pictures.push_back(&recording[k].bgr);
+    frames.push_back({cv::Mat(), robot.volumes(recording[k].state), robot.meshes(recording[k].state)});
   }
-  std::vector<std::vector<calib::PlacedVolume>> sample_volumes;
-  for (const RecordingSample& s : recording) sample_volumes.push_back(calib::placeVolumes(model, s.state, bodies));
   const double diagonal = std::hypot(start.width, start.height);
   const std::vector<double> widths = {0.10, 0.03, 0.015};
   calib::Camera cam = start;
@@ -79,11 +78,13 @@ calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<ca
   calib::RefineResult last;
   cv::Mat known;  // the kept round's
   for (std::size_t round = 0; round < widths.size(); ++round) {
-    std::vector<cv::Mat> regions;
-    for (const auto& v : region_volumes) regions.push_back(calib::robotRegion(cam, v, widths[round] * diagonal));
+    // Where the robot may be in each sample and each gathered frame; a fitted sample's is its sample's.
     std::vector<calib::BackgroundSample> samples;
     for (std::size_t k = 0; k < recording.size(); ++k)
       samples.push_back({recording[k].bgr, calib::robotRegion(cam, sample_volumes[k], widths[round] * diagonal)});
+    std::vector<cv::Mat> regions;
+    for (const auto& v : frame_volumes) regions.push_back(calib::robotRegion(cam, v, widths[round] * diagonal));
+    for (const std::size_t k : fitted_sample) regions.push_back(samples[k].robot);
     const calib::Background background = calib::estimateBackground(samples);
     for (std::size_t f = 0; f < frames.size(); ++f) {
       frames[f].mask = calib::foregroundMask({*pictures[f], regions[f]}, background);
@@ -231,7 +232,8 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
       throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no state of the model's " +
                             std::to_string(model.stateSize()) + " values: give --state, or --states with --time");
     if ((edges || from_recording) && g.frames[f].bgr.empty())
-      throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no picture to find edges in: give --image or --video");
+      throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no picture to find " +
+                            (edges ? "edges" : "the robot") + " in: give --image or --video");
     std::vector<calib::PlacedMesh> meshes = robot.meshes(state);
     out.meshes.push_back(meshes);
     if (edges) edge_frames.push_back({g.frames[f].bgr, robot.volumes(state), std::move(meshes)});

@@ -47,15 +47,18 @@ MaskAgreement::MaskAgreement(const std::string& folder, const calib::Camera& cam
 }
 
 MaskAgreement::MaskAgreement(const calib::Camera& camera, const Model& model, std::vector<int> bodies, std::string label)
-    : label_(std::move(label)), camera_(camera), robot_(model, movingBodies(model, checkedBodies(model, bodies, label_))),
-      region_bodies_(movingBodies(model, bodies)) {
-  if (region_bodies_.empty()) throw InputError(label_ + ": no body of the model (of those the masks show) moves with a joint");
+    : label_(std::move(label)), camera_(camera), robot_(model, movingBodies(model, checkedBodies(model, std::move(bodies), label_))) {
+  if (robot_.bodies().empty()) throw InputError(label_ + ": no body of the model (of those the masks show) moves with a joint");
+}
+
+cv::Mat MaskAgreement::regionAt(std::span<const double> state) const {
+  const double widen = 0.015 * std::hypot(camera_.width, camera_.height);
+  return calib::robotRegion(camera_, calib::placeVolumes(robot_.model(), state, robot_.bodies()), widen);
 }
 
 void MaskAgreement::learnBackground(FrameSource& frames, const std::function<double(std::size_t)>& log_time, const StateLog& log,
                                     double max_gap) {
   const Model& model = robot_.model();
-  const double widen = 0.015 * std::hypot(camera_.width, camera_.height);
   std::vector<calib::BackgroundSample> samples;
   indices_.clear();
   std::size_t read = 0;
@@ -67,7 +70,7 @@ void MaskAgreement::learnBackground(FrameSource& frames, const std::function<dou
     std::vector<double> state(static_cast<std::size_t>(model.stateSize()), 0.0);
     const double t = log_time(f.index);
     if (!std::isfinite(t) || stateAt(log, t, max_gap, state) == StateMatch::None) continue;
-    samples.push_back({std::move(f.bgr), calib::robotRegion(camera_, calib::placeVolumes(model, state, region_bodies_), widen)});
+    samples.push_back({std::move(f.bgr), regionAt(state)});
     indices_.push_back(f.index);
   }
   if (samples.size() < 8)
@@ -83,13 +86,12 @@ std::optional<double> MaskAgreement::at(std::size_t index, std::span<const doubl
       meshes.empty() ? calib::drawSilhouette(camera_, robot_.volumes(state)) : calib::drawMeshSilhouette(camera_, meshes);
   if (fromRecording()) {
     if (!background_ || picture.empty()) return std::nullopt;
-    const double widen = 0.015 * std::hypot(camera_.width, camera_.height);
-    const cv::Mat region = calib::robotRegion(camera_, calib::placeVolumes(robot_.model(), state, region_bodies_), widen);
-    const cv::Mat mask = calib::foregroundMask({picture, region}, *background_);
+    const cv::Mat mask = calib::foregroundMask({picture, regionAt(state)}, *background_);
     // Where the background is unknown (the robot never leaves), nothing is said: a frame whose
     // drawn robot lies mostly there has no agreement.
     const cv::Mat seen = drawn.mask & background_->known;
-    if (cv::countNonZero(seen) < 0.25 * cv::countNonZero(drawn.mask) || cv::countNonZero(seen) == 0) return std::nullopt;
+    const int seen_pixels = cv::countNonZero(seen);
+    if (seen_pixels == 0 || seen_pixels < 0.25 * cv::countNonZero(drawn.mask)) return std::nullopt;
     return calib::maskIou(seen, mask);
   }
   if (!std::binary_search(indices_.begin(), indices_.end(), index)) return std::nullopt;

@@ -14,6 +14,7 @@ namespace kccd::modelling {
 
 inline constexpr double kDefaultToleranceMm = 2.0;   ///< kccd import's default tolerance
 inline constexpr double kDefaultConcavityMm = 40.0;  ///< the concavity above which a part splits
+inline constexpr int kAutoPieces = 8;                ///< the most pieces of `pieces: auto`
 
 /// How a body's core points are chosen.
 enum class FitMethod {

@@ -23,7 +23,7 @@ struct ImportOptions {
   /// How each link (each piece of a concave one) is fitted: by default within 2 mm of its hull,
   /// concave links in up to 8 pieces. FitMethod::Hull: the links' convex hulls, a tight, slow
   /// reference to measure what a fit costs.
-  FitRequest fit{.method = FitMethod::Tolerance, .max_pieces = 8};
+  FitRequest fit{.method = FitMethod::Tolerance, .max_pieces = kAutoPieces};
   double safety_margin = 0.02;                  ///< written into the model
   std::map<std::string, std::string> packages;  ///< package:// NAME -> directory
   bool visuals = true;                          ///< write each link's <visual>s as `visuals:` (meshes must exist)

@@ -37,6 +37,7 @@ class RobotDrawing {
   /// "visual meshes", or "collision volumes" with the reason in brackets when the model has visuals.
   const std::string& drawn() const { return drawn_; }
   const Model& model() const { return model_; }
+  const std::vector<int>& bodies() const { return bodies_; }  ///< as given (empty: all)
 
  private:
   const Model& model_;

@@ -63,7 +63,9 @@ class MaskAgreement {
   const calib::Camera& camera_;
   RobotDrawing robot_;
   std::vector<std::size_t> indices_;  // sorted frame indices with a file (from the recording: the samples')
-  std::vector<int> region_bodies_;    // from the recording: the moving bodies, whose widened drawing the background leaves out
+  // From the recording: where the robot may be at `state`, its (moving) bodies' volumes widened by
+  // 1.5 % of the image's diagonal; the background leaves it out.
+  cv::Mat regionAt(std::span<const double> state) const;
   std::optional<calib::Background> background_;
 };
 
