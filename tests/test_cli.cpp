@@ -241,6 +241,22 @@ TEST(Cli, FitJsonContractAndErrors) {
     EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << e.err;
     EXPECT_NE(e.err.find("_huge.stl:6: vertex 3: "), std::string::npos) << value << ": " << e.err;
   }
+  // --scale and --seed: a factor of 0, two factors, a negative seed (never wrapped to 2^64 - 1).
+  for (const auto& [args, says] : {std::pair<std::string, std::string>{"--scale 0", "--scale: each factor must be a finite number other than 0"},
+                                   {"--scale 1,2", "--scale: give one factor or three (X,Y,Z)"},
+                                   {"--seed -1", "--seed: expected a whole number 0 ... "}}) {
+    e = runKccd("fit " + kModels + "simple/cube.iv -q " + args);
+    EXPECT_EQ(e.code, 2) << args << ": " << e.err;
+    EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << e.err;
+    EXPECT_NE(e.err.find(says), std::string::npos) << args << ": " << e.err;
+    EXPECT_EQ(e.out, "");
+  }
+  // Scaled per axis in the file's frame: the 2 x 2 x 2 cube becomes 1 x 1 x 4, or 1 x 1 x 1.
+  for (const auto& [scale, volume] : {std::pair<std::string, double>{"0.5,0.5,2", 4.0}, {"0.5", 1.0}}) {
+    const Outcome scaled = runKccd("fit " + kModels + "simple/cube.iv --points 8 --json --scale " + scale);
+    ASSERT_EQ(scaled.code, 0) << scaled.err;
+    EXPECT_NEAR(nlohmann::json::parse(scaled.out)["hull_volume"].get<double>(), volume, 1e-6) << scale;
+  }
   e = runKccd("fit /nonexistent/part.iv");
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(e.err.find("/nonexistent/part.iv: cannot open the file"), std::string::npos) << e.err;

@@ -40,6 +40,18 @@ std::string optionMessage(const std::string& text) {
   return oneLine(out);
 }
 
+CLI::Validator seedNumber() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::uint64_t v = 0;
+        const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+        if (ec != std::errc() || end != text.data() + text.size())
+          return "expected a whole number 0 ... 18446744073709551615, got '" + printable(text, 40) + "'";
+        return std::string();
+      },
+      "SEED");
+}
+
 CLI::Validator finiteIn(double lo, double hi) {
   return CLI::Validator(
       [lo, hi](std::string& text) -> std::string {

@@ -27,6 +27,9 @@ std::string optionMessage(const std::string& text);
 /// An option validator: a finite number in [lo, hi] (NaN and infinities are refused).
 CLI::Validator finiteIn(double lo, double hi);
 
+/// A seed: a whole number 0 ... 2^64 - 1 (a negative one is refused, never wrapped).
+CLI::Validator seedNumber();
+
 /// Parses "a,b,c" into numbers; `option` names the flag in error messages.
 std::vector<double> parseList(const std::string& text, const std::string& option);
 

@@ -141,7 +141,9 @@ Runner addFit(CLI::App& app) {
                       "Optimiser budget per start (volume evaluations; three starts are refined)")
           ->capture_default_str()
           ->check(CLI::Range(1, 10000000));
-  sub->add_option("--seed", args->seed, "Seed of the optimiser's random search directions")->capture_default_str();
+  sub->add_option("--seed", args->seed, "Seed of the optimiser's random search directions")
+      ->capture_default_str()
+      ->check(seedNumber());
   sub->add_option("--scale", args->scale,
                   "Scale of the part in its file's frame: one factor, or three (X,Y,Z), as a URDF mesh's scale (e.g. 0.001 for a "
                   "part drawn in millimetres)")

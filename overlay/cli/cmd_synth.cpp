@@ -64,7 +64,9 @@ Runner addSynth(CLI::App& app) {
   CLI::Option* height = sub->add_option("--height", a->height, "Image height of the default camera (px)")
                             ->capture_default_str()
                             ->check(CLI::Range(64, 4096));
-  sub->add_option("--seed", a->options.seed, "Seed of the trajectory search and the noise")->capture_default_str();
+  sub->add_option("--seed", a->options.seed, "Seed of the trajectory search and the noise")
+      ->capture_default_str()
+      ->check(seedNumber());
   sub->add_option("--codec", a->options.codec, "ffv1 (video.mkv, lossless), mjpg (video.avi) or mp4v (video.mp4)")
       ->capture_default_str();
   sub->add_option("--log-rate", a->options.log_rate, "State log rate (Hz; must differ from --fps)")
