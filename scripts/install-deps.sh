@@ -20,7 +20,8 @@ packages=(
 #            and npm's playwright-core in tests/e2e (scripts/test.sh); and the Python package's:
 #            pytest, mypy and typeshed's stubs (PyYAML's, for mypy --strict on kccd.batch); and the
 #            robot-log tests' fixture writers: ROS 1's rosbag with its sensor_msgs and lz4
-#            (python3-rosbag, python3-sensor-msgs, python3-roslz4), npm's @mcap/core (tests/bags).
+#            (python3-rosbag, python3-sensor-msgs, python3-roslz4), npm's @mcap/core (tests/bags);
+#            and clang-format and clang-tidy (scripts/lint.sh).
 #   --docs   also what scripts/docs.sh builds the site with: Sphinx, MyST (Markdown pages), Breathe
 #            on Doxygen's XML (the C++ API), the Furo theme
 tests=0
@@ -28,7 +29,7 @@ for arg in "$@"; do
   case "$arg" in
     --fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;
     --docs) packages+=(python3-sphinx python3-myst-parser python3-breathe doxygen furo) ;;
-    --tests) tests=1; packages+=(chromium python3-pytest python3-matplotlib mypy python3-typeshed python3-rosbag python3-sensor-msgs python3-roslz4) ;;
+    --tests) tests=1; packages+=(chromium python3-pytest python3-matplotlib mypy python3-typeshed python3-rosbag python3-sensor-msgs python3-roslz4 clang-format clang-tidy) ;;
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 2 ;;
   esac
 done

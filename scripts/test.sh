@@ -5,7 +5,8 @@
 # sanitizer build is GCC at -O1 -g1 (the reports' stacks keep files and lines; its tests run 1.3x
 # faster than clang-14's ASan at -O1, 1.8x faster than with libFuzzer's coverage too, so the fuzz
 # targets keep their own clang build, scripts/fuzz.sh), and its statistical tests draw fewer cases
-# (tests/support/sanitized.hpp). GCC 12 at -O1 with the sanitizers warns falsely about
+# (tests/support/sanitized.hpp). After the Release build, scripts/lint.sh checks the C++ files of
+# the last commit with clang-format and clang-tidy. GCC 12 at -O1 with the sanitizers warns falsely about
 # std::function inside <regex> (maybe-uninitialized): that warning is off there. Each stage's time
 # is printed at the end. Options:
 #   --no-sanitize   skip the sanitizer build
@@ -49,6 +50,7 @@ deps=(--tests --docs)
 stage "Installing dependencies" bash scripts/install-deps.sh "${deps[@]}"
 if [ $release -eq 1 ]; then
   stage "Release build" cmake_build build -DCMAKE_BUILD_TYPE=Release
+  stage "Lint: the last commit's C++ files (clang-format, clang-tidy)" bash scripts/lint.sh
   stage "Release tests" ctest --test-dir build -j "$jobs" --output-on-failure
   stage "Documentation site (warnings are errors)" bash scripts/docs.sh build
 fi

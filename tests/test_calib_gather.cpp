@@ -79,7 +79,7 @@ class CalibLibrary : public ::testing::Test {
                      facing(42, 0.2, Vec3(0.2, 0.3, 0.7), eye)};
     TagLayout scene = *layout_;
     scene.tags.push_back(facing(kUnknownId, 0.18, Vec3(0.8, -0.2, 0.25), eye));
-    frame_ = new cv::Mat(overlay::renderTagSceneBgr(*camera_, scene));
+    frame_ = new cv::Mat(calib::renderTagSceneBgr(*camera_, scene));
   }
   static void TearDownTestSuite() {
     delete camera_;

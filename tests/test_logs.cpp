@@ -958,7 +958,7 @@ TEST_F(McapFixtures, AJointMapRenamesScalesAndFixesStateValues) {
   const auto no_bag = runProgram(std::string(KCCD_CLI) + " overlay " + plain + " --camera " + camera + " --video v.mkv --states s.csv --joint-map " + map +
                                  " --report " + (out / "bad.json").string());
   EXPECT_EQ(no_bag.code, 2);
-  EXPECT_NE(no_bag.err.find("--joint-map go with --bag"), std::string::npos) << no_bag.err;
+  EXPECT_NE(no_bag.err.find("--joint-map: goes with --bag"), std::string::npos) << no_bag.err;
 }
 
 // A golden case on a frame of a robot log: its picture is the image topic's frame and its state the

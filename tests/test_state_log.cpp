@@ -136,20 +136,20 @@ TEST(StateLog, EveryMistakeIsOneLineWithItsPlace) {
        "log.csv:1:42: column 'arm': named twice (also at 1:11)"},
       {"time,base,time\n", "log.csv:1:11: column 'time': named twice (also at 1:1)"},
       {"time,base,arm,slide,pose.x,pose.y,pose.z,elbow\n",
-       "log.csv:1:42: column 'elbow': unknown column (a state value of the model? see kccd info; --ignore-columns skips "
-       "it)"},
+       "log.csv:1:42: column 'elbow': unknown column (a state value of the model? see kccd info; a column to skip is listed as "
+       "ignored)"},
       {"time,base,arm,slide,pose.x,pose.y,pose.z,elbow.vel\n",
-       "log.csv:1:42: column 'elbow.vel': unknown column (a state value of the model? see kccd info; --ignore-columns "
-       "skips it)"},
+       "log.csv:1:42: column 'elbow.vel': unknown column (a state value of the model? see kccd info; a column to skip is "
+       "listed as ignored)"},
       {"time,base,arm,slide,pose.x,pose.y,pose.z,time.vel\n",
-       "log.csv:1:42: column 'time.vel': unknown column (a state value of the model? see kccd info; --ignore-columns "
-       "skips it)"},
+       "log.csv:1:42: column 'time.vel': unknown column (a state value of the model? see kccd info; a column to skip is "
+       "listed as ignored)"},
       {"time,base, arm,slide,pose.x,pose.y,pose.z\n",
        "log.csv:1:11: column ' arm': space around the name (the dialect has no padding)"},
       {"time,,base\n", "log.csv:1:6: empty column name (field 2 of the header)"},
       {"time,base,\x01x\x7f\n",
-       "log.csv:1:11: column '\\x01x\\x7f': unknown column (a state value of the model? see kccd info; --ignore-columns "
-       "skips it)"},
+       "log.csv:1:11: column '\\x01x\\x7f': unknown column (a state value of the model? see kccd info; a column to skip is "
+       "listed as ignored)"},
       {"time,base,arm\rslide\n", "log.csv:1:14: a carriage return not followed by a line feed (line ends are LF or CRLF)"},
       {h + "0,0,0,0,0,0,0\r", "log.csv:2:14: a carriage return not followed by a line feed (line ends are LF or CRLF)"},
       // Rows.

@@ -187,7 +187,7 @@ TEST_F(SynthLib, BadOptionsAreSynthErrors) {
       {"visible_scale", [](SynthOptions& o) { o.visible_scale = 1.5; }},
       {"width", [](SynthOptions& o) { o.width = 32; }},
       {"appearance", [](SynthOptions& o) { o.appearance = kccd::overlay::SynthAppearance::Visuals; }},
-      {"-o", [](SynthOptions& o) { o.output = (fs::path(o.output).parent_path() / "rec").string(); }},  // exists
+      {"output", [](SynthOptions& o) { o.output = (fs::path(o.output).parent_path() / "rec").string(); }},  // exists
   };
   for (const Case& c : cases) {
     SynthOptions o = smallRecording(*root_ / "bad");
@@ -198,7 +198,7 @@ TEST_F(SynthLib, BadOptionsAreSynthErrors) {
     } catch (const SynthError& e) {
       EXPECT_NE(std::string(e.what()).find(c.says), std::string::npos) << e.what();
       // An option out of range is named by its field (no source), for each front end to spell.
-      if (std::string(c.says) != "-o") {
+      if (std::string(c.says) != "output") {  // a path: "output PATH: exists ..."
         EXPECT_TRUE(e.location().source.empty() && e.location().field == c.says) << e.what();
       }
     }

@@ -49,6 +49,13 @@ InputError::InputError(InputLocation where, const std::string& problem)
     : std::runtime_error(joined(where.text(), problem)),
       data_(std::make_shared<const Data>(Data{std::move(where), problem})) {}
 
+double checkFieldRange(double value, double lo, double hi, const std::string& field) {
+  if (!(value >= lo && value <= hi))
+    throw InputError(InputLocation{{}, 0, 0, field},
+                     "must be in [" + messageNumber(lo) + ", " + messageNumber(hi) + "], got " + messageNumber(value));
+  return value;
+}
+
 std::string InputError::messageFrom(std::string_view source) const {
   InputLocation where = location();
   where.source = source;

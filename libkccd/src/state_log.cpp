@@ -186,7 +186,7 @@ std::vector<Column> parseHeader(std::string_view line, const Parser& parser, con
       const char first = name.front(), last = name.back();
       if (first == ' ' || first == '\t' || last == ' ' || last == '\t')
         parser.fail(1, col, name, "space around the name (the dialect has no padding)");
-      parser.fail(1, col, name, "unknown column (a state value of the model? see kccd info; --ignore-columns skips it)");
+      parser.fail(1, col, name, "unknown column (a state value of the model? see kccd info; a column to skip is listed as ignored)");
     }
     columns.push_back(c);
     if (comma == std::string_view::npos) break;

@@ -63,7 +63,8 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
         .joint_topic = a.joint_topic,
         .image_topic = a.image_topic,
         .time_source = *overlay::timeSourceOf(a.time_source),  // checked by the option
-        .joint_map = a.joint_map.empty() || !model ? overlay::JointMap{} : overlay::loadJointMap(a.joint_map, *model)};
+        .joint_map = a.joint_map.empty() || !model ? overlay::JointMap{} : overlay::loadJointMap(a.joint_map, *model),
+        .spell = [](const std::string& field) { return optionSpelling(field); }};
     if (!a.joint_map.empty() && !model) throw UsageError("--joint-map: needs --model");
     // With a model (and no --state) the joint states give each frame's state; else the images alone.
     bag = model && a.states.empty() ? overlay::readBagRecording(bo, *model) : overlay::readBagImages(bo);

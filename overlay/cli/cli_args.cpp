@@ -128,13 +128,17 @@ StateBox parseStateBox(const Model& m, const std::string& state, const std::stri
   return box;
 }
 
+std::string optionSpelling(const std::string& field, const std::map<std::string, std::string>& spelling) {
+  if (const auto s = spelling.find(field); s != spelling.end()) return s->second;
+  std::string option = "--" + field.substr(field.rfind('.') + 1);
+  std::replace(option.begin(), option.end(), '_', '-');
+  return option;
+}
+
 void rethrowAsOption(const InputError& e, const std::map<std::string, std::string>& spelling) {
   const InputLocation& at = e.location();
   if (!at.source.empty() || at.field.empty() || at.line != 0) throw;
-  std::string option = "--" + at.field;
-  std::replace(option.begin(), option.end(), '_', '-');
-  if (const auto s = spelling.find(at.field); s != spelling.end()) option = s->second;
-  throw UsageError(option + ": " + e.problem());
+  throw UsageError(optionSpelling(at.field, spelling) + ": " + e.problem());
 }
 
 void checkFitOptions(const modelling::FitRequest& request) {

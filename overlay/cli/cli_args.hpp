@@ -49,6 +49,9 @@ StateBox parseStateBox(const Model& m, const std::string& state, const std::stri
 /// Called in a catch block with the library's error `e`: when it is about a field of a request
 /// ("fps: ...": a field, no source), a UsageError with the field as this command line spells it
 /// (`spelling[field]`, else --field with dashes for underscores); otherwise the error rethrown.
+/// A request field as the command line spells it: "--" and the field with '-' for '_' (after its
+/// last '.': "braking.latency" is --latency), unless `spelling` names it otherwise ("output": "-o").
+std::string optionSpelling(const std::string& field, const std::map<std::string, std::string>& spelling = {});
 [[noreturn]] void rethrowAsOption(const InputError& e, const std::map<std::string, std::string>& spelling = {});
 
 /// Checks a fit request built from the options; a field out of range is a UsageError naming its

@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include "cli_args.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/input_error.hpp"
@@ -72,6 +73,7 @@ struct BagExportArgs {
 Exit runBagExport(const BagExportArgs& args) {
   overlay::BagExportOptions o = args.options;
   o.time_source = *overlay::timeSourceOf(args.time_source);  // checked by the option
+  o.spell = [](const std::string& field) { return optionSpelling(field); };
   const overlay::BagExportReport r = overlay::exportBag(o);
   for (const std::string& w : r.warnings) std::cerr << "kccd bag export: warning: " << w << "\n";
   if (args.quiet) return Exit::Ok;

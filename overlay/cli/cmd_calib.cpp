@@ -88,6 +88,7 @@ std::optional<overlay::RefineInputs> refineInputs(const CalibArgs& a, const cali
     throw UsageError(edges ? "--refine edges: needs --model (the robot drawn to match the pictures)"
                            : "--masks: needs --model (the robot drawn to match the masks)");
   overlay::RefineInputs in;
+  in.spell = [](const std::string& field) { return optionSpelling(field); };
   if (edges) in.source = calib::RefineSource::Edges;
   in.draw = a.draw;
   for (const std::string& m : a.masks) {

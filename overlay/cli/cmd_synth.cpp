@@ -112,6 +112,9 @@ Runner addSynth(CLI::App& app) {
                    : a->appearance == "volumes" ? overlay::SynthAppearance::Volumes
                                                 : overlay::SynthAppearance::Auto;
     o.collision = !a->no_collision;
+    o.spell = [](const std::string& field) {
+      return optionSpelling(field, {{"output", "-o"}, {"collision", "--no-collision"}, {"replace", "--force"}});
+    };
     return runSynth(o, a->quiet);
   };
 }

@@ -20,6 +20,7 @@ from ._kccd import fit as fit
 from ._kccd import import_urdf as import_urdf
 from ._kccd import overlay_braking as overlay_braking
 from ._kccd import overlay_recording as overlay_recording
+from ._kccd import check_overlay_request as check_overlay_request
 from ._kccd import prove_pairs as prove_pairs
 from ._kccd import read_bag as read_bag
 from ._kccd import read_frame as read_frame
@@ -53,6 +54,7 @@ __all__ = [
     "import_urdf",
     "overlay_braking",
     "overlay_recording",
+    "check_overlay_request",
     "prove_pairs",
     "read_bag",
     "read_frame",

@@ -101,6 +101,7 @@ def provenance(rec: Recording, contact_frames: int = 12) -> dict[str, Any]:
         "braking": dict(rec.braking),
         "contact_frames": contact_frames,
         "bag": provenance_bag(rec),
+        "options": provenance_options(rec),
         "inputs": {key: _file_record(getattr(rec, key)) for key in rec.input_keys()},
     }
 
@@ -108,6 +109,11 @@ def provenance(rec: Recording, contact_frames: int = 12) -> dict[str, Any]:
 def provenance_bag(rec: Recording) -> dict[str, str] | None:
     """How a robot log is read (None for a video with its state log)."""
     return {"image_topic": rec.image_topic, "joint_topic": rec.joint_topic, "time_source": rec.time_source} if rec.bag else None
+
+
+def provenance_options(rec: Recording) -> dict[str, Any]:
+    """The other overlay keywords the manifest gives (fps, masks, ...), as JSON keeps them."""
+    return {key: list(value) if isinstance(value, tuple) else value for key, value in rec.options}
 
 
 def complete_summary(rec: Recording, out_dir: str, contact_frames: int = 12) -> dict[str, Any] | None:
@@ -124,6 +130,7 @@ def complete_summary(rec: Recording, out_dir: str, contact_frames: int = 12) -> 
         if made.get("kccd_version") != _core.__version__ or made.get("time_offset") != rec.time_offset \
                 or made.get("swept") != rec.swept or made.get("braking") != dict(rec.braking) \
                 or made.get("contact_frames") != contact_frames or made.get("bag") != provenance_bag(rec) \
+                or made.get("options", {}) != provenance_options(rec) \
                 or sorted(made["inputs"]) != sorted(rec.input_keys()):
             return None
         for key in rec.input_keys():
@@ -223,9 +230,7 @@ def run_recording(rec: Recording, out_dir: str, jobs: int = 0, contact_frames: i
             model, camera, rec.video, rec.states,
             output=os.path.join(stage, "overlay.mp4"), report=os.path.join(stage, "report.json"),
             contact_sheet=os.path.join(stage, "contact_sheet.png"), timeline=os.path.join(stage, "timeline.png"),
-            time_offset=rec.time_offset, swept=rec.swept, braking=_core.BrakingParams(**dict(rec.braking)) if rec.swept else None,
-            jobs=jobs, contact_frames=contact_frames, progress=progress, progress_every=1.0, bag=rec.bag, image_topic=rec.image_topic,
-            joint_topic=rec.joint_topic, time_source=rec.time_source, joint_map=rec.joint_map)
+            jobs=jobs, contact_frames=contact_frames, progress=progress, progress_every=1.0, **rec.keywords())
         # The report names its outputs as they are once committed: beside it.
         report["video"] = "overlay.mp4"
         report["contact_sheet"] = "contact_sheet.png"

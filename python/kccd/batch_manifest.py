@@ -21,8 +21,10 @@ MAX_MANIFEST_BYTES = 4 << 20
 _RESERVED = ("summary.json", "summary.md", "colliding_frames.png")
 _ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,127}")
 _BAG_KEYS = ("image_topic", "joint_topic", "time_source", "joint_map")
-_RECORDING_KEYS = ("id", "video", "states", "bag", "model", "camera", "time_offset", "swept", "braking") + _BAG_KEYS
-_DEFAULT_KEYS = ("model", "camera", "time_offset", "swept", "braking") + _BAG_KEYS
+#: More of kccd.overlay_recording's keywords, under their own names (checked by kccd.check_overlay_request).
+OVERLAY_KEYS = ("frame_times", "ignore_columns", "fps", "max_gap", "plain", "visuals", "masks", "mask_bodies", "frames")
+_RECORDING_KEYS = ("id", "video", "states", "bag", "model", "camera", "time_offset", "swept", "braking") + _BAG_KEYS + OVERLAY_KEYS
+_DEFAULT_KEYS = ("model", "camera", "time_offset", "swept", "braking") + _BAG_KEYS + OVERLAY_KEYS
 #: The braking of swept volumes unless a manifest says otherwise (kccd overlay's defaults).
 DEFAULT_BRAKING = {field: float(getattr(_core.overlay_braking(), field))
                    for field in ("latency", "deceleration", "max_acceleration", "position_error", "velocity_error")}
@@ -41,7 +43,7 @@ class Recording:
     states: str  #: "" for a robot log
     model: str
     camera: str
-    time_offset: float
+    time_offset: float | str  #: seconds, or "auto:A:B"
     swept: bool
     line: int  #: where the manifest lists it (1-based)
     braking: tuple[tuple[str, float], ...] = tuple(DEFAULT_BRAKING.items())  #: with swept, every joint
@@ -50,11 +52,27 @@ class Recording:
     joint_topic: str = ""
     time_source: str = "header"
     joint_map: str = ""
+    frame_times: str = ""  #: with a video: each frame's time
+    #: The other keywords of kccd.overlay_recording given (OVERLAY_KEYS but frame_times), lists as tuples.
+    options: tuple[tuple[str, Any], ...] = ()
 
     def input_keys(self) -> tuple[str, ...]:
         """The fields naming this recording's input files."""
-        recording = ("bag",) if self.bag else ("video", "states")
+        recording = ("bag",) if self.bag else ("video", "states") + (("frame_times",) if self.frame_times else ())
         return recording + ("model", "camera") + (("joint_map",) if self.joint_map else ())
+
+    def keywords(self) -> dict[str, Any]:
+        """kccd.overlay_recording's keywords for this recording (but its outputs, jobs and progress)."""
+        kw: dict[str, Any] = {"time_offset": self.time_offset, "swept": self.swept}
+        if self.swept:
+            kw["braking"] = _core.BrakingParams(**dict(self.braking))
+        if self.bag:
+            kw.update(bag=self.bag, image_topic=self.image_topic, joint_topic=self.joint_topic,
+                      time_source=self.time_source, joint_map=self.joint_map)
+        elif self.frame_times:
+            kw["frame_times"] = self.frame_times
+        kw.update({k: list(v) if isinstance(v, tuple) else v for k, v in self.options})
+        return kw
 
 
 # --------------------------------------------------------------------------------------------
@@ -150,9 +168,42 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
 
     def number_field(node: yaml.Node, field: str) -> float:
         x = finite(scalar(node, field))
-        if x is None or abs(x) > 1e6:
-            raise fail(node, field, "expected a finite number of seconds (|x| <= 1e6)")
+        if x is None:
+            raise fail(node, field, "expected a finite number")
         return x
+
+    def time_offset_field(node: yaml.Node, field: str) -> float | str:
+        v = scalar(node, field)
+        if isinstance(v, str) and v.startswith("auto:"):
+            return v
+        x = finite(v)
+        if x is None:
+            raise fail(node, field, "expected a finite number of seconds, or auto:A:B")
+        return x
+
+    def texts_field(node: yaml.Node, field: str) -> tuple[str, ...]:
+        if not isinstance(node, yaml.SequenceNode) or not node.value:
+            raise fail(node, field, "expected a non-empty list of names")
+        return tuple(text_field(v, f"{field}[{k}]") for k, v in enumerate(node.value))
+
+    def overlay_options(merged: dict[str, yaml.Node], where: Any) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        for key in OVERLAY_KEYS:
+            if key not in merged or key == "frame_times":
+                continue
+            node = merged[key]
+            if key in ("fps", "max_gap"):
+                out[key] = number_field(node, where(key))
+            elif key in ("plain", "visuals"):
+                out[key] = bool_field(node, where(key))
+            elif key in ("ignore_columns", "mask_bodies"):
+                out[key] = texts_field(node, where(key))
+            elif key == "masks":
+                masks = text_field(node, where(key))
+                out[key] = masks if masks == "auto" else resolve(node, where(key))
+            else:
+                out[key] = text_field(node, where(key))
+        return out
 
     def bool_field(node: yaml.Node, field: str) -> bool:
         v = scalar(node, field)
@@ -165,9 +216,8 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
         out = dict(DEFAULT_BRAKING)
         for key, v in given.items():
             x = finite(scalar(v, f"{field}.{key}"))
-            if x is None or x < 0 or (key == "deceleration" and x <= 0):
-                raise fail(v, f"{field}.{key}", "expected a finite number " + ("> 0" if key == "deceleration" else ">= 0")
-                           + " (SI units: s, rad or m, per s, per s^2)")
+            if x is None:
+                raise fail(v, f"{field}.{key}", "expected a finite number (SI units: s, rad or m, per s, per s^2)")
             out[key] = x
         return tuple(out.items())
 
@@ -191,6 +241,7 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
 
     out: list[Recording] = []
     inputs: list[tuple[str, str, yaml.Node, str]] = []  # kind, path, its node, its field: checked below
+    nodes: list[Any] = []  # each recording's field -> (its node, its field as the manifest names it)
     first_line: dict[str, int] = {}
     for i, item in enumerate(seq.value):
         name = f"recordings[{i}]"
@@ -222,17 +273,28 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
         for key in ("model", "camera"):
             if key not in merged:
                 raise fail(item, f"{name}.{key}", "missing (give it here or in defaults)")
-        keys = ("bag", "joint_map", "model", "camera") if "bag" in rec else ("video", "states", "model", "camera")
+        keys = ("bag", "joint_map", "model", "camera") if "bag" in rec else ("video", "states", "frame_times", "model", "camera")
         paths = {key: resolve(merged[key], where(key)) for key in keys if key in merged}
         inputs += [(key, paths[key], merged[key], where(key)) for key in paths]
         if "bag" not in rec:
             for key in _BAG_KEYS:
                 if key in rec:
                     raise fail(rec[key], f"{name}.{key}", "goes with bag")
+        elif "frame_times" in rec:
+            raise fail(rec["frame_times"], f"{name}.frame_times", "not with bag (each frame has its own time)")
         topics = {key: text_field(merged[key], where(key)) for key in ("image_topic", "joint_topic") if key in merged and "bag" in rec}
         time_source = text_field(merged["time_source"], where("time_source")) if "time_source" in merged else "header"
         if time_source not in ("header", "log"):
             raise fail(merged["time_source"], where("time_source"), "expected header or log")
+
+        def node_of(field: str, merged: dict[str, yaml.Node] = merged, item: yaml.Node = item, name: str = name,
+                    where: Any = where) -> tuple[yaml.Node, str]:
+            key, dot, rest = field.partition(".")  # "braking.latency": the braking node
+            if key in merged:
+                return merged[key], where(key) + dot + rest
+            return item, f"{name}.{field}" if field else name
+
+        nodes.append(node_of)
         out.append(Recording(
             id=rid,
             video=paths.get("video", ""),
@@ -243,15 +305,31 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
             joint_map=paths.get("joint_map", "") if "bag" in rec else "",
             time_source=time_source,
             **topics,
-            time_offset=number_field(merged["time_offset"], where("time_offset")) if "time_offset" in merged else 0.0,
+            time_offset=time_offset_field(merged["time_offset"], where("time_offset")) if "time_offset" in merged else 0.0,
+            frame_times=paths.get("frame_times", ""),
+            options=tuple(overlay_options(merged, where).items()),
             swept=bool_field(merged["swept"], where("swept")) if "swept" in merged else False,
             line=item.start_mark.line + 1,
             braking=braking_field(merged["braking"], where("braking"))
             if "braking" in merged else tuple(DEFAULT_BRAKING.items()),
         ))
 
+    def check_options(models: dict[str, Any]) -> None:
+        # The overlay's own checks of every option (kccd.check_overlay_request), each named by its node.
+        for recording, node_of in zip(out, nodes):
+            try:
+                # braking is checked whether or not this recording sweeps (a manifest's value is never ignored)
+                keywords: dict[str, Any] = {**recording.keywords(), "swept": True,
+                                            "braking": _core.BrakingParams(**dict(recording.braking))}
+                _core.check_overlay_request(models.get(recording.model), recording.video, recording.states, **keywords)
+            except _core.InputError as e:
+                node, field = node_of(e.field)
+                raise fail(node, field, e.problem) from None
+
+    check_options({})
     if check_inputs:
         checked: set[tuple[str, str]] = set()
+        models: dict[str, Any] = {}
         for key, p, node, field in inputs:
             if key == "video" and _is_sequence(p):
                 try:
@@ -269,11 +347,12 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
                 checked.add((key, p))
                 try:
                     if key == "model":
-                        _core.Model.load(p)
+                        models[p] = _core.Model.load(p)
                     else:
                         _core.Camera.load(p)
                 except _core.InputError as e:
                     raise fail(node, field, _one_line(str(e))) from None
+        check_options(models)
     return out
 
 

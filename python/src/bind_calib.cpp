@@ -96,7 +96,7 @@ py::array_t<double> covarianceArray(const cv::Matx66d& c) {
 // takes it.
 cv::Mat pictureOf(const py::handle& value, std::size_t index, const calib::Camera& camera) {
   const std::string name = "pictures[" + std::to_string(index) + "]";
-  const cv::Mat grey = py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__")
+  cv::Mat grey = py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__")
                            ? calib::readImageFile(py::str(py::module_::import("os").attr("fspath")(value)).cast<std::string>(),
                                                   calib::ImageColour::Grey)
                            : greyOf(value, name);
@@ -163,7 +163,10 @@ py::array_t<double> rows(const std::vector<std::array<double, 3>>& v, int cols) 
 
 }  // namespace
 
-void bindCalib(py::module_& m) {
+namespace {
+
+// Pictures and frames of recordings, as RGB arrays.
+void bindImages(py::module_& m) {
   m.def(
       "read_image",
       [](const std::string& path) { return rgbArray(calib::readImageFile(path, calib::ImageColour::Bgr)); },
@@ -202,7 +205,10 @@ void bindCalib(py::module_& m) {
       py::arg("video"), py::arg("indices"),
       "Frames `indices` (from 0, any order) of a recording as uint8 (H, W, 3) RGB arrays, in the order asked for, "
       "decoded once up to the last one. Raises InputError naming the recording and the frame.");
+}
 
+// AprilTags: detections, layouts and their correspondences.
+void bindTags(py::module_& m) {
   py::class_<calib::TagDetection>(m, "TagDetection", "One detected AprilTag (family tag36h11).")
       .def_readonly("id", &calib::TagDetection::id)
       .def_property_readonly(
@@ -275,7 +281,10 @@ void bindCalib(py::module_& m) {
       "Pairs each detected corner of a layout tag with its world point: a dict with 'names' ('tag3.c0' ... "
       "'tag3.c3'), 'pixels' float64 (N, 2), 'world' float64 (N, 3) (metres), in detection then corner order, and "
       "'unknown_ids' (detected ids the layout lacks). A tag detected twice raises InputError naming `image`.");
+}
 
+// The pose solve and its status.
+void bindPose(py::module_& m) {
   py::list members;
   const std::pair<const char*, calib::PoseStatus> statuses[] = {
       {"SOLVED", calib::PoseStatus::Solved},
@@ -351,7 +360,10 @@ quality, SOLVED only, else None), 'residuals_px' float64 (N,) and 'inlier' bool 
 (empty when none), 'rejected' (names), 'inliers', 'covariance' float64 (6, 6) of (rvec, tvec) or None, and
 'reprojection_rms_px', 'rotation_sigma_deg', 'position_sigma_m' (None unless SOLVED). Raises InputError for a
 non-finite coordinate, an empty or repeated name, or invalid intrinsics.)doc");
+}
 
+// The pose refined to robot masks or to the pictures' edges.
+void bindRefine(py::module_& m) {
   m.def(
       "refine_to_masks",
       [](const calib::Camera& camera, const std::shared_ptr<ModelHandle>& h, const py::sequence& masks,
@@ -438,6 +450,16 @@ the bodies in view (default all); start_is_prior as refine_to_masks (for a gain 
 edges); draw as refine_to_masks. Returns the dict of refine_to_masks, with per frame 'edge_share_before' and 'edge_share_after' (the share
 of the drawn outline within 2 px of an image edge of its direction) in place of the IoUs. Raises InputError for an
 unreadable picture file (naming it), ValueError for a picture of another size, a count that does not match the
-states, or an unknown body. The GIL is released while refining.)doc");}
+states, or an unknown body. The GIL is released while refining.)doc");
+}
+
+}  // namespace
+
+void bindCalib(py::module_& m) {
+  bindImages(m);
+  bindTags(m);
+  bindPose(m);
+  bindRefine(m);
+}
 
 }  // namespace kccd::python

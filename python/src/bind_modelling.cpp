@@ -48,7 +48,10 @@ int piecesArgument(const py::object& pieces) {
 
 }  // namespace
 
-void bindModelling(py::module_& m) {
+namespace {
+
+// One part fitted (kccd fit).
+void bindFit(py::module_& m) {
   m.def(
       "fit",
       [](const std::string& path, int k, const std::string& part_name, bool merge, const std::array<double, 3>& scale,
@@ -74,7 +77,7 @@ void bindModelling(py::module_& m) {
           text = modelling::fitJson(part, request, fitted, std::filesystem::path(path).stem().string());
         });
         py::dict d = py::module_::import("json").attr("loads")(text).cast<py::dict>();
-        const auto asArray = [](py::dict body) {
+        const auto asArray = [](const py::dict& body) {
           body["points"] = py::module_::import("numpy").attr("array")(body["points"], "float64").attr("reshape")(-1, 3);
         };
         if (d.contains("pieces"))
@@ -107,7 +110,10 @@ model file writes it: {points: [...], radius: ...}; see Model.with_body_geometry
 one such record per piece with its 'name' (FILE/1, FILE/2, ...) and 'concavity', in place of 'points' ... 'yaml'.
 Raises ValueError naming the argument out of range, InputError naming the file and place for a part that cannot
 be read. The GIL is released while fitting.)doc");
+}
 
+// URDF import (kccd import).
+void bindImport(py::module_& m) {
   m.def(
       "import_urdf",
       [](const std::string& path, const std::string& srdf, const std::optional<int>& k, double tolerance,
@@ -149,7 +155,10 @@ keep_adjacent) and the SRDF's disable_collisions (srdf: its path). packages: pac
 visuals: write each link's <visual> meshes for drawing. safety_margin: metres. progress(fraction) is called with
 the GIL held. Returns the text (kccd.Model.from_yaml(text) loads it; write it to a .yaml file to keep it).
 Raises InputError naming the file, line and element on any problem.)doc");
+}
 
+// Pair proofs (kccd prove).
+void bindProve(py::module_& m) {
   m.def(
       "prove_pairs",
       [](const std::shared_ptr<ModelHandle>& h, const std::optional<double>& margin, int max_boxes, bool keep_adjacent,
@@ -209,6 +218,14 @@ list of dicts with 'a', 'b', 'frame' (their LCA frame), 'verdict' ('never', 'alw
 else None), 'witness_state' (meets: float64 (state_size,) within the limits where they meet; else None),
 'witness_distance' and 'note'; 'ignore' and 'dropped' as (a, b, reason) tuples; 'model', the model with that
 ignore list written (everything else in its text kept). progress(fraction) is called with the GIL held.)doc");
+}
+
+}  // namespace
+
+void bindModelling(py::module_& m) {
+  bindFit(m);
+  bindImport(m);
+  bindProve(m);
 }
 
 }  // namespace kccd::python

@@ -8,6 +8,8 @@
 #include <cstring>
 #include <filesystem>
 #include <cmath>
+#include <functional>
+#include <map>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
@@ -22,6 +24,7 @@
 #include "kccd/overlay/bags/bag_recording.hpp"
 #include "kccd/overlay/recording/contact_sheet.hpp"
 #include "kccd/overlay/recording/mask_agreement.hpp"
+#include "kccd/overlay/jobs/overlay_job.hpp"
 #include "kccd/overlay/recording/overlay_recording.hpp"
 #include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/synth/synth.hpp"
@@ -34,9 +37,66 @@ namespace {
 
 py::object toPython(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
+// The keywords of overlay_recording after video and states: the request's fields under their own
+// names (and progress, progress_every, read by the caller). An unknown keyword is a TypeError.
+overlay::OverlayRequest overlayRequest(const py::kwargs& kwargs) {
+  overlay::OverlayRequest q;
+  const std::map<std::string, std::function<void(const py::handle&)>> fields = {
+      {"bag", [&](const py::handle& v) { q.bag = v.cast<std::string>(); }},
+      {"image_topic", [&](const py::handle& v) { q.image_topic = v.cast<std::string>(); }},
+      {"joint_topic", [&](const py::handle& v) { q.joint_topic = v.cast<std::string>(); }},
+      {"time_source", [&](const py::handle& v) { q.time_source = v.cast<std::string>(); }},
+      {"joint_map", [&](const py::handle& v) { q.joint_map = v.cast<std::string>(); }},
+      {"frame_times", [&](const py::handle& v) { q.frame_times = v.cast<std::string>(); }},
+      {"ignore_columns", [&](const py::handle& v) { q.ignore_columns = v.cast<std::vector<std::string>>(); }},
+      {"fps", [&](const py::handle& v) { q.fps = v.cast<double>(); }},
+      {"time_offset",
+       [&](const py::handle& v) {
+         if (py::isinstance<py::str>(v)) overlay::parseTimeOffset(v.cast<std::string>(), q);
+         else q.time_offset = v.cast<double>();
+       }},
+      {"max_gap", [&](const py::handle& v) { q.max_gap = v.cast<double>(); }},
+      {"swept", [&](const py::handle& v) { q.swept = v.cast<bool>(); }},
+      {"braking",
+       [&](const py::handle& v) {
+         if (!v.is_none()) q.braking = v.cast<BrakingParams>();
+       }},
+      {"plain", [&](const py::handle& v) { q.plain = v.cast<bool>(); }},
+      {"visuals", [&](const py::handle& v) { q.visuals = v.cast<bool>(); }},
+      {"masks", [&](const py::handle& v) { q.masks = v.cast<std::string>(); }},
+      {"mask_bodies", [&](const py::handle& v) { q.mask_bodies = v.cast<std::vector<std::string>>(); }},
+      {"frames", [&](const py::handle& v) { q.frames = v.cast<std::string>(); }},
+      {"jobs", [&](const py::handle& v) { q.jobs = v.cast<int>(); }},
+      {"timings", [&](const py::handle& v) { q.timings = v.cast<bool>(); }},
+      {"output", [&](const py::handle& v) { q.output = v.cast<std::string>(); }},
+      {"codec", [&](const py::handle& v) { q.codec = v.cast<std::string>(); }},
+      {"png_dir", [&](const py::handle& v) { q.png_dir = v.cast<std::string>(); }},
+      {"report", [&](const py::handle& v) { q.report = v.cast<std::string>(); }},
+      {"contact_sheet", [&](const py::handle& v) { q.contact_sheet = v.cast<std::string>(); }},
+      {"timeline", [&](const py::handle& v) { q.timeline = v.cast<std::string>(); }},
+      {"contact_frames", [&](const py::handle& v) { q.contact_frames = v.cast<int>(); }},
+  };
+  for (const auto& [key, value] : kwargs) {
+    const std::string name = key.cast<std::string>();
+    if (name == "progress" || name == "progress_every") continue;
+    const auto f = fields.find(name);
+    if (f == fields.end()) throw py::type_error("overlay_recording() got an unexpected keyword argument '" + name + "'");
+    try {
+      f->second(value);
+    } catch (const py::cast_error&) {
+      throw py::type_error(name + ": expected " + (name == "time_offset" ? "seconds or 'auto:A:B'" : "a value of the default's type") +
+                           ", got " + py::str(py::type::handle_of(value).attr("__name__")).cast<std::string>());
+    }
+  }
+  return q;
+}
+
 }  // namespace
 
-void bindOverlay(py::module_& m) {
+namespace {
+
+// kccd overlay's braking defaults and contact sheets from frames.
+void bindContactSheet(py::module_& m) {
   m.def("overlay_braking", [] { return overlay::kOverlayBraking; },
         "kccd overlay's braking for swept volumes, every joint (latency 0.01 s, deceleration 5): the default of "
         "overlay_recording(braking=) and of kccd.batch. A fresh copy each call.");
@@ -76,131 +136,94 @@ void bindOverlay(py::module_& m) {
       R"doc(Writes a contact sheet, as `kccd overlay --contact-sheet` draws one: `frames` (uint8 (H, W, 3) RGB each)
 side by side, in order, on a grid of at most 4 columns, each scaled to tile_width pixels and captioned with its
 caption. output: a .png, written under a temporary name and renamed when complete.)doc");
+}
 
-
+// The overlay job: overlay_recording and check_overlay_request (kccd/overlay/jobs/overlay_job.hpp).
+void bindOverlayJob(py::module_& m) {
+  py::options signature_in_doc;  // overlay_recording's doc starts with its keywords and defaults
+  signature_in_doc.disable_function_signatures();
   m.def(
       "overlay_recording",
       [](const std::shared_ptr<ModelHandle>& h, const calib::Camera& camera, const std::string& video,
-         const std::string& states, const std::string& output, const std::string& report, const std::string& contact_sheet,
-         double time_offset, bool swept, const std::optional<BrakingParams>& braking, int jobs, const std::string& frames,
-         int contact_frames, const py::object& progress, double progress_every, const std::string& bag, const std::string& image_topic,
-         const std::string& joint_topic, const std::string& time_source, const std::string& joint_map, const std::string& timeline,
-         const std::string& masks, const std::vector<std::string>& mask_bodies) {
-        const Model& model = *h->model;
+         const std::string& states, const py::kwargs& kwargs) {
+        overlay::OverlayRequest q = overlayRequest(kwargs);
+        q.video = video;
+        q.states = states;
+        q.model_file = h->source;
+        const py::object progress = kwargs.contains("progress") ? py::object(kwargs["progress"]) : py::object(py::none());
+        const double progress_every = kwargs.contains("progress_every") ? kwargs["progress_every"].cast<double>() : 0.0;
         if (!(progress_every >= 0.0) || !std::isfinite(progress_every))
           throw py::value_error("progress_every: must be a finite number of seconds >= 0");
-        if (bag.empty() == (video.empty() || states.empty()) || (!bag.empty() && (!video.empty() || !states.empty())))
-          throw py::value_error("give video and states, or bag (a robot log), not both");
-        if (bag.empty() && (!image_topic.empty() || !joint_topic.empty() || !joint_map.empty()))
-          throw py::value_error("image_topic, joint_topic and joint_map go with bag");
-        const std::optional<overlay::TimeSource> clock = overlay::timeSourceOf(time_source);
-        if (!clock) throw py::value_error("time_source: expected 'header' or 'log'");
-        std::optional<overlay::BagRecording> rec;
-        if (!bag.empty())
-          rec = overlay::readBagRecording({.bag = bag, .joint_topic = joint_topic, .image_topic = image_topic,
-                                           .time_source = *clock,
-                                           .joint_map = joint_map.empty() ? overlay::JointMap{} : overlay::loadJointMap(joint_map, model)},
-                                          model);
-        if (rec)
-          for (const std::string& w : rec->warnings)
-            if (PyErr_WarnEx(PyExc_UserWarning, ("bag " + bag + ": " + w).c_str(), 1) < 0) throw py::error_already_set();
-        const StateLog log = rec ? rec->log : loadStateLog(states, model);
-        overlay::OverlayInputs in{model, camera, log, rec ? bag : video, {}, rec ? "bag " + bag + " (topic " + rec->image_topic + ")" : "video " + video,
-                                  "camera", ""};
-        if (rec) {
-          in.frame_times = rec->frame_times;
-          in.open_frames = rec->open_frames;
-        }
-        std::optional<overlay::MaskAgreement> agreement;
-        if (!masks.empty()) {
-          std::vector<int> bodies;
-          for (const std::string& name : mask_bodies) {
-            const int b = model.bodyIndex(name);
-            if (b < 0) throw py::value_error("mask_bodies: '" + name + "' is not a body of the model");
-            bodies.push_back(b);
-          }
-          if (masks == "auto") agreement.emplace(camera, model, std::move(bodies), "masks auto");
-          else agreement.emplace(masks, camera, model, std::move(bodies), "masks " + masks);
-          in.masks = &*agreement;
-        } else if (!mask_bodies.empty()) {
-          throw py::value_error("mask_bodies: goes with masks");
-        }
-        overlay::OverlayOptions o;
-        o.time_offset = time_offset;
-        o.swept = swept;
-        if (braking) {
-          if (!swept) throw py::value_error("braking: only with swept=True (static volumes do not brake)");
-          const BrakingParams& b = *braking;
-          for (const auto& [field, value] : {std::pair{"position_error", b.position_error}, {"velocity_error", b.velocity_error},
-                                             {"latency", b.latency}, {"max_acceleration", b.max_acceleration}})
-            if (!(value >= 0.0) || !std::isfinite(value))
-              throw py::value_error(std::string("braking: ") + field + " must be a finite number >= 0");
-          if (!(b.deceleration > 0.0) || !std::isfinite(b.deceleration))
-            throw py::value_error("braking: deceleration must be a finite number > 0");
-          o.braking = b;
-        }
-        o.jobs = jobs;
-        o.frames = overlay::parseFrameRange(frames, "frames");
-        if (contact_frames < 1 || contact_frames > 64) throw py::value_error("contact_frames: expected 1 to 64");
-        o.contact_frames = contact_sheet.empty() ? 0 : static_cast<std::size_t>(contact_frames);
-        const overlay::OverlayOutputs outputs{.video = output,
-                                              .report = report,
-                                              .contact_sheet = contact_sheet,
-                                              .video_option = "output",
-                                              .report_option = "report",
-                                              .contact_sheet_option = "contact_sheet",
-                                              .frames_option = "frames",
-                                              .timeline = timeline,
-                                              .timeline_option = "timeline",
-                                              .timeline_title = std::filesystem::path(rec ? bag : video).filename().string()};
-        overlay::checkOverlayOutputs(outputs, std::vector<std::string>{video, states, bag, joint_map, h->source});
-        overlay::VideoSink sink({.video = output, .codec = "", .video_label = "output " + output, .png_dir = "", .png_label = ""});
+        overlay::OverlayJob job(q, *h->model, camera);
+        for (const std::string& w : job.warnings())
+          if (PyErr_WarnEx(PyExc_UserWarning, ("bag " + q.bag + ": " + w).c_str(), 1) < 0) throw py::error_already_set();
         ProgressRelay relay{progress, {}};
         nlohmann::json full;
         relay.run([&] {
-          overlay::OverlayReport r = overlay::overlayRecording(
-              in, o, sink.active() ? &sink : nullptr,
-              [&, last = std::chrono::steady_clock::time_point{}](const overlay::OverlayProgress& p) mutable {
-                // Throttled before the GIL is asked for: each acquisition may wait for Python's
-                // switch interval while other Python threads run (a Dask worker's event loop).
-                const auto now = std::chrono::steady_clock::now();
-                const bool last_frame = p.frames_expected > 0 && p.frames_done >= p.frames_expected;
-                if (!last_frame && last.time_since_epoch().count() != 0 &&
-                    std::chrono::duration<double>(now - last).count() < progress_every)
-                  return;
-                last = now;
-                relay(p.frames_done, p.frames_expected, p.frames_per_second);
-              });
-          if (rec) r.source = rec->source();
-          full = overlay::writeOverlayOutputs(outputs, r, model, sink);
+          full = job.run([&, last = std::chrono::steady_clock::time_point{}](const overlay::OverlayProgress& p) mutable {
+                       // Throttled before the GIL is asked for: each acquisition may wait for Python's
+                       // switch interval while other Python threads run (a Dask worker's event loop).
+                       const auto now = std::chrono::steady_clock::now();
+                       const bool last_frame = p.frames_expected > 0 && p.frames_done >= p.frames_expected;
+                       if (!last_frame && last.time_since_epoch().count() != 0 &&
+                           std::chrono::duration<double>(now - last).count() < progress_every)
+                         return;
+                       last = now;
+                       relay(p.frames_done, p.frames_expected, p.frames_per_second);
+                     })
+                     .json;
         });
         return toPython(full);
       },
-      py::arg("model"), py::arg("camera"), py::arg("video") = "", py::arg("states") = "", py::kw_only(), py::arg("output") = "",
-      py::arg("report") = "", py::arg("contact_sheet") = "", py::arg("time_offset") = 0.0, py::arg("swept") = false,
-      py::arg("braking") = py::none(), py::arg("jobs") = 0, py::arg("frames") = "", py::arg("contact_frames") = 12, py::arg("progress") = py::none(),
-      py::arg("progress_every") = 0.0, py::arg("bag") = "", py::arg("image_topic") = "", py::arg("joint_topic") = "",
-      py::arg("time_source") = "header", py::arg("joint_map") = "", py::arg("timeline") = "", py::arg("masks") = "",
-      py::arg("mask_bodies") = std::vector<std::string>{},
-      R"doc(The main job, as `kccd overlay`: every frame of `video` (a file or an image-sequence pattern) checked at
-the state the log `states` (CSV) gives at its time (log time = frame time + time_offset, seconds), the
-volumes drawn and composited. Outputs, checked before any frame is decoded (extension, an existing
-folder, not one of the inputs) and each written under a temporary name and renamed when complete:
-`output` (.mp4, .mkv or .avi), `report` (.json, the format of `kccd overlay --report`), `contact_sheet`
-(.png of contact_frames frames). swept: braking-interval volumes, with `braking` (a BrakingParams for every
-joint; None: kccd overlay's defaults, latency 0.01 s and deceleration 5). jobs: drawing threads (0: all cores).
-frames: 'FIRST:END:STEP' of the frames drawn (all are checked). progress(frames_done, frames_expected,
-frames_per_second) is called after each frame with the GIL held (progress_every: at most once per that many
-seconds, and after the last frame). Returns the report as a dict (with
-per-frame records under 'frames'). Instead of video and states, bag: a robot log (MCAP, rosbag2 .db3 or
-folder, ROS 1 .bag) whose image topic gives the frames at their own times and whose joint states give
-the states, as `kccd overlay --bag` (image_topic, joint_topic: default the only one of the type;
-time_source 'header' or 'log'; joint_map: a joint map file; warnings as UserWarning). timeline: a .png of
-the run over time (`kccd overlay --timeline`). masks: a folder of robot masks (frame_000000.png, ...) or
-'auto' (made from the recording's own background), as `kccd overlay --masks`: each frame's 'mask_iou' and the
-report's 'mask_agreement'; mask_bodies: the bodies the masks show (default all). Raises InputError naming the
-input and place.)doc");
+      py::arg("model"), py::arg("camera"), py::arg("video") = "", py::arg("states") = "",
+      R"doc(overlay_recording(model, camera, video='', states='', *, bag='', image_topic='', joint_topic='',
+time_source='header', joint_map='', frame_times='', ignore_columns=[], fps=0.0, time_offset=0.0, max_gap=0.0,
+swept=False, braking=None, plain=False, visuals=False, masks='', mask_bodies=[], frames='', jobs=0,
+timings=False, output='', codec='', png_dir='', report='', contact_sheet='', timeline='', contact_frames=12,
+progress=None, progress_every=0.0)
 
+The main job, as `kccd overlay` (every option of it under its own name, with its default and its checks):
+every frame of `video` (a file or an image-sequence pattern) checked at the state the log `states` (CSV)
+gives at its time (log time = frame time + time_offset, seconds; time_offset 'auto:A:B' searches [A, B];
+frame_times: a CSV 'frame,time' instead of index / fps; max_gap: the largest log gap bridged), the volumes
+drawn and composited. Outputs, checked before any frame is decoded (extension, an existing folder, not one
+of the inputs) and each written under a temporary name and renamed when complete: `output` (.mp4, .mkv or
+.avi; codec: a FourCC), `png_dir` (frame_NNNNNN.png), `report` (.json, the format of `kccd overlay
+--report`), `contact_sheet` (.png of contact_frames frames), `timeline` (.png of the run over time).
+swept: braking-interval volumes, with `braking` (a BrakingParams for every joint; None: kccd overlay's
+defaults, latency 0.01 s and deceleration 5). plain: no legend or status line; visuals: the model's
+visual geometry too. jobs: drawing threads (0: all cores). frames: 'FIRST:END:STEP' of the frames drawn
+(all are checked). progress(frames_done, frames_expected, frames_per_second) is called after each frame
+with the GIL held (progress_every: at most once per that many seconds, and after the last frame). Returns
+the report as a dict (with per-frame records under 'frames'). Instead of video and states, bag: a robot
+log (MCAP, rosbag2 .db3 or folder, ROS 1 .bag) whose image topic gives the frames at their own times and
+whose joint states give the states, as `kccd overlay --bag` (image_topic, joint_topic: default the only
+one of the type; time_source 'header' or 'log'; joint_map: a joint map file; warnings as UserWarning).
+masks: a folder of robot masks (frame_000000.png, ...) or 'auto' (made from the recording's own
+background): each frame's 'mask_iou' and the report's 'mask_agreement'; mask_bodies: the bodies the masks
+show (default all). An unknown keyword raises TypeError; a bad value InputError naming the keyword
+("fps: must be in ..."), a bad file InputError naming the file and place.)doc");
+  m.def(
+      "check_overlay_request",
+      [](const std::shared_ptr<ModelHandle>& h, const std::string& video, const std::string& states, const py::kwargs& kwargs) {
+        overlay::OverlayRequest q = overlayRequest(kwargs);
+        q.video = video;
+        q.states = states;
+        if (h) q.model_file = h->source;
+        overlay::checkOverlayRequest(q, h ? h->model.get() : nullptr);
+      },
+      py::arg("model") = nullptr, py::arg("video") = "", py::arg("states") = "",
+      R"doc(check_overlay_request(model=None, video='', states='', **keywords)
+
+Checks overlay_recording's keywords as overlay_recording does before it reads anything, opening no file
+(without a model, visuals and mask_bodies are not checked): raises the first problem as InputError naming
+the keyword ("fps: must be in ...", field in e.field), TypeError for an unknown keyword. kccd.batch checks
+each recording of a manifest with it before any starts.)doc");
+  signature_in_doc.enable_function_signatures();
+}
+
+// What a robot log holds, and what kccd overlay --bag reads of it.
+void bindReadBag(py::module_& m) {
   m.def(
       "read_bag",
       [](const std::string& path, const std::shared_ptr<ModelHandle>& h, const std::string& image_topic, const std::string& joint_topic,
@@ -260,7 +283,10 @@ clock), 'states' (one row per joint state, the model's state values matched by n
 interval's rate), 'warnings'. frames: indices of the image topic's frames returned under 'images' as uint8
 (H, W, 3) RGB. time_source: 'header' (header stamps) or 'log' (the recorder's times). Raises InputError
 naming the file, topic and place.)doc");
+}
 
+// Synthetic recordings with ground truth (kccd synth).
+void bindSynth(py::module_& m) {
   m.def(
       "synthesize_recording",
       [](const std::string& model, const std::string& output, const std::string& camera, double seconds, double fps,
@@ -284,6 +310,9 @@ naming the file, topic and place.)doc");
         o.codec = codec;
         o.collision = collision;
         o.replace = replace;
+        o.spell = [](const std::string& field) -> std::string {
+          return field == "collision" ? "collision=False" : field == "replace" ? "replace=True" : field;
+        };
         ProgressRelay relay{progress, {}};
         overlay::SynthResult r;
         relay.run([&] { r = overlay::synthesizeRecording(o, [&](double fraction) { relay(fraction); }); });
@@ -319,6 +348,15 @@ drawn radius fraction), blur and noise (sigmas). An option out of range raises I
 1 ... 240"). progress(fraction) is called after each frame with the GIL held. Returns
 a dict with the files' paths and the truth: per-frame 'min_distance' (metres), 'colliding_frames',
 'near_frames', 'collision_intervals' ([first, last] frames).)doc");
+}
+
+}  // namespace
+
+void bindOverlay(py::module_& m) {
+  bindContactSheet(m);
+  bindOverlayJob(m);
+  bindReadBag(m);
+  bindSynth(m);
 }
 
 }  // namespace kccd::python

@@ -3,6 +3,7 @@ with a corrupted video) give two outputs equal to `kccd overlay` on each and one
 a worker killed mid-run has its recording run again to completion; --resume runs only what is
 missing or changed; manifest mistakes are named by line and start nothing."""
 
+import dataclasses
 import json
 import os
 import pathlib
@@ -221,7 +222,28 @@ def test_resume_runs_only_what_is_missing(fleet: pathlib.Path, client, tmp_path:
      "  - {id: x, video: a/frame_%06d.png, states: a/states.csv}\n", "4: recordings[0].video: "),
     ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
      "  - {id: x, video: a/video.mkv, states: a/states.csv, braking: {deceleration: 0}}\n",
-     "4: recordings[0].braking.deceleration: expected a finite number > 0"),
+     "4: recordings[0].braking.deceleration: must be in [1e-09, 1000000000], got 0"),
+    # The overlay's own checks (kccd.check_overlay_request), placed at the value's line.
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: x, video: a/video.mkv, states: a/states.csv,\n     fps: -1}\n",
+     "5: recordings[0].fps: must be in [1e-06, 1000000], got -1"),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml, mask_bodies: [upper_arm]}\nrecordings:\n"
+     "  - {id: x, video: a/video.mkv, states: a/states.csv}\n", "2: defaults.mask_bodies: goes with masks"),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: x, video: a/video.mkv, states: a/states.csv, time_offset: 'auto:2:1'}\n",
+     "4: recordings[0].time_offset: expected auto:A:B with A < B"),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: x, video: a/video.mkv, states: a/states.csv, visuals: true}\n",
+     "4: recordings[0].visuals: the model has no visuals:"),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: x, video: a/video.mkv, states: a/states.csv, masks: auto, mask_bodies: [arm]}\n",
+     "4: recordings[0].mask_bodies: 'arm' is not a body of"),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: x, video: a/video.mkv, states: a/states.csv, frame_times: a/none.csv}\n",
+     "4: recordings[0].frame_times: "),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
+     "  - {id: x, video: a/video.mkv, states: a/states.csv, max_gap: 1e400}\n",
+     "4: recordings[0].max_gap: expected a finite number"),
 ])
 def test_manifest_mistakes(fleet: pathlib.Path, tmp_path: pathlib.Path, body: str, where: str) -> None:
     manifest = fleet / f"bad-{abs(hash(body))}.yaml"
@@ -233,6 +255,37 @@ def test_manifest_mistakes(fleet: pathlib.Path, tmp_path: pathlib.Path, body: st
     run = subprocess.run([sys.executable, "-m", "kccd.batch", str(manifest), "--out", str(tmp_path / "out")],
                          capture_output=True, text=True)
     assert run.returncode == 2 and where in run.stderr and not (tmp_path / "out").exists()
+
+
+def test_manifest_takes_the_overlays_options(cli, fleet: pathlib.Path, tmp_path: pathlib.Path) -> None:
+    # Options beyond the clock and braking reach the overlay as kccd overlay's flags do: the same report.
+    (fleet / "a" / "times.csv").write_text("frame,time\n" + "".join(f"{i},{i * 0.041:.3f}\n" for i in range(25)))
+    manifest = fleet / "options.yaml"
+    manifest.write_text("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml, plain: true}\n"
+                        "recordings:\n  - {id: opts, video: a/video.mkv, states: a/states.csv, frame_times: a/times.csv,\n"
+                        "     max_gap: 0.05, time_offset: 'auto:0:0.3', frames: '0:25:5'}\n")
+    [rec] = batch.read_manifest(str(manifest))
+    assert rec.frame_times == str(fleet / "a" / "times.csv") and "frame_times" in rec.input_keys()
+    assert dict(rec.options) == {"plain": True, "max_gap": 0.05, "frames": "0:25:5"}
+    summary = batch.run_recording(rec, str(tmp_path / "out"), jobs=1)
+    assert summary["status"] == "done" and summary["frames_total"] == 25
+    mine = json.loads((tmp_path / "out" / "opts" / "report.json").read_text())
+    made = json.loads((tmp_path / "out" / "opts" / "inputs.json").read_text())
+    assert made["options"] == {"plain": True, "max_gap": 0.05, "frames": "0:25:5"} and "frame_times" in made["inputs"]
+    subprocess.run([str(cli), "overlay", str(fleet / "arm.yaml"), "--camera", str(fleet / "a" / "camera_true.yaml"),
+                    "--video", str(fleet / "a" / "video.mkv"), "--states", str(fleet / "a" / "states.csv"),
+                    "--frame-times", str(fleet / "a" / "times.csv"), "--max-gap", "0.05", "--time-offset", "auto:0:0.3",
+                    "--frames", "0:25:5", "--plain", "--report", str(tmp_path / "cli.json"), "-q"], check=True)
+    ref = json.loads((tmp_path / "cli.json").read_text())
+    assert [f["written"] for f in mine["frames"]] == [i % 5 == 0 for i in range(25)]  # frames 0:25:5 into the video
+
+    def checked(report: dict) -> list[dict]:  # what each frame was found (the command wrote no video)
+        return [{k: v for k, v in f.items() if k != "written"} for f in report["frames"]]
+
+    assert checked(mine) == checked(ref) and mine["time_offset"] == ref["time_offset"] and mine["max_gap"] == 0.05
+    assert batch.complete_summary(rec, str(tmp_path / "out")) is not None
+    changed = dataclasses.replace(rec, options=(("plain", True), ("max_gap", 0.06), ("frames", "0:25:5")))
+    assert batch.complete_summary(changed, str(tmp_path / "out")) is None, "another option: run again"
 
 
 def test_only_and_usage(fleet: pathlib.Path, tmp_path: pathlib.Path) -> None:

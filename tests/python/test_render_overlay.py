@@ -137,13 +137,13 @@ def test_overlay_braking_is_checked(arm: kccd.Model, camera: kccd.Camera, tmp_pa
     states = tmp_path / "s.csv"
     states.write_text("time,shoulder_yaw,shoulder_pitch,elbow\n0,0,0,0\n0.1,0,0,0\n")
     video = str(tmp_path / "none_%04d.png")
-    with pytest.raises(ValueError, match="only with swept=True"):
+    with pytest.raises(ValueError, match="^braking: only with swept "):
         kccd.overlay_recording(arm, camera, video, str(states), braking=kccd.BrakingParams(latency=0.01))
     for field in ("latency", "position_error", "velocity_error", "max_acceleration"):
-        with pytest.raises(ValueError, match=f"braking: {field}"):
+        with pytest.raises(ValueError, match=rf"^braking\.{field}: must be in \["):
             kccd.overlay_recording(arm, camera, video, str(states), swept=True,
                                    braking=kccd.BrakingParams(**{field: -1.0}))  # type: ignore[arg-type]
-    with pytest.raises(ValueError, match="deceleration"):
+    with pytest.raises(ValueError, match=r"^braking\.deceleration: must be in \[1e-09, 1000000000\], got nan"):
         kccd.overlay_recording(arm, camera, video, str(states), swept=True,
                                braking=kccd.BrakingParams(deceleration=float("nan")))
 
@@ -202,3 +202,99 @@ def test_overlay_masks_equal_cli(cli, arm: kccd.Model, tmp_path: pathlib.Path) -
             assert py["mask_agreement"]["frames"] == s["frames"] and py["mask_agreement"]["mean_iou"] > 0.6
     with pytest.raises(ValueError, match="mask_bodies: 'arm' is not a body"):
         kccd.overlay_recording(arm, camera, s["video"], s["states"], masks=masks, mask_bodies=["arm"], report=str(tmp_path / "x.json"))
+
+
+# kccd overlay and kccd.overlay_recording are two spellings of one request (kccd/overlay/jobs/
+# overlay_job.hpp): every option has its keyword with the same default, and a bad value gets the same
+# message with the field spelled by each front end.
+OVERLAY_CLI_ONLY = {"--help", "--json", "--quiet", "--camera"}  # printing; Python takes a loaded Camera
+BRAKING_OPTIONS = {"--latency", "--deceleration", "--max-acceleration", "--position-error", "--velocity-error"}
+BRAKING_SPELLED = ", ".join(sorted(BRAKING_OPTIONS, key=["--latency", "--deceleration", "--max-acceleration",
+                                                          "--position-error", "--velocity-error"].index)[:-1]) + \
+    " and --velocity-error"
+
+
+def _overlay_keywords() -> dict[str, str]:
+    signature = " ".join(kccd.overlay_recording.__doc__.split("\n\n")[0].split())
+    assert signature.startswith("overlay_recording(model, camera, video='', states='', *,"), signature
+    return dict(re.findall(r"(\w+)=('[^']*'|\[\]|[\w.]+)", signature))
+
+
+def _python_default(text: str) -> object:
+    return {"''": "", "[]": "", "None": None, "False": False, "True": True}.get(text, text.strip("'"))
+
+
+def _field(option: str) -> str:
+    return "output" if option == "-o" else option[2:].replace("-", "_")
+
+
+def _as_fields(message: str) -> str:
+    # The command line's spelling of fields made Python's: "--max-gap" -> "max_gap", "-o" -> "output".
+    message = message.replace(BRAKING_SPELLED, "braking")
+    return re.sub(r"(?<![\w-])(--[a-z][a-z-]*|-o\b)",
+                  lambda m: ("braking." if m.group(1) in BRAKING_OPTIONS else "") + _field(m.group(1)), message)
+
+
+def test_every_overlay_option_has_its_python_keyword(cli, tmp_path: pathlib.Path) -> None:
+    text = subprocess.run([str(cli), "overlay", "--help"], check=True, capture_output=True, text=True).stdout
+    options = dict(re.findall(r"^\s+(?:-\w,)?(--[\w-]+)(?: [A-Z]+(?:=(\S+))?)?", text, re.M))
+    keywords = _overlay_keywords()
+    fields = {_field(o) for o in set(options) - OVERLAY_CLI_ONLY - BRAKING_OPTIONS} | {"braking"}
+    assert fields == set(keywords) - {"progress", "progress_every"}, sorted(fields ^ set(keywords))
+    for option, default in options.items():
+        if option in OVERLAY_CLI_ONLY or option in BRAKING_OPTIONS:
+            continue
+        py = _python_default(keywords[_field(option)])
+        cli_default: object = default or ""
+        if py in (False, True):  # a flag
+            assert cli_default == "" and py is False, option
+        elif isinstance(py, str) and py and py[0].isdigit():
+            assert float(cli_default or 0) == float(py), (option, cli_default, py)
+        else:
+            assert cli_default == py, (option, cli_default, py)
+    b = kccd.overlay_braking()
+    for option in BRAKING_OPTIONS:
+        assert float(options[option]) == getattr(b, _field(option)), option
+
+
+def test_overlay_messages_are_the_same_from_both_front_ends(cli, arm: kccd.Model, tmp_path: pathlib.Path) -> None:
+    s = kccd.synthesize_recording(str(DATA / "demo_arm.yaml"), str(tmp_path / "rec"), seconds=0.2)
+    camera = kccd.Camera.load(s["camera"])
+    swept = {"swept": True}
+    cases: list[tuple[list[str], dict[str, object]]] = [
+        (["--fps", "-1"], {"fps": -1.0}),
+        (["--max-gap", "-1"], {"max_gap": -1.0}),
+        (["--jobs", "300"], {"jobs": 300}),
+        (["--contact-frames", "0"], {"contact_frames": 0}),
+        (["--time-offset", "auto:2:1"], {"time_offset": "auto:2:1"}),
+        (["--time-offset", "soon"], {"time_offset": "soon"}),
+        (["--time-offset", "2e9"], {"time_offset": 2e9}),
+        (["--codec", "xx"], {"codec": "xx"}),
+        (["--frames", "5:2"], {"frames": "5:2"}),
+        (["--mask-bodies", "upper_arm"], {"mask_bodies": ["upper_arm"]}),
+        (["--masks", "auto", "--mask-bodies", "arm"], {"masks": "auto", "mask_bodies": ["arm"]}),
+        (["--latency", "0.5"], {"braking": kccd.BrakingParams(latency=0.5, deceleration=5.0)}),
+        (["--swept", "--latency", "1e4"], {**swept, "braking": kccd.BrakingParams(latency=1e4, deceleration=5.0)}),
+        (["--swept", "--deceleration", "0"], {**swept, "braking": kccd.BrakingParams(latency=0.01, deceleration=0.0)}),
+        (["--image-topic", "/c"], {"image_topic": "/c"}),
+        (["--joint-map", "m.yaml"], {"joint_map": "m.yaml"}),
+        (["--time-source", "wall"], {"time_source": "wall"}),
+        (["--visuals"], {"visuals": True}),
+        (["-o", str(tmp_path / "x.mov")], {"output": str(tmp_path / "x.mov")}),
+        (["--timeline", str(tmp_path / "no" / "t.png")], {"timeline": str(tmp_path / "no" / "t.png")}),
+        (["--frame-times", str(tmp_path / "none.csv")], {"frame_times": str(tmp_path / "none.csv")}),
+        (["--ignore-columns", "time"], {"ignore_columns": ["time"]}),
+    ]
+    base = [str(cli), "overlay", str(DATA / "demo_arm.yaml"), "--camera", s["camera"], "--video", s["video"],
+            "--states", s["states"], "--report", str(tmp_path / "r.json")]
+    for args, kwargs in cases:
+        run = subprocess.run(base + args, capture_output=True, text=True)
+        assert run.returncode == 2 and run.stderr.startswith("kccd: "), (args, run.stderr)
+        with pytest.raises(kccd.InputError) as e:
+            kccd.overlay_recording(arm, camera, s["video"], s["states"], report=str(tmp_path / "r.json"), **kwargs)
+        assert _as_fields(run.stderr.strip()[len("kccd: "):]) == str(e.value), args
+        assert not (tmp_path / "r.json").exists()
+    with pytest.raises(TypeError, match="unexpected keyword argument 'fsp'"):
+        kccd.overlay_recording(arm, camera, s["video"], s["states"], fsp=25.0)
+    with pytest.raises(TypeError, match="fps: expected"):
+        kccd.overlay_recording(arm, camera, s["video"], s["states"], fps="fast")

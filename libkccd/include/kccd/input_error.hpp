@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -49,6 +50,16 @@ class InputError : public std::runtime_error {
   };
   std::shared_ptr<const Data> data_;  // shared: copying an exception must not throw
 };
+
+/// How a front end spells a request's field in messages ("fps" -> "--fps" on the command line). An
+/// empty one leaves the field as it is (Python's keyword, a manifest's key).
+using FieldSpelling = std::function<std::string(const std::string& field)>;
+/// `field` as `spell` spells it.
+inline std::string spelledField(const FieldSpelling& spell, const std::string& field) { return spell ? spell(field) : field; }
+
+/// A request's field out of range: "must be in [lo, hi], got value" (NaN refused), thrown as an
+/// InputError with the field and no source. Returns `value`.
+double checkFieldRange(double value, double lo, double hi, const std::string& field);
 
 /// `value` as messages print it: printf's %g with `digits` significant digits (formatNumber).
 inline std::string messageNumber(double value, int digits = 10) { return formatNumber(value, digits); }

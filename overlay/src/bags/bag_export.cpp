@@ -96,18 +96,21 @@ cv::Mat imageOf(const Value& msg, bool compressed, const std::string& at) {
 }
 
 BagExportReport exportBag(const BagExportOptions& o) {
+  const auto named = [&](const std::string& field) { return spelledField(o.spell, field); };
   if (o.states.empty() && o.video.empty() && o.camera_info.empty())
-    throw InputError("kccd bag export: nothing to write: give --states, --video (with --frame-times) or --camera-info");
+    throw InputError("nothing to write: give " + named("states") + ", " + named("video") + " (with " + named("frame_times") +
+                     ") or " + named("camera_info"));
   if (!o.video.empty() && o.frame_times.empty())
-    throw InputError("--video " + o.video + ": needs --frame-times (a bag's frames are not evenly spaced)");
-  if (!o.frame_times.empty() && o.video.empty()) throw InputError("--frame-times " + o.frame_times + ": needs --video");
-  if (!o.states.empty()) checkOutputPath(o.states, "--states", ".csv");
-  if (!o.frame_times.empty()) checkOutputPath(o.frame_times, "--frame-times", ".csv");
-  if (!o.camera_info.empty()) checkOutputPath(o.camera_info, "--camera-info", ".yaml");
+    throw InputError(named("video") + " " + o.video + ": needs " + named("frame_times") + " (a bag's frames are not evenly spaced)");
+  if (!o.frame_times.empty() && o.video.empty()) throw InputError(named("frame_times") + " " + o.frame_times + ": needs " + named("video"));
+  if (!o.states.empty()) checkOutputPath(o.states, named("states"), ".csv");
+  if (!o.frame_times.empty()) checkOutputPath(o.frame_times, named("frame_times"), ".csv");
+  if (!o.camera_info.empty()) checkOutputPath(o.camera_info, named("camera_info"), ".yaml");
   if (!o.video.empty()) {
     const std::string ext = lowerExtension(o.video);
-    if (ext != ".mp4" && ext != ".mkv" && ext != ".avi") throw OutputError("--video " + o.video + ": the output must be a .mp4, .mkv or .avi file");
-    checkOutputPath(o.video, "--video", ext);
+    if (ext != ".mp4" && ext != ".mkv" && ext != ".avi")
+      throw OutputError(named("video") + " " + o.video + ": the output must be a .mp4, .mkv or .avi file");
+    checkOutputPath(o.video, named("video"), ext);
   }
   BagExportReport report;
   // Pass 1: which topics there are, and what the chosen ones hold.
@@ -116,9 +119,9 @@ BagExportReport exportBag(const BagExportOptions& o) {
   const LogSource* joints = nullptr;
   const LogSource* images = nullptr;
   const LogSource* info = nullptr;
-  if (!o.states.empty()) joints = sourceOf(sources, report.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, "--joint-topic", "sensor_msgs/JointState", o.bag));
-  if (!o.video.empty()) images = sourceOf(sources, report.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic, "--image-topic", "sensor_msgs/Image or CompressedImage", o.bag));
-  if (!o.camera_info.empty()) info = sourceOf(sources, report.camera_info_topic = chooseTopic(sources, {LogKind::CameraInfo}, o.camera_info_topic, "--camera-info-topic", "sensor_msgs/CameraInfo", o.bag));
+  if (!o.states.empty()) joints = sourceOf(sources, report.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, named("joint_topic"), "sensor_msgs/JointState", o.bag));
+  if (!o.video.empty()) images = sourceOf(sources, report.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic, named("image_topic"), "sensor_msgs/Image or CompressedImage", o.bag));
+  if (!o.camera_info.empty()) info = sourceOf(sources, report.camera_info_topic = chooseTopic(sources, {LogKind::CameraInfo}, o.camera_info_topic, named("camera_info_topic"), "sensor_msgs/CameraInfo", o.bag));
   if (joints) {
     if (joints->names.empty()) throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": the first joint state names no joint");
     std::vector<std::string> sorted = joints->names;
@@ -139,7 +142,7 @@ BagExportReport exportBag(const BagExportOptions& o) {
   std::optional<StagedOutput> states_out, times_out;
   std::ofstream states_file, times_file;
   if (joints) {
-    states_out.emplace(o.states, StagedOutput::Kind::File, "--states " + o.states);
+    states_out.emplace(o.states, StagedOutput::Kind::File, named("states") + " " + o.states);
     states_file.open(states_out->path(), std::ios::binary);
     states_file << "time";
     for (const std::string& n : report.joints) states_file << "," << n;
@@ -149,12 +152,12 @@ BagExportReport exportBag(const BagExportOptions& o) {
   }
   std::unique_ptr<VideoSink> sink;
   if (images) {
-    times_out.emplace(o.frame_times, StagedOutput::Kind::File, "--frame-times " + o.frame_times);
+    times_out.emplace(o.frame_times, StagedOutput::Kind::File, named("frame_times") + " " + o.frame_times);
     times_file.open(times_out->path(), std::ios::binary);
     times_file << "frame,time\n";
     VideoSinkOptions vo;
     vo.video = o.video;
-    vo.video_label = "--video " + o.video;
+    vo.video_label = named("video") + " " + o.video;
     sink = std::make_unique<VideoSink>(vo);
   }
   std::string camera_text;
@@ -244,16 +247,16 @@ BagExportReport exportBag(const BagExportOptions& o) {
   // All or nothing: every output in place only once all are written.
   if (states_file.is_open()) {
     states_file.close();
-    if (!states_file) throw OutputError("--states " + o.states + ": cannot be written");
+    if (!states_file) throw OutputError(named("states") + " " + o.states + ": cannot be written");
   }
   if (times_file.is_open()) {
     times_file.close();
-    if (!times_file) throw OutputError("--frame-times " + o.frame_times + ": cannot be written");
+    if (!times_file) throw OutputError(named("frame_times") + " " + o.frame_times + ": cannot be written");
   }
   if (sink) sink->commit();
   if (states_out) states_out->commit();
   if (times_out) times_out->commit();
-  if (!camera_text.empty()) writeFileAtomically(o.camera_info, camera_text, "--camera-info " + o.camera_info);
+  if (!camera_text.empty()) writeFileAtomically(o.camera_info, camera_text, named("camera_info") + " " + o.camera_info);
   return report;
 }
 

@@ -181,7 +181,7 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
           r.problem = e.what();
         }
       });
-  rec.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic, "--image-topic", "sensor_msgs/Image or CompressedImage", o.bag);
+  rec.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic, spelledField(o.spell, "image_topic"), "sensor_msgs/Image or CompressedImage", o.bag);
   const LogSource& images = *sourceOf(sources, rec.image_topic);
   if (!model) {
     rec.origin_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(images.first, 0));
@@ -189,7 +189,7 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
     imageTimes(o, images, rec);
     return rec;
   }
-  rec.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, "--joint-topic", "sensor_msgs/JointState", o.bag);
+  rec.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, spelledField(o.spell, "joint_topic"), "sensor_msgs/JointState", o.bag);
   std::uint16_t joint_channel = 0;
   for (const auto& [id, src] : sources)
     if (src.topic == rec.joint_topic) joint_channel = id;
@@ -207,7 +207,7 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
         if (s.line > 0 && printable(s.from, 60) == name)
           what = "'" + name + "', which " + map.source + " (line " + std::to_string(s.line) + ") reads '" + printable(s.state, 60) + "' from";
       throw InputError(o.bag + ": topic " + printable(rec.joint_topic, 60) + ": the joint states do not name " + what + " (they name: " + have +
-                       ")" + (map.source.empty() ? std::string("; --joint-map can rename, scale or fix a state value") : std::string()));
+                       ")" + (map.source.empty() ? "; " + spelledField(o.spell, "joint_map") + " can rename, scale or fix a state value" : std::string()));
     }
     throw InputError(r.problem);
   }
@@ -244,7 +244,7 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
       }
     text += "\n";
   }
-  rec.log = parseStateLog(text, "--bag " + o.bag + " (topic " + rec.joint_topic + ")", *model);
+  rec.log = parseStateLog(text, spelledField(o.spell, "bag") + " " + o.bag + " (topic " + rec.joint_topic + ")", *model);
   if (r.extra > 0) {
     std::string left_out;
     for (const std::string& j : joints.names)

@@ -46,7 +46,9 @@ std::optional<calib::Camera> roughPose(const calib::Camera& intrinsics, const Ga
 // frames' figures (IoUs before at `start`) and their masks in `out`.
 calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<calib::MaskFrame> frames, const Gathered& g,
                                       std::span<const RecordingSample> recording, const RobotDrawing& robot, std::span<const int> bodies,
-                                      const Model& model, const calib::RefineOptions& options, Refinement& out) {
+                                      const Model& model, const calib::RefineOptions& options, const FieldSpelling& spell,
+                                      Refinement& out) {
+  const auto named = [&](const std::string& field) { return spelledField(spell, field); };
   const std::size_t gathered = frames.size();
   std::vector<const cv::Mat*> pictures;
   for (const GatheredFrame& f : g.frames) pictures.push_back(&f.bgr);
@@ -54,10 +56,10 @@ calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<ca
   for (const GatheredFrame& f : g.frames) frame_volumes.push_back(calib::placeVolumes(model, f.state, bodies));
   for (const RecordingSample& s : recording) {
     if (s.bgr.type() != CV_8UC3 || s.bgr.cols != start.width || s.bgr.rows != start.height)
-      throw CalibInputError("--masks auto: the recording's frames are not 8-bit colour pictures of the camera's " +
+      throw CalibInputError(named("masks") + " auto: the recording's frames are not 8-bit colour pictures of the camera's " +
                             std::to_string(start.width) + "x" + std::to_string(start.height));
     if (static_cast<int>(s.state.size()) != model.stateSize())
-      throw CalibInputError("--masks auto: a frame of the recording without a state of the model's " + std::to_string(model.stateSize()) +
+      throw CalibInputError(named("masks") + " auto: a frame of the recording without a state of the model's " + std::to_string(model.stateSize()) +
                             " values");
     sample_volumes.push_back(calib::placeVolumes(model, s.state, bodies));
   }
@@ -208,32 +210,33 @@ std::vector<calib::PlacedMesh> RobotDrawing::meshes(std::span<const double> stat
 
 Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const calib::Camera& intrinsics, const Model& model,
                              const RefineInputs& in, const calib::Camera* truth) {
+  const auto named = [&](const std::string& field) { return spelledField(in.spell, field); };
   const bool edges = in.source == calib::RefineSource::Edges;
   const bool from_recording = !edges && in.masks.empty() && !in.recording.empty();
   if (!edges && !from_recording && in.masks.size() != g.frames.size())
-    throw CalibInputError("--masks: " + std::to_string(in.masks.size()) + " mask(s) for " + std::to_string(g.frames.size()) +
+    throw CalibInputError(named("masks") + ": " + std::to_string(in.masks.size()) + " mask(s) for " + std::to_string(g.frames.size()) +
                           " frame(s): give one mask per frame, in the same order");
   Refinement out;
   // Masks made from a recording hold only what moves.
   std::vector<int> bodies = in.bodies;
   if (from_recording) {
     bodies = movingBodies(model, in.bodies);
-    if (bodies.empty()) throw CalibInputError("--masks auto: no body of the model (of those the masks show) moves with a joint");
+    if (bodies.empty()) throw CalibInputError(named("masks") + " auto: no body of the model (of those the masks show) moves with a joint");
   }
   const RobotDrawing robot(model, bodies, in.draw);
   out.bodies = bodies;
   out.drawn = robot.drawn();
   std::vector<calib::MaskFrame> mask_frames;
   std::vector<calib::EdgeFrame> edge_frames;
-  const std::string what = edges ? "--refine edges" : from_recording ? "--masks auto" : "--masks";
+  const std::string what = edges ? named("refine") + " edges" : named("masks") + (from_recording ? " auto" : "");
   for (std::size_t f = 0; f < g.frames.size(); ++f) {
     const std::vector<double>& state = g.frames[f].state;
     if (static_cast<int>(state.size()) != model.stateSize())
       throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no state of the model's " +
-                            std::to_string(model.stateSize()) + " values: give --state, or --states with --time");
+                            std::to_string(model.stateSize()) + " values: give " + named("state") + ", or " + named("states") + " with " + named("time"));
     if ((edges || from_recording) && g.frames[f].bgr.empty())
       throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no picture to find " +
-                            (edges ? "edges" : "the robot") + " in: give --image or --video");
+                            (edges ? "edges" : "the robot") + " in: give " + named("image") + " or " + named("video"));
     std::vector<calib::PlacedMesh> meshes = robot.meshes(state);
     out.meshes.push_back(meshes);
     if (edges) edge_frames.push_back({g.frames[f].bgr, robot.volumes(state), std::move(meshes)});
@@ -249,7 +252,7 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
     start.rvec = in.rough->rvec, start.tvec = in.rough->tvec;
     out.start = "camera";
   } else {
-    throw CalibInputError(what + ": no start for the pose: give 4 or more labels or tag corners, or --camera ROUGH.yaml");
+    throw CalibInputError(what + ": no start for the pose: give 4 or more labels or tag corners, or " + named("camera") + " ROUGH.yaml");
   }
   if (edges) {
     calib::EdgeOptions options;
@@ -258,7 +261,7 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
   } else {
     calib::RefineOptions options;
     options.start_is_prior = out.start == "solve";
-    out.result = from_recording ? refineToRecording(start, mask_frames, g, in.recording, robot, bodies, model, options, out)
+    out.result = from_recording ? refineToRecording(start, mask_frames, g, in.recording, robot, bodies, model, options, in.spell, out)
                                 : calib::refineToMasks(start, mask_frames, options);
   }
   if (!out.result.improved) return out;

@@ -188,7 +188,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   FrameSource& video = *source;
   report.fps = opt.fps > 0.0 ? opt.fps : video.fps();
   if (in.frame_times.empty() && !(report.fps > 0.0 && report.fps < 1e6))
-    throw VideoError(video_label + ": the video gives no frame rate: give --fps or --frame-times");
+    throw VideoError(video_label + ": the video gives no frame rate: " + in.no_rate_hint);
   const FrameClock clock(in.frame_times, report.fps);
   if (opt.time_offset_search) {  // a first pass over the video
     const std::unique_ptr<FrameSource> first_pass = open();
@@ -224,7 +224,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   std::size_t in_flight = 0, decoded = 0;
   bool reader_done = false, abort = false;
   std::exception_ptr error;
-  auto fail = [&](std::exception_ptr e) {
+  auto fail = [&](const std::exception_ptr& e) {
     std::lock_guard lock(mu);
     if (!error) error = e;
     abort = true;

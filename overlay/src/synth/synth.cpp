@@ -33,8 +33,11 @@ SynthError fieldError(const std::string& field, const std::string& problem) { re
 
 // A number option within [lo, hi] (NaN refused).
 void checkRange(double value, double lo, double hi, const char* field) {
-  if (!(value >= lo && value <= hi))
-    throw fieldError(field, "must be in [" + messageNumber(lo) + ", " + messageNumber(hi) + "], got " + messageNumber(value));
+  try {
+    checkFieldRange(value, lo, hi, field);
+  } catch (const InputError& e) {
+    throw fieldError(field, e.problem());
+  }
 }
 
 // Every option that does not need the model's motion, in the order `kccd synth` has always checked
@@ -54,13 +57,14 @@ void checkOptions(const SynthOptions& o, const Model& m) {
   if (o.visible_scale) checkRange(*o.visible_scale, 0.1, 0.95, "visible_scale");
   const fs::path out = fs::path(o.output).lexically_normal();
   if (out.empty() || out.filename().empty() || out.filename() == "." || out.filename() == "..")
-    throw SynthError("-o " + o.output + ": give a folder name");
+    throw SynthError(spelledField(o.spell, "output") + " " + o.output + ": give a folder name");
   const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
   std::error_code ec;
   if (!fs::is_directory(parent, ec))
-    throw SynthError("-o " + o.output + ": folder " + parent.string() + " does not exist");
+    throw SynthError(spelledField(o.spell, "output") + " " + o.output + ": folder " + parent.string() + " does not exist");
   if (fs::exists(out, ec) && !(fs::is_directory(out, ec) && fs::is_empty(out, ec)) && !o.replace)
-    throw SynthError("-o " + o.output + ": exists and is not an empty folder (use --force to replace it)");
+    throw SynthError(spelledField(o.spell, "output") + " " + o.output + ": exists and is not an empty folder (" +
+                     spelledField(o.spell, "replace") + " replaces it)");
 }
 
 // The robot's appearance: its visual meshes (the model's visuals:) or shrunken SSCHs.
@@ -98,7 +102,8 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
   const int frames = static_cast<int>(std::floor(o.seconds * o.fps + 1e-9));
   const SynthMotion motion = searchMotion(
       m,
-      TrajectorySearch{.model = o.model, .seconds = o.seconds, .fps = o.fps, .seed = o.seed, .collision = o.collision},
+      TrajectorySearch{.model = o.model, .seconds = o.seconds, .fps = o.fps, .seed = o.seed, .collision = o.collision,
+                       .spell = o.spell},
       frames, o.log_rate, o.time_offset);
   const auto t_traj = Clock::now();
 
@@ -129,7 +134,7 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
   const auto t_bg = Clock::now();
 
   // Output folder, staged: an existing one is replaced only when the new one is complete.
-  StagedOutput staged(out, StagedOutput::Kind::Folder, "-o " + o.output, StagedOutput::Existing::ReplaceFolder);
+  StagedOutput staged(out, StagedOutput::Kind::Folder, spelledField(o.spell, "output") + " " + o.output, StagedOutput::Existing::ReplaceFolder);
   const fs::path dir = staged.path();
   const fs::path mask_dir = dir / "masks";
   fs::create_directory(mask_dir);
@@ -156,7 +161,7 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
       if (progress) progress(static_cast<double>(i + 1) / frames);
     }
     writer.finish();
-    if (!writer.error().empty()) throw SynthError("-o " + o.output + ": " + writer.error());
+    if (!writer.error().empty()) throw SynthError(spelledField(o.spell, "output") + " " + o.output + ": " + writer.error());
     written = writer.written();
     run.writer_s = writer.stageSeconds();
   }

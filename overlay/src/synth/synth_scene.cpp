@@ -208,13 +208,13 @@ calib::TagLayout makeTags(const Room& room, const Box3& box, const calib::Camera
 }
 
 cv::Mat renderRoom(const calib::Camera& camera, const calib::TagLayout& layout, const Room& room, std::uint64_t seed) {
-  TagSceneOptions so;
+  calib::TagSceneOptions so;
   so.supersample = 3;
   so.white = 235, so.black = 30, so.background = 90;
   so.surfaces = room.surfaces;
   so.light = room.light;
   so.seed = seed;
-  return renderTagSceneBgr(camera, layout, so);
+  return calib::renderTagSceneBgr(camera, layout, so);
 }
 
 }  // namespace kccd::overlay

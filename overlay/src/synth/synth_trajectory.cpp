@@ -243,7 +243,8 @@ Trajectory searchTrajectory(const Model& m, const TrajectorySearch& a, double t0
   }
   throw SynthError(a.model + ": found no trajectory with near-collisions" +
                    std::string(a.collision ? " and one collision" : "") +
-                   " within the joint limits (try another --seed or a longer --seconds)");
+                   " within the joint limits (try another " + spelledField(a.spell, "seed") + " or a longer " +
+                   spelledField(a.spell, "seconds") + ")");
 }
 
 std::string stateLogText(const Model& m, const Trajectory& tr, double offset, double rate, double duration) {
@@ -305,7 +306,8 @@ SynthMotion searchMotion(const Model& m, const TrajectorySearch& search, int fra
     if (out.intervals.size() == (search.collision ? 1u : 0u)) break;
     if (round == 7)
       throw SynthError(search.model + ": the trajectories found have " + std::to_string(out.intervals.size()) +
-                       " collision intervals at this frame rate (try another --seed, --fps or --seconds)");
+                       " collision intervals at this frame rate (try another " + spelledField(search.spell, "seed") + ", " +
+                       spelledField(search.spell, "fps") + " or " + spelledField(search.spell, "seconds") + ")");
   }
   return out;
 }

@@ -11,6 +11,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "kccd/input_error.hpp"
 #include "kccd/logs/message_value.hpp"
 
 namespace kccd::overlay {
@@ -36,6 +37,7 @@ struct BagExportOptions {
   /// Time 0 of the written files, nanoseconds on the chosen clock; default: the earliest time
   /// exported (of the joint states and the images alike).
   std::optional<std::uint64_t> origin_ns;
+  FieldSpelling spell;  ///< how messages name these fields (e.g. "--frame-times"; default: as they are)
 };
 
 /// What was written.

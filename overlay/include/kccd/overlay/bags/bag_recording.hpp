@@ -24,6 +24,7 @@ struct BagRecordingOptions {
   TimeSource time_source = TimeSource::Header;
   /// Where each state value comes from; empty (no states): every state value by its own name.
   JointMap joint_map;
+  FieldSpelling spell;  ///< how messages name these fields (e.g. "--joint-topic"; default: as they are)
 };
 
 /// The recording: what OverlayInputs takes, and what was found.

@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "kccd/calib/edge_refine.hpp"
+#include "kccd/input_error.hpp"
 #include "kccd/calib/mask_refine.hpp"
 #include "kccd/overlay/calibration/calib_gather.hpp"
 #include "kccd/overlay/calibration/calib_solve.hpp"
@@ -71,6 +72,7 @@ struct RefineInputs {
   /// be read ("auto"), only the collision volumes ("volumes"), or the visuals or an error ("visuals").
   std::string draw = "auto";
   std::optional<calib::Camera> rough;  ///< a start when the points do not give one
+  FieldSpelling spell;                 ///< how messages name the inputs ("masks" -> "--masks"; default: as they are)
 };
 
 /// What the refinement did.

@@ -47,6 +47,7 @@ struct OverlayInputs {
   std::string video_label;          ///< e.g. "--video rec.mkv" (default: the path)
   std::string camera_label;         ///< e.g. the camera file's path (default "camera")
   std::string frame_times_label;    ///< e.g. "--frame-times t.csv"
+  std::string no_rate_hint = "give the frame rate or the frame times";  ///< when the video declares no rate
   /// Opens the frames instead of `video` (e.g. a robot log's image topic, see bag_recording.hpp);
   /// called once per pass over the frames.
   std::function<std::unique_ptr<FrameSource>()> open_frames;

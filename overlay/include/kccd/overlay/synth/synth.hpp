@@ -58,6 +58,8 @@ struct SynthOptions {
   std::string codec = "ffv1";  ///< ffv1 (video.mkv, lossless), mjpg (video.avi) or mp4v (video.mp4)
   bool collision = true;       ///< one real collision (false: only near-collisions)
   bool replace = false;        ///< replace an existing non-empty output folder
+  /// How hints name these fields ("seed" -> "--seed", "collision" -> "--no-collision"; default: as they are).
+  FieldSpelling spell;
 };
 
 /// What was written, for the caller to report.

@@ -1,6 +1,6 @@
 // The scene of a synthetic recording: the box the robot moves in, the default camera, a room (a
 // tiled floor and two walls, lit by a point light) and the AprilTags on it, and the room drawn once
-// as the static background by the tag scene renderer (kccd/overlay/synth/tag_scene.hpp).
+// as the static background by the tag scene renderer (kccd/calib/tag_scene.hpp).
 #pragma once
 
 #include <cstdint>
@@ -11,11 +11,14 @@
 #include "kccd/calib/camera.hpp"
 #include "kccd/calib/tag_layout.hpp"
 #include "kccd/model.hpp"
-#include "kccd/overlay/synth/tag_scene.hpp"
+#include "kccd/calib/tag_scene.hpp"
 #include "kccd/ssch.hpp"
 #include "kccd/state_log.hpp"
 
 namespace kccd::overlay {
+
+using calib::SceneLight;    // the room drawn by calibration's tag scene renderer
+using calib::SceneSurface;
 
 /// An axis-aligned box (empty until something is added).
 struct Box3 {

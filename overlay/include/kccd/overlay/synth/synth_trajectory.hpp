@@ -3,6 +3,8 @@
 // log at its own rate and clock, and checked frame by frame at the logged states.
 #pragma once
 
+#include "kccd/input_error.hpp"
+
 #include <array>
 #include <cstdint>
 #include <span>
@@ -56,6 +58,7 @@ struct TrajectorySearch {
   double fps = 25.0;     ///< frames must show the collision
   std::uint64_t seed = 1;
   bool collision = true;  ///< false: near-collisions only
+  FieldSpelling spell;    ///< how hints name the options (SynthOptions::spell)
 };
 
 /// Searches a trajectory over log times t0 ... t1 sampled every dt. Throws SynthError when none is

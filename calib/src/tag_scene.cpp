@@ -7,7 +7,7 @@
 // outline crosses lies inside one cell (cells are convex) and takes its value; every other pixel
 // is the mean of supersample^2 rays, each solved exactly at its sub-pixel position. Surfaces
 // (floor, walls) are cast like tags, their checker tiles taking the place of the tag cells.
-#include "kccd/overlay/synth/tag_scene.hpp"
+#include "kccd/calib/tag_scene.hpp"
 
 #include <apriltag/apriltag.h>
 #include <apriltag/common/image_u8.h>
@@ -25,7 +25,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
-namespace kccd::overlay {
+namespace kccd::calib {
 namespace {
 
 using calib::Camera;
@@ -598,4 +598,4 @@ cv::Mat renderTagSceneBgr(const calib::Camera& camera, const calib::TagLayout& l
   return addNoise(renderScene(camera, layout, o), o);
 }
 
-}  // namespace kccd::overlay
+}  // namespace kccd::calib

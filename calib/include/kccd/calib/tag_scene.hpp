@@ -1,9 +1,9 @@
 // Synthetic AprilTag frames: what a calibrated camera sees of a tag layout (and optionally of the
 // floor and walls the tags are fixed to), drawn by ray casting through the camera's full lens
-// model. The static background of `kccd synth` (the room and its tags, overlay/src/synth_*.cpp) and
-// the oracle for the detection and pose tests (it uses neither the detector nor the solver, only
-// the camera model and the tag36h11 bitmaps). Calibration itself never draws tags: it lives here,
-// beside the recording code, not in kccd::calib.
+// model. The static background of `kccd synth` (the room and its tags, overlay/src/synth/) and the
+// oracle of calibration's image tests and benchmark (it uses neither the detector nor the solver,
+// only the camera model and the tag36h11 bitmaps). No calibration routine calls it; it is part of
+// kccd_calib, beside the tag layout it draws, so that those tests build with calibration alone.
 #pragma once
 
 #include <array>
@@ -16,7 +16,7 @@
 #include "kccd/calib/tag_layout.hpp"
 #include "kccd/ssch.hpp"
 
-namespace kccd::overlay {
+namespace kccd::calib {
 
 /// A flat rectangle behind the tags (a floor, a wall), drawn from whichever side the camera is on.
 /// Tags fixed to it must lie slightly in front of it (nearest hit wins).
@@ -79,4 +79,4 @@ std::vector<std::array<cv::Point2d, 4>> projectTagCorners(const calib::Camera& c
 /// cv::projectPoints does it; exposed so tests can check the renderer's model against OpenCV.
 cv::Point2d distortNormalised(const calib::Camera& camera, const cv::Point2d& normalised);
 
-}  // namespace kccd::overlay
+}  // namespace kccd::calib
