@@ -17,14 +17,15 @@ using namespace kccd::calib;
 constexpr int kW = 320, kH = 200;
 
 struct Recording {
-  cv::Mat scene;                   // the truth: the background
+  cv::Mat scene;                          // the truth: the background
   std::vector<cv::Mat> pictures, robots;  // each frame and where its robot is
 };
 
 // The robot at place `t` (0: at rest): a thick bar from its base to a ball.
 cv::Mat robotAt(double t) {
   cv::Mat m = cv::Mat::zeros(kH, kW, CV_8UC1);
-  const cv::Point base(160, 190), tip(static_cast<int>(160 + 120 * std::sin(t)), static_cast<int>(190 - 150 * std::cos(t)));
+  const cv::Point base(160, 190),
+      tip(static_cast<int>(160 + 120 * std::sin(t)), static_cast<int>(190 - 150 * std::cos(t)));
   cv::line(m, base, tip, cv::Scalar(255), 14);
   cv::circle(m, tip, 16, cv::Scalar(255), cv::FILLED);
   return m;
@@ -37,7 +38,8 @@ Recording paint(int frames, double rest_share, std::uint64_t seed) {
   r.scene = cv::Mat(kH, kW, CV_8UC3, cv::Scalar(90, 110, 120));
   for (int k = 0; k < 40; ++k) {
     const cv::Point a(x(rng), y(rng));
-    cv::rectangle(r.scene, a, a + cv::Point(8 + x(rng) / 8, 8 + y(rng) / 8), cv::Scalar(shade(rng), shade(rng), shade(rng)), cv::FILLED);
+    cv::rectangle(r.scene, a, a + cv::Point(8 + x(rng) / 8, 8 + y(rng) / 8),
+                  cv::Scalar(shade(rng), shade(rng), shade(rng)), cv::FILLED);
   }
   std::uniform_real_distribution<double> place(-1.3, 1.3), unit(0.0, 1.0);
   for (int f = 0; f < frames; ++f) {
@@ -118,7 +120,8 @@ TEST(Background, AGlobalGainIsNotForeground) {
 TEST(Background, FramesOfAnotherSizeAreRefused) {
   const Recording r = paint(4, 0.0, 1);
   EXPECT_THROW(estimateBackground({}), kccd::InputError);
-  std::vector<BackgroundSample> samples = {{r.pictures[0], r.robots[0]}, {r.pictures[1](cv::Rect(0, 0, 100, 100)).clone(), r.robots[1]}};
+  std::vector<BackgroundSample> samples = {{r.pictures[0], r.robots[0]},
+                                           {r.pictures[1](cv::Rect(0, 0, 100, 100)).clone(), r.robots[1]}};
   EXPECT_THROW(estimateBackground(samples), kccd::InputError);
   samples[1] = {r.pictures[1], cv::Mat::zeros(10, 10, CV_8UC1)};
   EXPECT_THROW(estimateBackground(samples), kccd::InputError);

@@ -101,7 +101,8 @@ TEST(CalibCamera, RoundTripsWithOpenCvBothWays) {
       SCOPED_TRACE(std::to_string(count) + (as_float ? " float" : " double"));
       const Camera c = randomCamera(rng, true);
       std::vector<double> coeffs(static_cast<std::size_t>(count), 0.0);
-      for (int i = 0; i < std::min(count, 5); ++i) coeffs[static_cast<std::size_t>(i)] = c.distortion[static_cast<std::size_t>(i)];
+      for (int i = 0; i < std::min(count, 5); ++i)
+        coeffs[static_cast<std::size_t>(i)] = c.distortion[static_cast<std::size_t>(i)];
       const int type = as_float ? CV_32F : CV_64F;
       cv::Mat k, d, r, t, points(1, 7, CV_32FC2);
       cv::Mat(c.camera_matrix).convertTo(k, type);
@@ -112,10 +113,14 @@ TEST(CalibCamera, RoundTripsWithOpenCvBothWays) {
       const std::string path = ::testing::TempDir() + "/kccd_cam_cv_written.yaml";
       {
         cv::FileStorage out(path, cv::FileStorage::WRITE);
-        out << "calibration_time" << "Sat Nov 28 2026" << "nr_of_frames" << 12 << "image_width" << c.width;
+        out << "calibration_time"
+            << "Sat Nov 28 2026"
+            << "nr_of_frames" << 12 << "image_width" << c.width;
         out << "image_height" << c.height << "flags" << 0 << "camera_matrix" << k << "distortion_coefficients" << d;
         out << "avg_reprojection_error" << 0.25 << "image_points" << points << "rvec" << r << "tvec" << t;
-        out << "per_view" << "{" << "errors" << std::vector<double>{0.1, 0.2} << "}";
+        out << "per_view"
+            << "{"
+            << "errors" << std::vector<double>{0.1, 0.2} << "}";
       }
       cv::FileStorage in(path, cv::FileStorage::READ);
       cv::Mat k2, d2, r2, t2;
@@ -140,11 +145,12 @@ TEST(CalibCamera, RoundTripsWithOpenCvBothWays) {
 TEST(CalibCamera, OpenCvCalibrationOutputWithoutAPoseLoadsAsIntrinsics) {
   // What OpenCV's calibration sample writes: no rvec/tvec, and fields of its own.
   const std::string path = ::testing::TempDir() + "/kccd_cam_opencv.yaml";
-  std::ofstream(path) << "%YAML:1.0\n---\ncalibration_time: \"Mon 23 Nov 2026\"\nnr_of_frames: 12\nimage_width: 640\n"
-                         "image_height: 480\nflags: 0\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
-                         "   data: [ 600., 0., 319.5, 0., 600., 239.5, 0., 0., 1. ]\n"
-                         "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
-                         "   data: [ -0.2, 0.05, 0., 0., 0. ]\navg_reprojection_error: 0.31\n";
+  std::ofstream(path)
+      << "%YAML:1.0\n---\ncalibration_time: \"Mon 23 Nov 2026\"\nnr_of_frames: 12\nimage_width: 640\n"
+         "image_height: 480\nflags: 0\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+         "   data: [ 600., 0., 319.5, 0., 600., 239.5, 0., 0., 1. ]\n"
+         "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n"
+         "   data: [ -0.2, 0.05, 0., 0., 0. ]\navg_reprojection_error: 0.31\n";
   const Camera c = loadCamera(path, CameraPose::Optional);
   EXPECT_EQ(c.width, 640);
   EXPECT_EQ(c.rvec, cv::Vec3d(0, 0, 0));
@@ -158,7 +164,8 @@ TEST(CalibCamera, OpenCvCalibrationOutputWithoutAPoseLoadsAsIntrinsics) {
     EXPECT_NE(std::string(e.what()).find("rvec: missing"), std::string::npos) << e.what();
   }
   // Half a pose is an error either way.
-  std::ofstream(path, std::ios::app) << "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0., 0., 1. ]\n";
+  std::ofstream(path, std::ios::app)
+      << "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0., 0., 1. ]\n";
   try {
     loadCamera(path, CameraPose::Optional);
     ADD_FAILURE() << "tvec without rvec loaded";
@@ -172,9 +179,11 @@ std::string cameraText(const std::string& replace_key = "", const std::string& w
       {"image_width", "image_width: 320\n"},
       {"image_height", "image_height: 240\n"},
       {"camera_matrix",
-       "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [300., 0., 160., 0., 300., 120., 0., 0., 1.]\n"},
+       "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [300., 0., 160., 0., 300., 120., "
+       "0., 0., 1.]\n"},
       {"distortion_coefficients",
-       "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n   data: [-0.1, 0.01, 0., 0., 0.]\n"},
+       "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n   data: [-0.1, 0.01, 0., 0., "
+       "0.]\n"},
       {"rvec", "rvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [0., 0., 0.]\n"},
       {"tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [0., 0., 2.]\n"}};
   if (!replace_key.empty()) fields[replace_key] = with;
@@ -205,13 +214,15 @@ TEST(CalibCamera, ErrorsNameFileAndField) {
                                "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [-300., 0., "
                                "160., 0., 300., 120., 0., 0., 1.]\n"),
                     "camera_matrix", "a negative focal length");
-  expectCameraError(cameraText("camera_matrix",
-                               "camera_matrix: !!opencv-matrix\n   rows: 2\n   cols: 2\n   dt: d\n   data: [1., 0., 0., 1.]\n"),
-                    "camera_matrix", "a 2x2 matrix");
-  expectCameraError(cameraText("distortion_coefficients",
-                               "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 3\n   dt: d\n   data: [0.1, "
-                               "0., 0.]\n"),
-                    "distortion_coefficients", "3 coefficients");
+  expectCameraError(
+      cameraText("camera_matrix",
+                 "camera_matrix: !!opencv-matrix\n   rows: 2\n   cols: 2\n   dt: d\n   data: [1., 0., 0., 1.]\n"),
+      "camera_matrix", "a 2x2 matrix");
+  expectCameraError(
+      cameraText("distortion_coefficients",
+                 "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 3\n   dt: d\n   data: [0.1, "
+                 "0., 0.]\n"),
+      "distortion_coefficients", "3 coefficients");
   expectCameraError(cameraText("rvec", "rvec: [1, 2]\n"), "rvec", "a malformed rvec");
   try {
     loadCamera("/nonexistent/cam.yaml");
@@ -269,7 +280,9 @@ std::string base64Decode(const std::string& text) {
 // input 142,098): it is refused with one line, at once.
 TEST(CalibCamera, TheFileThatHungOpenCvIsRefusedAtOnce) {
   const std::string hang = base64Decode(
-      "JVlBTUw6MS4wCi0tLQojZGF0YTogW2QKICAgZGE2////dGE6JVlBTUw6MS4wCi0gWyAtMC4xMSwgejAuMDcsINDRz9kwNiwgLTAucDAwNCwgIFsgJDEwMNIuLNzPLiwgNjQxLiwzIDAwLiwgMzU4LjIsLS0KIyBBIGZpeGVkIGNhbWVyYSBsb29raW5nIGF0ICAwLiwgMCCmYXQgYXJ0aGUgZGVtbSBmbw==");
+      "JVlBTUw6MS4wCi0tLQojZGF0YTogW2QKICAgZGE2////"
+      "dGE6JVlBTUw6MS4wCi0gWyAtMC4xMSwgejAuMDcsINDRz9kwNiwgLTAucDAwNCwgIFsgJDEwMNIuLNzPLiwgNjQxLiwzIDAwLiwgMzU4LjIsLS0K"
+      "IyBBIGZpeGVkIGNhbWVyYSBsb29raW5nIGF0ICAwLiwgMCCmYXQgYXJ0aGUgZGVtbSBmbw==");
   ASSERT_EQ(hang.size(), 169u);
   const auto start = std::chrono::steady_clock::now();
   const std::string msg = loadError("kccd_cam_hang.yaml", hang);
@@ -287,14 +300,18 @@ TEST(CalibCamera, RejectsDuplicateKeysAndTrailingDocuments) {
   std::string msg = loadError("kccd_cam_dup.yaml", dup);
   expectOneLine(msg, dir + "kccd_cam_dup.yaml:", "image_width: duplicate key");
   // The second of the two (the layout is sorted: the original one comes after image_height).
-  const int line = static_cast<int>(std::count(dup.begin(), dup.begin() + static_cast<long>(dup.rfind("image_width:")), '\n')) + 1;
+  const int line =
+      static_cast<int>(std::count(dup.begin(), dup.begin() + static_cast<long>(dup.rfind("image_width:")), '\n')) + 1;
   EXPECT_NE(msg.find(".yaml:" + std::to_string(line) + ":"), std::string::npos) << msg;
   // Flow style, inside a matrix.
-  std::string flow = cameraText("rvec", "rvec: !!opencv-matrix {rows: 3, cols: 1, dt: d, rows: 1, data: [0., 0., 0.]}\n");
+  std::string flow =
+      cameraText("rvec", "rvec: !!opencv-matrix {rows: 3, cols: 1, dt: d, rows: 1, data: [0., 0., 0.]}\n");
   expectOneLine(loadError("kccd_cam_flowdup.yaml", flow), "kccd_cam_flowdup.yaml:", "rvec.rows: duplicate key");
   // Anything after the document: '---' or '...' followed by more.
-  expectOneLine(loadError("kccd_cam_doc2.yaml", ok + "---\nimage_width: 640\n"), "kccd_cam_doc2.yaml:", "second YAML document");
-  expectOneLine(loadError("kccd_cam_doc3.yaml", ok + "...\nimage_width: 640\n"), "kccd_cam_doc3.yaml:", "second YAML document");
+  expectOneLine(loadError("kccd_cam_doc2.yaml", ok + "---\nimage_width: 640\n"),
+                "kccd_cam_doc2.yaml:", "second YAML document");
+  expectOneLine(loadError("kccd_cam_doc3.yaml", ok + "...\nimage_width: 640\n"),
+                "kccd_cam_doc3.yaml:", "second YAML document");
   EXPECT_EQ(loadError("kccd_cam_end.yaml", ok + "...\n"), "");  // an explicit end alone is fine
 }
 
@@ -316,18 +333,24 @@ TEST(CalibCamera, ParseErrorsAreOneLineWithThePlace) {
       {"kccd_cam_binary.yaml", std::string("%YAML:1.0\n\0\x01\x02\xff", 14), ".yaml:2: file: control byte \\x00"},
       // A quoted key is a key to YAML (OpenCV refused it): the file then lacks the other fields.
       {"kccd_cam_quoted.yaml", "%YAML:1.0\n---\n\"image_width\": 320\n", "image_height: missing"},
-      {"kccd_cam_quoted_value.yaml", cameraText("image_width", "image_width: \"320\"\n"), "image_width: not an integer"},
+      {"kccd_cam_quoted_value.yaml", cameraText("image_width", "image_width: \"320\"\n"),
+       "image_width: not an integer"},
       {"kccd_cam_matrix_huge.yaml",
-       cameraText("rvec", "rvec: !!opencv-matrix\n   rows: 3000000\n   cols: 3000000\n   dt: d\n   data: [0., 0., 0.]\n"),
+       cameraText("rvec",
+                  "rvec: !!opencv-matrix\n   rows: 3000000\n   cols: 3000000\n   dt: d\n   data: [0., 0., 0.]\n"),
        "rvec: 3000000x3000000 is not a camera matrix size"},
       {"kccd_cam_matrix_count.yaml",
-       cameraText("tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [0., 0.]\n"), "tvec: data has 2 values"},
+       cameraText("tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [0., 0.]\n"),
+       "tvec: data has 2 values"},
       {"kccd_cam_matrix_text.yaml",
-       cameraText("tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [0., a, 0.]\n"), "tvec: data holds"},
+       cameraText("tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [0., a, 0.]\n"),
+       "tvec: data holds"},
       {"kccd_cam_matrix_dt.yaml",
-       cameraText("tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: 3d\n   data: [0., 0., 0.]\n"), ".yaml:"},
+       cameraText("tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: 3d\n   data: [0., 0., 0.]\n"),
+       ".yaml:"},
       {"kccd_cam_matrix_dt2.yaml",
-       cameraText("tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: x\n   data: [0., 0., 0.]\n"), "tvec: dt 'x'"},
+       cameraText("tvec", "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: x\n   data: [0., 0., 0.]\n"),
+       "tvec: dt 'x'"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
@@ -348,7 +371,8 @@ TEST(CalibCamera, FilesThatAreNotRegularAreRejectedWithoutReading) {
       loadCamera(path);  // would block (FIFO) or never end (/dev/zero) if it were read
       ADD_FAILURE() << path;
     } catch (const CameraError& e) {
-      expectOneLine(e.what(), path, path == dir ? "a folder, not a camera file" : "not a regular file (a device, FIFO or socket)");
+      expectOneLine(e.what(), path,
+                    path == dir ? "a folder, not a camera file" : "not a regular file (a device, FIFO or socket)");
     }
   }
   std::filesystem::remove(fifo);
@@ -372,9 +396,12 @@ TEST(CalibCamera, BoundsWhatTheRendererCanDraw) {
       {"camera_matrix", k("1e-3, 0., 160., 0., 1e-3, 120., 0., 0., 1."), "camera_matrix", "must be in 1..1e+06 px"},
       {"camera_matrix", k("300., 0., 1e9, 0., 300., 120., 0., 0., 1."), "camera_matrix", "principal point"},
       {"camera_matrix", k("300., 0., 160., 0., 300., -1e9, 0., 0., 1."), "camera_matrix", "principal point"},
-      {"distortion_coefficients", d("1e6, 0., 0., 0., 0."), "distortion_coefficients", "coefficient 0 = 1e+06 is out of range"},
-      {"distortion_coefficients", d("-2.5, 0., 0., 0., 0."), "distortion_coefficients", "cannot be inverted at image pixel"},
-      {"distortion_coefficients", matrix("distortion_coefficients", 1, 14, "0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 2., 0."),
+      {"distortion_coefficients", d("1e6, 0., 0., 0., 0."), "distortion_coefficients",
+       "coefficient 0 = 1e+06 is out of range"},
+      {"distortion_coefficients", d("-2.5, 0., 0., 0., 0."), "distortion_coefficients",
+       "cannot be inverted at image pixel"},
+      {"distortion_coefficients",
+       matrix("distortion_coefficients", 1, 14, "0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 0., 2., 0."),
        "distortion_coefficients", "tilt"},
       {"rvec", matrix("rvec", 3, 1, "1e3, 0., 0."), "rvec", "longer than 100"},
       {"tvec", matrix("tvec", 3, 1, "0., 0., 1e300"), "tvec", "farther than"},
@@ -390,14 +417,17 @@ TEST(CalibCamera, BoundsWhatTheRendererCanDraw) {
   // Too many pixels, and a lens whose undistorted image would exceed 8192 pixels a side.
   std::string many = cameraText("image_width", "image_width: 8192\n");
   many.replace(many.find("image_height: 240"), 17, "image_height: 8192");
-  expectOneLine(loadError("kccd_cam_many.yaml", many), "kccd_cam_many.yaml: image_width: ", "more than 16777216 pixels");
+  expectOneLine(loadError("kccd_cam_many.yaml", many),
+                "kccd_cam_many.yaml: image_width: ", "more than 16777216 pixels");
   std::string wide = cameraText("image_width", "image_width: 8192\n");
   wide.replace(wide.find("image_height: 240"), 17, "image_height: 2048");
-  wide.replace(wide.find(k("300., 0., 160., 0., 300., 120., 0., 0., 1.")), k("300., 0., 160., 0., 300., 120., 0., 0., 1.").size(),
+  wide.replace(wide.find(k("300., 0., 160., 0., 300., 120., 0., 0., 1.")),
+               k("300., 0., 160., 0., 300., 120., 0., 0., 1.").size(),
                k("7000., 0., 4095.5, 0., 7000., 1023.5, 0., 0., 1."));
-  wide.replace(wide.find(d("-0.1, 0.01, 0., 0., 0.")), d("-0.1, 0.01, 0., 0., 0.").size(), d("-0.11, 0.06, 0.0006, -0.0004, -0.01"));
-  expectOneLine(loadError("kccd_cam_wide.yaml", wide), "kccd_cam_wide.yaml: distortion_coefficients: ",
-                "more than 8192 a side");
+  wide.replace(wide.find(d("-0.1, 0.01, 0., 0., 0.")), d("-0.1, 0.01, 0., 0., 0.").size(),
+               d("-0.11, 0.06, 0.0006, -0.0004, -0.01"));
+  expectOneLine(loadError("kccd_cam_wide.yaml", wide),
+                "kccd_cam_wide.yaml: distortion_coefficients: ", "more than 8192 a side");
 }
 
 // The pose quality figures calibration writes travel through the file; absent means unknown.
@@ -417,12 +447,16 @@ TEST(CalibCamera, ErrorsCarryTheirLocationAsData) {
   const CameraError field = cameraError("kccd_cam_where.yaml", cameraText("image_width", "image_width: -5\n"));
   EXPECT_EQ(field.location().source, path);
   const std::string with_field = cameraText("image_width", "image_width: -5\n");
-  const auto field_line = static_cast<std::size_t>(std::count(with_field.begin(), with_field.begin() + static_cast<long>(with_field.find("image_width: -5")), '\n')) + 1;
+  const auto field_line =
+      static_cast<std::size_t>(std::count(
+          with_field.begin(), with_field.begin() + static_cast<long>(with_field.find("image_width: -5")), '\n')) +
+      1;
   EXPECT_EQ(field.location().line, field_line);  // the node's own place
   EXPECT_EQ(field.location().column, 14u);
   EXPECT_EQ(field.location().field, "image_width");
   EXPECT_EQ(field.problem(), "-5 is not in 1..8192");
-  EXPECT_EQ(std::string(field.what()), path + ":" + std::to_string(field_line) + ":14: image_width: -5 is not in 1..8192");
+  EXPECT_EQ(std::string(field.what()),
+            path + ":" + std::to_string(field_line) + ":14: image_width: -5 is not in 1..8192");
   // The text checks know the line; the YAML pre-check the line and the column.
   const CameraError header = cameraError("kccd_cam_where.yaml", "image_width: 320\n");
   EXPECT_EQ(header.location().line, 1u);
@@ -481,7 +515,8 @@ TEST(CalibCamera, QualityFiguresRoundTrip) {
     loadCamera(with);
     FAIL() << "negative sigma accepted";
   } catch (const CameraError& e) {
-    EXPECT_NE(std::string(e.what()).find("rotation_sigma_deg: must be a finite number >= 0"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("rotation_sigma_deg: must be a finite number >= 0"), std::string::npos)
+        << e.what();
   }
 }
 

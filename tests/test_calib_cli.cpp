@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <sstream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -84,8 +84,8 @@ class CalibCli : public ::testing::Test {
         const double a = uniform(rng, 0, 2 * M_PI), r = uniform(rng, 40, 90);
         px += cv::Point2d(r * std::cos(a), r * std::sin(a));
       }
-      t += "  - {name: w" + std::to_string(made) + ", pixel: [" + fmt(px.x) + ", " + fmt(px.y) + "], world: [" + fmt(p.x) + ", " +
-           fmt(p.y) + ", " + fmt(p.z) + "]}\n";
+      t += "  - {name: w" + std::to_string(made) + ", pixel: [" + fmt(px.x) + ", " + fmt(px.y) + "], world: [" +
+           fmt(p.x) + ", " + fmt(p.y) + ", " + fmt(p.z) + "]}\n";
       ++made;
     }
     return t;
@@ -93,7 +93,8 @@ class CalibCli : public ::testing::Test {
 
   // Labels of every core point of the arm's bodies at `state` (0.3 px noise); the state written
   // into each label when `with_state`.
-  std::string bodyLabels(std::mt19937_64& rng, const std::vector<double>& state, bool with_state, const std::string& prefix) const {
+  std::string bodyLabels(std::mt19937_64& rng, const std::vector<double>& state, bool with_state,
+                         const std::string& prefix) const {
     std::vector<kccd::Pose> poses(model_.joints.size());
     EXPECT_TRUE(kccd::framePoses(model_, state, poses));
     std::string st;
@@ -105,8 +106,9 @@ class CalibCli : public ::testing::Test {
         cv::Point2d px = project(truth_, {w.x(), w.y(), w.z()});
         px += cv::Point2d(uniform(rng, -0.3, 0.3), uniform(rng, -0.3, 0.3));
         const kccd::Vec3& q = b.points[k];
-        t += "  - {name: " + prefix + b.name + std::to_string(k) + ", pixel: [" + fmt(px.x) + ", " + fmt(px.y) + "], body: " + b.name +
-             ", point: [" + fmt(q.x()) + ", " + fmt(q.y()) + ", " + fmt(q.z()) + "]" + (with_state ? ", state: [" + st + "]" : "") + "}\n";
+        t += "  - {name: " + prefix + b.name + std::to_string(k) + ", pixel: [" + fmt(px.x) + ", " + fmt(px.y) +
+             "], body: " + b.name + ", point: [" + fmt(q.x()) + ", " + fmt(q.y()) + ", " + fmt(q.z()) + "]" +
+             (with_state ? ", state: [" + st + "]" : "") + "}\n";
       }
     return t;
   }
@@ -116,7 +118,8 @@ class CalibCli : public ::testing::Test {
     std::string args, expect;
   };
   // Each case exits 2 with one line saying its `expect`, and `output` is not written.
-  void expectOneLineErrors(const std::string& base, const std::vector<ErrorCase>& cases, const std::string& output) const {
+  void expectOneLineErrors(const std::string& base, const std::vector<ErrorCase>& cases,
+                           const std::string& output) const {
     for (const ErrorCase& c : cases) {
       const Outcome r = runKccd(base + c.args);
       EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
@@ -155,8 +158,8 @@ TEST_F(CalibCli, LabelsSolveRejectMisclicksAndWriteTheCamera) {
   EXPECT_LT(rotationErrorDeg(c.rvec, truth_.rvec), std::max(0.02, 4 * *c.rotation_sigma_deg));
   EXPECT_LT(cv::norm(centre(c) - centre(truth_)), std::max(0.002, 4 * *c.position_sigma_m));
   // --truth reports the same errors.
-  const Outcome t = runKccd("calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --truth " + kCamera + " -o " +
-                            out("cam2.yaml") + " --json");
+  const Outcome t = runKccd("calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --truth " +
+                            kCamera + " -o " + out("cam2.yaml") + " --json");
   ASSERT_EQ(t.code, 0) << t.err;
   const nlohmann::json jt = nlohmann::json::parse(t.out);
   EXPECT_NEAR(jt["truth_error"]["rotation_deg"].get<double>(), rotationErrorDeg(c.rvec, truth_.rvec), 1e-9);
@@ -171,7 +174,8 @@ TEST_F(CalibCli, BodyLabelsPlacedByTheirStateOrByStateOption) {
   std::mt19937_64 rng(11);
   // State in the labels.
   write("own.yaml", bodyLabels(rng, {0.3, 0.4, 0.6}, true, ""));
-  Outcome r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("own.yaml") + " --model " + kDemo + " -o " + out("a.yaml") + " -q");
+  Outcome r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("own.yaml") + " --model " + kDemo + " -o " +
+                      out("a.yaml") + " -q");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.out, "");
   kccd::calib::Camera c = kccd::calib::loadCamera(out("a.yaml"));
@@ -179,13 +183,14 @@ TEST_F(CalibCli, BodyLabelsPlacedByTheirStateOrByStateOption) {
   EXPECT_LT(cv::norm(centre(c) - centre(truth_)), 0.005);
   // State from --state; a wrong state moves the points and the solve does not agree.
   write("plain.yaml", bodyLabels(rng, {-0.4, 0.9, -0.5}, false, ""));
-  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("plain.yaml") + " --model " + kDemo + " --state=-0.4,0.9,-0.5 -o " +
-              out("b.yaml"));
+  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("plain.yaml") + " --model " + kDemo +
+              " --state=-0.4,0.9,-0.5 -o " + out("b.yaml"));
   ASSERT_EQ(r.code, 0) << r.err;
   c = kccd::calib::loadCamera(out("b.yaml"));
   EXPECT_LT(rotationErrorDeg(c.rvec, truth_.rvec), 0.1);
   // Without any state: one line naming the label's place.
-  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("plain.yaml") + " --model " + kDemo + " -o " + out("c.yaml"));
+  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("plain.yaml") + " --model " + kDemo + " -o " +
+              out("c.yaml"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find(out("plain.yaml") + ":2:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("needs a state"), std::string::npos) << r.err;
@@ -203,13 +208,14 @@ TEST_F(CalibCli, SeveralFramesAddUp) {
   write("f2.yaml", bodyLabels(rng, {-0.9, 1.2, -1.0}, false, ""));
   write("f3.yaml", bodyLabels(rng, {0.0, -0.8, 1.4}, false, ""));
   auto sigma = [&](const std::string& args) {
-    const Outcome r = runKccd("calib --intrinsics " + kCamera + " --model " + kDemo + " " + args + " --json -o " + out("x.yaml"));
+    const Outcome r =
+        runKccd("calib --intrinsics " + kCamera + " --model " + kDemo + " " + args + " --json -o " + out("x.yaml"));
     EXPECT_EQ(r.code, 0) << r.err;
     return r.code == 0 ? nlohmann::json::parse(r.out) : nlohmann::json();
   };
   const nlohmann::json one = sigma("--labels " + out("f1.yaml") + " --state 0.9,0.2,0.1");
-  const nlohmann::json all = sigma("--labels " + out("f1.yaml") + " --labels " + out("f2.yaml") + " --labels " + out("f3.yaml") +
-                                   " --state 0.9,0.2,0.1 --state=-0.9,1.2,-1.0 --state 0.0,-0.8,1.4");
+  const nlohmann::json all = sigma("--labels " + out("f1.yaml") + " --labels " + out("f2.yaml") + " --labels " +
+                                   out("f3.yaml") + " --state 0.9,0.2,0.1 --state=-0.9,1.2,-1.0 --state 0.0,-0.8,1.4");
   ASSERT_TRUE(one.is_object() && all.is_object());
   EXPECT_LT(all["rotation_sigma_deg"].get<double>(), one["rotation_sigma_deg"].get<double>());
   EXPECT_LT(all["position_sigma_m"].get<double>(), one["position_sigma_m"].get<double>());
@@ -217,8 +223,9 @@ TEST_F(CalibCli, SeveralFramesAddUp) {
   EXPECT_EQ(all["residuals"][0]["name"].get<std::string>().rfind("f1/", 0), 0u);
   EXPECT_EQ(all["residuals"].back()["name"].get<std::string>().rfind("f3/", 0), 0u);
   // A state count that matches neither one nor every frame.
-  const Outcome r = runKccd("calib --intrinsics " + kCamera + " --model " + kDemo + " --labels " + out("f1.yaml") + " --labels " +
-                            out("f2.yaml") + " --labels " + out("f3.yaml") + " --state 0,0,0 --state 0,0,0 -o " + out("y.yaml"));
+  const Outcome r =
+      runKccd("calib --intrinsics " + kCamera + " --model " + kDemo + " --labels " + out("f1.yaml") + " --labels " +
+              out("f2.yaml") + " --labels " + out("f3.yaml") + " --state 0,0,0 --state 0,0,0 -o " + out("y.yaml"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--state: given 2 times for 3 frames"), std::string::npos) << r.err;
 }
@@ -226,8 +233,8 @@ TEST_F(CalibCli, SeveralFramesAddUp) {
 TEST_F(CalibCli, NotSolvableWritesNothingAndSaysWhatToAdd) {
   std::mt19937_64 rng(3);
   write("few.yaml", worldLabels(rng, 3));
-  Outcome r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("few.yaml") + " -o " + out("cam.yaml") + " --check " +
-                      out("check.png"));
+  Outcome r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("few.yaml") + " -o " + out("cam.yaml") +
+                      " --check " + out("check.png"));
   EXPECT_EQ(r.code, 4);
   EXPECT_NE(r.err.find("kccd: calib: 3 points given, at least"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1);
@@ -256,7 +263,8 @@ class CalibMasks : public CalibCli {
     cam_.camera_matrix(1, 2) = (cam_.camera_matrix(1, 2) + 0.5) / 2 - 0.5;
     kccd::calib::saveCamera(cam_, out("cam.yaml"));
     states_ = {{0.6, -0.3, 0.9}, {-0.5, 0.4, -0.7}};
-    for (std::size_t f = 0; f < states_.size(); ++f) cv::imwrite(out("mask" + std::to_string(f) + ".png"), mask(states_[f]));
+    for (std::size_t f = 0; f < states_.size(); ++f)
+      cv::imwrite(out("mask" + std::to_string(f) + ".png"), mask(states_[f]));
   }
   cv::Mat mask(const std::vector<double>& state, int scale = kccd::testing::kSilhouetteScale) const {
     std::vector<kccd::Pose> poses(model_.joints.size());
@@ -329,16 +337,19 @@ class CalibMasks : public CalibCli {
     for (int k = 0; k < 30; ++k) {
       const cv::Point a(static_cast<int>(uniform(rng, 0, cam_.width)), static_cast<int>(uniform(rng, 0, cam_.height)));
       const cv::Scalar colour(uniform(rng, 20, 200), uniform(rng, 20, 200), uniform(rng, 20, 200));
-      cv::rectangle(scene, a, a + cv::Point(static_cast<int>(uniform(rng, 10, 70)), static_cast<int>(uniform(rng, 10, 50))), colour,
-                    cv::FILLED);
+      cv::rectangle(scene, a,
+                    a + cv::Point(static_cast<int>(uniform(rng, 10, 70)), static_cast<int>(uniform(rng, 10, 50))),
+                    colour, cv::FILLED);
     }
     const std::vector<double> rest = {0.3, -0.2, 0.6};
     std::string log = "time,shoulder_yaw,shoulder_pitch,elbow\n";
-    cv::VideoWriter video(out("rec.mkv"), cv::VideoWriter::fourcc('F', 'F', 'V', '1'), kFps, cv::Size(cam_.width, cam_.height));
+    cv::VideoWriter video(out("rec.mkv"), cv::VideoWriter::fourcc('F', 'F', 'V', '1'), kFps,
+                          cv::Size(cam_.width, cam_.height));
     ASSERT_TRUE(video.isOpened());
     for (int f = 0; f < 48; ++f) {
       const std::vector<double> state =
-          f % 2 == 0 ? rest : std::vector<double>{uniform(rng, -1.2, 1.2), uniform(rng, -0.6, 0.6), uniform(rng, -1.0, 1.0)};
+          f % 2 == 0 ? rest
+                     : std::vector<double>{uniform(rng, -1.2, 1.2), uniform(rng, -0.6, 0.6), uniform(rng, -1.0, 1.0)};
       log += fmt(f / kFps + kClock) + "," + fmt(state[0]) + "," + fmt(state[1]) + "," + fmt(state[2]) + "\n";
       cv::Mat picture = scene.clone();
       picture.setTo(cv::Scalar(215, 210, 205), quickMask(state));
@@ -356,13 +367,15 @@ class CalibMasks : public CalibCli {
     std::vector<kccd::Pose> poses(model_.joints.size());
     EXPECT_TRUE(kccd::framePoses(model_, states_[f], poses));
     std::string t = "labels:\n";
-    const std::pair<const char*, cv::Point2d> picks[] = {{f == 0 ? "forearm" : "upper_arm", {8, 0}}, {"gripper", {0, -8}}};
+    const std::pair<const char*, cv::Point2d> picks[] = {{f == 0 ? "forearm" : "upper_arm", {8, 0}},
+                                                         {"gripper", {0, -8}}};
     for (const auto& [body, off] : picks) {
       const kccd::Body& b = model_.bodies[static_cast<std::size_t>(model_.bodyIndex(body))];
       const kccd::Vec3 w = kccd::framePose(poses, b.frame) * b.points[0];
       const cv::Point2d px = project(cam_, {w.x(), w.y(), w.z()}) + off;
-      t += std::string("  - {name: ") + body + std::to_string(f) + ", pixel: [" + fmt(px.x) + ", " + fmt(px.y) + "], body: " + body +
-           ", point: [" + fmt(b.points[0].x()) + ", " + fmt(b.points[0].y()) + ", " + fmt(b.points[0].z()) + "]}\n";
+      t += std::string("  - {name: ") + body + std::to_string(f) + ", pixel: [" + fmt(px.x) + ", " + fmt(px.y) +
+           "], body: " + body + ", point: [" + fmt(b.points[0].x()) + ", " + fmt(b.points[0].y()) + ", " +
+           fmt(b.points[0].z()) + "]}\n";
     }
     return t;
   }
@@ -371,8 +384,8 @@ class CalibMasks : public CalibCli {
     for (std::size_t f = 0; f < states_.size(); ++f) {
       std::string st;
       for (double v : states_[f]) st += (st.empty() ? "" : ",") + fmt(v);
-      a += (labels ? " --labels " + out("l" + std::to_string(f) + ".yaml") : std::string()) + " --state " + st + " --masks " +
-           out("mask" + std::to_string(f) + ".png");
+      a += (labels ? " --labels " + out("l" + std::to_string(f) + ".yaml") : std::string()) + " --state " + st +
+           " --masks " + out("mask" + std::to_string(f) + ".png");
     }
     return a + " --model " + kDemo + " --mask-bodies pedestal,shoulder,upper_arm,forearm,gripper";
   }
@@ -383,8 +396,8 @@ class CalibMasks : public CalibCli {
 
 TEST_F(CalibMasks, FourRoughClicksAndMasksGiveTheCamera) {
   for (std::size_t f = 0; f < states_.size(); ++f) write("l" + std::to_string(f) + ".yaml", roughClicks(f));
-  const Outcome r = runKccd("calib --intrinsics " + out("cam.yaml") + frameArgs(true) + " -o " + out("c.yaml") + " --json --check " +
-                            out("check.png"));
+  const Outcome r = runKccd("calib --intrinsics " + out("cam.yaml") + frameArgs(true) + " -o " + out("c.yaml") +
+                            " --json --check " + out("check.png"));
   ASSERT_EQ(r.code, 0) << r.err << r.out;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_TRUE(j["refinement"]["improved"].get<bool>()) << r.out;
@@ -414,14 +427,20 @@ TEST_F(CalibMasks, BadMasksAreOneLineExitTwoAndNothingWritten) {
   const std::string base = "calib --intrinsics " + out("cam.yaml") + " -o " + out("c.yaml");
   const std::string state = " --state 0,0,0";
   const std::vector<ErrorCase> cases = {
-      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("small.png"), "small.png: mask: 200x100, but the camera"},
-      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("empty.png"), "empty.png: mask: no robot in it"},
-      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("full.png"), "full.png: mask: nothing but robot"},
-      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("broken.png"), "broken.png: mask: "},
-      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("mask0.png") + " " + out("mask1.png"),
+      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("small.png"),
+       "small.png: mask: 200x100, but the camera"},
+      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("empty.png"),
+       "empty.png: mask: no robot in it"},
+      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("full.png"),
+       "full.png: mask: nothing but robot"},
+      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("broken.png"),
+       "broken.png: mask: "},
+      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("mask0.png") + " " +
+           out("mask1.png"),
        "--masks: 2 mask(s) for 1 frame(s)"},
       {" --labels " + out("l0.yaml") + state + " --masks " + out("mask0.png"), "--masks: needs --model"},
-      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("mask0.png") + " --mask-bodies arm",
+      {" --labels " + out("l0.yaml") + state + " --model " + kDemo + " --masks " + out("mask0.png") +
+           " --mask-bodies arm",
        "--mask-bodies: 'arm' is not a body"},
       {" --labels " + out("l0.yaml") + " --camera " + kCamera, "--camera: a start for --masks"},
   };
@@ -444,11 +463,12 @@ TEST_F(CalibMasks, FourRoughClicksAndThePicturesEdgesGiveTheCamera) {
     cv::imwrite(out("pic" + std::to_string(f) + ".png"), bgr);
     std::string st;
     for (double v : states_[f]) st += (st.empty() ? "" : ",") + fmt(v);
-    args += " --image " + out("pic" + std::to_string(f) + ".png") + " --labels " + out("l" + std::to_string(f) + ".yaml") + " --state " + st;
+    args += " --image " + out("pic" + std::to_string(f) + ".png") + " --labels " +
+            out("l" + std::to_string(f) + ".yaml") + " --state " + st;
   }
   const Outcome r = runKccd("calib --intrinsics " + out("cam.yaml") + args + " --model " + kDemo +
-                            " --mask-bodies pedestal,shoulder,upper_arm,forearm,gripper --refine edges -o " + out("c.yaml") +
-                            " --json --check " + out("check.png"));
+                            " --mask-bodies pedestal,shoulder,upper_arm,forearm,gripper --refine edges -o " +
+                            out("c.yaml") + " --json --check " + out("check.png"));
   ASSERT_EQ(r.code, 0) << r.err << r.out;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_TRUE(j["refinement"]["improved"].get<bool>()) << r.out;
@@ -457,8 +477,8 @@ TEST_F(CalibMasks, FourRoughClicksAndThePicturesEdgesGiveTheCamera) {
   const kccd::calib::Camera c = kccd::calib::loadCamera(out("c.yaml"));
   EXPECT_LT(rotationErrorDeg(c.rvec, cam_.rvec), 0.2);
   EXPECT_LT(cv::norm(centre(c) - centre(cam_)), 0.01);
-  std::printf("4 clicks 8 px off + the edges of 2 pictures: %.3f deg, %.2f mm from the truth\n", rotationErrorDeg(c.rvec, cam_.rvec),
-              1e3 * cv::norm(centre(c) - centre(cam_)));
+  std::printf("4 clicks 8 px off + the edges of 2 pictures: %.3f deg, %.2f mm from the truth\n",
+              rotationErrorDeg(c.rvec, cam_.rvec), 1e3 * cv::norm(centre(c) - centre(cam_)));
   EXPECT_NE(kccd::testing::readText(out("c.yaml")).find("refinement: edges"), std::string::npos);
   // The check image draws the drawn robot's outline (magenta) on the frame.
   const cv::Mat check = cv::imread(out("check.png"));
@@ -478,12 +498,13 @@ TEST_F(CalibMasks, MasksFromTheRecordingItselfGiveTheCamera) {
   std::string frames;
   for (const int f : {3, 17, 31}) frames += " --frame " + std::to_string(f) + " --time " + fmt(f / kFps + kClock);
   const Outcome r = runKccd("calib --intrinsics " + out("cam.yaml") + " --video " + out("rec.mkv") + frames +
-                            " --states " + out("rec.csv") + " --model " + kDemo + " --masks auto --camera " + out("rough.yaml") + " -o " +
-                            out("c.yaml") + " --json --check " + out("check.png"));
+                            " --states " + out("rec.csv") + " --model " + kDemo + " --masks auto --camera " +
+                            out("rough.yaml") + " -o " + out("c.yaml") + " --json --check " + out("check.png"));
   ASSERT_EQ(r.code, 0) << r.err << r.out;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_TRUE(j["refinement"]["improved"].get<bool>()) << r.out;
-  EXPECT_NE(j["refinement"]["masks_from"].get<std::string>().find("background over 40 frames"), std::string::npos) << r.out;
+  EXPECT_NE(j["refinement"]["masks_from"].get<std::string>().find("background over 40 frames"), std::string::npos)
+      << r.out;
   ASSERT_EQ(j["refinement"]["frames"].size(), 3u);
   double mean_iou = 0.0;
   for (const auto& fr : j["refinement"]["frames"]) {
@@ -496,18 +517,23 @@ TEST_F(CalibMasks, MasksFromTheRecordingItselfGiveTheCamera) {
   std::printf("masks from the recording, from 6 deg / 6 cm off: %.3f deg, %.2f mm from the truth\n", deg, mm);
   EXPECT_LT(deg, 0.15);  // measured 0.045 deg, 4.6 mm; the same frames' true masks give 0.044 deg, 4.6 mm
   EXPECT_LT(mm, 10.0);
-  EXPECT_NE(kccd::testing::readText(out("c.yaml")).find("refinement_masks: \"masks from the recording"), std::string::npos);
+  EXPECT_NE(kccd::testing::readText(out("c.yaml")).find("refinement_masks: \"masks from the recording"),
+            std::string::npos);
   // The check image shows the mask made (yellow) and the drawn robot (magenta).
   cv::Mat yellow;
   cv::inRange(cv::imread(out("check.png")), cv::Scalar(0, 170, 200), cv::Scalar(60, 255, 255), yellow);
   EXPECT_GT(cv::countNonZero(yellow), 100);
 
   // What --masks auto needs, said in one line each.
-  const std::string base = "calib --intrinsics " + out("cam.yaml") + " --model " + kDemo + " --camera " + out("rough.yaml") + " -o " + out("d.yaml");
+  const std::string base = "calib --intrinsics " + out("cam.yaml") + " --model " + kDemo + " --camera " +
+                           out("rough.yaml") + " -o " + out("d.yaml");
   const std::vector<ErrorCase> cases = {
-      {" --image " + out("check.png") + " --state 0,0,0 --masks auto", "--masks auto: makes the masks from a recording"},
-      {" --video " + out("rec.mkv") + " --frame 3 --state 0,0,0 --masks auto", "--masks auto: needs each frame's state"},
-      {" --video " + out("rec.mkv") + " --frame 3 --states " + out("rec.csv") + " --masks auto " + out("mask0.png"), "give it alone"},
+      {" --image " + out("check.png") + " --state 0,0,0 --masks auto",
+       "--masks auto: makes the masks from a recording"},
+      {" --video " + out("rec.mkv") + " --frame 3 --state 0,0,0 --masks auto",
+       "--masks auto: needs each frame's state"},
+      {" --video " + out("rec.mkv") + " --frame 3 --states " + out("rec.csv") + " --masks auto " + out("mask0.png"),
+       "give it alone"},
   };
   expectOneLineErrors(base, cases, out("d.yaml"));
 }
@@ -532,17 +558,19 @@ TEST_F(CalibMasks, OverlayAgreementWithMasksFromTheRecording) {
   }
   write("bad.csv", bad);
   const auto agreement = [&](const std::string& log, double offset) {
-    const Outcome r = runKccd("overlay " + kDemo + " --camera " + out("cam.yaml") + " --video " + out("rec.mkv") + " --states " + out(log) +
-                              " --time-offset " + fmt(offset) + " --masks auto --report " + out("r.json") + " -q");
+    const Outcome r =
+        runKccd("overlay " + kDemo + " --camera " + out("cam.yaml") + " --video " + out("rec.mkv") + " --states " +
+                out(log) + " --time-offset " + fmt(offset) + " --masks auto --report " + out("r.json") + " -q");
     EXPECT_EQ(r.code, 0) << r.err << r.out;
     return nlohmann::json::parse(kccd::testing::readText(out("r.json")))["mask_agreement"];
   };
   const nlohmann::json right = agreement("rec.csv", kClock), late = agreement("rec.csv", kClock + 1 / kFps),
                        offset = agreement("bad.csv", kClock);
-  std::printf("masks from the recording: IoU at the log's clock mean %.3f (smallest %.3f, %d low); a frame late %.3f; "
-              "shoulder 0.3 rad off in 10 frames: %d low\n",
-              right["mean_iou"].get<double>(), right["min_iou"].get<double>(), right["low_frames"].get<int>(), late["mean_iou"].get<double>(),
-              offset["low_frames"].get<int>());
+  std::printf(
+      "masks from the recording: IoU at the log's clock mean %.3f (smallest %.3f, %d low); a frame late %.3f; "
+      "shoulder 0.3 rad off in 10 frames: %d low\n",
+      right["mean_iou"].get<double>(), right["min_iou"].get<double>(), right["low_frames"].get<int>(),
+      late["mean_iou"].get<double>(), offset["low_frames"].get<int>());
   EXPECT_GE(right["frames"].get<int>(), 40);
   EXPECT_GT(right["mean_iou"].get<double>(), 0.9);
   EXPECT_LE(right["low_frames"].get<int>(), 1) << right.dump();
@@ -554,9 +582,11 @@ TEST_F(CalibMasks, OverlayAgreementWithMasksFromTheRecording) {
 
 TEST_F(CalibMasks, BadRefineOptionsAreOneLineExitTwo) {
   write("l0.yaml", roughClicks(0));
-  const std::string base = "calib --intrinsics " + out("cam.yaml") + " -o " + out("c.yaml") + " --labels " + out("l0.yaml") + " --state 0,0,0";
+  const std::string base = "calib --intrinsics " + out("cam.yaml") + " -o " + out("c.yaml") + " --labels " +
+                           out("l0.yaml") + " --state 0,0,0";
   const std::vector<ErrorCase> cases = {
-      {" --model " + kDemo + " --refine edges --masks " + out("mask0.png"), "--refine edges: refines to the pictures themselves"},
+      {" --model " + kDemo + " --refine edges --masks " + out("mask0.png"),
+       "--refine edges: refines to the pictures themselves"},
       {" --refine edges", "--refine edges: needs --model"},
       {" --model " + kDemo + " --refine masks", "--refine masks: give the masks"},
       {" --model " + kDemo + " --refine lines", "--refine"},
@@ -573,8 +603,9 @@ TEST_F(CalibMasks, MasksThatCannotBeMatchedExitFourWithWhatToAdd) {
   far.tvec[0] += 0.6;  // a rough camera far off
   kccd::calib::saveCamera(far, out("rough.yaml"));
   cv::imwrite(out("frame.png"), cv::Mat(cam_.height, cam_.width, CV_8UC3, cv::Scalar(90, 90, 90)));
-  const Outcome r = runKccd("calib --intrinsics " + out("cam.yaml") + " --image " + out("frame.png") + " --masks " + out("wrong.png") +
-                            " --state 0.6,-0.3,0.9 --model " + kDemo + " --camera " + out("rough.yaml") + " -o " + out("c.yaml"));
+  const Outcome r = runKccd("calib --intrinsics " + out("cam.yaml") + " --image " + out("frame.png") + " --masks " +
+                            out("wrong.png") + " --state 0.6,-0.3,0.9 --model " + kDemo + " --camera " +
+                            out("rough.yaml") + " -o " + out("c.yaml"));
   EXPECT_EQ(r.code, 4) << r.err << r.out;
   EXPECT_NE(r.err.find("add labels of the robot or tags"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out("c.yaml")));
@@ -595,14 +626,20 @@ TEST_F(CalibCli, BadInputIsOneLineExitTwo) {
   const cv::Mat picture(240, 320, CV_8UC3, cv::Scalar(40, 90, 200));
   for (const std::string ext : {".jpg", ".bmp", ".ppm", ".tif", ".webp"}) {
     cv::imencode(ext, picture, encoded);
-    write("cut" + ext.substr(1) + ".png", std::string(encoded.begin(), encoded.begin() + static_cast<long>(encoded.size() / 2)));
+    write("cut" + ext.substr(1) + ".png",
+          std::string(encoded.begin(), encoded.begin() + static_cast<long>(encoded.size() / 2)));
   }
   const std::vector<Case> cases{
-      {"--intrinsics " + kCamera + " --image " + out("cutjpg.png") + l + " -o " + out("c.yaml"), "image: a damaged JPEG (Premature end of JPEG file)"},
-      {"--intrinsics " + kCamera + " --image " + out("cutbmp.png") + l + " -o " + out("c.yaml"), "image: a damaged image (Unexpected end of input stream)"},
-      {"--intrinsics " + kCamera + " --image " + out("cutppm.png") + l + " -o " + out("c.yaml"), "image: a damaged image (Unexpected end of input stream)"},
-      {"--intrinsics " + kCamera + " --image " + out("cuttif.png") + l + " -o " + out("c.yaml"), "image: not an image OpenCV can decode"},
-      {"--intrinsics " + kCamera + " --image " + out("cutwebp.png") + l + " -o " + out("c.yaml"), "image: not an image OpenCV can decode"},
+      {"--intrinsics " + kCamera + " --image " + out("cutjpg.png") + l + " -o " + out("c.yaml"),
+       "image: a damaged JPEG (Premature end of JPEG file)"},
+      {"--intrinsics " + kCamera + " --image " + out("cutbmp.png") + l + " -o " + out("c.yaml"),
+       "image: a damaged image (Unexpected end of input stream)"},
+      {"--intrinsics " + kCamera + " --image " + out("cutppm.png") + l + " -o " + out("c.yaml"),
+       "image: a damaged image (Unexpected end of input stream)"},
+      {"--intrinsics " + kCamera + " --image " + out("cuttif.png") + l + " -o " + out("c.yaml"),
+       "image: not an image OpenCV can decode"},
+      {"--intrinsics " + kCamera + " --image " + out("cutwebp.png") + l + " -o " + out("c.yaml"),
+       "image: not an image OpenCV can decode"},
       {"--intrinsics " + kCamera + l, "-o CAMERA.yaml is required"},
       {l + " -o " + out("c.yaml"), "--intrinsics CAMERA.yaml is required"},
       {"--intrinsics " + kCamera + " -o " + out("c.yaml"), "give --image FRAME"},
@@ -611,9 +648,12 @@ TEST_F(CalibCli, BadInputIsOneLineExitTwo) {
       {"--intrinsics " + kCamera + l + " -o " + out("c.yaml") + " --check " + out("c.jpg"), "must be a .png file"},
       {"--intrinsics " + out("missing.yaml") + l + " -o " + out("c.yaml"), out("missing.yaml")},
       {"--intrinsics " + kCamera + " --labels " + out("missing.yaml") + " -o " + out("c.yaml"), out("missing.yaml")},
-      {"--intrinsics " + kCamera + " --image " + out("small.png") + l + " -o " + out("c.yaml"), "the image is 200x100 but the camera"},
-      {"--intrinsics " + kCamera + " --image " + out("not_image.png") + l + " -o " + out("c.yaml"), "image: not an image OpenCV can decode"},
-      {"--intrinsics " + kCamera + " --image " + out("small.png") + " -o " + out("c.yaml"), "give --tags LAYOUT, --labels LABELS and/or --masks MASK"},
+      {"--intrinsics " + kCamera + " --image " + out("small.png") + l + " -o " + out("c.yaml"),
+       "the image is 200x100 but the camera"},
+      {"--intrinsics " + kCamera + " --image " + out("not_image.png") + l + " -o " + out("c.yaml"),
+       "image: not an image OpenCV can decode"},
+      {"--intrinsics " + kCamera + " --image " + out("small.png") + " -o " + out("c.yaml"),
+       "give --tags LAYOUT, --labels LABELS and/or --masks MASK"},
       {"--intrinsics " + kCamera + l + " --tags " + kCamera + " -o " + out("c.yaml"), "--tags: needs --image"},
       {"--intrinsics " + kCamera + l + " --state 0,0,0 -o " + out("c.yaml"), "--state: needs --model"},
       {"--intrinsics " + kCamera + l + " --model " + kDemo + " --state 0,0 -o " + out("c.yaml"), "has 2 values"},
@@ -651,8 +691,8 @@ TEST_F(CalibCli, SheetNumbersCandidatesAndWritesAFillableTemplate) {
   // (a filled rectangle covers pixels p ... p + 60: its edges are at p - 0.5 and p + 60.5)
   int near = 0;
   for (const cv::Point& p : squares)
-    for (const cv::Point2d& c : {cv::Point2d(p.x - 0.5, p.y - 0.5), cv::Point2d(p.x + 60.5, p.y - 0.5), cv::Point2d(p.x - 0.5, p.y + 60.5),
-                                 cv::Point2d(p.x + 60.5, p.y + 60.5)})
+    for (const cv::Point2d& c : {cv::Point2d(p.x - 0.5, p.y - 0.5), cv::Point2d(p.x + 60.5, p.y - 0.5),
+                                 cv::Point2d(p.x - 0.5, p.y + 60.5), cv::Point2d(p.x + 60.5, p.y + 60.5)})
       for (std::size_t at = text.find("pixel: ["); at != std::string::npos; at = text.find("pixel: [", at + 1)) {
         const double u = std::stod(text.substr(at + 8)), v = std::stod(text.substr(text.find(',', at) + 1));
         near += std::hypot(u - c.x, v - c.y) < 0.25;
@@ -667,16 +707,17 @@ TEST_F(CalibCli, SheetNumbersCandidatesAndWritesAFillableTemplate) {
   std::string filled;
   std::istringstream lines(text);
   for (std::string line; std::getline(lines, line);) {
-    const bool model_point = line.find("name: table.") != std::string::npos || line.find("name: gripper.") != std::string::npos ||
-                             line.find("name: post.") != std::string::npos || line.find("name: pedestal.") != std::string::npos;
+    const bool model_point =
+        line.find("name: table.") != std::string::npos || line.find("name: gripper.") != std::string::npos ||
+        line.find("name: post.") != std::string::npos || line.find("name: pedestal.") != std::string::npos;
     if (model_point)
       filled += line.substr(1, line.find("  # projected") - 1) + "\n";
     else if (line.rfind("#", 0) != 0)
       filled += line + "\n";
   }
   write("filled.yaml", filled);
-  const Outcome solve = runKccd("calib --intrinsics " + kCamera + " --labels " + out("filled.yaml") + " --model " + kDemo + " -o " +
-                                out("cam.yaml") + " --json");
+  const Outcome solve = runKccd("calib --intrinsics " + kCamera + " --labels " + out("filled.yaml") + " --model " +
+                                kDemo + " -o " + out("cam.yaml") + " --json");
   ASSERT_EQ(solve.code, 0) << solve.err << filled;
   const kccd::calib::Camera c = kccd::calib::loadCamera(out("cam.yaml"));
   EXPECT_LT(rotationErrorDeg(c.rvec, truth_.rvec), 0.05);
@@ -704,8 +745,8 @@ TEST_F(CalibCli, BodyLabelsPlacedByTheStateLogAtTheFrameTime) {
   write("log.csv", log);
   std::mt19937_64 rng(21);
   write("labels.yaml", bodyLabels(rng, {0.3, 0.4, 0.6}, false, ""));
-  const std::string base = "calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --model " + kDemo + " --states " +
-                           out("log.csv") + " -o " + out("cam.yaml");
+  const std::string base = "calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --model " + kDemo +
+                           " --states " + out("log.csv") + " -o " + out("cam.yaml");
   Outcome r = runKccd(base + " --time 1.25");
   ASSERT_EQ(r.code, 0) << r.err;
   const kccd::calib::Camera c = kccd::calib::loadCamera(out("cam.yaml"));
@@ -717,7 +758,8 @@ TEST_F(CalibCli, BodyLabelsPlacedByTheStateLogAtTheFrameTime) {
   const nlohmann::json wrong = nlohmann::json::parse(r.out);
   ASSERT_EQ(r.code, 0) << r.out;
   for (const char* name : {"gripper0", "gripper1", "gripper2", "gripper3"})
-    EXPECT_NE(std::find(wrong["rejected"].begin(), wrong["rejected"].end(), name), wrong["rejected"].end()) << name << r.out;
+    EXPECT_NE(std::find(wrong["rejected"].begin(), wrong["rejected"].end(), name), wrong["rejected"].end())
+        << name << r.out;
   // Outside the log, beyond --max-gap, a missing --time, a typo in a column: one line, exit 2.
   r = runKccd(base + " --time 7");
   EXPECT_EQ(r.code, 2);
@@ -726,13 +768,13 @@ TEST_F(CalibCli, BodyLabelsPlacedByTheStateLogAtTheFrameTime) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--time"), std::string::npos) << r.err;
   write("typo.csv", "time,shoulder_yaw,shoulder_pitch,elbow,elbo\n0,0,0,0,0\n");
-  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --model " + kDemo + " --states " + out("typo.csv") +
-              " --time 0 -o " + out("cam2.yaml"));
+  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --model " + kDemo + " --states " +
+              out("typo.csv") + " --time 0 -o " + out("cam2.yaml"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find(out("typo.csv") + ":1:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("elbo"), std::string::npos) << r.err;
-  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --model " + kDemo + " --states " + out("typo.csv") +
-              " --ignore-columns elbo --time 0 -o " + out("cam2.yaml"));
+  r = runKccd("calib --intrinsics " + kCamera + " --labels " + out("labels.yaml") + " --model " + kDemo + " --states " +
+              out("typo.csv") + " --ignore-columns elbo --time 0 -o " + out("cam2.yaml"));
   EXPECT_NE(r.code, 2) << r.err;
 }
 

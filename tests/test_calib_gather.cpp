@@ -26,8 +26,8 @@
 #include "kccd/overlay/calibration/calib_gather.hpp"
 #include "kccd/overlay/calibration/calib_report.hpp"
 #include "kccd/overlay/calibration/calib_solve.hpp"
-#include "kccd/overlay/labelling/labelling_candidates.hpp"
 #include "kccd/overlay/calibration/model_points.hpp"
+#include "kccd/overlay/labelling/labelling_candidates.hpp"
 #include "kccd/overlay/recording/video_source.hpp"
 #include "support/tag_scene.hpp"
 

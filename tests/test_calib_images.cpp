@@ -16,10 +16,10 @@
 #include <apriltag/tag36h11.h>
 #include <opencv2/calib3d.hpp>
 
-#include "support/sanitized.hpp"
 #include "kccd/calib/pose.hpp"
 #include "kccd/calib/tag_detect.hpp"
 #include "support/cameras.hpp"
+#include "support/sanitized.hpp"
 #include "support/tag_scene.hpp"
 
 namespace {
@@ -27,8 +27,8 @@ namespace {
 using namespace kccd;
 using namespace kccd::calib;
 using kccd::testing::projectTagCorners;
-using kccd::testing::rotationErrorDeg;
 using kccd::testing::renderTagScene;
+using kccd::testing::rotationErrorDeg;
 using kccd::testing::TagSceneOptions;
 
 constexpr double kPi = 3.14159265358979323846;

@@ -118,20 +118,30 @@ TEST(CalibTagLayout, EveryMistakeIsOneLineNamingThePlaceAndField) {
   } cases[] = {
       {"tags:\n  - " + ok + "\n  - {id: 1, size: 0.2, xyz: [1, 0, 0], rpy: [0, 0, 0]}\n",
        "layout.yaml:3:10: tags[1].id: tag 1 is listed twice (also tags[0])"},
-      {"tags:\n  - {id: 587, size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n", "layout.yaml:2:10: tags[0].id: '587' is not a tag36h11 id"},
+      {"tags:\n  - {id: 587, size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n",
+       "layout.yaml:2:10: tags[0].id: '587' is not a tag36h11 id"},
       {"tags:\n  - {id: -1, size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n", "layout.yaml:2:10: tags[0].id: '-1' is not"},
-      {"tags:\n  - {id: 2.5, size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n", "layout.yaml:2:10: tags[0].id: '2.5' is not"},
-      {"tags:\n  - {id: x, size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n", "layout.yaml:2:10: tags[0].id: expected a number, got 'x'"},
-      {"tags:\n  - {id: 1, size: 0, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n", "layout.yaml:2:19: tags[0].size: the edge of the black square must be > 0"},
+      {"tags:\n  - {id: 2.5, size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n",
+       "layout.yaml:2:10: tags[0].id: '2.5' is not"},
+      {"tags:\n  - {id: x, size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n",
+       "layout.yaml:2:10: tags[0].id: expected a number, got 'x'"},
+      {"tags:\n  - {id: 1, size: 0, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n",
+       "layout.yaml:2:19: tags[0].size: the edge of the black square must be > 0"},
       {"tags:\n  - {id: 1, size: -0.1, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n", "layout.yaml:2:19: tags[0].size: the edge"},
       {"tags:\n  - {id: 1, size: 101, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n", "layout.yaml:2:19: tags[0].size: the edge"},
-      {"tags:\n  - {id: 1, size: .nan, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n", "layout.yaml:2:19: tags[0].size: must be finite"},
-      {"tags:\n  - {id: 1, size: 0.1, xyz: [0, 2e6, 0], rpy: [0, 0, 0]}\n", "layout.yaml:2:33: tags[0].xyz[1]: beyond the largest"},
-      {"tags:\n  - {id: 1, size: 0.1, xyz: [0, 0], rpy: [0, 0, 0]}\n", "layout.yaml:2:29: tags[0].xyz: expected 3 numbers, got 2"},
-      {"tags:\n  - {id: 1, size: 0.1, xyz: [0, 0, 0], rpy: [0, .inf, 0]}\n", "layout.yaml:2:49: tags[0].rpy[1]: must be finite"},
+      {"tags:\n  - {id: 1, size: .nan, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n",
+       "layout.yaml:2:19: tags[0].size: must be finite"},
+      {"tags:\n  - {id: 1, size: 0.1, xyz: [0, 2e6, 0], rpy: [0, 0, 0]}\n",
+       "layout.yaml:2:33: tags[0].xyz[1]: beyond the largest"},
+      {"tags:\n  - {id: 1, size: 0.1, xyz: [0, 0], rpy: [0, 0, 0]}\n",
+       "layout.yaml:2:29: tags[0].xyz: expected 3 numbers, got 2"},
+      {"tags:\n  - {id: 1, size: 0.1, xyz: [0, 0, 0], rpy: [0, .inf, 0]}\n",
+       "layout.yaml:2:49: tags[0].rpy[1]: must be finite"},
       {"tags:\n  - {id: 1, size: 0.1, xyz: [0, 0, 0]}\n", "layout.yaml:2:5: tags[0].rpy: required field is missing"},
-      {"tags:\n  - {size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n", "layout.yaml:2:5: tags[0].id: required field is missing"},
-      {"tags:\n  - {id: 1, size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0], colour: red}\n", "layout.yaml:2:56: tags[0].colour: unknown field"},
+      {"tags:\n  - {size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n",
+       "layout.yaml:2:5: tags[0].id: required field is missing"},
+      {"tags:\n  - {id: 1, size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0], colour: red}\n",
+       "layout.yaml:2:56: tags[0].colour: unknown field"},
       {"tag:\n  - " + ok + "\n", "layout.yaml:1:1: layout.tag: unknown field"},
       {"tags: []\n", "layout.yaml:1:7: tags: a layout needs at least one tag"},
       {"tags: 3\n", "layout.yaml:1:7: tags: expected a list"},
@@ -148,13 +158,15 @@ TEST(CalibTagLayout, EveryMistakeIsOneLineNamingThePlaceAndField) {
 
 TEST(CalibTagLayout, FilesThatAreNotRegularOrTooLarge) {
   const std::string missing = ::testing::TempDir() + "/kccd_no_such_layout.yaml";
-  EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(missing); }), missing + ": cannot open the tag layout (no such file)");
+  EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(missing); }),
+            missing + ": cannot open the tag layout (no such file)");
   const std::string dir = ::testing::TempDir();
   EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(dir); }), dir + ": a folder, not a tag layout");
   const std::string fifo = ::testing::TempDir() + "/kccd_layout_fifo";
   std::filesystem::remove(fifo);
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(fifo); }), fifo + ": not a regular file (a device, FIFO or socket)");
+  EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(fifo); }),
+            fifo + ": not a regular file (a device, FIFO or socket)");
   std::filesystem::remove(fifo);
   const std::string big = writeTemp("kccd_layout_big.yaml", "# " + std::string(kMaxTagLayoutBytes, 'x') + "\n");
   EXPECT_EQ(errorOf<TagLayoutError>([&] { loadTagLayout(big); }), big + ": larger than 1 MiB");
@@ -187,14 +199,15 @@ Vec3 forearmPoint(const Vec3& p, double q0, double q1, double q2) {
 }
 
 TEST(CalibLabels, LoadsWorldAndBodyLabels) {
-  const std::string path = writeTemp("kccd_labels.yaml",
-                                     "labels:\n"
-                                     "  - {name: table_corner, pixel: [512.5, 301.0], world: [1.2, 0.4, 0.0]}\n"
-                                     "  - {name: wrist, pixel: [640.0, 210.5], body: forearm, point: [0.0, 0.0, 0.3], state: [0.1, -0.4, 0.05]}\n"
-                                     "  - name: tip\n"
-                                     "    pixel: [-3, 1e5]\n"
-                                     "    body: forearm\n"
-                                     "    point: [0.3, 0, 0]\n");
+  const std::string path = writeTemp(
+      "kccd_labels.yaml",
+      "labels:\n"
+      "  - {name: table_corner, pixel: [512.5, 301.0], world: [1.2, 0.4, 0.0]}\n"
+      "  - {name: wrist, pixel: [640.0, 210.5], body: forearm, point: [0.0, 0.0, 0.3], state: [0.1, -0.4, 0.05]}\n"
+      "  - name: tip\n"
+      "    pixel: [-3, 1e5]\n"
+      "    body: forearm\n"
+      "    point: [0.3, 0, 0]\n");
   const Labels labels = loadLabels(path);
   ASSERT_EQ(labels.labels.size(), 3u);
   const Label& a = labels.labels[0];
@@ -269,26 +282,42 @@ TEST(CalibLabels, EveryMistakeIsOneLineNamingThePlaceAndField) {
        "labels.yaml:3:12: labels[1].name: label 'a' is given twice (also labels[0])"},
       {"labels:\n  - {name: a, pixel: [1, 2], world: [0, 0, 0], body: b, point: [0, 0, 0]}\n",
        "labels.yaml:2:5: label 'a': give either world or body (with point), not both"},
-      {"labels:\n  - {name: a, pixel: [1, 2]}\n", "labels.yaml:2:5: label 'a': needs world: [x, y, z] or body: NAME with point"},
-      {"labels:\n  - {name: a, pixel: [1, 2], body: b}\n", "labels.yaml:2:5: label 'a'.point: required field is missing"},
+      {"labels:\n  - {name: a, pixel: [1, 2]}\n",
+       "labels.yaml:2:5: label 'a': needs world: [x, y, z] or body: NAME with point"},
+      {"labels:\n  - {name: a, pixel: [1, 2], body: b}\n",
+       "labels.yaml:2:5: label 'a'.point: required field is missing"},
       {"labels:\n  - {name: a, pixel: [1, 2], world: [0, 0, 0], point: [0, 0, 0]}\n",
        "labels.yaml:2:55: label 'a'.point: point belongs to a body label"},
-      {"labels:\n  - {name: a, pixel: [1, 2], world: [0, 0, 0], state: [0]}\n", "labels.yaml:2:55: label 'a'.state: state belongs to a body label"},
-      {"labels:\n  - {name: a, pixel: [1, .nan], world: [0, 0, 0]}\n", "labels.yaml:2:26: label 'a'.pixel[1]: must be finite"},
-      {"labels:\n  - {name: a, pixel: [1, 2e6], world: [0, 0, 0]}\n", "labels.yaml:2:26: label 'a'.pixel[1]: beyond the largest"},
-      {"labels:\n  - {name: a, pixel: [1, 2, 3], world: [0, 0, 0]}\n", "labels.yaml:2:22: label 'a'.pixel: expected 2 numbers, got 3"},
+      {"labels:\n  - {name: a, pixel: [1, 2], world: [0, 0, 0], state: [0]}\n",
+       "labels.yaml:2:55: label 'a'.state: state belongs to a body label"},
+      {"labels:\n  - {name: a, pixel: [1, .nan], world: [0, 0, 0]}\n",
+       "labels.yaml:2:26: label 'a'.pixel[1]: must be finite"},
+      {"labels:\n  - {name: a, pixel: [1, 2e6], world: [0, 0, 0]}\n",
+       "labels.yaml:2:26: label 'a'.pixel[1]: beyond the largest"},
+      {"labels:\n  - {name: a, pixel: [1, 2, 3], world: [0, 0, 0]}\n",
+       "labels.yaml:2:22: label 'a'.pixel: expected 2 numbers, got 3"},
       {"labels:\n  - {name: a, world: [0, 0, 0]}\n", "labels.yaml:2:5: label 'a'.pixel: required field is missing"},
-      {"labels:\n  - {name: a, pixel: [1, 2], world: [0, zero, 0]}\n", "labels.yaml:2:41: label 'a'.world[1]: expected a number, got 'zero'"},
-      {"labels:\n  - {name: a, pixel: [1, 2], world: [0, 0, -1e7]}\n", "labels.yaml:2:44: label 'a'.world[2]: beyond the largest"},
+      {"labels:\n  - {name: a, pixel: [1, 2], world: [0, zero, 0]}\n",
+       "labels.yaml:2:41: label 'a'.world[1]: expected a number, got 'zero'"},
+      {"labels:\n  - {name: a, pixel: [1, 2], world: [0, 0, -1e7]}\n",
+       "labels.yaml:2:44: label 'a'.world[2]: beyond the largest"},
       {"labels:\n  - {name: a, pixel: [1, 2], body: b, point: [0, 0, 0], state: [0, .inf]}\n",
        "labels.yaml:2:68: label 'a'.state[1]: must be finite"},
-      {"labels:\n  - {name: a, pixel: [1, 2], body: b, point: [0, 0, 0], state: 3}\n", "labels.yaml:2:64: label 'a'.state: expected a list"},
-      {"labels:\n  - {name: a, pixel: [1, 2], body: [b], point: [0, 0, 0]}\n", "labels.yaml:2:36: label 'a'.body: expected a string"},
-      {"labels:\n  - {name: '', pixel: [1, 2], world: [0, 0, 0]}\n", "labels.yaml:2:12: labels[0].name: must not be empty"},
-      {"labels:\n  - {name: \"a\\tb\", pixel: [1, 2], world: [0, 0, 0]}\n", "labels.yaml:2:12: labels[0].name: contains a control character: 'a\\x09b'"},
-      {"labels:\n  - {name: a\xff" "b, pixel: [1, 2], world: [0, 0, 0]}\n", "labels.yaml:2:12: labels[0].name: is not UTF-8 text: 'a\\xffb'"},
-      {"labels:\n  - {pixel: [1, 2], world: [0, 0, 0]}\n", "labels.yaml:2:5: labels[0].name: required field is missing"},
-      {"labels:\n  - {name: a, pixel: [1, 2], world: [0, 0, 0], colour: red}\n", "labels.yaml:2:48: labels[0].colour: unknown field"},
+      {"labels:\n  - {name: a, pixel: [1, 2], body: b, point: [0, 0, 0], state: 3}\n",
+       "labels.yaml:2:64: label 'a'.state: expected a list"},
+      {"labels:\n  - {name: a, pixel: [1, 2], body: [b], point: [0, 0, 0]}\n",
+       "labels.yaml:2:36: label 'a'.body: expected a string"},
+      {"labels:\n  - {name: '', pixel: [1, 2], world: [0, 0, 0]}\n",
+       "labels.yaml:2:12: labels[0].name: must not be empty"},
+      {"labels:\n  - {name: \"a\\tb\", pixel: [1, 2], world: [0, 0, 0]}\n",
+       "labels.yaml:2:12: labels[0].name: contains a control character: 'a\\x09b'"},
+      {"labels:\n  - {name: a\xff"
+       "b, pixel: [1, 2], world: [0, 0, 0]}\n",
+       "labels.yaml:2:12: labels[0].name: is not UTF-8 text: 'a\\xffb'"},
+      {"labels:\n  - {pixel: [1, 2], world: [0, 0, 0]}\n",
+       "labels.yaml:2:5: labels[0].name: required field is missing"},
+      {"labels:\n  - {name: a, pixel: [1, 2], world: [0, 0, 0], colour: red}\n",
+       "labels.yaml:2:48: labels[0].colour: unknown field"},
       {"labels: []\n", "labels.yaml:1:9: labels: at least one label is needed"},
       {"label:\n  - " + ok + "\n", "labels.yaml:1:1: file.label: unknown field"},
       {"labels:\n  - " + ok + "\nlabels:\n  - " + ok + "\n", "labels.yaml:3:1: labels: duplicate key"},
@@ -299,7 +328,8 @@ TEST(CalibLabels, EveryMistakeIsOneLineNamingThePlaceAndField) {
     EXPECT_EQ(m.rfind(c.expected, 0), 0u) << "got:      " << m << "\nexpected: " << c.expected << "\nfor:\n" << c.text;
   }
   const std::string missing = ::testing::TempDir() + "/kccd_no_such_labels.yaml";
-  EXPECT_EQ(errorOf<LabelsError>([&] { loadLabels(missing); }), missing + ": cannot open the labels file (no such file)");
+  EXPECT_EQ(errorOf<LabelsError>([&] { loadLabels(missing); }),
+            missing + ": cannot open the labels file (no such file)");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -335,7 +365,8 @@ TEST(CalibTagDetect, CornersLandWhereTheyWereDrawn) {
     ASSERT_TRUE(d.id == 3 || d.id == 42 || d.id == 500) << d.id;
     EXPECT_EQ(d.hamming, 0);
     for (std::size_t k = 0; k < 4; ++k)
-      EXPECT_LT(cv::norm(d.corners[k] - drawn[k]), 0.5) << "tag " << d.id << " corner " << k << " at " << d.corners[k] << ", drawn " << drawn[k];
+      EXPECT_LT(cv::norm(d.corners[k] - drawn[k]), 0.5)
+          << "tag " << d.id << " corner " << k << " at " << d.corners[k] << ", drawn " << drawn[k];
   }
 
   const TagLayout layout = parseTagLayout(
@@ -357,7 +388,8 @@ TEST(CalibTagDetect, CornersLandWhereTheyWereDrawn) {
 
   const std::vector<TagDetection> twice{found[0], found[1], found[0]};
   EXPECT_EQ(errorOf<TagDetectionError>([&] { tagCorrespondences(twice, layout, "frame.png"); }),
-            "frame.png: tags: tag " + std::to_string(found[0].id) + " is detected twice (each id may appear once: is it printed twice?)");
+            "frame.png: tags: tag " + std::to_string(found[0].id) +
+                " is detected twice (each id may appear once: is it printed twice?)");
   EXPECT_THROW(detectTags(cv::Mat(10, 10, CV_8UC3)), std::invalid_argument);
 }
 

@@ -80,7 +80,8 @@ TEST_F(IntrinsicsCli, BadInputIsOneLineNamingTheFile) {
     std::string args, expect;
   } cases[] = {
       {"--image " + a + " " + b + " " + small + kGrid, small + ": image: 160x120 differs from " + a},
-      {"--image " + a + " " + path("missing.png") + kGrid, path("missing.png") + ": image: cannot open the image (no such file)"},
+      {"--image " + a + " " + path("missing.png") + kGrid,
+       path("missing.png") + ": image: cannot open the image (no such file)"},
       {"--image " + a + " " + path("text.png") + kGrid, path("text.png") + ": image: not an image"},
       {"--image " + a + " " + path("cut.png") + kGrid, path("cut.png") + ": image: a damaged PNG ("},
       {"--image " + a + " " + path("wide.png") + kGrid, path("wide.png") + ": image: a damaged PNG ("},
@@ -117,7 +118,8 @@ TEST_F(IntrinsicsCli, BadInputIsOneLineNamingTheFile) {
 TEST_F(IntrinsicsCli, NoBoardInTheImagesIsNotSolvableAndWritesNothing) {
   const std::string a = blank("a.png", 320, 240), b = blank("b.png", 320, 240), c = blank("c.png", 320, 240);
   const std::string out = path("cam.yaml");
-  const Outcome r = runKccd("calib intrinsics --image " + a + " " + b + " --image " + c + kGrid + " -o " + out + " --json");
+  const Outcome r =
+      runKccd("calib intrinsics --image " + a + " " + b + " --image " + c + kGrid + " -o " + out + " --json");
   EXPECT_EQ(r.code, 4) << r.err;
   EXPECT_NE(r.err.find("too few views"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("add images"), std::string::npos) << r.err;
@@ -170,14 +172,15 @@ TEST_F(IntrinsicsCli, RecoversTheCameraFromRenderedImagesOfAGridBoard) {
   // Eight views: tilted 25-40 deg about different axes, the board in the centre and towards the corners.
   const struct {
     double tilt, axis, roll, x, y, z;
-  } poses[] = {{30, 0, 5, 0.0, 0.0, 0.42},       {35, 90, -8, 0.06, -0.04, 0.45},  {30, 45, 12, -0.08, 0.06, 0.46},
-               {40, 135, -4, 0.09, 0.07, 0.5},   {25, 200, 6, -0.1, -0.06, 0.48},  {35, 270, -10, 0.0, 0.08, 0.44},
-               {30, 315, 3, 0.1, -0.07, 0.5},    {38, 160, 15, -0.09, 0.02, 0.47}};
+  } poses[] = {{30, 0, 5, 0.0, 0.0, 0.42},     {35, 90, -8, 0.06, -0.04, 0.45}, {30, 45, 12, -0.08, 0.06, 0.46},
+               {40, 135, -4, 0.09, 0.07, 0.5}, {25, 200, 6, -0.1, -0.06, 0.48}, {35, 270, -10, 0.0, 0.08, 0.44},
+               {30, 315, 3, 0.1, -0.07, 0.5},  {38, 160, 15, -0.09, 0.02, 0.47}};
   std::string images;
   int n = 0;
   for (const auto& p : poses) {
     scene.seed = static_cast<std::uint64_t>(++n);
-    const cv::Mat image = kccd::testing::renderTagScene(viewOf(board, p.tilt, p.axis, p.roll, {p.x, p.y, p.z}), board.layout, scene);
+    const cv::Mat image =
+        kccd::testing::renderTagScene(viewOf(board, p.tilt, p.axis, p.roll, {p.x, p.y, p.z}), board.layout, scene);
     const std::string name = path("view" + std::to_string(n) + ".png");
     ASSERT_TRUE(cv::imwrite(name, image));
     images += " " + name;
@@ -202,9 +205,9 @@ TEST_F(IntrinsicsCli, RecoversTheCameraFromRenderedImagesOfAGridBoard) {
   const Camera t = trueCamera();
   const cv::Matx33d& k = c.camera_matrix;
   std::ostringstream summary;
-  summary << "fx " << k(0, 0) << " (" << 100 * (k(0, 0) / 560.0 - 1) << " %), fy " << k(1, 1) << " (" << 100 * (k(1, 1) / 556.0 - 1)
-          << " %), cx " << k(0, 2) - 324.5 << " px, cy " << k(1, 2) - 236.0 << " px, k1 " << c.distortion[0] - t.distortion[0]
-          << ", rms " << j["rms_px"] << " px";
+  summary << "fx " << k(0, 0) << " (" << 100 * (k(0, 0) / 560.0 - 1) << " %), fy " << k(1, 1) << " ("
+          << 100 * (k(1, 1) / 556.0 - 1) << " %), cx " << k(0, 2) - 324.5 << " px, cy " << k(1, 2) - 236.0 << " px, k1 "
+          << c.distortion[0] - t.distortion[0] << ", rms " << j["rms_px"] << " px";
   std::printf("recovered from rendered images: %s\n", summary.str().c_str());
   EXPECT_EQ(c.width, 640);
   EXPECT_EQ(c.height, 480);
@@ -228,17 +231,20 @@ TEST_F(IntrinsicsCli, RecoversTheCameraFromRenderedImagesOfAGridBoard) {
     std::ofstream layout(path("grid.yaml"));
     layout << "tags:\n";
     for (const Tag& t : board.layout.tags)
-      layout << "  - {id: " << t.id << ", size: " << t.size << ", xyz: [" << t.xyz.x() << ", " << t.xyz.y() << ", 0], rpy: [0, 0, 0]}\n";
+      layout << "  - {id: " << t.id << ", size: " << t.size << ", xyz: [" << t.xyz.x() << ", " << t.xyz.y()
+             << ", 0], rpy: [0, 0, 0]}\n";
   }
-  const Outcome pose = runKccd("calib --intrinsics " + out + " --image " + path("view1.png") + " --tags " + path("grid.yaml") +
-                               " -o " + path("posed.yaml") + " -q");
+  const Outcome pose = runKccd("calib --intrinsics " + out + " --image " + path("view1.png") + " --tags " +
+                               path("grid.yaml") + " -o " + path("posed.yaml") + " -q");
   ASSERT_EQ(pose.code, 0) << pose.err;
   const Camera posed = loadCamera(path("posed.yaml"));
-  const Camera truth1 = viewOf(board, poses[0].tilt, poses[0].axis, poses[0].roll, {poses[0].x, poses[0].y, poses[0].z});
+  const Camera truth1 =
+      viewOf(board, poses[0].tilt, poses[0].axis, poses[0].roll, {poses[0].x, poses[0].y, poses[0].z});
   cv::Matx33d r_posed, r_truth;
   cv::Rodrigues(posed.rvec, r_posed);
   cv::Rodrigues(truth1.rvec, r_truth);
-  const double angle = cv::norm(cv::Mat(r_posed.t() * r_truth) - cv::Mat(cv::Matx33d::eye()));  // ~ rotation angle (rad) * sqrt(2)
+  const double angle =
+      cv::norm(cv::Mat(r_posed.t() * r_truth) - cv::Mat(cv::Matx33d::eye()));  // ~ rotation angle (rad) * sqrt(2)
   EXPECT_LT(angle, 0.01) << posed.rvec << " vs " << truth1.rvec;
   EXPECT_LT(cv::norm(posed.tvec - truth1.tvec), 0.003) << posed.tvec << " vs " << truth1.tvec;
 
@@ -250,13 +256,15 @@ TEST_F(IntrinsicsCli, RecoversTheCameraFromRenderedImagesOfAGridBoard) {
 
   // An image of another size among them: bad input, naming it; nothing written.
   cv::imwrite(path("other.png"), cv::Mat(240, 320, CV_8UC1, cv::Scalar(128)));
-  const Outcome mixed = runKccd("calib intrinsics --image" + images + " " + path("other.png") + kGrid + " -o " + path("mixed.yaml"));
+  const Outcome mixed =
+      runKccd("calib intrinsics --image" + images + " " + path("other.png") + kGrid + " -o " + path("mixed.yaml"));
   EXPECT_EQ(mixed.code, 2);
   EXPECT_NE(mixed.err.find(path("other.png") + ": image: 320x240 differs"), std::string::npos) << mixed.err;
   EXPECT_FALSE(fs::exists(path("mixed.yaml")));
 
   // The board described with the wrong first id: no board tags, and the message says which ids were seen.
-  const Outcome wrong = runKccd("calib intrinsics -q --image" + images + kGrid + " --first-id 100 -o " + path("wrong.yaml"));  // -q: no progress line on a slow machine
+  const Outcome wrong = runKccd("calib intrinsics -q --image" + images + kGrid + " --first-id 100 -o " +
+                                path("wrong.yaml"));  // -q: no progress line on a slow machine
   EXPECT_EQ(wrong.code, 4);
   EXPECT_NE(wrong.err.find("too few views"), std::string::npos) << wrong.err;
   EXPECT_NE(wrong.err.find("the images show tags 0, 1, 2"), std::string::npos) << wrong.err;
@@ -270,7 +278,8 @@ TEST_F(IntrinsicsCli, FaceOnImagesAreNotSolvable) {
   std::string images;
   const double shifts[][2] = {{0, 0}, {0.05, 0.03}, {-0.05, -0.03}, {0.04, -0.04}};
   for (int i = 0; i < 4; ++i) {
-    const cv::Mat image = kccd::testing::renderTagScene(viewOf(board, 2.0, 90.0 * i, 0, {shifts[i][0], shifts[i][1], 0.45}), board.layout);
+    const cv::Mat image = kccd::testing::renderTagScene(
+        viewOf(board, 2.0, 90.0 * i, 0, {shifts[i][0], shifts[i][1], 0.45}), board.layout);
     const std::string name = path("flat" + std::to_string(i) + ".png");
     ASSERT_TRUE(cv::imwrite(name, image));
     images += " " + name;

@@ -43,7 +43,8 @@ class CalibLabelCli : public ::testing::Test {
   // its stdout, then "rc=N", then its stderr after a line "--".
   Outcome serveAndStop(const std::string& args, const char* signal) {
     const std::string out = (dir_ / "out.txt").string(), err = (dir_ / "err.txt").string();
-    const std::string script = base() + " " + args + " > " + out + " 2> " + err + " & p=$!; for i in $(seq 300); do [ -s " + out +
+    const std::string script = base() + " " + args + " > " + out + " 2> " + err +
+                               " & p=$!; for i in $(seq 300); do [ -s " + out +
                                " ] && break; sleep 0.05; done; kill -" + signal + " $p; wait $p; echo rc=$? >> " + out +
                                "; cat " + out + "; echo --; cat " + err;
     return kccd::testing::runProgram(script);
@@ -66,7 +67,8 @@ TEST_F(CalibLabelCli, PrintsItsAddressFirstAndEndsOnSignals) {
 
 TEST_F(CalibLabelCli, WarnsWhenReachableFromOtherMachines) {
   const Outcome o = serveAndStop("--labels " + (dir_ / "l.yaml").string() + " --host 0.0.0.0 -q", "TERM");
-  EXPECT_NE(o.out.find("warning: --host 0.0.0.0: the page and its API are reachable from other machines"), std::string::npos)
+  EXPECT_NE(o.out.find("warning: --host 0.0.0.0: the page and its API are reachable from other machines"),
+            std::string::npos)
       << o.out;
   EXPECT_TRUE(std::regex_search(o.out, std::regex("http://0\\.0\\.0\\.0:[0-9]+/"))) << o.out;
   EXPECT_NE(o.out.find("rc=0"), std::string::npos) << o.out;
@@ -85,7 +87,8 @@ TEST_F(CalibLabelCli, MistakesAreOneLineAndExit2) {
       {"--labels " + labels + " -o " + (dir_ / "cam.txt").string(), "the camera file must be a .yaml or .yml file"},
       {"--labels " + (dir_ / "bad.yaml").string(), (dir_ / "bad.yaml").string() + ":2:"},
       {"--labels " + labels + " --image " + (dir_ / "small.png").string(), "--labels: given 1 times for 2"},
-      {"--labels " + labels + " --web-root " + (dir_ / "nothing").string(), "--web-root " + (dir_ / "nothing").string() + ": not a folder"},
+      {"--labels " + labels + " --web-root " + (dir_ / "nothing").string(),
+       "--web-root " + (dir_ / "nothing").string() + ": not a folder"},
       // Snap to the robot: a mask per frame, of the camera's size, with robot in it.
       {"--labels " + labels + " --masks " + (dir_ / "small.png").string(), "small.png: mask: 10x10, but the camera"},
       {"--labels " + labels + " --masks " + frame_ + " " + frame_, "--masks: 2 mask(s) for 1 frame(s)"},
@@ -99,8 +102,9 @@ TEST_F(CalibLabelCli, MistakesAreOneLineAndExit2) {
     EXPECT_TRUE(o.out.empty()) << "no address printed: " << o.out;
   }
   // A frame of another size than the camera.
-  const Outcome o = kccd::testing::runProgram(kCli + " calib label --intrinsics " + kData + "/demo_camera.yaml --image " +
-                                              (dir_ / "small.png").string() + " --labels " + labels + " -q");
+  const Outcome o =
+      kccd::testing::runProgram(kCli + " calib label --intrinsics " + kData + "/demo_camera.yaml --image " +
+                                (dir_ / "small.png").string() + " --labels " + labels + " -q");
   EXPECT_EQ(o.code, 2) << o.err;
   EXPECT_NE(o.err.find("small.png"), std::string::npos) << o.err;
   EXPECT_FALSE(fs::exists(labels));

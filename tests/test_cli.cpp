@@ -134,7 +134,8 @@ TEST(Cli, QueryTypesAndState) {
     ASSERT_EQ(r.code, 0) << type << ": " << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["status"], "ok");
   }
-  const auto n = nlohmann::json::parse(runKccd("query " + kDemo + " --state 0.1,0.3,0.4 --json --type nclosest --n 3").out);
+  const auto n =
+      nlohmann::json::parse(runKccd("query " + kDemo + " --state 0.1,0.3,0.4 --json --type nclosest --n 3").out);
   EXPECT_EQ(n["pairs"].size(), 3u);
   EXPECT_LE(n["pairs"][0]["distance"].get<double>(), n["pairs"][1]["distance"].get<double>());
 }
@@ -242,9 +243,10 @@ TEST(Cli, FitJsonContractAndErrors) {
     EXPECT_NE(e.err.find("_huge.stl:6: vertex 3: "), std::string::npos) << value << ": " << e.err;
   }
   // --scale and --seed: a factor of 0, two factors, a negative seed (never wrapped to 2^64 - 1).
-  for (const auto& [args, says] : {std::pair<std::string, std::string>{"--scale 0", "--scale: each factor must be a finite number other than 0"},
-                                   {"--scale 1,2", "--scale: give one factor or three (X,Y,Z)"},
-                                   {"--seed -1", "--seed: expected a whole number 0 ... "}}) {
+  for (const auto& [args, says] :
+       {std::pair<std::string, std::string>{"--scale 0", "--scale: each factor must be a finite number other than 0"},
+        {"--scale 1,2", "--scale: give one factor or three (X,Y,Z)"},
+        {"--seed -1", "--seed: expected a whole number 0 ... "}}) {
     e = runKccd("fit " + kModels + "simple/cube.iv -q " + args);
     EXPECT_EQ(e.code, 2) << args << ": " << e.err;
     EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << e.err;
@@ -294,7 +296,8 @@ TEST(Cli, OptionErrorsFollowTheOneLineContract) {
       {"query " + kDemo + " --state 0,0,0 --margin -1", "--margin: must be in [0, 1e+06]"},
       {"pairs " + kDemo + " --max-boxes 0", "--max-boxes: expected a whole number"},
       {"query " + kDemo + " --state \"$(printf '0,\\033[31m,0')\"", "\\x1b[31m"},
-      {"fit " + std::string(KCCD_DATA_DIR) + "/parts/gripper.iv --tolerance 0", "--tolerance: must be in [1e-06, 1e+06]"},
+      {"fit " + std::string(KCCD_DATA_DIR) + "/parts/gripper.iv --tolerance 0",
+       "--tolerance: must be in [1e-06, 1e+06]"},
       {"fit " + std::string(KCCD_DATA_DIR) + "/parts/gripper.iv --pieces many", "--pieces: expected auto or a number"},
       {"fit " + std::string(KCCD_DATA_DIR) + "/parts/gripper.iv --tolerance 1 --hull", "excludes"},
       {"import x.urdf --pieces 0", "--pieces: expected auto or a number of pieces 1 ... 64, got '0'"},
@@ -323,8 +326,8 @@ TEST(Cli, HugeAnglesAndAxesStaySafe) {
         << ", limits: [-2e16, 2e16]}]\nbodies:\n  - {name: b, frame: world, points: [[1, 0, 0]], radius: 0.1}\n"
         << "  - {name: c, frame: r, points: [[0, 1.1, 0]], radius: 0.1}\n";
     }
-    for (const char* box : {"--lower=-1e17 --upper=1e17", "--lower=1e17 --upper=1.00000000001e17",
-                            "--lower=-3.4e38 --upper=3.4e38"}) {
+    for (const char* box :
+         {"--lower=-1e17 --upper=1e17", "--lower=1e17 --upper=1.00000000001e17", "--lower=-3.4e38 --upper=3.4e38"}) {
       const Outcome r = runKccd("query " + model + " " + box + " --json");
       ASSERT_EQ(r.code, 0) << r.err;
       EXPECT_TRUE(nlohmann::json::parse(r.out)["collision"].get<bool>()) << axis << " " << box << ": " << r.out;
@@ -380,7 +383,8 @@ TEST(Cli, FitIntoAModelReplacesTheBodysTolerance) {
   ASSERT_NE(text.find(radius), std::string::npos);
   text.replace(text.find(radius), radius.size(), radius + "    tolerance: 0.123\n");  // a stale bound
   std::ofstream(model, std::ios::binary) << text;
-  const Outcome fit = runKccd("fit " + kModels + "simple/cone.iv --tolerance 2 --json --model " + model + " --body forearm");
+  const Outcome fit =
+      runKccd("fit " + kModels + "simple/cone.iv --tolerance 2 --json --model " + model + " --body forearm");
   ASSERT_EQ(fit.code, 0) << fit.err;
   const double bound = nlohmann::json::parse(fit.out)["tolerance"].get<double>();
   EXPECT_LE(bound, 0.002);
@@ -447,8 +451,8 @@ TEST(Cli, PairsProvesAndWrites) {
 TEST(Cli, ImportWritesALoadableModel) {
   const std::string dir = std::string(KCCD_TEST_DATA_DIR) + "/urdf";
   const std::string out = ::testing::TempDir() + "/" + std::to_string(getpid()) + "_imported.yaml";
-  const Outcome r = runKccd("import " + dir + "/two_link.urdf --srdf " + dir + "/two_link.srdf --package-path kccd_test=" +
-                         dir + " -k 4 -q -o " + out);
+  const Outcome r = runKccd("import " + dir + "/two_link.urdf --srdf " + dir +
+                            "/two_link.srdf --package-path kccd_test=" + dir + " -k 4 -q -o " + out);
   ASSERT_EQ(r.code, 0) << r.err;
   const Outcome info = runKccd("info " + out + " --json");
   ASSERT_EQ(info.code, 0) << info.err;
@@ -459,8 +463,8 @@ TEST(Cli, ImportWritesALoadableModel) {
   EXPECT_EQ(runKccd("import " + dir + "/two_link.urdf --package-path nonsense -q").code, 2);
   // --pairs: the proofs of `kccd pairs` written into the ignore list, next to the SRDF's pairs.
   const std::string proven = ::testing::TempDir() + "/" + std::to_string(getpid()) + "_proven.yaml";
-  const Outcome p = runKccd("import " + dir + "/two_link.urdf --srdf " + dir + "/two_link.srdf --package-path kccd_test=" +
-                            dir + " -k 4 --pairs -o " + proven);
+  const Outcome p = runKccd("import " + dir + "/two_link.urdf --srdf " + dir +
+                            "/two_link.srdf --package-path kccd_test=" + dir + " -k 4 --pairs -o " + proven);
   ASSERT_EQ(p.code, 0) << p.err;
   EXPECT_NE(p.err.find("pairs: "), std::string::npos) << p.err;
   const Outcome again = runKccd("pairs " + proven + " --json");
@@ -505,9 +509,9 @@ TEST(Cli, ImportedGripperArmRecordingHasNoCollidingFrame) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::string model = dir + "/arm.yaml";
-  const Outcome imp =
-      runKccd("import " + std::string(KCCD_TEST_DATA_DIR) + "/urdf/gripper_arm.urdf -k " +
-              std::to_string(kccd::testing::casesFor(8, 4)) + " --pairs -q -o " + model);  // the fit: 44 s at 8 under ASan
+  const Outcome imp = runKccd("import " + std::string(KCCD_TEST_DATA_DIR) + "/urdf/gripper_arm.urdf -k " +
+                              std::to_string(kccd::testing::casesFor(8, 4)) + " --pairs -q -o " +
+                              model);  // the fit: 44 s at 8 under ASan
   ASSERT_EQ(imp.code, 0) << imp.err;
   const auto info = nlohmann::json::parse(runKccd("info " + model + " --json").out);
   std::map<std::string, std::string> reason;
@@ -520,7 +524,8 @@ TEST(Cli, ImportedGripperArmRecordingHasNoCollidingFrame) {
   const Outcome text = runKccd("info " + model);
   EXPECT_NE(text.out.find("ignored pairs (pairs: ignore) and why:"), std::string::npos) << text.out;
 
-  const Outcome synth = runKccd("synth " + model + " -o " + dir + "/rec --seconds 4 --fps 10 --width 640 --height 480 "
+  const Outcome synth = runKccd("synth " + model + " -o " + dir +
+                                "/rec --seconds 4 --fps 10 --width 640 --height 480 "
                                 "--no-collision -q");
   ASSERT_EQ(synth.code, 0) << synth.err;
   const auto truth = nlohmann::json::parse(std::ifstream(dir + "/rec/synth.json"));
@@ -549,8 +554,8 @@ TEST(Cli, ImportedGripperArmRecordingHasNoCollidingFrame) {
   EXPECT_GE(top.at("min_distance").get<double>(), 0.3 * 0.01);  // synth's near misses: about half the margin
   EXPECT_LE(top.at("first_within").get<double>(), top.at("last_within").get<double>());
   // --ignored also surveys the ignored pairs: the rigid hand overlaps link3 in every state.
-  const auto all = nlohmann::json::parse(
-      runKccd("pairs " + model + " --states " + dir + "/rec/states.csv --ignored --json -q").out);
+  const auto all =
+      nlohmann::json::parse(runKccd("pairs " + model + " --states " + dir + "/rec/states.csv --ignored --json -q").out);
   bool rigid_seen = false;
   for (const auto& p : all.at("pairs"))
     if (p.at("a") == "link3" && p.at("b") == "hand") {
@@ -575,7 +580,8 @@ TEST(Cli, ImportedGripperArmRecordingHasNoCollidingFrame) {
 
 // Survey input errors: one line naming the log and place, exit 2; options that need --states.
 TEST(Cli, PairsSurveyBadInput) {
-  const std::string bad = writeLog("survey_bad.csv", "time,shoulder_yaw,shoulder_pitch,elbow", {"0,0,0,0", "0.1,0,x,0"});
+  const std::string bad =
+      writeLog("survey_bad.csv", "time,shoulder_yaw,shoulder_pitch,elbow", {"0,0,0,0", "0.1,0,x,0"});
   const Outcome r = runKccd("pairs " + kDemo + " --states " + bad);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("survey_bad.csv:3:"), std::string::npos) << r.err;
@@ -586,8 +592,8 @@ TEST(Cli, PairsSurveyBadInput) {
   EXPECT_EQ(runKccd("pairs " + kDemo + " --random 0").code, 2);
   EXPECT_EQ(runKccd("pairs " + kDemo + " --random 5 --states " + bad).code, 2);
   EXPECT_EQ(runKccd("pairs " + kDemo + " --seed 3").code, 2);
-  const std::string good = writeLog("survey_good.csv", "time,shoulder_yaw,shoulder_pitch,elbow",
-                                    {"0,-0.5,0,0", "0.1,0.5,0,0", "0.2,0,0,0"});
+  const std::string good =
+      writeLog("survey_good.csv", "time,shoulder_yaw,shoulder_pitch,elbow", {"0,-0.5,0,0", "0.1,0.5,0,0", "0.2,0,0,0"});
   const Outcome ok = runKccd("pairs " + kDemo + " --states " + good + " --all");
   ASSERT_EQ(ok.code, 0) << ok.err;
   EXPECT_NE(ok.out.find("3 recorded states"), std::string::npos) << ok.out;

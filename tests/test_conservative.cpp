@@ -9,10 +9,10 @@
 #include <iostream>
 #include <random>
 
-#include "support/sanitized.hpp"
 #include "kccd/checker.hpp"
 #include "support/random_model.hpp"
 #include "support/reference_distance.hpp"
+#include "support/sanitized.hpp"
 
 namespace kccd {
 namespace {
@@ -43,8 +43,7 @@ struct Tally {
 };
 
 // Runs one case; returns false (with a message) on a violation.
-bool runCase(std::uint64_t seed, Tally& tally, std::string& why,
-             testing::MobileBase base = testing::MobileBase::None) {
+bool runCase(std::uint64_t seed, Tally& tally, std::string& why, testing::MobileBase base = testing::MobileBase::None) {
   std::mt19937_64 rng(seed);
   const Model m = testing::randomModel(rng, 5, 4, base);
   std::vector<double> lower, upper;
@@ -55,7 +54,9 @@ bool runCase(std::uint64_t seed, Tally& tally, std::string& why,
   // Every third case refines every pair by the exact stage (those clear of the margin to
   // kExactDistanceTolerance), every third the default (the margin plus a band of 0.2 m or of 5 m:
   // every pair of most trees), every third none.
-  opt.exact_below = seed % 3 == 0 ? std::numeric_limits<double>::infinity() : seed % 3 == 1 ? -1.0 : -std::numeric_limits<double>::infinity();
+  opt.exact_below = seed % 3 == 0   ? std::numeric_limits<double>::infinity()
+                    : seed % 3 == 1 ? -1.0
+                                    : -std::numeric_limits<double>::infinity();
   opt.tight_volumes = (seed / 3) % 2 == 0;  // the display volumes are bounds too
   opt.exact_band = (seed / 6) % 2 == 0 ? 0.2 : 5.0;
   opt.exact_splits = (seed / 12) % 3 == 0 ? 0 : (seed / 12) % 3 == 1 ? 8 : kMaxExactSplits;  // box splitting
@@ -111,9 +112,8 @@ TEST(Conservative, BoundNeverExceedsSampledDistance) {
     }
   }
   std::cout << "[ property ] " << tally.cases << " cases, " << tally.pair_checks << " pair samples, "
-            << tally.nontrivial << " with a positive bound, " << tally.oracle_calls
-            << " exact oracle calls, " << tally.split_pairs << " pairs split; tightest margin true - bound = "
-            << tally.worst_gap << " m\n";
+            << tally.nontrivial << " with a positive bound, " << tally.oracle_calls << " exact oracle calls, "
+            << tally.split_pairs << " pairs split; tightest margin true - bound = " << tally.worst_gap << " m\n";
   EXPECT_EQ(failures, 0);
   if (single < 0) {
     EXPECT_EQ(tally.cases, cases);
@@ -136,12 +136,12 @@ TEST(Conservative, MobileBasesFromUrdfJointsAreConservative) {
       std::string why;
       if (!runCase(seed, tally, why, base)) {
         ++failures;
-        ADD_FAILURE() << (base == testing::MobileBase::Planar ? "planar" : "floating") << " base, seed " << seed
-                      << ": " << why;
+        ADD_FAILURE() << (base == testing::MobileBase::Planar ? "planar" : "floating") << " base, seed " << seed << ": "
+                      << why;
       }
     }
-    std::cout << "[ property ] " << (base == testing::MobileBase::Planar ? "planar" : "floating") << " bases: "
-              << tally.cases << " cases, " << tally.nontrivial << " pair samples with a positive bound, "
+    std::cout << "[ property ] " << (base == testing::MobileBase::Planar ? "planar" : "floating")
+              << " bases: " << tally.cases << " cases, " << tally.nontrivial << " pair samples with a positive bound, "
               << tally.oracle_calls << " exact oracle calls, " << tally.split_pairs
               << " pairs split; tightest true - bound = " << tally.worst_gap << " m\n";
     EXPECT_EQ(failures, 0);
@@ -175,7 +175,9 @@ TEST(Conservative, CarriedOverBoundsStayValidAcrossCycles) {
       opt.type = static_cast<QueryType>(std::uniform_int_distribution<int>(0, 3)(rng));
       opt.n = 1 + static_cast<int>(u(rng) * np);
       opt.max_pairs = u(rng) < 0.3 ? -1 : static_cast<int>(u(rng) * np);
-      opt.exact_below = u(rng) < 0.5 ? -1.0 : u(rng) < 0.5 ? std::numeric_limits<double>::infinity() : 0.1 * u(rng) - 0.01;
+      opt.exact_below = u(rng) < 0.5   ? -1.0
+                        : u(rng) < 0.5 ? std::numeric_limits<double>::infinity()
+                                       : 0.1 * u(rng) - 0.01;
       ASSERT_EQ(checker.query(lower, upper, opt).status, Status::Ok);
       // Read the whole table for this box without recomputing anything.
       QueryOptions peek;
@@ -190,9 +192,9 @@ TEST(Conservative, CarriedOverBoundsStayValidAcrossCycles) {
           if (pd.distance <= 0.0) continue;
           ++carried_checks;
           const BodyPair& pair = m.pairs[pd.pair];
-          const double truth = static_cast<double>(testing::referenceSschDistance(
-              testing::worldPoints(m, poses, pair.a), m.bodies[pair.a].radius, testing::worldPoints(m, poses, pair.b),
-              m.bodies[pair.b].radius));
+          const double truth = static_cast<double>(
+              testing::referenceSschDistance(testing::worldPoints(m, poses, pair.a), m.bodies[pair.a].radius,
+                                             testing::worldPoints(m, poses, pair.b), m.bodies[pair.b].radius));
           if (pd.distance > truth + 1e-12) {
             ++violations;
             ADD_FAILURE() << "carried-over bound invalid, seed " << seed << " cycle " << cycle << ": bound "

@@ -52,7 +52,8 @@ struct Scene {
 
   // `clutter`: boxes and bars on the background, a second arm and a shadow.
   Scene(int frames, std::uint64_t seed, bool clutter) {
-    truth = kccd::testing::lookAt(Vec3(1.25, -0.95, 0.9), Vec3(0.2, 0.0, 0.35), 640, 360, 520.0, {-0.08, 0.03, 0.0005, -0.0003, 0.0});
+    truth = kccd::testing::lookAt(Vec3(1.25, -0.95, 0.9), Vec3(0.2, 0.0, 0.35), 640, 360, 520.0,
+                                  {-0.08, 0.03, 0.0005, -0.0003, 0.0});
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     std::uniform_int_distribution<int> shade(20, 235), x(0, 639), y(0, 359);
@@ -111,16 +112,17 @@ void expectNear(const RefineResult& r, const Camera& truth, double max_deg, doub
   const double pos = cv::norm(cameraCentre(r.camera) - cameraCentre(truth));
   EXPECT_LT(rot, max_deg) << what << ": " << r.message;
   EXPECT_LT(pos, max_m) << what << ": " << r.message;
-  std::printf("%s: %.3f deg, %.2f mm from the truth (sigma %.3f deg, %.2f mm), %d iterations; %s\n", what.c_str(), rot, pos * 1e3,
-              *r.camera.rotation_sigma_deg, *r.camera.position_sigma_m * 1e3, r.iterations, r.message.c_str());
+  std::printf("%s: %.3f deg, %.2f mm from the truth (sigma %.3f deg, %.2f mm), %d iterations; %s\n", what.c_str(), rot,
+              pos * 1e3, *r.camera.rotation_sigma_deg, *r.camera.position_sigma_m * 1e3, r.iterations,
+              r.message.c_str());
 }
 
 TEST(EdgeRefine, ConvergesOnAPlainBackground) {
   const Scene scene(4, 1, false);
   std::mt19937_64 rng(2);
   for (int s = 0; s < kccd::testing::casesFor(4, 2); ++s)
-    expectNear(refineToEdges(perturbed(scene.truth, 4.0, 0.04, rng), scene.frames(scene.states)), scene.truth, 0.15, 0.006,
-               "plain, start " + std::to_string(s));
+    expectNear(refineToEdges(perturbed(scene.truth, 4.0, 0.04, rng), scene.frames(scene.states)), scene.truth, 0.15,
+               0.006, "plain, start " + std::to_string(s));
 }
 
 TEST(EdgeRefine, ClutterASecondArmAndAShadowDoNotPullItAway) {
@@ -130,8 +132,8 @@ TEST(EdgeRefine, ClutterASecondArmAndAShadowDoNotPullItAway) {
       cv::imwrite(std::string(dir) + "/edge_" + std::to_string(f) + ".png", scene.pictures[f]);
   std::mt19937_64 rng(4);
   for (int s = 0; s < kccd::testing::casesFor(4, 2); ++s)
-    expectNear(refineToEdges(perturbed(scene.truth, 6.0, 0.06, rng), scene.frames(scene.states)), scene.truth, 0.15, 0.005,
-               "cluttered, start " + std::to_string(s));
+    expectNear(refineToEdges(perturbed(scene.truth, 6.0, 0.06, rng), scene.frames(scene.states)), scene.truth, 0.15,
+               0.005, "cluttered, start " + std::to_string(s));
 }
 
 // Four clicks 8 px off, one body's centre on each of four pictures (on one picture this planar
@@ -158,19 +160,22 @@ TEST(EdgeRefine, FourRoughClicksAreEnoughToStartMostly) {
       for (const Vec3& p : v[b].points) c += p / static_cast<double>(v[b].points.size());
       world.emplace_back(c.x(), c.y(), c.z());
     }
-    cv::projectPoints(world, scene.truth.rvec, scene.truth.tvec, scene.truth.camera_matrix, scene.truth.distortion, pixels);
+    cv::projectPoints(world, scene.truth.rvec, scene.truth.tvec, scene.truth.camera_matrix, scene.truth.distortion,
+                      pixels);
     for (std::size_t i = 0; i < world.size(); ++i) {
       pixels[i] += cv::Point2d(click(rng), click(rng));
       clicks.push_back({"b" + std::to_string(i), pixels[i], world[i]});
     }
     Camera start = scene.truth;
-    ASSERT_TRUE(cv::solvePnP(world, pixels, start.camera_matrix, start.distortion, start.rvec, start.tvec, false, cv::SOLVEPNP_SQPNP));
+    ASSERT_TRUE(cv::solvePnP(world, pixels, start.camera_matrix, start.distortion, start.rvec, start.tvec, false,
+                             cv::SOLVEPNP_SQPNP));
     const double start_deg = rotationErrorDeg(start.rvec, scene.truth.rvec);
     const double start_m = cv::norm(cameraCentre(start) - cameraCentre(scene.truth));
     const RefineResult r = refineToEdges(start, scene.frames(scene.states), {}, clicks);
     const double deg = rotationErrorDeg(r.camera.rvec, scene.truth.rvec);
     const double m = cv::norm(cameraCentre(r.camera) - cameraCentre(scene.truth));
-    std::printf("clicks %d: from %.2f deg, %.1f mm to %.3f deg, %.2f mm; %s\n", s, start_deg, start_m * 1e3, deg, m * 1e3, r.message.c_str());
+    std::printf("clicks %d: from %.2f deg, %.1f mm to %.3f deg, %.2f mm; %s\n", s, start_deg, start_m * 1e3, deg,
+                m * 1e3, r.message.c_str());
     if (r.improved) {
       EXPECT_LT(deg, start_deg) << s;
       EXPECT_LT(m, start_m) << s;

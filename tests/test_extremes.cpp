@@ -13,10 +13,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <limits>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -39,7 +39,9 @@ long envOr(const char* name, long fallback) {
   return v != nullptr ? std::atol(v) : fallback;
 }
 
-double uniform(std::mt19937_64& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
 int uniformInt(std::mt19937_64& rng, int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); }
 bool chance(std::mt19937_64& rng, double p) { return uniform(rng, 0.0, 1.0) < p; }
 double signedPow10(std::mt19937_64& rng, double e_lo, double e_hi) {
@@ -104,8 +106,11 @@ RawModel generate(std::mt19937_64& rng) {
     RawJoint j;
     j.parent = uniformInt(rng, -1, i - 1);
     const int t = uniformInt(rng, 0, 9);
-    j.type = t < 5 ? JointType::Revolute : t < 7 ? JointType::Prismatic : t < 8 ? JointType::Fixed
-           : t < 9 ? JointType::Translation3d : JointType::Rotation3d;
+    j.type = t < 5   ? JointType::Revolute
+             : t < 7 ? JointType::Prismatic
+             : t < 8 ? JointType::Fixed
+             : t < 9 ? JointType::Translation3d
+                     : JointType::Rotation3d;
     const double reach = chance(rng, 0.1) ? 9.9e5 : 0.4;  // origins near the loader's bound, sometimes
     for (double& v : j.xyz) v = uniform(rng, -reach, reach);
     for (double& v : j.rpy) v = chance(rng, 0.15) ? signedPow10(rng, 0, 300) : uniform(rng, -3.2, 3.2);
@@ -117,7 +122,8 @@ RawModel generate(std::mt19937_64& rng) {
       j.axis[k] = style == 0 ? d[k] : style == 1 ? d[k] * overall : signedPow10(rng, -150, 200);
       if (style == 3 && k != 0 && chance(rng, 0.5)) j.axis[k] = 0.0;
     }
-    y << "  - {name: j" << i << ", parent: " << (j.parent == kWorld ? std::string("world") : "j" + std::to_string(j.parent))
+    y << "  - {name: j" << i
+      << ", parent: " << (j.parent == kWorld ? std::string("world") : "j" + std::to_string(j.parent))
       << ", type: " << toString(j.type) << ", origin: {xyz: [" << num(j.xyz[0]) << ", " << num(j.xyz[1]) << ", "
       << num(j.xyz[2]) << "], rpy: [" << num(j.rpy[0]) << ", " << num(j.rpy[1]) << ", " << num(j.rpy[2]) << "]}";
     if (j.type == JointType::Revolute || j.type == JointType::Prismatic) {
@@ -135,8 +141,10 @@ RawModel generate(std::mt19937_64& rng) {
       }
     }
     if (j.type != JointType::Fixed) y << ", sweep: " << modes[uniformInt(rng, 0, 4)];
-    if (j.type == JointType::Translation3d && chance(rng, 0.7)) j.error = chance(rng, 0.1) ? 9e5 : uniform(rng, 0, 0.05);
-    if (j.type == JointType::Rotation3d && chance(rng, 0.7)) j.error = chance(rng, 0.1) ? uniform(rng, 3, 1e3) : uniform(rng, 0, 0.4);
+    if (j.type == JointType::Translation3d && chance(rng, 0.7))
+      j.error = chance(rng, 0.1) ? 9e5 : uniform(rng, 0, 0.05);
+    if (j.type == JointType::Rotation3d && chance(rng, 0.7))
+      j.error = chance(rng, 0.1) ? uniform(rng, 3, 1e3) : uniform(rng, 0, 0.4);
     if (j.error > 0.0) y << ", error: " << num(j.error);
     y << "}\n";
     j.dof = j.type == JointType::Fixed ? 0 : (j.type == JointType::Revolute || j.type == JointType::Prismatic) ? 1 : 3;
@@ -156,10 +164,12 @@ RawModel generate(std::mt19937_64& rng) {
     for (auto& p : b.points)
       for (int k = 0; k < 3; ++k) p[k] = std::clamp(p[k], -1e6, 1e6);
     b.radius = chance(rng, 0.2) ? 0.0 : chance(rng, 0.05) ? uniform(rng, 0, 1e6) : uniform(rng, 0.0, 0.05);
-    y << "  - {name: b" << i << ", frame: " << (b.frame == kWorld ? std::string("world") : "j" + std::to_string(b.frame))
+    y << "  - {name: b" << i
+      << ", frame: " << (b.frame == kWorld ? std::string("world") : "j" + std::to_string(b.frame))
       << ", radius: " << num(b.radius) << ", points: [";
     for (std::size_t k = 0; k < b.points.size(); ++k)
-      y << (k ? ", " : "") << "[" << num(b.points[k].x()) << ", " << num(b.points[k].y()) << ", " << num(b.points[k].z()) << "]";
+      y << (k ? ", " : "") << "[" << num(b.points[k].x()) << ", " << num(b.points[k].y()) << ", "
+        << num(b.points[k].z()) << "]";
     y << "]}\n";
     raw.bodies.push_back(b);
   }
@@ -241,10 +251,17 @@ std::vector<Eigen::Vector3d> pointsIn(const RawModel& raw, const Sample& s, int 
     M3 m_rot = M3::Identity();
     V3 m_t = V3::Zero();
     switch (j.type) {
-      case JointType::Fixed: break;
-      case JointType::Revolute: m_rot = rodrigues(axis, q[0]); break;
-      case JointType::Prismatic: m_t = axis * Real(q[0]); break;
-      case JointType::Translation3d: m_t = V3(q[0], q[1], q[2]) + s.t_err[*it]; break;
+      case JointType::Fixed:
+        break;
+      case JointType::Revolute:
+        m_rot = rodrigues(axis, q[0]);
+        break;
+      case JointType::Prismatic:
+        m_t = axis * Real(q[0]);
+        break;
+      case JointType::Translation3d:
+        m_t = V3(q[0], q[1], q[2]) + s.t_err[*it];
+        break;
       case JointType::Rotation3d: {
         const M3 measured = rotationVector(V3(q[0], q[1], q[2]));
         m_rot = s.err_first[*it] ? M3(measured * s.r_err[*it]) : M3(s.r_err[*it] * measured);
@@ -326,7 +343,6 @@ bool runCase(std::uint64_t seed, Tally& tally, std::string& why) {
       // Rounding of the points to double (and of the oracle) at this magnitude.
       tol[p] = std::max(tol[p], 1e-12 + 1e-15 * (scale + ra + rb));
       truth_min[p] = std::min(truth_min[p], static_cast<double>(testing::referenceSschDistance(a, ra, b, rb)));
-
     }
   }
   for (const Answer& ans : answers) {
@@ -363,7 +379,8 @@ TEST(Extremes, BoundsStayConservativeAtTheExtremes) {
   Tally tally;
   long failures = 0;
   for (long i = 0; i < cases && failures < 5; ++i) {
-    const std::uint64_t seed = single >= 0 ? static_cast<std::uint64_t>(single) : 0x657874 + static_cast<std::uint64_t>(i);
+    const std::uint64_t seed =
+        single >= 0 ? static_cast<std::uint64_t>(single) : 0x657874 + static_cast<std::uint64_t>(i);
     std::string why;
     if (!runCase(seed, tally, why)) {
       ++failures;
@@ -371,12 +388,12 @@ TEST(Extremes, BoundsStayConservativeAtTheExtremes) {
     }
   }
   std::cout << "[ property ] " << tally.cases << " extreme cases, " << tally.queries << " queries ("
-            << tally.failed_status << " answered with an unsafe status), " << tally.checks << " reported bounds checked, "
-            << tally.positive << " of them positive\n";
+            << tally.failed_status << " answered with an unsafe status), " << tally.checks
+            << " reported bounds checked, " << tally.positive << " of them positive\n";
   EXPECT_EQ(failures, 0);
   if (single < 0) {
-    EXPECT_GT(tally.positive, tally.checks / 10);               // most answers are not trivially 0
-    EXPECT_LT(tally.failed_status, tally.queries / 5);          // and most are answers, not refusals
+    EXPECT_GT(tally.positive, tally.checks / 10);       // most answers are not trivially 0
+    EXPECT_LT(tally.failed_status, tally.queries / 5);  // and most are answers, not refusals
   }
 }
 
@@ -391,8 +408,8 @@ Model oneRevolute(const std::string& axis) {
 TEST(Extremes, HugeRevoluteIntervalsAreNotClear) {
   const Model m = oneRevolute("[0, 0, 1]");
   Checker c(m);
-  const double boxes[][2] = {{-1e17, 1e17}, {1e17, 1.00000000001e17}, {-3.4e38, 3.4e38}, {2e16, 2e16 + 8},
-                             {1e300, 1e300 * (1 + 1e-15)}, {-1e9 - 4, -1e9 + 4}};
+  const double boxes[][2] = {{-1e17, 1e17},    {1e17, 1.00000000001e17},     {-3.4e38, 3.4e38},
+                             {2e16, 2e16 + 8}, {1e300, 1e300 * (1 + 1e-15)}, {-1e9 - 4, -1e9 + 4}};
   for (const auto& box : boxes) {
     const std::vector<double> lo{box[0]}, hi{box[1]};
     const QueryResult& r = c.query(lo, hi, {});
@@ -466,10 +483,12 @@ TEST(Extremes, PairProofsHoldOverTheWholeRange) {
         const double ra = raw.bodies[r.a].radius, rb = raw.bodies[r.b].radius;
         const double truth = static_cast<double>(testing::referenceSschDistance(a, ra, b, rb));
         ++checks;
-        if (truth + 1e-12 + 1e-15 * (scale + ra + rb) <= m.safety_margin || truth + 1e-12 + 1e-15 * (scale + ra + rb) < r.bound) {
+        if (truth + 1e-12 + 1e-15 * (scale + ra + rb) <= m.safety_margin ||
+            truth + 1e-12 + 1e-15 * (scale + ra + rb) < r.bound) {
           ++violations;
           ADD_FAILURE() << "seed " << seed << ": pair b" << r.a << "-b" << r.b << " proven never (bound " << r.bound
-                        << ") but a configuration within the limits is at " << truth << "\n" << raw.yaml;
+                        << ") but a configuration within the limits is at " << truth << "\n"
+                        << raw.yaml;
           break;
         }
       }

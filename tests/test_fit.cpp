@@ -8,11 +8,11 @@
 
 #include <gtest/gtest.h>
 
-#include "support/sanitized.hpp"
 #include "kccd/modelling/convex_hull.hpp"
 #include "kccd/modelling/fit.hpp"
 #include "kccd/modelling/part.hpp"
 #include "support/reference_distance.hpp"
+#include "support/sanitized.hpp"
 
 namespace km = kccd::modelling;
 using kccd::Vec3;
@@ -233,7 +233,8 @@ TEST(Fit, CylindersComeCloseToTheBestPrismFamily) {
   EXPECT_NEAR(bestPrismFamilyRatio(1.0, 4), 4.0 / kPi, 1e-9);
   EXPECT_NEAR(bestPrismFamilyRatio(1.0, 8), 8.0 * std::tan(kPi / 8.0) / kPi, 1e-9);
   // Under the sanitizers one length only (the fit's code paths are the same for each).
-  const std::vector<double> lengths = kccd::testing::kSanitized ? std::vector<double>{1.0} : std::vector<double>{0.5, 1.0, 3.0};
+  const std::vector<double> lengths =
+      kccd::testing::kSanitized ? std::vector<double>{1.0} : std::vector<double>{0.5, 1.0, 3.0};
   for (const double h : lengths) {
     km::Part cylinder;  // radius 1 along y
     cylinder.addCylinderY(Eigen::Affine3d::Identity(), 1.0, 2.0 * h);
@@ -243,7 +244,8 @@ TEST(Fit, CylindersComeCloseToTheBestPrismFamily) {
       const double ratio = f.volume / (2.0 * kPi * h), family = bestPrismFamilyRatio(h, k / 2);
       RecordProperty("h" + std::to_string(h) + "_k" + std::to_string(k), std::to_string(ratio));
       // Measured: K = 8 within 0.1 % of the family's best, K = 16 within 4.3 %.
-      EXPECT_LE(ratio, (k == 8 ? 1.01 : 1.05) * family) << "half-length " << h << ", K = " << k << ", family " << family;
+      EXPECT_LE(ratio, (k == 8 ? 1.01 : 1.05) * family)
+          << "half-length " << h << ", K = " << k << ", family " << family;
       expectContains(f, cylinder, {}, "cylinder");
     }
   }
@@ -267,11 +269,11 @@ TEST(Fit, ExactHullContainsThePartAndAddsOnlyRounding) {
   without_balls.balls.clear();
   expectContains(h, without_balls, truth, "exact hull");
   EXPECT_EQ(static_cast<int>(h.points.size()), h.hull_vertices);
-  EXPECT_LT(h.radius, 1e-9);                                   // analytic input: rounding only
+  EXPECT_LT(h.radius, 1e-9);  // analytic input: rounding only
   // Above the hull of the sampled surface only by the ball's circumscribed polytope.
   EXPECT_GE(h.volume, h.hull_volume * (1.0 - 1e-9));
   EXPECT_LT(h.volume, 1.05 * h.hull_volume);
-  const km::FitResult f = km::fit(part, quick(16));            // a fit is larger
+  const km::FitResult f = km::fit(part, quick(16));  // a fit is larger
   EXPECT_GT(f.volume, h.volume);
   EXPECT_THROW(km::exactHull(km::Part{}), std::invalid_argument);
 }
@@ -296,9 +298,9 @@ TEST(ReadPart, RealInventorModelsAreContained) {
     const char* path;
     bool merge;
   };
-  for (const File& f : {File{"household/mug.iv", false}, File{"simple/cone.iv", false},
-                        File{"robots/roboHand.iv", true}, File{"machines/coarseGear.iv", true},
-                        File{"toys/top.iv", true}}) {
+  for (const File& f :
+       {File{"household/mug.iv", false}, File{"simple/cone.iv", false}, File{"robots/roboHand.iv", true},
+        File{"machines/coarseGear.iv", true}, File{"toys/top.iv", true}}) {
     if (!std::filesystem::exists(kModels + f.path)) GTEST_SKIP() << "inventor-data not installed";
     const km::Part part = km::readPart(kModels + f.path, {.merge = f.merge});
     EXPECT_GT(part.triangles + part.primitives, 0) << f.path;
@@ -314,12 +316,13 @@ TEST(ReadPart, VrmlStlAndBinaryInventor) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "kccd_test_fit";
   std::filesystem::create_directories(dir);
   {
-    std::ofstream(dir / "part.wrl") << "#VRML V2.0 utf8\n"
-                                       "Transform { translation 1 0 0 children [\n"
-                                       "  Shape { geometry Sphere { radius 0.5 } }\n"
-                                       "  Transform { translation 0 2 0 children Shape { geometry Box { size 1 1 1 } } }\n"
-                                       "  Shape { geometry Cylinder { radius 0.2 height 3 } }\n"
-                                       "] }\n";
+    std::ofstream(dir / "part.wrl")
+        << "#VRML V2.0 utf8\n"
+           "Transform { translation 1 0 0 children [\n"
+           "  Shape { geometry Sphere { radius 0.5 } }\n"
+           "  Transform { translation 0 2 0 children Shape { geometry Box { size 1 1 1 } } }\n"
+           "  Shape { geometry Cylinder { radius 0.2 height 3 } }\n"
+           "] }\n";
   }
   const km::Part vrml = km::readPart((dir / "part.wrl").string());
   ASSERT_EQ(vrml.balls.size(), 1u);
@@ -337,9 +340,10 @@ TEST(ReadPart, VrmlStlAndBinaryInventor) {
     EXPECT_GT(binary.primitives, 5);
   }
   {
-    std::ofstream(dir / "tet.stl") << "solid t\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n"
-                                      "   vertex 0 1 0\n  endloop\n endfacet\n facet normal 0 0 1\n  outer loop\n"
-                                      "   vertex 0 0 0\n   vertex 0 1 0\n   vertex 0 0 1\n  endloop\n endfacet\nendsolid t\n";
+    std::ofstream(dir / "tet.stl")
+        << "solid t\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n"
+           "   vertex 0 1 0\n  endloop\n endfacet\n facet normal 0 0 1\n  outer loop\n"
+           "   vertex 0 0 0\n   vertex 0 1 0\n   vertex 0 0 1\n  endloop\n endfacet\nendsolid t\n";
   }
   const km::Part stl = km::readPart((dir / "tet.stl").string());
   EXPECT_EQ(stl.triangles, 2);

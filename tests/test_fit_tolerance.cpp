@@ -31,7 +31,8 @@ constexpr double kPi = std::numbers::pi;
 // A closed box mesh (12 triangles) from lo to hi.
 void addBox(km::Part& part, const Vec3& lo, const Vec3& hi) {
   auto corner = [&](int i) { return Vec3(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z()); };
-  static constexpr int kFaces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+  static constexpr int kFaces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                                       {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
   for (const auto& f : kFaces) {
     part.addTriangle(corner(f[0]), corner(f[1]), corner(f[2]));
     part.addTriangle(corner(f[0]), corner(f[2]), corner(f[3]));
@@ -141,8 +142,8 @@ TEST(FitToTolerance, VolumesStayWithinTheirToleranceAndHoldThePart) {
         EXPECT_LT(r.points.size(), hull.size() / 2) << r.method;
       }
       std::cout << name << " at " << tol * 1e3 << " mm: " << r.points.size() << " points (" << r.method << ") of "
-                << hull.size() << " hull vertices, radius " << r.radius * 1e3 << " mm, outside <= "
-                << r.outside * 1e3 << " mm (sampled " << sampled * 1e3 << ")\n";
+                << hull.size() << " hull vertices, radius " << r.radius * 1e3 << " mm, outside <= " << r.outside * 1e3
+                << " mm (sampled " << sampled * 1e3 << ")\n";
     }
   }
   EXPECT_EQ(cases, kccd::testing::kSanitized ? 6 : 9);

@@ -26,7 +26,10 @@ std::string errorOf(const std::string& text) {
 TEST(FrameTimes, ReadsTheTable) {
   EXPECT_EQ(parseFrameTimes("frame,time\n0,0\n1,0.04\n2,0.09\n", "t.csv"), (std::vector<double>{0.0, 0.04, 0.09}));
   // BOM, CRLF, no final newline, signed and exponent forms.
-  EXPECT_EQ(parseFrameTimes("\xEF\xBB\xBF" "frame,time\r\n0,-1.5e-3\r\n1,2e0", "t.csv"), (std::vector<double>{-1.5e-3, 2.0}));
+  EXPECT_EQ(parseFrameTimes("\xEF\xBB\xBF"
+                            "frame,time\r\n0,-1.5e-3\r\n1,2e0",
+                            "t.csv"),
+            (std::vector<double>{-1.5e-3, 2.0}));
 }
 
 TEST(FrameTimes, EveryMistakeNamesItsLine) {
@@ -41,8 +44,10 @@ TEST(FrameTimes, EveryMistakeNamesItsLine) {
       {"frame,time\n0,abc\n", "t.csv:2:3: column 'time': not a finite number: 'abc'"},
       {"frame,time\n0,nan\n", "t.csv:2:3: column 'time': not a finite number: 'nan'"},
       {"frame,time\n0,1e301\n", "t.csv:2:3: column 'time': not a finite number: '1e301'"},
-      {"frame,time\n0,0\n2,1\n", "t.csv:3:1: column 'frame': expected frame 1, found 2 (one row per frame, from 0, in order)"},
-      {"frame,time\n0,0\n0,1\n", "t.csv:3:1: column 'frame': expected frame 1, found 0 (one row per frame, from 0, in order)"},
+      {"frame,time\n0,0\n2,1\n",
+       "t.csv:3:1: column 'frame': expected frame 1, found 2 (one row per frame, from 0, in order)"},
+      {"frame,time\n0,0\n0,1\n",
+       "t.csv:3:1: column 'frame': expected frame 1, found 0 (one row per frame, from 0, in order)"},
       {"frame,time\n0,1\n1,1\n", "t.csv:3:3: column 'time': times must increase strictly"},
       {"frame,time\n0,0\n1,\x1b[31m\n", "t.csv:3:3: column 'time': not a finite number: '\\x1b[31m'"},
   };
@@ -50,7 +55,8 @@ TEST(FrameTimes, EveryMistakeNamesItsLine) {
 }
 
 TEST(FrameTimes, FilesAreRegularAndBounded) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("kccd_frame_times_" + std::to_string(::getpid()));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("kccd_frame_times_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::string file = (dir / "times.csv").string();
   std::ofstream(file) << "frame,time\n0,0.5\n";
@@ -63,7 +69,8 @@ TEST(FrameTimes, FilesAreRegularAndBounded) {
     }
     return std::string("(no error)");
   };
-  EXPECT_EQ(error((dir / "missing.csv").string()), (dir / "missing.csv").string() + ": cannot open the frame-times file (no such file)");
+  EXPECT_EQ(error((dir / "missing.csv").string()),
+            (dir / "missing.csv").string() + ": cannot open the frame-times file (no such file)");
   EXPECT_EQ(error(dir.string()), dir.string() + ": a folder, not a frame-times file");
   const std::string fifo = (dir / "fifo").string();
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);

@@ -26,8 +26,12 @@ Points degenerateSet(std::mt19937_64& rng, Family f, const Vec3& centre, double 
   const Vec3 e2 = e1.unitOrthogonal();
   Points pts;
   switch (f) {
-    case Family::Coincident: pts.assign(n, centre); break;
-    case Family::SinglePoint: pts.push_back(centre); break;
+    case Family::Coincident:
+      pts.assign(n, centre);
+      break;
+    case Family::SinglePoint:
+      pts.push_back(centre);
+      break;
     case Family::Collinear:
       for (int i = 0; i < n; ++i) pts.push_back(centre + scale * u(rng) * e1);
       break;
@@ -39,7 +43,9 @@ Points degenerateSet(std::mt19937_64& rng, Family f, const Vec3& centre, double 
       for (int i = 0; i < n; ++i) pts.push_back(base[i % 4]);
       break;
     }
-    case Family::General: pts = testing::randomCloud(rng, n, centre, scale); break;
+    case Family::General:
+      pts = testing::randomCloud(rng, n, centre, scale);
+      break;
   }
   return pts;
 }
@@ -53,7 +59,7 @@ double maxCoord(const Points& a, const Points& b) {
 
 TEST(GjkExtremes, DegenerateSetsAtEveryScale) {
   std::mt19937_64 rng(314159);
-  const Family families[] = {Family::Coincident, Family::Collinear, Family::Coplanar,
+  const Family families[] = {Family::Coincident,  Family::Collinear,  Family::Coplanar,
                              Family::SinglePoint, Family::Duplicated, Family::General};
   const double scales[] = {1e-6, 1e-3, 1.0, 1e2, 1e4};
   const double offsets[] = {0.0, 1.0, 1e4};
@@ -77,8 +83,10 @@ TEST(GjkExtremes, DegenerateSetsAtEveryScale) {
             ASSERT_TRUE(std::isfinite(r.distance));
             ASSERT_TRUE(r.witness_a.allFinite() && r.witness_b.allFinite() && r.direction.allFinite());
             ASSERT_LE(r.iterations, GjkOptions{}.max_iterations);
-            ASSERT_LE(r.distance, ref + slack) << int(fa) << " " << int(fb) << " scale " << scale << " offset " << offset;
-            ASSERT_NEAR(r.distance, ref, slack) << int(fa) << " " << int(fb) << " scale " << scale << " offset " << offset;
+            ASSERT_LE(r.distance, ref + slack)
+                << int(fa) << " " << int(fb) << " scale " << scale << " offset " << offset;
+            ASSERT_NEAR(r.distance, ref, slack)
+                << int(fa) << " " << int(fb) << " scale " << scale << " offset " << offset;
             ++cases;
           }
         }
@@ -148,10 +156,12 @@ TEST(GjkExtremes, InvalidInputIsReportedAsUnsafe) {
 
 TEST(GjkExtremes, KnownAnalyticDistances) {
   // Segment to segment (skew lines), point to triangle interior, triangle to triangle edges.
-  EXPECT_NEAR(distance({Points{{-1, 0, 0}, {1, 0, 0}}, 0.0}, {Points{{0, -1, 2}, {0, 1, 2}}, 0.0}).distance, 2.0, 1e-13);
-  EXPECT_NEAR(distance({Points{{0.2, 0.2, 0.7}}, 0.0}, {Points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, 0.0}).distance, 0.7, 1e-13);
-  const DistanceResult r = distance({Points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, 0.25},
-                                    {Points{{2, 2, 0}, {3, 2, 0}, {2, 3, 0}}, 0.25});
+  EXPECT_NEAR(distance({Points{{-1, 0, 0}, {1, 0, 0}}, 0.0}, {Points{{0, -1, 2}, {0, 1, 2}}, 0.0}).distance, 2.0,
+              1e-13);
+  EXPECT_NEAR(distance({Points{{0.2, 0.2, 0.7}}, 0.0}, {Points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, 0.0}).distance, 0.7,
+              1e-13);
+  const DistanceResult r =
+      distance({Points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, 0.25}, {Points{{2, 2, 0}, {3, 2, 0}, {2, 3, 0}}, 0.25});
   EXPECT_NEAR(r.distance, std::sqrt(2.0) * 1.5 - 0.5, 1e-13);
   EXPECT_NEAR(r.witness_a.x(), r.witness_a.y(), 1e-12);
 }

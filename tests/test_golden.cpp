@@ -12,8 +12,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "kccd/checker.hpp"
 #include "kccd/calib/camera.hpp"
+#include "kccd/checker.hpp"
 #include "kccd/render/projection.hpp"
 #include "kccd/render/renderer.hpp"
 #include "kccd/render/scene.hpp"
@@ -134,7 +134,10 @@ TEST(RenderBackends, EglAndOsMesaAreBitIdentical) {
       frames[b].push_back(r.render(volumes, Style{.shaded = true}, true, false));
     }
   }
-  if (saved == nullptr) ::unsetenv("KCCD_GL"); else ::setenv("KCCD_GL", restore.c_str(), 1);
+  if (saved == nullptr)
+    ::unsetenv("KCCD_GL");
+  else
+    ::setenv("KCCD_GL", restore.c_str(), 1);
   EXPECT_NE(names[0].find("EGL"), std::string::npos) << names[0];
   EXPECT_NE(names[1].find("OSMesa"), std::string::npos) << names[1];
   ASSERT_EQ(frames[0].size(), frames[1].size());

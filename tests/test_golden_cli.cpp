@@ -158,7 +158,8 @@ TEST_F(GoldenCli, UpdateThenRunPassesAndASecondUpdateIsByteIdentical) {
   EXPECT_NE(up.out.find("8 of 8 case(s) written"), std::string::npos) << up.out;
   const auto goldens = tree(dir_ / "goldens");
   EXPECT_EQ(goldens.size(), 8u * 3) << "2 images and golden.json per case (rec-f5: overlay and mask)";
-  ASSERT_TRUE(goldens.count("home/mask.png") && goldens.count("home/colour.png") && goldens.count("rec-f5/overlay.png"));
+  ASSERT_TRUE(goldens.count("home/mask.png") && goldens.count("home/colour.png") &&
+              goldens.count("rec-f5/overlay.png"));
   const nlohmann::json side = nlohmann::json::parse(goldens.at("rec-f5/golden.json"));
   EXPECT_EQ(side["outputs"]["mask"]["labels"]["4"], "shoulder");
   EXPECT_EQ(side["inputs"]["video"]["frame"], 5);
@@ -202,30 +203,38 @@ TEST_F(GoldenCli, RealChangesFailNamingCaseOutputAndCause) {
   // moved by one pixel across and, separately, along itself.
   const double px = 1.9 / 300.0;
   std::vector<nlohmann::json> true_changes;  // the metrics of the smallest true changes
-  for (const auto& [from, to, what] : {std::tuple{std::string("[[0.6, 0, 0], [0.6, 0, 0.8]]"),
-                                                  "[[0.6, " + std::to_string(px) + ", 0], [0.6, " + std::to_string(px) + ", 0.8]]", "across"},
-                                       std::tuple{std::string("[[0.6, 0, 0], [0.6, 0, 0.8]]"),
-                                                  "[[0.6, 0, " + std::to_string(1.2 * px) + "], [0.6, 0, " + std::to_string(0.8 + 1.2 * px) + "]]",
-                                                  "along"}}) {
+  for (const auto& [from, to, what] :
+       {std::tuple{std::string("[[0.6, 0, 0], [0.6, 0, 0.8]]"),
+                   "[[0.6, " + std::to_string(px) + ", 0], [0.6, " + std::to_string(px) + ", 0.8]]", "across"},
+        std::tuple{std::string("[[0.6, 0, 0], [0.6, 0, 0.8]]"),
+                   "[[0.6, 0, " + std::to_string(1.2 * px) + "], [0.6, 0, " + std::to_string(0.8 + 1.2 * px) + "]]",
+                   "along"}}) {
     writeText(dir_ / "robot.yaml", replaced(model_, from, to));
     o = golden("run " + manifest() + " --case home --out " + out() + " -q");
     EXPECT_EQ(o.code, 1) << what << ": " << o.out;
     EXPECT_NE(o.out.find("home: mask failed"), std::string::npos) << what << ": " << o.out;
     EXPECT_NE(o.out.find("likely cause: the model changed (robot.yaml)"), std::string::npos) << what << ": " << o.out;
-    const nlohmann::json m = nlohmann::json::parse(readText(dir_ / "out/results.json"))["cases"][0]["outputs"][0]["metrics"];
-    std::printf("post moved 1 px %s: mask largest cluster %d px, worst centroid shift %.3f px, worst area change %.2f x allowed\n", what,
-                m["largest_cluster_px"].get<int>(), m["worst_centroid_shift_px"].get<double>(), m["worst_area_change_ratio"].get<double>());
+    const nlohmann::json m =
+        nlohmann::json::parse(readText(dir_ / "out/results.json"))["cases"][0]["outputs"][0]["metrics"];
+    std::printf(
+        "post moved 1 px %s: mask largest cluster %d px, worst centroid shift %.3f px, worst area change %.2f x "
+        "allowed\n",
+        what, m["largest_cluster_px"].get<int>(), m["worst_centroid_shift_px"].get<double>(),
+        m["worst_area_change_ratio"].get<double>());
     true_changes.push_back(m);
   }
   // Each true change breaks a rule (cluster 4 px, centroid 0.25 px): by 2.75x along, 28x across
   // when measured; GoldensCrossTheGlBackEnds keeps the back ends' differences 3x inside the rules.
   for (const nlohmann::json& m : true_changes)
-    EXPECT_TRUE(m["largest_cluster_px"].get<int>() > 4 || m["worst_centroid_shift_px"].get<double>() > 0.25) << m.dump();
+    EXPECT_TRUE(m["largest_cluster_px"].get<int>() > 4 || m["worst_centroid_shift_px"].get<double>() > 0.25)
+        << m.dump();
 
   // A body removed: the set of bodies differs before any pixel is compared.
-  writeText(dir_ / "robot.yaml", replaced(model_, "  - name: post                  # a 5 cm pole standing 0.6 m in front of the robot\n"
-                                                  "    frame: world\n    points: [[0.6, 0, 0], [0.6, 0, 0.8]]\n    radius: 0.025\n",
-                                          ""));
+  writeText(dir_ / "robot.yaml",
+            replaced(model_,
+                     "  - name: post                  # a 5 cm pole standing 0.6 m in front of the robot\n"
+                     "    frame: world\n    points: [[0.6, 0, 0], [0.6, 0, 0.8]]\n    radius: 0.025\n",
+                     ""));
   o = golden("run " + manifest() + " --case home --out " + out() + " -q");
   EXPECT_EQ(o.code, 1);
   EXPECT_NE(o.out.find("home: mask failed: bodies: missing 'post'"), std::string::npos) << o.out;
@@ -254,7 +263,9 @@ TEST_F(GoldenCli, UpdateOnlyFailedAndApproveGiveTheBytesOfUpdate) {
   // the trees would differ for that alone. Pinned, such a step fails saying why.
   const std::string renderer = nlohmann::json::parse(before.at("reach/golden.json")).at("renderer");
   const std::string gl = renderer.find("OSMesa") != std::string::npos ? "osmesa" : "egl";
-  const auto golden = [&](const std::string& args) { return kccd::testing::runProgram("KCCD_GL=" + gl + " " + kCli + " golden " + args); };
+  const auto golden = [&](const std::string& args) {
+    return kccd::testing::runProgram("KCCD_GL=" + gl + " " + kCli + " golden " + args);
+  };
   writeText(dir_ / "robot.yaml", replaced(model_, "radius: 0.045", "radius: 0.05"));  // the forearm, seen by every case
   // The failing run's actual images become the goldens...
   ASSERT_EQ(golden("run " + manifest() + " --case reach* --out " + out() + " -q").code, 1);
@@ -291,17 +302,23 @@ TEST_F(GoldenCli, MistakesAreOneLineWithThePlace) {
   };
   const Case cases[] = {
       {"kccd_golden: 2\ncases: []\n", ":1:14: kccd_golden: expected 1"},
-      {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml}\ncases:\n  - {id: a, state: [0, 0, 0]}\n  - {id: a, state: [0, 0, 0]}\n",
+      {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml}\ncases:\n  - {id: a, state: [0, 0, 0]}\n  - "
+       "{id: a, state: [0, 0, 0]}\n",
        ":5:10: cases[1].id: 'a' is given twice"},
       {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml}\ncases:\n  - {id: a, state: [0, 0]}\n",
        "case 'a'.state: 2 values, model 'demo_arm' has 3"},
-      {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml}\ncases:\n  - {id: a, state: [0, 0, 0], outputs: [mask, depth]}\n",
+      {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml}\ncases:\n  - {id: a, state: [0, 0, 0], "
+       "outputs: [mask, depth]}\n",
        ":4:47: case 'a'.outputs[1]: expected mask, colour or overlay, got 'depth'"},
-      {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml}\ncases:\n  - {id: a, state: [0, 0, 0], outputs: [overlay]}\n",
+      {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml}\ncases:\n  - {id: a, state: [0, 0, 0], "
+       "outputs: [overlay]}\n",
        "case 'a'.outputs: overlay needs a recorded frame"},
-      {"kccd_golden: 1\ndefaults: {model: nothing.yaml, camera: front.yaml}\ncases:\n  - {id: a, state: [0, 0, 0]}\n", "nothing.yaml"},
-      {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml}\ncases:\n  - {id: ../x, state: [0, 0, 0]}\n", "is not a folder name"},
-      {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml, supersample: 5}\ncases:\n  - {id: a, state: [0, 0, 0]}\n",
+      {"kccd_golden: 1\ndefaults: {model: nothing.yaml, camera: front.yaml}\ncases:\n  - {id: a, state: [0, 0, 0]}\n",
+       "nothing.yaml"},
+      {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml}\ncases:\n  - {id: ../x, state: [0, 0, 0]}\n",
+       "is not a folder name"},
+      {"kccd_golden: 1\ndefaults: {model: robot.yaml, camera: front.yaml, supersample: 5}\ncases:\n  - {id: a, state: "
+       "[0, 0, 0]}\n",
        ":2:64: defaults.supersample: must be in 1..4"},
   };
   for (const Case& c : cases) {
@@ -324,14 +341,15 @@ TEST_F(GoldenCli, AUrdfEditReimportedFails) {
   fs::copy(fs::path(KCCD_TEST_DATA_DIR) / "urdf", urdf, fs::copy_options::recursive);
   const std::string original = readText(urdf / "two_link.urdf");
   auto import = [&] {
-    const Outcome o = kccd::testing::runProgram(kCli + " import " + (urdf / "two_link.urdf").string() + " --srdf " +
-                                                (urdf / "two_link.srdf").string() + " --package-path kccd_test=" + urdf.string() +
-                                                " -k 4 -q -o " + (dir_ / "cell.yaml").string());
+    const Outcome o = kccd::testing::runProgram(
+        kCli + " import " + (urdf / "two_link.urdf").string() + " --srdf " + (urdf / "two_link.srdf").string() +
+        " --package-path kccd_test=" + urdf.string() + " -k 4 -q -o " + (dir_ / "cell.yaml").string());
     ASSERT_EQ(o.code, 0) << o.err;
   };
   import();
-  kccd::calib::saveCamera(kccd::testing::lookAt({1.4, -1.1, 0.7}, {0.05, 0.0, 0.3}, 320, 240, 320, {-0.06, 0.01, 0, 0, 0}),
-                          (dir_ / "cell_cam.yaml").string());
+  kccd::calib::saveCamera(
+      kccd::testing::lookAt({1.4, -1.1, 0.7}, {0.05, 0.0, 0.3}, 320, 240, 320, {-0.06, 0.01, 0, 0, 0}),
+      (dir_ / "cell_cam.yaml").string());
   writeText(dir_ / "cell_golden.yaml", R"(kccd_golden: 1
 goldens: cell_goldens/
 defaults: {model: cell.yaml, camera: cell_cam.yaml, outputs: [mask, colour]}
@@ -346,7 +364,8 @@ cases:
   Outcome o = golden("run " + m + " --out " + out() + " -q");
   EXPECT_EQ(o.code, 0) << "the same URDF imported again: " << o.out;
 
-  writeText(urdf / "two_link.urdf", replaced(original, R"(<cylinder radius="0.05" length="0.5"/>)", R"(<cylinder radius="0.055" length="0.5"/>)"));
+  writeText(urdf / "two_link.urdf", replaced(original, R"(<cylinder radius="0.05" length="0.5"/>)",
+                                             R"(<cylinder radius="0.055" length="0.5"/>)"));
   import();
   o = golden("run " + m + " --out " + out() + " -q");
   EXPECT_EQ(o.code, 1) << o.out;
@@ -414,18 +433,21 @@ namespace {
 TEST_F(GoldenCli, GoldensCrossTheGlBackEnds) {
   for (const auto& [make, check] : {std::pair{"osmesa", "egl"}, std::pair{"egl", "osmesa"}}) {
     fs::remove_all(dir_ / "goldens");
-    const Outcome up = kccd::testing::runProgram("KCCD_GL=" + std::string(make) + " " + kCli + " golden update " + manifest() + " -q");
+    const Outcome up =
+        kccd::testing::runProgram("KCCD_GL=" + std::string(make) + " " + kCli + " golden update " + manifest() + " -q");
     ASSERT_EQ(up.code, 0) << make << ": " << up.err;
-    const Outcome run =
-        kccd::testing::runProgram("KCCD_GL=" + std::string(check) + " " + kCli + " golden run " + manifest() + " --out " + out() + " -q");
+    const Outcome run = kccd::testing::runProgram("KCCD_GL=" + std::string(check) + " " + kCli + " golden run " +
+                                                  manifest() + " --out " + out() + " -q");
     EXPECT_EQ(run.code, 0) << make << " goldens under " << check << ": " << run.out;
     const nlohmann::json results = nlohmann::json::parse(readText(dir_ / "out/results.json"));
     for (const nlohmann::json& c : results["cases"])
       for (const nlohmann::json& o : c["outputs"]) {
         const nlohmann::json& m = o["metrics"];
-        std::printf("%s goldens under %s: %s %s: changed %d px, largest cluster %d px, centroid %.3f px, area %.2f x allowed\n", make,
-                    check, c["id"].get<std::string>().c_str(), o["output"].get<std::string>().c_str(), m["changed_px"].get<int>(),
-                    m["largest_cluster_px"].get<int>(), m["worst_centroid_shift_px"].get<double>(), m["worst_area_change_ratio"].get<double>());
+        std::printf(
+            "%s goldens under %s: %s %s: changed %d px, largest cluster %d px, centroid %.3f px, area %.2f x allowed\n",
+            make, check, c["id"].get<std::string>().c_str(), o["output"].get<std::string>().c_str(),
+            m["changed_px"].get<int>(), m["largest_cluster_px"].get<int>(), m["worst_centroid_shift_px"].get<double>(),
+            m["worst_area_change_ratio"].get<double>());
         EXPECT_LE(3 * m["largest_cluster_px"].get<int>(), 4);
         EXPECT_LE(3 * m["worst_centroid_shift_px"].get<double>(), 0.25);
         EXPECT_LE(3 * m["worst_area_change_ratio"].get<double>(), 1.0);

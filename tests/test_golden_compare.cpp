@@ -66,9 +66,9 @@ TEST(GoldenCompare, IsolatedFlipsAlongEdgesPass) {
   // A rasteriser that rounds differently where an edge passes a pixel centre: single pixels,
   // far apart, each flipped to the neighbouring label.
   cv::Mat flipped = scene();
-  for (int x = 12; x < 50; x += 6) flipped.at<std::uint8_t>(80, x) = 0;     // the base's top edge
-  for (int x = 42; x < 118; x += 7) flipped.at<std::uint8_t>(49, x) = 2;    // above the link
-  flipped.at<std::uint8_t>(90, 142) = 0;                                     // the tool's rim
+  for (int x = 12; x < 50; x += 6) flipped.at<std::uint8_t>(80, x) = 0;   // the base's top edge
+  for (int x = 42; x < 118; x += 7) flipped.at<std::uint8_t>(49, x) = 2;  // above the link
+  flipped.at<std::uint8_t>(90, 142) = 0;                                  // the tool's rim
   const Comparison c = compareMasks(scene(), kNames, flipped, kNames);
   EXPECT_TRUE(c.passed) << c.reason;
   EXPECT_FALSE(c.identical);
@@ -101,7 +101,8 @@ TEST(GoldenCompare, ColourChangesBeyondTheThresholdCountAndShiftsFail) {
   std::uniform_int_distribution<int> noise(-24, 24);
   for (int y = 0; y < b.rows; ++y)
     for (int x = 0; x < b.cols; ++x)
-      for (int k = 0; k < 4; ++k) b.at<cv::Vec4b>(y, x)[k] = cv::saturate_cast<std::uint8_t>(b.at<cv::Vec4b>(y, x)[k] + noise(rng));
+      for (int k = 0; k < 4; ++k)
+        b.at<cv::Vec4b>(y, x)[k] = cv::saturate_cast<std::uint8_t>(b.at<cv::Vec4b>(y, x)[k] + noise(rng));
   const Comparison noisy = compareColour(a, b);
   EXPECT_TRUE(noisy.passed) << noisy.reason;
   EXPECT_FALSE(noisy.identical);
@@ -114,7 +115,8 @@ TEST(GoldenCompare, ColourChangesBeyondTheThresholdCountAndShiftsFail) {
   EXPECT_EQ(shift.largest_cluster_px, 30);
 
   cv::Mat scattered = a.clone();
-  for (int k = 0; k < 50; ++k) scattered.at<cv::Vec4b>(2 + (k / 10) * 3, 2 + (k % 10) * 7) = cv::Vec4b(255, 255, 255, 255);
+  for (int k = 0; k < 50; ++k)
+    scattered.at<cv::Vec4b>(2 + (k / 10) * 3, 2 + (k % 10) * 7) = cv::Vec4b(255, 255, 255, 255);
   const Comparison many = compareColour(a, scattered);
   EXPECT_FALSE(many.passed);
   EXPECT_EQ(many.reason, "50 changed pixels (allowed 40)");

@@ -5,12 +5,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <zlib.h>
 #include <cstdio>
 #include <cstring>
 #include <random>
 #include <string>
 #include <vector>
-#include <zlib.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -127,7 +127,8 @@ TEST(ImageFile, DamagedPngsAreOneErrorAndNothingOnStderr) {
       damaged.push_back(b);
     }
   // Cut anywhere, and bytes of the compressed data changed (CRC recomputed).
-  for (std::size_t cut = 1; cut < good.size(); cut += 7) damaged.emplace_back(good.begin(), good.begin() + static_cast<long>(cut));
+  for (std::size_t cut = 1; cut < good.size(); cut += 7)
+    damaged.emplace_back(good.begin(), good.begin() + static_cast<long>(cut));
   for (int k = 0; k < 200; ++k) {
     std::vector<std::uint8_t> b = good;
     b[41 + rng() % (good.size() - 41 - 16)] ^= static_cast<std::uint8_t>(1 + rng() % 255);
@@ -168,13 +169,15 @@ std::vector<std::uint8_t> withOrientation(const std::vector<std::uint8_t>& jpeg,
   std::vector<std::uint8_t> tiff = big_endian ? std::vector<std::uint8_t>{'M', 'M', 0, 42, 0, 0, 0, 8}
                                               : std::vector<std::uint8_t>{'I', 'I', 42, 0, 8, 0, 0, 0};
   const auto u16 = [&](unsigned v) {
-    if (big_endian) tiff.push_back(static_cast<std::uint8_t>(v >> 8)), tiff.push_back(static_cast<std::uint8_t>(v & 0xFF));
-    else tiff.push_back(static_cast<std::uint8_t>(v & 0xFF)), tiff.push_back(static_cast<std::uint8_t>(v >> 8));
+    if (big_endian)
+      tiff.push_back(static_cast<std::uint8_t>(v >> 8)), tiff.push_back(static_cast<std::uint8_t>(v & 0xFF));
+    else
+      tiff.push_back(static_cast<std::uint8_t>(v & 0xFF)), tiff.push_back(static_cast<std::uint8_t>(v >> 8));
   };
-  u16(1);                                   // one entry
-  u16(0x0112), u16(3), u16(1), u16(0);      // Orientation, SHORT, count 1 (the count's high half)
-  u16(static_cast<unsigned>(o)), u16(0);    // the value, padding
-  u16(0), u16(0);                           // no next IFD
+  u16(1);                                 // one entry
+  u16(0x0112), u16(3), u16(1), u16(0);    // Orientation, SHORT, count 1 (the count's high half)
+  u16(static_cast<unsigned>(o)), u16(0);  // the value, padding
+  u16(0), u16(0);                         // no next IFD
   std::vector<std::uint8_t> app1 = {'E', 'x', 'i', 'f', 0, 0};
   app1.insert(app1.end(), tiff.begin(), tiff.end());
   const std::size_t length = app1.size() + 2;
@@ -208,7 +211,8 @@ TEST(ImageFile, JpegPixelsAreOpenCvsInEveryMode) {
         for (const bool big : {false, true}) {
           const std::vector<std::uint8_t> bytes = o == 1 && !big ? jpeg : withOrientation(jpeg, o, big);
           const cv::Mat buf(1, static_cast<int>(bytes.size()), CV_8U, const_cast<std::uint8_t*>(bytes.data()));
-          for (const auto& [mode, flag] : {std::pair{kc::ImageColour::Bgr, cv::IMREAD_COLOR}, std::pair{kc::ImageColour::Grey, cv::IMREAD_GRAYSCALE},
+          for (const auto& [mode, flag] : {std::pair{kc::ImageColour::Bgr, cv::IMREAD_COLOR},
+                                           std::pair{kc::ImageColour::Grey, cv::IMREAD_GRAYSCALE},
                                            std::pair{kc::ImageColour::Unchanged, cv::IMREAD_UNCHANGED}}) {
             SCOPED_TRACE(std::to_string(type) + " orientation " + std::to_string(o) + (big ? " MM" : " II") + " mode " +
                          std::to_string(static_cast<int>(mode)));
@@ -233,7 +237,8 @@ TEST(ImageFile, DamagedJpegsAreOneErrorAndNothingOnStderr) {
   std::vector<std::uint8_t> jpeg;
   ASSERT_TRUE(cv::imencode(".jpg", m, jpeg));
   std::vector<std::vector<std::uint8_t>> damaged;
-  for (std::size_t cut = 3; cut + 2 < jpeg.size(); cut += 97) damaged.emplace_back(jpeg.begin(), jpeg.begin() + static_cast<long>(cut));
+  for (std::size_t cut = 3; cut + 2 < jpeg.size(); cut += 97)
+    damaged.emplace_back(jpeg.begin(), jpeg.begin() + static_cast<long>(cut));
   int refused = 0;
   for (const auto& b : damaged) {
     std::string problem;

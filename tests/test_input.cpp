@@ -206,13 +206,14 @@ TEST(InputErrorLocation, AliasesThatMultiplyAreRefused) {
   EXPECT_EQ(ok["c"].size(), 3u);
   std::string bomb = "a0: &a0 [1, 2, 3, 4, 5, 6, 7, 8]\n";
   for (int i = 1; i < 40; ++i)
-    bomb += "a" + std::to_string(i) + ": &a" + std::to_string(i) + " [*a" + std::to_string(i - 1) + ", *a" + std::to_string(i - 1) +
-            ", *a" + std::to_string(i - 1) + ", *a" + std::to_string(i - 1) + "]\n";
+    bomb += "a" + std::to_string(i) + ": &a" + std::to_string(i) + " [*a" + std::to_string(i - 1) + ", *a" +
+            std::to_string(i - 1) + ", *a" + std::to_string(i - 1) + ", *a" + std::to_string(i - 1) + "]\n";
   try {
     (void)r.load(bomb);
     ADD_FAILURE() << "4^39 values accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("aliases expand the document to more than 4194304 values"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("aliases expand the document to more than 4194304 values"), std::string::npos)
+        << e.what();
     // The values through a9 number 3.3 million; a10's first alias (line 11) adds 2.4 million more.
     EXPECT_EQ(e.location().line, 11u) << e.what();
   }

@@ -69,25 +69,28 @@ IntrinsicsView view(const std::string& name, const Camera& camera, const Board& 
     std::vector<cv::Point2d> pix;
     cv::projectPoints(world, rvec, tvec, camera.camera_matrix, camera.distortion, pix);
     bool inside = true;
-    for (const auto& p : pix) inside = inside && p.x > 3 && p.y > 3 && p.x < camera.width - 4 && p.y < camera.height - 4;
+    for (const auto& p : pix)
+      inside = inside && p.x > 3 && p.y > 3 && p.x < camera.width - 4 && p.y < camera.height - 4;
     if (!inside) continue;  // a tag is detected whole or not at all
     for (int i = 0; i < 4; ++i)
       v.points.push_back({"tag" + std::to_string(tag.id) + ".c" + std::to_string(i),
-                          pix[static_cast<std::size_t>(i)] + cv::Point2d(noise(rng), noise(rng)), world[static_cast<std::size_t>(i)]});
+                          pix[static_cast<std::size_t>(i)] + cv::Point2d(noise(rng), noise(rng)),
+                          world[static_cast<std::size_t>(i)]});
   }
   return v;
 }
 
 // `n` views from random tilted poses (tilt 20..45 deg about random axes) spread over the image.
-std::vector<IntrinsicsView> tiltedViews(const Camera& camera, const Board& board, int n, double noise_px, std::mt19937_64& rng,
-                                        double tilt_lo = 20, double tilt_hi = 45) {
+std::vector<IntrinsicsView> tiltedViews(const Camera& camera, const Board& board, int n, double noise_px,
+                                        std::mt19937_64& rng, double tilt_lo = 20, double tilt_hi = 45) {
   std::uniform_real_distribution<double> tilt(tilt_lo, tilt_hi), axis(0, 360), roll(-20, 20), off(-0.12, 0.12),
       dist(0.38, 0.55);
   std::vector<IntrinsicsView> views;
   while (static_cast<int>(views.size()) < n) {
     cv::Vec3d rvec, tvec;
     const double z = dist(rng);
-    boardPose(board, tilt(rng), axis(rng), roll(rng), cv::Vec3d(off(rng) * z / 0.45, off(rng) * 0.8 * z / 0.45, z), rvec, tvec);
+    boardPose(board, tilt(rng), axis(rng), roll(rng), cv::Vec3d(off(rng) * z / 0.45, off(rng) * 0.8 * z / 0.45, z),
+              rvec, tvec);
     IntrinsicsView v = view("view" + std::to_string(views.size() + 1), camera, board, rvec, tvec, noise_px, rng);
     if (v.points.size() >= 40) views.push_back(std::move(v));
   }
@@ -176,9 +179,11 @@ TEST(CalibIntrinsics, RecoversAKnownDistortedCamera) {
 TEST(CalibIntrinsics, TheIntrinsicsFileWritesAndReads) {
   std::mt19937_64 rng(7);
   const Camera truth = trueCamera();
-  const IntrinsicsResult r = calibrateIntrinsics(tiltedViews(truth, Board::grid(grid()), 8, 0.2, rng), cv::Size(960, 720));
+  const IntrinsicsResult r =
+      calibrateIntrinsics(tiltedViews(truth, Board::grid(grid()), 8, 0.2, rng), cv::Size(960, 720));
   ASSERT_EQ(r.status, IntrinsicsStatus::Solved) << r.message;
-  const std::string path = (std::filesystem::path(::testing::TempDir()) / ("kccd_intr_" + std::to_string(getpid()) + ".yaml")).string();
+  const std::string path =
+      (std::filesystem::path(::testing::TempDir()) / ("kccd_intr_" + std::to_string(getpid()) + ".yaml")).string();
   saveCamera(r.camera, path);
   const Camera c = loadCamera(path);
   std::filesystem::remove(path);

@@ -131,11 +131,13 @@ TEST_F(LabelServerTest, TheSessionHasTheFramesLabelsBodiesAndTheSolve) {
   const auto frame = client_->Get("/frame/0.png");
   ASSERT_TRUE(frame);
   EXPECT_EQ(frame->get_header_value("Content-Type"), "image/png");
-  const cv::Mat decoded = cv::imdecode(std::vector<unsigned char>(frame->body.begin(), frame->body.end()), cv::IMREAD_UNCHANGED);
+  const cv::Mat decoded =
+      cv::imdecode(std::vector<unsigned char>(frame->body.begin(), frame->body.end()), cv::IMREAD_UNCHANGED);
   EXPECT_EQ(decoded.size(), cv::Size(1280, 720));
   const auto layer = client_->Get("/overlay/0.png?rev=0");
   ASSERT_TRUE(layer);
-  const cv::Mat rgba = cv::imdecode(std::vector<unsigned char>(layer->body.begin(), layer->body.end()), cv::IMREAD_UNCHANGED);
+  const cv::Mat rgba =
+      cv::imdecode(std::vector<unsigned char>(layer->body.begin(), layer->body.end()), cv::IMREAD_UNCHANGED);
   ASSERT_EQ(rgba.type(), CV_8UC4);
   std::vector<cv::Mat> channels;
   cv::split(rgba, channels);
@@ -233,7 +235,8 @@ TEST_F(LabelServerTest, ABadDocumentIsRefusedWithTheReadersMessage) {
   EXPECT_EQ(nlohmann::json::parse(put->body)["error"], expected);
   EXPECT_EQ(expected.rfind(labels_ + ":2:", 0), 0u) << expected;  // the line the saved file would have it on
   // A body label without a model's body, and a body that does not exist: refused as kccd calib would.
-  const nlohmann::json unknown = {{"labels", {{{"name", "b"}, {"pixel", {1, 2}}, {"body", "nope"}, {"point", {0, 0, 0}}}}}};
+  const nlohmann::json unknown = {
+      {"labels", {{{"name", "b"}, {"pixel", {1, 2}}, {"body", "nope"}, {"point", {0, 0, 0}}}}}};
   const auto put2 = putLabels(unknown);
   EXPECT_EQ(put2->status, 400);
   EXPECT_NE(put2->body.find("nope"), std::string::npos) << put2->body;
@@ -298,7 +301,8 @@ TEST_F(LabelServerTest, TheVolumesPickTheBodyUnderAPoint) {
 
   // Where the overlay layer is transparent no volume is drawn: no body.
   const auto layer = client_->Get("/overlay/0.png");
-  const cv::Mat rgba = cv::imdecode(std::vector<unsigned char>(layer->body.begin(), layer->body.end()), cv::IMREAD_UNCHANGED);
+  const cv::Mat rgba =
+      cv::imdecode(std::vector<unsigned char>(layer->body.begin(), layer->body.end()), cv::IMREAD_UNCHANGED);
   ASSERT_EQ(rgba.at<cv::Vec4b>(0, 0)[3], 0);
   EXPECT_TRUE(getJson("/api/pick?frame=0&x=0&y=0")["body"].is_null());
   EXPECT_TRUE(getJson("/api/pick?frame=0&x=-5&y=3e8")["body"].is_null());
@@ -340,7 +344,6 @@ TEST_F(LabelServerTest, EditsAreAutosavedAndOfferedAgain) {
   EXPECT_TRUE(again["frames"][0]["recovered"].is_null());
   EXPECT_EQ(again["labels"], doc);
 }
-
 
 // The page itself: built in, with a content security policy that allows nothing from elsewhere.
 TEST_F(LabelServerTest, ThePageIsServedFromTheProgram) {
@@ -424,7 +427,8 @@ TEST_F(LabelServerTest, SnapToTheRobotFromFourRoughClicksAndAMisclick) {
   // The overlay carries the mask's outline (yellow) and the drawn robot's (magenta), opaque.
   const auto png = client_->Get("/overlay/0.png");
   ASSERT_TRUE(png);
-  const cv::Mat layer = cv::imdecode(std::vector<unsigned char>(png->body.begin(), png->body.end()), cv::IMREAD_UNCHANGED);
+  const cv::Mat layer =
+      cv::imdecode(std::vector<unsigned char>(png->body.begin(), png->body.end()), cv::IMREAD_UNCHANGED);
   ASSERT_EQ(layer.type(), CV_8UC4);
   cv::Mat magenta, yellow;
   cv::inRange(layer, cv::Scalar(200, 0, 200, 255), cv::Scalar(255, 60, 255, 255), magenta);

@@ -24,13 +24,13 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "kccd/calib/camera.hpp"
 #include "kccd/input_error.hpp"
 #include "kccd/logs/bag_summary.hpp"
 #include "kccd/logs/decode.hpp"
+#include "kccd/logs/log_reader.hpp"
 #include "kccd/logs/mcap_reader.hpp"
 #include "kccd/logs/message_definition.hpp"
-#include "kccd/logs/log_reader.hpp"
-#include "kccd/calib/camera.hpp"
 #include "kccd/overlay/bags/bag_export.hpp"
 #include "support/files.hpp"
 #include "support/run_program.hpp"
@@ -50,11 +50,14 @@ class McapFixtures : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = kccd::testing::scratchFolder("test_logs") / "bags";
     fs::create_directories(dir_);
-    const auto r = runProgram(std::string(KCCD_NODE) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_mcap.mjs " + dir_.string(), true);
+    const auto r = runProgram(
+        std::string(KCCD_NODE) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_mcap.mjs " + dir_.string(), true);
     ASSERT_EQ(r.code, 0) << "the fixture writer failed (npm ci in tests/bags?): " << r.out;
-    const auto db = runProgram(std::string(KCCD_PYTHON) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_db3.py " + dir_.string(), true);
+    const auto db = runProgram(
+        std::string(KCCD_PYTHON) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_db3.py " + dir_.string(), true);
     ASSERT_EQ(db.code, 0) << "the sqlite3 fixture writer failed: " << db.out;
-    const auto ros1 = runProgram(std::string(KCCD_PYTHON) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_ros1.py " + dir_.string(), true);
+    const auto ros1 = runProgram(
+        std::string(KCCD_PYTHON) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_ros1.py " + dir_.string(), true);
     ASSERT_EQ(ros1.code, 0) << "the ROS 1 fixture writer failed (python3-rosbag, python3-sensor-msgs?): " << ros1.out;
     truth_ = nlohmann::json::parse(readText((dir_ / "truth.json").string()));
   }
@@ -72,10 +75,12 @@ class McapFixtures : public ::testing::Test {
   static std::vector<std::string> exportOf(const std::string& bag, const std::string& tag) {
     const fs::path out = dir_ / ("export_" + tag);
     fs::create_directories(out);
-    const auto r = runProgram(std::string(KCCD_CLI) + " bag export " + bag + " -q --states " + (out / "s.csv").string() + " --video " +
-                              (out / "v.mkv").string() + " --frame-times " + (out / "t.csv").string() + " --camera-info " + (out / "c.yaml").string());
+    const auto r = runProgram(std::string(KCCD_CLI) + " bag export " + bag + " -q --states " +
+                              (out / "s.csv").string() + " --video " + (out / "v.mkv").string() + " --frame-times " +
+                              (out / "t.csv").string() + " --camera-info " + (out / "c.yaml").string());
     EXPECT_EQ(r.code, 0) << r.err;
-    return std::vector<std::string>{readText((out / "s.csv").string()), readText((out / "t.csv").string()), readText((out / "c.yaml").string())};
+    return std::vector<std::string>{readText((out / "s.csv").string()), readText((out / "t.csv").string()),
+                                    readText((out / "c.yaml").string())};
   }
   static inline fs::path dir_;
   static inline nlohmann::json truth_;
@@ -88,9 +93,12 @@ std::uint64_t ns(const nlohmann::json& s) { return std::stoull(s.get<std::string
 std::string camera64(const std::string& name) {
   return kccd::testing::writeScratch(
       "test_logs", name,
-      "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
-      "   data: [ 40, 0, 31.5, 0, 40, 23.5, 0, 0, 1 ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n"
-      "   data: [ 0, 0, 0, 0, 0 ]\nrvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 1.5707963267948966, 0, 0 ]\n"
+      "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   "
+      "dt: d\n"
+      "   data: [ 40, 0, 31.5, 0, 40, 23.5, 0, 0, 1 ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: "
+      "5\n   dt: d\n"
+      "   data: [ 0, 0, 0, 0, 0 ]\nrvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ "
+      "1.5707963267948966, 0, 0 ]\n"
       "tvec: !!opencv-matrix\n   rows: 3\n   cols: 1\n   dt: d\n   data: [ 0, 0.5, 2 ]\n");
 }
 
@@ -107,10 +115,12 @@ TEST_F(McapFixtures, EveryFileReadsAsWritten) {
     if (t["compression"].is_null()) {
       EXPECT_TRUE(r.chunks().empty());
     } else {
-      EXPECT_GT(r.chunks().at(t["compression"].get<std::string>().empty() ? "none" : t["compression"].get<std::string>()), 3);
+      EXPECT_GT(
+          r.chunks().at(t["compression"].get<std::string>().empty() ? "none" : t["compression"].get<std::string>()), 3);
     }
     // Per topic, the definitions the file stores decode every message to what was written.
-    const MessageDefinitions joint = MessageDefinitions::parse("sensor_msgs/msg/JointState", msgs.front().schema->data, Dialect::Ros2);
+    const MessageDefinitions joint =
+        MessageDefinitions::parse("sensor_msgs/msg/JointState", msgs.front().schema->data, Dialect::Ros2);
     std::size_t j = 0, i = 0;
     std::uint64_t last = 0;
     for (std::size_t k = 0; k < msgs.size(); ++k) {
@@ -135,7 +145,8 @@ TEST_F(McapFixtures, EveryFileReadsAsWritten) {
           EXPECT_EQ(v.field("velocity")->items[q].f, w["velocity"][q].get<double>());
         }
         ASSERT_EQ(v.field("effort")->items.size(), w["effort"].size());
-        for (std::size_t q = 0; q < w["effort"].size(); ++q) EXPECT_EQ(v.field("effort")->items[q].f, w["effort"][q].get<double>());
+        for (std::size_t q = 0; q < w["effort"].size(); ++q)
+          EXPECT_EQ(v.field("effort")->items[q].f, w["effort"][q].get<double>());
       } else if (m.channel->topic == "/camera/camera_info") {
         const nlohmann::json& w = truth_["camera_infos"][0];
         const MessageDefinitions info = MessageDefinitions::parse(m.schema->name, m.schema->data, Dialect::Ros2);
@@ -178,7 +189,8 @@ TEST_F(McapFixtures, BagInfoMatchesTheWriter) {
     const nlohmann::json& topics = truth_["files"][name]["topics"];
     ASSERT_EQ(j["topics"].size(), topics.size());
     for (const nlohmann::json& w : topics) {
-      const auto it = std::find_if(j["topics"].begin(), j["topics"].end(), [&](const nlohmann::json& t) { return t["topic"] == w["topic"]; });
+      const auto it = std::find_if(j["topics"].begin(), j["topics"].end(),
+                                   [&](const nlohmann::json& t) { return t["topic"] == w["topic"]; });
       ASSERT_NE(it, j["topics"].end()) << w["topic"];
       const nlohmann::json& t = *it;
       EXPECT_EQ(t["type"], w["schema_name"]);
@@ -203,7 +215,10 @@ TEST_F(McapFixtures, BagInfoMatchesTheWriter) {
   // The text form names both topics with their types and the skews in milliseconds.
   const auto text = runProgram(std::string(KCCD_CLI) + " bag info " + file("joint_zstd.mcap"));
   ASSERT_EQ(text.code, 0) << text.err;
-  EXPECT_NE(text.out.find("/joint_states  sensor_msgs/msg/JointState  200 messages from 0.000 to 0.199 s, 1000.0 Hz, skew 2.000 / 2.000 / 2.000 ms"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("/joint_states  sensor_msgs/msg/JointState  200 messages from 0.000 to 0.199 s, 1000.0 Hz, "
+                          "skew 2.000 / 2.000 / 2.000 ms"),
+            std::string::npos)
+      << text.out;
   EXPECT_NE(text.out.find("/camera/image_raw  sensor_msgs/msg/Image  10 messages"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find(" zstd\n"), std::string::npos) << text.out;
 }
@@ -238,7 +253,8 @@ TEST_F(McapFixtures, ACutFileReadsAPrefixWithAWarning) {
   }
   // The command: a bag cut at 60 % of its bytes is summarised with one warning naming the byte.
   const std::string bytes = readText(file("joint_lz4.mcap"));
-  const std::string path = kccd::testing::writeScratch("test_logs", "sixty.mcap", bytes.substr(0, bytes.size() * 6 / 10));
+  const std::string path =
+      kccd::testing::writeScratch("test_logs", "sixty.mcap", bytes.substr(0, bytes.size() * 6 / 10));
   const auto r = runProgram(std::string(KCCD_CLI) + " bag info " + path + " --json");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("warning: " + path + ": cut short at byte "), std::string::npos) << r.err;
@@ -295,8 +311,8 @@ TEST(MessageDecoding, TypesThatTakeNoBytesCannotMultiply) {
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
   }
   // An empty type a few times over is still read.
-  const MessageDefinitions few = MessageDefinitions::parse("fuzz_msgs/Root", "E[4] e\n" + std::string(80, '=') + "\nMSG: fuzz_msgs/E\n",
-                                                          Dialect::Ros2);
+  const MessageDefinitions few = MessageDefinitions::parse(
+      "fuzz_msgs/Root", "E[4] e\n" + std::string(80, '=') + "\nMSG: fuzz_msgs/E\n", Dialect::Ros2);
   EXPECT_EQ(decodeCdr(few, std::vector<std::uint8_t>{0, 1, 0, 0}).items.front().items.size(), 4u);
 }
 
@@ -311,11 +327,16 @@ TEST(McapReader, NotAnMcapFileOrNoFile) {
   EXPECT_THROW(McapReader("/nonexistent/x.mcap"), kccd::InputError);
   const auto r = runProgram(std::string(KCCD_CLI) + " bag info " + text);
   EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(r.err, "kccd: " + text + ": byte 0: not a robot log kccd reads: its first bytes are those of no MCAP file, rosbag2 sqlite3 (.db3) "
-                   "file or ROS 1 bag (a rosbag2 folder is given as the folder)\n");
+  EXPECT_EQ(
+      r.err,
+      "kccd: " + text +
+          ": byte 0: not a robot log kccd reads: its first bytes are those of no MCAP file, rosbag2 sqlite3 (.db3) "
+          "file or ROS 1 bag (a rosbag2 folder is given as the folder)\n");
   const std::string empty = kccd::testing::writeScratch("test_logs", "empty.db3", "");
-  EXPECT_EQ(runProgram(std::string(KCCD_CLI) + " bag info " + empty).err, "kccd: " + empty + ": byte 0: an empty file, not a robot log\n");
-  EXPECT_EQ(runProgram(std::string(KCCD_CLI) + " bag info /nonexistent/x.db3").err, "kccd: /nonexistent/x.db3: file: cannot be opened (no such file)\n");
+  EXPECT_EQ(runProgram(std::string(KCCD_CLI) + " bag info " + empty).err,
+            "kccd: " + empty + ": byte 0: an empty file, not a robot log\n");
+  EXPECT_EQ(runProgram(std::string(KCCD_CLI) + " bag info /nonexistent/x.db3").err,
+            "kccd: /nonexistent/x.db3: file: cannot be opened (no such file)\n");
 }
 
 // An encoder of this file's own (it shares nothing with the decoder): CDR aligned to each
@@ -459,7 +480,8 @@ TEST(RosMessages, DefinitionsParseTheirSyntaxAndNameTheLineOfAMistake) {
     }
   }
   // ROS 1: time and duration are primitives, Header is std_msgs/Header.
-  const MessageDefinitions r1 = MessageDefinitions::parse("p/T", "Header h\ntime t\nduration d\n====\nMSG: std_msgs/Header\nuint32 seq\n", Dialect::Ros1);
+  const MessageDefinitions r1 = MessageDefinitions::parse(
+      "p/T", "Header h\ntime t\nduration d\n====\nMSG: std_msgs/Header\nuint32 seq\n", Dialect::Ros1);
   EXPECT_EQ(r1.root().fields[0].type_name, "std_msgs/Header");
   EXPECT_EQ(r1.root().fields[1].primitive, Primitive::Time);
   EXPECT_EQ(r1.root().fields[2].primitive, Primitive::Duration);
@@ -475,7 +497,8 @@ TEST_F(McapFixtures, Db3BagsReadAsTheSameMessages) {
   const std::vector<LogMessage> want = all(mcap, &want_bytes);
   std::vector<std::string> topics;
   for (const LogMessage& m : want) topics.push_back(m.channel->topic);
-  const std::string mcap_info = runProgram(std::string(KCCD_CLI) + " bag info " + file("joint_plain.mcap") + " --json").out;
+  const std::string mcap_info =
+      runProgram(std::string(KCCD_CLI) + " bag info " + file("joint_plain.mcap") + " --json").out;
   for (const char* name : {"humble.db3", "jazzy.db3", "split"}) {
     SCOPED_TRACE(name);
     const std::unique_ptr<LogReader> r = openLog(file(name));
@@ -493,7 +516,8 @@ TEST_F(McapFixtures, Db3BagsReadAsTheSameMessages) {
     EXPECT_TRUE(r->damage().empty()) << r->damage();
     EXPECT_EQ(got_topics, topics);
     EXPECT_EQ(got_bytes, want_bytes);
-    for (std::size_t k = 0; k < want.size() && k < got_times.size(); ++k) EXPECT_EQ(got_times[k], want[k].log_time) << k;
+    for (std::size_t k = 0; k < want.size() && k < got_times.size(); ++k)
+      EXPECT_EQ(got_times[k], want[k].log_time) << k;
     // bag info: the same topics, counts, times and skews as the MCAP file's; where the definitions came from.
     const auto info = runProgram(std::string(KCCD_CLI) + " bag info " + file(name) + " --json");
     ASSERT_EQ(info.code, 0) << info.err;
@@ -516,12 +540,16 @@ TEST_F(McapFixtures, Db3BagsReadAsTheSameMessages) {
   std::vector<std::size_t> counts;
   for (const int percent : {30, 60, 90}) {
     SCOPED_TRACE(percent);
-    const std::string cut = kccd::testing::writeScratch("test_logs", "cut" + std::to_string(percent) + ".db3", bytes.substr(0, bytes.size() * percent / 100));
+    const std::string cut = kccd::testing::writeScratch("test_logs", "cut" + std::to_string(percent) + ".db3",
+                                                        bytes.substr(0, bytes.size() * percent / 100));
     std::unique_ptr<LogReader> r;
     try {
       r = openLog(cut);
     } catch (const kccd::InputError& e) {  // nothing left to read: said so
-      EXPECT_NE(std::string(e.what()).find("cut short at byte " + std::to_string(bytes.size() * percent / 100) + " of the "), std::string::npos) << e.what();
+      EXPECT_NE(
+          std::string(e.what()).find("cut short at byte " + std::to_string(bytes.size() * percent / 100) + " of the "),
+          std::string::npos)
+          << e.what();
       counts.push_back(0);
       continue;
     }
@@ -537,7 +565,9 @@ TEST_F(McapFixtures, Db3BagsReadAsTheSameMessages) {
       last = m.log_time;
       ++n, ++k;
     }
-    EXPECT_NE(r->damage().find("cut short at byte " + std::to_string(bytes.size() * percent / 100) + " of the "), std::string::npos) << r->damage();
+    EXPECT_NE(r->damage().find("cut short at byte " + std::to_string(bytes.size() * percent / 100) + " of the "),
+              std::string::npos)
+        << r->damage();
     counts.push_back(n);
     const auto info = runProgram(std::string(KCCD_CLI) + " bag info " + cut);
     EXPECT_EQ(info.code, n > 0 ? 0 : 2) << info.err;
@@ -563,7 +593,8 @@ TEST_F(McapFixtures, Db3BagsReadAsTheSameMessages) {
 // ROS 1 bags written by ROS 1's rosbag (chunks plain, bz2, lz4) from the same list: the same
 // topics, counts, times and stamps; every cut a prefix with a warning; the same exported bytes.
 TEST_F(McapFixtures, Ros1BagsReadAsTheSameRecording) {
-  const nlohmann::json mcap = nlohmann::json::parse(runProgram(std::string(KCCD_CLI) + " bag info " + file("joint_plain.mcap") + " --json").out);
+  const nlohmann::json mcap = nlohmann::json::parse(
+      runProgram(std::string(KCCD_CLI) + " bag info " + file("joint_plain.mcap") + " --json").out);
   for (const char* name : {"ros1_none.bag", "ros1_bz2.bag", "ros1_lz4.bag"}) {
     SCOPED_TRACE(name);
     const auto info = runProgram(std::string(KCCD_CLI) + " bag info " + file(name) + " --json");
@@ -597,7 +628,8 @@ TEST_F(McapFixtures, Ros1BagsReadAsTheSameRecording) {
           EXPECT_EQ(std::make_pair(m.channel->topic, m.log_time), full[k]) << "cut at " << cut;
           ++k;
         }
-      }) << "cut at " << cut;
+      }) << "cut at "
+         << cut;
       EXPECT_NE(r->damage().find("cut short at byte"), std::string::npos) << "cut at " << cut;
       ++cuts;
     }
@@ -609,7 +641,8 @@ TEST_F(McapFixtures, Ros1BagsReadAsTheSameRecording) {
 // Nanoseconds as the decimal text of seconds ("3.3335"): what an exported time must read back as.
 double decimalSeconds(std::uint64_t ns) {
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%llu.%09llu", static_cast<unsigned long long>(ns / 1000000000), static_cast<unsigned long long>(ns % 1000000000));
+  std::snprintf(buf, sizeof buf, "%llu.%09llu", static_cast<unsigned long long>(ns / 1000000000),
+                static_cast<unsigned long long>(ns % 1000000000));
   return std::stod(buf);
 }
 
@@ -631,10 +664,11 @@ TEST_F(McapFixtures, ExportWritesTheSuitesOwnFiles) {
   fs::create_directories(out);
   for (const char* clock : {"header", "log"}) {
     SCOPED_TRACE(clock);
-    const std::string s = (out / "states.csv").string(), v = (out / "video.mkv").string(), t = (out / "times.csv").string(),
-                      c = (out / "camera.yaml").string();
-    const auto r = runProgram(std::string(KCCD_CLI) + " bag export " + file("joint_lz4.mcap") + " --states " + s + " --video " + v +
-                              " --frame-times " + t + " --camera-info " + c + " --time-source " + clock);
+    const std::string s = (out / "states.csv").string(), v = (out / "video.mkv").string(),
+                      t = (out / "times.csv").string(), c = (out / "camera.yaml").string();
+    const auto r =
+        runProgram(std::string(KCCD_CLI) + " bag export " + file("joint_lz4.mcap") + " --states " + s + " --video " +
+                   v + " --frame-times " + t + " --camera-info " + c + " --time-source " + clock);
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(r.err, "");
     // Time 0: the earliest exported time on that clock (the first image's: its stamp is 35 ms behind).
@@ -650,12 +684,15 @@ TEST_F(McapFixtures, ExportWritesTheSuitesOwnFiles) {
     EXPECT_EQ(rows[0][14], "joint7.vel");
     for (std::size_t i = 0; i < 200; ++i) {
       const nlohmann::json& w = truth_["joint_states"][i];
-      const std::uint64_t when = header ? std::uint64_t(w["stamp_sec"].get<std::int64_t>()) * 1000000000 + w["stamp_nanosec"].get<std::uint64_t>()
+      const std::uint64_t when = header ? std::uint64_t(w["stamp_sec"].get<std::int64_t>()) * 1000000000 +
+                                              w["stamp_nanosec"].get<std::uint64_t>()
                                         : ns(w["log_time_ns"]);
-      EXPECT_EQ(std::stod(rows[i + 1][0]), decimalSeconds(when - origin)) << i;  // exactly the decimal, not a product with 1e-9
+      EXPECT_EQ(std::stod(rows[i + 1][0]), decimalSeconds(when - origin))
+          << i;  // exactly the decimal, not a product with 1e-9
       for (std::size_t q = 0; q < 7; ++q) {
         const std::string name = w["name"][q];
-        const std::size_t col = static_cast<std::size_t>(std::find(rows[0].begin(), rows[0].end(), name) - rows[0].begin());
+        const std::size_t col =
+            static_cast<std::size_t>(std::find(rows[0].begin(), rows[0].end(), name) - rows[0].begin());
         ASSERT_LT(col, 8u) << name;
         EXPECT_EQ(std::stod(rows[i + 1][col]), w["position"][q].get<double>()) << i << " " << name;
         EXPECT_EQ(std::stod(rows[i + 1][col + 7]), w["velocity"][q].get<double>()) << i << " " << name;
@@ -698,7 +735,9 @@ TEST_F(McapFixtures, ExportWritesTheSuitesOwnFiles) {
     std::string args, message;
   };
   const Case cases[] = {
-      {" --states " + s + " --joint-topic /nope", "--joint-topic /nope: " + file("joint_zstd.mcap") + " has no sensor_msgs/JointState topic of that name (it has: /joint_states)"},
+      {" --states " + s + " --joint-topic /nope",
+       "--joint-topic /nope: " + file("joint_zstd.mcap") +
+           " has no sensor_msgs/JointState topic of that name (it has: /joint_states)"},
       {" --video " + (out / "v.mkv").string(), "needs --frame-times"},
       {"", "nothing to write"},
       {" --states " + (out / "bad.txt").string(), ".csv"},
@@ -716,13 +755,16 @@ TEST(BagImages, EveryEncodingBecomesTheSameBgrFrame) {
   // A 5x3 BGR image, and the same pixels in every encoding the export reads.
   cv::Mat bgr(3, 5, CV_8UC3);
   cv::randu(bgr, 0, 256);
-  const std::string def = "uint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\nuint32 step\nuint8[] data\n";
+  const std::string def =
+      "uint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\nuint32 step\nuint8[] data\n";
   const MessageDefinitions types = MessageDefinitions::parse("sensor_msgs/Image", def, Dialect::Ros1);
   auto message = [&](const cv::Mat& m, const std::string& enc, std::vector<std::uint8_t>& bytes, int padding) {
     Encoder e(false, false);
     const std::size_t step = m.cols * m.elemSize() + static_cast<std::size_t>(padding);
-    e.put<std::uint32_t>(static_cast<std::uint32_t>(m.rows)), e.put<std::uint32_t>(static_cast<std::uint32_t>(m.cols)), e.str(enc);
-    e.put<std::uint8_t>(0), e.put<std::uint32_t>(static_cast<std::uint32_t>(step)), e.put<std::uint32_t>(static_cast<std::uint32_t>(step * m.rows));
+    e.put<std::uint32_t>(static_cast<std::uint32_t>(m.rows)), e.put<std::uint32_t>(static_cast<std::uint32_t>(m.cols)),
+        e.str(enc);
+    e.put<std::uint8_t>(0), e.put<std::uint32_t>(static_cast<std::uint32_t>(step)),
+        e.put<std::uint32_t>(static_cast<std::uint32_t>(step * m.rows));
     for (int y = 0; y < m.rows; ++y) {
       e.out_.insert(e.out_.end(), m.ptr<std::uint8_t>(y), m.ptr<std::uint8_t>(y) + m.cols * m.elemSize());
       e.out_.insert(e.out_.end(), static_cast<std::size_t>(padding), 0xAB);
@@ -734,7 +776,8 @@ TEST(BagImages, EveryEncodingBecomesTheSameBgrFrame) {
   cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
   cv::cvtColor(bgr, bgra, cv::COLOR_BGR2BGRA);
   cv::cvtColor(bgr, rgba, cv::COLOR_BGR2RGBA);
-  for (const auto& [m, enc] : std::vector<std::pair<cv::Mat, std::string>>{{bgr, "bgr8"}, {rgb, "rgb8"}, {bgra, "bgra8"}, {rgba, "rgba8"}})
+  for (const auto& [m, enc] :
+       std::vector<std::pair<cv::Mat, std::string>>{{bgr, "bgr8"}, {rgb, "rgb8"}, {bgra, "bgra8"}, {rgba, "rgba8"}})
     for (const int padding : {0, 3}) {
       std::vector<std::uint8_t> bytes;
       const Value v = message(m, enc, bytes, padding);
@@ -746,10 +789,12 @@ TEST(BagImages, EveryEncodingBecomesTheSameBgrFrame) {
   cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
   cv::cvtColor(grey, grey_bgr, cv::COLOR_GRAY2BGR);
   std::vector<std::uint8_t> bytes;
-  EXPECT_EQ(cv::norm(kccd::overlay::imageOf(message(grey, "mono8", bytes, 0), false, "test"), grey_bgr, cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(kccd::overlay::imageOf(message(grey, "mono8", bytes, 0), false, "test"), grey_bgr, cv::NORM_INF),
+            0);
   cv::Mat grey16;
   grey.convertTo(grey16, CV_16U, 256.0);
-  EXPECT_EQ(cv::norm(kccd::overlay::imageOf(message(grey16, "mono16", bytes, 0), false, "test"), grey_bgr, cv::NORM_INF), 0);
+  EXPECT_EQ(
+      cv::norm(kccd::overlay::imageOf(message(grey16, "mono16", bytes, 0), false, "test"), grey_bgr, cv::NORM_INF), 0);
   // Data shorter than its rows, an unknown encoding: one line naming the place.
   try {
     Value v = message(bgr, "bgr8", bytes, 0);
@@ -757,11 +802,14 @@ TEST(BagImages, EveryEncodingBecomesTheSameBgrFrame) {
     kccd::overlay::imageOf(v, false, "bag.mcap: byte 7: topic /cam: message 3");
     ADD_FAILURE();
   } catch (const kccd::InputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("bag.mcap: byte 7: topic /cam: message 3: the image's data (10 bytes)", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("bag.mcap: byte 7: topic /cam: message 3: the image's data (10 bytes)", 0),
+              0u)
+        << e.what();
   }
   EXPECT_THROW(kccd::overlay::imageOf(message(bgr, "yuv422", bytes, 0), false, "x"), kccd::InputError);
   // Compressed: PNG and JPEG as OpenCV encodes them.
-  const MessageDefinitions ctypes = MessageDefinitions::parse("sensor_msgs/CompressedImage", "string format\nuint8[] data\n", Dialect::Ros1);
+  const MessageDefinitions ctypes =
+      MessageDefinitions::parse("sensor_msgs/CompressedImage", "string format\nuint8[] data\n", Dialect::Ros1);
   for (const char* ext : {".png", ".jpg"}) {
     std::vector<std::uint8_t> enc;
     cv::imencode(ext, bgr, enc);
@@ -785,18 +833,22 @@ TEST_F(McapFixtures, OverlayOfABagIsTheOverlayOfItsExportedFiles) {
   // Seven revolute joints named as the log names them, each with a capsule; a 64x48 camera 2 m away.
   std::string model = "kccd: 1\nname: seven\nsafety_margin: 0.02\njoints:\n";
   for (int k = 1; k <= 7; ++k)
-    model += "  - {name: joint" + std::to_string(k) + ", parent: " + (k == 1 ? std::string("world") : "joint" + std::to_string(k - 1)) +
-             ", type: revolute, origin: {xyz: [0, 0, " + (k == 1 ? "0" : "0.12") + "]}, axis: [" + (k % 2 ? "0, 0, 1" : "0, 1, 0") +
-             "], limits: [-3, 3]}\n";
+    model += "  - {name: joint" + std::to_string(k) +
+             ", parent: " + (k == 1 ? std::string("world") : "joint" + std::to_string(k - 1)) +
+             ", type: revolute, origin: {xyz: [0, 0, " + (k == 1 ? "0" : "0.12") + "]}, axis: [" +
+             (k % 2 ? "0, 0, 1" : "0, 1, 0") + "], limits: [-3, 3]}\n";
   model += "bodies:\n  - {name: base, frame: world, points: [[0.3, 0, 0], [0.3, 0, 0.5]], radius: 0.05}\n";
   for (int k = 1; k <= 7; ++k)
-    model += "  - {name: link" + std::to_string(k) + ", frame: joint" + std::to_string(k) + ", points: [[0, 0, 0], [0.05, 0, 0.1]], radius: 0.03}\n";
+    model += "  - {name: link" + std::to_string(k) + ", frame: joint" + std::to_string(k) +
+             ", points: [[0, 0, 0], [0.05, 0, 0.1]], radius: 0.03}\n";
   const std::string model_path = kccd::testing::writeScratch("test_logs", "seven.yaml", model);
   const std::string camera_path = camera64("cam64.yaml");
   const std::string base = std::string(KCCD_CLI) + " overlay " + model_path + " --camera " + camera_path + " --quiet";
   auto frames = [&](const fs::path& dir) {
     std::vector<std::string> v;
-    for (int i = 0; i < 10; ++i) v.push_back(readText((dir / ("frame_" + std::string(6 - std::to_string(i).size(), '0') + std::to_string(i) + ".png")).string()));
+    for (int i = 0; i < 10; ++i)
+      v.push_back(readText(
+          (dir / ("frame_" + std::string(6 - std::to_string(i).size(), '0') + std::to_string(i) + ".png")).string()));
     return v;
   };
   auto reportFrames = [&](const fs::path& report) {
@@ -808,14 +860,16 @@ TEST_F(McapFixtures, OverlayOfABagIsTheOverlayOfItsExportedFiles) {
     SCOPED_TRACE(name);
     const fs::path d = out / name;
     fs::create_directories(d);
-    const auto ex = runProgram(std::string(KCCD_CLI) + " bag export " + file(name) + " -q --states " + (d / "s.csv").string() + " --video " +
-                               (d / "v.mkv").string() + " --frame-times " + (d / "t.csv").string());
+    const auto ex =
+        runProgram(std::string(KCCD_CLI) + " bag export " + file(name) + " -q --states " + (d / "s.csv").string() +
+                   " --video " + (d / "v.mkv").string() + " --frame-times " + (d / "t.csv").string());
     ASSERT_EQ(ex.code, 0) << ex.err;
-    const auto files = runProgram(base + " --video " + (d / "v.mkv").string() + " --states " + (d / "s.csv").string() + " --frame-times " +
-                                  (d / "t.csv").string() + " --png-dir " + (d / "files").string() + " --report " + (d / "files.json").string());
+    const auto files = runProgram(base + " --video " + (d / "v.mkv").string() + " --states " + (d / "s.csv").string() +
+                                  " --frame-times " + (d / "t.csv").string() + " --png-dir " + (d / "files").string() +
+                                  " --report " + (d / "files.json").string());
     ASSERT_EQ(files.code, 0) << files.err;
-    const auto direct = runProgram(base + " --bag " + file(name) + " --png-dir " + (d / "bag").string() + " --report " + (d / "bag.json").string() +
-                                   " --timeline " + (d / "timeline.png").string());
+    const auto direct = runProgram(base + " --bag " + file(name) + " --png-dir " + (d / "bag").string() + " --report " +
+                                   (d / "bag.json").string() + " --timeline " + (d / "timeline.png").string());
     ASSERT_EQ(direct.code, 0) << direct.err;
     EXPECT_EQ(direct.err, "");
     const cv::Mat timeline = cv::imread((d / "timeline.png").string());
@@ -831,7 +885,8 @@ TEST_F(McapFixtures, OverlayOfABagIsTheOverlayOfItsExportedFiles) {
   // times it has the first one exactly. Joint 1 moves 0.001 rad per ms: each frame meets states 33 ms
   // later on the log clock.
   const auto header = runProgram(base + " --bag " + file("joint_zstd.mcap") + " --report " + (out / "h.json").string());
-  const auto log = runProgram(base + " --bag " + file("joint_zstd.mcap") + " --time-source log --report " + (out / "l.json").string());
+  const auto log = runProgram(base + " --bag " + file("joint_zstd.mcap") + " --time-source log --report " +
+                              (out / "l.json").string());
   ASSERT_EQ(header.code, 0) << header.err;
   ASSERT_EQ(log.code, 0) << log.err;
   const nlohmann::json h = reportFrames(out / "h.json"), l = reportFrames(out / "l.json");
@@ -844,12 +899,16 @@ TEST_F(McapFixtures, OverlayOfABagIsTheOverlayOfItsExportedFiles) {
   EXPECT_EQ(h.at(0).at("state"), "none");
   EXPECT_EQ(l.at(0).at("state"), "exact");
   EXPECT_EQ(l.at(0).at("state_values").at(0).get<double>(), 0.1);
-  for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(h.at(i).at("time"), l.at(i).at("time")) << i;  // the frames' own times: 1/30 s apart
-  // Joint states cover 200 ms: frames 1-5 have one on both clocks (the stamps' runs out after frame 6, the log's after 5).
+  for (std::size_t i = 0; i < 10; ++i)
+    EXPECT_EQ(h.at(i).at("time"), l.at(i).at("time")) << i;  // the frames' own times: 1/30 s apart
+  // Joint states cover 200 ms: frames 1-5 have one on both clocks (the stamps' runs out after frame 6, the log's after
+  // 5).
   EXPECT_NE(h.at(6).at("state"), "none");
   EXPECT_EQ(l.at(6).at("state"), "none");
   for (std::size_t i = 1; i <= 5; ++i) {
-    EXPECT_NEAR(l.at(i).at("state_values").at(0).get<double>() - h.at(i).at("state_values").at(0).get<double>(), 0.033, 1e-9) << i;
+    EXPECT_NEAR(l.at(i).at("state_values").at(0).get<double>() - h.at(i).at("state_values").at(0).get<double>(), 0.033,
+                1e-9)
+        << i;
   }
   // Mistakes: one line each.
   struct Case {
@@ -861,9 +920,12 @@ TEST_F(McapFixtures, OverlayOfABagIsTheOverlayOfItsExportedFiles) {
   const Case cases[] = {
       {base + " --bag " + file("joint_zstd.mcap") + " --video x.mkv --report r.json", "--video: not with --bag"},
       {base + " --report r.json", "give --video and --states, or --bag"},
-      {std::string(KCCD_CLI) + " overlay " + other + " --camera " + camera_path + " --bag " + file("joint_zstd.mcap") + " --report " + (out / "e.json").string(),
-       "the joint states do not name the model's state value 'elbow' (they name: joint1, joint2, joint3, joint4, joint5, joint6, joint7)"},
-      {base + " --bag " + file("joint_zstd.mcap") + " --image-topic /nope --report " + (out / "e.json").string(), "--image-topic /nope: "},
+      {std::string(KCCD_CLI) + " overlay " + other + " --camera " + camera_path + " --bag " + file("joint_zstd.mcap") +
+           " --report " + (out / "e.json").string(),
+       "the joint states do not name the model's state value 'elbow' (they name: joint1, joint2, joint3, joint4, "
+       "joint5, joint6, joint7)"},
+      {base + " --bag " + file("joint_zstd.mcap") + " --image-topic /nope --report " + (out / "e.json").string(),
+       "--image-topic /nope: "},
   };
   for (const Case& c : cases) {
     const auto r = runProgram(c.args);
@@ -883,8 +945,12 @@ TEST_F(McapFixtures, AJointMapRenamesScalesAndFixesStateValues) {
     std::string model = "kccd: 1\nname: seven\nsafety_margin: 0.02\njoints:\n";
     for (int k = 1; k <= 7; ++k) {
       const std::string name = k == 3 ? j3 : k == 7 ? j7 : "joint" + std::to_string(k);
-      model += "  - {name: " + name + ", parent: " + (k == 1 ? std::string("world") : k == 4 ? j3 : "joint" + std::to_string(k - 1)) +
-               ", type: revolute, origin: {xyz: [0, 0, " + (k == 1 ? "0" : "0.12") + "]}, axis: [0, 0, 1], limits: [-300, 300]}\n";
+      model += "  - {name: " + name + ", parent: " +
+               (k == 1   ? std::string("world")
+                : k == 4 ? j3
+                         : "joint" + std::to_string(k - 1)) +
+               ", type: revolute, origin: {xyz: [0, 0, " + (k == 1 ? "0" : "0.12") +
+               "]}, axis: [0, 0, 1], limits: [-300, 300]}\n";
     }
     model += "bodies:\n  - {name: base, frame: world, points: [[0.3, 0, 0], [0.3, 0, 0.5]], radius: 0.05}\n";
     model += "  - {name: tip, frame: " + j7 + ", points: [[0, 0, 0], [0.05, 0, 0.1]], radius: 0.03}\n";
@@ -902,22 +968,25 @@ TEST_F(McapFixtures, AJointMapRenamesScalesAndFixesStateValues) {
   const std::string bag = file("joint_lz4.mcap");
   auto run = [&](const std::string& model, const std::string& extra, const std::string& tag) {
     const fs::path report = out / (tag + ".json");
-    const auto r = runProgram(std::string(KCCD_CLI) + " overlay " + model + " --camera " + camera + " --bag " + bag + " --report " +
-                              report.string() + " --quiet " + extra);
+    const auto r = runProgram(std::string(KCCD_CLI) + " overlay " + model + " --camera " + camera + " --bag " + bag +
+                              " --report " + report.string() + " --quiet " + extra);
     EXPECT_EQ(r.code, 0) << r.err;
-    return std::make_pair(r, r.code == 0 ? nlohmann::json::parse(readText(report.string())).at("frames") : nlohmann::json());
+    return std::make_pair(
+        r, r.code == 0 ? nlohmann::json::parse(readText(report.string())).at("frames") : nlohmann::json());
   };
   const auto [plain_run, a] = run(plain, "", "plain");
   const auto [mapped_run, b] = run(renamed, "--joint-map " + map, "mapped");
   ASSERT_EQ(a.size(), 10u);
   ASSERT_EQ(b.size(), 10u);
   EXPECT_EQ(plain_run.err, "");
-  EXPECT_NE(mapped_run.err.find("logged joints the model does not read, left out: joint3, joint5\n"), std::string::npos) << mapped_run.err;
+  EXPECT_NE(mapped_run.err.find("logged joints the model does not read, left out: joint3, joint5\n"), std::string::npos)
+      << mapped_run.err;
   int compared = 0;
   for (std::size_t i = 0; i < a.size(); ++i) {
     ASSERT_EQ(a[i].at("state"), b[i].at("state")) << i;
     if (a[i].at("state") == "none") continue;
-    std::vector<double> p = a[i].at("state_values").get<std::vector<double>>(), q = b[i].at("state_values").get<std::vector<double>>();
+    std::vector<double> p = a[i].at("state_values").get<std::vector<double>>(),
+                        q = b[i].at("state_values").get<std::vector<double>>();
     ASSERT_EQ(p.size(), 7u);
     ASSERT_EQ(q.size(), 7u);
     EXPECT_EQ(q[0], p[0]);
@@ -936,27 +1005,30 @@ TEST_F(McapFixtures, AJointMapRenamesScalesAndFixesStateValues) {
   };
   const Case cases[] = {
       {"", "the joint states do not name the model's state value 'rail' (they name: "},
-      {"kccd_joint_map: 1\njoints:\n  wrist: joint7\n  elbow: joint3\n", "map.yaml:4:3: joints.elbow: the model has no state value of that name"},
+      {"kccd_joint_map: 1\njoints:\n  wrist: joint7\n  elbow: joint3\n",
+       "map.yaml:4:3: joints.elbow: the model has no state value of that name"},
       {"kccd_joint_map: 1\njoints:\n  wrist: joint7\n  rail: {from: joint3, constant: 1}\n", "map.yaml:4:"},
-      {"kccd_joint_map: 1\njoints:\n  wrist: joint7\n  rail: {from: joint3, scale: 0}\n", "joints.rail.scale: 0 would ignore the log"},
+      {"kccd_joint_map: 1\njoints:\n  wrist: joint7\n  rail: {from: joint3, scale: 0}\n",
+       "joints.rail.scale: 0 would ignore the log"},
       {"kccd_joint_map: 1\njoints:\n  wrist: joint7\n  rail: {from: joint3, gain: 2}\n", "joints.rail"},
       {"kccd_joint_map: 2\njoints: {}\n", "kccd_joint_map: expected 1"},
       {"kccd_joint_map: 1\njoints:\n  wrist: joint7\n  rail: {from: joint9}\n",
-       "the joint states do not name 'joint9', which " },
+       "the joint states do not name 'joint9', which "},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.map);
     std::string extra;
     if (!c.map.empty()) extra = " --joint-map " + kccd::testing::writeScratch("test_logs", "bad_map.yaml", c.map);
-    const auto r = runProgram(std::string(KCCD_CLI) + " overlay " + renamed + " --camera " + camera + " --bag " + bag + " --report " +
-                              (out / "bad.json").string() + extra);
+    const auto r = runProgram(std::string(KCCD_CLI) + " overlay " + renamed + " --camera " + camera + " --bag " + bag +
+                              " --report " + (out / "bad.json").string() + extra);
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_FALSE(fs::exists(out / "bad.json"));
   }
-  const auto no_bag = runProgram(std::string(KCCD_CLI) + " overlay " + plain + " --camera " + camera + " --video v.mkv --states s.csv --joint-map " + map +
-                                 " --report " + (out / "bad.json").string());
+  const auto no_bag =
+      runProgram(std::string(KCCD_CLI) + " overlay " + plain + " --camera " + camera +
+                 " --video v.mkv --states s.csv --joint-map " + map + " --report " + (out / "bad.json").string());
   EXPECT_EQ(no_bag.code, 2);
   EXPECT_NE(no_bag.err.find("--joint-map: goes with --bag"), std::string::npos) << no_bag.err;
 }
@@ -972,29 +1044,40 @@ TEST_F(McapFixtures, AGoldenCaseOnABagFrameIsTheOverlaysFrame) {
       "test_logs", "golden_seven.yaml",
       "kccd: 1\nname: seven\nsafety_margin: 0.02\njoints:\n"
       "  - {name: joint1, parent: world, type: revolute, axis: [0, 0, 1], limits: [-3, 3]}\n"
-      "  - {name: joint2, parent: joint1, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 1, 0], limits: [-3, 3]}\n"
-      "  - {name: joint3, parent: joint2, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 0, 1], limits: [-3, 3]}\n"
-      "  - {name: joint4, parent: joint3, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 1, 0], limits: [-3, 3]}\n"
-      "  - {name: joint5, parent: joint4, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 0, 1], limits: [-3, 3]}\n"
-      "  - {name: joint6, parent: joint5, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 1, 0], limits: [-3, 3]}\n"
-      "  - {name: joint7, parent: joint6, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 0, 1], limits: [-3, 3]}\n"
+      "  - {name: joint2, parent: joint1, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 1, 0], limits: [-3, "
+      "3]}\n"
+      "  - {name: joint3, parent: joint2, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 0, 1], limits: [-3, "
+      "3]}\n"
+      "  - {name: joint4, parent: joint3, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 1, 0], limits: [-3, "
+      "3]}\n"
+      "  - {name: joint5, parent: joint4, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 0, 1], limits: [-3, "
+      "3]}\n"
+      "  - {name: joint6, parent: joint5, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 1, 0], limits: [-3, "
+      "3]}\n"
+      "  - {name: joint7, parent: joint6, type: revolute, origin: {xyz: [0, 0, 0.12]}, axis: [0, 0, 1], limits: [-3, "
+      "3]}\n"
       "bodies:\n  - {name: base, frame: world, points: [[0.3, 0, 0], [0.3, 0, 0.5]], radius: 0.05}\n"
       "  - {name: arm, frame: joint4, points: [[0, 0, 0], [0.3, 0, 0.1]], radius: 0.04}\n");
   const std::string camera = camera64("golden_cam.yaml");
   const std::string manifest = (out / "manifest.yaml").string();
-  std::ofstream(manifest) << "kccd_golden: 1\ndefaults: {model: " << model << ", camera: " << camera << ", bag: " << file("joint_zstd.mcap")
-                          << ", outputs: [mask, overlay]}\ncases:\n  - {id: mcap-f2, frame: 2}\n  - {id: mcap-f5, frame: 5}\n"
-                          << "  - {id: db3-f5, frame: 5, bag: " << file("jazzy.db3") << "}\n  - {id: ros1-f5, frame: 5, bag: " << file("ros1_bz2.bag")
-                          << "}\n";
+  std::ofstream(manifest)
+      << "kccd_golden: 1\ndefaults: {model: " << model << ", camera: " << camera << ", bag: " << file("joint_zstd.mcap")
+      << ", outputs: [mask, overlay]}\ncases:\n  - {id: mcap-f2, frame: 2}\n  - {id: mcap-f5, frame: 5}\n"
+      << "  - {id: db3-f5, frame: 5, bag: " << file("jazzy.db3")
+      << "}\n  - {id: ros1-f5, frame: 5, bag: " << file("ros1_bz2.bag") << "}\n";
   const auto update = runProgram(std::string(KCCD_CLI) + " golden update " + manifest + " -q");
   ASSERT_EQ(update.code, 0) << update.err;
-  const auto run = runProgram(std::string(KCCD_CLI) + " golden run " + manifest + " --out " + (out / "results").string() + " -q");
+  const auto run =
+      runProgram(std::string(KCCD_CLI) + " golden run " + manifest + " --out " + (out / "results").string() + " -q");
   EXPECT_EQ(run.code, 0) << run.out << run.err;
-  const auto overlay = runProgram(std::string(KCCD_CLI) + " overlay " + model + " --camera " + camera + " --bag " + file("joint_zstd.mcap") +
-                                  " --png-dir " + (out / "overlay").string() + " -q");
+  const auto overlay = runProgram(std::string(KCCD_CLI) + " overlay " + model + " --camera " + camera + " --bag " +
+                                  file("joint_zstd.mcap") + " --png-dir " + (out / "overlay").string() + " -q");
   ASSERT_EQ(overlay.code, 0) << overlay.err;
-  auto same = [](const cv::Mat& a, const cv::Mat& b) { return a.size() == b.size() && cv::norm(a, b, cv::NORM_INF) == 0; };
-  const cv::Mat drawn2 = cv::imread((out / "overlay" / "frame_000002.png").string()), drawn5 = cv::imread((out / "overlay" / "frame_000005.png").string());
+  auto same = [](const cv::Mat& a, const cv::Mat& b) {
+    return a.size() == b.size() && cv::norm(a, b, cv::NORM_INF) == 0;
+  };
+  const cv::Mat drawn2 = cv::imread((out / "overlay" / "frame_000002.png").string()),
+                drawn5 = cv::imread((out / "overlay" / "frame_000005.png").string());
   ASSERT_FALSE(drawn5.empty());
   EXPECT_TRUE(same(cv::imread((out / "goldens" / "mcap-f2" / "overlay.png").string()), drawn2));
   for (const char* id : {"mcap-f5", "db3-f5", "ros1-f5"}) {
@@ -1002,20 +1085,26 @@ TEST_F(McapFixtures, AGoldenCaseOnABagFrameIsTheOverlaysFrame) {
     EXPECT_TRUE(same(cv::imread((out / "goldens" / id / "overlay.png").string()), drawn5));
   }
   EXPECT_FALSE(same(drawn2, drawn5));  // another frame, another state: the comparison can fail
-  const nlohmann::json g = nlohmann::json::parse(readText((out / "goldens" / "mcap-f5" / "golden.json").string())).at("inputs").at("bag");
+  const nlohmann::json g =
+      nlohmann::json::parse(readText((out / "goldens" / "mcap-f5" / "golden.json").string())).at("inputs").at("bag");
   EXPECT_EQ(g.at("frame"), 5);
   EXPECT_EQ(g.at("image_topic"), "/camera/image_raw");
   EXPECT_EQ(g.at("joint_topic"), "/joint_states");
   EXPECT_EQ(g.at("time_source"), "header");
   // Mistakes: a frame the bag does not have; a bag and a video in one case.
-  std::ofstream(manifest) << "kccd_golden: 1\ndefaults: {model: " << model << ", camera: " << camera << ", bag: " << file("joint_zstd.mcap")
-                          << "}\ncases:\n  - {id: far, frame: 10}\n";
-  const auto far = runProgram(std::string(KCCD_CLI) + " golden run " + manifest + " --out " + (out / "r2").string() + " -q");
+  std::ofstream(manifest) << "kccd_golden: 1\ndefaults: {model: " << model << ", camera: " << camera
+                          << ", bag: " << file("joint_zstd.mcap") << "}\ncases:\n  - {id: far, frame: 10}\n";
+  const auto far =
+      runProgram(std::string(KCCD_CLI) + " golden run " + manifest + " --out " + (out / "r2").string() + " -q");
   EXPECT_EQ(far.code, 2);
-  EXPECT_NE(far.err.find("case 'far'.frame: 10: " + file("joint_zstd.mcap") + " has 10 images on /camera/image_raw"), std::string::npos) << far.err;
-  std::ofstream(manifest) << "kccd_golden: 1\ndefaults: {model: " << model << ", camera: " << camera << "}\ncases:\n  - {id: both, frame: 1, bag: "
-                          << file("joint_zstd.mcap") << ", video: v.mkv, states: s.csv}\n";
-  const auto both = runProgram(std::string(KCCD_CLI) + " golden run " + manifest + " --out " + (out / "r3").string() + " -q");
+  EXPECT_NE(far.err.find("case 'far'.frame: 10: " + file("joint_zstd.mcap") + " has 10 images on /camera/image_raw"),
+            std::string::npos)
+      << far.err;
+  std::ofstream(manifest) << "kccd_golden: 1\ndefaults: {model: " << model << ", camera: " << camera
+                          << "}\ncases:\n  - {id: both, frame: 1, bag: " << file("joint_zstd.mcap")
+                          << ", video: v.mkv, states: s.csv}\n";
+  const auto both =
+      runProgram(std::string(KCCD_CLI) + " golden run " + manifest + " --out " + (out / "r3").string() + " -q");
   EXPECT_EQ(both.code, 2);
   EXPECT_NE(both.err.find("manifest.yaml:4:"), std::string::npos) << both.err;
   EXPECT_NE(both.err.find("give video and states, or bag, not both"), std::string::npos) << both.err;

@@ -79,8 +79,9 @@ TEST(RenderMask, MatchesIndependentCpuSilhouette) {
     EXPECT_LE(boundary, 0.02 * cv::countNonZero(ref));
     worst_boundary = std::max(worst_boundary, static_cast<double>(boundary) / cv::countNonZero(ref));
   }
-  std::cout << "mask vs CPU silhouette: worst IoU " << worst_iou << ", CPU pixels outside the mask (all within 1 px): at most "
-            << 100.0 * worst_boundary << "% of the silhouette\n";
+  std::cout << "mask vs CPU silhouette: worst IoU " << worst_iou
+            << ", CPU pixels outside the mask (all within 1 px): at most " << 100.0 * worst_boundary
+            << "% of the silhouette\n";
 }
 
 // Every mask pixel that disagrees with the independent silhouette at its centre lies within the
@@ -165,8 +166,10 @@ TEST(RenderMask, NearestBodyWinsAndLabelsAreIndexPlusOne) {
 // shaded look, multisampling): the same masks either way, in any order of frames.
 TEST(RenderMask, SameLabelsFromTheColourPassAndAlone) {
   const Camera c = lookAt(Vec3(1.5, -1.0, 1.0), Vec3(0, 0, 0), 200, 150, 180, {-0.1, 0.01, 0, 0, 0});
-  const std::vector<Vec3> a = {Vec3(-0.2, 0, 0), Vec3(0.2, 0.1, 0)}, b = {Vec3(0.1, 0.1, 0.1)}, d = {Vec3(0, -0.3, 0.2)};
-  const Volume v[] = {{a, 0.15, SafetyStatus::Clear, "a"}, {b, 0.2, SafetyStatus::Colliding, "b"},
+  const std::vector<Vec3> a = {Vec3(-0.2, 0, 0), Vec3(0.2, 0.1, 0)}, b = {Vec3(0.1, 0.1, 0.1)},
+                          d = {Vec3(0, -0.3, 0.2)};
+  const Volume v[] = {{a, 0.15, SafetyStatus::Clear, "a"},
+                      {b, 0.2, SafetyStatus::Colliding, "b"},
                       {d, 0.1, SafetyStatus::WithinMargin, "d"}};
   Renderer plain(c);
   Renderer msaa(c, RenderOptions{.msaa_samples = 4});
@@ -198,7 +201,7 @@ TEST(RenderMask, LabelsDoNotDependOnTheNearPlane) {
   const Camera c = lookAt(Vec3(3, 0, 0), Vec3(0, 0, 0), 320, 240, 300, {0, 0, 0, 0, 0});
   const std::vector<Vec3> a = {Vec3(0, -0.5, 0), Vec3(0, 0.5, 0)};
   const std::vector<Vec3> b = {Vec3(0.0002, -0.5, 0.002), Vec3(0.0002, 0.5, -0.002)};  // crossing a at 0.2 mm
-  const std::vector<Vec3> close = {Vec3(3 - 0.0005, 0.0025, 0)};  // 0.5 mm in front, 2.5 mm aside
+  const std::vector<Vec3> close = {Vec3(3 - 0.0005, 0.0025, 0)};                       // 0.5 mm in front, 2.5 mm aside
   const Volume pair[] = {{a, 0.1, SafetyStatus::Clear, "a"}, {b, 0.1, SafetyStatus::Colliding, "b"}};
   const Volume with_close[] = {pair[0], pair[1], {close, 0.001, SafetyStatus::Clear, "close"}};
   Renderer r(c);
@@ -257,7 +260,8 @@ TEST(RenderMask, SurfacesDrawBothSidesWithTheirOwnLabels) {
   std::vector<Vec3> corners, soup;
   for (int i = 0; i < 8; ++i) corners.emplace_back(i & 1 ? 0.2 : -0.2, i & 2 ? 0.2 : -0.2, i & 4 ? 0.2 : -0.2);
   const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& f : faces) soup.insert(soup.end(), {corners[f[0]], corners[f[1]], corners[f[2]], corners[f[0]], corners[f[2]], corners[f[3]]});
+  for (const auto& f : faces)
+    soup.insert(soup.end(), {corners[f[0]], corners[f[1]], corners[f[2]], corners[f[0]], corners[f[2]], corners[f[3]]});
   const auto box = std::make_shared<const Mesh>(surfaceMesh(soup));
   EXPECT_EQ(box->vertices.size(), 24u);  // each corner once per face: the creases stay sharp
   EXPECT_EQ(box->triangles.size(), 12u);
@@ -318,7 +322,7 @@ TEST(RenderMask, DegenerateVolumesAreVisible) {
                       {point, 0.05, SafetyStatus::Clear, ""}};
   const Frame f = r.render(v, Style{}, true, true);
   EXPECT_GT(f.pixels[0], 500);  // a flat square seen at an angle
-  EXPECT_GT(f.pixels[2], 20);    // a ball
+  EXPECT_GT(f.pixels[2], 20);   // a ball
   EXPECT_GT(f.pixels[1], 0);    // a radius-0 segment, drawn 1 mm thick
   EXPECT_GT(cv::countNonZero(f.mask), 500);
 }
@@ -330,8 +334,10 @@ TEST(RenderMask, VolumesThatCannotBeDrawnAreReported) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::vector<Vec3> behind = {Vec3(5, 0, 0)}, far = {Vec3(-2e7, 0, 0)}, bad = {Vec3(nan, 0, 0)},
                           distant = {Vec3(-500, 0, 0)}, off_axis = {Vec3(1.9999, -1e5, 0)};
-  const Volume v[] = {{behind, 0.5, SafetyStatus::Clear, "behind"},  {far, 1e3, SafetyStatus::Clear, "far"},
-                      {bad, 0.1, SafetyStatus::Clear, "bad"},        {distant, 30, SafetyStatus::Clear, "distant"},
+  const Volume v[] = {{behind, 0.5, SafetyStatus::Clear, "behind"},
+                      {far, 1e3, SafetyStatus::Clear, "far"},
+                      {bad, 0.1, SafetyStatus::Clear, "bad"},
+                      {distant, 30, SafetyStatus::Clear, "distant"},
                       {off_axis, 0.01, SafetyStatus::Clear, "off axis"}};
   const Frame f = r.render(v, Style{.labels = true}, true, true);
   EXPECT_EQ(f.visibility[0], Visibility::BehindCamera);
@@ -360,7 +366,8 @@ TEST(RenderMask, VolumesThatCannotBeDrawnAreReported) {
   EXPECT_EQ(g.pixels[1], c.width * c.height);
   EXPECT_EQ(cv::countNonZero(g.mask == 2), c.width * c.height);
   EXPECT_NEAR(g.bgra.at<cv::Vec4b>(0, 0)[3], 0.35 * 255, 2);
-  EXPECT_GT(g.bgra.at<cv::Vec4b>(c.height / 2, c.width / 2)[3], g.bgra.at<cv::Vec4b>(0, 0)[3]);  // the ball shows through
+  EXPECT_GT(g.bgra.at<cv::Vec4b>(c.height / 2, c.width / 2)[3],
+            g.bgra.at<cv::Vec4b>(0, 0)[3]);  // the ball shows through
 }
 
 TEST(RenderContext, ReportsItsRenderer) {
@@ -370,8 +377,8 @@ TEST(RenderContext, ReportsItsRenderer) {
   const char* chosen = std::getenv("KCCD_GL");
   // Unset: EGL when this build has it (OSMesa only when EGL gives no context; not on CI machines).
   const GlBackend expected = chosen != nullptr && std::string(chosen) == "osmesa" ? GlBackend::OsMesa
-                             : chosen == nullptr && !compiledIn(GlBackend::Egl) ? GlBackend::OsMesa
-                                                                                 : GlBackend::Egl;
+                             : chosen == nullptr && !compiledIn(GlBackend::Egl)   ? GlBackend::OsMesa
+                                                                                  : GlBackend::Egl;
   EXPECT_EQ(ctx->backend(), expected) << toString(ctx->backend());
   EXPECT_NE(ctx->renderer().find(expected == GlBackend::Egl ? "EGL" : "OSMesa"), std::string::npos);
 }
@@ -386,7 +393,10 @@ TEST(RenderContext, UnknownOrMissingBackendIsAOneLineError) {
   } catch (const GlContextError& e) {
     EXPECT_EQ(std::string(e.what()), "KCCD_GL=vulkan: unknown GL back end (use egl or osmesa)");
   }
-  if (saved == nullptr) ::unsetenv("KCCD_GL"); else ::setenv("KCCD_GL", restore.c_str(), 1);
+  if (saved == nullptr)
+    ::unsetenv("KCCD_GL");
+  else
+    ::setenv("KCCD_GL", restore.c_str(), 1);
   for (const GlBackend b : {GlBackend::Egl, GlBackend::OsMesa}) {
     if (compiledIn(b)) {
       EXPECT_EQ(GlContext::make(b)->backend(), b);

@@ -27,8 +27,8 @@ namespace {
 using namespace kccd;
 using namespace kccd::calib;
 using kccd::testing::cameraCentre;
-using kccd::testing::rotationErrorDeg;
 using kccd::testing::perturbed;
+using kccd::testing::rotationErrorDeg;
 
 const std::string kData = KCCD_DATA_DIR;
 const std::vector<int> kRobot = {0, 3, 4, 5, 6};  // demo_arm: pedestal, shoulder, upper arm, forearm, gripper
@@ -36,7 +36,8 @@ const std::vector<int> kRobot = {0, 3, 4, 5, 6};  // demo_arm: pedestal, shoulde
 // The true mask of the robot's bodies at `state`, by the independent rasteriser.
 cv::Mat trueMask(const Model& model, const Camera& cam, const std::vector<double>& state) {
   cv::Mat mask = cv::Mat::zeros(cam.height, cam.width, CV_8UC1);
-  for (const PlacedVolume& v : placeVolumes(model, state, kRobot)) mask |= kccd::testing::cpuSilhouette(cam, v.points, v.radius);
+  for (const PlacedVolume& v : placeVolumes(model, state, kRobot))
+    mask |= kccd::testing::cpuSilhouette(cam, v.points, v.radius);
   return mask * 255;
 }
 
@@ -46,7 +47,8 @@ struct Scene {
   std::vector<std::vector<double>> states;
   std::vector<cv::Mat> masks;
   Scene(int frames, std::uint64_t seed) {
-    truth = kccd::testing::lookAt(Vec3(1.25, -0.95, 0.9), Vec3(0.2, 0.0, 0.35), 640, 360, 520.0, {-0.08, 0.03, 0.0005, -0.0003, 0.0});
+    truth = kccd::testing::lookAt(Vec3(1.25, -0.95, 0.9), Vec3(0.2, 0.0, 0.35), 640, 360, 520.0,
+                                  {-0.08, 0.03, 0.0005, -0.0003, 0.0});
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     for (int f = 0; f < frames; ++f) {
@@ -74,8 +76,8 @@ TEST(MaskRefine, ConvergesFromTenDegreesAndTenCentimetres) {
     EXPECT_LT(rot, 0.1) << r.message;
     EXPECT_LT(pos, 0.003) << r.message;
     for (const FrameAgreement& a : r.frames) EXPECT_GT(a.iou_after, 0.97);
-    std::printf("start %d: %.3f deg, %.2f mm from the truth (sigma %.3f deg, %.2f mm), %d iterations\n", s, rot, pos * 1e3,
-                *r.camera.rotation_sigma_deg, *r.camera.position_sigma_m * 1e3, r.iterations);
+    std::printf("start %d: %.3f deg, %.2f mm from the truth (sigma %.3f deg, %.2f mm), %d iterations\n", s, rot,
+                pos * 1e3, *r.camera.rotation_sigma_deg, *r.camera.position_sigma_m * 1e3, r.iterations);
   }
 }
 
@@ -88,22 +90,39 @@ TEST(MaskRefine, DamagedMasksStillConverge) {
     std::function<cv::Mat(const cv::Mat&, std::size_t)> damage;
     double max_deg, max_m;
   } cases[] = {
-      {"eroded 3 px", [&](const cv::Mat& m, std::size_t) { cv::Mat o; cv::erode(m, o, k3); return o; }, 2.0, 0.15},
-      {"dilated 3 px", [&](const cv::Mat& m, std::size_t) { cv::Mat o; cv::dilate(m, o, k3); return o; }, 2.0, 0.15},
-      {"holes", [&](const cv::Mat& m, std::size_t f) {
+      {"eroded 3 px",
+       [&](const cv::Mat& m, std::size_t) {
+         cv::Mat o;
+         cv::erode(m, o, k3);
+         return o;
+       },
+       2.0, 0.15},
+      {"dilated 3 px",
+       [&](const cv::Mat& m, std::size_t) {
+         cv::Mat o;
+         cv::dilate(m, o, k3);
+         return o;
+       },
+       2.0, 0.15},
+      {"holes",
+       [&](const cv::Mat& m, std::size_t f) {
          cv::Mat o = m.clone();
          std::mt19937 r(static_cast<unsigned>(f));
          std::vector<cv::Point> in;
          cv::findNonZero(m, in);
          for (int k = 0; k < 8 && !in.empty(); ++k) cv::circle(o, in[r() % in.size()], 4, cv::Scalar(0), cv::FILLED);
          return o;
-       }, 0.2, 0.005},
-      {"a blob beside the robot", [&](const cv::Mat& m, std::size_t) {
+       },
+       0.2, 0.005},
+      {"a blob beside the robot",
+       [&](const cv::Mat& m, std::size_t) {
          cv::Mat o = m.clone();
          cv::circle(o, cv::Point(40, 300), 25, cv::Scalar(255), cv::FILLED);
          return o;
-       }, 0.2, 0.005},
-      {"an occluding box", [&](const cv::Mat& m, std::size_t f) {
+       },
+       0.2, 0.005},
+      {"an occluding box",
+       [&](const cv::Mat& m, std::size_t f) {
          cv::Mat o = m.clone();
          cv::Rect box;
          std::vector<cv::Point> in;
@@ -112,7 +131,8 @@ TEST(MaskRefine, DamagedMasksStillConverge) {
          box = cv::Rect(bb.x + bb.width / 3, bb.y + (f % 2 ? 0 : bb.height / 2), bb.width / 4, bb.height / 2);
          o(box & cv::Rect(0, 0, o.cols, o.rows)).setTo(0);
          return o;
-       }, 0.5, 0.01},
+       },
+       0.5, 0.01},
   };
   for (const auto& c : cases) {
     std::vector<cv::Mat> damaged;
@@ -137,7 +157,8 @@ TEST(MaskRefine, NoNearbyPoseAgreesBetterByAnIndependentRasteriser) {
   ASSERT_TRUE(r.improved) << r.message;
   auto score = [&](const Camera& c) {
     double iou = 0;
-    for (std::size_t f = 0; f < scene.states.size(); ++f) iou += maskIou(trueMask(scene.model, c, scene.states[f]), scene.masks[f]);
+    for (std::size_t f = 0; f < scene.states.size(); ++f)
+      iou += maskIou(trueMask(scene.model, c, scene.states[f]), scene.masks[f]);
     return iou / static_cast<double>(scene.states.size());
   };
   const double best = score(r.camera);

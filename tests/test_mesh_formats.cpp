@@ -62,7 +62,8 @@ std::string daeBox(const Vec3& size, double meter, const std::string& up, const 
   s.precision(17);
   s << R"(<?xml version="1.0" encoding="utf-8"?>
 <COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
-  <asset><unit name="unit" meter=")" << meter << R"("/><up_axis>)" << up << R"(</up_axis></asset>
+  <asset><unit name="unit" meter=")"
+    << meter << R"("/><up_axis>)" << up << R"(</up_axis></asset>
   <library_geometries>
     <geometry id="box-mesh" name="box">
       <mesh>
@@ -83,7 +84,8 @@ std::string daeBox(const Vec3& size, double meter, const std::string& up, const 
   </library_geometries>
   <library_visual_scenes>
     <visual_scene id="Scene" name="Scene">
-      <node id="box" name="box"><translate>)" << translate.x() << " " << translate.y() << " " << translate.z()
+      <node id="box" name="box"><translate>)"
+    << translate.x() << " " << translate.y() << " " << translate.z()
     << R"(</translate><instance_geometry url="#box-mesh"/></node>
     </visual_scene>
   </library_visual_scenes>
@@ -121,10 +123,10 @@ std::string glbBox(const Vec3& size, const Vec3& translation) {
   j << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0,"translation":[)"
     << translation.x() << "," << translation.y() << "," << translation.z()
     << R"(]}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],"buffers":[{"byteLength":)"
-    << bin.size() << R"(}],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":96},{"buffer":0,"byteOffset":96,"byteLength":144}],)"
+    << bin.size()
+    << R"(}],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":96},{"buffer":0,"byteOffset":96,"byteLength":144}],)"
     << R"("accessors":[{"bufferView":0,"componentType":5126,"count":8,"type":"VEC3","min":[0,0,0],"max":[)" << size.x()
-    << "," << size.y() << "," << size.z()
-    << R"(]},{"bufferView":1,"componentType":5125,"count":36,"type":"SCALAR"}]})";
+    << "," << size.y() << "," << size.z() << R"(]},{"bufferView":1,"componentType":5125,"count":36,"type":"SCALAR"}]})";
   std::string json = j.str();
   while (json.size() % 4) json += ' ';
   while (bin.size() % 4) bin += '\0';
@@ -171,7 +173,8 @@ void expectExactly(const km::Part& part, const std::vector<Vec3>& expected) {
     EXPECT_LT(best, 1e-6 * (1.0 + expected[at].norm())) << p.transpose();
     seen[at] = true;
   }
-  for (std::size_t k = 0; k < expected.size(); ++k) EXPECT_TRUE(seen[k]) << "corner " << expected[k].transpose() << " not read";
+  for (std::size_t k = 0; k < expected.size(); ++k)
+    EXPECT_TRUE(seen[k]) << "corner " << expected[k].transpose() << " not read";
 }
 
 // The fitted SSCH contains every expected point (independent point-to-hull distance).
@@ -243,8 +246,8 @@ TEST(MeshFormats, UrdfScaleAppliesAfterTheFileTransforms) {
 }
 
 TEST(MeshFormats, SeveralObjectsArePartsToPickOrMerge) {
-  const std::string two =
-      write("two.obj", objBox(Vec3(1, 1, 1), "left") + objFaces(1) + objBox(Vec3(0.5, 0.5, 0.5), "right") + objFaces(9));
+  const std::string two = write(
+      "two.obj", objBox(Vec3(1, 1, 1), "left") + objFaces(1) + objBox(Vec3(0.5, 0.5, 0.5), "right") + objFaces(9));
   const std::string e = errorOf(two);
   EXPECT_EQ(e.rfind(two + ": holds 2 top-level parts", 0), 0u) << e;
   EXPECT_NE(e.find("'left'"), std::string::npos) << e;
@@ -265,8 +268,9 @@ TEST(MeshFormats, BadMeshesAreOneLineErrorsNamingTheFile) {
       {"garbage.glb", std::string("glTF\x02\0\0\0\xff\xff\xff\x7f", 12)},
       {"garbage.ply", "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n"},
       {"nan.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"},
-      {"inf.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                  "element face 1\nproperty list uchar int vertex_indices\nend_header\n1e39 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
+      {"inf.ply",
+       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+       "element face 1\nproperty list uchar int vertex_indices\nend_header\n1e39 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
       {"index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"},
       // Assimp's PLY reader never returns on this header (found by fuzz_part): refused before it.
       {"element_without_count.ply", "ply\nformat ascii 1.0\nelement 0\n0.3 0.2 0\n3 0 2 6\n"},
@@ -306,7 +310,8 @@ TEST(MeshFormats, UrdfMixingEveryFormatImports) {
   urdf << "<robot name=\"mix\">\n  <material name=\"orange\"><color rgba=\"1 0.5 0 1\"/></material>\n"
        << "  <link name=\"base\"><collision><geometry><mesh filename=\"mix_box.obj\"/></geometry></collision>"
        << "<visual><origin xyz=\"0 0 0.01\"/><geometry><mesh filename=\"mix_box.dae\" scale=\"2 2 2\"/></geometry>"
-       << "<material name=\"orange\"/></visual><visual><geometry><cylinder radius=\"0.1\" length=\"0.3\"/></geometry></visual>"
+       << "<material name=\"orange\"/></visual><visual><geometry><cylinder radius=\"0.1\" "
+          "length=\"0.3\"/></geometry></visual>"
        << "</link>\n";
   const char* files[] = {"mix_box.ply", "mix_box.stl", "mix_box.glb", "mix_box.dae"};
   std::string parent = "base";
@@ -315,7 +320,8 @@ TEST(MeshFormats, UrdfMixingEveryFormatImports) {
     urdf << "  <link name=\"" << link << "\"><collision><geometry><mesh filename=\"" << files[i]
          << "\" scale=\"2 2 2\"/></geometry></collision></link>\n"
          << "  <joint name=\"j" << i << "\" type=\"revolute\"><parent link=\"" << parent << "\"/><child link=\"" << link
-         << "\"/><origin xyz=\"0 0 0.3\"/><axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>\n";
+         << "\"/><origin xyz=\"0 0 0.3\"/><axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
+            "velocity=\"1\"/></joint>\n";
     parent = link;
   }
   urdf << "</robot>\n";

@@ -103,20 +103,26 @@ struct BadCase {
 
 TEST(Model, EveryMistakeGetsOneClearMessage) {
   const std::vector<BadCase> cases = {
-      {"unknown joint type", edit("type: prismatic", "type: prismatik"),
+      {"unknown joint type",
+       edit("type: prismatic", "type: prismatik"),
        {"cell.yaml:14:", "joint 'slide'.type", "unknown joint type 'prismatik'"}},
-      {"parent not yet defined", edit("parent: base", "parent: later"),
+      {"parent not yet defined",
+       edit("parent: base", "parent: later"),
        {"cell.yaml:13:", "joint 'slide'.parent", "'later' is not a joint defined earlier"}},
       {"duplicate joint", edit("name: slide", "name: base"), {"cell.yaml:12:", "duplicate joint name 'base'"}},
       {"duplicate body", edit("name: tool", "name: arm"), {"cell.yaml:", "duplicate body name 'arm'"}},
-      {"wrong vector length", edit("axis: [1, 0, 0]", "axis: [1, 0]"),
+      {"wrong vector length",
+       edit("axis: [1, 0, 0]", "axis: [1, 0]"),
        {"cell.yaml:15:", "joint 'slide'.axis", "expected 3 numbers, got 2"}},
       {"zero axis", edit("axis: [1, 0, 0]", "axis: [0, 0, 0]"), {"cell.yaml:15:", "zero axis"}},
-      {"negative radius", edit("radius: 0.05", "radius: -0.05"),
+      {"negative radius",
+       edit("radius: 0.05", "radius: -0.05"),
        {"cell.yaml:32:", "body 'arm'.radius", "negative radius"}},
-      {"empty point list", edit("points: [[0, 0, 0], [1, 0, 0]]", "points: []"),
+      {"empty point list",
+       edit("points: [[0, 0, 0], [1, 0, 0]]", "points: []"),
        {"cell.yaml:31:", "body 'arm'.points", "empty point list"}},
-      {"unknown body in pairs", edit("ignore: [[arm, tool]]", "ignore: [[arm, tol]]"),
+      {"unknown body in pairs",
+       edit("ignore: [[arm, tool]]", "ignore: [[arm, tol]]"),
        {"cell.yaml:42:", "pairs.ignore[0]", "unknown body 'tol'"}},
       {"unknown frame", edit("frame: slide", "frame: slider"), {"body 'tool'.frame", "unknown joint 'slider'"}},
       {"not a number", edit("radius: 0.1", "radius: big"), {"cell.yaml:28:", "expected a number, got 'big'"}},
@@ -132,30 +138,40 @@ TEST(Model, EveryMistakeGetsOneClearMessage) {
       {"YAML syntax", edit("name: t", "name: [t"), {"cell.yaml:", "YAML syntax error"}},
       {"world as joint name", edit("name: slide", "name: world"), {"'world' is reserved"}},
       {"pair with itself", edit("ignore: [[arm, tool]]", "ignore: [[arm, arm]]"), {"a body paired with itself"}},
-      {"negative tolerance", edit("    radius: 0.05\n", "    radius: 0.05\n    tolerance: -0.001\n"),
+      {"negative tolerance",
+       edit("    radius: 0.05\n", "    radius: 0.05\n    tolerance: -0.001\n"),
        {"cell.yaml:33:", "body 'arm'.tolerance", "must be >= 0"}},
       {"pieces of a link in two frames",
        edit("    radius: 0.05\n  - name: tool\n", "    radius: 0.05\n    link: limb\n  - name: tool\n    link: limb\n"),
        {"body 'tool'.link", "piece of link 'limb' in frame 'slide'", "body 'arm' of that link is in frame 'base'"}},
-      {"a link named like a whole body", edit("    radius: 0.05\n", "    radius: 0.05\n    link: floor\n"),
+      {"a link named like a whole body",
+       edit("    radius: 0.05\n", "    radius: 0.05\n    link: floor\n"),
        {"cell.yaml:33:", "body 'arm'.link", "link 'floor' is also a whole body's name"}},
-      {"empty link name", edit("    radius: 0.05\n", "    radius: 0.05\n    link: \"\"\n"), {"cell.yaml:33:", "body 'arm'.link", "must not be empty"}},
+      {"empty link name",
+       edit("    radius: 0.05\n", "    radius: 0.05\n    link: \"\"\n"),
+       {"cell.yaml:33:", "body 'arm'.link", "must not be empty"}},
       {"same-frame include", edit("ignore: [[arm, tool]]", "include: [[floor, floor]]"), {"a body paired with itself"}},
       {"bad check", edit("ignore: [[arm, tool]]", "check: some"), {"pairs.check", "expected 'all' or 'none'"}},
       // The model used must be the model written: YAML's rules, not the first value that fits.
-      {"duplicate key", edit("    radius: 0.1\n", "    radius: 0.1\n    radius: 0.9\n"),
+      {"duplicate key",
+       edit("    radius: 0.1\n", "    radius: 0.1\n    radius: 0.9\n"),
        {"cell.yaml:29:", "bodies[0].radius", "duplicate key 'radius'"}},
-      {"duplicate key, flow style", edit("{xyz: [0, 0, 0.5],", "{xyz: [0, 0, 0.5], xyz: [1, 1, 1],"),
+      {"duplicate key, flow style",
+       edit("{xyz: [0, 0, 0.5],", "{xyz: [0, 0, 0.5], xyz: [1, 1, 1],"),
        {"cell.yaml:8:32", "joints[0].origin.xyz", "duplicate key 'xyz'"}},
       {"duplicate version", edit("kccd: 1\n", "kccd: 1\nkccd: 2\n"), {"cell.yaml:2:1", "duplicate key 'kccd'"}},
       {"second bodies block", kGood + "bodies: []\n", {"cell.yaml:", "duplicate key 'bodies'"}},
       {"second document", kGood + "---\nkccd: 1\n", {"cell.yaml:", "a second YAML document"}},
       {"text after the end marker", kGood + "...\nradius: 3\n", {"cell.yaml:", "a second YAML document"}},
-      {"deep nesting", edit("points: [[0, 0, 0]]", "points: " + std::string(100, '[') + std::string(100, ']')),
+      {"deep nesting",
+       edit("points: [[0, 0, 0]]", "points: " + std::string(100, '[') + std::string(100, ']')),
        {"cell.yaml:", "nested deeper than 64 levels"}},
-      {"a list as a key", edit("name: t\n", "? [a, b]\n: t\n"), {"cell.yaml:2:", "a mapping key must be a plain value"}},
+      {"a list as a key",
+       edit("name: t\n", "? [a, b]\n: t\n"),
+       {"cell.yaml:2:", "a mapping key must be a plain value"}},
       {"length beyond the bound", edit("radius: 0.1", "radius: 2e6"), {"body 'floor'.radius", "largest length"}},
-      {"coordinate beyond the bound", edit("points: [[0, 0, 0], [1, 0, 0]]", "points: [[0, 0, 0], [1e7, 0, 0]]"),
+      {"coordinate beyond the bound",
+       edit("points: [[0, 0, 0], [1, 0, 0]]", "points: [[0, 0, 0], [1e7, 0, 0]]"),
        {"body 'arm'.points[1][0]", "largest length"}},
       {"control byte in a name", edit("name: tool", "name: \"to\\x1bol\""), {"control character", "to\\x1bol"}},
       // A name must print as JSON (kccd info --json): bytes that are not UTF-8 are refused here.
@@ -203,7 +219,8 @@ TEST(Model, PiecesOfALinkAndTheirTolerances) {
             std::string::npos);
   std::string later = text;
   later.replace(later.find("  - name: box\n"), 14, "  - name: tool\n");
-  EXPECT_NE(loadError(later).find("'tool' is already the link of body 'tool/1'"), std::string::npos) << loadError(later);
+  EXPECT_NE(loadError(later).find("'tool' is already the link of body 'tool/1'"), std::string::npos)
+      << loadError(later);
 }
 
 TEST(Model, VisualsLoadAndTheirMistakesPointAtTheLine) {
@@ -252,16 +269,20 @@ TEST(Model, VisualsLoadAndTheirMistakesPointAtTheLine) {
   };
   expectIn(error("frame: base\n    mesh", "frame: bse\n    mesh"), "cell.yaml:" + std::to_string(line) + ":");
   expectIn(error("frame: base\n    mesh", "frame: bse\n    mesh"), "visuals[0].frame: unknown joint 'bse'");
-  expectIn(error("    box: [1, 2, 0.1]\n", "    box: [1, 2, 0.1]\n    sphere: 1\n"), "exactly one of mesh, box, cylinder, sphere");
+  expectIn(error("    box: [1, 2, 0.1]\n", "    box: [1, 2, 0.1]\n    sphere: 1\n"),
+           "exactly one of mesh, box, cylinder, sphere");
   expectIn(error("colour: [1, 0.5, 0]", "colour: [1, 1.5, 0]"), "visuals[0].colour[1]: must be in 0..1");
   expectIn(error("box: [1, 2, 0.1]", "box: [1, 0, 0.1]"), "visuals[1].box[1]: must be > 0");
-  expectIn(error("    box: [1, 2, 0.1]\n", "    box: [1, 2, 0.1]\n    scale: [1, 1, 1]\n"), "a scale applies to meshes only");
+  expectIn(error("    box: [1, 2, 0.1]\n", "    box: [1, 2, 0.1]\n    scale: [1, 1, 1]\n"),
+           "a scale applies to meshes only");
   expectIn(error("scale: [0.001, 0.001, 0.001]", "scale: [0.001, 0, 0.001]"), "factors must be non-zero");
   expectIn(error("cylinder: {radius: 0.05, length: 0.2}", "cylinder: {radius: 0.05}"), "cylinder.length");
   expectIn(error("sphere: 0.3", "sphere: 1e7"), "beyond the largest length");
-  expectIn(error("mesh: meshes/arm.dae", "mesh: package://robot/arm.dae"), "package:// paths are resolved by kccd import");
-  EXPECT_EQ(parseModel(edit_text(visuals, "mesh: /abs/tool.stl", "mesh: file:///abs/tool.stl"), "c.yaml").visuals[4].mesh,
-            "/abs/tool.stl");
+  expectIn(error("mesh: meshes/arm.dae", "mesh: package://robot/arm.dae"),
+           "package:// paths are resolved by kccd import");
+  EXPECT_EQ(
+      parseModel(edit_text(visuals, "mesh: /abs/tool.stl", "mesh: file:///abs/tool.stl"), "c.yaml").visuals[4].mesh,
+      "/abs/tool.stl");
   expectIn(error("    sphere: 0.3\n", "    sphere: 0.3\n    texture: wood\n"), "unknown field");
 }
 
@@ -270,7 +291,8 @@ TEST(Model, AxesOfAnyScaleNormalise) {
     const Model m = parseModel(edit("axis: [0, 0, 2]", std::string("axis: ") + axis), "cell.yaml");
     EXPECT_NEAR(m.joints[0].axis.norm(), 1.0, 1e-15) << axis;
   }
-  EXPECT_NEAR(parseModel(edit("axis: [0, 0, 2]", "axis: [1e200, 1e200, 0]"), "c").joints[0].axis.x(), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(parseModel(edit("axis: [0, 0, 2]", "axis: [1e200, 1e200, 0]"), "c").joints[0].axis.x(), std::sqrt(0.5),
+              1e-15);
   // Angles of any finite size are angles: limits as exporters write "unlimited".
   EXPECT_NO_THROW(parseModel(edit("limits: [-1, 1]", "limits: [-3.4e38, 3.4e38]"), "cell.yaml"));
 }

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "kccd/calib/camera.hpp"
@@ -174,7 +174,8 @@ TEST(ModelViewBudget, BodyAboveThePointBudgetIsDrawnAsItIs) {
       far = std::max(far, static_cast<double>((in ? to_outside : to_inside).at<float>(fy, fx)) / k);
     }
   ASSERT_GT(silhouette, 2000);
-  EXPECT_LE(far, f.images.mask_edge_px + 0.15) << "drawn " << cv::countNonZero(drawn) << " px, silhouette " << silhouette;
+  EXPECT_LE(far, f.images.mask_edge_px + 0.15)
+      << "drawn " << cv::countNonZero(drawn) << " px, silhouette " << silhouette;
   // The checker's stand-in for this body: 4 points and a larger radius, a larger silhouette.
   Checker checker(m);
   checker.query(q, q, QueryOptions{.type = QueryType::Distances});
@@ -204,7 +205,8 @@ TEST_F(ModelViewTest, ARepeatedRequestReusesTheLastAnswerAndLayer) {
   for (int frame = 0; frame < 36; ++frame) {
     SCOPED_TRACE("frame " + std::to_string(frame));
     const bool swept = frame >= 18;
-    const int step = frame % 6;  // 0: moved; 1, 2: held; 3: the last bit of one value; 4: held; 5: style or request kind changed
+    const int step =
+        frame % 6;  // 0: moved; 1, 2: held; 3: the last bit of one value; 4: held; 5: style or request kind changed
     if (step == 0) {
       for (std::size_t i = 0; i < q.size(); ++i) q[i] += 0.2 * std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
       for (std::size_t i = 0; i < q.size(); ++i) lo[i] = q[i] - 0.05, hi[i] = q[i] + 0.08;
@@ -219,8 +221,10 @@ TEST_F(ModelViewTest, ARepeatedRequestReusesTheLastAnswerAndLayer) {
     cv::randu(photo, 0, 256);
     cv::Mat onto = photo.clone();
     const bool query_only = step == 5 && frame % 12 == 11;
-    if (query_only) request.colour = false;
-    else request.onto = &onto;
+    if (query_only)
+      request.colour = false;
+    else
+      request.onto = &onto;
     if (frame == 20) (void)view.draw(ModelViewRequest{.state = q, .colour = false, .mask = true});  // a mask in between
     const ModelFrame f = view.draw(request);
     // The same request to a new view: nothing to reuse.
@@ -230,8 +234,8 @@ TEST_F(ModelViewTest, ARepeatedRequestReusesTheLastAnswerAndLayer) {
     if (!query_only) again.onto = &expected_onto;
     const ModelFrame e = fresh.draw(again);
     EXPECT_FALSE(e.reused);
-    const bool repeats = last_onto && !query_only && frame != 20 && step != 0 && step != 3 && request.style == last.style &&
-                         (swept == !last.lower.empty());
+    const bool repeats = last_onto && !query_only && frame != 20 && step != 0 && step != 3 &&
+                         request.style == last.style && (swept == !last.lower.empty());
     EXPECT_EQ(f.reused, repeats);
     reused += f.reused, expected_reused += repeats;
     EXPECT_TRUE(sameImage(onto, expected_onto));
@@ -310,7 +314,8 @@ TEST_F(ModelViewTest, GivenStatusesAndColoursColourTheVolumes) {
   Checker checker(m);
   checker.query(q, q, QueryOptions{.type = QueryType::Distances, .tight_volumes = true});
   Renderer renderer(smallCamera());
-  const Frame expected = renderer.render(staticSceneVolumes(m, checker, q, colliding), Style{.legend = false}, true, true);
+  const Frame expected =
+      renderer.render(staticSceneVolumes(m, checker, q, colliding), Style{.legend = false}, true, true);
   EXPECT_TRUE(sameImage(f.images.bgra, expected.bgra));
 
   // One colour for every body, thinner volumes: fewer pixels, and the volumes' pixels in that hue.
@@ -347,7 +352,7 @@ TEST_F(ModelViewTest, VisualsArePlacedAtTheState) {
   m.visuals.push_back(box);
   const std::vector<LoadedVisual> visuals = loadVisuals(m);
   ASSERT_EQ(visuals.size(), 1u);
-  EXPECT_EQ(visuals[0].label, upper_arm + 1);  // the mask label of the body in its frame
+  EXPECT_EQ(visuals[0].label, upper_arm + 1);           // the mask label of the body in its frame
   EXPECT_EQ(visuals[0].colour, cv::Scalar(255, 0, 0));  // BGR
   ASSERT_TRUE(visuals[0].mesh);
   EXPECT_EQ(visuals[0].mesh->triangles.size(), 12u);

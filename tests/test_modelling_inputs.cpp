@@ -44,7 +44,8 @@ std::string partError(const std::string& name, const std::string& text, const km
 
 std::string urdfError(const std::string& name, const std::string& text) {
   const std::string path = write(name, text);
-  return errorOf([&] { km::importUrdf(path, {.fit = {.method = km::FitMethod::Tolerance, .points = 2, .max_pieces = 8}}); });
+  return errorOf(
+      [&] { km::importUrdf(path, {.fit = {.method = km::FitMethod::Tolerance, .points = 2, .max_pieces = 8}}); });
 }
 
 const std::string kIv = "#Inventor V2.1 ascii\n";
@@ -87,8 +88,9 @@ TEST(PartInputs, NegativeAndOverflowingSizesAreRefused) {
 }
 
 TEST(PartInputs, IncludesAreRefused) {
-  EXPECT_NE(partError("self.iv", kIv + "File { name \"self.iv\" }\n").find("self.iv:2: File: includes are not supported"),
-            std::string::npos);
+  EXPECT_NE(
+      partError("self.iv", kIv + "File { name \"self.iv\" }\n").find("self.iv:2: File: includes are not supported"),
+      std::string::npos);
   EXPECT_NE(partError("zero.iv", kIv + "Separator {\n  File { name \"/dev/zero\" }\n}\n").find("zero.iv:3: File"),
             std::string::npos);
   EXPECT_NE(partError("missing.iv", kIv + "Separator { Cube {} File { name \"nowhere.iv\" } }\n").find("File"),
@@ -98,9 +100,9 @@ TEST(PartInputs, IncludesAreRefused) {
             std::string::npos);
   EXPECT_NE(partError("extern.wrl", "#VRML V2.0 utf8\nEXTERNPROTO P [] \"p.wrl\"\n").find("EXTERNPROTO"),
             std::string::npos);
-  EXPECT_NE(partError("www.wrl", "#VRML V1.0 ascii\nSeparator { Cube {} WWWInline { name \"x.wrl\" } }\n")
-                .find("WWWInline"),
-            std::string::npos);
+  EXPECT_NE(
+      partError("www.wrl", "#VRML V1.0 ascii\nSeparator { Cube {} WWWInline { name \"x.wrl\" } }\n").find("WWWInline"),
+      std::string::npos);
   // A binary Open Inventor File node: refused before Coin follows it.
   std::string binary = "#Inventor V2.1 binary  \n";
   binary += std::string("\0\0\0\4File", 8);
@@ -122,7 +124,8 @@ TEST(PartInputs, NestingIsBoundedBeforeCoin) {
   EXPECT_EQ(km::readPart(write("fine.iv", fine)).triangles, 12);
   // Braces in strings and comments do not count; a stray closing brace is an error, not the end.
   EXPECT_EQ(km::readPart(write("strings.iv", kIv + "# {{{{\nInfo { string \"}}} {{\" }\nCube {}\n")).triangles, 12);
-  EXPECT_NE(partError("stray.iv", kIv + "Separator { Cube {} } }\nSeparator { Sphere {} }\n").find("stray.iv:2: '}' closes nothing"),
+  EXPECT_NE(partError("stray.iv", kIv + "Separator { Cube {} } }\nSeparator { Sphere {} }\n")
+                .find("stray.iv:2: '}' closes nothing"),
             std::string::npos);
 }
 
@@ -135,13 +138,15 @@ TEST(PartInputs, CoordinateIndicesOutsideTheirCoordinatesAreRefused) {
       {kIv + coords + "IndexedFaceSet { coordIndex [0, 1, 2, -1, 0, 1, 1000000, -1] }\n",
        "IndexedFaceSet: coordIndex[6]: 1000000 is not a coordinate index (4 coordinates)"},
       {kIv + coords + "IndexedFaceSet { coordIndex [0, 1, -7, -1] }\n", "coordIndex[2]: -7"},
-      {kIv + coords + "IndexedTriangleStripSet { coordIndex [0, 1, 2, 4] }\n", "IndexedTriangleStripSet: coordIndex[3]"},
+      {kIv + coords + "IndexedTriangleStripSet { coordIndex [0, 1, 2, 4] }\n",
+       "IndexedTriangleStripSet: coordIndex[3]"},
       {kIv + coords + "IndexedLineSet { coordIndex [0, 9] }\n", "IndexedLineSet: coordIndex[1]"},
       {kIv + "IndexedFaceSet { vertexProperty VertexProperty { vertex [0 0 0, 1 0 0, 0 1 0] } coordIndex [0, 1, 3] }\n",
        "coordIndex[2]: 3 is not a coordinate index (3 coordinates)"},
       {kIv + coords + "FaceSet { numVertices [3, 3] }\n", "FaceSet: numVertices: 6 vertices"},
       {kIv + coords + "TriangleStripSet { startIndex 2 numVertices [3] }\n", "TriangleStripSet: numVertices"},
-      {kIv + coords + "QuadMesh { verticesPerRow 3 verticesPerColumn 3 }\n", "QuadMesh: verticesPerColumn x verticesPerRow"},
+      {kIv + coords + "QuadMesh { verticesPerRow 3 verticesPerColumn 3 }\n",
+       "QuadMesh: verticesPerColumn x verticesPerRow"},
       // Faces and strips of fewer than 3 vertices: Coin reads past its arrays (SIGSEGV) or
       // allocates without end (found by fuzz_part).
       {kIv + coords + "FaceSet { numVertices [2] }\n", "FaceSet: numVertices[0]: 2 vertices, at least 3 needed"},
@@ -177,8 +182,9 @@ TEST(PartInputs, OnlyRegularFilesOfBoundedSize) {
   ::unlink(fifo.c_str());
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   EXPECT_NE(errorOf([&] { km::readPart(fifo); }).find("not a regular file"), std::string::npos);  // no hang
-  EXPECT_NE(errorOf([&] { km::readInputFile(write("big.iv", std::string(2000, ' ')), 1000); }).find("larger than 1000 bytes"),
-            std::string::npos);
+  EXPECT_NE(
+      errorOf([&] { km::readInputFile(write("big.iv", std::string(2000, ' ')), 1000); }).find("larger than 1000 bytes"),
+      std::string::npos);
 }
 
 TEST(PartInputs, NurbsSurfacesAreCoveredByTheirControlPoints) {
@@ -262,16 +268,19 @@ TEST(UrdfInputs, EveryMalformedCollisionIsAnError) {
     EXPECT_NE(message.find(c.expected), std::string::npos) << message;
     expectOneLine(message, name);
   }
-  const std::string origin = urdfError("origin.urdf", "<robot name=\"r\">\n<link name=\"a\"><collision>\n<origin xyz=\"0 0 inf\"/>"
-                                                      "<geometry><sphere radius=\"1\"/></geometry></collision></link>\n</robot>\n");
-  EXPECT_NE(origin.find("origin.urdf:3: link 'a': collision 1: origin xyz: 'inf' is not a finite number"), std::string::npos)
+  const std::string origin = urdfError("origin.urdf",
+                                       "<robot name=\"r\">\n<link name=\"a\"><collision>\n<origin xyz=\"0 0 inf\"/>"
+                                       "<geometry><sphere radius=\"1\"/></geometry></collision></link>\n</robot>\n");
+  EXPECT_NE(origin.find("origin.urdf:3: link 'a': collision 1: origin xyz: 'inf' is not a finite number"),
+            std::string::npos)
       << origin;
 }
 
 TEST(UrdfInputs, UrdfdomPrintsNothingAndExplains) {
-  const std::string path = write("limits.urdf", "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/>"
-                                                "<joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/>"
-                                                "</joint></robot>");
+  const std::string path = write("limits.urdf",
+                                 "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/>"
+                                 "<joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/>"
+                                 "</joint></robot>");
   std::string message;
   const std::string console = consoleOf([&] { message = errorOf([&] { km::importUrdf(path); }); });
   EXPECT_EQ(console, "");

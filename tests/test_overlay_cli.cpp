@@ -43,7 +43,8 @@ constexpr double kFps = 10.0;
 cv::Mat syntheticFrame(int i, int w = kW, int h = kH) {
   cv::Mat f(h, w, CV_8UC3);
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) f.at<cv::Vec3b>(y, x) = cv::Vec3b(uchar((x + 7 * i) % 256), uchar((y * 2) % 256), uchar(40 + 10 * i));
+    for (int x = 0; x < w; ++x)
+      f.at<cv::Vec3b>(y, x) = cv::Vec3b(uchar((x + 7 * i) % 256), uchar((y * 2) % 256), uchar(40 + 10 * i));
   return f;
 }
 
@@ -188,9 +189,9 @@ TEST_F(OverlayCli, FrameTimesAndImageSequence) {
     times += std::to_string(i) + "," + std::to_string(0.2 * i + 0.05) + "\n";
   }
   writeText(out("input_times.csv"), times);
-  const Outcome r = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_seq/frame_%06d.png") +
-                            " --states " + log_ + " -q --frame-times " + out("input_times.csv") + " --report " +
-                            out("report.json") + " --png-dir " + out("pngs"));
+  const Outcome r = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " +
+                            out("input_seq/frame_%06d.png") + " --states " + log_ + " -q --frame-times " +
+                            out("input_times.csv") + " --report " + out("report.json") + " --png-dir " + out("pngs"));
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(readText(out("report.json")));
   ASSERT_EQ(j["frames_total"], 6);
@@ -203,24 +204,27 @@ TEST_F(OverlayCli, FrameTimesAndImageSequence) {
 
   // A frame without a time is an error naming it.
   writeText(out("input_times.csv"), "frame,time\n0,0.0\n1,0.1\n");
-  const Outcome bad = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_seq/frame_%06d.png") +
-                              " --states " + log_ + " -q --frame-times " + out("input_times.csv") + " --report " +
-                              out("r2.json"));
+  const Outcome bad =
+      runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_seq/frame_%06d.png") +
+              " --states " + log_ + " -q --frame-times " + out("input_times.csv") + " --report " + out("r2.json"));
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("no time for frame 2"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(out("r2.json")));
   // A gap or a huge frame number is refused at its line (no table sized by the number).
   for (const std::string& rows : {std::string("0,0.0\n5,0.5\n"), std::string("0,0.0\n100000000,1.0\n")}) {
     writeText(out("input_times.csv"), "frame,time\n" + rows);
-    const Outcome gap = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_seq/frame_%06d.png") +
-                                " --states " + log_ + " -q --frame-times " + out("input_times.csv") + " --report " + out("r3.json"));
+    const Outcome gap =
+        runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_seq/frame_%06d.png") +
+                " --states " + log_ + " -q --frame-times " + out("input_times.csv") + " --report " + out("r3.json"));
     EXPECT_EQ(gap.code, 2);
-    EXPECT_NE(gap.err.find(out("input_times.csv") + ":3:1: column 'frame': expected frame 1"), std::string::npos) << gap.err;
+    EXPECT_NE(gap.err.find(out("input_times.csv") + ":3:1: column 'frame': expected frame 1"), std::string::npos)
+        << gap.err;
     EXPECT_EQ(lines(gap.err), 1) << gap.err;
   }
   // Not a regular file: refused without reading.
-  const Outcome dir = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_seq/frame_%06d.png") +
-                              " --states " + log_ + " -q --frame-times " + out("input_seq") + " --report " + out("r3.json"));
+  const Outcome dir =
+      runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_seq/frame_%06d.png") +
+              " --states " + log_ + " -q --frame-times " + out("input_seq") + " --report " + out("r3.json"));
   EXPECT_EQ(dir.code, 2);
   EXPECT_NE(dir.err.find("a folder, not a frame-times file"), std::string::npos) << dir.err;
   EXPECT_FALSE(fs::exists(out("r3.json")));
@@ -251,7 +255,8 @@ TEST_F(OverlayCli, PixelsMatchRenderComposited) {
   // Frame 4 is at the sample (0, 0, 0): `kccd render --state 0,0,0 --no-legend` over the decoded frame.
   const Outcome r = runKccd(base() + " --plain --png-dir " + out("pngs") + " --frames 4");
   ASSERT_EQ(r.code, 0) << r.err;
-  const Outcome layer = runKccd("render " + kDemo + " --camera " + camera_ + " --state 0,0,0 --no-legend -o " + out("layer.png"));
+  const Outcome layer =
+      runKccd("render " + kDemo + " --camera " + camera_ + " --state 0,0,0 --no-legend -o " + out("layer.png"));
   ASSERT_EQ(layer.code, 0) << layer.err;
   cv::Mat frame = readVideo(video_).at(4);
   const cv::Mat rgba = cv::imread(out("layer.png"), cv::IMREAD_UNCHANGED);
@@ -307,11 +312,14 @@ TEST_F(OverlayCli, SweptDiffersFromStatic) {
 }
 
 TEST_F(OverlayCli, SameResultWithOneOrTwoJobs) {
-  const Outcome a = runKccd(base() + " --jobs 1 --png-dir " + out("j1") + " --frames 0:20:4 --report " + out("j1.json"));
-  const Outcome b = runKccd(base() + " --jobs 3 --png-dir " + out("j3") + " --frames 0:20:4 --report " + out("j3.json"));
+  const Outcome a =
+      runKccd(base() + " --jobs 1 --png-dir " + out("j1") + " --frames 0:20:4 --report " + out("j1.json"));
+  const Outcome b =
+      runKccd(base() + " --jobs 3 --png-dir " + out("j3") + " --frames 0:20:4 --report " + out("j3.json"));
   ASSERT_EQ(a.code, 0) << a.err;
   ASSERT_EQ(b.code, 0) << b.err;
-  EXPECT_EQ(nlohmann::json::parse(readText(out("j1.json")))["frames"], nlohmann::json::parse(readText(out("j3.json")))["frames"]);
+  EXPECT_EQ(nlohmann::json::parse(readText(out("j1.json")))["frames"],
+            nlohmann::json::parse(readText(out("j3.json")))["frames"]);
   for (int i = 0; i < kFrames; i += 4) {
     char name[32];
     std::snprintf(name, sizeof name, "/frame_%06d.png", i);
@@ -331,8 +339,8 @@ TEST_F(OverlayCli, AHeldStateReusesTheLastFrameAndDrawsTheSame) {
   for (const std::string look : {"", " --swept"}) {
     SCOPED_TRACE(look.empty() ? "static" : "swept");
     fs::remove_all(out("all"));
-    const Outcome r = runKccd(base() + look + " --jobs 1 --timings --json --png-dir " + out("all") + " --report " + out("all.json") +
-                              " -o " + out("all.avi") + " --codec mjpg");
+    const Outcome r = runKccd(base() + look + " --jobs 1 --timings --json --png-dir " + out("all") + " --report " +
+                              out("all.json") + " -o " + out("all.avi") + " --codec mjpg");
     ASSERT_EQ(r.code, 0) << r.err;
     const auto summary = nlohmann::json::parse(r.out);
     // Frames 8..19 lie between equal samples; swept, the velocity is zero from 1.2 s on.
@@ -342,8 +350,8 @@ TEST_F(OverlayCli, AHeldStateReusesTheLastFrameAndDrawsTheSame) {
     for (const int k : {9, 14, 19}) {
       SCOPED_TRACE("frame " + std::to_string(k));
       fs::remove_all(out("one"));
-      const Outcome one = runKccd(base() + look + " --jobs 1 --png-dir " + out("one") + " --frames " + std::to_string(k) +
-                                  " --report " + out("one.json"));
+      const Outcome one = runKccd(base() + look + " --jobs 1 --png-dir " + out("one") + " --frames " +
+                                  std::to_string(k) + " --report " + out("one.json"));
       ASSERT_EQ(one.code, 0) << one.err;
       char name[32];
       std::snprintf(name, sizeof name, "/frame_%06d.png", k);
@@ -387,9 +395,9 @@ TEST_F(OverlayCli, TruncatedVideoIsAnError) {
 
 TEST_F(OverlayCli, CameraSizeMismatchIsAnError) {
   writeVideo(out("input_small.mkv"), 3, 160, 90);
-  const Outcome r = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_small.mkv") +
-                            " --states " + log_ + " -q -o " + out("out.mkv") + " --png-dir " + out("pngs") +
-                            " --report " + out("report.json"));
+  const Outcome r =
+      runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_small.mkv") + " --states " + log_ +
+              " -q -o " + out("out.mkv") + " --png-dir " + out("pngs") + " --report " + out("report.json"));
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("160x90"), std::string::npos) << r.err;
@@ -401,10 +409,10 @@ TEST_F(OverlayCli, BadStateLogsNameFileLineColumn) {
   struct Case {
     std::string text, expect;
   } cases[] = {
-      {"time,shoulder_yaw,shoulder_pitch\n0,0,0\n", "log.csv:1:"},                  // missing column
-      {"time,shoulder_yaw,shoulder_pitch,elbow,elbw\n0,0,0,0,0\n", "log.csv:1:"},   // unknown column
+      {"time,shoulder_yaw,shoulder_pitch\n0,0,0\n", "log.csv:1:"},                       // missing column
+      {"time,shoulder_yaw,shoulder_pitch,elbow,elbw\n0,0,0,0,0\n", "log.csv:1:"},        // unknown column
       {"time,shoulder_yaw,shoulder_pitch,elbow\n0,0,0,0\n0.1,0,nan,0\n", "log.csv:3:"},  // NaN
-      {"time,shoulder_yaw,shoulder_pitch,elbow\n0,0,0,0\n0,0,0,0\n", "log.csv:3:"},  // time not increasing
+      {"time,shoulder_yaw,shoulder_pitch,elbow\n0,0,0,0\n0,0,0,0\n", "log.csv:3:"},      // time not increasing
   };
   for (const Case& c : cases) {
     writeText(log_, c.text);
@@ -417,10 +425,9 @@ TEST_F(OverlayCli, BadStateLogsNameFileLineColumn) {
 }
 
 TEST_F(OverlayCli, BadOptions) {
-  for (const std::string& extra : {std::string(" -o ") + out("out.gif"), " --frames 5:2 -o " + out("out.mkv"),
-                                   " --frames x -o " + out("out.mkv"), std::string(""),
-                                   " -o " + out("nowhere/out.mkv"), " --report " + out("r.txt"),
-                                   " -o " + out("in.mkv")}) {
+  for (const std::string& extra :
+       {std::string(" -o ") + out("out.gif"), " --frames 5:2 -o " + out("out.mkv"), " --frames x -o " + out("out.mkv"),
+        std::string(""), " -o " + out("nowhere/out.mkv"), " --report " + out("r.txt"), " -o " + out("in.mkv")}) {
     const Outcome r = runKccd(base() + extra);
     EXPECT_EQ(r.code, 2) << extra;
     EXPECT_EQ(lines(r.err), 1) << r.err;
@@ -440,7 +447,8 @@ TEST_F(OverlayCli, BadMaskOptionsAreOneLineExitTwoAndNothingWritten) {
       {" --masks " + out("input_empty_masks"), ": no mask in the folder (expected frame_000000.png"},
       {" --mask-bodies arm", "--mask-bodies: goes with --masks"},
       {" --masks " + out("input_masks") + " --mask-bodies wing", "--mask-bodies: 'wing' is not a body"},
-      {" --masks " + out("input_masks"), "frame_000000.png: mask: " + std::to_string(kW) + "x" + std::to_string(kH + 1)},
+      {" --masks " + out("input_masks"),
+       "frame_000000.png: mask: " + std::to_string(kW) + "x" + std::to_string(kH + 1)},
   };
   for (const auto& c : cases) {
     const Outcome r = runKccd(base() + " --report " + out("r.json") + c.extra);
@@ -494,8 +502,8 @@ TEST_F(OverlayCli, AutoTimeOffsetFindsTheShift) {
   const Outcome rec = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_still.mkv") +
                               " --states " + log_ + " -q --plain --time-offset 0.5 -o " + out("input_rec.mkv"));
   ASSERT_EQ(rec.code, 0) << rec.err;
-  const Outcome r = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_rec.mkv") + " --states " +
-                            log_ + " -q --time-offset auto:0:1 --report " + out("report.json"));
+  const Outcome r = runKccd("overlay " + kDemo + " --camera " + camera_ + " --video " + out("input_rec.mkv") +
+                            " --states " + log_ + " -q --time-offset auto:0:1 --report " + out("report.json"));
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(readText(out("report.json")));
   EXPECT_NEAR(j["time_offset"].get<double>(), 0.5, 0.03) << j["time_offset_auto"].dump();
@@ -518,7 +526,8 @@ TEST_F(OverlayCli, AutoTimeOffsetFindsTheShift) {
 namespace {
 
 TEST_F(OverlayCli, ContactSheetShowsSpreadFramesAndTheCollidingOne) {
-  const Outcome r = runKccd(base() + " --contact-sheet " + out("sheet.png") + " --contact-frames 4 --report " + out("report.json"));
+  const Outcome r =
+      runKccd(base() + " --contact-sheet " + out("sheet.png") + " --contact-frames 4 --report " + out("report.json"));
   ASSERT_EQ(r.code, 0) << r.err;
   const cv::Mat sheet = cv::imread(out("sheet.png"));
   ASSERT_FALSE(sheet.empty());
@@ -547,8 +556,10 @@ TEST_F(OverlayCli, SelectedFramesMatchGoldenImages) {
   const Outcome info = runKccd("render " + kDemo + " --camera " + camera_ + " --state 0,0,0 --json -o " + out("r.png"));
   ASSERT_EQ(info.code, 0) << info.err;
   const std::string renderer = nlohmann::json::parse(info.out)["renderer"];
-  EXPECT_TRUE(kccd::testing::compareGolden(cv::imread(out("pngs/frame_000004.png")), "overlay_frame4_colliding", renderer));
-  EXPECT_TRUE(kccd::testing::compareGolden(cv::imread(out("pngs/frame_000007.png")), "overlay_frame7_no_state", renderer));
+  EXPECT_TRUE(
+      kccd::testing::compareGolden(cv::imread(out("pngs/frame_000004.png")), "overlay_frame4_colliding", renderer));
+  EXPECT_TRUE(
+      kccd::testing::compareGolden(cv::imread(out("pngs/frame_000007.png")), "overlay_frame7_no_state", renderer));
 }
 
 }  // namespace

@@ -34,7 +34,7 @@ constexpr double kFps = 8.0;
 // The log: rows (time, three joint values); a gap between 0.75 and 1.5 s (median period 0.25 s,
 // so at most 0.375 s is bridged). At 0.5 s the arm points straight at the post.
 const std::vector<std::array<double, 4>> kRows = {
-    {0.0, -1.0, -0.5, 0.5}, {0.25, -0.8, -0.4, 0.4}, {0.5, 0.0, 0.0, 0.0}, {0.75, -0.6, -0.2, 0.2},
+    {0.0, -1.0, -0.5, 0.5}, {0.25, -0.8, -0.4, 0.4}, {0.5, 0.0, 0.0, 0.0},  {0.75, -0.6, -0.2, 0.2},
     {1.5, -1.0, -0.6, 0.6}, {1.75, -1.2, -0.6, 0.6}, {2.0, -1.4, -0.6, 0.6}};
 
 // The state at time t by linear interpolation between the rows around it, if they are at most
@@ -55,7 +55,8 @@ std::optional<std::vector<double>> stateHere(double t, double max_gap) {
 cv::Mat inputFrame(int i) {
   cv::Mat f(kH, kW, CV_8UC3);
   for (int y = 0; y < kH; ++y)
-    for (int x = 0; x < kW; ++x) f.at<cv::Vec3b>(y, x) = cv::Vec3b(uchar((x + 5 * i) % 256), uchar(y % 256), uchar(30 + 9 * i));
+    for (int x = 0; x < kW; ++x)
+      f.at<cv::Vec3b>(y, x) = cv::Vec3b(uchar((x + 5 * i) % 256), uchar(y % 256), uchar(30 + 9 * i));
   return f;
 }
 
@@ -92,16 +93,20 @@ class OverlayRecording : public ::testing::Test {
     camera_.camera_matrix(0, 2) = (camera_.camera_matrix(0, 2) + 0.5) * s - 0.5;
     camera_.camera_matrix(1, 2) = (camera_.camera_matrix(1, 2) + 0.5) * s - 0.5;
     video_ = (dir_ / "in.mkv").string();
-    cv::VideoWriter vw(video_, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), kFps, cv::Size(kW, kH), true);
+    cv::VideoWriter vw(video_, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), kFps, cv::Size(kW, kH),
+                       true);
     ASSERT_TRUE(vw.isOpened());
     for (int i = 0; i < kFrames; ++i) vw.write(inputFrame(i));
     std::string csv = "time,shoulder_yaw,shoulder_pitch,elbow\n";
-    for (const auto& r : kRows) csv += std::to_string(r[0]) + "," + std::to_string(r[1]) + "," + std::to_string(r[2]) + "," + std::to_string(r[3]) + "\n";
+    for (const auto& r : kRows)
+      csv += std::to_string(r[0]) + "," + std::to_string(r[1]) + "," + std::to_string(r[2]) + "," +
+             std::to_string(r[3]) + "\n";
     log_.emplace(parseStateLog(csv, "log.csv", model_));
   }
   void TearDown() override { fs::remove_all(dir_); }
   overlay::OverlayReport run(overlay::FrameSink* sink, overlay::OverlayOptions o = {}, const std::string& video = "") {
-    const overlay::OverlayInputs in{model_, camera_, *log_, video.empty() ? video_ : video, {}, "--video in.mkv", "cam.yaml", ""};
+    const overlay::OverlayInputs in{model_, camera_,          *log_,      video.empty() ? video_ : video,
+                                    {},     "--video in.mkv", "cam.yaml", ""};
     return overlay::overlayRecording(in, o, sink);
   }
   fs::path dir_;
@@ -188,7 +193,8 @@ TEST_F(OverlayRecording, TheAnswerDoesNotDependOnTheNumberOfThreads) {
 TEST_F(OverlayRecording, ARecordingOfAnotherSizeIsOneLineNamingIt) {
   const std::string small = (dir_ / "small.mkv").string();
   {
-    cv::VideoWriter vw(small, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), kFps, cv::Size(64, 36), true);
+    cv::VideoWriter vw(small, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), kFps, cv::Size(64, 36),
+                       true);
     for (int i = 0; i < 3; ++i) vw.write(cv::Mat(36, 64, CV_8UC3, cv::Scalar(i, 2 * i, 3 * i)));
   }
   try {
@@ -273,7 +279,8 @@ TEST(Timeline, SpansCurveAndMarginSitWhereTheReportSays) {
     }
     return xs;
   };
-  const std::vector<int> within = columns({150, 220, 255}), colliding = columns({170, 170, 250}), none = columns({215, 215, 215});
+  const std::vector<int> within = columns({150, 220, 255}), colliding = columns({170, 170, 250}),
+                         none = columns({215, 215, 215});
   ASSERT_FALSE(within.empty());
   ASSERT_FALSE(colliding.empty());
   ASSERT_FALSE(none.empty());
@@ -302,7 +309,8 @@ TEST(Timeline, SpansCurveAndMarginSitWhereTheReportSays) {
   };
   const int zero = curveRow(static_cast<int>(c3)), half = curveRow(static_cast<int>(c5));
   int margin_row = -1;
-  for (int x = within.front(); x <= within.back() && margin_row < 0; ++x) margin_row = marginRow(x);  // the line is dashed
+  for (int x = within.front(); x <= within.back() && margin_row < 0; ++x)
+    margin_row = marginRow(x);  // the line is dashed
   ASSERT_GT(zero, 0);
   ASSERT_GT(half, 0);
   ASSERT_GT(margin_row, 0);

@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "kccd/model.hpp"
 #include "kccd/checker.hpp"
+#include "kccd/model.hpp"
 #include "kccd/modelling/pair_proof.hpp"
 #include "kccd/modelling/pair_survey.hpp"
 #include "kccd/modelling/urdf_import.hpp"
@@ -37,12 +37,10 @@ void randomLimits(Model& m, std::mt19937_64& rng) {
 }
 
 double trueDistance(const Model& m, const std::vector<kccd::Pose>& poses, int a, int b) {
-  return static_cast<double>(kccd::testing::referenceSschDistance(kccd::testing::worldPoints(m, poses, a),
-                                                                  m.bodies[a].radius,
-                                                                  kccd::testing::worldPoints(m, poses, b),
-                                                                  m.bodies[b].radius));
+  return static_cast<double>(
+      kccd::testing::referenceSschDistance(kccd::testing::worldPoints(m, poses, a), m.bodies[a].radius,
+                                           kccd::testing::worldPoints(m, poses, b), m.bodies[b].radius));
 }
-
 
 // One configuration with no joint error realised: a recorded or drawn state.
 kccd::testing::Sample pointSample(const Model& m, std::vector<double> q) {
@@ -137,7 +135,11 @@ TEST(Pairs, AlwaysTouchingThroughFixedJointsHoldsAtEveryAngle) {
     const int base = add("base", kccd::kWorld, kccd::JointType::Fixed);
     const int plate = add("plate", base, kccd::JointType::Fixed);
     const int bracket = add("bracket", base, kccd::JointType::Fixed);
-    const int turn = add("turn", trial % 3 == 0 ? kccd::kWorld : trial % 3 == 1 ? base : plate, kccd::JointType::Revolute);
+    const int turn = add("turn",
+                         trial % 3 == 0   ? kccd::kWorld
+                         : trial % 3 == 1 ? base
+                                          : plate,
+                         kccd::JointType::Revolute);
     const int flange = add("flange", turn, kccd::JointType::Fixed);
     const int tool = add("tool", flange, kccd::JointType::Fixed);
     const int holder = trial % 2 ? base : bracket;
@@ -213,7 +215,10 @@ std::string reasonOf(const Model& m, const std::string& a, const std::string& b)
 
 Model gripperArm(bool keep_adjacent) {
   km::ImportOptions opt;
-  opt.fit = {.method = km::FitMethod::Points, .points = 4, .max_pieces = 1};  // fixed K = 4 fits, whole links: the rules under test, on the geometry they were written for
+  opt.fit = {
+      .method = km::FitMethod::Points,
+      .points = 4,
+      .max_pieces = 1};  // fixed K = 4 fits, whole links: the rules under test, on the geometry they were written for
   opt.keep_adjacent = keep_adjacent;
   return kccd::parseModel(km::importUrdf(std::string(KCCD_TEST_DATA_DIR) + "/urdf/gripper_arm.urdf", opt), "gripper");
 }
@@ -225,15 +230,15 @@ Model gripperArm(bool keep_adjacent) {
 // pairs with their reasons, and keeps every pair with a body on a link between the two.
 TEST(Pairs, RigidAndAdjacentPairsOfAGripperArm) {
   const Model m = gripperArm(false);
-  EXPECT_EQ(reasonOf(m, "link3", "hand"), "rigid");      // fixed, fixed (flange has no geometry)
+  EXPECT_EQ(reasonOf(m, "link3", "hand"), "rigid");  // fixed, fixed (flange has no geometry)
   EXPECT_EQ(reasonOf(m, "link3", "camera"), "rigid");
-  EXPECT_EQ(reasonOf(m, "camera", "hand"), "rigid");     // siblings on fixed joints
+  EXPECT_EQ(reasonOf(m, "camera", "hand"), "rigid");  // siblings on fixed joints
   EXPECT_EQ(reasonOf(m, "base", "link1"), "adjacent");
   EXPECT_EQ(reasonOf(m, "link2", "link3"), "adjacent");
-  EXPECT_EQ(reasonOf(m, "hand", "left_finger"), "adjacent");   // one prismatic joint
+  EXPECT_EQ(reasonOf(m, "hand", "left_finger"), "adjacent");  // one prismatic joint
   EXPECT_EQ(reasonOf(m, "hand", "right_finger"), "adjacent");
-  EXPECT_EQ(reasonOf(m, "link2", "hand"), "checked");          // link3 lies between
-  EXPECT_EQ(reasonOf(m, "link3", "left_finger"), "checked");   // the hand lies between
+  EXPECT_EQ(reasonOf(m, "link2", "hand"), "checked");                // link3 lies between
+  EXPECT_EQ(reasonOf(m, "link3", "left_finger"), "checked");         // the hand lies between
   EXPECT_EQ(reasonOf(m, "left_finger", "right_finger"), "checked");  // two moving joints
   EXPECT_EQ(reasonOf(m, "base", "link2"), "checked");
   EXPECT_EQ(m.ignored.size(), 8u);
@@ -273,10 +278,8 @@ TEST(Pairs, RigidAndAdjacentPairsOfAGripperArm) {
   EXPECT_EQ(planned("link3", "hand"), "rigid");
   EXPECT_EQ(planned("hand", "left_finger"), "adjacent");
   EXPECT_EQ(planned("link1", "link2"), "always_touching");
-  EXPECT_EQ(planned("left_finger", "right_finger"), reportOf(m, reports, "left_finger", "right_finger").verdict ==
-                                                            km::Verdict::Never
-                                                        ? "never"
-                                                        : "checked");
+  EXPECT_EQ(planned("left_finger", "right_finger"),
+            reportOf(m, reports, "left_finger", "right_finger").verdict == km::Verdict::Never ? "never" : "checked");
   const km::IgnorePlan keep = km::ignoreList(m, reports, {.keep_adjacent = true});
   for (const auto& e : keep.ignore) EXPECT_NE(e.reason, kccd::IgnoreReason::Adjacent);
   EXPECT_EQ(keep.dropped.size(), 2u);  // the fingers' adjacent entries of the file: checked again
@@ -330,8 +333,7 @@ TEST(Pairs, AnIgnoredPairNeverChangesTheBoundOfAPairKept) {
     const Model all = kccd::testing::randomModel(rng, 6, 5);
     Model fewer = all;
     std::vector<std::array<int, 2>> ignore;
-    for (const auto& e : km::structuralIgnores(all).ignore)
-      ignore.push_back({all.bodyIndex(e.a), all.bodyIndex(e.b)});
+    for (const auto& e : km::structuralIgnores(all).ignore) ignore.push_back({all.bodyIndex(e.a), all.bodyIndex(e.b)});
     fewer.finalize(true, ignore, {});
     ignored += static_cast<int>(all.pairs.size() - fewer.pairs.size());
     kccd::Checker ca(all), cf(fewer);

@@ -6,9 +6,9 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <string>
 #include <limits>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "kccd/render/gl_context.hpp"
@@ -58,9 +58,9 @@ TEST(RenderPrepare, SortsEveryKindOfVolume) {
   const std::vector<Vec3> far_away = {Vec3(-2e6, 0, 0)};
   const std::vector<Vec3> at_camera = {Vec3(3, 0, 0)};
   const Volume volumes[] = {
-      {centre, 0.2, SafetyStatus::Clear, "ball"},    {{}, 0.2, SafetyStatus::Clear, "empty"},
-      {nan, 0.2, SafetyStatus::Clear, "nan"},        {behind, 0.5, SafetyStatus::Clear, "behind"},
-      {far_away, 0.5, SafetyStatus::Clear, "far"},   {at_camera, 0.5, SafetyStatus::Colliding, "around"},
+      {centre, 0.2, SafetyStatus::Clear, "ball"},  {{}, 0.2, SafetyStatus::Clear, "empty"},
+      {nan, 0.2, SafetyStatus::Clear, "nan"},      {behind, 0.5, SafetyStatus::Clear, "behind"},
+      {far_away, 0.5, SafetyStatus::Clear, "far"}, {at_camera, 0.5, SafetyStatus::Colliding, "around"},
   };
   const PreparedFrame f = preparer.prepare(volumes, PrepareNeeds{.outlines = true, .meshes = false});
   ASSERT_EQ(f.frame.visibility.size(), 6u);
@@ -86,7 +86,8 @@ TEST(RenderPrepare, SortsEveryKindOfVolume) {
   // The outline contains the ball's image and lies at most the tolerance (0.5 px) outside it.
   std::vector<Vec3> corners;
   for (std::size_t k = 0; k < n; ++k)
-    corners.emplace_back(ball.outline_vertices[3 * k], ball.outline_vertices[3 * k + 1], ball.outline_vertices[3 * k + 2]);
+    corners.emplace_back(ball.outline_vertices[3 * k], ball.outline_vertices[3 * k + 1],
+                         ball.outline_vertices[3 * k + 2]);
   const double outside = discRadius(0.2, 3.0) + 0.5 / kFocal;  // half a pixel more
   EXPECT_GE(projectedArea(corners), discArea(0.2, 3.0) * (1.0 - 1e-6));
   EXPECT_LE(projectedArea(corners), std::numbers::pi * outside * outside);
@@ -117,7 +118,8 @@ TEST(RenderPrepare, MeshesComeFromTheCacheAndTheirSilhouetteIsTheSphereImage) {
   EXPECT_EQ(p.fill.size(), 3 * (p.silhouette.size() - 2));
   EXPECT_EQ(p.outline.size(), 2 * p.silhouette.size());
   std::vector<Vec3> loop;
-  for (const std::uint32_t k : p.silhouette) loop.emplace_back(p.vertices[3 * k], p.vertices[3 * k + 1], p.vertices[3 * k + 2]);
+  for (const std::uint32_t k : p.silhouette)
+    loop.emplace_back(p.vertices[3 * k], p.vertices[3 * k + 1], p.vertices[3 * k + 2]);
   const double disc = discArea(0.2, 3.0);
   EXPECT_GT(projectedArea(loop), disc);
   EXPECT_LT(projectedArea(loop), disc * 1.02);

@@ -70,7 +70,8 @@ TEST(RenderProjection, DistortionWarpMatchesProjectPoints) {
       const Vec3 x = randomVisiblePoint(rng, c);
       const cv::Point2d ref = cvProject(c, x);
       if (ref.x < 0 || ref.y < 0 || ref.x > c.width - 1 || ref.y > c.height - 1) continue;
-      const int u0 = std::min(static_cast<int>(ref.x), c.width - 2), v0 = std::min(static_cast<int>(ref.y), c.height - 2);
+      const int u0 = std::min(static_cast<int>(ref.x), c.width - 2),
+                v0 = std::min(static_cast<int>(ref.y), c.height - 2);
       const double fu = ref.x - u0, fv = ref.y - v0;
       auto bilinear = [&](const cv::Mat& m) {
         return (1 - fu) * (1 - fv) * m.at<float>(v0, u0) + fu * (1 - fv) * m.at<float>(v0, u0 + 1) +

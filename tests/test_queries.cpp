@@ -569,7 +569,8 @@ TEST(Queries, Rotation3dApexBoundsStayBelowTheSampledMinimum) {
     for (const Vec3& p : body) body_radius = std::max(body_radius, (p - body_centre).norm());
     const Vec3 nominal = j.origin * (Eigen::AngleAxisd(centre.norm(), centre.normalized()) * body_centre);
     const Vec3 away = nominal + vec(1.0).normalized() * (body_radius + 0.3 + 0.05 + 0.5 * u(rng));
-    for (int k = 1 + static_cast<int>(3 * u(rng)); k > 0; --k) other.push_back(away + vec(0.1).cwiseMin(0.1).cwiseMax(-0.1));
+    for (int k = 1 + static_cast<int>(3 * u(rng)); k > 0; --k)
+      other.push_back(away + vec(0.1).cwiseMin(0.1).cwiseMax(-0.1));
     m.bodies.push_back({"other", kWorld, other, 0.05 * u(rng)});
     m.bodies.push_back({"body", 0, body, 0.05 * u(rng)});
     m.finalize(true, {}, {});
@@ -597,7 +598,8 @@ TEST(Queries, Rotation3dApexBoundsStayBelowTheSampledMinimum) {
   }
   // The apexes are in use: accurate is tighter by over a millimetre in many cases.
   EXPECT_GT(tighter, cases / 4);
-  std::cout << "[ property ] rotation3d apexes: " << tighter << " of " << cases << " bounds tighter than the ball by > 1 mm\n";
+  std::cout << "[ property ] rotation3d apexes: " << tighter << " of " << cases
+            << " bounds tighter than the ball by > 1 mm\n";
 }
 
 TEST(Braking, StoppingDistanceAndIntervals) {

@@ -147,7 +147,8 @@ TEST_F(RenderCli, BadInputExitsTwoWithOneLine) {
   std::ofstream(out("bad_cam.yaml")) << "%YAML:1.0\n---\nimage_width: 320\nimage_height: 0\n";
   const Outcome r = runKccd("render " + kDemo + " --camera " + out("bad_cam.yaml") + " --state 0,0,0" + o);
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("bad_cam.yaml:4:15: image_height: 0 is not in"), std::string::npos) << r.err;  // the value's place
+  EXPECT_NE(r.err.find("bad_cam.yaml:4:15: image_height: 0 is not in"), std::string::npos)
+      << r.err;  // the value's place
   EXPECT_FALSE(fs::exists(out("bad.png")));
   // No partial or temporary files are left behind.
   for (const auto& e : fs::directory_iterator(dir_))
@@ -173,10 +174,17 @@ TEST_F(RenderCli, CameraFileErrorsExitTwoWithOneLine) {
       {"empty.yaml", "", ": file: empty"},
       {"noheader.yaml", ok.substr(ok.find('\n') + 1), ":1: header"},
       {"list.yaml", "%YAML:1.0\n---\n- 1\n", ":3:1: document: the top level must be a mapping"},
-      {"binary.yaml", std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10), ":1: file: control byte"},
+      {"binary.yaml",
+       std::string("\x7f"
+                   "ELF\x02\x01\x01\0\0\0",
+                   10),
+       ":1: file: control byte"},
       {"truncated.yaml", ok.substr(0, ok.find("data:") + 12), ":"},
       {"height.yaml", height,
-       ":" + std::to_string(std::count(height.begin(), height.begin() + static_cast<long>(height.find("image_height: 20000")), '\n') + 1) +
+       ":" +
+           std::to_string(std::count(height.begin(),
+                                     height.begin() + static_cast<long>(height.find("image_height: 20000")), '\n') +
+                          1) +
            ":15: image_height: 20000 is not in 1..8192"},
       {"dir.yaml", "", ": a folder, not a camera file"},
       {"fifo.yaml", "", ": not a regular file (a device, FIFO or socket)"},
@@ -185,8 +193,7 @@ TEST_F(RenderCli, CameraFileErrorsExitTwoWithOneLine) {
     if (c.name != "dir.yaml" && c.name != "fifo.yaml") std::ofstream(out(c.name), std::ios::binary) << c.text;
     const Outcome r = runKccd("render " + kDemo + " --camera " + out(c.name) + o);
     EXPECT_EQ(r.code, 2) << c.name << "\n" << r.err;
-    EXPECT_EQ(r.err.rfind("kccd: " + out(c.name) + c.expect, 0), 0u)
-        << c.name << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("kccd: " + out(c.name) + c.expect, 0), 0u) << c.name << "\n" << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << "\n" << r.err;
   }
   EXPECT_FALSE(fs::exists(out("bad.png")));
@@ -239,7 +246,8 @@ TEST_F(RenderCli, UnsafeStatusExitsThreeAndStillWrites) {
                           "  - {name: j, parent: world, type: revolute, axis: [0, 0, 1], sweep: exact}\n"
                           "bodies:\n  - {name: base, frame: world, points: [[0, 0, 0]], radius: 0.1}\n"
                           "  - {name: arm, frame: j, points: [[0.5, 0, 0.3]], radius: 0.05}\n";
-  const Outcome r = runKccd("render " + model + " --camera " + camera_ + " --lower 0 --upper 0.1 -o " + out("u.png") + " --json");
+  const Outcome r =
+      runKccd("render " + model + " --camera " + camera_ + " --lower 0 --upper 0.1 -o " + out("u.png") + " --json");
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_NE(r.err.find("unsafe"), std::string::npos);
   EXPECT_TRUE(fs::exists(out("u.png")));

@@ -25,8 +25,8 @@ using kccd::SafetyStatus;
 using kccd::Vec3;
 using kccd::calib::Camera;
 using kccd::render::Frame;
-using kccd::render::RenderOptions;
 using kccd::render::Renderer;
+using kccd::render::RenderOptions;
 using kccd::render::Style;
 using kccd::render::Volume;
 
@@ -50,7 +50,8 @@ TEST(RenderCrop, TheCroppedLayerIsTheWholeLayerBitForBit) {
       double radius = 0.01 + 0.08 * std::abs(u(rng));
       if (i == 0 && trial % 6 == 3) at = eye * 0.97;
       if (i == 0 && trial % 12 == 5) at = eye, radius = 0.3;
-      const auto cloud = kccd::testing::randomCloud(rng, 1 + static_cast<int>(rng() % 10), at, 0.02 + 0.15 * std::abs(u(rng)));
+      const auto cloud =
+          kccd::testing::randomCloud(rng, 1 + static_cast<int>(rng() % 10), at, 0.02 + 0.15 * std::abs(u(rng)));
       clouds.emplace_back(cloud.begin(), cloud.end());
       scene.push_back(Volume{clouds.back(), radius, static_cast<SafetyStatus>(i % 4), "body " + std::to_string(i)});
     }
@@ -141,7 +142,8 @@ TEST(RenderCrop, WhatEarlierFramesDrewNeverShowsThrough) {
         Vec3 at(0.8 * u(rng), 0.8 * u(rng), 0.8 * u(rng));
         double radius = 0.01 + 0.1 * std::abs(u(rng));
         if (i == 0 && frame % 13 == 6) at = eye, radius = 0.3;  // around the camera: the whole view
-        const auto cloud = kccd::testing::randomCloud(rng, 1 + static_cast<int>(rng() % 8), at, 0.02 + 0.2 * std::abs(u(rng)));
+        const auto cloud =
+            kccd::testing::randomCloud(rng, 1 + static_cast<int>(rng() % 8), at, 0.02 + 0.2 * std::abs(u(rng)));
         clouds.emplace_back(cloud.begin(), cloud.end());
         scene.push_back(Volume{clouds.back(), radius, static_cast<SafetyStatus>(i % 4), "body " + std::to_string(i)});
       }

@@ -11,9 +11,9 @@
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/distance.hpp"
+#include "kccd/render/mesh_cache.hpp"
 #include "kccd/render/projection.hpp"
 #include "kccd/render/renderer.hpp"
-#include "kccd/render/mesh_cache.hpp"
 #include "kccd/render/ssch_mesh.hpp"
 #include "support/cameras.hpp"
 #include "support/random_shapes.hpp"
@@ -95,7 +95,8 @@ TEST(RenderMesh, ContainsTheTrueVolume) {
           ASSERT_LE(m.normals[t].dot(x), m.normals[t].dot(m.vertices[m.triangles[t][0]]) + 1e-9);
       }
       // Not much larger than needed: every vertex is within the tessellation's outward error.
-      const double allowed = r * (spherePolytope(level).scale - 1.0) + 1e-5 * (1.0 + 2000.0) * spherePolytope(level).scale;
+      const double allowed =
+          r * (spherePolytope(level).scale - 1.0) + 1e-5 * (1.0 + 2000.0) * spherePolytope(level).scale;
       for (const Vec3& v : m.vertices) {
         double nearest = 1e300;  // distance to the nearest core point bounds the distance to the hull
         for (const Vec3& p : sh.points) nearest = std::min(nearest, (v - p).norm());
@@ -119,7 +120,9 @@ void checkMesh(const Mesh& m, const std::vector<Vec3>& points, double radius, in
   ASSERT_GE(m.triangles.size(), 4u);
   ASSERT_EQ(m.normals.size(), m.triangles.size());
   for (const auto& e : m.edges) ASSERT_NE(e[2], e[3]);
-  ASSERT_EQ(static_cast<long>(m.vertices.size()) - static_cast<long>(m.edges.size()) + static_cast<long>(m.triangles.size()), 2);
+  ASSERT_EQ(
+      static_cast<long>(m.vertices.size()) - static_cast<long>(m.edges.size()) + static_cast<long>(m.triangles.size()),
+      2);
   ASSERT_EQ(m.edges.size() * 2, m.triangles.size() * 3);  // every edge has exactly two triangles
   std::vector<double> offsets(m.triangles.size());
   for (std::size_t t = 0; t < m.triangles.size(); ++t) {
@@ -161,7 +164,8 @@ void checkMesh(const Mesh& m, const std::vector<Vec3>& points, double radius, in
       }
       x = c / total + r * d;
     }
-    for (std::size_t t = 0; t < m.triangles.size(); ++t) ASSERT_LE(m.normals[t].dot(x), offsets[t] + tiny) << "sample " << k;
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+      ASSERT_LE(m.normals[t].dot(x), offsets[t] + tiny) << "sample " << k;
   }
   // Not much larger: every vertex within the circumscribed radius of conv(points).
   const double allowed = r * spherePolytope(level).scale + 2e-6 * (1.0 + extent) * spherePolytope(level).scale;
@@ -182,20 +186,35 @@ std::vector<Shape> degenerateShapes() {
       {{Vec3(0, 0, 0), Vec3(0, 0.1, 0), Vec3(0, 0.3, 0), Vec3(0, 0.3, 0)}, 0.04, "collinear with duplicates"},
       {{a, b, a + 0.25 * (b - a), a + 0.7 * (b - a)}, 0.02, "collinear, oblique"},
       {{a, b}, 0.0, "segment, radius 0"},
-      {{Vec3(0, 0, 0), Vec3(0.4, 0, 0), Vec3(0.4, 0.2, 0), Vec3(0, 0.2, 0), Vec3(0.2, 0.1, 0)}, 0.03, "axis-aligned slab"},
+      {{Vec3(0, 0, 0), Vec3(0.4, 0, 0), Vec3(0.4, 0.2, 0), Vec3(0, 0.2, 0), Vec3(0.2, 0.1, 0)},
+       0.03,
+       "axis-aligned slab"},
       {{a, b, c, a + 0.3 * (b - a) + 0.3 * (c - a), b, c}, 0.02, "oblique triangle with duplicates"},
       {{a, b, c}, 0.0, "triangle, radius 0"},
-      {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1), Vec3(1, 0, 1), Vec3(0, 1, 1), Vec3(1, 1, 0)}, 0.05, "axis-aligned cube"},
-      {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1), Vec3(1, 0, 1), Vec3(0, 1, 1), Vec3(1, 1, 0)}, 0.0, "cube, radius 0"},
+      {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1), Vec3(1, 0, 1), Vec3(0, 1, 1),
+        Vec3(1, 1, 0)},
+       0.05,
+       "axis-aligned cube"},
+      {{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1), Vec3(1, 0, 1), Vec3(0, 1, 1),
+        Vec3(1, 1, 0)},
+       0.0,
+       "cube, radius 0"},
       {{a, b, c, d}, 0.0, "tetrahedron, radius 0"},
-      {{a, b, c, d, 0.5 * (a + b), 0.5 * (c + d), 0.25 * (a + b + c + d)}, 0.08, "tetrahedron with edge and inner points"},
-      {{Vec3(1000, 2000, -500), Vec3(1000.3, 2000, -500), Vec3(1000, 2000.2, -500.1), Vec3(1000.1, 2000.1, -499.8)}, 0.05, "far from the origin"},
+      {{a, b, c, d, 0.5 * (a + b), 0.5 * (c + d), 0.25 * (a + b + c + d)},
+       0.08,
+       "tetrahedron with edge and inner points"},
+      {{Vec3(1000, 2000, -500), Vec3(1000.3, 2000, -500), Vec3(1000, 2000.2, -500.1), Vec3(1000.1, 2000.1, -499.8)},
+       0.05,
+       "far from the origin"},
   };
   for (const double thick : {1e-12, 1e-10, 1e-8, 1e-6, 1e-3}) {
-    s.push_back({{a, b, c, 0.3 * a + 0.3 * b + 0.4 * c + thick * n}, 0.02, "thin tetrahedron " + std::to_string(thick)});
+    s.push_back(
+        {{a, b, c, 0.3 * a + 0.3 * b + 0.4 * c + thick * n}, 0.02, "thin tetrahedron " + std::to_string(thick)});
     const Vec3 side = (b - a).cross(n).normalized();
     s.push_back({{a, b, a + 0.5 * (b - a) + thick * side}, 0.02, "thin triangle " + std::to_string(thick)});
-    s.push_back({{a, a + Vec3(thick, 0, 0), a + Vec3(0, thick, 0), a + Vec3(0, 0, thick)}, 0.02, "tiny tetrahedron " + std::to_string(thick)});
+    s.push_back({{a, a + Vec3(thick, 0, 0), a + Vec3(0, thick, 0), a + Vec3(0, 0, thick)},
+                 0.02,
+                 "tiny tetrahedron " + std::to_string(thick)});
   }
   return s;
 }
@@ -224,7 +243,8 @@ TEST(RenderMesh, DegenerateCores) {
   for (const Vec3& v : capsule.vertices) {
     const double to_end = std::min(v.norm(), (v - seg[1]).norm());
     const double to_axis = Vec3(v.x(), v.y(), 0.0).norm();
-    EXPECT_TRUE(std::abs(to_end - capsule.mesh_radius) < 1e-12 || (to_axis <= capsule.mesh_radius + 1e-12 && to_axis >= 0.05 * 0.99));
+    EXPECT_TRUE(std::abs(to_end - capsule.mesh_radius) < 1e-12 ||
+                (to_axis <= capsule.mesh_radius + 1e-12 && to_axis >= 0.05 * 0.99));
   }
   // A flat square: both faces offset by at most the mesh radius, and no qhull at all.
   const std::vector<Vec3> square = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)};
@@ -255,20 +275,38 @@ TEST(RenderMesh, RandomCoresFuzz) {
     std::vector<Vec3> pts;
     for (int k = 0; k < n; ++k) {
       switch (kind) {
-        case 0: pts.push_back(o + 0.5 * Vec3(u(rng), u(rng), u(rng))); break;
-        case 1: pts.push_back(o + 0.5 * u(rng) * e1); break;
-        case 2: pts.push_back(o + 0.5 * u(rng) * e1 + 0.5 * u(rng) * e2); break;
-        case 3: pts.push_back(0.1 * Vec3(static_cast<double>(rng() % 3), static_cast<double>(rng() % 3), static_cast<double>(rng() % 2))); break;
-        case 4: pts.push_back(k % 3 == 0 || pts.empty() ? o + 0.3 * Vec3(u(rng), u(rng), u(rng)) : pts[rng() % pts.size()]); break;
-        case 5: pts.push_back(o + 0.5 * u(rng) * e1 + 0.5 * u(rng) * e2 + std::pow(10.0, -3.0 - 9.0 * std::abs(u(rng))) * u(rng) * e3); break;
-        case 6: pts.push_back(Vec3(300, -200, 150) + 0.4 * Vec3(u(rng), u(rng), u(rng))); break;
-        default: pts.push_back(o + 0.3 * u(rng) * Vec3(0, 0, 1) + (k % 2) * 0.2 * Vec3(1, 0, 0)); break;  // axis-aligned
+        case 0:
+          pts.push_back(o + 0.5 * Vec3(u(rng), u(rng), u(rng)));
+          break;
+        case 1:
+          pts.push_back(o + 0.5 * u(rng) * e1);
+          break;
+        case 2:
+          pts.push_back(o + 0.5 * u(rng) * e1 + 0.5 * u(rng) * e2);
+          break;
+        case 3:
+          pts.push_back(0.1 * Vec3(static_cast<double>(rng() % 3), static_cast<double>(rng() % 3),
+                                   static_cast<double>(rng() % 2)));
+          break;
+        case 4:
+          pts.push_back(k % 3 == 0 || pts.empty() ? o + 0.3 * Vec3(u(rng), u(rng), u(rng)) : pts[rng() % pts.size()]);
+          break;
+        case 5:
+          pts.push_back(o + 0.5 * u(rng) * e1 + 0.5 * u(rng) * e2 +
+                        std::pow(10.0, -3.0 - 9.0 * std::abs(u(rng))) * u(rng) * e3);
+          break;
+        case 6:
+          pts.push_back(Vec3(300, -200, 150) + 0.4 * Vec3(u(rng), u(rng), u(rng)));
+          break;
+        default:
+          pts.push_back(o + 0.3 * u(rng) * Vec3(0, 0, 1) + (k % 2) * 0.2 * Vec3(1, 0, 0));
+          break;  // axis-aligned
       }
     }
     const double radius = c % 5 == 0 ? 0.0 : 0.2 * std::abs(u(rng));
     const int level = static_cast<int>(rng() % 4);
-    SCOPED_TRACE("case " + std::to_string(c) + " kind " + std::to_string(kind) + ", " + std::to_string(n) + " points, level " +
-                 std::to_string(level));
+    SCOPED_TRACE("case " + std::to_string(c) + " kind " + std::to_string(kind) + ", " + std::to_string(n) +
+                 " points, level " + std::to_string(level));
     const Mesh m = buildSschMesh(pts, radius, level);
     ++cases;
     if (!m.direct) ++fallbacks;
@@ -386,15 +424,18 @@ TEST(RenderMesh, PolygonFillCoversTheSamePixelsAsTheTriangles) {
   int polygons = 0, volumes = 0;
   for (int trial = 0; trial < 16; ++trial) {
     Camera c = kccd::testing::randomCamera(rng, trial % 2 == 0, 480, 320);
-    const Vec3 eye(kccd::testing::cameraCentre(c)[0], kccd::testing::cameraCentre(c)[1], kccd::testing::cameraCentre(c)[2]);
+    const Vec3 eye(kccd::testing::cameraCentre(c)[0], kccd::testing::cameraCentre(c)[1],
+                   kccd::testing::cameraCentre(c)[2]);
     std::vector<std::vector<Vec3>> cores;
     std::vector<Volume> scene;
     const int n = 2 + trial % 6;
     for (int i = 0; i < n; ++i) {
       // Around the origin (what the random cameras look at); every fourth trial one volume
       // right in front of the camera, partly behind its near plane.
-      const Vec3 centre = (trial % 4 == 3 && i == 0) ? Vec3(eye * 0.97) : Vec3(0.6 * u(rng), 0.6 * u(rng), 0.6 * u(rng));
-      cores.push_back(kccd::testing::randomCloud(rng, 1 + static_cast<int>(rng() % 12), centre, 0.1 + 0.4 * std::abs(u(rng))));
+      const Vec3 centre =
+          (trial % 4 == 3 && i == 0) ? Vec3(eye * 0.97) : Vec3(0.6 * u(rng), 0.6 * u(rng), 0.6 * u(rng));
+      cores.push_back(
+          kccd::testing::randomCloud(rng, 1 + static_cast<int>(rng() % 12), centre, 0.1 + 0.4 * std::abs(u(rng))));
     }
     for (int i = 0; i < n; ++i) {
       const SafetyStatus status = static_cast<SafetyStatus>(i % 3);

@@ -48,7 +48,8 @@ double cross(const Vec2& o, const Vec2& a, const Vec2& b) {
 
 // Andrew's monotone chain, counter-clockwise (x right, y up).
 std::vector<Vec2> hull2d(std::vector<Vec2> p) {
-  std::sort(p.begin(), p.end(), [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  std::sort(p.begin(), p.end(),
+            [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
   std::vector<Vec2> h(2 * p.size());
   std::size_t k = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -126,8 +127,8 @@ TEST(RenderOutline, ContainsTheImageAndIsWithinTolerance) {
   std::size_t most = 0;
   // Under the sanitizers without the longest focal length (the finest outlines and oracle rims:
   // the same code with more corners).
-  const std::vector<double> focals = kccd::testing::kSanitized ? std::vector<double>{300.0, 1000.0}
-                                                                : std::vector<double>{300.0, 1000.0, 4000.0};
+  const std::vector<double> focals =
+      kccd::testing::kSanitized ? std::vector<double>{300.0, 1000.0} : std::vector<double>{300.0, 1000.0, 4000.0};
   for (const double focal : focals)
     for (const Case& k : cases(rng)) {
       SCOPED_TRACE(k.what + ", focal " + std::to_string(focal));
@@ -147,8 +148,7 @@ TEST(RenderOutline, ContainsTheImageAndIsWithinTolerance) {
       most = std::max(most, poly.size());
       // Convex and counter-clockwise (as the support directions turn).
       for (std::size_t i = 0; i < poly.size(); ++i)
-        ASSERT_GE(cross(poly[i], poly[(i + 1) % poly.size()], poly[(i + 2) % poly.size()]), -1e-12)
-            << "corner " << i;
+        ASSERT_GE(cross(poly[i], poly[(i + 1) % poly.size()], poly[(i + 2) % poly.size()]), -1e-12) << "corner " << i;
       // Containment: every rim point of every sphere (exact image boundary points), and so the
       // hull of them, lies inside.
       std::vector<Vec2> rim;
@@ -186,20 +186,20 @@ TEST(RenderOutline, ContainsTheImageAndIsWithinTolerance) {
     }
   EXPECT_GT(drawn, 40 * static_cast<int>(focals.size()));
   EXPECT_GT(refused, 0);
-  std::cout << drawn << " outlines, " << refused << " refused (nearer than min_depth); farthest corner "
-            << worst << " px outside the image (tolerance 0.5); at most " << most << " corners\n";
+  std::cout << drawn << " outlines, " << refused << " refused (nearer than min_depth); farthest corner " << worst
+            << " px outside the image (tolerance 0.5); at most " << most << " corners\n";
 }
 
 TEST(RenderOutline, RefusesWhatItCannotDraw) {
   std::vector<Vec2> poly;
   const OutlineOptions o{.focal_px = 1000, .tolerance_px = 0.5, .min_depth = 0.05};
   EXPECT_FALSE(sschOutline(std::vector<Vec3>{}, 0.1, o, poly));
-  EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(0, 0, -1)}, 0.1, o, poly));           // behind
-  EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(0, 0, 0.1)}, 0.08, o, poly));         // nearer than min_depth
-  EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(0, 0, 1)}, 2.0, o, poly));            // contains the camera
-  EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(0, NAN, 1)}, 0.1, o, poly));          // not finite
+  EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(0, 0, -1)}, 0.1, o, poly));    // behind
+  EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(0, 0, 0.1)}, 0.08, o, poly));  // nearer than min_depth
+  EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(0, 0, 1)}, 2.0, o, poly));     // contains the camera
+  EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(0, NAN, 1)}, 0.1, o, poly));   // not finite
   EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(0, 0, 1)}, INFINITY, o, poly));
-  EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(1e300, 0, 1)}, 0.1, o, poly));        // overflows
+  EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(1e300, 0, 1)}, 0.1, o, poly));  // overflows
   EXPECT_TRUE(poly.empty());
   // Too fine for the vertex limit.
   EXPECT_FALSE(sschOutline(std::vector<Vec3>{Vec3(0, 0, 1)}, 0.5,
@@ -245,8 +245,9 @@ TEST(RenderOutline, ColourLayerMatchesTheCpuSilhouette) {
   int outlines = 0;
   for (int trial = 0; trial < 10; ++trial) {
     const Camera c = kccd::testing::randomCamera(rng, trial % 4 != 3);
-    const std::vector<Vec3> pts = kccd::testing::randomCloud(rng, 1 + static_cast<int>(rng() % 5),
-                                                             Vec3(0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng)), 0.1 + 0.3 * std::abs(u(rng)));
+    const std::vector<Vec3> pts =
+        kccd::testing::randomCloud(rng, 1 + static_cast<int>(rng() % 5), Vec3(0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng)),
+                                   0.1 + 0.3 * std::abs(u(rng)));
     const double radius = 0.05 + 0.15 * std::abs(u(rng));
     const cv::Mat cpu = kccd::testing::cpuSilhouette(c, pts, radius) > 0;
     Renderer r(c);

@@ -127,30 +127,36 @@ TEST(StateLog, EveryMistakeIsOneLineWithItsPlace) {
       {kHeader, "log.csv:1: no data rows after the header (a log needs at least one sample)"},
       {h + "\n", "log.csv:1: no data rows after the header (a log needs at least one sample)"},
       // Header.
-      {"time,\"base\",arm,slide,pose.x,pose.y,pose.z\n" + ok, "log.csv:1:6: a '\"': quoting is not part of the dialect"},
+      {"time,\"base\",arm,slide,pose.x,pose.y,pose.z\n" + ok,
+       "log.csv:1:6: a '\"': quoting is not part of the dialect"},
       {"# time,base\n" + h + ok, "log.csv:1:1: a comment line (the dialect has none)"},
-      {"base,arm,slide,pose.x,pose.y,pose.z\n0,0,0,0,0,0\n", "log.csv:1: column 'time': missing (the sample times in seconds)"},
+      {"base,arm,slide,pose.x,pose.y,pose.z\n0,0,0,0,0,0\n",
+       "log.csv:1: column 'time': missing (the sample times in seconds)"},
       {"time,base,arm,slide,pose.x,pose.z\n0,0,0,0,0,0\n",
        "log.csv:1: column 'pose.y': missing (a state value of the model: every one needs a column)"},
-      {"time,base,arm,slide,pose.x,pose.y,pose.z,arm\n",
-       "log.csv:1:42: column 'arm': named twice (also at 1:11)"},
+      {"time,base,arm,slide,pose.x,pose.y,pose.z,arm\n", "log.csv:1:42: column 'arm': named twice (also at 1:11)"},
       {"time,base,time\n", "log.csv:1:11: column 'time': named twice (also at 1:1)"},
       {"time,base,arm,slide,pose.x,pose.y,pose.z,elbow\n",
-       "log.csv:1:42: column 'elbow': unknown column (a state value of the model? see kccd info; a column to skip is listed as "
+       "log.csv:1:42: column 'elbow': unknown column (a state value of the model? see kccd info; a column to skip is "
+       "listed as "
        "ignored)"},
       {"time,base,arm,slide,pose.x,pose.y,pose.z,elbow.vel\n",
-       "log.csv:1:42: column 'elbow.vel': unknown column (a state value of the model? see kccd info; a column to skip is "
+       "log.csv:1:42: column 'elbow.vel': unknown column (a state value of the model? see kccd info; a column to skip "
+       "is "
        "listed as ignored)"},
       {"time,base,arm,slide,pose.x,pose.y,pose.z,time.vel\n",
-       "log.csv:1:42: column 'time.vel': unknown column (a state value of the model? see kccd info; a column to skip is "
+       "log.csv:1:42: column 'time.vel': unknown column (a state value of the model? see kccd info; a column to skip "
+       "is "
        "listed as ignored)"},
       {"time,base, arm,slide,pose.x,pose.y,pose.z\n",
        "log.csv:1:11: column ' arm': space around the name (the dialect has no padding)"},
       {"time,,base\n", "log.csv:1:6: empty column name (field 2 of the header)"},
       {"time,base,\x01x\x7f\n",
-       "log.csv:1:11: column '\\x01x\\x7f': unknown column (a state value of the model? see kccd info; a column to skip is "
+       "log.csv:1:11: column '\\x01x\\x7f': unknown column (a state value of the model? see kccd info; a column to "
+       "skip is "
        "listed as ignored)"},
-      {"time,base,arm\rslide\n", "log.csv:1:14: a carriage return not followed by a line feed (line ends are LF or CRLF)"},
+      {"time,base,arm\rslide\n",
+       "log.csv:1:14: a carriage return not followed by a line feed (line ends are LF or CRLF)"},
       {h + "0,0,0,0,0,0,0\r", "log.csv:2:14: a carriage return not followed by a line feed (line ends are LF or CRLF)"},
       // Rows.
       {h + ok + "1,0,0,0,0,0\n", "log.csv:3: 6 fields, but the header has 7 columns"},
@@ -173,8 +179,10 @@ TEST(StateLog, EveryMistakeIsOneLineWithItsPlace) {
       {h + "0,-,0,0,0,0,0\n", "log.csv:2:3: column 'base': not a decimal number: '-'"},
       {h + "0,.,0,0,0,0,0\n", "log.csv:2:3: column 'base': not a decimal number: '.'"},
       {h + "0,1\x01,0,0,0,0,0\n", "log.csv:2:3: column 'base': not a decimal number: '1\\x01'"},
-      {h + "0, 1.5,0,0,0,0,0\n", "log.csv:2:3: column 'base': space around the number ' 1.5' (the dialect has no padding)"},
-      {h + "0,1.5 ,0,0,0,0,0\n", "log.csv:2:3: column 'base': space around the number '1.5 ' (the dialect has no padding)"},
+      {h + "0, 1.5,0,0,0,0,0\n",
+       "log.csv:2:3: column 'base': space around the number ' 1.5' (the dialect has no padding)"},
+      {h + "0,1.5 ,0,0,0,0,0\n",
+       "log.csv:2:3: column 'base': space around the number '1.5 ' (the dialect has no padding)"},
       {h + "0,1e400,0,0,0,0,0\n", "log.csv:2:3: column 'base': '1e400' is out of the range of a double"},
       {h + "0,0,0,0,0,0,-2e300\n",
        "log.csv:2:13: column 'pose.z': '-2e300' is beyond the largest magnitude accepted (1e300)"},
@@ -209,9 +217,10 @@ TEST(StateLog, AModelStateNamedTimeCannotBeLogged) {
     parseStateLog("time\n0\n", "log.csv", m);
     FAIL() << "parsed";
   } catch (const StateLogError& e) {
-    EXPECT_EQ(std::string(e.what()),
-              "log.csv:1: column 'time': the model has a state value named 'time', which a log cannot tell from its time "
-              "column");
+    EXPECT_EQ(
+        std::string(e.what()),
+        "log.csv:1: column 'time': the model has a state value named 'time', which a log cannot tell from its time "
+        "column");
   }
 }
 
@@ -270,10 +279,10 @@ TEST(StateAt, InterpolatesTheChordOfCurvedMotion) {
   const StateLog log = logOf(kHeader + "\n0,0,0,0,0,0,0\n0.5,0,0.25,0,0,0,0\n2,0,4,0,0,0,0\n");
   std::vector<double> state(6), velocity(6);
   EXPECT_EQ(stateAt(log, 0.2, 10.0, state, velocity), StateMatch::Interpolated);
-  EXPECT_DOUBLE_EQ(state[1], 0.1);       // 0 + 0.2 * (0.25 / 0.5)
+  EXPECT_DOUBLE_EQ(state[1], 0.1);  // 0 + 0.2 * (0.25 / 0.5)
   EXPECT_DOUBLE_EQ(velocity[1], 0.5);
   EXPECT_EQ(stateAt(log, 1.5, 10.0, state, velocity), StateMatch::Interpolated);
-  EXPECT_DOUBLE_EQ(state[1], 2.75);      // 0.25 + 1.0 * (3.75 / 1.5)
+  EXPECT_DOUBLE_EQ(state[1], 2.75);  // 0.25 + 1.0 * (3.75 / 1.5)
   EXPECT_DOUBLE_EQ(velocity[1], 2.5);
 }
 
@@ -307,14 +316,16 @@ TEST(StateAt, UnlimitedRevoluteJointsTakeTheShorterArc) {
 }
 
 TEST(StateAt, ExactTimesGiveTheSampleItself) {
-  const StateLog log = logOf(kHeader + "\n0,0.1,0.2,0.3,0.4,0.5,0.6\n0.1,1.1,1.2,1.3,1.4,1.5,1.6\n0.3,3.1,-3.2,3.3,3.4,3.5,3.6\n");
+  const StateLog log =
+      logOf(kHeader + "\n0,0.1,0.2,0.3,0.4,0.5,0.6\n0.1,1.1,1.2,1.3,1.4,1.5,1.6\n0.3,3.1,-3.2,3.3,3.4,3.5,3.6\n");
   std::vector<double> state(6), velocity(6);
   for (const double dt : {0.0, 0.9e-9, -0.9e-9}) {
     ASSERT_EQ(stateAt(log, 0.1 + dt, 0.0, state), StateMatch::Exact) << dt;  // no gap allowed: only samples
-    EXPECT_EQ(std::vector<double>(state.begin(), state.end()), std::vector<double>(log.row(1).begin(), log.row(1).end()));
+    EXPECT_EQ(std::vector<double>(state.begin(), state.end()),
+              std::vector<double>(log.row(1).begin(), log.row(1).end()));
   }
   EXPECT_EQ(stateAt(log, 0.1 + 2e-9, 0.0, state), StateMatch::None);
-  EXPECT_EQ(stateAt(log, -0.5e-9, 0.0, state), StateMatch::Exact);   // just before the first sample
+  EXPECT_EQ(stateAt(log, -0.5e-9, 0.0, state), StateMatch::Exact);       // just before the first sample
   EXPECT_EQ(stateAt(log, 0.3 + 0.5e-9, 0.0, state), StateMatch::Exact);  // just after the last
   EXPECT_EQ(state[1], -3.2);
   // The velocity at a sample: the central difference of its neighbours, one-sided at the ends.
@@ -342,8 +353,8 @@ TEST(StateAt, GapsAndTheEndsOfTheLogGiveNoState) {
   std::vector<double> state(6, -7.0);
   EXPECT_EQ(stateAt(log, 0.05, 0.15, state), StateMatch::Interpolated);
   EXPECT_NEAR(state[3], 0.5, 1e-12);
-  EXPECT_EQ(stateAt(log, 0.5, 0.15, state), StateMatch::None);          // a 0.8 s gap
-  EXPECT_NEAR(state[3], 0.5, 1e-12);                                    // left unchanged
+  EXPECT_EQ(stateAt(log, 0.5, 0.15, state), StateMatch::None);            // a 0.8 s gap
+  EXPECT_NEAR(state[3], 0.5, 1e-12);                                      // left unchanged
   EXPECT_EQ(stateAt(log, 0.5, 0.8001, state), StateMatch::Interpolated);  // the gap allowed
   EXPECT_NEAR(state[3], 5.0, 1e-12);
   EXPECT_EQ(stateAt(log, 0.5, 0.7999, state), StateMatch::None);
@@ -412,7 +423,8 @@ TEST(StateAt, WrongSpanSizesAreCallerErrors) {
 }
 
 TEST(StateLog, MedianPeriod) {
-  EXPECT_NEAR(logOf(kHeader + "\n" + row(0) + row(0.1) + row(0.3) + row(0.4) + row(2.0) + row(2.1)).medianPeriod(), 0.1, 1e-12);
+  EXPECT_NEAR(logOf(kHeader + "\n" + row(0) + row(0.1) + row(0.3) + row(0.4) + row(2.0) + row(2.1)).medianPeriod(), 0.1,
+              1e-12);
   EXPECT_DOUBLE_EQ(logOf(kHeader + "\n" + row(0) + row(1) + row(3)).medianPeriod(), 1.5);
 }
 

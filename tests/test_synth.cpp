@@ -223,8 +223,9 @@ TEST_F(Synth, CalibrationRecoversTheTrueCamera) {
     fs::create_directories(dir("seq"));
     ASSERT_TRUE(cv::imwrite(dir("seq") + "/frame_000000.png", first));
     const std::string from_sequence = dir("overlay_camera_seq.yaml");
-    const Outcome q = runKccd("calib --intrinsics " + dir("a") + "/intrinsics.yaml --video " + dir("seq") +
-                              "/frame_%06d.png --frame 0 --tags " + dir("a") + "/tags.yaml -o " + from_sequence + " -q");
+    const Outcome q =
+        runKccd("calib --intrinsics " + dir("a") + "/intrinsics.yaml --video " + dir("seq") +
+                "/frame_%06d.png --frame 0 --tags " + dir("a") + "/tags.yaml -o " + from_sequence + " -q");
     ASSERT_EQ(q.code, 0) << q.err << q.out;
     EXPECT_EQ(kccd::testing::readText(from_sequence), kccd::testing::readText(solved));
   }
@@ -260,33 +261,46 @@ TEST_F(Synth, ARecordingAsABagCalibratesAndOverlaysAsItsFiles) {
   }
   std::ofstream(dir("bagrec") + "/times.csv") << times;
   const std::string bag = dir("bagrec") + "/rec.mcap";
-  const Outcome w = kccd::testing::runProgram(std::string(KCCD_NODE) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_recording.mjs " + bag + " --images " +
-                                              dir("bagrec") + "/f_%06d.png --frame-times " + dir("bagrec") + "/times.csv --states " + dir("a") +
-                                              "/states.csv --state-offset " + kccd::shortestNumber(offset), true);
+  const Outcome w = kccd::testing::runProgram(
+      std::string(KCCD_NODE) + " " + KCCD_SOURCE_DIR + "/tests/bags/write_recording.mjs " + bag + " --images " +
+          dir("bagrec") + "/f_%06d.png --frame-times " + dir("bagrec") + "/times.csv --states " + dir("a") +
+          "/states.csv --state-offset " + kccd::shortestNumber(offset),
+      true);
   ASSERT_EQ(w.code, 0) << "the bag writer failed (npm ci in tests/bags?): " << w.out;
   // calib: frame 0 of the video with the log's state at its time, against frame 0 of the bag.
-  const std::string common = "calib --intrinsics " + dir("a") + "/intrinsics.yaml --tags " + dir("a") + "/tags.yaml --model " + kHumanoid + " -q";
-  const Outcome files = runKccd(common + " --video " + dir("a") + "/video.mkv --frame 3 --states " + dir("a") + "/states.csv --time " +
-                                kccd::shortestNumber(3 / fps + offset) + " -o " + dir("bagrec") + "/cam_files.yaml --check " + dir("bagrec") + "/check_files.png");
-  const Outcome from_bag = runKccd(common + " --bag " + bag + " --frame 3 -o " + dir("bagrec") + "/cam_bag.yaml --check " + dir("bagrec") + "/check_bag.png");
+  const std::string common = "calib --intrinsics " + dir("a") + "/intrinsics.yaml --tags " + dir("a") +
+                             "/tags.yaml --model " + kHumanoid + " -q";
+  const Outcome files = runKccd(common + " --video " + dir("a") + "/video.mkv --frame 3 --states " + dir("a") +
+                                "/states.csv --time " + kccd::shortestNumber(3 / fps + offset) + " -o " +
+                                dir("bagrec") + "/cam_files.yaml --check " + dir("bagrec") + "/check_files.png");
+  const Outcome from_bag = runKccd(common + " --bag " + bag + " --frame 3 -o " + dir("bagrec") +
+                                   "/cam_bag.yaml --check " + dir("bagrec") + "/check_bag.png");
   ASSERT_EQ(files.code, 0) << files.err;
   ASSERT_EQ(from_bag.code, 0) << from_bag.err;
   EXPECT_EQ(from_bag.err, "");
-  EXPECT_EQ(kccd::testing::readText(dir("bagrec") + "/cam_bag.yaml"), kccd::testing::readText(dir("bagrec") + "/cam_files.yaml"));
-  EXPECT_EQ(kccd::testing::readText(dir("bagrec") + "/check_bag.png"), kccd::testing::readText(dir("bagrec") + "/check_files.png"));
+  EXPECT_EQ(kccd::testing::readText(dir("bagrec") + "/cam_bag.yaml"),
+            kccd::testing::readText(dir("bagrec") + "/cam_files.yaml"));
+  EXPECT_EQ(kccd::testing::readText(dir("bagrec") + "/check_bag.png"),
+            kccd::testing::readText(dir("bagrec") + "/check_files.png"));
   // A frame the bag does not have, and options that do not go with --bag: one line each.
   const Outcome beyond = runKccd(common + " --bag " + bag + " --frame 10 -o " + dir("bagrec") + "/x.yaml");
   EXPECT_EQ(beyond.code, 2);
-  EXPECT_NE(beyond.err.find("--frame 10: " + bag + " has 10 images on /camera/image_raw/compressed (frames 0 ... 9)"), std::string::npos) << beyond.err;
-  const Outcome both = runKccd(common + " --bag " + bag + " --frame 0 --states " + dir("a") + "/states.csv --time 0 -o " + dir("bagrec") + "/x.yaml");
+  EXPECT_NE(beyond.err.find("--frame 10: " + bag + " has 10 images on /camera/image_raw/compressed (frames 0 ... 9)"),
+            std::string::npos)
+      << beyond.err;
+  const Outcome both = runKccd(common + " --bag " + bag + " --frame 0 --states " + dir("a") +
+                               "/states.csv --time 0 -o " + dir("bagrec") + "/x.yaml");
   EXPECT_EQ(both.code, 2);
   EXPECT_NE(both.err.find("not with --bag"), std::string::npos) << both.err;
   EXPECT_FALSE(fs::exists(dir("bagrec") + "/x.yaml"));
   // overlay: the bag's ten frames against the first ten of the files' run.
   const std::string camera = dir("a") + "/camera_true.yaml";
-  const Outcome a = runKccd("overlay " + kHumanoid + " --camera " + camera + " --bag " + bag + " --report " + dir("bagrec") + "/bag.json -q");
-  const Outcome b = runKccd("overlay " + kHumanoid + " --camera " + camera + " --video " + dir("a") + "/video.mkv --states " + dir("a") +
-                            "/states.csv --time-offset " + kccd::shortestNumber(offset) + " --frames 0:10 --report " + dir("bagrec") + "/files.json -q");
+  const Outcome a = runKccd("overlay " + kHumanoid + " --camera " + camera + " --bag " + bag + " --report " +
+                            dir("bagrec") + "/bag.json -q");
+  const Outcome b =
+      runKccd("overlay " + kHumanoid + " --camera " + camera + " --video " + dir("a") + "/video.mkv --states " +
+              dir("a") + "/states.csv --time-offset " + kccd::shortestNumber(offset) + " --frames 0:10 --report " +
+              dir("bagrec") + "/files.json -q");
   ASSERT_EQ(a.code, 0) << a.err;
   ASSERT_EQ(b.code, 0) << b.err;
   const json ra = json::parse(kccd::testing::readText(dir("bagrec") + "/bag.json")).at("frames");
@@ -315,18 +329,19 @@ TEST_F(Synth, ARecordingAsABagCalibratesAndOverlaysAsItsFiles) {
 TEST_F(Synth, OverlayMasksAgreeAtTheTrueClockAndNotAtAWrongOne) {
   const double offset = summary()["state_log"]["time_offset"].get<double>();
   const auto agreement = [&](double t, const std::string& name) {
-    const Outcome r = runKccd("overlay " + kHumanoid + " --camera " + dir("a") + "/camera_true.yaml --video " + dir("a") +
-                              "/video.mkv --states " + dir("a") + "/states.csv --masks " + dir("a") + "/masks --time-offset " +
-                              kccd::formatNumber(t, 17) + " --report " + dir(name) + ".json --timeline " + dir(name) + ".png -q");
+    const Outcome r =
+        runKccd("overlay " + kHumanoid + " --camera " + dir("a") + "/camera_true.yaml --video " + dir("a") +
+                "/video.mkv --states " + dir("a") + "/states.csv --masks " + dir("a") + "/masks --time-offset " +
+                kccd::formatNumber(t, 17) + " --report " + dir(name) + ".json --timeline " + dir(name) + ".png -q");
     EXPECT_EQ(r.code, 0) << r.err;
     return json::parse(kccd::testing::readText(dir(name) + ".json"));
   };
   const json right = agreement(offset, "agree_right"), wrong = agreement(offset + 0.2, "agree_wrong");
   const json& a = right["mask_agreement"];
   const json& b = wrong["mask_agreement"];
-  std::printf("true clock: mean IoU %.3f (smallest %.3f, %d low); 0.2 s off: %.3f (smallest %.3f, %d low)\n", a["mean_iou"].get<double>(),
-              a["min_iou"].get<double>(), a["low_frames"].get<int>(), b["mean_iou"].get<double>(), b["min_iou"].get<double>(),
-              b["low_frames"].get<int>());
+  std::printf("true clock: mean IoU %.3f (smallest %.3f, %d low); 0.2 s off: %.3f (smallest %.3f, %d low)\n",
+              a["mean_iou"].get<double>(), a["min_iou"].get<double>(), a["low_frames"].get<int>(),
+              b["mean_iou"].get<double>(), b["min_iou"].get<double>(), b["low_frames"].get<int>());
   EXPECT_EQ(a["frames"].get<int>(), static_cast<int>(std::lround(kSeconds * kFps)));
   EXPECT_GT(a["min_iou"].get<double>(), 0.7);
   EXPECT_EQ(a["low_frames"].get<int>(), 0);
@@ -384,12 +399,14 @@ void writeVisualArm(const std::string& path) {
     std::ofstream obj(fs::path(path).parent_path() / "upper_arm.obj");
     for (int i = 0; i < 8; ++i)
       obj << "v " << (i & 1 ? 0.4 : 0.0) << " " << (i & 2 ? 0.04 : -0.04) << " " << (i & 4 ? 0.04 : -0.04) << "\n";
-    obj << "f 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\nf 1 2 6\nf 1 6 5\nf 3 7 8\nf 3 8 4\nf 1 5 7\nf 1 7 3\nf 2 4 8\nf 2 8 6\n";
+    obj << "f 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\nf 1 2 6\nf 1 6 5\nf 3 7 8\nf 3 8 4\nf 1 5 7\nf 1 7 3\nf 2 4 8\nf 2 8 "
+           "6\n";
   }
-  model += "visuals:\n"
-           "  - frame: world\n    cylinder: {radius: 0.08, length: 0.35}\n    origin: {xyz: [0, 0, 0.175]}\n"
-           "  - frame: shoulder_pitch\n    mesh: upper_arm.obj\n    colour: [0.9, 0.4, 0.1]\n"
-           "  - frame: elbow\n    box: [0.4, 0.07, 0.07]\n    origin: {xyz: [0.2, 0, 0]}\n";
+  model +=
+      "visuals:\n"
+      "  - frame: world\n    cylinder: {radius: 0.08, length: 0.35}\n    origin: {xyz: [0, 0, 0.175]}\n"
+      "  - frame: shoulder_pitch\n    mesh: upper_arm.obj\n    colour: [0.9, 0.4, 0.1]\n"
+      "  - frame: elbow\n    box: [0.4, 0.07, 0.07]\n    origin: {xyz: [0.2, 0, 0]}\n";
   std::ofstream(path) << model;
 }
 
@@ -398,7 +415,8 @@ void writeVisualArm(const std::string& path) {
 // meshes, sharing no code with it), closer than from the volumes, which are wider than the visuals.
 TEST_F(Synth, MaskRefinementDrawsTheModelsVisuals) {
   writeVisualArm(dir("visual_arm_masks.yaml"));
-  const Outcome r = runKccd("synth " + dir("visual_arm_masks.yaml") + " -o " + dir("vm") + " --seconds 0.4 --fps 10 --seed 4 --no-collision -q");
+  const Outcome r = runKccd("synth " + dir("visual_arm_masks.yaml") + " -o " + dir("vm") +
+                            " --seconds 0.4 --fps 10 --seed 4 --no-collision -q");
   ASSERT_EQ(r.code, 0) << r.err;
   const double offset = summary("vm")["state_log"]["time_offset"].get<double>();
   kccd::calib::Camera rough = kccd::calib::loadCamera(dir("vm") + "/camera_true.yaml");
@@ -406,20 +424,25 @@ TEST_F(Synth, MaskRefinementDrawsTheModelsVisuals) {
   rough.tvec[1] -= 0.03;
   kccd::calib::saveCamera(rough, dir("vm_rough.yaml"));
   const auto calib = [&](const std::string& draw, const std::string& bodies) {
-    const Outcome c = runKccd("calib --intrinsics " + dir("vm") + "/intrinsics.yaml --video " + dir("vm") + "/video.mkv --frame 0 --frame 3" +
-                              " --time " + kccd::formatNumber(offset, 17) + " --time " + kccd::formatNumber(offset + 0.3, 17) +
-                              " --model " + dir("visual_arm_masks.yaml") + " --states " + dir("vm") + "/states.csv --masks " + dir("vm") +
-                              "/masks/frame_000000.png " + dir("vm") + "/masks/frame_000003.png --camera " + dir("vm_rough.yaml") +
-                              " --truth " + dir("vm") + "/camera_true.yaml --draw " + draw + bodies + " -o " + dir("vm_" + draw + ".yaml") + " --json");
+    const Outcome c =
+        runKccd("calib --intrinsics " + dir("vm") + "/intrinsics.yaml --video " + dir("vm") +
+                "/video.mkv --frame 0 --frame 3" + " --time " + kccd::formatNumber(offset, 17) + " --time " +
+                kccd::formatNumber(offset + 0.3, 17) + " --model " + dir("visual_arm_masks.yaml") + " --states " +
+                dir("vm") + "/states.csv --masks " + dir("vm") + "/masks/frame_000000.png " + dir("vm") +
+                "/masks/frame_000003.png --camera " + dir("vm_rough.yaml") + " --truth " + dir("vm") +
+                "/camera_true.yaml --draw " + draw + bodies + " -o " + dir("vm_" + draw + ".yaml") + " --json");
     EXPECT_EQ(c.code, 0) << c.err << c.out;
     return json::parse(c.out);
   };
   const json visuals = calib("visuals", ""), volumes = calib("volumes", " --mask-bodies pedestal,upper_arm,forearm");
   EXPECT_EQ(visuals["refinement"]["drawn"], "visual meshes");
   EXPECT_EQ(volumes["refinement"]["drawn"], "collision volumes (asked for)");
-  const double vis_deg = visuals["truth_error"]["rotation_deg"].get<double>(), vis_m = visuals["truth_error"]["position_m"].get<double>();
-  const double vol_deg = volumes["truth_error"]["rotation_deg"].get<double>(), vol_m = volumes["truth_error"]["position_m"].get<double>();
-  std::printf("drawn visuals: %.3f deg, %.2f mm; volumes: %.3f deg, %.2f mm from the true camera\n", vis_deg, vis_m * 1e3, vol_deg, vol_m * 1e3);
+  const double vis_deg = visuals["truth_error"]["rotation_deg"].get<double>(),
+               vis_m = visuals["truth_error"]["position_m"].get<double>();
+  const double vol_deg = volumes["truth_error"]["rotation_deg"].get<double>(),
+               vol_m = volumes["truth_error"]["position_m"].get<double>();
+  std::printf("drawn visuals: %.3f deg, %.2f mm; volumes: %.3f deg, %.2f mm from the true camera\n", vis_deg,
+              vis_m * 1e3, vol_deg, vol_m * 1e3);
   EXPECT_LT(vis_deg, 0.1);
   EXPECT_LT(vis_m, 0.004);
   EXPECT_LT(vis_m, vol_m);
@@ -460,13 +483,15 @@ TEST_F(Synth, DrawsTheModelsVisualGeometry) {
   }
   // `kccd overlay --visuals` draws the same appearance over the recording: where the visuals'
   // mask says the robot is, the overlay with --visuals differs from the one without.
-  const std::string common = "overlay " + dir("visual_arm.yaml") + " --camera " + dir("v") + "/camera_true.yaml --video " +
-                             dir("v") + "/video.mkv --states " + dir("v") + "/states.csv --time-offset 0.137 -q --plain";
+  const std::string common = "overlay " + dir("visual_arm.yaml") + " --camera " + dir("v") +
+                             "/camera_true.yaml --video " + dir("v") + "/video.mkv --states " + dir("v") +
+                             "/states.csv --time-offset 0.137 -q --plain";
   const Outcome with = runKccd(common + " --visuals --png-dir " + dir("ov_with"));
   ASSERT_EQ(with.code, 0) << with.err;
   const Outcome without = runKccd(common + " --png-dir " + dir("ov_without"));
   ASSERT_EQ(without.code, 0) << without.err;
-  const cv::Mat a = cv::imread(dir("ov_with") + "/frame_000000.png"), b = cv::imread(dir("ov_without") + "/frame_000000.png");
+  const cv::Mat a = cv::imread(dir("ov_with") + "/frame_000000.png"),
+                b = cv::imread(dir("ov_without") + "/frame_000000.png");
   const cv::Mat robot = cv::imread(dir("v") + "/masks/frame_000000.png", cv::IMREAD_UNCHANGED) > 0;
   ASSERT_FALSE(a.empty());
   ASSERT_EQ(a.size(), robot.size());
@@ -475,16 +500,18 @@ TEST_F(Synth, DrawsTheModelsVisualGeometry) {
   cv::cvtColor(diff, changed, cv::COLOR_BGR2GRAY);
   changed = changed > 0;
   EXPECT_GT(cv::countNonZero(changed & robot), cv::countNonZero(robot) / 2);
-  const Outcome none = runKccd("overlay " + kData + "/demo_arm.yaml --camera " + dir("v") + "/camera_true.yaml --video " +
-                               dir("v") + "/video.mkv --states " + dir("v") + "/states.csv -q --visuals --png-dir " + dir("ov_none"));
+  const Outcome none =
+      runKccd("overlay " + kData + "/demo_arm.yaml --camera " + dir("v") + "/camera_true.yaml --video " + dir("v") +
+              "/video.mkv --states " + dir("v") + "/states.csv -q --visuals --png-dir " + dir("ov_none"));
   EXPECT_EQ(none.code, 2);
   EXPECT_NE(none.err.find("has no visuals"), std::string::npos) << none.err;
-  const Outcome scale = runKccd("synth " + dir("visual_arm.yaml") + " -o " + dir("s") + " --seconds 0.2 --visible-scale 0.5 -q");
+  const Outcome scale =
+      runKccd("synth " + dir("visual_arm.yaml") + " -o " + dir("s") + " --seconds 0.2 --visible-scale 0.5 -q");
   EXPECT_EQ(scale.code, 2);
   EXPECT_NE(scale.err.find("--visible-scale"), std::string::npos) << scale.err;
   // A visual mesh that cannot be read is one line naming the visual and the file.
-  std::ofstream(dir("broken_visual.yaml")) << kccd::testing::readText(kData + "/demo_arm.yaml")
-                                           << "visuals:\n  - frame: world\n    mesh: missing.obj\n";
+  std::ofstream(dir("broken_visual.yaml"))
+      << kccd::testing::readText(kData + "/demo_arm.yaml") << "visuals:\n  - frame: world\n    mesh: missing.obj\n";
   const Outcome e = runKccd("synth " + dir("broken_visual.yaml") + " -o " + dir("w") + " --seconds 0.2 -q");
   EXPECT_EQ(e.code, 2);
   EXPECT_NE(e.err.find("visuals[0]: "), std::string::npos) << e.err;
@@ -529,8 +556,8 @@ namespace {
 TEST_F(Synth, CalibratedOverlayCoversTheVisibleGeometry) {
   const json j = summary();
   const std::string solved = dir("overlay_camera.yaml");
-  const Outcome r = runKccd("calib --intrinsics " + dir("a") + "/intrinsics.yaml --video " + dir("a") + "/video.mkv --frame 0 --tags " +
-                            dir("a") + "/tags.yaml -o " + solved + " -q");
+  const Outcome r = runKccd("calib --intrinsics " + dir("a") + "/intrinsics.yaml --video " + dir("a") +
+                            "/video.mkv --frame 0 --tags " + dir("a") + "/tags.yaml -o " + solved + " -q");
   ASSERT_EQ(r.code, 0) << r.err << r.out;
   const kccd::Model m = kccd::loadModel(kHumanoid);
   const kccd::StateLog log = kccd::loadStateLog(dir("a") + "/states.csv", m);
@@ -543,7 +570,8 @@ TEST_F(Synth, CalibratedOverlayCoversTheVisibleGeometry) {
     const int index = f["index"];
     if (kccd::stateAt(log, index / fps + offset, 1.5 * log.medianPeriod(), s) == kccd::StateMatch::None) continue;
     checker.query(s, s, kccd::QueryOptions{.type = kccd::QueryType::Distances});
-    const kccd::render::Frame frame = renderer.render(kccd::render::staticSceneVolumes(m, checker, s, {}), {}, false, true);
+    const kccd::render::Frame frame =
+        renderer.render(kccd::render::staticSceneVolumes(m, checker, s, {}), {}, false, true);
     char name[32];
     std::snprintf(name, sizeof name, "/masks/frame_%06d.png", index);
     const cv::Mat visible = cv::imread(dir("a") + name, cv::IMREAD_UNCHANGED);

@@ -65,7 +65,8 @@ class TimeOffsetSearch : public ::testing::Test {
     for (int i = 0; i < frames; ++i) {
       cv::Mat m(120, 160, CV_8UC3, cv::Scalar(40, 40, 40));
       const double x = 80 + 30 * position(i / fps + shift);
-      cv::rectangle(m, cv::Rect(static_cast<int>(std::lround(x)) - 10, 50, 20, 20), cv::Scalar(255, 255, 255), cv::FILLED);
+      cv::rectangle(m, cv::Rect(static_cast<int>(std::lround(x)) - 10, 50, 20, 20), cv::Scalar(255, 255, 255),
+                    cv::FILLED);
       w.write(m);
     }
   }

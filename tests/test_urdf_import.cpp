@@ -106,13 +106,16 @@ TEST(UrdfImport, ClearErrors) {
     }
     return std::string("no error");
   };
-  const std::string link = "<link name=\"a\"><collision><geometry><sphere radius=\"0.1\"/></geometry></collision></link>";
+  const std::string link =
+      "<link name=\"a\"><collision><geometry><sphere radius=\"0.1\"/></geometry></collision></link>";
   std::ofstream(dir / "broken.urdf") << "<robot name=\"r\">\n<link name=\"a\">\n</robot>\n";
   EXPECT_NE(message((dir / "broken.urdf").string()).find("broken.urdf:"), std::string::npos);
-  std::ofstream(dir / "package.urdf") << "<robot name=\"r\"><link name=\"a\"><collision><geometry>"
-                                         "<mesh filename=\"package://nowhere/m.stl\"/></geometry></collision></link></robot>";
-  EXPECT_NE(message((dir / "package.urdf").string()).find("unknown package 'nowhere' (give --package-path nowhere=DIR)"),
-            std::string::npos);
+  std::ofstream(dir / "package.urdf")
+      << "<robot name=\"r\"><link name=\"a\"><collision><geometry>"
+         "<mesh filename=\"package://nowhere/m.stl\"/></geometry></collision></link></robot>";
+  EXPECT_NE(
+      message((dir / "package.urdf").string()).find("unknown package 'nowhere' (give --package-path nowhere=DIR)"),
+      std::string::npos);
   EXPECT_NE(message((dir / "missing.urdf").string()).find("cannot open"), std::string::npos);
   // A mesh that is not there: the message starts with the URDF and names the link and the mesh.
   std::ofstream(dir / "mesh.urdf") << "<robot name=\"r\"><link name=\"a\"><collision><geometry>"
@@ -122,7 +125,8 @@ TEST(UrdfImport, ClearErrors) {
   EXPECT_NE(missing_mesh.find("none.stl: cannot open the file"), std::string::npos) << missing_mesh;
   // A moving joint with a zero axis (found by fuzz_urdf), and a model the loader refuses (a link
   // beyond the 1e6 m bound): both start with the URDF's name.
-  const std::string two_links = "<link name=\"b\"><collision><geometry><sphere radius=\"0.1\"/></geometry></collision></link>";
+  const std::string two_links =
+      "<link name=\"b\"><collision><geometry><sphere radius=\"0.1\"/></geometry></collision></link>";
   std::ofstream(dir / "axis.urdf") << "<robot name=\"r\">" << link << two_links
                                    << "<joint name=\"j\" type=\"continuous\"><parent link=\"a\"/><child link=\"b\"/>"
                                       "<axis xyz=\"0 0 0\"/></joint></robot>";
@@ -233,8 +237,8 @@ TEST(UrdfImport, HullBodiesAreTheLinksConvexHulls) {
   for (const Vec3& d : std::vector<Vec3>{Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ(), Vec3(1, 1, 1).normalized(),
                                          Vec3(1, -2, 3).normalized()})
     for (double sign : {1.0, -1.0})
-      EXPECT_LE(static_cast<double>(kccd::testing::referencePointHullDistance(Vec3(0.1, 0, 0) + sign * 0.04 * d,
-                                                                             slider.points)),
+      EXPECT_LE(static_cast<double>(
+                    kccd::testing::referencePointHullDistance(Vec3(0.1, 0, 0) + sign * 0.04 * d, slider.points)),
                 slider.radius + 1e-12)
           << d.transpose();
   opt.fit.method = km::FitMethod::Tolerance;
@@ -256,11 +260,14 @@ std::string boxesStl(const std::vector<std::array<Vec3, 2>>& boxes) {
   std::ostringstream out;
   out.precision(17);
   out << "solid boxes\n";
-  static constexpr int kFaces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+  static constexpr int kFaces[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1},
+                                       {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
   for (const auto& box : boxes) {
     const Vec3& lo = box[0];
     const Vec3& hi = box[1];
-    auto corner = [&](int i) { return Vec3(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z()); };
+    auto corner = [&](int i) {
+      return Vec3(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+    };
     for (const auto& f : kFaces)
       for (const std::array<int, 3> t : {std::array<int, 3>{f[0], f[1], f[2]}, std::array<int, 3>{f[0], f[2], f[3]}}) {
         out << "facet normal 0 0 0\nouter loop\n";
@@ -276,7 +283,8 @@ std::string boxesStl(const std::vector<std::array<Vec3, 2>>& boxes) {
 // A forearm ending in a fork around a wrist (the KR5's shape): the default import splits the
 // forearm into pieces (bodies forearm/1, ... with link: forearm, each within the tolerance of its
 // piece's hull), which leave the wrist in the gap clear of a 1 mm margin where the forearm's one
-// hull holds it (the gap leaves 15 mm each side; a piece may keep up to the 10 mm concavity); the pieces hold every vertex of the mesh, and the point budget holds every body.
+// hull holds it (the gap leaves 15 mm each side; a piece may keep up to the 10 mm concavity); the pieces hold every
+// vertex of the mesh, and the point budget holds every body.
 TEST(UrdfImport, ConcaveLinkInPiecesClearsWhatItsHullHolds) {
   const std::string tag = "kccd_import_pieces";
   kccd::testing::writeScratch(tag, "forearm.stl",

@@ -103,7 +103,9 @@ TEST_F(VideoSourceTest, SequencesCountFromOneWithoutAFrameZeroAndNameADamagedFra
     ADD_FAILURE() << "a damaged frame read";
   } catch (const VideoError& e) {
     const std::string what = e.what();
-    EXPECT_EQ(what.rfind("--video from1: frame 1 cannot be decoded (" + path("from1/f_2.png") + ": image: a damaged PNG (", 0), 0u)
+    EXPECT_EQ(what.rfind(
+                  "--video from1: frame 1 cannot be decoded (" + path("from1/f_2.png") + ": image: a damaged PNG (", 0),
+              0u)
         << what;
   }
 }
@@ -114,7 +116,8 @@ TEST_F(VideoSourceTest, UnreadableRecordingsAreOneLineNamingThem) {
   EXPECT_EQ(errorOf(path("seq"), "--video seq"),
             "--video seq: not a regular file (a video file, or an image sequence such as frames/frame_%06d.png)");
   std::ofstream(path("junk.mp4")) << "not a video\n";
-  EXPECT_EQ(errorOf(path("junk.mp4"), "--video junk.mp4"), "--video junk.mp4: cannot open the video (not a video OpenCV reads)");
+  EXPECT_EQ(errorOf(path("junk.mp4"), "--video junk.mp4"),
+            "--video junk.mp4: cannot open the video (not a video OpenCV reads)");
   EXPECT_EQ(errorOf(path("seq/none_%06d.png"), "--video none"),
             "--video none: no image of the sequence can be read (no file " + path("seq/none_000000.png") + " or " +
                 path("seq/none_000001.png") + ")");

@@ -56,12 +56,14 @@ Background estimateBackground(std::span<const BackgroundSample> samples, int min
         if (m < min_samples) continue;
         cv::Vec3b median;
         for (int k = 0; k < 3; ++k) {
-          for (int i = 0; i < m; ++i) channel[static_cast<std::size_t>(i)] = free[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)];
+          for (int i = 0; i < m; ++i)
+            channel[static_cast<std::size_t>(i)] = free[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)];
           median[k] = medianOf(channel.data(), m);
         }
         for (int i = 0; i < m; ++i) {
           const auto& c = free[static_cast<std::size_t>(i)];
-          distance[static_cast<std::size_t>(i)] = std::abs(c[0] - median[0]) + std::abs(c[1] - median[1]) + std::abs(c[2] - median[2]);
+          distance[static_cast<std::size_t>(i)] =
+              std::abs(c[0] - median[0]) + std::abs(c[1] - median[1]) + std::abs(c[2] - median[2]);
         }
         out.bgr.at<cv::Vec3b>(y, x) = median;
         out.spread.at<float>(y, x) = static_cast<float>(1.4826 * medianOf(distance.data(), m));
@@ -93,7 +95,8 @@ cv::Mat foregroundMask(const BackgroundSample& frame, const Background& backgrou
       if (sb >= 60) ratios.push_back(static_cast<float>(sf) / static_cast<float>(sb));
     }
   double gain = 1.0;
-  if (ratios.size() >= 100) gain = std::clamp(static_cast<double>(medianOf(ratios.data(), static_cast<int>(ratios.size()))), 0.5, 2.0);
+  if (ratios.size() >= 100)
+    gain = std::clamp(static_cast<double>(medianOf(ratios.data(), static_cast<int>(ratios.size()))), 0.5, 2.0);
   cv::Mat mask = cv::Mat::zeros(size, CV_8UC1);
   for (int y = 0; y < size.height; ++y)
     for (int x = 0; x < size.width; ++x) {

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <charconv>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <optional>
 
@@ -45,7 +45,8 @@ std::string checkCameraText(const std::string& text, const std::string& path) {
   std::size_t line = 1;
   for (const char ch : text) {
     const auto c = static_cast<unsigned char>(ch);
-    if (c == '\n') ++line;
+    if (c == '\n')
+      ++line;
     else if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7f)
       failAt(path, line, "file", "control byte " + printable(std::string_view(&ch, 1)) + " (not a text file)");
   }
@@ -59,7 +60,8 @@ std::string checkCameraText(const std::string& text, const std::string& path) {
     }
     const char next = at + 3 < text.size() ? text[at + 3] : '\n';
     if (next != '\n' && next != '\r' && next != ' ' && next != '\t')
-      failAt(path, line, "document", "'" + text.substr(at, 3) + "' must stand alone at the start of a line (a document marker)");
+      failAt(path, line, "document",
+             "'" + text.substr(at, 3) + "' must stand alone at the start of a line (a document marker)");
     if (text.find('\n', at) == std::string::npos) break;
   }
   std::size_t start = 0;
@@ -67,12 +69,15 @@ std::string checkCameraText(const std::string& text, const std::string& path) {
   const std::size_t eol = std::min(text.find('\n', start), text.size());
   std::string first = text.substr(start, eol - start);
   while (!first.empty() && (first.back() == '\r' || first.back() == ' ' || first.back() == '\t')) first.pop_back();
-  const bool header = first.size() > 8 && (first.compare(0, 8, "%YAML:1.") == 0 || first.compare(0, 8, "%YAML 1.") == 0) &&
+  const bool header = first.size() > 8 &&
+                      (first.compare(0, 8, "%YAML:1.") == 0 || first.compare(0, 8, "%YAML 1.") == 0) &&
                       std::all_of(first.begin() + 8, first.end(), [](char c) { return c >= '0' && c <= '9'; });
-  if (text.find_first_not_of(" \t\r\n") == std::string::npos) fail(path, "file", "empty (an OpenCV YAML camera file starts with %YAML:1.0)");
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos)
+    fail(path, "file", "empty (an OpenCV YAML camera file starts with %YAML:1.0)");
   if (!header)
-    failAt(path, 1, "header", "the first line must be %YAML:1.0 (an OpenCV FileStorage YAML camera file), not '" +
-                                  printable(first, 40) + "'");
+    failAt(path, 1, "header",
+           "the first line must be %YAML:1.0 (an OpenCV FileStorage YAML camera file), not '" + printable(first, 40) +
+               "'");
   std::string yaml = text;
   std::fill(yaml.begin(), yaml.begin() + static_cast<std::ptrdiff_t>(eol), ' ');
   return yaml;
@@ -128,13 +133,15 @@ class CameraNodes {
     const std::optional<long long> r = integer(rows), c = integer(cols);
     if (!r || !c || !dt.IsScalar() || !data.IsSequence()) failAtNode(node, field, layout);
     if (*r < 1 || *r > kMaxMatrixSide || *c < 1 || *c > kMaxMatrixSide)
-      failAtNode(node, field, std::to_string(*r) + "x" + std::to_string(*c) +
-                                  " is not a camera matrix size (rows and cols in 1.." + std::to_string(kMaxMatrixSide) + ")");
+      failAtNode(node, field,
+                 std::to_string(*r) + "x" + std::to_string(*c) + " is not a camera matrix size (rows and cols in 1.." +
+                     std::to_string(kMaxMatrixSide) + ")");
     const std::string type = dt.Scalar();
     if (type.size() != 1 || std::string("ucwsifd").find(type[0]) == std::string::npos)
       failAtNode(dt, field, "dt '" + printable(type, 20) + "' is not one of u, c, w, s, i, f, d");
     if (data.size() != static_cast<std::size_t>(*r * *c))
-      failAtNode(data, field, "data has " + std::to_string(data.size()) + " values, rows x cols is " + std::to_string(*r * *c));
+      failAtNode(data, field,
+                 "data has " + std::to_string(data.size()) + " values, rows x cols is " + std::to_string(*r * *c));
     cv::Mat m(static_cast<int>(*r), static_cast<int>(*c), CV_64F);
     for (std::size_t i = 0; i < data.size(); ++i) {
       const std::optional<double> v = real(data[i]);
@@ -149,7 +156,8 @@ class CameraNodes {
     if (!node.IsDefined() || node.IsNull()) fail(reader_.source(), field, "missing");
     const std::optional<long long> v = integer(node);
     if (!v) failAtNode(node, field, "not an integer");
-    if (*v <= 0 || *v > kMaxImageSide) failAtNode(node, field, std::to_string(*v) + " is not in 1.." + std::to_string(kMaxImageSide));
+    if (*v <= 0 || *v > kMaxImageSide)
+      failAtNode(node, field, std::to_string(*v) + " is not in 1.." + std::to_string(kMaxImageSide));
     return static_cast<int>(*v);
   }
 
@@ -173,13 +181,20 @@ class CameraNodes {
   // `v` stored as OpenCV stores a value of element type `dt` (rounded and saturated for integers).
   static double asType(double v, char dt) {
     switch (dt) {
-      case 'u': return cv::saturate_cast<std::uint8_t>(v);
-      case 'c': return cv::saturate_cast<std::int8_t>(v);
-      case 'w': return cv::saturate_cast<std::uint16_t>(v);
-      case 's': return cv::saturate_cast<std::int16_t>(v);
-      case 'i': return cv::saturate_cast<int>(v);
-      case 'f': return static_cast<double>(static_cast<float>(v));
-      default: return v;
+      case 'u':
+        return cv::saturate_cast<std::uint8_t>(v);
+      case 'c':
+        return cv::saturate_cast<std::int8_t>(v);
+      case 'w':
+        return cv::saturate_cast<std::uint16_t>(v);
+      case 's':
+        return cv::saturate_cast<std::int16_t>(v);
+      case 'i':
+        return cv::saturate_cast<int>(v);
+      case 'f':
+        return static_cast<double>(static_cast<float>(v));
+      default:
+        return v;
     }
   }
 
@@ -205,7 +220,8 @@ void undistortPixels(const Camera& camera, const cv::Mat& pixels, cv::Mat& norma
   cv::projectPoints(xyz, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.camera_matrix, camera.distortion, back);
   // At most one image width / height of extra field on each side.
   const double x_lo = -(cx + 0.5) / fx - camera.width / fx, x_hi = (camera.width - cx - 0.5) / fx + camera.width / fx;
-  const double y_lo = -(cy + 0.5) / fy - camera.height / fy, y_hi = (camera.height - cy - 0.5) / fy + camera.height / fy;
+  const double y_lo = -(cy + 0.5) / fy - camera.height / fy,
+               y_hi = (camera.height - cy - 0.5) / fy + camera.height / fy;
   valid.assign(n, 0);
   for (int i = 0; i < n; ++i) {
     const cv::Vec2d p = normal.at<cv::Vec2d>(i), b = back.at<cv::Vec2d>(i), u = pixels.at<cv::Vec2d>(i);
@@ -235,8 +251,9 @@ void Camera::validate(const std::string& source) const {
   if (width <= 0 || width > kMaxImageSide) fail(source, "image_width", sides);
   if (height <= 0 || height > kMaxImageSide) fail(source, "image_height", sides);
   if (static_cast<long>(width) * height > kMaxImagePixels)
-    fail(source, "image_width", std::to_string(width) + "x" + std::to_string(height) + " has more than " +
-                                    std::to_string(kMaxImagePixels) + " pixels");
+    fail(source, "image_width",
+         std::to_string(width) + "x" + std::to_string(height) + " has more than " + std::to_string(kMaxImagePixels) +
+             " pixels");
   const cv::Matx33d& k = camera_matrix;
   for (int i = 0; i < 9; ++i)
     if (!std::isfinite(k.val[i])) fail(source, "camera_matrix", "non-finite value");
@@ -301,7 +318,8 @@ Camera loadCamera(const std::string& path, CameraPose pose) {
   Camera c;
   try {
     const YAML::Node root = nodes.load(checkCameraText(text, path));
-    if (!root.IsMap()) nodes.failAtNode(root, "document", "the top level must be a mapping of camera fields (image_width: ...)");
+    if (!root.IsMap())
+      nodes.failAtNode(root, "document", "the top level must be a mapping of camera fields (image_width: ...)");
     c.width = nodes.size(root, "image_width");
     c.height = nodes.size(root, "image_height");
     const cv::Mat k = nodes.matrix(root, "camera_matrix");

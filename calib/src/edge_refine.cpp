@@ -22,9 +22,9 @@ constexpr double kMaxTurnDeg = 30.0;  // an edge within this of the outline's di
 // One pyramid level of a picture's edges: per pixel the edge's gradient direction in whole
 // degrees of [0, 180) plus 1 (0: no edge), and the gradient's magnitude.
 struct EdgeLevel {
-  cv::Mat direction;  // CV_8U
-  cv::Mat magnitude;  // CV_32F
-  double scale = 1.0; // level pixels per full-resolution pixel: 1 / 2^level
+  cv::Mat direction;   // CV_8U
+  cv::Mat magnitude;   // CV_32F
+  double scale = 1.0;  // level pixels per full-resolution pixel: 1 / 2^level
 };
 
 // The value below which `share` of `values` lie (a sample of every 7th, enough for a threshold).
@@ -152,7 +152,8 @@ class ShiftSearch {
   };
 
   // Sum over `points` of 1 - d / 2 level px (0 beyond), each moved to c + growth (p - c) + shift.
-  double score(std::span<const Point> points, const cv::Point2d& centre, double growth, const cv::Point2d& shift) const {
+  double score(std::span<const Point> points, const cv::Point2d& centre, double growth,
+               const cv::Point2d& shift) const {
     double sum = 0.0;
     for (const Point& p : points) {
       const cv::Point2d q = centre + growth * (p.pixel - centre) + shift;
@@ -204,7 +205,8 @@ Camera preAlign(const Camera& start, std::span<const detail::FrameShape> volumes
     for (int j = -reach; j <= reach; ++j)
       for (int i = -reach; i <= reach; ++i) {
         const cv::Point2d shift(i * step, j * step);
-        if (const double s = search.score(points, centre, growth, shift); s > best) best = s, best_growth = growth, best_shift = shift;
+        if (const double s = search.score(points, centre, growth, shift); s > best)
+          best = s, best_growth = growth, best_shift = shift;
       }
   if (!(best > 1.1 * at_start)) return start;
   // The camera turned so the centre lands where the search put it after the move along the axis,
@@ -224,12 +226,15 @@ RefineResult refineToEdges(const Camera& start, std::span<const EdgeFrame> frame
   for (const EdgeFrame& f : frames) {
     if (f.image.cols != start.width || f.image.rows != start.height || f.image.depth() != CV_8U ||
         (f.image.channels() != 1 && f.image.channels() != 3))
-      throw InputError("edges: a picture of " + std::to_string(f.image.cols) + "x" + std::to_string(f.image.rows) + " with " +
-                       std::to_string(f.image.channels()) + " channel(s) for a camera of " + std::to_string(start.width) + "x" +
-                       std::to_string(start.height) + " (8-bit grey or BGR needed)");
+      throw InputError("edges: a picture of " + std::to_string(f.image.cols) + "x" + std::to_string(f.image.rows) +
+                       " with " + std::to_string(f.image.channels()) + " channel(s) for a camera of " +
+                       std::to_string(start.width) + "x" + std::to_string(start.height) +
+                       " (8-bit grey or BGR needed)");
     cv::Mat grey;
-    if (f.image.channels() == 3) cv::cvtColor(f.image, grey, cv::COLOR_BGR2GRAY);
-    else grey = f.image;
+    if (f.image.channels() == 3)
+      cv::cvtColor(f.image, grey, cv::COLOR_BGR2GRAY);
+    else
+      grey = f.image;
     levels.push_back({edgesOf(grey, 0), edgesOf(grey, 1), edgesOf(grey, 2)});
     shapes.push_back({f.volumes, f.meshes});
     volumes.push_back({f.volumes, {}});
@@ -239,7 +244,9 @@ RefineResult refineToEdges(const Camera& start, std::span<const EdgeFrame> frame
   result.camera = start;
   result.frames.resize(frames.size());
   const auto samplesAt = [&](const Camera& at) { return detail::outlineSamples(at, shapes, options.spacing_px); };
-  const auto volumeSamplesAt = [&](const Camera& at) { return detail::outlineSamples(at, volumes, options.spacing_px); };
+  const auto volumeSamplesAt = [&](const Camera& at) {
+    return detail::outlineSamples(at, volumes, options.spacing_px);
+  };
   const bool meshes = std::any_of(frames.begin(), frames.end(), [](const EdgeFrame& f) { return !f.meshes.empty(); });
 
   // Coarse to fine: (level, Cauchy scale as a share of the diagonal); the search reaches 3 scales.
@@ -265,8 +272,8 @@ RefineResult refineToEdges(const Camera& start, std::span<const EdgeFrame> frame
         cam = detail::fitPose(cam, samplesAt, edgeField(levels, stage.level, 3.0 * c), scales, options.max_iterations,
                               result.iterations, &anchors, 1e-5, 1e-4);
       else
-        cam = detail::fitPose(cam, volumeSamplesAt, edgeField(levels, stage.level, 3.0 * c), scales, options.max_iterations,
-                              result.iterations, &anchors);
+        cam = detail::fitPose(cam, volumeSamplesAt, edgeField(levels, stage.level, 3.0 * c), scales,
+                              options.max_iterations, result.iterations, &anchors);
     }
     return cam;
   };
@@ -316,7 +323,8 @@ RefineResult refineToEdges(const Camera& start, std::span<const EdgeFrame> frame
   if (!clicks.empty()) {
     std::vector<cv::Point2d> px;
     cv::projectPoints(anchors.world, cam.rvec, cam.tvec, cam.camera_matrix, cam.distortion, px);
-    for (std::size_t i = 0; i < px.size(); ++i) clicks_rms += std::pow(cv::norm(px[i] - anchors.pixel[i]), 2) / static_cast<double>(px.size());
+    for (std::size_t i = 0; i < px.size(); ++i)
+      clicks_rms += std::pow(cv::norm(px[i] - anchors.pixel[i]), 2) / static_cast<double>(px.size());
     clicks_rms = std::sqrt(clicks_rms);
   }
 
@@ -343,19 +351,22 @@ RefineResult refineToEdges(const Camera& start, std::span<const EdgeFrame> frame
     return keepStart("the drawn robot's outline is not in the pictures (" + std::to_string(at_end.samples.size()) +
                      " points): the start is kept");
   if (!(after > before + 1e-3) || worst_drop > 0.05)
-    return keepStart("the edges did not improve the pose (" + formatNumber(100 * before, 3) + "% of the outline on edges at the start, " +
-                     formatNumber(100 * after, 3) + "% refined" +
-                     (worst_drop > 0.05 ? ", one frame " + formatNumber(100 * worst_drop, 3) + " points worse" : std::string()) +
-                     "): the start is kept");
+    return keepStart(
+        "the edges did not improve the pose (" + formatNumber(100 * before, 3) +
+        "% of the outline on edges at the start, " + formatNumber(100 * after, 3) + "% refined" +
+        (worst_drop > 0.05 ? ", one frame " + formatNumber(100 * worst_drop, 3) + " points worse" : std::string()) +
+        "): the start is kept");
   if (clicks_rms > 3.0 * options.click_px)
-    return keepStart("the edges' best pose leaves the clicks " + formatNumber(clicks_rms, 3) + " px rms from their points (more than 3 x " +
-                     formatNumber(options.click_px, 3) + " px): the edges and the clicks disagree, the start is kept (check the clicks, "
+    return keepStart("the edges' best pose leaves the clicks " + formatNumber(clicks_rms, 3) +
+                     " px rms from their points (more than 3 x " + formatNumber(options.click_px, 3) +
+                     " px): the edges and the clicks disagree, the start is kept (check the clicks, "
                      "or start closer)");
   if (const std::optional<detail::FromStart> d = detail::fromStart(cam, start); options.start_is_prior && d) {
     if (d->sigmas > 3.0 && after - before < 0.05)
       return keepStart("the edges' best pose lies " + formatNumber(d->difference.rotation_deg, 3) + " deg and " +
-                       formatNumber(d->difference.position_m * 1000, 3) + " mm from the start (" + formatNumber(d->sigmas, 3) +
-                       " sigma) for " + formatNumber(100 * (after - before), 3) + " points more of the outline on edges: the start is kept");
+                       formatNumber(d->difference.position_m * 1000, 3) + " mm from the start (" +
+                       formatNumber(d->sigmas, 3) + " sigma) for " + formatNumber(100 * (after - before), 3) +
+                       " points more of the outline on edges: the start is kept");
   }
   const detail::Evaluation e = detail::evaluate(cam, cam.rvec, cam.tvec, at_end.samples, fine, c_final, true);
   result.covariance = detail::poseCovariance(e);
@@ -363,17 +374,18 @@ RefineResult refineToEdges(const Camera& start, std::span<const EdgeFrame> frame
   cam.rotation_sigma_deg = rotation_sigma;
   cam.position_sigma_m = position_sigma;
   if (after < options.min_matched || !(*cam.rotation_sigma_deg <= options.max_rotation_sigma_deg))
-    return keepStart("the drawn robot's outline and the pictures' edges agree too little (" + formatNumber(100 * after, 3) +
-                     "% on edges, at least " + formatNumber(100 * options.min_matched, 3) + "% needed; rotation +-" +
-                     formatNumber(*cam.rotation_sigma_deg, 3) +
-                     " deg, at most " + formatNumber(options.max_rotation_sigma_deg, 3) +
-                     "): add frames with the robot elsewhere, check each frame's state and which bodies are in view, or give masks; "
-                     "the start is kept");
+    return keepStart(
+        "the drawn robot's outline and the pictures' edges agree too little (" + formatNumber(100 * after, 3) +
+        "% on edges, at least " + formatNumber(100 * options.min_matched, 3) + "% needed; rotation +-" +
+        formatNumber(*cam.rotation_sigma_deg, 3) + " deg, at most " + formatNumber(options.max_rotation_sigma_deg, 3) +
+        "): add frames with the robot elsewhere, check each frame's state and which bodies are in view, or give masks; "
+        "the start is kept");
   result.camera = cam;
   result.improved = true;
   result.message = "refined to the edges: " + formatNumber(100 * before, 3) + "% -> " + formatNumber(100 * after, 3) +
                    "% of the outline on edges over " + std::to_string(frames.size()) + " frame(s), rotation +-" +
-                   formatNumber(*cam.rotation_sigma_deg, 3) + " deg, position +-" + formatNumber(*cam.position_sigma_m, 3) + " m";
+                   formatNumber(*cam.rotation_sigma_deg, 3) + " deg, position +-" +
+                   formatNumber(*cam.position_sigma_m, 3) + " m";
   return result;
 }
 

@@ -13,9 +13,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "jpeg_decode.hpp"
 #include "kccd/calib/camera.hpp"
 #include "kccd/file_reader.hpp"
-#include "jpeg_decode.hpp"
 
 namespace kccd::calib {
 
@@ -35,7 +35,8 @@ std::string tooLarge(long width, long height) {
 // messages to itself. The pixels are OpenCV's: 16-bit samples keep their high byte in 8-bit
 // output, alpha is dropped (not composited) in BGR and grey output, grey with alpha reads as
 // BGRA when unchanged.
-cv::Mat decodePng(std::span<const std::uint8_t> bytes, ImageColour colour, const std::function<void(const std::string&)>& fail) {
+cv::Mat decodePng(std::span<const std::uint8_t> bytes, ImageColour colour,
+                  const std::function<void(const std::string&)>& fail) {
   png_image image;
   std::memset(&image, 0, sizeof image);
   image.version = PNG_IMAGE_VERSION;
@@ -45,7 +46,8 @@ cv::Mat decodePng(std::span<const std::uint8_t> bytes, ImageColour colour, const
     png_image* image;
     ~Release() { png_image_free(image); }
   } release{&image};
-  if (const std::string problem = tooLarge(static_cast<long>(image.width), static_cast<long>(image.height)); !problem.empty())
+  if (const std::string problem = tooLarge(static_cast<long>(image.width), static_cast<long>(image.height));
+      !problem.empty())
     fail(problem);
   const bool sixteen = (image.format & PNG_FORMAT_FLAG_LINEAR) != 0;  // 16-bit samples, read as stored
   const bool alpha = (image.format & PNG_FORMAT_FLAG_ALPHA) != 0;
@@ -53,8 +55,10 @@ cv::Mat decodePng(std::span<const std::uint8_t> bytes, ImageColour colour, const
   image.format = (col ? PNG_FORMAT_FLAG_COLOR | PNG_FORMAT_FLAG_BGR : 0u) | (alpha ? PNG_FORMAT_FLAG_ALPHA : 0u) |
                  (sixteen ? PNG_FORMAT_FLAG_LINEAR : 0u);
   const int channels = static_cast<int>(PNG_IMAGE_SAMPLE_CHANNELS(image.format));
-  cv::Mat stored(static_cast<int>(image.height), static_cast<int>(image.width), CV_MAKETYPE(sixteen ? CV_16U : CV_8U, channels));
-  if (!png_image_finish_read(&image, nullptr, stored.data, static_cast<png_int_32>(stored.step[0] / stored.elemSize1()), nullptr))
+  cv::Mat stored(static_cast<int>(image.height), static_cast<int>(image.width),
+                 CV_MAKETYPE(sixteen ? CV_16U : CV_8U, channels));
+  if (!png_image_finish_read(&image, nullptr, stored.data, static_cast<png_int_32>(stored.step[0] / stored.elemSize1()),
+                             nullptr))
     fail("a damaged PNG (" + printable(image.message) + ")");
   if (sixteen && alpha) {  // the simplified API gives 16-bit colour premultiplied by alpha: undone
     const int colours = channels - 1;
@@ -63,7 +67,8 @@ cv::Mat decodePng(std::span<const std::uint8_t> bytes, ImageColour colour, const
       for (int c = 0; c < stored.cols; ++c, px += channels) {
         const std::uint32_t a = px[colours];
         for (int k = 0; k < colours; ++k)
-          px[k] = a == 0 ? 0 : static_cast<std::uint16_t>(std::min<std::uint32_t>(65535u, (px[k] * 65535u + a / 2) / a));
+          px[k] =
+              a == 0 ? 0 : static_cast<std::uint16_t>(std::min<std::uint32_t>(65535u, (px[k] * 65535u + a / 2) / a));
       }
     }
   }
@@ -75,7 +80,8 @@ cv::Mat decodePng(std::span<const std::uint8_t> bytes, ImageColour colour, const
     for (int r = 0; r < stored.rows; ++r) {
       const auto* in = stored.ptr<std::uint16_t>(r);
       auto* out = eight.ptr<std::uint8_t>(r);
-      for (std::size_t k = 0; k < static_cast<std::size_t>(stored.cols) * stored.channels(); ++k) out[k] = static_cast<std::uint8_t>(in[k] >> 8);
+      for (std::size_t k = 0; k < static_cast<std::size_t>(stored.cols) * stored.channels(); ++k)
+        out[k] = static_cast<std::uint8_t>(in[k] >> 8);
     }
   }
   const int n = eight.channels();

@@ -16,9 +16,7 @@ namespace {
 
 constexpr double kPlaneTolerance = 1e-3;  // of the board's extent
 
-std::string plural(std::size_t n, const char* word) {
-  return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
-}
+std::string plural(std::size_t n, const char* word) { return std::to_string(n) + " " + word + (n == 1 ? "" : "s"); }
 
 // The plane through points: centroid, in-plane axes, normal (the direction of least spread), the
 // largest distance of a point from it (and which point) and the extent (bounding-box diagonal).
@@ -104,7 +102,8 @@ double median(std::vector<double> v) {
 }
 
 const char* const kAddViews =
-    "add images of the whole board from different angles (tilted 20-45 deg about different axes, some near the image corners)";
+    "add images of the whole board from different angles (tilted 20-45 deg about different axes, some near the image "
+    "corners)";
 
 }  // namespace
 
@@ -112,18 +111,21 @@ Board Board::grid(const TagGrid& g) {
   const auto fail = [](const std::string& field, const std::string& problem) {
     throw InputError(InputLocation{"grid", 0, 0, field}, problem);
   };
-  if (g.cols < 1 || g.cols > kMaxTagId + 1) fail("cols", std::to_string(g.cols) + " is not in 1.." + std::to_string(kMaxTagId + 1));
-  if (g.rows < 1 || g.rows > kMaxTagId + 1) fail("rows", std::to_string(g.rows) + " is not in 1.." + std::to_string(kMaxTagId + 1));
+  if (g.cols < 1 || g.cols > kMaxTagId + 1)
+    fail("cols", std::to_string(g.cols) + " is not in 1.." + std::to_string(kMaxTagId + 1));
+  if (g.rows < 1 || g.rows > kMaxTagId + 1)
+    fail("rows", std::to_string(g.rows) + " is not in 1.." + std::to_string(kMaxTagId + 1));
   if (g.cols * g.rows < 2) fail("size", "a board needs at least 2 tags (a view needs 8 corners)");
   if (!std::isfinite(g.tag_size) || !(g.tag_size > 0) || g.tag_size > kMaxTagSize)
     fail("tag size", formatNumber(g.tag_size, 3) + " m is not in (0, " + formatNumber(kMaxTagSize, 3) + "]");
   if (!std::isfinite(g.spacing) || g.spacing < 0 || g.spacing > kMaxTagSize)
     fail("spacing", formatNumber(g.spacing, 3) + " m is not in [0, " + formatNumber(kMaxTagSize, 3) + "]");
-  if (g.first_id < 0 || g.first_id > kMaxTagId) fail("first id", std::to_string(g.first_id) + " is not in 0.." + std::to_string(kMaxTagId));
+  if (g.first_id < 0 || g.first_id > kMaxTagId)
+    fail("first id", std::to_string(g.first_id) + " is not in 0.." + std::to_string(kMaxTagId));
   const int last = g.first_id + g.cols * g.rows - 1;
   if (last > kMaxTagId)
-    fail("first id", "the ids " + std::to_string(g.first_id) + ".." + std::to_string(last) + " go beyond tag36h11's last id " +
-                         std::to_string(kMaxTagId));
+    fail("first id", "the ids " + std::to_string(g.first_id) + ".." + std::to_string(last) +
+                         " go beyond tag36h11's last id " + std::to_string(kMaxTagId));
   Board b;
   const double pitch = g.tag_size + g.spacing;
   for (int r = 0; r < g.rows; ++r)
@@ -163,7 +165,8 @@ Board Board::fromLayout(const TagLayout& layout, const std::string& source) {
   return b;
 }
 
-std::vector<Correspondence> Board::correspondences(const std::vector<TagDetection>& detections, const std::string& image) const {
+std::vector<Correspondence> Board::correspondences(const std::vector<TagDetection>& detections,
+                                                   const std::string& image) const {
   return tagCorrespondences(detections, layout, image).points;
 }
 
@@ -187,16 +190,20 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
                                      const IntrinsicsOptions& options) {
   // ---- input
   const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
-  if (options.min_views < 3 || options.min_points_per_view < 6 || !(options.min_tilt_deg >= 0) || !(options.min_tilt_deg < 90) ||
-      !positive(options.outlier_ratio) || !(options.outlier_floor_px >= 0) || !std::isfinite(options.outlier_floor_px) ||
-      !(options.noise_floor_px >= 0) || !std::isfinite(options.noise_floor_px) || !positive(options.max_focal_sigma_ratio) ||
+  if (options.min_views < 3 || options.min_points_per_view < 6 || !(options.min_tilt_deg >= 0) ||
+      !(options.min_tilt_deg < 90) || !positive(options.outlier_ratio) || !(options.outlier_floor_px >= 0) ||
+      !std::isfinite(options.outlier_floor_px) || !(options.noise_floor_px >= 0) ||
+      !std::isfinite(options.noise_floor_px) || !positive(options.max_focal_sigma_ratio) ||
       !positive(options.max_principal_sigma_ratio) || (options.fix_k3 && options.rational))
-    throw InputError("intrinsics options: a threshold is out of range, min_views < 3, min_points_per_view < 6, or fix_k3 with rational");
+    throw InputError(
+        "intrinsics options: a threshold is out of range, min_views < 3, min_points_per_view < 6, or fix_k3 with "
+        "rational");
   const int width = image_size.width, height = image_size.height;
   if (width < 1 || width > kMaxImageSide || height < 1 || height > kMaxImageSide ||
       static_cast<long>(width) * height > kMaxImagePixels)
     throw InputError("image size: " + std::to_string(width) + "x" + std::to_string(height) + " is not in 1.." +
-                     std::to_string(kMaxImageSide) + " a side with at most " + std::to_string(kMaxImagePixels) + " pixels");
+                     std::to_string(kMaxImageSide) + " a side with at most " + std::to_string(kMaxImagePixels) +
+                     " pixels");
   std::unordered_set<std::string> view_names;
   for (std::size_t i = 0; i < views.size(); ++i) {
     const IntrinsicsView& v = views[i];
@@ -234,8 +241,10 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
     result.rejected.clear();
     result.used.clear();
     for (const auto& r : result.views) {
-      if (r.used) result.used.push_back(r.name);
-      else if (!r.note.empty()) result.rejected.push_back(r.name);
+      if (r.used)
+        result.used.push_back(r.name);
+      else if (!r.note.empty())
+        result.rejected.push_back(r.name);
     }
   };
   const auto too_few = [&](const std::string& why) {
@@ -388,12 +397,14 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
   result.sigmas.fy = std_int.at<double>(1);
   result.sigmas.cx = std_int.at<double>(2);
   result.sigmas.cy = std_int.at<double>(3);
-  for (std::size_t j = 0; j < n_dist; ++j) result.sigmas.distortion.push_back(std_int.at<double>(static_cast<int>(4 + j)));
+  for (std::size_t j = 0; j < n_dist; ++j)
+    result.sigmas.distortion.push_back(std_int.at<double>(static_cast<int>(4 + j)));
   Camera cam;
   cam.width = width;
   cam.height = height;
   cam.camera_matrix = cv::Matx33d(k);
-  cam.distortion.assign(d.begin<double>(), d.begin<double>() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(n_dist, d.total())));
+  cam.distortion.assign(d.begin<double>(),
+                        d.begin<double>() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(n_dist, d.total())));
   cam.reprojection_rms_px = rms;
   result.camera = cam;
   if (max_tilt < options.min_tilt_deg) return fronto(max_tilt);
@@ -406,8 +417,10 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
     return std::string(name) + " " + formatNumber(value, 5) + " is known only to +-" + formatNumber(sigma * scale, 3) +
            " px";
   };
-  if (!(result.sigmas.fx * scale <= options.max_focal_sigma_ratio * fx)) weak = known("fx", result.sigmas.fx, fx);
-  else if (!(result.sigmas.fy * scale <= options.max_focal_sigma_ratio * fy)) weak = known("fy", result.sigmas.fy, fy);
+  if (!(result.sigmas.fx * scale <= options.max_focal_sigma_ratio * fx))
+    weak = known("fx", result.sigmas.fx, fx);
+  else if (!(result.sigmas.fy * scale <= options.max_focal_sigma_ratio * fy))
+    weak = known("fy", result.sigmas.fy, fy);
   else if (!(result.sigmas.cx * scale <= options.max_principal_sigma_ratio * width))
     weak = known("cx", result.sigmas.cx, cam.camera_matrix(0, 2));
   else if (!(result.sigmas.cy * scale <= options.max_principal_sigma_ratio * height))
@@ -422,7 +435,8 @@ IntrinsicsResult calibrateIntrinsics(const std::vector<IntrinsicsView>& views, c
     cam.validate("solved camera");
   } catch (const CameraError& e) {
     result.status = IntrinsicsStatus::IllConditioned;
-    result.message = std::string(e.what()) + ": the lens model is not usable; add views with the board near the image corners and edges";
+    result.message = std::string(e.what()) +
+                     ": the lens model is not usable; add views with the board near the image corners and edges";
     return result;
   }
   result.status = IntrinsicsStatus::Solved;

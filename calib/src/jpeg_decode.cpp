@@ -8,8 +8,8 @@
 #include <opencv2/core.hpp>
 
 // jpeglib.h needs size_t and FILE declared first.
-#include <jpeglib.h>
 #include <jerror.h>
+#include <jpeglib.h>
 
 namespace kccd::calib::detail {
 namespace {
@@ -72,7 +72,8 @@ int exifOrientation(const jpeg_saved_marker_ptr markers) {
       return little ? tiff[at] | (tiff[at + 1] << 8) : (tiff[at] << 8) | tiff[at + 1];
     };
     const auto u32 = [&](std::size_t at) -> std::size_t {
-      return little ? std::size_t{u16(at)} | (std::size_t{u16(at + 2)} << 16) : (std::size_t{u16(at)} << 16) | u16(at + 2);
+      return little ? std::size_t{u16(at)} | (std::size_t{u16(at + 2)} << 16)
+                    : (std::size_t{u16(at)} << 16) | u16(at + 2);
     };
     const std::size_t ifd = u32(4);
     if (ifd + 2 > size) continue;
@@ -92,14 +93,29 @@ int exifOrientation(const jpeg_saved_marker_ptr markers) {
 // Turns `img` as Exif orientation `o` says, as OpenCV's imdecode does.
 void orientImage(cv::Mat& img, int o) {
   switch (o) {
-    case 2: cv::flip(img, img, 1); break;
-    case 3: cv::flip(img, img, -1); break;
-    case 4: cv::flip(img, img, 0); break;
-    case 5: cv::transpose(img, img); break;
-    case 6: cv::transpose(img, img), cv::flip(img, img, 1); break;
-    case 7: cv::transpose(img, img), cv::flip(img, img, -1); break;
-    case 8: cv::transpose(img, img), cv::flip(img, img, 0); break;
-    default: break;
+    case 2:
+      cv::flip(img, img, 1);
+      break;
+    case 3:
+      cv::flip(img, img, -1);
+      break;
+    case 4:
+      cv::flip(img, img, 0);
+      break;
+    case 5:
+      cv::transpose(img, img);
+      break;
+    case 6:
+      cv::transpose(img, img), cv::flip(img, img, 1);
+      break;
+    case 7:
+      cv::transpose(img, img), cv::flip(img, img, -1);
+      break;
+    case 8:
+      cv::transpose(img, img), cv::flip(img, img, 0);
+      break;
+    default:
+      break;
   }
 }
 

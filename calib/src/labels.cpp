@@ -23,7 +23,8 @@ Labels parseLabels(const std::string& yaml_text, const std::string& source) {
     if (!root.IsMap()) r.fail(root, "labels", "expected a mapping with labels: [...]");
     r.onlyKeys(root, "file", {"labels"});
     const YAML::Node list = r.require(root, "labels", "file");
-    if (!list.IsSequence()) r.fail(list, "labels", "expected a list of {name, pixel, world} or {name, pixel, body, point, state}");
+    if (!list.IsSequence())
+      r.fail(list, "labels", "expected a list of {name, pixel, world} or {name, pixel, body, point, state}");
     if (list.size() == 0) r.fail(list, "labels", "at least one label is needed");
     Labels out;
     std::map<std::string, std::size_t> seen;  // name -> index
@@ -36,7 +37,9 @@ Labels parseLabels(const std::string& yaml_text, const std::string& source) {
       const YAML::Node name = r.require(n, "name", f);
       l.name = r.text(name, f + ".name");
       if (const auto it = seen.find(l.name); it != seen.end())
-        r.fail(name, f + ".name", "label '" + printable(l.name, 40) + "' is given twice (also labels[" + std::to_string(it->second) + "])");
+        r.fail(
+            name, f + ".name",
+            "label '" + printable(l.name, 40) + "' is given twice (also labels[" + std::to_string(it->second) + "])");
       seen.emplace(l.name, i);
       const std::string fl = "label '" + printable(l.name, 40) + "'";
       const Eigen::Vector2d px = r.vec<2>(r.require(n, "pixel", fl), fl + ".pixel", kMaxLabelPixel, "1e6 px");
@@ -55,9 +58,11 @@ Labels parseLabels(const std::string& yaml_text, const std::string& source) {
         l.point = cv::Point3d(p.x(), p.y(), p.z());
         if (const YAML::Node s = n["state"]) {
           if (!s.IsSequence()) r.fail(s, fl + ".state", "expected a list of numbers");
-          if (s.size() > kMaxLabelState) r.fail(s, fl + ".state", "more than " + std::to_string(kMaxLabelState) + " values");
+          if (s.size() > kMaxLabelState)
+            r.fail(s, fl + ".state", "more than " + std::to_string(kMaxLabelState) + " values");
           std::vector<double> state;
-          for (std::size_t k = 0; k < s.size(); ++k) state.push_back(r.number(s[k], fl + ".state[" + std::to_string(k) + "]"));
+          for (std::size_t k = 0; k < s.size(); ++k)
+            state.push_back(r.number(s[k], fl + ".state[" + std::to_string(k) + "]"));
           l.state = std::move(state);
         }
       }
@@ -87,21 +92,24 @@ cv::Point3d worldPoint(const Model& model, const Label& label, std::span<const d
   if (label.world) return *label.world;
   const std::string fl = label.where + ": label '" + printable(label.name, 40) + "'";
   const int b = model.bodyIndex(label.body);
-  if (b < 0) throw LabelsError(fl + ".body: no body '" + printable(label.body, 40) + "' in model '" + printable(model.name, 40) + "'");
+  if (b < 0)
+    throw LabelsError(fl + ".body: no body '" + printable(label.body, 40) + "' in model '" + printable(model.name, 40) +
+                      "'");
   if (static_cast<int>(state.size()) != model.stateSize())
-    throw LabelsError(fl + ".state: " + std::to_string(state.size()) + " state values, model '" + printable(model.name, 40) +
-                      "' has " + std::to_string(model.stateSize()));
+    throw LabelsError(fl + ".state: " + std::to_string(state.size()) + " state values, model '" +
+                      printable(model.name, 40) + "' has " + std::to_string(model.stateSize()));
   std::vector<Pose> poses(model.joints.size());
   if (!framePoses(model, state, poses)) throw LabelsError(fl + ".state: a state value is not finite");
-  const Vec3 w = framePose(poses, model.bodies[static_cast<std::size_t>(b)].frame) * Vec3(label.point.x, label.point.y, label.point.z);
+  const Vec3 w = framePose(poses, model.bodies[static_cast<std::size_t>(b)].frame) *
+                 Vec3(label.point.x, label.point.y, label.point.z);
   return {w.x(), w.y(), w.z()};
 }
 
 cv::Point3d worldPoint(const Model& model, const Label& label) {
   if (label.world) return *label.world;
   if (!label.state)
-    throw LabelsError(label.where + ": label '" + printable(label.name, 40) + "'.state: no state given (a state log must place body '" +
-                      printable(label.body, 40) + "')");
+    throw LabelsError(label.where + ": label '" + printable(label.name, 40) +
+                      "'.state: no state given (a state log must place body '" + printable(label.body, 40) + "')");
   return worldPoint(model, label, *label.state);
 }
 

@@ -47,11 +47,13 @@ cv::Mat cleanMask(const cv::Mat& mask, const cv::Mat& drawn) {
   std::vector<char> keep(static_cast<std::size_t>(n), 0);
   for (int y = 0; y < mask.rows; ++y)
     for (int x = 0; x < mask.cols; ++x)
-      if (const int l = labels.at<int>(y, x); l > 0 && near.at<unsigned char>(y, x)) keep[static_cast<std::size_t>(l)] = 1;
+      if (const int l = labels.at<int>(y, x); l > 0 && near.at<unsigned char>(y, x))
+        keep[static_cast<std::size_t>(l)] = 1;
   cv::Mat out = cv::Mat::zeros(mask.size(), CV_8UC1);
   for (int y = 0; y < mask.rows; ++y)
     for (int x = 0; x < mask.cols; ++x)
-      if (keep[static_cast<std::size_t>(labels.at<int>(y, x))] && labels.at<int>(y, x) > 0) out.at<unsigned char>(y, x) = 255;
+      if (keep[static_cast<std::size_t>(labels.at<int>(y, x))] && labels.at<int>(y, x) > 0)
+        out.at<unsigned char>(y, x) = 255;
   if (cv::countNonZero(out) == 0) out = mask.clone();  // nothing near: keep all, the fit says what it can
   // Holes: background components that do not touch the border and are small.
   cv::Mat background = out == 0, holes;
@@ -68,7 +70,8 @@ cv::Mat cleanMask(const cv::Mat& mask, const cv::Mat& drawn) {
   for (int y = 0; y < out.rows; ++y)
     for (int x = 0; x < out.cols; ++x) {
       const int l = holes.at<int>(y, x);
-      if (l > 0 && !border[static_cast<std::size_t>(l)] && area[static_cast<std::size_t>(l)] < small) out.at<unsigned char>(y, x) = 255;
+      if (l > 0 && !border[static_cast<std::size_t>(l)] && area[static_cast<std::size_t>(l)] < small)
+        out.at<unsigned char>(y, x) = 255;
     }
   return out;
 }
@@ -117,7 +120,8 @@ detail::Field maskField(const std::vector<Target>& targets) {
 // turned so the drawn robot's centroid lands on the mask's, and moved along its axis so their
 // areas match, over all frames together. Rotation shows first as a shift of the whole image,
 // distance as a change of size; the fit then starts where the outlines overlap.
-Camera preAlign(const Camera& start, std::span<const MaskFrame> frames, const std::vector<Target>& targets, double spacing) {
+Camera preAlign(const Camera& start, std::span<const MaskFrame> frames, const std::vector<Target>& targets,
+                double spacing) {
   const std::vector<detail::FrameShape> volumes = shapesOf(frames);
   Camera cam = start;
   for (int round = 0; round < 6; ++round) {
@@ -126,7 +130,8 @@ Camera preAlign(const Camera& start, std::span<const MaskFrame> frames, const st
     double du = 0, dv = 0, drawn_area = 0, mask_area = 0;
     int used = 0;
     for (std::size_t f = 0; f < frames.size(); ++f) {
-      const cv::Moments a = cv::moments(targets[f].inKnown(drawn[f]), true), b = cv::moments(targets[f].inKnown(targets[f].mask), true);
+      const cv::Moments a = cv::moments(targets[f].inKnown(drawn[f]), true),
+                        b = cv::moments(targets[f].inKnown(targets[f].mask), true);
       if (a.m00 < 1 || b.m00 < 1) continue;
       du += b.m10 / b.m00 - a.m10 / a.m00;
       dv += b.m01 / b.m00 - a.m01 / a.m00;
@@ -156,8 +161,8 @@ cv::Mat readMask(const std::string& path, int width, int height, bool robot_and_
   }
   if (img.cols != width || img.rows != height)
     throw MaskError(InputLocation{path, 0, 0, "mask"}, std::to_string(img.cols) + "x" + std::to_string(img.rows) +
-                                                         ", but the camera's images are " + std::to_string(width) + "x" +
-                                                         std::to_string(height));
+                                                           ", but the camera's images are " + std::to_string(width) +
+                                                           "x" + std::to_string(height));
   std::vector<cv::Mat> channels;
   cv::split(img, channels);
   cv::Mat mask = cv::Mat::zeros(img.size(), CV_8UC1);
@@ -180,8 +185,8 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   if (frames.empty()) throw InputError("masks: no frame to refine the pose with");
   for (const MaskFrame& f : frames) {
     if (f.mask.cols != start.width || f.mask.rows != start.height || f.mask.type() != CV_8UC1)
-      throw InputError("masks: a mask of " + std::to_string(f.mask.cols) + "x" + std::to_string(f.mask.rows) + " for a camera of " +
-                       std::to_string(start.width) + "x" + std::to_string(start.height));
+      throw InputError("masks: a mask of " + std::to_string(f.mask.cols) + "x" + std::to_string(f.mask.rows) +
+                       " for a camera of " + std::to_string(start.width) + "x" + std::to_string(start.height));
     if (!f.known.empty() && (f.known.size() != f.mask.size() || f.known.type() != CV_8UC1))
       throw InputError("masks: a known region that is not an 8-bit mask of the mask's size");
   }
@@ -214,7 +219,8 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
       after += targets[f].iou(drawn[f]);
     }
     if (after > before) {
-      for (std::size_t f = 0; f < frames.size(); ++f) targets[f].set(cleanMask(targets[f].inKnown(frames[f].mask != 0), drawn[f]));
+      for (std::size_t f = 0; f < frames.size(); ++f)
+        targets[f].set(cleanMask(targets[f].inKnown(frames[f].mask != 0), drawn[f]));
     } else {
       cam = start;
     }
@@ -226,8 +232,9 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   for (const double scale : {0.08, 0.03, 0.01, 0.004}) scales.push_back(std::max(1.5, scale * diagonal));
   const detail::Field field = maskField(targets);
   const bool meshes = std::any_of(frames.begin(), frames.end(), [](const MaskFrame& f) { return !f.meshes.empty(); });
-  cam = detail::fitPose(cam, [&](const Camera& at) { return samplesAt(at); }, field, scales, options.max_iterations, result.iterations,
-                        nullptr, meshes ? 1e-5 : 1e-7, meshes ? 1e-4 : 0.0);
+  cam = detail::fitPose(
+      cam, [&](const Camera& at) { return samplesAt(at); }, field, scales, options.max_iterations, result.iterations,
+      nullptr, meshes ? 1e-5 : 1e-7, meshes ? 1e-4 : 0.0);
 
   // Agreement at the result, and whether it is kept.
   std::vector<cv::Mat> drawn_after;
@@ -270,7 +277,8 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   if (!(after > before + 1e-4) || worst_drop > options.max_frame_drop)
     return keepStart("the masks did not improve the pose (mean IoU " + formatNumber(before, 4) + " at the start, " +
                      formatNumber(after, 4) + " refined" +
-                     (worst_drop > options.max_frame_drop ? ", one frame " + formatNumber(worst_drop, 3) + " worse" : std::string()) +
+                     (worst_drop > options.max_frame_drop ? ", one frame " + formatNumber(worst_drop, 3) + " worse"
+                                                          : std::string()) +
                      "): the start is kept");
   // A start with known uncertainty is a strong prior: a refined pose far outside it (3 sigma) for a
   // small gain in agreement says the masks and the volumes differ (a robot thinner than its
@@ -279,8 +287,8 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
     const double gain = after - before;
     if (d->sigmas > 3.0 && gain < 0.02)
       return keepStart("the masks' best pose lies " + formatNumber(d->difference.rotation_deg, 3) + " deg and " +
-                       formatNumber(d->difference.position_m * 1000, 3) + " mm from the start (" + formatNumber(d->sigmas, 3) +
-                       " sigma) for a mean IoU gain of " + formatNumber(gain, 3) +
+                       formatNumber(d->difference.position_m * 1000, 3) + " mm from the start (" +
+                       formatNumber(d->sigmas, 3) + " sigma) for a mean IoU gain of " + formatNumber(gain, 3) +
                        ": the start is kept (are the volumes wider or the masks narrower than the robot?)");
   }
   result.covariance = detail::poseCovariance(e);
@@ -288,14 +296,17 @@ RefineResult refineToMasks(const Camera& start, std::span<const MaskFrame> frame
   cam.rotation_sigma_deg = rotation_sigma;
   cam.position_sigma_m = position_sigma;
   if (after < options.min_iou || !(*cam.rotation_sigma_deg <= options.max_rotation_sigma_deg))
-    return keepStart("the drawn robot and the masks agree too little (mean IoU " + formatNumber(after, 3) + ", at least " +
-                     formatNumber(options.min_iou, 3) + " needed; rotation +-" + formatNumber(*cam.rotation_sigma_deg, 3) +
-                     " deg): check each frame's state, the clock, and which bodies the masks show (--mask-bodies); the start is kept");
+    return keepStart("the drawn robot and the masks agree too little (mean IoU " + formatNumber(after, 3) +
+                     ", at least " + formatNumber(options.min_iou, 3) + " needed; rotation +-" +
+                     formatNumber(*cam.rotation_sigma_deg, 3) +
+                     " deg): check each frame's state, the clock, and which bodies the masks show (--mask-bodies); the "
+                     "start is kept");
   result.camera = cam;
   result.improved = true;
-  result.message = "refined to the masks: mean IoU " + formatNumber(before, 4) + " -> " + formatNumber(after, 4) + " over " +
-                   std::to_string(frames.size()) + " frame(s), rotation +-" + formatNumber(*cam.rotation_sigma_deg, 3) +
-                   " deg, position +-" + formatNumber(*cam.position_sigma_m, 3) + " m";
+  result.message = "refined to the masks: mean IoU " + formatNumber(before, 4) + " -> " + formatNumber(after, 4) +
+                   " over " + std::to_string(frames.size()) + " frame(s), rotation +-" +
+                   formatNumber(*cam.rotation_sigma_deg, 3) + " deg, position +-" +
+                   formatNumber(*cam.position_sigma_m, 3) + " m";
   return result;
 }
 

@@ -56,13 +56,15 @@ double sampleField(const cv::Mat& f, double x, double y) {
   return (1 - ay) * ((1 - ax) * r0[x0] + ax * r0[x0 + 1]) + ay * ((1 - ax) * r1[x0] + ax * r1[x0 + 1]);
 }
 
-Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& tvec, std::span<const OutlineSample> samples,
-                    const Field& field, double c, bool normal_equations, const Anchors* anchors) {
+Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& tvec,
+                    std::span<const OutlineSample> samples, const Field& field, double c, bool normal_equations,
+                    const Anchors* anchors) {
   Evaluation e;
   if (anchors && !anchors->world.empty()) {
     std::vector<cv::Point2d> px;
     cv::Mat jac;
-    cv::projectPoints(anchors->world, rvec, tvec, cam.camera_matrix, cam.distortion, px, normal_equations ? jac : cv::noArray());
+    cv::projectPoints(anchors->world, rvec, tvec, cam.camera_matrix, cam.distortion, px,
+                      normal_equations ? jac : cv::noArray());
     const double a = anchors->scale_px;
     for (std::size_t i = 0; i < px.size(); ++i)
       for (int k = 0; k < 2; ++k) {
@@ -99,9 +101,9 @@ Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& t
   return e;
 }
 
-Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const Camera&)>& samples_at, const Field& field,
-               std::span<const double> scales_px, int max_iterations, int& iterations, const Anchors* anchors, double tiny,
-               double min_gain) {
+Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const Camera&)>& samples_at,
+               const Field& field, std::span<const double> scales_px, int max_iterations, int& iterations,
+               const Anchors* anchors, double tiny, double min_gain) {
   for (const double c : scales_px) {
     double lambda = 1e-3;
     for (int it = 0; it < max_iterations; ++it) {

@@ -68,16 +68,17 @@ struct Evaluation {
   cv::Vec6d jtr = cv::Vec6d::all(0);
   double weight_sum = 0.0, weighted_sq = 0.0;  ///< sum of w, sum of w r^2 (a robust rms)
 };
-Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& tvec, std::span<const OutlineSample> samples,
-                    const Field& field, double c, bool normal_equations, const Anchors* anchors = nullptr);
+Evaluation evaluate(const Camera& cam, const cv::Vec3d& rvec, const cv::Vec3d& tvec,
+                    std::span<const OutlineSample> samples, const Field& field, double c, bool normal_equations,
+                    const Anchors* anchors = nullptr);
 
 /// Levenberg-Marquardt from `cam` for each Cauchy scale in turn (px), outline samples redrawn
 /// every iteration; `samples_at` gives them at a pose. A stage ends when a step changes (rvec,
 /// tvec) by less than `tiny` (norm) or lowers the cost by less than `min_gain` of it (a drawing
 /// quantised to pixels never settles to `tiny`). Returns the pose, counts iterations.
-Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const Camera&)>& samples_at, const Field& field,
-               std::span<const double> scales_px, int max_iterations, int& iterations, const Anchors* anchors = nullptr,
-               double tiny = 1e-7, double min_gain = 0.0);
+Camera fitPose(Camera cam, const std::function<std::vector<OutlineSample>(const Camera&)>& samples_at,
+               const Field& field, std::span<const double> scales_px, int max_iterations, int& iterations,
+               const Anchors* anchors = nullptr, double tiny = 1e-7, double min_gain = 0.0);
 
 /// How far `cam` lies from `start` in the start's own sigmas (the larger of rotation and position),
 /// and the difference; none when the start has no sigmas.

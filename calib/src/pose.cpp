@@ -189,7 +189,8 @@ std::pair<double, double> poseSigmas(const cv::Vec3d& rvec, const cv::Vec3d& tve
   cv::Rodrigues(rvec, rmat);
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) g(r, 3 + c) = -rmat(c, r);
-  return {std::sqrt(largestEigen(a * covariance * a.t())) * 180.0 / std::numbers::pi, std::sqrt(largestEigen(g * covariance * g.t()))};
+  return {std::sqrt(largestEigen(a * covariance * a.t())) * 180.0 / std::numbers::pi,
+          std::sqrt(largestEigen(g * covariance * g.t()))};
 }
 
 PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>& points, const PoseOptions& options) {
@@ -452,7 +453,8 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   for (int p = 0; p < k; ++p)
     for (int q = p + 1; q < k; ++q) {
       const cv::Vec3d x(norm[idx[p]].x, norm[idx[p]].y, 1), y(norm[idx[q]].x, norm[idx[q]].y, 1);
-      extent = std::max(extent, std::acos(std::clamp(x.dot(y) / (cv::norm(x) * cv::norm(y)), -1.0, 1.0)) * 180.0 / std::numbers::pi);
+      extent = std::max(
+          extent, std::acos(std::clamp(x.dot(y) / (cv::norm(x) * cv::norm(y)), -1.0, 1.0)) * 180.0 / std::numbers::pi);
     }
   if (rot_gate > options.max_rotation_sigma_deg || pos_gate > options.max_position_sigma_ratio * distance) {
     result.status = PoseStatus::PoorGeometry;

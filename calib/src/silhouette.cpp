@@ -12,8 +12,8 @@
 namespace kccd::calib {
 namespace {
 
-constexpr int kRimSamples = 32;  // per sphere; the polygon's radius is set between inscribed and circumscribed
-constexpr int kSubpixel = 8;     // fill precision: 1/256 px (cv::fillConvexPoly's shift)
+constexpr int kRimSamples = 32;      // per sphere; the polygon's radius is set between inscribed and circumscribed
+constexpr int kSubpixel = 8;         // fill precision: 1/256 px (cv::fillConvexPoly's shift)
 constexpr double kNearPlane = 0.01;  // m: a volume reaching closer to the camera is left out
 
 // The 3-D rim of the sphere (centre c, radius r) seen from `eye`, appended to `rim` (nothing when
@@ -41,14 +41,15 @@ bool appendRim(const Vec3& eye, const Vec3& c, double r, std::vector<Vec3>& rim)
 std::vector<PlacedVolume> placeVolumes(const Model& model, std::span<const double> state, std::span<const int> bodies) {
   std::vector<Pose> poses(model.joints.size());
   if (!framePoses(model, state, poses))
-    throw InputError("state: " + std::to_string(state.size()) + " values for a model of " + std::to_string(model.stateSize()) +
-                     " (or a value that is not finite)");
+    throw InputError("state: " + std::to_string(state.size()) + " values for a model of " +
+                     std::to_string(model.stateSize()) + " (or a value that is not finite)");
   std::vector<int> chosen(bodies.begin(), bodies.end());
   if (chosen.empty())
     for (std::size_t b = 0; b < model.bodies.size(); ++b) chosen.push_back(static_cast<int>(b));
   std::vector<PlacedVolume> out;
   for (const int b : chosen) {
-    if (b < 0 || static_cast<std::size_t>(b) >= model.bodies.size()) throw InputError("body index " + std::to_string(b) + " out of range");
+    if (b < 0 || static_cast<std::size_t>(b) >= model.bodies.size())
+      throw InputError("body index " + std::to_string(b) + " out of range");
     const Body& body = model.bodies[static_cast<std::size_t>(b)];
     const Pose& frame = framePose(poses, body.frame);
     PlacedVolume v;
@@ -66,8 +67,8 @@ Silhouette drawSilhouette(const Camera& camera, std::span<const PlacedVolume> vo
   const Vec3 eye = w2c.inverse().translation();
   const double fx = camera.camera_matrix(0, 0), fy = camera.camera_matrix(1, 1);
   struct Outline {
-    std::vector<Vec3> world;          // per sample
-    std::vector<cv::Point2d> pixel;   // per sample
+    std::vector<Vec3> world;         // per sample
+    std::vector<cv::Point2d> pixel;  // per sample
   };
   std::vector<Outline> outlines;
   for (const PlacedVolume& vol : volumes) {
@@ -112,12 +113,14 @@ Silhouette drawSilhouette(const Camera& camera, std::span<const PlacedVolume> vo
         normalised.emplace_back(c.x() / c.z(), c.y() / c.z(), 1.0);
       }
     }
-    cv::projectPoints(normalised, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.camera_matrix, camera.distortion, o.pixel);
+    cv::projectPoints(normalised, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.camera_matrix, camera.distortion,
+                      o.pixel);
     std::vector<cv::Point> fixed;
     fixed.reserve(o.pixel.size());
     for (const cv::Point2d& p : o.pixel) {
       const double x = std::clamp(p.x, -1e5, 1e5), y = std::clamp(p.y, -1e5, 1e5);
-      fixed.emplace_back(static_cast<int>(std::lround(x * (1 << kSubpixel))), static_cast<int>(std::lround(y * (1 << kSubpixel))));
+      fixed.emplace_back(static_cast<int>(std::lround(x * (1 << kSubpixel))),
+                         static_cast<int>(std::lround(y * (1 << kSubpixel))));
     }
     cv::fillPoly(s.mask, std::vector<std::vector<cv::Point>>{fixed}, cv::Scalar(255), cv::LINE_8, kSubpixel);
     outlines.push_back(std::move(o));
@@ -140,7 +143,8 @@ Silhouette drawSilhouette(const Camera& camera, std::span<const PlacedVolume> vo
       const cv::Point2d normal(sign * t.y / len, -sign * t.x / len);
       const cv::Point2d probe = o.pixel[i] + 1.5 * normal;
       const int px = static_cast<int>(std::lround(probe.x)), py = static_cast<int>(std::lround(probe.y));
-      if (px >= 0 && py >= 0 && px < camera.width && py < camera.height && s.mask.at<unsigned char>(py, px) != 0) continue;
+      if (px >= 0 && py >= 0 && px < camera.width && py < camera.height && s.mask.at<unsigned char>(py, px) != 0)
+        continue;
       s.outline.push_back({o.world[i], o.pixel[i], normal});
     }
   }
@@ -169,7 +173,8 @@ Silhouette drawMeshSilhouette(const Camera& camera, std::span<const PlacedMesh> 
       normalised[i] = p.front[i] ? cv::Point3d(c.x() / c.z(), c.y() / c.z(), 1.0) : cv::Point3d(0, 0, 1);
     }
     if (!normalised.empty())
-      cv::projectPoints(normalised, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.camera_matrix, camera.distortion, p.pixel);
+      cv::projectPoints(normalised, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.camera_matrix, camera.distortion,
+                        p.pixel);
     for (std::size_t t = 0; t < m.triangles.size(); ++t) {
       const auto& tri = m.triangles[t];
       if (!p.front[tri[0]] || !p.front[tri[1]] || !p.front[tri[2]]) continue;
@@ -178,7 +183,8 @@ Silhouette drawMeshSilhouette(const Camera& camera, std::span<const PlacedMesh> 
       for (int k = 0; k < 3; ++k) {
         const cv::Point2d& q = p.pixel[tri[static_cast<std::size_t>(k)]];
         if (!(std::abs(q.x) < 1e5 && std::abs(q.y) < 1e5)) inside = false;
-        corners[k] = cv::Point(static_cast<int>(std::lround(q.x * (1 << kSubpixel))), static_cast<int>(std::lround(q.y * (1 << kSubpixel))));
+        corners[k] = cv::Point(static_cast<int>(std::lround(q.x * (1 << kSubpixel))),
+                               static_cast<int>(std::lround(q.y * (1 << kSubpixel))));
       }
       if (inside) cv::fillConvexPoly(id, corners, 3, cv::Scalar(next + static_cast<int>(t)), cv::LINE_8, kSubpixel);
     }
@@ -195,17 +201,22 @@ Silhouette drawMeshSilhouette(const Camera& camera, std::span<const PlacedMesh> 
     const int n = static_cast<int>(c.size());
     if (n < 3) continue;
     for (int i = 0; i < n; i += step) {
-      const cv::Point2d t = cv::Point2d(c[static_cast<std::size_t>((i + 2) % n)] - c[static_cast<std::size_t>((i + n - 2) % n)]);
+      const cv::Point2d t =
+          cv::Point2d(c[static_cast<std::size_t>((i + 2) % n)] - c[static_cast<std::size_t>((i + n - 2) % n)]);
       const double len = std::hypot(t.x, t.y);
       if (!(len > 0)) continue;
       cv::Point2d normal(t.y / len, -t.x / len);
       const cv::Point at = c[static_cast<std::size_t>(i)];
-      const cv::Point probe(static_cast<int>(std::lround(at.x + 1.5 * normal.x)), static_cast<int>(std::lround(at.y + 1.5 * normal.y)));
-      if (probe.x >= 0 && probe.y >= 0 && probe.x < camera.width && probe.y < camera.height && s.mask.at<unsigned char>(probe) != 0)
+      const cv::Point probe(static_cast<int>(std::lround(at.x + 1.5 * normal.x)),
+                            static_cast<int>(std::lround(at.y + 1.5 * normal.y)));
+      if (probe.x >= 0 && probe.y >= 0 && probe.x < camera.width && probe.y < camera.height &&
+          s.mask.at<unsigned char>(probe) != 0)
         normal = -normal;  // pointed inward
       const int tri = id.at<int>(at);
       if (tri < 0) continue;
-      const auto owner = std::upper_bound(projected.begin(), projected.end(), tri, [](int v, const Projected& p) { return v < p.first; }) - 1;
+      const auto owner = std::upper_bound(projected.begin(), projected.end(), tri,
+                                          [](int v, const Projected& p) { return v < p.first; }) -
+                         1;
       const auto& corners = owner->mesh->triangles[static_cast<std::size_t>(tri - owner->first)];
       const cv::Point2d a = owner->pixel[corners[0]], b = owner->pixel[corners[1]], d = owner->pixel[corners[2]];
       // Where the ray from the pixel's centre along the normal leaves the triangle: the outline
@@ -219,7 +230,7 @@ Silhouette drawMeshSilhouette(const Camera& camera, std::span<const PlacedMesh> 
           const cv::Point2d e0 = corner[k], e = corner[(k + 1) % 3] - corner[k];
           const double den = normal.x * e.y - normal.y * e.x;
           if (std::abs(den) < 1e-12) continue;
-          const double t = ((e0.x - q0.x) * e.y - (e0.y - q0.y) * e.x) / den;       // along the normal
+          const double t = ((e0.x - q0.x) * e.y - (e0.y - q0.y) * e.x) / den;            // along the normal
           const double u = ((e0.x - q0.x) * normal.y - (e0.y - q0.y) * normal.x) / den;  // along the edge
           if (t > -1.0 && t < 1.5 && u >= -0.01 && u <= 1.01 && t > best) best = t;
         }

@@ -54,11 +54,14 @@ TagLayout parseTagLayout(const std::string& yaml_text, const std::string& source
       const YAML::Node id = r.require(n, "id", f);
       const double v = r.number(id, f + ".id");
       if (v != std::floor(v) || v < 0 || v > kMaxTagId)
-        r.fail(id, f + ".id", "'" + printable(id.Scalar(), 40) + "' is not a tag36h11 id (an integer in 0.." + std::to_string(kMaxTagId) + ")");
+        r.fail(id, f + ".id",
+               "'" + printable(id.Scalar(), 40) + "' is not a tag36h11 id (an integer in 0.." +
+                   std::to_string(kMaxTagId) + ")");
       t.id = static_cast<int>(v);
       if (seen[static_cast<std::size_t>(t.id)])
-        r.fail(id, f + ".id", "tag " + std::to_string(t.id) + " is listed twice (also tags[" +
-                                  std::to_string(seen[static_cast<std::size_t>(t.id)] - 1) + "])");
+        r.fail(id, f + ".id",
+               "tag " + std::to_string(t.id) + " is listed twice (also tags[" +
+                   std::to_string(seen[static_cast<std::size_t>(t.id)] - 1) + "])");
       seen[static_cast<std::size_t>(t.id)] = i + 1;
       const YAML::Node size = r.require(n, "size", f);
       t.size = r.number(size, f + ".size");

@@ -8,8 +8,8 @@
 
 #include <kccd/calib/camera.hpp>
 #include <kccd/model.hpp>
-#include <kccd/overlay/recording/overlay_recording.hpp>
 #include <kccd/overlay/common/staged_output.hpp>
+#include <kccd/overlay/recording/overlay_recording.hpp>
 #include <kccd/overlay/recording/video_sink.hpp>
 #include <kccd/state_log.hpp>
 #include <nlohmann/json.hpp>
@@ -32,14 +32,17 @@ int main(int argc, char** argv) {
     kccd::overlay::VideoSink video({.video = out + "/overlay.mkv"});  // lossless FFV1, staged
     const kccd::overlay::OverlayReport report =
         kccd::overlay::overlayRecording(inputs, options, &video, [](const kccd::overlay::OverlayProgress& p) {
-          if (p.frames_done % 25 == 0) std::fprintf(stderr, "%zu frames, %.1f fps\n", p.frames_done, p.frames_per_second);
+          if (p.frames_done % 25 == 0)
+            std::fprintf(stderr, "%zu frames, %.1f fps\n", p.frames_done, p.frames_per_second);
         });
     video.commit();  // the video appears whole, or not at all
-    kccd::overlay::writeFileAtomically(out + "/report.json", kccd::overlay::reportJson(report, model, true).dump(1) + "\n");
+    kccd::overlay::writeFileAtomically(out + "/report.json",
+                                       kccd::overlay::reportJson(report, model, true).dump(1) + "\n");
 
-    std::printf("%zu frames: clear %zu, within margin %zu, colliding %zu, no state %zu (%.1f frames/s with %d threads)\n",
-                report.frames.size(), report.clear, report.within_margin, report.colliding, report.no_state,
-                report.frames.size() / (report.seconds > 0 ? report.seconds : 1.0), report.jobs);
+    std::printf(
+        "%zu frames: clear %zu, within margin %zu, colliding %zu, no state %zu (%.1f frames/s with %d threads)\n",
+        report.frames.size(), report.clear, report.within_margin, report.colliding, report.no_state,
+        report.frames.size() / (report.seconds > 0 ? report.seconds : 1.0), report.jobs);
     return report.firstUnsafe() ? 3 : 0;
   } catch (const kccd::InputError& e) {  // every reader's and the job's input errors: one line
     std::fprintf(stderr, "%s\n", e.what());

@@ -8,8 +8,8 @@ namespace kccd {
 double stoppingDistance(double u, const BrakingParams& p) noexcept {
   const double t = p.latency;
   const double after_latency = std::max(0.0, u + p.max_acceleration * t);
-  return std::max(0.0, u * t + 0.5 * p.max_acceleration * t * t +
-                           after_latency * after_latency / (2.0 * p.deceleration));
+  return std::max(0.0,
+                  u * t + 0.5 * p.max_acceleration * t * t + after_latency * after_latency / (2.0 * p.deceleration));
 }
 
 void brakingInterval(double q, double v, const BrakingParams& p, double& lower, double& upper) noexcept {

@@ -25,7 +25,9 @@ double rhoBoxBound(const Vec3& axis, const Vec3& centre, const Vec3& half) {
 }
 
 // The chain's sphere below level l (level 0: the body's own).
-const Sphere& sphereBelow(const ChainView& c, int l) { return l == 0 ? c.base : c.levels[static_cast<std::size_t>(l) - 1].core; }
+const Sphere& sphereBelow(const ChainView& c, int l) {
+  return l == 0 ? c.base : c.levels[static_cast<std::size_t>(l) - 1].core;
+}
 
 }  // namespace
 
@@ -58,7 +60,8 @@ ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, 
   out.box_half = (0.5 * (bhi - blo)).array() + box_guard;
   out.has_box = out.box_centre.allFinite() && out.box_half.allFinite();
   double reach = 0.0;
-  for (int v = 0; v < out.count; ++v) reach = std::max(reach, (centres[v] - out.core.center).norm() + below.radius * maps.scale[v]);
+  for (int v = 0; v < out.count; ++v)
+    reach = std::max(reach, (centres[v] - out.core.center).norm() + below.radius * maps.scale[v]);
   const double extent = below.center.norm() + below.radius;  // |x| bound in the joint frame
   out.core.radius = roundedUp(reach, 8) + roundingGuard(extent * out.max_scale + maps.offset_norm, 32);
   // What the cover adds to the radius: the sagitta of the farthest point from the axis (chords of
@@ -77,7 +80,8 @@ ChainLevel chainLevel(const JointMaps& maps, bool tangent, const Sphere& below, 
     const double rho = below_in_swept ? std::min(rhoBound(maps.axis, swept), own) : own;
     growth += maps.sagitta * rho;
   }
-  out.growth = roundedUp(growth, 8) + roundingGuard(std::max(extent, swept_extent) * out.max_scale + maps.offset_norm, 32);
+  out.growth =
+      roundedUp(growth, 8) + roundingGuard(std::max(extent, swept_extent) * out.max_scale + maps.offset_norm, 32);
   // A map moves a point within e of a true position to within scale * e of the mapped true
   // position; an apex lies rho (1 / cos - 1) beyond the arc's middle, a true position.
   double overshoot = below_overshoot * out.max_scale;

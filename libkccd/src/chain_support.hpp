@@ -19,7 +19,7 @@ struct ChainLevel {
   int count = 0;
   double growth = 0.0;
   Sphere core;
-  double max_scale = 1.0;  ///< largest operator norm among the maps used
+  double max_scale = 1.0;        ///< largest operator norm among the maps used
   bool rotation_apexes = false;  ///< the maps include a rotation3d joint's apexes
   /// How far the core set may lie beyond the true swept core (apexes reach past their arcs).
   double overshoot = 0.0;
@@ -59,8 +59,8 @@ struct ChainEntry {
 struct ChainWork {
   ChainEntry* stack;
   int* choice;
-  int* best_choice;  ///< the best leaf's map per level, kept for the next call
-  bool warm = false; ///< best_choice holds a leaf of this chain: start from it
+  int* best_choice;   ///< the best leaf's map per level, kept for the next call
+  bool warm = false;  ///< best_choice holds a leaf of this chain: start from it
 };
 int chainStackSize(int levels) noexcept;
 

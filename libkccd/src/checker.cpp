@@ -59,7 +59,8 @@ Checker::Checker(const Model& model) : model_(model) {
       hi = hi.cwiseMax(p);
     }
     base_box_.push_back(0.5 * lo + 0.5 * hi);
-    base_box_.push_back(0.5 * (hi - lo) + Vec3::Constant(detail::roundingGuard(lo.cwiseAbs().maxCoeff() + hi.cwiseAbs().maxCoeff(), 4)));
+    base_box_.push_back(0.5 * (hi - lo) +
+                        Vec3::Constant(detail::roundingGuard(lo.cwiseAbs().maxCoeff() + hi.cwiseAbs().maxCoeff(), 4)));
   }
   chain_stack_.resize(detail::chainStackSize(max_levels));
   split_box_.assign(2 * static_cast<std::size_t>(kMaxExactSplits) * static_cast<std::size_t>(ns), 0.0);
@@ -144,9 +145,14 @@ void Checker::computeReach() {
         const Joint& j = model.joints[path_[level_begin_[b] + level]];
         double* reach = dense.data() + static_cast<std::size_t>(p) * ns + j.state_offset;
         switch (j.type) {
-          case JointType::Fixed: break;
-          case JointType::Revolute: reach[0] += extent; break;
-          case JointType::Prismatic: reach[0] += 1.0; break;
+          case JointType::Fixed:
+            break;
+          case JointType::Revolute:
+            reach[0] += extent;
+            break;
+          case JointType::Prismatic:
+            reach[0] += 1.0;
+            break;
           case JointType::Translation3d:
             for (int k = 0; k < 3; ++k) reach[k] += 1.0;
             break;
@@ -269,8 +275,9 @@ const Sphere* Checker::sphere(int body, int level, Box box) noexcept {
   const Sphere* below = sphere(body, level - 1, box);
   if (below == nullptr) return nullptr;
   const Joint& joint = model_.joints[path_[idx - 1]];
-  v.swept_sphere = detail::sweepSphere(joint, box.lower.data() + joint.state_offset,
-                                       box.upper.data() + joint.state_offset, revoluteTrig(path_[idx - 1], box), *below);
+  v.swept_sphere =
+      detail::sweepSphere(joint, box.lower.data() + joint.state_offset, box.upper.data() + joint.state_offset,
+                          revoluteTrig(path_[idx - 1], box), *below);
   if (!v.swept_sphere.center.allFinite() || !std::isfinite(v.swept_sphere.radius)) return nullptr;
   v.sphere_stamp = geo_cycle_;
   return &v.swept_sphere;
@@ -427,9 +434,9 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   tight_volumes_ = options.tight_volumes;
   const double band = options.exact_band > 0.0 ? options.exact_band : 0.0;  // (NaN: none)
   exact_below_ = std::isnan(options.exact_below) || options.exact_below == -kInf ? -kInf
-                 : options.exact_below >= 0.0                                 ? options.exact_below
-                 : options.type == QueryType::Collision                       ? margin
-                                                                              : margin + band;
+                 : options.exact_below >= 0.0                                    ? options.exact_below
+                 : options.type == QueryType::Collision                          ? margin
+                                                                                 : margin + band;
   if (!validate(lower, upper)) {
     result_.collision = true;
     result_.min_distance = 0.0;
@@ -447,10 +454,9 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
   // Budgets beyond kMaxBudgetUs (and NaN) mean unlimited: converting them to clock ticks would overflow.
   Budget budget;
   budget.timed = options.budget_us > 0.0 && options.budget_us <= kMaxBudgetUs;
-  budget.deadline =
-      start + (budget.timed
-                   ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::micro>(options.budget_us))
-                   : Clock::duration::zero());
+  budget.deadline = start + (budget.timed ? std::chrono::duration_cast<Clock::duration>(
+                                                std::chrono::duration<double, std::micro>(options.budget_us))
+                                          : Clock::duration::zero());
   budget.max_pairs = options.max_pairs;
   std::fill(fresh_.begin(), fresh_.end(), 0);
   // Splitting: distance queries whose exact stage reaches above the margin.
@@ -461,12 +467,20 @@ const QueryResult& Checker::query(std::span<const double> lower, std::span<const
 
   const int np = static_cast<int>(model_.pairs.size());
   const int n_wanted = std::clamp(options.n, 1, std::max(np, 1));  // NClosest
-  int hit = -1;  // Collision: the pair reported
+  int hit = -1;                                                    // Collision: the pair reported
   switch (options.type) {
-    case QueryType::Collision: hit = refineCollision(candidates, margin, budget, box); break;
-    case QueryType::Closest: refineClosest(candidates, margin, budget, box); break;
-    case QueryType::NClosest: refineNClosest(n_wanted, budget, box); break;
-    case QueryType::Distances: refineDistances(budget, box); break;
+    case QueryType::Collision:
+      hit = refineCollision(candidates, margin, budget, box);
+      break;
+    case QueryType::Closest:
+      refineClosest(candidates, margin, budget, box);
+      break;
+    case QueryType::NClosest:
+      refineNClosest(n_wanted, budget, box);
+      break;
+    case QueryType::Distances:
+      refineDistances(budget, box);
+      break;
   }
 
   publishAnswer(options.type, margin, hit, n_wanted);

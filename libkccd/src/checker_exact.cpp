@@ -43,8 +43,8 @@ bool Checker::exactStage(int p, double stop_above, Box box, double& bound) noexc
   // query that asks the exact stage for verdicts only (exact_below up to the margin), needs no more.
   const double stop_below =
       result_.type == QueryType::Collision || exact_below_ <= result_.margin ? result_.margin : -kInf;
-  double chord_upper = kInf;  // upper bound on the distance of the chord chains' cores
-  double chord_lower = -kInf; // the chord chains' lower bound
+  double chord_upper = kInf;   // upper bound on the distance of the chord chains' cores
+  double chord_lower = -kInf;  // the chord chains' lower bound
   // A pair already clear of the margin is refined for its distance only: supports to within
   // kExactDistanceTolerance (their slack counted in the bound) and GJK to a relative 1e-3.
   const bool for_distance = bound > result_.margin;
@@ -196,8 +196,9 @@ bool Checker::splitPair(int p, Box box, double& bound) noexcept {
     const double key = posedDistance(p, centre_.data(), nullptr);
     split_key_[static_cast<std::size_t>(leaf)] = std::isnan(key) ? kInf : key;
   }
-  std::sort(split_order_.begin(), split_order_.begin() + leaves,
-            [&](int x, int y) { return split_key_[static_cast<std::size_t>(x)] < split_key_[static_cast<std::size_t>(y)]; });
+  std::sort(split_order_.begin(), split_order_.begin() + leaves, [&](int x, int y) {
+    return split_key_[static_cast<std::size_t>(x)] < split_key_[static_cast<std::size_t>(y)];
+  });
   double split = kInf;
   Vec3 best_a = witness_a, best_b = witness_b;
   for (int i = 0; i < leaves && split > bound; ++i) {
@@ -278,9 +279,14 @@ double Checker::posedDistance(int p, const double* q, double* grad) noexcept {
       const Vec3 arm = w - f.translation();
       double* g = grad + j.state_offset;
       switch (j.type) {
-        case JointType::Fixed: break;
-        case JointType::Revolute: g[0] += sign * n.dot((f.linear() * j.axis).cross(arm)); break;
-        case JointType::Prismatic: g[0] += sign * n.dot(f.linear() * j.axis); break;
+        case JointType::Fixed:
+          break;
+        case JointType::Revolute:
+          g[0] += sign * n.dot((f.linear() * j.axis).cross(arm));
+          break;
+        case JointType::Prismatic:
+          g[0] += sign * n.dot(f.linear() * j.axis);
+          break;
         case JointType::Translation3d:
           for (int k = 0; k < 3; ++k) g[k] += sign * n.dot(f.linear().col(k));
           break;

@@ -26,7 +26,9 @@ std::string describe(const std::string& label, FileProblem kind, int system_erro
     case FileProblem::CannotOpen:
       return "cannot open the " + label + " (" + reason + ")";
     case FileProblem::Directory:
-      return std::string("a folder, not ") + (std::string_view("aeiou").find(label.empty() ? 'x' : label[0]) == std::string_view::npos ? "a " : "an ") + label;
+      return std::string("a folder, not ") +
+             (std::string_view("aeiou").find(label.empty() ? 'x' : label[0]) == std::string_view::npos ? "a " : "an ") +
+             label;
     case FileProblem::NotRegular:
       return "not a regular file (a device, FIFO or socket)";
     case FileProblem::TooLarge:

@@ -9,8 +9,8 @@
 #include <cmath>
 #include <limits>
 
-#include "kccd/distance.hpp"
 #include "gjk_core.hpp"
+#include "kccd/distance.hpp"
 #include "rounding.hpp"
 
 namespace kccd {
@@ -82,8 +82,8 @@ bool allFinite(std::span<const Vec3> points) noexcept {
 
 DistanceResult distance(const SschView& a, const SschView& b, const GjkOptions& options) noexcept {
   DistanceResult result;
-  if (a.points.empty() || b.points.empty() || !(a.radius >= 0.0) || !(b.radius >= 0.0) ||
-      !std::isfinite(a.radius) || !std::isfinite(b.radius)) {
+  if (a.points.empty() || b.points.empty() || !(a.radius >= 0.0) || !(b.radius >= 0.0) || !std::isfinite(a.radius) ||
+      !std::isfinite(b.radius)) {
     return result;  // InvalidInput, distance 0
   }
   const SetSummary sum_a = summarize(a.points);

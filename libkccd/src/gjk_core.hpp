@@ -39,9 +39,7 @@ struct Simplex {
 };
 
 // Both non-zero with equal signs; bitwise operators keep it free of branches.
-inline bool sameSign(double a, double b) {
-  return (a != 0.0) & (b != 0.0) & (std::signbit(a) == std::signbit(b));
-}
+inline bool sameSign(double a, double b) { return (a != 0.0) & (b != 0.0) & (std::signbit(a) == std::signbit(b)); }
 
 // Branch-free select of an index.
 inline int pick(bool condition, int if_true, int if_false) {
@@ -138,8 +136,7 @@ inline void closestOnTetrahedron(const Vec3* w, double* lam) {
   const double c[4] = {det3(w[1], w[2], w[3]), -det3(w[0], w[2], w[3]), det3(w[0], w[1], w[3]),
                        -det3(w[0], w[1], w[2])};
   const double vol = c[0] + c[1] + c[2] + c[3];
-  if (vol != 0.0 && sameSign(vol, c[0]) && sameSign(vol, c[1]) && sameSign(vol, c[2]) &&
-      sameSign(vol, c[3])) {
+  if (vol != 0.0 && sameSign(vol, c[0]) && sameSign(vol, c[1]) && sameSign(vol, c[2]) && sameSign(vol, c[3])) {
     for (int x = 0; x < 4; ++x) lam[x] = c[x] / vol;
     return;
   }
@@ -159,10 +156,18 @@ inline void closestOnTetrahedron(const Vec3* w, double* lam) {
 inline Vec3 reduce(Simplex& s) {
   double lam[4] = {0.0, 0.0, 0.0, 0.0};
   switch (s.size) {
-    case 1: lam[0] = 1.0; break;
-    case 2: closestOnSegment(s.w, 0, 1, lam); break;
-    case 3: closestOnTriangle(s.w, 0, 1, 2, lam); break;
-    default: closestOnTetrahedron(s.w, lam); break;
+    case 1:
+      lam[0] = 1.0;
+      break;
+    case 2:
+      closestOnSegment(s.w, 0, 1, lam);
+      break;
+    case 3:
+      closestOnTriangle(s.w, 0, 1, 2, lam);
+      break;
+    default:
+      closestOnTetrahedron(s.w, lam);
+      break;
   }
   int n = 0;
   for (int x = 0; x < s.size; ++x) {
@@ -204,8 +209,7 @@ DistanceResult gjkDistance(const SupportA& sa, const SupportB& sb, double ra, do
 
   // Start from the given points' difference (e.g. the centroids: near the middle of the difference).
   Vec3 v = info.start_a - info.start_b;
-  if (options.warm_start != nullptr && options.warm_start->allFinite() &&
-      options.warm_start->squaredNorm() > 0.0) {
+  if (options.warm_start != nullptr && options.warm_start->allFinite() && options.warm_start->squaredNorm() > 0.0) {
     v = *options.warm_start;
   }
 

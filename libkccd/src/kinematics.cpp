@@ -9,11 +9,20 @@ namespace kccd {
 Pose jointMotion(const Joint& joint, const double* q) noexcept {
   Pose motion = Pose::Identity();
   switch (joint.type) {
-    case JointType::Fixed: break;
-    case JointType::Revolute: motion.linear() = Eigen::AngleAxisd(q[0], joint.axis).toRotationMatrix(); break;
-    case JointType::Prismatic: motion.translation() = q[0] * joint.axis; break;
-    case JointType::Translation3d: motion.translation() = Vec3(q[0], q[1], q[2]); break;
-    case JointType::Rotation3d: motion.linear() = rotationFromVector(Vec3(q[0], q[1], q[2])); break;
+    case JointType::Fixed:
+      break;
+    case JointType::Revolute:
+      motion.linear() = Eigen::AngleAxisd(q[0], joint.axis).toRotationMatrix();
+      break;
+    case JointType::Prismatic:
+      motion.translation() = q[0] * joint.axis;
+      break;
+    case JointType::Translation3d:
+      motion.translation() = Vec3(q[0], q[1], q[2]);
+      break;
+    case JointType::Rotation3d:
+      motion.linear() = rotationFromVector(Vec3(q[0], q[1], q[2]));
+      break;
   }
   return motion;
 }

@@ -43,7 +43,9 @@ void Model::finalize(bool check_all, const std::vector<std::array<int, 2>>& igno
       throw ModelError("joint '" + j.name + "': parent must be a joint listed earlier");
     j.state_offset = state_size_;
     switch (j.type) {
-      case JointType::Fixed: j.dof = 0; break;
+      case JointType::Fixed:
+        j.dof = 0;
+        break;
       case JointType::Revolute:
       case JointType::Prismatic:
         j.dof = 1;
@@ -85,31 +87,44 @@ void Model::finalize(bool check_all, const std::vector<std::array<int, 2>>& igno
 
 const char* toString(JointType type) {
   switch (type) {
-    case JointType::Fixed: return "fixed";
-    case JointType::Revolute: return "revolute";
-    case JointType::Prismatic: return "prismatic";
-    case JointType::Translation3d: return "translation3d";
-    case JointType::Rotation3d: return "rotation3d";
+    case JointType::Fixed:
+      return "fixed";
+    case JointType::Revolute:
+      return "revolute";
+    case JointType::Prismatic:
+      return "prismatic";
+    case JointType::Translation3d:
+      return "translation3d";
+    case JointType::Rotation3d:
+      return "rotation3d";
   }
   return "?";
 }
 
 const char* toString(SweepMode mode) {
   switch (mode) {
-    case SweepMode::Exact: return "exact";
-    case SweepMode::Accurate: return "accurate";
+    case SweepMode::Exact:
+      return "exact";
+    case SweepMode::Accurate:
+      return "accurate";
   }
   return "?";
 }
 
 const char* toString(IgnoreReason reason) {
   switch (reason) {
-    case IgnoreReason::User: return "user";
-    case IgnoreReason::Adjacent: return "adjacent";
-    case IgnoreReason::Rigid: return "rigid";
-    case IgnoreReason::Never: return "never";
-    case IgnoreReason::AlwaysTouching: return "always_touching";
-    case IgnoreReason::Srdf: return "srdf";
+    case IgnoreReason::User:
+      return "user";
+    case IgnoreReason::Adjacent:
+      return "adjacent";
+    case IgnoreReason::Rigid:
+      return "rigid";
+    case IgnoreReason::Never:
+      return "never";
+    case IgnoreReason::AlwaysTouching:
+      return "always_touching";
+    case IgnoreReason::Srdf:
+      return "srdf";
   }
   return "?";
 }

@@ -119,7 +119,8 @@ void parseJoints(const Reader& r, const YAML::Node& list, Model& m) {
     if (n["error"]) {
       if (j.type != JointType::Translation3d && j.type != JointType::Rotation3d)
         r.fail(n["error"], fn + ".error", "an error bound applies to translation3d and rotation3d joints only");
-      j.error = j.type == JointType::Translation3d ? r.length(n["error"], fn + ".error") : r.number(n["error"], fn + ".error");
+      j.error = j.type == JointType::Translation3d ? r.length(n["error"], fn + ".error")
+                                                   : r.number(n["error"], fn + ".error");
       if (j.error < 0.0) r.fail(n["error"], fn + ".error", "must be >= 0");
     }
     m.joints.push_back(std::move(j));
@@ -129,7 +130,9 @@ void parseJoints(const Reader& r, const YAML::Node& list, Model& m) {
 void parseBodies(const Reader& r, const YAML::Node& list, Model& m) {
   if (!list.IsSequence()) r.fail(list, "bodies", "expected a list");
   if (list.size() > kMaxModelBodies)
-    r.fail(list, "bodies", std::to_string(list.size()) + " bodies, more than a model may hold (" + std::to_string(kMaxModelBodies) + ")");
+    r.fail(
+        list, "bodies",
+        std::to_string(list.size()) + " bodies, more than a model may hold (" + std::to_string(kMaxModelBodies) + ")");
   std::map<std::string, int> links;  // link name -> its first piece (body index)
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YAML::Node n = list[i];
@@ -163,11 +166,12 @@ void parseBodies(const Reader& r, const YAML::Node& list, Model& m) {
       const auto [it, fresh] = links.try_emplace(b.link, static_cast<int>(m.bodies.size()));
       const Body& first = fresh ? b : m.bodies[it->second];
       if (first.frame != b.frame)
-        r.fail(n["link"], fb + ".link", "piece of link '" + b.link + "' in frame '" + m.frameName(b.frame) +
-                                            "', but body '" + first.name + "' of that link is in frame '" +
-                                            m.frameName(first.frame) + "'");
+        r.fail(n["link"], fb + ".link",
+               "piece of link '" + b.link + "' in frame '" + m.frameName(b.frame) + "', but body '" + first.name +
+                   "' of that link is in frame '" + m.frameName(first.frame) + "'");
     } else if (const auto it = links.find(b.name); it != links.end()) {
-      r.fail(n["name"], f + ".name", "'" + b.name + "' is already the link of body '" + m.bodies[it->second].name + "'");
+      r.fail(n["name"], f + ".name",
+             "'" + b.name + "' is already the link of body '" + m.bodies[it->second].name + "'");
     }
     m.bodies.push_back(std::move(b));
   }
@@ -193,7 +197,8 @@ void parseVisuals(const Reader& r, const YAML::Node& list, Model& m, const std::
       v.shape = Visual::Shape::Mesh;
       std::string mesh = r.text(n["mesh"], f + ".mesh");
       if (mesh.rfind("package://", 0) == 0)
-        r.fail(n["mesh"], f + ".mesh", "package:// paths are resolved by kccd import (--package-path); give a file path");
+        r.fail(n["mesh"], f + ".mesh",
+               "package:// paths are resolved by kccd import (--package-path); give a file path");
       if (mesh.rfind("file://", 0) == 0) mesh.erase(0, 7);
       const std::filesystem::path file = mesh;
       // Relative to the model file's folder when the model came from a file.
@@ -229,7 +234,8 @@ void parseVisuals(const Reader& r, const YAML::Node& list, Model& m, const std::
     if (n["origin"]) v.origin = parseOrigin(r, n["origin"], f + ".origin");
     if (n["colour"]) {
       const YAML::Node c = n["colour"];
-      if (!c.IsSequence() || (c.size() != 3 && c.size() != 4)) r.fail(c, f + ".colour", "expected [r, g, b] or [r, g, b, a] in 0..1");
+      if (!c.IsSequence() || (c.size() != 3 && c.size() != 4))
+        r.fail(c, f + ".colour", "expected [r, g, b] or [r, g, b, a] in 0..1");
       for (std::size_t k = 0; k < c.size(); ++k) {
         const double x = r.number(c[k], f + ".colour[" + std::to_string(k) + "]");
         if (x < 0.0 || x > 1.0) r.fail(c[k], f + ".colour[" + std::to_string(k) + "]", "must be in 0..1");
@@ -251,7 +257,8 @@ std::vector<std::array<int, 2>> parsePairList(const Reader& r, const YAML::Node&
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YAML::Node p = list[i];
     const std::string f = field + "[" + std::to_string(i) + "]";
-    if (!p.IsSequence() || p.size() < 2 || p.size() > (reasons_out ? 3u : 2u)) r.fail(p, f, std::string("expected ") + shape);
+    if (!p.IsSequence() || p.size() < 2 || p.size() > (reasons_out ? 3u : 2u))
+      r.fail(p, f, std::string("expected ") + shape);
     std::array<int, 2> ids{};
     for (int k = 0; k < 2; ++k) {
       const std::string name = r.text(p[k], f);
@@ -264,8 +271,9 @@ std::vector<std::array<int, 2>> parsePairList(const Reader& r, const YAML::Node&
       if (p.size() == 3) {
         const std::string word = r.text(p[2], f + ".reason");
         if (!parseIgnoreReason(word, entry.reason))
-          r.fail(p[2], f + ".reason",
-                 "unknown reason '" + printable(word, 40) + "' (user, adjacent, rigid, never, always_touching or srdf)");
+          r.fail(
+              p[2], f + ".reason",
+              "unknown reason '" + printable(word, 40) + "' (user, adjacent, rigid, never, always_touching or srdf)");
       }
       reasons_out->push_back(entry);
     }
@@ -291,7 +299,8 @@ Model parse(const std::string& yaml_text, const std::string& source) {
   }
   if (root["point_budget"]) {
     const double b = r.number(root["point_budget"], "point_budget");
-    if (b != std::floor(b) || b < 4 || b > 4096) r.fail(root["point_budget"], "point_budget", "must be an integer in 4..4096");
+    if (b != std::floor(b) || b < 4 || b > 4096)
+      r.fail(root["point_budget"], "point_budget", "must be an integer in 4..4096");
     m.point_budget = static_cast<int>(b);
   }
   if (root["joints"]) parseJoints(r, root["joints"], m);

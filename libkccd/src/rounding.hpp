@@ -22,9 +22,7 @@ constexpr double roundingGuard(double magnitude, int ulps) noexcept {
 
 /// A length `value` grown by `ulps` relative ulps: value * (1 + ulps * eps). Use for a computed
 /// length that must not be underestimated (a radius, a growth, an arc width).
-constexpr double roundedUp(double value, int ulps) noexcept {
-  return value * (1.0 + static_cast<double>(ulps) * kEps);
-}
+constexpr double roundedUp(double value, int ulps) noexcept { return value * (1.0 + static_cast<double>(ulps) * kEps); }
 
 /// Relative shrink applied to a distance lower bound before it is stored or reported: the
 /// bound is multiplied by (1 - kBoundShrink), which covers the few ulps of error in a difference

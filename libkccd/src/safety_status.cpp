@@ -5,10 +5,14 @@ namespace kccd {
 
 const char* toString(SafetyStatus status) {
   switch (status) {
-    case SafetyStatus::Clear: return "clear";
-    case SafetyStatus::WithinMargin: return "within_margin";
-    case SafetyStatus::Colliding: return "colliding";
-    case SafetyStatus::NoState: return "no_state";
+    case SafetyStatus::Clear:
+      return "clear";
+    case SafetyStatus::WithinMargin:
+      return "within_margin";
+    case SafetyStatus::Colliding:
+      return "colliding";
+    case SafetyStatus::NoState:
+      return "no_state";
   }
   return "?";
 }

@@ -58,8 +58,7 @@ class Parser {
     }
     double v = 0.0;
     const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), v);
-    if (ec == std::errc::result_out_of_range)
-      fail(line, col, column, quoted() + " is out of the range of a double");
+    if (ec == std::errc::result_out_of_range) fail(line, col, column, quoted() + " is out of the range of a double");
     if (ec != std::errc() || end != field.data() + field.size())
       fail(line, col, column, "not a decimal number: " + quoted());
     if (!(std::abs(v) <= kMaxStateLogMagnitude))
@@ -114,7 +113,8 @@ class Lines {
     if (const std::size_t cr = line.find('\r'); cr != std::string_view::npos)
       parser_.fail(number_, cr + 1, {}, "a carriage return not followed by a line feed (line ends are LF or CRLF)");
     if (line.empty()) {
-      if (number_ == 1) parser_.fail(1, kNoColumn, {}, "empty header line (expected time and the model's state value names)");
+      if (number_ == 1)
+        parser_.fail(1, kNoColumn, {}, "empty header line (expected time and the model's state value names)");
       if (at_end) return false;  // one empty line at the very end
       parser_.fail(number_, kNoColumn, {}, "empty line (the dialect has none between rows)");
     }
@@ -139,13 +139,15 @@ std::vector<Column> parseHeader(std::string_view line, const Parser& parser, con
   std::unordered_map<std::string_view, int> values;  // state value name -> index
   for (std::size_t i = 0; i < names.size(); ++i) {
     if (names[i] == "time")
-      parser.fail(1, kNoColumn, names[i], "the model has a state value named 'time', which a log cannot tell from its time column");
+      parser.fail(1, kNoColumn, names[i],
+                  "the model has a state value named 'time', which a log cannot tell from its time column");
     if (!values.emplace(names[i], static_cast<int>(i)).second)
       parser.fail(1, kNoColumn, names[i], "the model names two state values so: a log cannot tell them apart");
   }
   for (const std::string& n : names)
     if (n.ends_with(".vel") && values.contains(std::string_view(n).substr(0, n.size() - 4)))
-      parser.fail(1, kNoColumn, n, "the model has a state value of this name, which a log cannot tell from a velocity column");
+      parser.fail(1, kNoColumn, n,
+                  "the model has a state value of this name, which a log cannot tell from a velocity column");
   const std::unordered_set<std::string_view> ignore(ignore_columns.begin(), ignore_columns.end());
 
   std::vector<Column> columns;
@@ -186,7 +188,8 @@ std::vector<Column> parseHeader(std::string_view line, const Parser& parser, con
       const char first = name.front(), last = name.back();
       if (first == ' ' || first == '\t' || last == ' ' || last == '\t')
         parser.fail(1, col, name, "space around the name (the dialect has no padding)");
-      parser.fail(1, col, name, "unknown column (a state value of the model? see kccd info; a column to skip is listed as ignored)");
+      parser.fail(1, col, name,
+                  "unknown column (a state value of the model? see kccd info; a column to skip is listed as ignored)");
     }
     columns.push_back(c);
     if (comma == std::string_view::npos) break;
@@ -194,7 +197,8 @@ std::vector<Column> parseHeader(std::string_view line, const Parser& parser, con
   }
   if (!has_time) parser.fail(1, kNoColumn, "time", "missing (the sample times in seconds)");
   for (std::size_t i = 0; i < names.size(); ++i)
-    if (!has_value[i]) parser.fail(1, kNoColumn, names[i], "missing (a state value of the model: every one needs a column)");
+    if (!has_value[i])
+      parser.fail(1, kNoColumn, names[i], "missing (a state value of the model: every one needs a column)");
   return columns;
 }
 
@@ -216,7 +220,8 @@ StateLog parseStateLog(std::string_view text, const std::string& source, const M
                        std::span<const std::string> ignore_columns) {
   const Parser parser(source);
   if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
-  if (text.empty()) parser.fail(1, kNoColumn, {}, "empty file (expected a header line: time and the model's state value names)");
+  if (text.empty())
+    parser.fail(1, kNoColumn, {}, "empty file (expected a header line: time and the model's state value names)");
 
   StateLog log;
   log.names = model.stateNames();
@@ -230,13 +235,14 @@ StateLog parseStateLog(std::string_view text, const std::string& source, const M
   std::string_view line;
   lines.next(line);  // the text is not empty: a header line or an error
   const std::vector<Column> columns = parseHeader(line, parser, model, ignore_columns, log);
-  const bool velocities = std::any_of(log.logged_velocity.begin(), log.logged_velocity.end(), [](std::uint8_t v) { return v != 0; });
+  const bool velocities =
+      std::any_of(log.logged_velocity.begin(), log.logged_velocity.end(), [](std::uint8_t v) { return v != 0; });
 
   // Room for the rows the text can hold: each needs a byte per number, the commas and a line end,
   // so the numbers take at most about 4 bytes per byte of text (8 with velocity columns, stored
   // for every value), however hostile the text.
-  const std::size_t parsed = static_cast<std::size_t>(std::count_if(
-      columns.begin(), columns.end(), [](const Column& c) { return c.kind != Column::Kind::Ignored; }));
+  const std::size_t parsed = static_cast<std::size_t>(
+      std::count_if(columns.begin(), columns.end(), [](const Column& c) { return c.kind != Column::Kind::Ignored; }));
   const std::size_t expected_rows = std::min(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1,
                                              text.size() / (parsed + columns.size()) + 1);
   log.times.reserve(expected_rows);
@@ -248,7 +254,9 @@ StateLog parseStateLog(std::string_view text, const std::string& source, const M
     const std::size_t at = lines.number();
     const std::size_t found = static_cast<std::size_t>(std::count(line.begin(), line.end(), ','));
     if (found != commas)
-      parser.fail(at, kNoColumn, {}, std::to_string(found + 1) + " fields, but the header has " + std::to_string(columns.size()) + " columns");
+      parser.fail(
+          at, kNoColumn, {},
+          std::to_string(found + 1) + " fields, but the header has " + std::to_string(columns.size()) + " columns");
     const std::size_t row = log.times.size();
     log.times.push_back(0.0);
     log.values.resize(log.values.size() + n);
@@ -268,15 +276,21 @@ StateLog parseStateLog(std::string_view text, const std::string& source, const M
                               " (time must increase strictly)");
             log.times[row] = v;
             break;
-          case Column::Kind::Value: log.values[row * n + static_cast<std::size_t>(c.index)] = v; break;
-          case Column::Kind::Velocity: log.velocities[row * n + static_cast<std::size_t>(c.index)] = v; break;
-          case Column::Kind::Ignored: break;
+          case Column::Kind::Value:
+            log.values[row * n + static_cast<std::size_t>(c.index)] = v;
+            break;
+          case Column::Kind::Velocity:
+            log.velocities[row * n + static_cast<std::size_t>(c.index)] = v;
+            break;
+          case Column::Kind::Ignored:
+            break;
         }
       }
       start = end + 1;
     }
   }
-  if (log.times.empty()) parser.fail(1, kNoColumn, {}, "no data rows after the header (a log needs at least one sample)");
+  if (log.times.empty())
+    parser.fail(1, kNoColumn, {}, "no data rows after the header (a log needs at least one sample)");
   return log;
 }
 
@@ -292,9 +306,12 @@ StateLog loadStateLog(const std::string& path, const Model& model, std::span<con
 
 const char* toString(StateMatch match) {
   switch (match) {
-    case StateMatch::Exact: return "exact";
-    case StateMatch::Interpolated: return "interpolated";
-    case StateMatch::None: return "none";
+    case StateMatch::Exact:
+      return "exact";
+    case StateMatch::Interpolated:
+      return "interpolated";
+    case StateMatch::None:
+      return "none";
   }
   return "?";
 }
@@ -309,7 +326,8 @@ double difference(double a, double b, bool circular) {
 
 }  // namespace
 
-StateMatch stateAt(const StateLog& log, double time, double max_gap, std::span<double> state, std::span<double> velocity) {
+StateMatch stateAt(const StateLog& log, double time, double max_gap, std::span<double> state,
+                   std::span<double> velocity) {
   const std::size_t n = log.names.size();
   if (state.size() != n || (!velocity.empty() && velocity.size() != n))
     throw std::invalid_argument("stateAt: state and velocity need the log's state size");

@@ -90,7 +90,7 @@ int sweepRevolute(const Joint& j, const RevoluteTrig& trig, std::span<const Vec3
   const double* s_end = trig.s_end;
   const double half_cos = trig.half_cos;
   const double c_centre = trig.c_mid, s_centre = trig.s_mid;
-  const double sagitta = 1.0 - half_cos;       // per unit rho
+  const double sagitta = 1.0 - half_cos;      // per unit rho
   const double half_chord = trig.half_chord;  // per unit rho
   // Chords for the points farthest from the axis, as many as the budget holds; the arc's middle
   // point (radius growth rho * 2 sin(w / 4)) for the rest. Squared distances from the axis
@@ -277,9 +277,12 @@ RevoluteTrig revoluteTrig(double lo, double hi) noexcept {
 int sweepExpansion(const Joint& joint) noexcept {
   const int pieces = revolutePieces(kTwoPi);
   switch (joint.type) {
-    case JointType::Revolute: return pieces + 1;
-    case JointType::Prismatic: return 2;
-    default: return 1;
+    case JointType::Revolute:
+      return pieces + 1;
+    case JointType::Prismatic:
+      return 2;
+    default:
+      return 1;
   }
 }
 
@@ -397,7 +400,9 @@ JointMaps jointMaps(const Joint& joint, const double* lo, const double* hi, cons
   };
   m.offset_norm = t.norm();
   switch (joint.type) {
-    case JointType::Fixed: add(rot, t, 1.0); break;
+    case JointType::Fixed:
+      add(rot, t, 1.0);
+      break;
     case JointType::Revolute: {
       const Vec3& a = joint.axis;
       const Eigen::Matrix3d axial = a * a.transpose();
@@ -500,7 +505,8 @@ Sphere sweepSphere(const Joint& joint, const double* lo, const double* hi, const
   Sphere out = in;
   const Vec3& c = in.center;
   switch (joint.type) {
-    case JointType::Fixed: break;
+    case JointType::Fixed:
+      break;
     case JointType::Revolute: {
       // The centre's arc lies within rho sin(w / 2) of its chord's middle (w < pi), or within
       // rho of the axis point for wider arcs.

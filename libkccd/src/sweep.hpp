@@ -15,15 +15,15 @@ inline constexpr double kMaxPieceAngle = 1.5707963267948966;  // pi / 2
 /// docs/algorithms.md section 1) and the sines and cosines they use: made once per joint and box,
 /// shared by every body swept through the joint. Default-constructed: made for no interval.
 struct RevoluteTrig {
-  static constexpr int kMaxPieces = 4;  // 2 pi / kMaxPieceAngle
-  double lo = 0.0, hi = -1.0;  ///< the interval it was made for (lo > hi: none)
-  double start = 0.0, width = 0.0;  ///< the arc: its first angle (in [0, 2 pi)) and width
-  int pieces = 0;              ///< 0: a single angle, start
+  static constexpr int kMaxPieces = 4;                            // 2 pi / kMaxPieceAngle
+  double lo = 0.0, hi = -1.0;                                     ///< the interval it was made for (lo > hi: none)
+  double start = 0.0, width = 0.0;                                ///< the arc: its first angle (in [0, 2 pi)) and width
+  int pieces = 0;                                                 ///< 0: a single angle, start
   double c_end[kMaxPieces + 1] = {}, s_end[kMaxPieces + 1] = {};  ///< the pieces' ends
-  double half_cos = 1.0;       ///< cos(step / 2)
-  double c_mid = 1.0, s_mid = 0.0;    ///< the arc's middle
-  double c_half = 1.0, s_half = 0.0;  ///< cos and sin of width / 2
-  double half_chord = 0.0;     ///< 2 sin(width / 4)
+  double half_cos = 1.0;                                          ///< cos(step / 2)
+  double c_mid = 1.0, s_mid = 0.0;                                ///< the arc's middle
+  double c_half = 1.0, s_half = 0.0;                              ///< cos and sin of width / 2
+  double half_chord = 0.0;                                        ///< 2 sin(width / 4)
 };
 
 /// The arc and trigonometry of the revolute interval [lo, hi] (finite values).
@@ -62,17 +62,17 @@ struct JointMaps {
   int chord_count = 0;
   Eigen::Matrix3d lin[kMax];
   Vec3 off[kMax];
-  double scale[kMax];        ///< bound on the operator norm of lin
-  bool revolute = false;     ///< a revolute interval of non-zero width (sagitta applies)
+  double scale[kMax];     ///< bound on the operator norm of lin
+  bool revolute = false;  ///< a revolute interval of non-zero width (sagitta applies)
   Vec3 axis = Vec3::UnitZ();
   double sagitta = 0.0;
   double apex_excess = 0.0;  ///< an apex lies at most this times rho (rotation3d: |p|) beyond the motion
   double fixed_growth = 0.0;
   double point_growth = 0.0;
-  bool shared_lin = false;        ///< every map has the same linear part (translations)
-  bool rotation_apexes = false;   ///< rotation3d apexes follow the chord map
-  double apex_point_growth = 0.0; ///< point_growth of the cover with the rotation3d apexes
-  double offset_norm = 0.0;  ///< bound on |off|
+  bool shared_lin = false;         ///< every map has the same linear part (translations)
+  bool rotation_apexes = false;    ///< rotation3d apexes follow the chord map
+  double apex_point_growth = 0.0;  ///< point_growth of the cover with the rotation3d apexes
+  double offset_norm = 0.0;        ///< bound on |off|
 };
 
 /// The vertex maps of `joint` over [lo, hi] (values finite; the caller checks). `trig` is

@@ -29,7 +29,9 @@ class Checker final : public YAML::EventHandler {
   Checker(const std::string& source, const YamlLimits& limits) : source_(source), limits_(limits) {}
 
   void OnDocumentStart(const YAML::Mark& mark) override {
-    if (++documents_ > 1) fail(mark, "document", "a second YAML document ('---' or '...' followed by more): the file must hold exactly one");
+    if (++documents_ > 1)
+      fail(mark, "document",
+           "a second YAML document ('---' or '...' followed by more): the file must hold exactly one");
   }
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override {
@@ -48,11 +50,13 @@ class Checker final : public YAML::EventHandler {
     named(anchor, 1);
     leaf(mark, value, true);
   }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                       YAML::EmitterStyle::value) override {
     count(mark, 1);
     open(mark, false, anchor);
   }
-  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                  YAML::EmitterStyle::value) override {
     count(mark, 1);
     open(mark, true, anchor);
   }
@@ -74,8 +78,9 @@ class Checker final : public YAML::EventHandler {
   void count(const YAML::Mark& mark, std::size_t nodes) {
     expanded_ += nodes;
     if (expanded_ > limits_.max_expanded_nodes)
-      fail(mark, path(), "aliases expand the document to more than " + std::to_string(limits_.max_expanded_nodes) +
-                             " values (anchors and aliases are for sharing a little, not for multiplying)");
+      fail(mark, path(),
+           "aliases expand the document to more than " + std::to_string(limits_.max_expanded_nodes) +
+               " values (anchors and aliases are for sharing a little, not for multiplying)");
   }
 
   // Remembers the size of the node an anchor names.
@@ -123,8 +128,10 @@ class Checker final : public YAML::EventHandler {
   void done() {
     if (stack_.empty()) return;
     Frame& f = stack_.back();
-    if (f.map) f.expect_key = true;
-    else ++f.index;
+    if (f.map)
+      f.expect_key = true;
+    else
+      ++f.index;
   }
 
   void leaf(const YAML::Mark& mark, const std::string& value, bool plain) {

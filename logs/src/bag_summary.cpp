@@ -41,7 +41,9 @@ BagSummary summarizeBag(const std::string& path) {
     if (fresh) {
       t.summary.topic = m.channel->topic;
       t.summary.message_encoding = m.channel->message_encoding;
-      if (m.schema) t.summary.type = m.schema->name, t.summary.schema_encoding = m.schema->encoding, t.summary.definition = "stored";
+      if (m.schema)
+        t.summary.type = m.schema->name, t.summary.schema_encoding = m.schema->encoding,
+        t.summary.definition = "stored";
       for (const auto& [k, v] : m.channel->metadata)
         if (k == "kccd_definition" && v == "built in") t.summary.definition = "built in";
       if (!m.schema)
@@ -49,15 +51,20 @@ BagSummary summarizeBag(const std::string& path) {
           if (k == "kccd_no_definition") t.summary.type = v;
       const bool ros2 = m.schema && m.schema->encoding == "ros2msg" && m.channel->message_encoding == "cdr";
       const bool ros1 = m.schema && m.schema->encoding == "ros1msg" && m.channel->message_encoding == "ros1";
-      if (!m.schema) t.summary.no_stamps = "no definition in the log";
-      else if (!ros1 && !ros2) t.summary.no_stamps = "schema " + m.schema->encoding + ", messages " + m.channel->message_encoding + ": not decoded";
+      if (!m.schema)
+        t.summary.no_stamps = "no definition in the log";
+      else if (!ros1 && !ros2)
+        t.summary.no_stamps =
+            "schema " + m.schema->encoding + ", messages " + m.channel->message_encoding + ": not decoded";
       else {
         try {
           t.types = MessageDefinitions::parse(m.schema->name, m.schema->data, ros2 ? Dialect::Ros2 : Dialect::Ros1);
         } catch (const DefinitionError& e) {
-          throw InputError(InputLocation{path, 0, 0, reader.place(m.offset)},
-                           "topic " + printable(t.summary.topic, 60) + ": the definition of " + printable(m.schema->name, 60) +
-                               (e.line() > 0 ? " (line " + std::to_string(e.line()) + " of its schema)" : std::string()) + ": " + printable(e.what(), 200));
+          throw InputError(
+              InputLocation{path, 0, 0, reader.place(m.offset)},
+              "topic " + printable(t.summary.topic, 60) + ": the definition of " + printable(m.schema->name, 60) +
+                  (e.line() > 0 ? " (line " + std::to_string(e.line()) + " of its schema)" : std::string()) + ": " +
+                  printable(e.what(), 200));
         }
         t.cdr = ros2;
         const Field* first = t.types->root().fields.empty() ? nullptr : &t.types->root().fields.front();
@@ -75,16 +82,19 @@ BagSummary summarizeBag(const std::string& path) {
         v = t.cdr ? decodeCdr(*t.types, m.data) : decodeRos1(*t.types, m.data);
       } catch (const DecodeError& e) {
         throw InputError(InputLocation{path, 0, 0, reader.place(m.offset)},
-                         "topic " + printable(s.topic, 60) + " (" + printable(s.type, 60) + "): message " + std::to_string(s.count) +
-                             " does not decode: byte " + std::to_string(e.offset()) + " of its " + std::to_string(m.data.size()) + ": " + printable(e.what(), 200));
+                         "topic " + printable(s.topic, 60) + " (" + printable(s.type, 60) + "): message " +
+                             std::to_string(s.count) + " does not decode: byte " + std::to_string(e.offset()) +
+                             " of its " + std::to_string(m.data.size()) + ": " + printable(e.what(), 200));
       }
       if (const auto stamp = headerStamp(v)) {
         ++s.stamped;
-        if (*stamp == 0) ++s.zero_stamps;
+        if (*stamp == 0)
+          ++s.zero_stamps;
         else {
           // Nanoseconds subtracted exactly (both within 2^62), then divided: 35 ms reads 0.035.
           const auto log = static_cast<std::int64_t>(std::min<std::uint64_t>(m.log_time, std::uint64_t{1} << 62));
-          const std::int64_t stamped = std::clamp<std::int64_t>(*stamp, -(std::int64_t{1} << 62), std::int64_t{1} << 62);
+          const std::int64_t stamped =
+              std::clamp<std::int64_t>(*stamp, -(std::int64_t{1} << 62), std::int64_t{1} << 62);
           t.skews.push_back(static_cast<double>(log - stamped) / 1e9);
         }
       }
@@ -107,7 +117,8 @@ BagSummary summarizeBag(const std::string& path) {
     out.messages += s.count;
     out.topics.push_back(std::move(s));
   }
-  std::sort(out.topics.begin(), out.topics.end(), [](const TopicSummary& a, const TopicSummary& b) { return a.topic < b.topic; });
+  std::sort(out.topics.begin(), out.topics.end(),
+            [](const TopicSummary& a, const TopicSummary& b) { return a.topic < b.topic; });
   return out;
 }
 

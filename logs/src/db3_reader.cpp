@@ -20,12 +20,14 @@ std::string db3Message(sqlite3* db) { return printable(sqlite3_errmsg(db), 200);
 const std::string kDefSep = std::string(80, '=') + "\n";
 const std::string kTimeDef = "int32 sec\nuint32 nanosec\n";
 const std::string kHeaderDef = "builtin_interfaces/Time stamp\nstring frame_id\n";
-const std::string kHeaderDeps = kDefSep + "MSG: std_msgs/Header\n" + kHeaderDef + kDefSep + "MSG: builtin_interfaces/Time\n" + kTimeDef;
+const std::string kHeaderDeps =
+    kDefSep + "MSG: std_msgs/Header\n" + kHeaderDef + kDefSep + "MSG: builtin_interfaces/Time\n" + kTimeDef;
 
 // A text column of the current row ("" for NULL).
 std::string columnText(sqlite3_stmt* st, int c) {
   const unsigned char* p = sqlite3_column_text(st, c);
-  return p ? std::string(reinterpret_cast<const char*>(p), static_cast<std::size_t>(sqlite3_column_bytes(st, c))) : std::string();
+  return p ? std::string(reinterpret_cast<const char*>(p), static_cast<std::size_t>(sqlite3_column_bytes(st, c)))
+           : std::string();
 }
 
 }  // namespace
@@ -33,14 +35,21 @@ std::string columnText(sqlite3_stmt* st, int c) {
 std::string builtinDefinition(const std::string& type) {
   const std::string t = normalTypeName(type);
   if (t == "sensor_msgs/JointState")
-    return "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n" + kHeaderDeps;
+    return "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n" +
+           kHeaderDeps;
   if (t == "sensor_msgs/Image")
-    return "std_msgs/Header header\nuint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\nuint32 step\nuint8[] data\n" + kHeaderDeps;
+    return "std_msgs/Header header\nuint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\nuint32 "
+           "step\nuint8[] data\n" +
+           kHeaderDeps;
   if (t == "sensor_msgs/CompressedImage") return "std_msgs/Header header\nstring format\nuint8[] data\n" + kHeaderDeps;
   if (t == "sensor_msgs/CameraInfo")
-    return "std_msgs/Header header\nuint32 height\nuint32 width\nstring distortion_model\nfloat64[] d\nfloat64[9] k\nfloat64[9] r\n"
+    return "std_msgs/Header header\nuint32 height\nuint32 width\nstring distortion_model\nfloat64[] d\nfloat64[9] "
+           "k\nfloat64[9] r\n"
            "float64[12] p\nuint32 binning_x\nuint32 binning_y\nRegionOfInterest roi\n" +
-           kDefSep + "MSG: sensor_msgs/RegionOfInterest\nuint32 x_offset\nuint32 y_offset\nuint32 height\nuint32 width\nbool do_rectify\n" + kHeaderDeps;
+           kDefSep +
+           "MSG: sensor_msgs/RegionOfInterest\nuint32 x_offset\nuint32 y_offset\nuint32 height\nuint32 width\nbool "
+           "do_rectify\n" +
+           kHeaderDeps;
   if (t == "std_msgs/Header") return kHeaderDef + kDefSep + "MSG: builtin_interfaces/Time\n" + kTimeDef;
   return {};
 }
@@ -75,7 +84,10 @@ namespace {
 // The bytes a database file's 100-byte header `h` declares (page size x the in-header page count,
 // when the count is valid: its version number equals the change counter), or 0 when it declares none.
 std::uint64_t declaredBytes(const unsigned char (&h)[100]) {
-  auto be32 = [&](int at) { return (std::uint32_t{h[at]} << 24) | (std::uint32_t{h[at + 1]} << 16) | (std::uint32_t{h[at + 2]} << 8) | h[at + 3]; };
+  auto be32 = [&](int at) {
+    return (std::uint32_t{h[at]} << 24) | (std::uint32_t{h[at + 1]} << 16) | (std::uint32_t{h[at + 2]} << 8) |
+           h[at + 3];
+  };
   const std::uint32_t page = h[16] == 0 && h[17] == 1 ? 65536u : (std::uint32_t{h[16]} << 8) | h[17];
   if (page < 512 || (page & (page - 1)) != 0 || be32(24) != be32(92)) return 0;
   return std::uint64_t{page} * be32(28);
@@ -106,9 +118,9 @@ int wpReserved(sqlite3_file* f, int* out) { return realOf(f)->pMethods->xCheckRe
 int wpControl(sqlite3_file* f, int op, void* arg) { return realOf(f)->pMethods->xFileControl(realOf(f), op, arg); }
 int wpSector(sqlite3_file* f) { return realOf(f)->pMethods->xSectorSize(realOf(f)); }
 int wpDevice(sqlite3_file* f) { return realOf(f)->pMethods->xDeviceCharacteristics(realOf(f)); }
-const sqlite3_io_methods kWholePagesMethods = {1, wpClose, wpRead, wpWrite, wpTruncate, wpSync, wpFileSize, wpLock,
-                                               wpUnlock, wpReserved, wpControl, wpSector, wpDevice,
-                                               nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+const sqlite3_io_methods kWholePagesMethods = {
+    1,         wpClose,  wpRead,   wpWrite, wpTruncate, wpSync,  wpFileSize, wpLock,  wpUnlock, wpReserved,
+    wpControl, wpSector, wpDevice, nullptr, nullptr,    nullptr, nullptr,    nullptr, nullptr};
 int wpOpen(sqlite3_vfs*, sqlite3_filename name, sqlite3_file* f, int flags, int* out_flags) {
   f->pMethods = nullptr;
   const int rc = g_default_vfs->xOpen(g_default_vfs, name, realOf(f), flags, out_flags);
@@ -158,7 +170,8 @@ std::vector<std::pair<std::int64_t, std::int64_t>> salvageRows(sqlite3* db) {
 
 }  // namespace
 
-Db3Reader::Db3Reader(std::vector<std::string> files, std::string label) : files_(std::move(files)), label_(std::move(label)) {
+Db3Reader::Db3Reader(std::vector<std::string> files, std::string label)
+    : files_(std::move(files)), label_(std::move(label)) {
   if (files_.empty()) throw InputError(label_ + ": no .db3 file");
   if (label_.empty()) label_ = files_.front();
   open(0);
@@ -173,7 +186,9 @@ std::string Db3Reader::filePrefix() const {
 std::string Db3Reader::place(std::uint64_t offset) const {
   // offset: the file's index in the high bits, the row id below.
   const std::uint64_t file = offset >> 48, row = offset & ((std::uint64_t{1} << 48) - 1);
-  return (files_.size() > 1 ? std::filesystem::path(files_[std::min<std::size_t>(file, files_.size() - 1)]).filename().string() + " " : std::string()) +
+  return (files_.size() > 1
+              ? std::filesystem::path(files_[std::min<std::size_t>(file, files_.size() - 1)]).filename().string() + " "
+              : std::string()) +
          "row " + std::to_string(row);
 }
 
@@ -193,15 +208,18 @@ void Db3Reader::open(std::size_t index) {
     if (std::memcmp(header, "SQLite format 3", 16) != 0) fail("not an SQLite database (rosbag2 .db3)");
   }
   std::error_code size_error;
-  const std::uint64_t size = std::filesystem::file_size(path, size_error), declared = got == 100 ? declaredBytes(header) : 0;
+  const std::uint64_t size = std::filesystem::file_size(path, size_error),
+                      declared = got == 100 ? declaredBytes(header) : 0;
   const bool cut = !size_error && declared > size;
-  if (sqlite3_open_v2(path.c_str(), &db_->db, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX, cut ? wholePagesVfs() : nullptr) != SQLITE_OK)
+  if (sqlite3_open_v2(path.c_str(), &db_->db, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX,
+                      cut ? wholePagesVfs() : nullptr) != SQLITE_OK)
     fail(std::string("cannot be opened: ") + (db_->db ? db3Message(db_->db) : "out of memory"));
   // Nothing in the file's schema runs as trusted code; no value is longer than the file could
   // hold; the work of every query is bounded by the file's size.
   sqlite3_db_config(db_->db, SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0, nullptr);
   const std::uint64_t bytes = size_error ? 0 : size;
-  sqlite3_limit(db_->db, SQLITE_LIMIT_LENGTH, static_cast<int>(std::min<std::uint64_t>(bytes + (1u << 20), 1000000000u)));
+  sqlite3_limit(db_->db, SQLITE_LIMIT_LENGTH,
+                static_cast<int>(std::min<std::uint64_t>(bytes + (1u << 20), 1000000000u)));
   db_->max_ticks = (256 * bytes + 200'000'000) / 1000;
   sqlite3_progress_handler(db_->db, 1000, &Db::onProgress, db_.get());
   {
@@ -210,7 +228,8 @@ void Db3Reader::open(std::size_t index) {
     // taken as it is lets the rows that remain be found one by one.
     if (cut) {
       db_->salvage = true;
-      db_->cut = "cut short at byte " + std::to_string(size) + " of the " + std::to_string(declared) + " its header declares";
+      db_->cut =
+          "cut short at byte " + std::to_string(size) + " of the " + std::to_string(declared) + " its header declares";
       sqlite3_exec(db_->db, "PRAGMA writable_schema=ON", nullptr, nullptr, nullptr);
     }
   }
@@ -224,7 +243,10 @@ void Db3Reader::open(std::size_t index) {
     return std::make_pair(st, std::string());
   };
   // rosbag2 writes tables: a view (which can compute rows without end) in their place is refused.
-  if (sqlite3_stmt* st = query("SELECT name, type FROM sqlite_master WHERE lower(name) IN ('messages', 'topics', 'message_definitions')").first) {
+  if (sqlite3_stmt* st =
+          query(
+              "SELECT name, type FROM sqlite_master WHERE lower(name) IN ('messages', 'topics', 'message_definitions')")
+              .first) {
     while (sqlite3_step(st) == SQLITE_ROW)
       if (columnText(st, 1) != "table") {
         const std::string what = columnText(st, 0) + "' is a " + columnText(st, 1);
@@ -235,7 +257,8 @@ void Db3Reader::open(std::size_t index) {
   }
   // The stored definitions (rosbag2 Jazzy and later: message_definitions), by type.
   std::map<std::string, std::pair<std::string, std::string>> stored;  // type -> (encoding, text)
-  if (sqlite3_stmt* st = query("SELECT topic_type, encoding, encoded_message_definition FROM message_definitions").first) {
+  if (sqlite3_stmt* st =
+          query("SELECT topic_type, encoding, encoded_message_definition FROM message_definitions").first) {
     while (sqlite3_step(st) == SQLITE_ROW) stored[columnText(st, 0)] = {columnText(st, 1), columnText(st, 2)};
     sqlite3_finalize(st);
   }
@@ -247,7 +270,8 @@ void Db3Reader::open(std::size_t index) {
   const auto topics_query = query("SELECT id, name, type, serialization_format FROM topics");
   sqlite3_stmt* const topics = topics_query.first;
   const std::string& terr = topics_query.second;
-  if (!topics) fail(damaged() ? "damaged: " + terr + recover : "no topics table (" + terr + "): not a rosbag2 sqlite3 file");
+  if (!topics)
+    fail(damaged() ? "damaged: " + terr + recover : "no topics table (" + terr + "): not a rosbag2 sqlite3 file");
   topic_ids_.clear();
   int rc = 0;
   while ((rc = sqlite3_step(topics)) == SQLITE_ROW) {
@@ -288,18 +312,19 @@ void Db3Reader::open(std::size_t index) {
     topic_ids_[id] = it->second;
   }
   sqlite3_finalize(topics);
-  if (rc != SQLITE_DONE) fail(std::string("the topics table cannot be read: ") + db3Message(db_->db) + (damaged() ? recover : ""));
+  if (rc != SQLITE_DONE)
+    fail(std::string("the topics table cannot be read: ") + db3Message(db_->db) + (damaged() ? recover : ""));
   if (db_->salvage) {
     db_->found = salvageRows(db_->db);
     db_->row_by_id = query("SELECT id, topic_id, timestamp, data FROM messages WHERE id = ?").first;
-    if (!db_->row_by_id || db_->found.empty())
-      fail(db_->cut + ", and no message row is left in what remains");
+    if (!db_->row_by_id || db_->found.empty()) fail(db_->cut + ", and no message row is left in what remains");
     return;
   }
   const auto rows_query = query("SELECT id, topic_id, timestamp, data FROM messages ORDER BY timestamp, id");
   sqlite3_stmt* const rows = rows_query.first;
   const std::string& merr = rows_query.second;
-  if (!rows) fail(damaged() ? "damaged: " + merr + recover : "no messages table (" + merr + "): not a rosbag2 sqlite3 file");
+  if (!rows)
+    fail(damaged() ? "damaged: " + merr + recover : "no messages table (" + merr + "): not a rosbag2 sqlite3 file");
   db_->rows = rows;
 }
 
@@ -325,7 +350,8 @@ bool Db3Reader::next(LogMessage& out) {
       const std::int64_t stamp = sqlite3_column_int64(st, 2);
       const auto t = topic_ids_.find(topic);
       if (t == topic_ids_.end())
-        throw InputError(InputLocation{files_[file_], 0, 0, "row " + std::to_string(row)}, "a message of topic id " + std::to_string(topic) + ", which the topics table does not list");
+        throw InputError(InputLocation{files_[file_], 0, 0, "row " + std::to_string(row)},
+                         "a message of topic id " + std::to_string(topic) + ", which the topics table does not list");
       const void* blob = sqlite3_column_blob(st, 3);
       const int bytes = sqlite3_column_bytes(st, 3);
       data_.assign(static_cast<const std::uint8_t*>(blob), static_cast<const std::uint8_t*>(blob) + (blob ? bytes : 0));
@@ -335,14 +361,16 @@ bool Db3Reader::next(LogMessage& out) {
       out.sequence = static_cast<std::uint32_t>(row);
       out.log_time = out.publish_time = static_cast<std::uint64_t>(std::max<std::int64_t>(stamp, 0));
       out.data = data_;
-      out.offset = (static_cast<std::uint64_t>(file_) << 48) | (static_cast<std::uint64_t>(row) & ((std::uint64_t{1} << 48) - 1));
+      out.offset = (static_cast<std::uint64_t>(file_) << 48) |
+                   (static_cast<std::uint64_t>(row) & ((std::uint64_t{1} << 48) - 1));
       ++row_;
       return true;
     }
     if (rc != SQLITE_DONE) {
       // A file cut short or damaged: what was read stands, with the damage named.
-      damage_ = filePrefix() + (db_->exhausted() ? std::string("reading stopped: far more work than a file of this size needs")
-                                                 : db3Message(db_->db)) +
+      damage_ = filePrefix() +
+                (db_->exhausted() ? std::string("reading stopped: far more work than a file of this size needs")
+                                  : db3Message(db_->db)) +
                 " (after " + std::to_string(row_) + " messages)";
       db_.reset();
       return false;

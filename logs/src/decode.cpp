@@ -18,10 +18,14 @@ const Value* Value::field(std::string_view name) const {
 double Value::number() const {
   switch (kind) {
     case Kind::Bool:
-    case Kind::UInt: return static_cast<double>(u);
-    case Kind::Int: return static_cast<double>(i);
-    case Kind::Float: return f;
-    default: return std::numeric_limits<double>::quiet_NaN();
+    case Kind::UInt:
+      return static_cast<double>(u);
+    case Kind::Int:
+      return static_cast<double>(i);
+    case Kind::Float:
+      return f;
+    default:
+      return std::numeric_limits<double>::quiet_NaN();
   }
 }
 
@@ -44,8 +48,10 @@ std::optional<std::int64_t> headerStamp(const Value& message) {
   if (!stamp) return std::nullopt;
   const Value* sec = nullptr;
   const Value* nsec = nullptr;
-  if (stamp->kind == Value::Kind::Array && stamp->items.size() == 2) sec = &stamp->items[0], nsec = &stamp->items[1];  // ROS 1 time
-  else sec = stamp->field("sec"), nsec = stamp->field("nanosec");
+  if (stamp->kind == Value::Kind::Array && stamp->items.size() == 2)
+    sec = &stamp->items[0], nsec = &stamp->items[1];  // ROS 1 time
+  else
+    sec = stamp->field("sec"), nsec = stamp->field("nanosec");
   if (!sec || !nsec) return std::nullopt;
   const auto s = wholeField(*sec), n = wholeField(*nsec);
   if (!s || !n) return std::nullopt;
@@ -67,8 +73,8 @@ class Decoder {
     // (a message type whose fields are two of a type of two of a type ... of an empty type holds
     // 2^64 values in no bytes at all).
     if (++values_ > 4 * data_.size() + 4096)
-      throw DecodeError(pos_, "more than " + std::to_string(4 * data_.size() + 4096) +
-                                  " nested messages for " + std::to_string(data_.size()) + " bytes (types that take no bytes, multiplied)");
+      throw DecodeError(pos_, "more than " + std::to_string(4 * data_.size() + 4096) + " nested messages for " +
+                                  std::to_string(data_.size()) + " bytes (types that take no bytes, multiplied)");
     Value v;
     v.kind = Value::Kind::Struct;
     v.type = &t;
@@ -92,8 +98,8 @@ class Decoder {
   // `what`, and `name` after it when given, says what was being read (the text is made on failure only).
   void need(std::size_t n, const char* what, const std::string* name = nullptr) const {
     if (n > data_.size() - pos_)
-      fail(std::string("the message ends inside ") + what + (name ? " " + *name : std::string()) + " (" + std::to_string(n) +
-           " bytes needed, " + std::to_string(data_.size() - pos_) + " left)");
+      fail(std::string("the message ends inside ") + what + (name ? " " + *name : std::string()) + " (" +
+           std::to_string(n) + " bytes needed, " + std::to_string(data_.size() - pos_) + " left)");
   }
   template <class T>
   T read(const char* what, const std::string* name = nullptr) {
@@ -110,37 +116,78 @@ class Decoder {
   }
   // A 32-bit count of `what` ("a string", or "the array" followed by `name`), believed only as far
   // as the remaining bytes can hold it. The message text is made only when it is needed.
-  std::uint32_t count(std::size_t least_element_bytes, const char* what, const std::string* name = nullptr, const char* unit = "elements") {
+  std::uint32_t count(std::size_t least_element_bytes, const char* what, const std::string* name = nullptr,
+                      const char* unit = "elements") {
     const std::uint32_t n = read<std::uint32_t>(what, name);
     if (least_element_bytes > 0 && n > (data_.size() - pos_) / least_element_bytes)
-      fail(std::string(what) + (name ? " " + *name : std::string()) + " of " + std::to_string(n) + " " + unit + ", more than the " +
-           std::to_string(data_.size() - pos_) + " bytes left hold");
+      fail(std::string(what) + (name ? " " + *name : std::string()) + " of " + std::to_string(n) + " " + unit +
+           ", more than the " + std::to_string(data_.size() - pos_) + " bytes left hold");
     return n;
   }
   static std::size_t sizeOf(Primitive p) {
     switch (p) {
-      case Primitive::Bool: case Primitive::Byte: case Primitive::Char: case Primitive::Int8: case Primitive::UInt8: return 1;
-      case Primitive::Int16: case Primitive::UInt16: return 2;
-      case Primitive::Int32: case Primitive::UInt32: case Primitive::Float32: return 4;
-      case Primitive::Int64: case Primitive::UInt64: case Primitive::Float64: case Primitive::Time: case Primitive::Duration: return 8;
-      default: return 4;  // strings: at least their length
+      case Primitive::Bool:
+      case Primitive::Byte:
+      case Primitive::Char:
+      case Primitive::Int8:
+      case Primitive::UInt8:
+        return 1;
+      case Primitive::Int16:
+      case Primitive::UInt16:
+        return 2;
+      case Primitive::Int32:
+      case Primitive::UInt32:
+      case Primitive::Float32:
+        return 4;
+      case Primitive::Int64:
+      case Primitive::UInt64:
+      case Primitive::Float64:
+      case Primitive::Time:
+      case Primitive::Duration:
+        return 8;
+      default:
+        return 4;  // strings: at least their length
     }
   }
 
   Value primitive(Primitive p) {
     Value v;
     switch (p) {
-      case Primitive::Bool: v.kind = Value::Kind::Bool, v.u = read<std::uint8_t>("a bool") != 0; break;
-      case Primitive::Byte: case Primitive::Char: case Primitive::UInt8: v.kind = Value::Kind::UInt, v.u = read<std::uint8_t>("a uint8"); break;
-      case Primitive::Int8: v.kind = Value::Kind::Int, v.i = read<std::int8_t>("an int8"); break;
-      case Primitive::UInt16: v.kind = Value::Kind::UInt, v.u = read<std::uint16_t>("a uint16"); break;
-      case Primitive::Int16: v.kind = Value::Kind::Int, v.i = read<std::int16_t>("an int16"); break;
-      case Primitive::UInt32: v.kind = Value::Kind::UInt, v.u = read<std::uint32_t>("a uint32"); break;
-      case Primitive::Int32: v.kind = Value::Kind::Int, v.i = read<std::int32_t>("an int32"); break;
-      case Primitive::UInt64: v.kind = Value::Kind::UInt, v.u = read<std::uint64_t>("a uint64"); break;
-      case Primitive::Int64: v.kind = Value::Kind::Int, v.i = read<std::int64_t>("an int64"); break;
-      case Primitive::Float32: v.kind = Value::Kind::Float, v.f = read<float>("a float32"); break;
-      case Primitive::Float64: v.kind = Value::Kind::Float, v.f = read<double>("a float64"); break;
+      case Primitive::Bool:
+        v.kind = Value::Kind::Bool, v.u = read<std::uint8_t>("a bool") != 0;
+        break;
+      case Primitive::Byte:
+      case Primitive::Char:
+      case Primitive::UInt8:
+        v.kind = Value::Kind::UInt, v.u = read<std::uint8_t>("a uint8");
+        break;
+      case Primitive::Int8:
+        v.kind = Value::Kind::Int, v.i = read<std::int8_t>("an int8");
+        break;
+      case Primitive::UInt16:
+        v.kind = Value::Kind::UInt, v.u = read<std::uint16_t>("a uint16");
+        break;
+      case Primitive::Int16:
+        v.kind = Value::Kind::Int, v.i = read<std::int16_t>("an int16");
+        break;
+      case Primitive::UInt32:
+        v.kind = Value::Kind::UInt, v.u = read<std::uint32_t>("a uint32");
+        break;
+      case Primitive::Int32:
+        v.kind = Value::Kind::Int, v.i = read<std::int32_t>("an int32");
+        break;
+      case Primitive::UInt64:
+        v.kind = Value::Kind::UInt, v.u = read<std::uint64_t>("a uint64");
+        break;
+      case Primitive::Int64:
+        v.kind = Value::Kind::Int, v.i = read<std::int64_t>("an int64");
+        break;
+      case Primitive::Float32:
+        v.kind = Value::Kind::Float, v.f = read<float>("a float32");
+        break;
+      case Primitive::Float64:
+        v.kind = Value::Kind::Float, v.f = read<double>("a float64");
+        break;
       case Primitive::Time:
       case Primitive::Duration: {  // ROS 1: seconds and nanoseconds, as a structure-less pair
         v.kind = Value::Kind::Array;
@@ -167,8 +214,10 @@ class Decoder {
         pos_ += n;
         break;
       }
-      case Primitive::WString: fail("wstring fields are not read");
-      case Primitive::None: fail("internal: not a primitive");
+      case Primitive::WString:
+        fail("wstring fields are not read");
+      case Primitive::None:
+        fail("internal: not a primitive");
     }
     return v;
   }
@@ -183,7 +232,8 @@ class Decoder {
     }
     if (f.array == Field::Array::None) return sub ? message(*sub, depth + 1) : primitive(f.primitive);
     std::size_t n = f.length;
-    if (f.array == Field::Array::Dynamic) n = count(sub ? 0 : sizeOf(f.primitive), "the array", &f.name);
+    if (f.array == Field::Array::Dynamic)
+      n = count(sub ? 0 : sizeOf(f.primitive), "the array", &f.name);
     else if (!sub && n > (data_.size() - pos_) / sizeOf(f.primitive))
       fail("the array " + f.name + " of " + std::to_string(n) + " elements, more than the bytes left hold");
     Value v;
@@ -199,7 +249,8 @@ class Decoder {
       const std::size_t before = pos_;
       v.items.push_back(sub ? message(*sub, depth + 1) : primitive(f.primitive));
       // An element that takes no bytes (an empty message type) cannot be counted against the data.
-      if (pos_ == before && n > data_.size()) fail("the array " + f.name + " of " + std::to_string(n) + " empty elements");
+      if (pos_ == before && n > data_.size())
+        fail("the array " + f.name + " of " + std::to_string(n) + " empty elements");
     }
     return v;
   }
@@ -218,8 +269,8 @@ Value decodeCdr(const MessageDefinitions& types, std::span<const std::uint8_t> d
   // Plain CDR only (what ROS 2's middlewares write): 0x0000 big-endian, 0x0001 little-endian.
   if (data[0] != 0 || data[1] > 1)
     throw DecodeError(0, "CDR encapsulation 0x" + std::string(1, "0123456789abcdef"[data[0] >> 4]) +
-                             "0123456789abcdef"[data[0] & 15] + "0123456789abcdef"[data[1] >> 4] + "0123456789abcdef"[data[1] & 15] +
-                             " is not plain CDR (0x0000 or 0x0001)");
+                             "0123456789abcdef"[data[0] & 15] + "0123456789abcdef"[data[1] >> 4] +
+                             "0123456789abcdef"[data[1] & 15] + " is not plain CDR (0x0000 or 0x0001)");
   Decoder d(types, data, 4, true, data[1] == 0);
   return d.message(types.root(), 0);
 }

@@ -12,8 +12,8 @@ namespace {
 constexpr std::size_t kStep = std::size_t{1} << 20;  // the buffer grows by at most this per call
 
 std::string sizeMismatch(const std::string& what, std::size_t got, std::uint64_t size, bool complete) {
-  return "the " + what + " chunk decompresses to " + std::to_string(got) + " bytes, not the " + std::to_string(size) + " it declares" +
-         (complete ? "" : " (its data is not complete)");
+  return "the " + what + " chunk decompresses to " + std::to_string(got) + " bytes, not the " + std::to_string(size) +
+         " it declares" + (complete ? "" : " (its data is not complete)");
 }
 
 std::string zstd(std::span<const std::uint8_t> in, std::uint64_t size, std::vector<std::uint8_t>& out) {
@@ -104,14 +104,16 @@ std::string bz2(std::span<const std::uint8_t> in, std::uint64_t size, std::vecto
     if (made == 0 && s.avail_in == 0) break;
   }
   BZ2_bzDecompressEnd(&s);
-  if (ret != BZ_OK && ret != BZ_STREAM_END) return "the bz2 chunk does not decompress (bzip2 error " + std::to_string(ret) + ")";
+  if (ret != BZ_OK && ret != BZ_STREAM_END)
+    return "the bz2 chunk does not decompress (bzip2 error " + std::to_string(ret) + ")";
   if (ret != BZ_STREAM_END || out.size() != size) return sizeMismatch("bz2", out.size(), size, ret == BZ_STREAM_END);
   return {};
 }
 
 }  // namespace
 
-std::string decompress(const std::string& compression, std::span<const std::uint8_t> in, std::uint64_t size, std::vector<std::uint8_t>& out) {
+std::string decompress(const std::string& compression, std::span<const std::uint8_t> in, std::uint64_t size,
+                       std::vector<std::uint8_t>& out) {
   out.clear();
   if (compression == "zstd") return zstd(in, size, out);
   if (compression == "lz4") return lz4(in, size, out);

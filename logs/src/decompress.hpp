@@ -2,8 +2,8 @@
 // with what the data really holds, never past the size the log declares for it.
 #pragma once
 
-#include <cstdint>
 #include <algorithm>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -26,7 +26,8 @@ inline std::uint64_t decompressBudget(std::uint64_t file_bytes) {
 
 /// Takes `bytes` from what is `left` of the budget; "" or the problem when it would run out.
 inline std::string takeFromBudget(std::uint64_t& left, std::uint64_t bytes) {
-  if (bytes > left) return "the chunks decompress to more than 256 MiB plus 256 times the file's size in all (a decompression bomb)";
+  if (bytes > left)
+    return "the chunks decompress to more than 256 MiB plus 256 times the file's size in all (a decompression bomb)";
   left -= bytes;
   return {};
 }

@@ -14,17 +14,30 @@ namespace {
 
 constexpr std::uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
 enum Op : std::uint8_t {
-  kHeader = 0x01, kFooter = 0x02, kSchema = 0x03, kChannel = 0x04, kMessage = 0x05, kChunk = 0x06,
-  kMessageIndex = 0x07, kChunkIndex = 0x08, kAttachment = 0x09, kAttachmentIndex = 0x0A, kStatistics = 0x0B,
-  kMetadata = 0x0C, kMetadataIndex = 0x0D, kSummaryOffset = 0x0E, kDataEnd = 0x0F,
+  kHeader = 0x01,
+  kFooter = 0x02,
+  kSchema = 0x03,
+  kChannel = 0x04,
+  kMessage = 0x05,
+  kChunk = 0x06,
+  kMessageIndex = 0x07,
+  kChunkIndex = 0x08,
+  kAttachment = 0x09,
+  kAttachmentIndex = 0x0A,
+  kStatistics = 0x0B,
+  kMetadata = 0x0C,
+  kMetadataIndex = 0x0D,
+  kSummaryOffset = 0x0E,
+  kDataEnd = 0x0F,
 };
 // A decompressed chunk may be larger than the file, but not without limit.
 constexpr std::uint64_t kMaxChunk = std::uint64_t{1} << 31;
 
 const char* opName(std::uint8_t op) {
-  static const char* names[] = {"?", "Header", "Footer", "Schema", "Channel", "Message", "Chunk", "Message Index",
-                                "Chunk Index", "Attachment", "Attachment Index", "Statistics", "Metadata",
-                                "Metadata Index", "Summary Offset", "Data End"};
+  static const char* names[] = {
+      "?",        "Header",         "Footer",         "Schema",     "Channel",          "Message",
+      "Chunk",    "Message Index",  "Chunk Index",    "Attachment", "Attachment Index", "Statistics",
+      "Metadata", "Metadata Index", "Summary Offset", "Data End"};
   return op < 16 ? names[op] : "unknown";
 }
 
@@ -62,7 +75,8 @@ class Fields {
   void need(std::uint64_t n, const char* what) {
     if (n > b_.size() - pos_)
       throw std::out_of_range(std::string("the ") + record_ + " record is too short for its " + what + " (" +
-                              std::to_string(n) + " bytes at " + std::to_string(pos_) + " of " + std::to_string(b_.size()) + ")");
+                              std::to_string(n) + " bytes at " + std::to_string(pos_) + " of " +
+                              std::to_string(b_.size()) + ")");
   }
   std::span<const std::uint8_t> b_;
   std::size_t pos_ = 0;
@@ -98,7 +112,8 @@ McapReader::McapReader(const std::string& path) : path_(path) {
   decompress_left_ = detail::decompressBudget(size_);
   std::uint8_t magic[8] = {};
   if (size_ < 8 || !in_.read(reinterpret_cast<char*>(magic), 8) || std::memcmp(magic, kMagic, 8) != 0)
-    throw InputError(InputLocation{path, 0, 0, "byte 0"}, "not an MCAP file (its first 8 bytes are not the MCAP magic)");
+    throw InputError(InputLocation{path, 0, 0, "byte 0"},
+                     "not an MCAP file (its first 8 bytes are not the MCAP magic)");
   data_crc_ = crc32Of(0, magic, 8);
   pos_ = 8;
   if (!readIndex()) {
@@ -172,7 +187,9 @@ bool McapReader::readIndex() {
         c.end = f.num<std::uint64_t>("message_end_time");
         c.offset = f.num<std::uint64_t>("chunk_start_offset");
         c.length = f.num<std::uint64_t>("chunk_length");
-        if (c.offset < 8 || c.length < 9 || c.offset > summary_start || c.length > summary_start - c.offset || c.start > c.end) return false;
+        if (c.offset < 8 || c.length < 9 || c.offset > summary_start || c.length > summary_start - c.offset ||
+            c.start > c.end)
+          return false;
         merge->order.push_back(c);
       }
     }
@@ -181,7 +198,8 @@ bool McapReader::readIndex() {
   }
   if (merge->order.size() < 2) return false;
   // Overlap: a chunk (in file order) that starts before an earlier one ends.
-  std::sort(merge->order.begin(), merge->order.end(), [](const Merge::Chunk& a, const Merge::Chunk& b) { return a.offset < b.offset; });
+  std::sort(merge->order.begin(), merge->order.end(),
+            [](const Merge::Chunk& a, const Merge::Chunk& b) { return a.offset < b.offset; });
   bool overlap = false;
   std::uint64_t latest = 0;
   for (const Merge::Chunk& c : merge->order) {
@@ -201,7 +219,8 @@ bool McapReader::readIndex() {
     if (head[0] == kMessage) return false;
     if (head[0] == kSchema || head[0] == kChannel || head[0] == kHeader) {
       content.resize(static_cast<std::size_t>(len));
-      if (len > 0 && !in_.read(reinterpret_cast<char*>(content.data()), static_cast<std::streamsize>(len))) return false;
+      if (len > 0 && !in_.read(reinterpret_cast<char*>(content.data()), static_cast<std::streamsize>(len)))
+        return false;
       try {
         handle(head[0], content, p, false);
       } catch (const std::exception&) {
@@ -211,7 +230,8 @@ bool McapReader::readIndex() {
     if (head[0] == kDataEnd) break;
     p += 9 + len;
   }
-  std::stable_sort(merge->order.begin(), merge->order.end(), [](const Merge::Chunk& a, const Merge::Chunk& b) { return a.start < b.start; });
+  std::stable_sort(merge->order.begin(), merge->order.end(),
+                   [](const Merge::Chunk& a, const Merge::Chunk& b) { return a.start < b.start; });
   merge_ = std::move(merge);
   return true;
 }
@@ -233,9 +253,11 @@ bool McapReader::nextMerged(LogMessage& out) {
       std::vector<std::uint8_t> record(static_cast<std::size_t>(c.length));
       in_.clear();
       in_.seekg(static_cast<std::streamoff>(c.offset));
-      if (!in_.read(reinterpret_cast<char*>(record.data()), static_cast<std::streamsize>(record.size())) || record[0] != kChunk)
+      if (!in_.read(reinterpret_cast<char*>(record.data()), static_cast<std::streamsize>(record.size())) ||
+          record[0] != kChunk)
         fail(c.offset, "the chunk index points at no Chunk record here");
-      if (le64(record.data() + 1) != c.length - 9) fail(c.offset, "the chunk index gives this chunk another length than its record");
+      if (le64(record.data() + 1) != c.length - 9)
+        fail(c.offset, "the chunk index gives this chunk another length than its record");
       try {
         decompressChunk(std::span<const std::uint8_t>(record).subspan(9), c.offset, o->records);
       } catch (const std::out_of_range& e) {
@@ -245,14 +267,17 @@ bool McapReader::nextMerged(LogMessage& out) {
         std::uint8_t op = 0;
         const std::span<const std::uint8_t> content = chunkRecord(o->records, p, c.offset, op);
         if (op == kMessage) {
-          if (content.size() < 22) fail(c.offset, "the Message record is too short for its header (" + std::to_string(content.size()) + " bytes)");
+          if (content.size() < 22)
+            fail(c.offset,
+                 "the Message record is too short for its header (" + std::to_string(content.size()) + " bytes)");
           const std::size_t at = static_cast<std::size_t>(content.data() - o->records.data());
           o->messages.push_back({le64(content.data() + 6), at, content.size()});
         } else if (op == kSchema || op == kChannel) {
           handle(op, content, c.offset, true);
         }
       }
-      std::stable_sort(o->messages.begin(), o->messages.end(), [](const Merge::Entry& a, const Merge::Entry& b) { return a.log_time < b.log_time; });
+      std::stable_sort(o->messages.begin(), o->messages.end(),
+                       [](const Merge::Entry& a, const Merge::Entry& b) { return a.log_time < b.log_time; });
       if (!o->messages.empty()) g.open.push_back(std::move(o));
       continue;
     }
@@ -299,8 +324,10 @@ bool McapReader::readRecord(std::uint8_t& opcode, std::vector<std::uint8_t>& con
     return false;
   }
   content.resize(static_cast<std::size_t>(len));
-  if (len > 0 && !in_.read(reinterpret_cast<char*>(content.data()), static_cast<std::streamsize>(len))) fail(pos_, "cannot be read");
-  if (data_crc_on_ && opcode != kDataEnd) data_crc_ = crc32Of(crc32Of(data_crc_, head, 9), content.data(), content.size());
+  if (len > 0 && !in_.read(reinterpret_cast<char*>(content.data()), static_cast<std::streamsize>(len)))
+    fail(pos_, "cannot be read");
+  if (data_crc_on_ && opcode != kDataEnd)
+    data_crc_ = crc32Of(crc32Of(data_crc_, head, 9), content.data(), content.size());
   if (in_summary_) {
     // The summary CRC runs up to the footer's summary_crc field (its last 4 bytes).
     const std::size_t counted = opcode == kFooter && content.size() >= 4 ? content.size() - 4 : content.size();
@@ -310,15 +337,16 @@ bool McapReader::readRecord(std::uint8_t& opcode, std::vector<std::uint8_t>& con
   return true;
 }
 
-std::span<const std::uint8_t> McapReader::chunkRecord(const std::vector<std::uint8_t>& records, std::size_t& pos, std::uint64_t at,
-                                                      std::uint8_t& op) const {
+std::span<const std::uint8_t> McapReader::chunkRecord(const std::vector<std::uint8_t>& records, std::size_t& pos,
+                                                      std::uint64_t at, std::uint8_t& op) const {
   const std::size_t left = records.size() - pos;
   if (left < 9) fail(at, "the chunk ends inside a record's opcode and length");
   op = records[pos];
   const std::uint64_t len = le64(records.data() + pos + 1);
   if (len > left - 9) fail(at, std::string("a ") + opName(op) + " record inside the chunk runs past its end");
   if (op != kSchema && op != kChannel && op != kMessage && op <= kDataEnd)
-    fail(at, std::string("a ") + opName(op) + " record inside a chunk (only schemas, channels and messages belong there)");
+    fail(at,
+         std::string("a ") + opName(op) + " record inside a chunk (only schemas, channels and messages belong there)");
   const std::span<const std::uint8_t> content(records.data() + pos + 9, static_cast<std::size_t>(len));
   pos += 9 + static_cast<std::size_t>(len);
   return content;
@@ -330,7 +358,8 @@ void McapReader::openChunk(std::span<const std::uint8_t> content, std::uint64_t 
   chunk_pos_ = 0;
 }
 
-void McapReader::decompressChunk(std::span<const std::uint8_t> content, std::uint64_t at, std::vector<std::uint8_t>& chunk) {
+void McapReader::decompressChunk(std::span<const std::uint8_t> content, std::uint64_t at,
+                                 std::vector<std::uint8_t>& chunk) {
   std::vector<std::uint8_t>& chunk_ = chunk;
   Fields f(content, "Chunk");
   f.num<std::uint64_t>("message_start_time");
@@ -339,11 +368,14 @@ void McapReader::decompressChunk(std::span<const std::uint8_t> content, std::uin
   const std::uint32_t crc = f.num<std::uint32_t>("uncompressed_crc");
   const std::string compression = f.str("compression");
   const std::span<const std::uint8_t> records = f.bytes64("records");
-  if (size > kMaxChunk) fail(at, "a chunk of " + std::to_string(size) + " bytes uncompressed, more than this reader takes (2 GiB)");
+  if (size > kMaxChunk)
+    fail(at, "a chunk of " + std::to_string(size) + " bytes uncompressed, more than this reader takes (2 GiB)");
   chunk_.clear();
   if (const std::string problem = detail::takeFromBudget(decompress_left_, size); !problem.empty()) fail(at, problem);
   if (compression.empty()) {
-    if (records.size() != size) fail(at, "an uncompressed chunk of " + std::to_string(records.size()) + " bytes says it holds " + std::to_string(size));
+    if (records.size() != size)
+      fail(at, "an uncompressed chunk of " + std::to_string(records.size()) + " bytes says it holds " +
+                   std::to_string(size));
     chunk_.assign(records.begin(), records.end());
   } else if (compression == "zstd" || compression == "lz4") {
     // Streamed: the buffer grows with what the data really decompresses to, not with the claim.
@@ -352,7 +384,8 @@ void McapReader::decompressChunk(std::span<const std::uint8_t> content, std::uin
   } else {
     fail(at, "the chunk's compression '" + printable(compression, 40) + "' is not none, zstd or lz4");
   }
-  if (crc != 0 && crc32Of(0, chunk_.data(), chunk_.size()) != crc) fail(at, "the chunk's CRC does not match its records (damaged)");
+  if (crc != 0 && crc32Of(0, chunk_.data(), chunk_.size()) != crc)
+    fail(at, "the chunk's CRC does not match its records (damaged)");
   ++chunks_[compression.empty() ? "none" : compression];
 }
 
@@ -375,7 +408,8 @@ void McapReader::handle(std::uint8_t opcode, std::span<const std::uint8_t> conte
         s.data.assign(reinterpret_cast<const char*>(d.data()), d.size());
         if (s.id == 0) fail(at, "a Schema record with id 0 (reserved for 'no schema')");
         const auto it = schemas_.find(s.id);
-        if (it != schemas_.end() && (it->second.name != s.name || it->second.encoding != s.encoding || it->second.data != s.data))
+        if (it != schemas_.end() &&
+            (it->second.name != s.name || it->second.encoding != s.encoding || it->second.data != s.data))
           fail(at, "schema " + std::to_string(s.id) + " is defined twice, differently");
         schemas_[s.id] = std::move(s);
         break;
@@ -394,7 +428,8 @@ void McapReader::handle(std::uint8_t opcode, std::span<const std::uint8_t> conte
           c.metadata.emplace_back(std::move(k), m.str("metadata value"));
         }
         if (c.schema_id != 0 && !schemas_.count(c.schema_id))
-          fail(at, "channel " + std::to_string(c.id) + " (" + printable(c.topic, 60) + ") names schema " + std::to_string(c.schema_id) + ", which no earlier record defines");
+          fail(at, "channel " + std::to_string(c.id) + " (" + printable(c.topic, 60) + ") names schema " +
+                       std::to_string(c.schema_id) + ", which no earlier record defines");
         const auto it = channels_.find(c.id);
         if (it != channels_.end() && (it->second.topic != c.topic || it->second.schema_id != c.schema_id ||
                                       it->second.message_encoding != c.message_encoding))
@@ -412,7 +447,8 @@ void McapReader::handle(std::uint8_t opcode, std::span<const std::uint8_t> conte
         m.publish_time = f.num<std::uint64_t>("publish_time");
         m.data = f.rest();
         const auto c = channels_.find(channel);
-        if (c == channels_.end()) fail(at, "a message on channel " + std::to_string(channel) + ", which no earlier record defines");
+        if (c == channels_.end())
+          fail(at, "a message on channel " + std::to_string(channel) + ", which no earlier record defines");
         m.channel = &c->second;
         m.schema = nullptr;
         if (c->second.schema_id != 0) m.schema = &schemas_.at(c->second.schema_id);
@@ -439,12 +475,14 @@ void McapReader::handle(std::uint8_t opcode, std::span<const std::uint8_t> conte
         const std::uint64_t summary_start = f.num<std::uint64_t>("summary_start");
         f.num<std::uint64_t>("summary_offset_start");
         const std::uint32_t crc = f.num<std::uint32_t>("summary_crc");
-        if (crc != 0 && summary_start != 0 && crc != summary_crc_) fail(at, "the summary section's CRC does not match (damaged)");
+        if (crc != 0 && summary_start != 0 && crc != summary_crc_)
+          fail(at, "the summary section's CRC does not match (damaged)");
         ended_ = true;
         break;
       }
       default:
-        break;  // indexes, statistics, attachments, metadata and records of later versions: not needed to read the messages
+        break;  // indexes, statistics, attachments, metadata and records of later versions: not needed to read the
+                // messages
     }
   } catch (const std::out_of_range& e) {
     fail(at, e.what());

@@ -16,11 +16,11 @@ std::string_view trim(std::string_view s) {
 
 Primitive primitiveOf(std::string_view t, Dialect d) {
   static const std::pair<std::string_view, Primitive> table[] = {
-      {"bool", Primitive::Bool},       {"byte", Primitive::Byte},       {"char", Primitive::Char},
-      {"int8", Primitive::Int8},       {"uint8", Primitive::UInt8},     {"int16", Primitive::Int16},
-      {"uint16", Primitive::UInt16},   {"int32", Primitive::Int32},     {"uint32", Primitive::UInt32},
-      {"int64", Primitive::Int64},     {"uint64", Primitive::UInt64},   {"float32", Primitive::Float32},
-      {"float64", Primitive::Float64}, {"string", Primitive::String},   {"wstring", Primitive::WString}};
+      {"bool", Primitive::Bool},       {"byte", Primitive::Byte},     {"char", Primitive::Char},
+      {"int8", Primitive::Int8},       {"uint8", Primitive::UInt8},   {"int16", Primitive::Int16},
+      {"uint16", Primitive::UInt16},   {"int32", Primitive::Int32},   {"uint32", Primitive::UInt32},
+      {"int64", Primitive::Int64},     {"uint64", Primitive::UInt64}, {"float32", Primitive::Float32},
+      {"float64", Primitive::Float64}, {"string", Primitive::String}, {"wstring", Primitive::WString}};
   for (const auto& [name, p] : table)
     if (t == name) return p;
   if (d == Dialect::Ros1 && t == "time") return Primitive::Time;
@@ -30,7 +30,8 @@ Primitive primitiveOf(std::string_view t, Dialect d) {
 
 bool validName(std::string_view s) {
   if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
-  return std::all_of(s.begin(), s.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+  return std::all_of(s.begin(), s.end(),
+                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
 }
 
 bool validTypeName(std::string_view s) {
@@ -38,7 +39,8 @@ bool validTypeName(std::string_view s) {
   std::size_t start = 0;
   for (;;) {
     const std::size_t slash = s.find('/', start);
-    if (!validName(s.substr(start, slash == std::string_view::npos ? std::string_view::npos : slash - start))) return false;
+    if (!validName(s.substr(start, slash == std::string_view::npos ? std::string_view::npos : slash - start)))
+      return false;
     if (slash == std::string_view::npos) return true;
     start = slash + 1;
   }
@@ -77,7 +79,8 @@ MessageDefinitions MessageDefinitions::parse(std::string_view root_name, std::st
   MessageDefinitions out;
   out.dialect_ = dialect;
   out.root_ = normalTypeName(root_name);
-  if (!validTypeName(out.root_)) throw DefinitionError(0, "the type name '" + std::string(root_name) + "' is not pkg/Type");
+  if (!validTypeName(out.root_))
+    throw DefinitionError(0, "the type name '" + std::string(root_name) + "' is not pkg/Type");
   // Split into sections: the root, then "MSG: name" after a line of '='.
   std::vector<Section> sections{{out.root_, 1, {}}};
   std::size_t line_no = 0;
@@ -92,10 +95,12 @@ MessageDefinitions MessageDefinitions::parse(std::string_view root_name, std::st
       expect_msg = true;
     } else if (expect_msg && t.substr(0, 4) == "MSG:") {
       sections.push_back({normalTypeName(t.substr(4)), line_no + 1, {}});
-      if (!validTypeName(sections.back().name)) throw DefinitionError(line_no, "'" + std::string(t) + "': expected MSG: pkg/Type");
+      if (!validTypeName(sections.back().name))
+        throw DefinitionError(line_no, "'" + std::string(t) + "': expected MSG: pkg/Type");
       expect_msg = false;
     } else {
-      if (expect_msg && !t.empty()) throw DefinitionError(line_no, "expected a 'MSG: pkg/Type' line after the line of '='");
+      if (expect_msg && !t.empty())
+        throw DefinitionError(line_no, "expected a 'MSG: pkg/Type' line after the line of '='");
       sections.back().lines.push_back(line);
     }
     if (end == text.size()) break;
@@ -124,12 +129,14 @@ MessageDefinitions MessageDefinitions::parse(std::string_view root_name, std::st
       if (sp == std::string_view::npos) throw DefinitionError(at, "'" + std::string(l) + "': expected TYPE NAME");
       std::string_view type_text = l.substr(0, sp);
       const std::string_view rest = trim(l.substr(sp));
-      const std::string_view field_name = rest.substr(0, rest.find_first_of(" \t"));  // a ROS 2 default value may follow
+      const std::string_view field_name =
+          rest.substr(0, rest.find_first_of(" \t"));  // a ROS 2 default value may follow
       if (!validName(field_name)) throw DefinitionError(at, "'" + std::string(field_name) + "' is not a field name");
       Field f;
       f.name = std::string(field_name);
       if (const std::size_t bracket = type_text.find('['); bracket != std::string_view::npos) {
-        if (type_text.back() != ']') throw DefinitionError(at, "'" + std::string(type_text) + "': an array type ends with ']'");
+        if (type_text.back() != ']')
+          throw DefinitionError(at, "'" + std::string(type_text) + "': an array type ends with ']'");
         std::string_view inside = type_text.substr(bracket + 1, type_text.size() - bracket - 2);
         type_text = type_text.substr(0, bracket);
         if (inside.empty() || inside.substr(0, 2) == "<=") {
@@ -144,12 +151,14 @@ MessageDefinitions MessageDefinitions::parse(std::string_view root_name, std::st
         }
       }
       // Bounded strings ("string<=10") are strings on the wire.
-      if (const std::size_t le = type_text.find("<="); le != std::string_view::npos) type_text = type_text.substr(0, le);
+      if (const std::size_t le = type_text.find("<="); le != std::string_view::npos)
+        type_text = type_text.substr(0, le);
       f.primitive = primitiveOf(type_text, dialect);
       if (f.primitive == Primitive::None) {
         std::string t = normalTypeName(type_text);
         if (!validTypeName(t)) throw DefinitionError(at, "'" + std::string(type_text) + "' is not a type");
-        if (t.find('/') == std::string::npos) t = (dialect == Dialect::Ros1 && t == "Header" ? "std_msgs" : package) + "/" + t;
+        if (t.find('/') == std::string::npos)
+          t = (dialect == Dialect::Ros1 && t == "Header" ? "std_msgs" : package) + "/" + t;
         f.type_name = t;
       }
       type.fields.push_back(std::move(f));
@@ -161,9 +170,12 @@ MessageDefinitions MessageDefinitions::parse(std::string_view root_name, std::st
   std::vector<std::string> path;
   auto visit = [&](auto&& self, const std::string& n) -> void {
     if (done.count(n)) return;
-    if (std::find(path.begin(), path.end(), n) != path.end()) throw DefinitionError(0, "the type " + n + " contains itself");
+    if (std::find(path.begin(), path.end(), n) != path.end())
+      throw DefinitionError(0, "the type " + n + " contains itself");
     const MessageType* t = out.find(n);
-    if (!t) throw DefinitionError(0, "the type " + n + " is used but not defined" + (path.empty() ? "" : " (in " + path.back() + ")"));
+    if (!t)
+      throw DefinitionError(
+          0, "the type " + n + " is used but not defined" + (path.empty() ? "" : " (in " + path.back() + ")"));
     path.push_back(n);
     for (const Field& f : t->fields)
       if (f.primitive == Primitive::None) self(self, f.type_name);

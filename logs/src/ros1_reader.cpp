@@ -11,9 +11,18 @@ namespace {
 
 constexpr char kRos1Magic[] = "#ROSBAG V2.0\n";
 constexpr std::uint64_t kMaxRos1Chunk = std::uint64_t{1} << 31;
-enum : std::uint8_t { kOpMessage = 0x02, kOpBagHeader = 0x03, kOpIndex = 0x04, kOpChunk = 0x05, kOpChunkInfo = 0x06, kOpConnection = 0x07 };
+enum : std::uint8_t {
+  kOpMessage = 0x02,
+  kOpBagHeader = 0x03,
+  kOpIndex = 0x04,
+  kOpChunk = 0x05,
+  kOpChunkInfo = 0x06,
+  kOpConnection = 0x07
+};
 
-std::uint32_t le32(const std::uint8_t* p) { return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24; }
+std::uint32_t le32(const std::uint8_t* p) {
+  return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
+}
 
 // A record header's (or connection header's) fields: "name=value" each after a 32-bit length.
 std::map<std::string, std::string> fieldsOf(std::span<const std::uint8_t> h, std::string& problem) {
@@ -47,7 +56,8 @@ bool numberOf(const std::map<std::string, std::string>& f, const char* name, T& 
   const auto it = f.find(name);
   if (it == f.end() || it->second.size() != sizeof(T)) return false;
   out = 0;
-  for (std::size_t k = 0; k < sizeof(T); ++k) out |= static_cast<T>(static_cast<T>(static_cast<std::uint8_t>(it->second[k])) << (8 * k));
+  for (std::size_t k = 0; k < sizeof(T); ++k)
+    out |= static_cast<T>(static_cast<T>(static_cast<std::uint8_t>(it->second[k])) << (8 * k));
   return true;
 }
 
@@ -62,7 +72,8 @@ Ros1Reader::Ros1Reader(const std::string& path) : path_(path) {
   in_.seekg(0);
   char magic[13] = {};
   if (size_ < 13 || !in_.read(magic, 13) || std::memcmp(magic, kRos1Magic, 13) != 0)
-    throw InputError(InputLocation{path, 0, 0, "byte 0"}, "not a ROS 1 bag of format 2.0 (its first line is not #ROSBAG V2.0)");
+    throw InputError(InputLocation{path, 0, 0, "byte 0"},
+                     "not a ROS 1 bag of format 2.0 (its first line is not #ROSBAG V2.0)");
   pos_ = 13;
 }
 
@@ -72,7 +83,8 @@ void Ros1Reader::fail(std::uint64_t at, const std::string& problem) const {
   throw InputError(InputLocation{path_, 0, 0, "byte " + std::to_string(at)}, problem);
 }
 
-bool Ros1Reader::record(std::span<const std::uint8_t> header, std::span<const std::uint8_t> data, std::uint64_t at, bool in_chunk) {
+bool Ros1Reader::record(std::span<const std::uint8_t> header, std::span<const std::uint8_t> data, std::uint64_t at,
+                        bool in_chunk) {
   std::string problem;
   const auto f = fieldsOf(header, problem);
   if (!problem.empty()) fail(at, problem);
@@ -112,7 +124,8 @@ bool Ros1Reader::record(std::span<const std::uint8_t> header, std::span<const st
       std::uint64_t time = 0;
       if (!numberOf(f, "conn", conn) || !numberOf(f, "time", time)) fail(at, "a message record without conn and time");
       const auto c = channel_of_conn_.find(conn);
-      if (c == channel_of_conn_.end()) fail(at, "a message on connection " + std::to_string(conn) + ", which no earlier record defines");
+      if (c == channel_of_conn_.end())
+        fail(at, "a message on connection " + std::to_string(conn) + ", which no earlier record defines");
       const Channel& ch = channels_.at(c->second);
       message_.channel = &ch;
       message_.schema = ch.schema_id ? &schemas_.at(ch.schema_id) : nullptr;
@@ -129,9 +142,12 @@ bool Ros1Reader::record(std::span<const std::uint8_t> header, std::span<const st
       const auto comp = f.find("compression");
       if (comp == f.end() || !numberOf(f, "size", size)) fail(at, "a chunk record without compression and size");
       if (size > kMaxRos1Chunk) fail(at, "a chunk of " + std::to_string(size) + " bytes");
-      if (const std::string problem = detail::takeFromBudget(decompress_left_, size); !problem.empty()) fail(at, problem);
+      if (const std::string problem = detail::takeFromBudget(decompress_left_, size); !problem.empty())
+        fail(at, problem);
       if (comp->second == "none") {
-        if (data.size() != size) fail(at, "an uncompressed chunk of " + std::to_string(data.size()) + " bytes says it holds " + std::to_string(size));
+        if (data.size() != size)
+          fail(at, "an uncompressed chunk of " + std::to_string(data.size()) + " bytes says it holds " +
+                       std::to_string(size));
         chunk_.assign(data.begin(), data.end());
       } else if (comp->second == "bz2" || comp->second == "lz4") {
         const std::string p = detail::decompress(comp->second, data, size, chunk_);
@@ -145,7 +161,8 @@ bool Ros1Reader::record(std::span<const std::uint8_t> header, std::span<const st
       break;
     }
     case kOpBagHeader:
-      if (!numberOf(f, "index_pos", index_pos_) || !numberOf(f, "chunk_count", chunk_count_)) fail(at, "a bag header without index_pos and chunk_count");
+      if (!numberOf(f, "index_pos", index_pos_) || !numberOf(f, "chunk_count", chunk_count_))
+        fail(at, "a bag header without index_pos and chunk_count");
       have_header_ = true;
       break;
     case kOpChunkInfo:
@@ -167,7 +184,8 @@ bool Ros1Reader::next(LogMessage& out) {
       if (hl > left - 4 || left - 4 - hl < 4) fail(chunk_at_, "a record inside the chunk runs past its end");
       const std::uint32_t dl = le32(chunk_.data() + chunk_pos_ + 4 + hl);
       if (dl > left - 8 - hl) fail(chunk_at_, "a record inside the chunk runs past its end");
-      const std::span<const std::uint8_t> h(chunk_.data() + chunk_pos_ + 4, hl), d(chunk_.data() + chunk_pos_ + 8 + hl, dl);
+      const std::span<const std::uint8_t> h(chunk_.data() + chunk_pos_ + 4, hl),
+          d(chunk_.data() + chunk_pos_ + 8 + hl, dl);
       chunk_pos_ += 8 + hl + dl;
       if (record(h, d, chunk_at_, true)) {
         out = message_;
@@ -182,10 +200,14 @@ bool Ros1Reader::next(LogMessage& out) {
     };
     if (pos_ == size_) {
       // A bag ends after its index: a cut at a record's end shows as a missing index or part of it.
-      if (!have_header_) cut("no bag header record");
-      else if (index_pos_ == 0) damage_ = "not closed: the bag header points at no index (the recording stopped before the bag was closed)";
-      else if (size_ <= index_pos_) cut("before its index at byte " + std::to_string(index_pos_));
-      else if (chunk_infos_ < chunk_count_) cut("its index lists " + std::to_string(chunk_infos_) + " of its " + std::to_string(chunk_count_) + " chunks");
+      if (!have_header_)
+        cut("no bag header record");
+      else if (index_pos_ == 0)
+        damage_ = "not closed: the bag header points at no index (the recording stopped before the bag was closed)";
+      else if (size_ <= index_pos_)
+        cut("before its index at byte " + std::to_string(index_pos_));
+      else if (chunk_infos_ < chunk_count_)
+        cut("its index lists " + std::to_string(chunk_infos_) + " of its " + std::to_string(chunk_count_) + " chunks");
       ended_ = true;
       return false;
     }

@@ -13,11 +13,14 @@ namespace {
 
 // About `a.recording_samples` frames spread over the recording (`bag`, else --video) with their
 // states in `log` (for masks made from the recording); those without a state left out.
-std::vector<overlay::RecordingSample> recordingSamples(const FrameOptions& a, const overlay::BagRecording* bag, const StateLog* log,
-                                                       const Model& model, double max_gap, const std::string& log_name) {
+std::vector<overlay::RecordingSample> recordingSamples(const FrameOptions& a, const overlay::BagRecording* bag,
+                                                       const StateLog* log, const Model& model, double max_gap,
+                                                       const std::string& log_name) {
   std::vector<overlay::RecordingSample> out;
-  if (a.video.empty() && !bag) throw UsageError("--masks auto: makes the masks from a recording: give --video (with --states) or --bag");
-  if (!log) throw UsageError("--masks auto: needs each frame's state: give --states LOG.csv (or --bag with joint states)");
+  if (a.video.empty() && !bag)
+    throw UsageError("--masks auto: makes the masks from a recording: give --video (with --states) or --bag");
+  if (!log)
+    throw UsageError("--masks auto: needs each frame's state: give --states LOG.csv (or --bag with joint states)");
   std::vector<int> indices;
   std::vector<cv::Mat> pictures;
   std::vector<double> sample_times;
@@ -28,8 +31,10 @@ std::vector<overlay::RecordingSample> recordingSamples(const FrameOptions& a, co
     pictures = overlay::framesAt(*bag, std::vector<long>(indices.begin(), indices.end()), "--masks auto");
     for (const int i : indices) sample_times.push_back(bag->frame_times[static_cast<std::size_t>(i)]);
   } else {
-    overlay::RecordingFrames r = overlay::sampleRecordingFrames(a.video, a.recording_samples, indices, "--video " + a.video);
-    if (!(r.fps > 0.0)) throw UsageError("--masks auto: --video " + a.video + " declares no frame rate, so its frames have no times");
+    overlay::RecordingFrames r =
+        overlay::sampleRecordingFrames(a.video, a.recording_samples, indices, "--video " + a.video);
+    if (!(r.fps > 0.0))
+      throw UsageError("--masks auto: --video " + a.video + " declares no frame rate, so its frames have no times");
     pictures = std::move(r.frames);
     // The frames' --time, when given, says where the log's clock stands against frame / fps.
     const double offset = a.times.empty() ? 0.0 : a.times.front() - a.video_frames.front() / r.fps;
@@ -37,7 +42,8 @@ std::vector<overlay::RecordingSample> recordingSamples(const FrameOptions& a, co
   }
   for (std::size_t k = 0; k < pictures.size(); ++k) {
     std::vector<double> state(static_cast<std::size_t>(model.stateSize()), 0.0);
-    if (stateAt(*log, sample_times[k], max_gap, state) != StateMatch::None) out.push_back({pictures[k], std::move(state)});
+    if (stateAt(*log, sample_times[k], max_gap, state) != StateMatch::None)
+      out.push_back({pictures[k], std::move(state)});
   }
   if (out.size() < 8)
     throw UsageError("--masks auto: only " + std::to_string(out.size()) + " of " + std::to_string(pictures.size()) +
@@ -47,17 +53,22 @@ std::vector<overlay::RecordingSample> recordingSamples(const FrameOptions& a, co
 
 }  // namespace
 
-GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, const std::optional<Model>& model, bool refined) {
+GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, const std::optional<Model>& model,
+                        bool refined) {
   std::vector<std::string> picture_names = a.images;
   std::vector<cv::Mat> video_pictures;
   std::vector<double> times = a.times;
   std::optional<overlay::BagRecording> bag;
   std::vector<std::string> warnings;
   if (!a.bag.empty()) {
-    if (!a.images.empty() || !a.video.empty()) throw UsageError("--bag: give --image files, --video or --bag, one of them");
-    if (a.video_frames.empty()) throw UsageError("--bag: say which frames of its image topic with --frame N (repeat for several)");
+    if (!a.images.empty() || !a.video.empty())
+      throw UsageError("--bag: give --image files, --video or --bag, one of them");
+    if (a.video_frames.empty())
+      throw UsageError("--bag: say which frames of its image topic with --frame N (repeat for several)");
     if (!a.state_log.empty() || !a.times.empty() || !a.ignore_columns.empty())
-      throw UsageError("--states, --time and --ignore-columns: not with --bag (its joint states give each frame's state at the frame's time)");
+      throw UsageError(
+          "--states, --time and --ignore-columns: not with --bag (its joint states give each frame's state at the "
+          "frame's time)");
     const overlay::BagRecordingOptions bo{
         .bag = a.bag,
         .joint_topic = a.joint_topic,
@@ -69,7 +80,8 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
     // With a model (and no --state) the joint states give each frame's state; else the images alone.
     bag = model && a.states.empty() ? overlay::readBagRecording(bo, *model) : overlay::readBagImages(bo);
     for (const std::string& w : bag->warnings) warnings.push_back("--bag " + a.bag + ": " + w);
-    video_pictures = overlay::framesAt(*bag, std::vector<long>(a.video_frames.begin(), a.video_frames.end()), "--frame");
+    video_pictures =
+        overlay::framesAt(*bag, std::vector<long>(a.video_frames.begin(), a.video_frames.end()), "--frame");
     for (const int f : a.video_frames) {
       picture_names.push_back(a.bag + "#" + std::to_string(f));
       if (bag->log.rows() > 0) times.push_back(bag->frame_times[static_cast<std::size_t>(f)]);
@@ -92,13 +104,17 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
     throw UsageError("--frame: needs --video or --bag");
   }
   const std::size_t n = picture_names.empty() ? labels : picture_names.size();
-  if (n == 0) throw UsageError("give --image FRAME (with --tags and/or --labels) or --labels LABELS (see kccd calib --help)");
+  if (n == 0)
+    throw UsageError("give --image FRAME (with --tags and/or --labels) or --labels LABELS (see kccd calib --help)");
   if (!picture_names.empty() && labels != 0 && labels != picture_names.size())
-    throw UsageError("--labels: given " + std::to_string(labels) + " times for " + std::to_string(picture_names.size()) +
+    throw UsageError("--labels: given " + std::to_string(labels) + " times for " +
+                     std::to_string(picture_names.size()) +
                      " images: give one labels file per --image, in the same order");
   if (tags && picture_names.empty()) throw UsageError("--tags: needs --image (tags are detected in the images)");
   if (!picture_names.empty() && !tags && labels == 0 && !refined)
-    throw UsageError("--image: give --tags LAYOUT, --labels LABELS and/or --masks MASK (or --refine edges) to say what the image shows");
+    throw UsageError(
+        "--image: give --tags LAYOUT, --labels LABELS and/or --masks MASK (or --refine edges) to say what the image "
+        "shows");
   if (!a.states.empty() && a.states.size() != 1 && a.states.size() != n)
     throw UsageError("--state: given " + std::to_string(a.states.size()) + " times for " + std::to_string(n) +
                      " frames: give it once (all frames) or once per frame");
@@ -106,9 +122,11 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
   if (!a.state_log.empty() && !model) throw UsageError("--states: needs --model");
   if (!a.state_log.empty() && !a.states.empty()) throw UsageError("--state and --states: give one of them");
   if (a.state_log.empty() != times.empty() && !bag)
-    throw UsageError(a.state_log.empty() ? "--time: needs --states LOG.csv" : "--states: give each frame's time with --time");
+    throw UsageError(a.state_log.empty() ? "--time: needs --states LOG.csv"
+                                         : "--states: give each frame's time with --time");
   if (!times.empty() && times.size() != n)
-    throw UsageError("--time: given " + std::to_string(times.size()) + " times for " + std::to_string(n) + " frames: give one per frame");
+    throw UsageError("--time: given " + std::to_string(times.size()) + " times for " + std::to_string(n) +
+                     " frames: give one per frame");
   std::optional<StateLog> log;
   double max_gap = a.max_gap;
   if (!a.state_log.empty()) log = loadStateLog(a.state_log, *model, splitCommas(a.ignore_columns));
@@ -117,7 +135,8 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
   const std::string log_name = bag ? "--bag " + a.bag : a.state_log;
 
   GivenFrames out;
-  if (a.recording_samples > 0) out.recording = recordingSamples(a, bag ? &*bag : nullptr, log ? &*log : nullptr, *model, max_gap, log_name);
+  if (a.recording_samples > 0)
+    out.recording = recordingSamples(a, bag ? &*bag : nullptr, log ? &*log : nullptr, *model, max_gap, log_name);
   out.names = std::move(picture_names);
   out.pictures = std::move(video_pictures);
   out.count = n;
@@ -129,9 +148,11 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
     } else if (log) {
       std::vector<double> state(static_cast<std::size_t>(model->stateSize()), 0.0);
       if (stateAt(*log, times[f], max_gap, state) == StateMatch::None)
-        throw UsageError((bag ? "--frame " + std::to_string(a.video_frames[f]) + " (at " + format(times[f]) + " s)" : "--time " + format(times[f])) + ": " +
-                         log_name + " has no sample within --max-gap " + format(max_gap) +
-                         " s of it (the log covers " + format(log->times.front()) + " ... " + format(log->times.back()) + " s)");
+        throw UsageError((bag ? "--frame " + std::to_string(a.video_frames[f]) + " (at " + format(times[f]) + " s)"
+                              : "--time " + format(times[f])) +
+                         ": " + log_name + " has no sample within --max-gap " + format(max_gap) +
+                         " s of it (the log covers " + format(log->times.front()) + " ... " +
+                         format(log->times.back()) + " s)");
       out.states[f] = std::move(state);
     }
   }
@@ -140,14 +161,20 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
 
 void addBagOptions(CLI::App& command, FrameOptions& o) {
   command.add_option("--bag", o.bag,
-                     "A robot log (MCAP, rosbag2 .db3 or folder, ROS 1 .bag) whose image topic's --frame N are the frames; with --model "
+                     "A robot log (MCAP, rosbag2 .db3 or folder, ROS 1 .bag) whose image topic's --frame N are the "
+                     "frames; with --model "
                      "(and no --state) its joint states give each frame's state at the frame's time");
-  command.add_option("--image-topic", o.image_topic, "With --bag: the sensor_msgs/Image or CompressedImage topic (default: the only one)");
-  command.add_option("--joint-topic", o.joint_topic, "With --bag: the sensor_msgs/JointState topic (default: the only one)");
-  command.add_option("--time-source", o.time_source, "With --bag: header (the messages' header stamps) or log (the recorder's times)")
+  command.add_option("--image-topic", o.image_topic,
+                     "With --bag: the sensor_msgs/Image or CompressedImage topic (default: the only one)");
+  command.add_option("--joint-topic", o.joint_topic,
+                     "With --bag: the sensor_msgs/JointState topic (default: the only one)");
+  command
+      .add_option("--time-source", o.time_source,
+                  "With --bag: header (the messages' header stamps) or log (the recorder's times)")
       ->check(CLI::IsMember({"header", "log"}))
       ->default_str("header");
-  command.add_option("--joint-map", o.joint_map, "With --bag: which logged joint each state value is read from (see kccd overlay --help)");
+  command.add_option("--joint-map", o.joint_map,
+                     "With --bag: which logged joint each state value is read from (see kccd overlay --help)");
 }
 
 }  // namespace kccd::cli

@@ -25,16 +25,17 @@ struct FrameOptions {
   std::vector<double> times;
   std::vector<int> video_frames;
   double max_gap = 0.0;  ///< 0: 1.5 x the log's median period
-  std::size_t recording_samples = 0;  ///< > 0: also about this many frames spread over the --video or --bag, with their states
+  std::size_t recording_samples =
+      0;  ///< > 0: also about this many frames spread over the --video or --bag, with their states
 };
 
 /// The frames the options give, in order.
 struct GivenFrames {
-  std::vector<std::string> names;   ///< the image files, or "VIDEO#N"; empty: labels only
-  std::vector<cv::Mat> pictures;    ///< the decoded frames of --video; empty: read `names` as image files
+  std::vector<std::string> names;  ///< the image files, or "VIDEO#N"; empty: labels only
+  std::vector<cv::Mat> pictures;   ///< the decoded frames of --video; empty: read `names` as image files
   std::vector<std::optional<std::vector<double>>> states;  ///< one per frame
-  std::size_t count = 0;            ///< frames (pictures, or labels files when there are none)
-  std::vector<std::string> warnings;  ///< one line each (e.g. a bag cut short)
+  std::size_t count = 0;                                   ///< frames (pictures, or labels files when there are none)
+  std::vector<std::string> warnings;                       ///< one line each (e.g. a bag cut short)
   std::vector<overlay::RecordingSample> recording;  ///< with recording_samples: those of them the log has a state for
 };
 
@@ -45,6 +46,7 @@ void addBagOptions(CLI::App& command, FrameOptions& o);
 /// and reads the recording's frames and the state log; `refined`: masks or edges say what the
 /// pictures show. Throws UsageError (also for recording_samples without a recording and a state
 /// log, or with fewer than 8 of its frames in the log), or the readers' errors.
-GivenFrames givenFrames(const FrameOptions& o, std::size_t labels, bool tags, const std::optional<Model>& model, bool refined = false);
+GivenFrames givenFrames(const FrameOptions& o, std::size_t labels, bool tags, const std::optional<Model>& model,
+                        bool refined = false);
 
 }  // namespace kccd::cli

@@ -29,7 +29,8 @@ std::string optionMessage(const std::string& text) {
   static const std::pair<std::regex, const char*> plain[] = {
       {std::regex("^(\\S+): [0-9]+ required \\S+ missing$"), "$1: needs a value"},
       {std::regex("^The following arguments? (was|were) not expected: (.*)$"), "unknown option or extra argument: $2"},
-      {std::regex("^--([A-Za-z-]+): Value (.*) not in range (.*) to (.*)$"), "--$1: expected a whole number from $3 to $4, got '$2'"},
+      {std::regex("^--([A-Za-z-]+): Value (.*) not in range (.*) to (.*)$"),
+       "--$1: expected a whole number from $3 to $4, got '$2'"},
       {std::regex("^(.*) is required$"), "$1 is required"},
   };
   for (const auto& [pattern, replacement] : plain)
@@ -82,7 +83,8 @@ std::vector<double> parseList(const std::string& text, const std::string& option
     }
     while (used < item.size() && std::isspace(static_cast<unsigned char>(item[used]))) ++used;
     if (used == 0 || used != item.size())
-      throw UsageError(option + ": value " + std::to_string(index + 1) + " ('" + printable(item, 40) + "') is not a number");
+      throw UsageError(option + ": value " + std::to_string(index + 1) + " ('" + printable(item, 40) +
+                       "') is not a number");
     out.push_back(v);
     ++index;
   }
@@ -111,7 +113,7 @@ std::vector<double> stateVector(const Model& m, const std::string& text, const s
 StateBox parseStateBox(const Model& m, const std::string& state, const std::string& lower, const std::string& upper,
                        const std::string& missing, bool finite) {
   StateBox box;
-  if (m.stateSize() == 0 && lower.empty() && upper.empty()) {  // only fixed joints: one configuration
+  if (m.stateSize() == 0 && lower.empty() && upper.empty()) {      // only fixed joints: one configuration
     if (!state.empty()) stateVector(m, state, "--state", finite);  // explains a value given anyway
     box.point = true;
     return box;
@@ -161,8 +163,9 @@ std::vector<std::string> splitCommas(const std::string& text) {
 
 void addPieceOptions(CLI::App& sub, std::string& pieces, double& concavity_mm, const std::string& what) {
   sub.add_option("--pieces", pieces,
-                 what + " in convex pieces: auto (up to 8) or N (1: never split); it splits while its concavity exceeds "
-                        "--concavity")
+                 what +
+                     " in convex pieces: auto (up to 8) or N (1: never split); it splits while its concavity exceeds "
+                     "--concavity")
       ->capture_default_str();
   sub.add_option("--concavity", concavity_mm,
                  "Millimetres of empty space inside the hull (the hull's surface to the mesh's solid) above which it "

@@ -11,7 +11,6 @@
 #include <filesystem>
 #include <vector>
 
-
 #include "cli_args.hpp"
 #include "kccd/overlay/recording/video_sink.hpp"
 
@@ -36,7 +35,8 @@ void editFile(const std::string& path, const std::function<std::string(const std
   for (int attempt = 0;; ++attempt) {
     fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) throw UsageError(path + ": cannot read the file (" + std::strerror(errno) + ")");
-    struct stat locked {}, named {};
+    struct stat locked {
+    }, named{};
     if (flock(fd, LOCK_EX) != 0 || fstat(fd, &locked) != 0) {
       ::close(fd);
       throw UsageError(path + ": cannot lock the file for editing (" + std::strerror(errno) + ")");
@@ -61,7 +61,7 @@ void editFile(const std::string& path, const std::function<std::string(const std
   if (expected != nullptr && text != *expected)
     throw UsageError(path + ": the file changed while kccd worked on it; nothing written (run again)");
   const std::string edited = edit(text);  // an EditError names the file and place itself
-  writeFileAtomically(path, edited);  // keeps the file's mode
+  writeFileAtomically(path, edited);      // keeps the file's mode
 }
 
 void writePngAtomically(const std::string& path, const cv::Mat& image, const std::string& option) {

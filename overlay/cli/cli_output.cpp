@@ -58,7 +58,8 @@ void Progress::update(double fraction, const std::string& detail) {
     shown_ = true;
   } else if (t - last_time_ >= 5.0) {
     const std::lock_guard<std::mutex> lock(calib::stderrLock());
-    std::cerr << what_ << ": " << static_cast<int>(fraction * 100) << "%" << (detail.empty() ? "" : " " + detail) << "\n";
+    std::cerr << what_ << ": " << static_cast<int>(fraction * 100) << "%" << (detail.empty() ? "" : " " + detail)
+              << "\n";
     last_time_ = t;
   }
   last_ = fraction;

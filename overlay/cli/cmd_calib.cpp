@@ -51,7 +51,8 @@ overlay::GatherInputs gatherInputs(const CalibArgs& a, const calib::Camera& cam,
                                    std::vector<overlay::RecordingSample>& recording) {
   FrameOptions frames = a;
   if (autoMasks(a)) frames.recording_samples = 40;
-  GivenFrames given = givenFrames(frames, a.labels.size(), !a.tags.empty(), model, !a.masks.empty() || a.refine == "edges");
+  GivenFrames given =
+      givenFrames(frames, a.labels.size(), !a.tags.empty(), model, !a.masks.empty() || a.refine == "edges");
   recording = std::move(given.recording);
   for (const std::string& w : given.warnings) std::cerr << "kccd calib: warning: " << w << "\n";
   overlay::GatherInputs in;
@@ -75,10 +76,13 @@ overlay::GatherInputs gatherInputs(const CalibArgs& a, const calib::Camera& cam,
 
 // What the pose is refined to: the masks (read and checked before anything else is) or the
 // pictures' edges, the bodies they show and a rough start.
-std::optional<overlay::RefineInputs> refineInputs(const CalibArgs& a, const calib::Camera& cam, const std::optional<Model>& model) {
+std::optional<overlay::RefineInputs> refineInputs(const CalibArgs& a, const calib::Camera& cam,
+                                                  const std::optional<Model>& model) {
   const bool edges = a.refine == "edges";
-  if (edges && !a.masks.empty()) throw UsageError("--refine edges: refines to the pictures themselves; --masks goes with --refine masks");
-  if (a.refine == "masks" && a.masks.empty()) throw UsageError("--refine masks: give the masks with --masks M1.png ...");
+  if (edges && !a.masks.empty())
+    throw UsageError("--refine edges: refines to the pictures themselves; --masks goes with --refine masks");
+  if (a.refine == "masks" && a.masks.empty())
+    throw UsageError("--refine masks: give the masks with --masks M1.png ...");
   if (a.masks.empty() && !edges) {
     if (!a.rough_camera.empty()) throw UsageError("--camera: a start for --masks or --refine edges (give one)");
     if (!a.mask_bodies.empty()) throw UsageError("--mask-bodies: goes with --masks or --refine edges");
@@ -93,7 +97,8 @@ std::optional<overlay::RefineInputs> refineInputs(const CalibArgs& a, const cali
   in.draw = a.draw;
   for (const std::string& m : a.masks) {
     if (autoMasks(a)) break;
-    if (m == "auto") throw UsageError("--masks auto: makes every frame's mask from the recording: give it alone, not with mask files");
+    if (m == "auto")
+      throw UsageError("--masks auto: makes every frame's mask from the recording: give it alone, not with mask files");
     in.masks.push_back(calib::readMask(m, cam.width, cam.height));
     in.mask_names.push_back(m);
   }
@@ -101,7 +106,8 @@ std::optional<overlay::RefineInputs> refineInputs(const CalibArgs& a, const cali
     std::stringstream list(a.mask_bodies);
     for (std::string name; std::getline(list, name, ',');) {
       const int b = model->bodyIndex(name);
-      if (b < 0) throw UsageError("--mask-bodies: '" + name + "' is not a body of " + a.model + " (kccd info lists them)");
+      if (b < 0)
+        throw UsageError("--mask-bodies: '" + name + "' is not a body of " + a.model + " (kccd info lists them)");
       in.bodies.push_back(b);
     }
   }
@@ -147,26 +153,30 @@ Exit runCalib(const CalibArgs& a) {
   const calib::PoseResult& r = s.pose;
   std::string renderer_name;
   if (s.solved()) {
-    writeFileAtomically(a.output, calib::cameraText(r.camera) + (refinement ? overlay::refinementText(*refinement) : std::string()));
+    writeFileAtomically(
+        a.output, calib::cameraText(r.camera) + (refinement ? overlay::refinementText(*refinement) : std::string()));
     for (std::size_t f = 0; !a.check.empty() && f < g.frames.size(); ++f) {
       overlay::CheckImage check =
-          overlay::checkImage(g, s, f, model ? &*model : nullptr, {.magnify = a.magnify,
-                              .camera_name = a.intrinsics,
-                              .pose_source = a.refine == "edges" ? "the pictures' edges" : "the robot's masks"});
+          overlay::checkImage(g, s, f, model ? &*model : nullptr,
+                              {.magnify = a.magnify,
+                               .camera_name = a.intrinsics,
+                               .pose_source = a.refine == "edges" ? "the pictures' edges" : "the robot's masks"});
       if (!check.renderer.empty()) renderer_name = check.renderer;
       if (refinement)
-        overlay::drawMaskAgreement(check.bgr, r.camera,
-                                   !refinement->masks.empty()      ? refinement->masks[f]
-                                   : refine_inputs->masks.empty() ? cv::Mat()
-                                                                  : refine_inputs->masks[f],
-                                   calib::placeVolumes(*model, g.frames[f].state, refinement->bodies),
-                                   f < refinement->meshes.size() ? refinement->meshes[f] : std::vector<calib::PlacedMesh>{});
+        overlay::drawMaskAgreement(
+            check.bgr, r.camera,
+            !refinement->masks.empty()     ? refinement->masks[f]
+            : refine_inputs->masks.empty() ? cv::Mat()
+                                           : refine_inputs->masks[f],
+            calib::placeVolumes(*model, g.frames[f].state, refinement->bodies),
+            f < refinement->meshes.size() ? refinement->meshes[f] : std::vector<calib::PlacedMesh>{});
       writePngAtomically(checkPath(a.check, f), check.bgr, "--check");
     }
   }
 
   if (a.json) {
-    nlohmann::json report = overlay::calibReport(g, s, {.camera = a.output, .check = a.check, .renderer = renderer_name});
+    nlohmann::json report =
+        overlay::calibReport(g, s, {.camera = a.output, .check = a.check, .renderer = renderer_name});
     if (refinement) report["refinement"] = overlay::refinementJson(*refinement);
     std::cout << report.dump(2) << "\n";
   } else if (!a.quiet) {
@@ -177,8 +187,9 @@ Exit runCalib(const CalibArgs& a) {
           std::cout << "frame " << f + 1 << ": outline on edges " << format(100 * fa.matched_before, 3) << "%";
           if (refinement->result.improved) std::cout << " -> " << format(100 * fa.matched_after, 3) << "%";
         } else {
-          std::cout << (autoMasks(a) ? "frame " + std::to_string(f + 1) + " (mask from the recording)" : "mask " + a.masks[f]) << ": IoU "
-                    << format(fa.iou_before, 4);
+          std::cout << (autoMasks(a) ? "frame " + std::to_string(f + 1) + " (mask from the recording)"
+                                     : "mask " + a.masks[f])
+                    << ": IoU " << format(fa.iou_before, 4);
           if (refinement->result.improved) std::cout << " -> " << format(fa.iou_after, 4);
         }
         std::cout << ", outline " << format(fa.rms_px, 3) << " px rms over " << fa.outline_points << " points"
@@ -223,8 +234,10 @@ Runner addCalib(CLI::App& app) {
       "Exit 0 solved (camera file written), 2 bad input, 4 not solvable (the message says what to add).");
   sub->require_subcommand(0, 1);
   auto a = std::make_shared<CalibArgs>();
-  sub->add_option("--intrinsics", a->intrinsics, "Camera file with the intrinsics and lens distortion (its pose is ignored); required");
-  sub->add_option("--image", a->images, "A frame from the fixed camera (repeat for several frames)")->allow_extra_args(false);
+  sub->add_option("--intrinsics", a->intrinsics,
+                  "Camera file with the intrinsics and lens distortion (its pose is ignored); required");
+  sub->add_option("--image", a->images, "A frame from the fixed camera (repeat for several frames)")
+      ->allow_extra_args(false);
   sub->add_option("--video", a->video,
                   "A recording from the fixed camera (a video file or an image sequence such as frames/frame_%06d.png, "
                   "as kccd overlay reads): its frames given by --frame are the frames");
@@ -233,25 +246,35 @@ Runner addCalib(CLI::App& app) {
       ->check(CLI::Range(0, 100000000));
   addBagOptions(*sub, *a);
   sub->add_option("--tags", a->tags, "Tag layout: where the AprilTags are in the world");
-  sub->add_option("--labels", a->labels, "Labelled points (repeat: one file per --image, same order; none for a frame without labels, e.g. 4 labels on "
-                  "one frame and the others used by --masks or --refine edges only)")->allow_extra_args(false);
+  sub->add_option(
+         "--labels", a->labels,
+         "Labelled points (repeat: one file per --image, same order; none for a frame without labels, e.g. 4 labels on "
+         "one frame and the others used by --masks or --refine edges only)")
+      ->allow_extra_args(false);
   sub->add_option("--model", a->model, "Model file placing the body labels (and drawn in the check image)");
-  sub->add_option("--state", a->states,
-                  "The robot's state in the frames (comma-separated; once for all frames, or once per frame) for body labels "
-                  "without their own state, and for the check image")
+  sub->add_option(
+         "--state", a->states,
+         "The robot's state in the frames (comma-separated; once for all frames, or once per frame) for body labels "
+         "without their own state, and for the check image")
       ->allow_extra_args(false);
   sub->add_option("--states", a->state_log,
-                  "State log (CSV: time and one column per state value, see kccd info) placing the body labels at each frame's --time");
-  sub->add_option("--time", a->times, "Each frame's time in the state log's clock (s; once per frame; with --video default frame / fps)")
+                  "State log (CSV: time and one column per state value, see kccd info) placing the body labels at each "
+                  "frame's --time");
+  sub->add_option("--time", a->times,
+                  "Each frame's time in the state log's clock (s; once per frame; with --video default frame / fps)")
       ->allow_extra_args(false)
       ->check(finiteIn(-1e300, 1e300));
-  sub->add_option("--max-gap", a->max_gap, "No state when the log has no sample this close (s; default 1.5 x its median period)")
+  sub->add_option("--max-gap", a->max_gap,
+                  "No state when the log has no sample this close (s; default 1.5 x its median period)")
       ->check(finiteIn(0, 1e300));
-  sub->add_option("--ignore-columns", a->ignore_columns, "Comma-separated state log columns to skip (an unknown column is an error)");
-  sub->add_option("-o,--output", a->output, "Camera file to write (intrinsics, pose, quality); written only when solved; required");
-  sub->add_option("--check", a->check,
-                  "Check image (.png): the frame, the model at the state, every point seen (o), projected (+) and its residual "
-                  "magnified; with several frames also NAME_2.png, ...");
+  sub->add_option("--ignore-columns", a->ignore_columns,
+                  "Comma-separated state log columns to skip (an unknown column is an error)");
+  sub->add_option("-o,--output", a->output,
+                  "Camera file to write (intrinsics, pose, quality); written only when solved; required");
+  sub->add_option(
+      "--check", a->check,
+      "Check image (.png): the frame, the model at the state, every point seen (o), projected (+) and its residual "
+      "magnified; with several frames also NAME_2.png, ...");
   sub->add_option("--truth", a->truth, "A known camera file (e.g. from kccd synth): also report the error against it");
   sub->add_option("--threshold", a->threshold, "RANSAC: a point farther than this from its projection is rejected (px)")
       ->check(finiteIn(0.1, 1000))
@@ -262,29 +285,36 @@ Runner addCalib(CLI::App& app) {
   sub->add_option("--magnify", a->magnify, "Residual vectors in the check image are drawn this many times longer")
       ->check(finiteIn(1, 1000))
       ->capture_default_str();
-  sub->add_option("--masks", a->masks,
-                  "Robot masks, one per frame in the same order (PNG or any image; non-zero = robot, e.g. a segmentation "
-                  "tool's output): the pose is refined so the model's drawn robot matches them over all frames; needs "
-                  "--model and each frame's state. --masks auto: made from the recording itself (--video with --states, or "
-                  "--bag; a fixed camera): the robot is what differs from the background, estimated over 40 frames spread over "
-                  "the recording (at frame / fps on the log's clock, shifted as the first --time says when given), each pixel from "
-                  "the frames in which the drawn robot is away from it; people moving, lighting "
-                  "changes and the robot's shadows are foreground too")
+  sub->add_option(
+         "--masks", a->masks,
+         "Robot masks, one per frame in the same order (PNG or any image; non-zero = robot, e.g. a segmentation "
+         "tool's output): the pose is refined so the model's drawn robot matches them over all frames; needs "
+         "--model and each frame's state. --masks auto: made from the recording itself (--video with --states, or "
+         "--bag; a fixed camera): the robot is what differs from the background, estimated over 40 frames spread over "
+         "the recording (at frame / fps on the log's clock, shifted as the first --time says when given), each pixel "
+         "from "
+         "the frames in which the drawn robot is away from it; people moving, lighting "
+         "changes and the robot's shadows are foreground too")
       ->expected(1, -1);
   sub->add_option("--refine", a->refine,
-                  "What the pose is refined to: masks (the default with --masks) or edges (no masks: the robot's drawn outline is "
-                  "pulled onto the pictures' own edges of its direction, coarse to fine; needs --model, each frame's picture and "
+                  "What the pose is refined to: masks (the default with --masks) or edges (no masks: the robot's drawn "
+                  "outline is "
+                  "pulled onto the pictures' own edges of its direction, coarse to fine; needs --model, each frame's "
+                  "picture and "
                   "state, and a start a few degrees off at most, e.g. from 4 rough labels)")
       ->check(CLI::IsMember({"masks", "edges"}));
   sub->add_option("--draw", a->draw,
-                  "What --masks or --refine edges draws of the robot: auto (the model's visuals, what the robot looks like, when "
+                  "What --masks or --refine edges draws of the robot: auto (the model's visuals, what the robot looks "
+                  "like, when "
                   "it has them and they can be read; else its collision volumes), visuals, or volumes")
       ->check(CLI::IsMember({"auto", "visuals", "volumes"}))
       ->capture_default_str();
   sub->add_option("--camera", a->rough_camera,
-                  "A rough camera file to start --masks or --refine edges from when no labels or tags give a start (its pose is used)");
+                  "A rough camera file to start --masks or --refine edges from when no labels or tags give a start "
+                  "(its pose is used)");
   sub->add_option("--mask-bodies", a->mask_bodies,
-                  "Comma-separated bodies of the model that the masks (or, with --refine edges, the pictures) show (default: all bodies)");
+                  "Comma-separated bodies of the model that the masks (or, with --refine edges, the pictures) show "
+                  "(default: all bodies)");
   sub->add_flag("--json", a->json, "Print the result as JSON (status, sigmas, rejected, residuals)");
   sub->add_flag("-q,--quiet", a->quiet, "Print nothing but errors");
 

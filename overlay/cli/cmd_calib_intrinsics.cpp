@@ -9,7 +9,6 @@
 
 #include <unistd.h>
 
-
 #include "cli_args.hpp"
 #include "cli_files.hpp"
 #include "cli_output.hpp"
@@ -35,7 +34,8 @@ struct IntrinsicsArgs {
 };
 
 calib::Board boardFrom(const IntrinsicsArgs& args) {
-  const bool grid_options = !args.grid.empty() || args.tag_size_opt->count() || args.spacing_opt->count() || args.first_id_opt->count();
+  const bool grid_options =
+      !args.grid.empty() || args.tag_size_opt->count() || args.spacing_opt->count() || args.first_id_opt->count();
   if (!args.board.empty() && grid_options)
     throw UsageError("--board and --grid/--tag-size/--spacing/--first-id describe the board twice: give one of them");
   if (!args.board.empty()) return calib::Board::fromLayout(calib::loadTagLayout(args.board), args.board);
@@ -46,7 +46,8 @@ calib::Board boardFrom(const IntrinsicsArgs& args) {
   if (!std::regex_match(args.grid, m, size))
     throw UsageError("--grid " + printable(args.grid, 40) + ": expected COLSxROWS (tags across x tags down), e.g. 6x4");
   if (!args.tag_size_opt->count() || !args.spacing_opt->count())
-    throw UsageError("--grid needs --tag-size S (black square edge) and --spacing D (white gap between squares), in metres");
+    throw UsageError(
+        "--grid needs --tag-size S (black square edge) and --spacing D (white gap between squares), in metres");
   calib::TagGrid g;
   g.cols = std::stoi(m[1].str());
   g.rows = std::stoi(m[2].str());
@@ -65,7 +66,8 @@ Exit runIntrinsics(const IntrinsicsArgs& args) {
   if (args.images.empty()) throw UsageError("give the images: --image A.png B.png ... (at least 3 views of the board)");
   {
     const std::string ext = fs::path(args.output).extension().string();
-    if (ext != ".yaml" && ext != ".yml") throw UsageError("-o " + args.output + ": the camera file must be a .yaml or .yml file");
+    if (ext != ".yaml" && ext != ".yml")
+      throw UsageError("-o " + args.output + ": the camera file must be a .yaml or .yml file");
     checkOutputPath(args.output, "-o", ext);
     for (const std::string& in : args.images)
       if (sameFile(args.output, in)) throw UsageError("-o " + args.output + ": is the input image " + in);
@@ -75,7 +77,8 @@ Exit runIntrinsics(const IntrinsicsArgs& args) {
   for (std::size_t i = 0; i < args.images.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (args.images[i] == args.images[j] || sameFile(args.images[i], args.images[j]))
-        throw UsageError(args.images[i] + ": image: given twice (--image " + std::to_string(j + 1) + " and " + std::to_string(i + 1) + ")");
+        throw UsageError(args.images[i] + ": image: given twice (--image " + std::to_string(j + 1) + " and " +
+                         std::to_string(i + 1) + ")");
 
   // ---- detect the tags of every image
   calib::BoardViews seen;
@@ -112,14 +115,17 @@ Exit runIntrinsics(const IntrinsicsArgs& args) {
       j["distortion"] = r.camera.distortion;
       nlohmann::json sd = nlohmann::json::array();
       for (double s : r.sigmas.distortion) sd.push_back(number(s));
-      j["std_dev"] = {{"fx", number(r.sigmas.fx)}, {"fy", number(r.sigmas.fy)}, {"cx", number(r.sigmas.cx)},
-                      {"cy", number(r.sigmas.cy)}, {"distortion", sd}};
+      j["std_dev"] = {{"fx", number(r.sigmas.fx)},
+                      {"fy", number(r.sigmas.fy)},
+                      {"cx", number(r.sigmas.cx)},
+                      {"cy", number(r.sigmas.cy)},
+                      {"distortion", sd}};
     }
     j["views"] = nlohmann::json::array();
     for (std::size_t i = 0; i < r.views.size(); ++i) {
       const auto& v = r.views[i];
-      nlohmann::json jv = {{"image", v.name},    {"tags", tags_seen[i]},        {"corners", v.points},
-                           {"used", v.used},     {"rms_px", number(v.rms_px)}, {"tilt_deg", number(v.tilt_deg)},
+      nlohmann::json jv = {{"image", v.name},          {"tags", tags_seen[i]},       {"corners", v.points},
+                           {"used", v.used},           {"rms_px", number(v.rms_px)}, {"tilt_deg", number(v.tilt_deg)},
                            {"unknown_ids", unknown[i]}};
       if (!v.note.empty()) jv["note"] = v.note;
       j["views"].push_back(jv);
@@ -159,7 +165,8 @@ Exit runIntrinsics(const IntrinsicsArgs& args) {
     if (r.status == calib::IntrinsicsStatus::TooFewViews && !foreign.empty()) {
       hint = " (the images show tag";
       hint += foreign.size() == 1 ? " " : "s ";
-      for (std::size_t i = 0; i < std::min<std::size_t>(foreign.size(), 8); ++i) hint += (i ? ", " : "") + std::to_string(foreign[i]);
+      for (std::size_t i = 0; i < std::min<std::size_t>(foreign.size(), 8); ++i)
+        hint += (i ? ", " : "") + std::to_string(foreign[i]);
       if (foreign.size() > 8) hint += ", ...";
       hint += " that the board does not have: check --grid, --first-id or --board)";
     }
@@ -174,15 +181,17 @@ Exit runIntrinsics(const IntrinsicsArgs& args) {
 Runner addCalibIntrinsics(CLI::App& calib) {
   auto args = std::make_shared<IntrinsicsArgs>();
   CLI::App* sub = calib.add_subcommand(
-      "intrinsics", "Camera intrinsics (focal lengths, principal point, lens distortion) from several images of a flat "
-                    "AprilTag board");
+      "intrinsics",
+      "Camera intrinsics (focal lengths, principal point, lens distortion) from several images of a flat "
+      "AprilTag board");
   sub->add_option("--image", args->images, "Images of the board (repeat --image or list several after it)")->required();
   CLI::Option* board = sub->add_option("--board", args->board, "Tag layout of the board (YAML; all tags in one plane)");
   CLI::Option* grid = sub->add_option("--grid", args->grid, "A regular board of COLSxROWS tags (e.g. 6x4)");
   args->tag_size_opt = sub->add_option("--tag-size", args->tag_size, "Grid: edge of a tag's black square (metres)")
                            ->check(finiteIn(1e-6, calib::kMaxTagSize));
-  args->spacing_opt = sub->add_option("--spacing", args->spacing, "Grid: white gap between neighbouring black squares (metres)")
-                          ->check(finiteIn(0.0, calib::kMaxTagSize));
+  args->spacing_opt =
+      sub->add_option("--spacing", args->spacing, "Grid: white gap between neighbouring black squares (metres)")
+          ->check(finiteIn(0.0, calib::kMaxTagSize));
   args->first_id_opt = sub->add_option("--first-id", args->first_id, "Grid: id of the top-left tag (default 0)")
                            ->check(CLI::Range(0, calib::kMaxTagId));
   board->excludes(grid);

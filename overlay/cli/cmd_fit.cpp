@@ -34,7 +34,7 @@ struct FitArgs {
 
 // The request the options make (checked, options named).
 modelling::FitRequest fitRequest(const FitArgs& args) {
-  const modelling::FitRequest r{.method = args.hull                ? modelling::FitMethod::Hull
+  const modelling::FitRequest r{.method = args.hull               ? modelling::FitMethod::Hull
                                           : args.tolerance_mm > 0 ? modelling::FitMethod::Tolerance
                                                                   : modelling::FitMethod::Points,
                                 .points = args.points,
@@ -56,12 +56,15 @@ Exit runFit(const FitArgs& args) {
   } else {
     throw UsageError("--scale: give one factor or three (X,Y,Z)");
   }
-  const Vec3 scale = args.scale.size() == 1 ? Vec3::Constant(args.scale[0]) : Vec3(args.scale[0], args.scale[1], args.scale[2]);
+  const Vec3 scale =
+      args.scale.size() == 1 ? Vec3::Constant(args.scale[0]) : Vec3(args.scale[0], args.scale[1], args.scale[2]);
   const auto t0 = std::chrono::steady_clock::now();
-  const modelling::Part part = modelling::readPart(args.part_file, {.part = args.part, .merge = args.merge, .scale = scale});
+  const modelling::Part part =
+      modelling::readPart(args.part_file, {.part = args.part, .merge = args.merge, .scale = scale});
   modelling::FittedPart fitted;
   {
-    Progress progress("fitting " + std::filesystem::path(args.part_file).filename().string(), args.quiet || args.json || args.hull);
+    Progress progress("fitting " + std::filesystem::path(args.part_file).filename().string(),
+                      args.quiet || args.json || args.hull);
     fitted = modelling::fitPart(part, request, [&](double f) { progress.update(f); });
   }
   const int count = static_cast<int>(fitted.pieces.size());
@@ -69,11 +72,13 @@ Exit runFit(const FitArgs& args) {
     throw UsageError("--model replaces one body, but " + args.part_file + " splits into " + std::to_string(count) +
                      " pieces (--pieces 1 fits it whole; kccd import writes a link's pieces)");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const std::string stem =
-      args.name.empty() ? (args.body.empty() ? std::filesystem::path(args.part_file).stem().string() : args.body)
-                        : args.name;
+  const std::string stem = args.name.empty()
+                               ? (args.body.empty() ? std::filesystem::path(args.part_file).stem().string() : args.body)
+                               : args.name;
   auto nameOf = [&](int k) { return modelling::pieceName(stem, k, count); };
-  const auto fitOf = [&](int k) -> const modelling::FitResult& { return fitted.pieces[static_cast<std::size_t>(k)].fit; };
+  const auto fitOf = [&](int k) -> const modelling::FitResult& {
+    return fitted.pieces[static_cast<std::size_t>(k)].fit;
+  };
 
   if (!args.model.empty()) {
     const modelling::FitResult& r = fitOf(0);
@@ -102,7 +107,7 @@ Exit runFit(const FitArgs& args) {
     const double hull = r.hull_volume;
     auto ratio = [&](double v) { return hull > 0 ? v / hull : std::numeric_limits<double>::infinity(); };
     out << "# " << (count > 1 ? nameOf(k) + ": " : "")
-        << (args.hull                ? "exact convex hull, " + std::to_string(r.points.size()) + " points"
+        << (args.hull               ? "exact convex hull, " + std::to_string(r.points.size()) + " points"
             : args.tolerance_mm > 0 ? std::string(r.method) + ", " + std::to_string(r.points.size()) + " points"
                                     : "K = " + std::to_string(args.points))
         << ": volume " << formatNumber(r.volume, 6) << " = " << formatNumber(ratio(r.volume), 4) << " x convex hull ("
@@ -113,7 +118,8 @@ Exit runFit(const FitArgs& args) {
   }
   if (!args.model.empty()) out << "# written into " << args.model << ", body " << args.body << "\n";
   for (int k = 0; k < count; ++k)
-    out << modelling::bodyYaml({.name = nameOf(k), .link = count > 1 ? stem : std::string(), .frame = args.frame, .fit = &fitOf(k)});
+    out << modelling::bodyYaml(
+        {.name = nameOf(k), .link = count > 1 ? stem : std::string(), .frame = args.frame, .fit = &fitOf(k)});
   std::cout << out.str();
   return Exit::Ok;
 }
@@ -145,7 +151,8 @@ Runner addFit(CLI::App& app) {
       ->capture_default_str()
       ->check(seedNumber());
   sub->add_option("--scale", args->scale,
-                  "Scale of the part in its file's frame: one factor, or three (X,Y,Z), as a URDF mesh's scale (e.g. 0.001 for a "
+                  "Scale of the part in its file's frame: one factor, or three (X,Y,Z), as a URDF mesh's scale (e.g. "
+                  "0.001 for a "
                   "part drawn in millimetres)")
       ->delimiter(',')
       ->expected(1, 3)
@@ -160,7 +167,8 @@ Runner addFit(CLI::App& app) {
                   "(the K fit when it does, else hull vertices added farthest first)")
       ->check(finiteIn(1e-6, 1e6))
       ->excludes("--hull");
-  addPieceOptions(*sub, args->pieces, args->concavity_mm, "A concave part (each piece a body NAME/1, NAME/2, ... with link: NAME)");
+  addPieceOptions(*sub, args->pieces, args->concavity_mm,
+                  "A concave part (each piece a body NAME/1, NAME/2, ... with link: NAME)");
   sub->add_flag("--json", args->json, "Machine-readable output");
   sub->add_flag("--quiet,-q", args->quiet, "No progress display");
   sub->footer(

@@ -15,11 +15,11 @@
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/file_reader.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/golden/golden_check.hpp"
 #include "kccd/overlay/golden/golden_manifest.hpp"
 #include "kccd/overlay/golden/golden_render.hpp"
 #include "kccd/overlay/golden/golden_report.hpp"
-#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/render/gl_context.hpp"
 
 namespace kccd::cli {
@@ -53,7 +53,8 @@ std::string outputsText(const CaseResult& r) {
   std::string s;
   for (const OutputResult& o : r.outputs)
     if (o.status != GoldenStatus::Passed)
-      s += std::string(s.empty() ? "" : "; ") + goldenOutputName(o.output) + " " + goldenStatusName(o.status) + ": " + o.reason;
+      s += std::string(s.empty() ? "" : "; ") + goldenOutputName(o.output) + " " + goldenStatusName(o.status) + ": " +
+           o.reason;
   return s;
 }
 
@@ -70,7 +71,10 @@ GoldenRun check(const GoldenManifest& m, const std::vector<std::size_t>& cases, 
     CaseResult result = checkCase(c, r, goldenFolder(m, c.id));
     if (!quiet) {
       std::cerr << "[" << k + 1 << "/" << cases.size() << "] " << c.id << ": "
-                << (result.passed() ? "passed" : !result.unsafe.empty() ? "unsafe query status " + result.unsafe : outputsText(result)) << "\n";
+                << (result.passed()          ? "passed"
+                    : !result.unsafe.empty() ? "unsafe query status " + result.unsafe
+                                             : outputsText(result))
+                << "\n";
     }
     run.renderings.push_back(std::move(r));
     run.results.push_back(std::move(result));
@@ -90,7 +94,8 @@ Exit runRun(const GoldenArgs& a) {
     unsafe |= !r.unsafe.empty();
     failed |= !r.passed();
     if (!r.passed())
-      std::cout << r.id << ": " << (r.unsafe.empty() ? outputsText(r) : "the query's status is " + r.unsafe + " (unsafe)")
+      std::cout << r.id << ": "
+                << (r.unsafe.empty() ? outputsText(r) : "the query's status is " + r.unsafe + " (unsafe)")
                 << (r.cause.empty() ? "" : " -- likely cause: " + r.cause) << "\n";
   }
   std::cout << goldenSummaryLine(run) << "; report " << (fs::path(a.out) / "report.html").string() << "\n";
@@ -107,18 +112,21 @@ Exit runUpdate(const GoldenArgs& a) {
   for (std::size_t k = 0; k < cases.size(); ++k) {
     const CaseResult& r = run.results[k];
     bool missing = false, failed = false;
-    for (const OutputResult& o : r.outputs) missing |= o.status == GoldenStatus::Missing, failed |= o.status == GoldenStatus::Failed;
+    for (const OutputResult& o : r.outputs)
+      missing |= o.status == GoldenStatus::Missing, failed |= o.status == GoldenStatus::Failed;
     const bool take = a.only == "all" || missing || (a.only == "failed" && failed);
     if (!take) continue;
     if (!r.unsafe.empty()) {
-      std::cerr << "kccd: golden update: " << r.id << ": the query's status is " << r.unsafe << " (unsafe): no golden written\n";
+      std::cerr << "kccd: golden update: " << r.id << ": the query's status is " << r.unsafe
+                << " (unsafe): no golden written\n";
       ++unsafe;
       continue;
     }
     const std::string folder = goldenFolder(m, r.id);
     writeGoldens(run.renderings[k], folder);
     ++written;
-    if (!a.quiet) std::cerr << "wrote " << folder << (missing ? " (was missing)" : failed ? " (was failing)" : "") << "\n";
+    if (!a.quiet)
+      std::cerr << "wrote " << folder << (missing ? " (was missing)" : failed ? " (was failing)" : "") << "\n";
   }
   std::cout << "golden update: " << written << " of " << cases.size() << " case(s) written (--only " << a.only << ")\n";
   return unsafe ? Exit::Unsafe : Exit::Ok;
@@ -134,7 +142,8 @@ Exit runApprove(const GoldenArgs& a) {
   } catch (const nlohmann::json::exception& e) {
     throw InputError(results_path + ": not the results of kccd golden run (" + std::string(e.what()) + ")");
   }
-  if (!results.is_object() || results.value("kccd_golden_results", 0) != 1 || !results.contains("cases") || !results["cases"].is_array())
+  if (!results.is_object() || results.value("kccd_golden_results", 0) != 1 || !results.contains("cases") ||
+      !results["cases"].is_array())
     throw InputError(results_path + ": not the results of kccd golden run (no kccd_golden_results: 1 with cases)");
   std::set<std::string> ids;
   for (const GoldenCase& c : m.cases) ids.insert(c.id);
@@ -153,11 +162,14 @@ Exit runApprove(const GoldenArgs& a) {
       if (!actual.contains("file") || !actual["file"].is_string()) continue;
       const std::string file = actual["file"];
       const std::string output = o.value("output", std::string());
-      if (file != id + "/" + output + ".actual.png") throw InputError(results_path + ": case '" + id + "': unexpected file '" + printable(file, 80) + "'");
+      if (file != id + "/" + output + ".actual.png")
+        throw InputError(results_path + ": case '" + id + "': unexpected file '" + printable(file, 80) + "'");
       const std::string bytes = readRegularFile((from / file).string(), 1u << 30, "actual image");
-      const std::string sha = sha256Hex(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()));
+      const std::string sha =
+          sha256Hex(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()));
       if (sha != actual.value("sha256", std::string()))
-        throw InputError((from / file).string() + ": its SHA-256 is not the one the run recorded (changed since the run)");
+        throw InputError((from / file).string() +
+                         ": its SHA-256 is not the one the run recorded (changed since the run)");
       copies.push_back({from / file, fs::path(goldenFolder(m, id)) / (output + ".png")});
       any = true;
     }
@@ -189,8 +201,11 @@ Exit runList(const GoldenArgs& a) {
         absent += std::string(absent.empty() ? "" : ",") + goldenOutputName(o);
     }
     missing += !absent.empty();
-    std::cout << c.id << "\t" << (c.hasVideo() ? "frame" : !c.state.empty() ? "state" : "box") << "\t" << outs << "\t"
-              << (absent.empty() ? "goldens present" : "missing: " + absent) << "\n";
+    std::cout << c.id << "\t"
+              << (c.hasVideo()       ? "frame"
+                  : !c.state.empty() ? "state"
+                                     : "box")
+              << "\t" << outs << "\t" << (absent.empty() ? "goldens present" : "missing: " + absent) << "\n";
   }
   int unused = 0;
   std::error_code ec;
@@ -200,7 +215,8 @@ Exit runList(const GoldenArgs& a) {
         std::cout << "unused golden: " << e.path().string() << "\n";
         ++unused;
       }
-  std::cout << m.cases.size() << " case(s), " << missing << " with missing goldens, " << unused << " unused golden folder(s)\n";
+  std::cout << m.cases.size() << " case(s), " << missing << " with missing goldens, " << unused
+            << " unused golden folder(s)\n";
   return Exit::Ok;
 }
 
@@ -224,17 +240,24 @@ Runner addGolden(CLI::App& app) {
       "unsafe query status.");
   g->require_subcommand(1);
   auto a = std::make_shared<GoldenArgs>();
-  CLI::App* run = g->add_subcommand("run", "Render, compare, report (results.json, junit.xml, summary.md, report.html); never writes goldens");
-  CLI::App* update = g->add_subcommand("update", "Render and write goldens with their golden.json (the inputs' hashes, renderer, version)");
-  CLI::App* approve = g->add_subcommand("approve", "Take the actual images of an earlier run (e.g. a CI artifact) as the goldens, hashes checked");
+  CLI::App* run = g->add_subcommand(
+      "run", "Render, compare, report (results.json, junit.xml, summary.md, report.html); never writes goldens");
+  CLI::App* update = g->add_subcommand(
+      "update", "Render and write goldens with their golden.json (the inputs' hashes, renderer, version)");
+  CLI::App* approve = g->add_subcommand(
+      "approve", "Take the actual images of an earlier run (e.g. a CI artifact) as the goldens, hashes checked");
   CLI::App* list = g->add_subcommand("list", "The cases, their missing goldens, and golden folders no case uses");
-  for (CLI::App* s : {run, update, approve, list}) s->add_option("manifest", a->manifest, "The golden manifest (YAML)")->required();
+  for (CLI::App* s : {run, update, approve, list})
+    s->add_option("manifest", a->manifest, "The golden manifest (YAML)")->required();
   for (CLI::App* s : {run, update})
-    s->add_option("--case", a->cases, "Only the cases whose id matches this glob (repeat for several)")->allow_extra_args(false);
+    s->add_option("--case", a->cases, "Only the cases whose id matches this glob (repeat for several)")
+        ->allow_extra_args(false);
   run->add_option("--out", a->out, "Folder for the reports and the failing cases' images")->capture_default_str();
   run->add_flag("--keep-passing", a->keep_passing, "Write the images of passing cases too");
-  update->add_option("--only", a->only, "Which cases: missing (no golden yet), failed (failing or missing), all")->capture_default_str();
-  approve->add_option("--from", a->from, "The --out folder of the run whose actual images become the goldens")->required();
+  update->add_option("--only", a->only, "Which cases: missing (no golden yet), failed (failing or missing), all")
+      ->capture_default_str();
+  approve->add_option("--from", a->from, "The --out folder of the run whose actual images become the goldens")
+      ->required();
   for (CLI::App* s : {run, update, approve}) s->add_flag("-q,--quiet", a->quiet, "Print the summary and failures only");
   return [a, run, update, approve, list]() -> Exit {
     if (run->parsed()) return guarded(runRun, *a);

@@ -34,7 +34,8 @@ std::string withProvenPairs(const std::string& text, const ImportArgs& args) {
   std::vector<modelling::PairReport> reports;
   {
     Progress progress("proving pairs", args.quiet);
-    reports = modelling::provePairs(m, {.max_boxes = args.max_boxes, .progress = [&](double f) { progress.update(f); }});
+    reports =
+        modelling::provePairs(m, {.max_boxes = args.max_boxes, .progress = [&](double f) { progress.update(f); }});
   }
   const modelling::IgnorePlan plan =
       modelling::ignoreList(m, reports, {.keep_adjacent = args.keep_adjacent, .world_is_link = true});
@@ -103,8 +104,8 @@ Runner addImport(CLI::App& app) {
       "a conservative SSCH");
   sub->add_option("urdf", args->urdf, "URDF file")->required();
   sub->add_option("--srdf", args->srdf, "SRDF file: its disable_collisions become pairs: ignore");
-  CLI::Option* points = sub->add_option("--points,-k", args->points,
-                                        "Expert knob: exactly K core points per link (1 ... 16), instead of --tolerance");
+  CLI::Option* points = sub->add_option(
+      "--points,-k", args->points, "Expert knob: exactly K core points per link (1 ... 16), instead of --tolerance");
   CLI::Option* tolerance =
       sub->add_option("--tolerance", args->tolerance_mm,
                       "Millimetres each link's volume may reach outside the link's convex hull: per link the fewest "
@@ -112,24 +113,28 @@ Runner addImport(CLI::App& app) {
           ->capture_default_str()
           ->check(finiteIn(1e-6, 1e6))
           ->excludes(points);
-  addPieceOptions(*sub, args->pieces, args->concavity_mm, "Concave links (each piece a body LINK/1, LINK/2, ... with link: LINK)");
+  addPieceOptions(*sub, args->pieces, args->concavity_mm,
+                  "Concave links (each piece a body LINK/1, LINK/2, ... with link: LINK)");
   sub->add_option("--margin", args->margin, "safety_margin written into the model (metres)")
       ->capture_default_str()
       ->check(finiteIn(0.0, kMaxModelLength));
   sub->add_option("--package-path", args->packages, "Resolves package://NAME/... meshes: NAME=DIR (repeatable)");
   sub->add_option("-o,--output", args->output, "Model file to write (default: standard output)");
-  sub->add_flag("--no-visuals", args->no_visuals,
-                "Leave out the links' <visual> geometry (written as visuals: for drawing; their mesh files must exist)");
+  sub->add_flag(
+      "--no-visuals", args->no_visuals,
+      "Leave out the links' <visual> geometry (written as visuals: for drawing; their mesh files must exist)");
   sub->add_flag("--pairs", args->pairs,
                 "Also prove which pairs never come within the margin inside the joint limits, or always touch, "
                 "and ignore them (as kccd pairs --write)");
   sub->add_flag("--hulls", args->hulls,
-                "Bodies are the links' (with --pieces, each piece's) convex hulls (every hull vertex, no fit): a tight but slow reference model "
+                "Bodies are the links' (with --pieces, each piece's) convex hulls (every hull vertex, no fit): a tight "
+                "but slow reference model "
                 "to measure what a fit costs (kccd query on both)")
       ->excludes(points)
       ->excludes(tolerance);
-  sub->add_flag("--keep-adjacent", args->keep_adjacent,
-                "Check links joined by one moving joint (by default they are ignored, as MoveIt does: reason adjacent)");
+  sub->add_flag(
+      "--keep-adjacent", args->keep_adjacent,
+      "Check links joined by one moving joint (by default they are ignored, as MoveIt does: reason adjacent)");
   sub->add_option("--max-boxes", args->max_boxes, "With --pairs: boxes per pair before a pair is undecided")
       ->capture_default_str()
       ->check(CLI::Range(1, 10000000))
@@ -142,7 +147,8 @@ Runner addImport(CLI::App& app) {
       "joints (conservative).\n"
       "Ignored pairs, each with its reason in pairs: ignore: links with only fixed joints between them (rigid: one "
       "constant distance), links joined by one moving joint with no link with geometry between them (adjacent, "
-      "MoveIt's rule; --keep-adjacent checks them), the SRDF's disable_collisions (srdf), and with --pairs the pairs proven never "
+      "MoveIt's rule; --keep-adjacent checks them), the SRDF's disable_collisions (srdf), and with --pairs the pairs "
+      "proven never "
       "within the margin (never) or touching at every configuration (always_touching).\n"
       "Exit status: 0 done, 2 bad input.");
   return [args, points] {

@@ -17,10 +17,14 @@ namespace {
 
 const char* shapeName(Visual::Shape shape) {
   switch (shape) {
-    case Visual::Shape::Mesh: return "mesh";
-    case Visual::Shape::Box: return "box";
-    case Visual::Shape::Cylinder: return "cylinder";
-    case Visual::Shape::Sphere: return "sphere";
+    case Visual::Shape::Mesh:
+      return "mesh";
+    case Visual::Shape::Box:
+      return "box";
+    case Visual::Shape::Cylinder:
+      return "cylinder";
+    case Visual::Shape::Sphere:
+      return "sphere";
   }
   return "?";
 }
@@ -30,8 +34,10 @@ std::vector<std::pair<std::string, std::vector<std::string>>> linksOf(const Mode
   std::vector<std::pair<std::string, std::vector<std::string>>> out;
   for (const Body& b : m.bodies) {
     auto it = std::find_if(out.begin(), out.end(), [&](const auto& l) { return l.first == b.linkName(); });
-    if (it == out.end()) out.push_back({b.linkName(), {b.name}});
-    else it->second.push_back(b.name);
+    if (it == out.end())
+      out.push_back({b.linkName(), {b.name}});
+    else
+      it->second.push_back(b.name);
   }
   return out;
 }
@@ -52,14 +58,18 @@ Exit runInfo(const InfoArgs& args) {
     j["point_budget"] = m.point_budget;
     j["state"] = m.stateNames();
     for (const Joint& jt : m.joints) {
-      nlohmann::json o{{"name", jt.name}, {"type", toString(jt.type)}, {"parent", m.frameName(jt.parent)}, {"dof", jt.dof}};
+      nlohmann::json o{
+          {"name", jt.name}, {"type", toString(jt.type)}, {"parent", m.frameName(jt.parent)}, {"dof", jt.dof}};
       if (jt.type != JointType::Fixed) o["sweep"] = toString(jt.sweep);
       if (jt.limits) o["limits"] = {(*jt.limits)[0], (*jt.limits)[1]};
       if (jt.type == JointType::Translation3d || jt.type == JointType::Rotation3d) o["error"] = jt.error;
       j["joints"].push_back(o);
     }
     for (const Body& b : m.bodies) {
-      nlohmann::json o{{"name", b.name}, {"frame", m.frameName(b.frame)}, {"points", b.points.size()}, {"radius", b.radius},
+      nlohmann::json o{{"name", b.name},
+                       {"frame", m.frameName(b.frame)},
+                       {"points", b.points.size()},
+                       {"radius", b.radius},
                        {"link", b.linkName()}};
       if (b.tolerance >= 0.0) o["tolerance"] = b.tolerance;
       j["bodies"].push_back(o);
@@ -78,16 +88,17 @@ Exit runInfo(const InfoArgs& args) {
       if (v.shape == Visual::Shape::Mesh) o["mesh"] = v.mesh;
       j["visuals"].push_back(o);
     }
-    j["totals"] = {{"joints", m.joints.size()}, {"dof", m.stateSize()}, {"bodies", m.bodies.size()},
-                   {"links", linksOf(m).size()}, {"points", points},
-                   {"pairs", m.pairs.size()}, {"ignored", m.ignored.size()}, {"visuals", m.visuals.size()}};
+    j["totals"] = {{"joints", m.joints.size()},   {"dof", m.stateSize()},       {"bodies", m.bodies.size()},
+                   {"links", linksOf(m).size()},  {"points", points},           {"pairs", m.pairs.size()},
+                   {"ignored", m.ignored.size()}, {"visuals", m.visuals.size()}};
     std::cout << j.dump(2) << "\n";
     return Exit::Ok;
   }
   const std::size_t links = linksOf(m).size();
   std::cout << "model " << m.name << ": " << m.joints.size() << " joints, " << m.stateSize() << " state values, "
             << m.bodies.size() << " bodies"
-            << (links != m.bodies.size() ? " (" + std::to_string(links) + " links, concave ones in pieces)" : std::string())
+            << (links != m.bodies.size() ? " (" + std::to_string(links) + " links, concave ones in pieces)"
+                                         : std::string())
             << ", " << points << " points, " << m.pairs.size() << " checked pairs, " << m.ignored.size() << " ignored\n"
             << "safety margin " << m.safety_margin << " m, point budget " << m.point_budget << "\n\njoints:\n";
   for (const Joint& jt : m.joints) {

@@ -30,8 +30,8 @@ struct PairsArgs {
 // The proofs hold for the model as it was read: the list is written only into that same text.
 void writeIgnoreList(const std::string& model, const std::string& proven_text,
                      const std::vector<modelling::IgnoreEntry>& ignore) {
-  editFile(model, [&](const std::string& text) { return modelling::withIgnoreList(text, model, ignore); },
-           &proven_text);
+  editFile(
+      model, [&](const std::string& text) { return modelling::withIgnoreList(text, model, ignore); }, &proven_text);
 }
 
 std::string pairName(const Model& m, int a, int b) { return m.bodies[a].name + " - " + m.bodies[b].name; }
@@ -57,14 +57,22 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
   const std::vector<const modelling::PairSurvey*> link_order = modelling::byConcern(s.links);
   const double n = static_cast<double>(std::max<std::size_t>(1, s.samples));
   if (args.json) {
-    nlohmann::json j{{"margin", s.margin},         {"states", random ? nlohmann::json("random") : nlohmann::json(args.states)},
+    nlohmann::json j{{"margin", s.margin},
+                     {"states", random ? nlohmann::json("random") : nlohmann::json(args.states)},
                      {"time_offset", args.time_offset},
-                     {"samples", s.samples},       {"samples_within", s.samples_within},
-                     {"unsafe", s.unsafe},         {"pairs", nlohmann::json::array()}};
+                     {"samples", s.samples},
+                     {"samples_within", s.samples_within},
+                     {"unsafe", s.unsafe},
+                     {"pairs", nlohmann::json::array()}};
     for (const auto* p : order) {
-      nlohmann::json o{{"a", m.bodies[p->a].name},  {"b", m.bodies[p->b].name}, {"frame", m.frameName(p->lca)},
-                       {"checked", p->checked},     {"within", p->within},      {"fraction", p->within / n},
-                       {"overlapping", p->overlapping}, {"min_distance", number(p->min_distance)},
+      nlohmann::json o{{"a", m.bodies[p->a].name},
+                       {"b", m.bodies[p->b].name},
+                       {"frame", m.frameName(p->lca)},
+                       {"checked", p->checked},
+                       {"within", p->within},
+                       {"fraction", p->within / n},
+                       {"overlapping", p->overlapping},
+                       {"min_distance", number(p->min_distance)},
                        {"min_time", number(p->min_time)}};
       if (!p->checked) o["ignored"] = modelling::currentIgnoreReason(m, p->a, p->b);
       if (p->within > 0) o["first_within"] = p->first_within, o["last_within"] = p->last_within;
@@ -73,11 +81,16 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
     }
     j["links"] = nlohmann::json::array();
     for (const auto* p : link_order) {
-      nlohmann::json o{{"a", m.bodies[p->a].linkName()}, {"b", m.bodies[p->b].linkName()},
+      nlohmann::json o{{"a", m.bodies[p->a].linkName()},
+                       {"b", m.bodies[p->b].linkName()},
                        {"closest_bodies", {m.bodies[p->a].name, m.bodies[p->b].name}},
-                       {"body_pairs", p->body_pairs}, {"checked", p->checked}, {"within", p->within},
-                       {"fraction", p->within / n}, {"overlapping", p->overlapping},
-                       {"min_distance", number(p->min_distance)}, {"min_time", number(p->min_time)}};
+                       {"body_pairs", p->body_pairs},
+                       {"checked", p->checked},
+                       {"within", p->within},
+                       {"fraction", p->within / n},
+                       {"overlapping", p->overlapping},
+                       {"min_distance", number(p->min_distance)},
+                       {"min_time", number(p->min_time)}};
       if (p->within > 0) o["first_within"] = p->first_within, o["last_within"] = p->last_within;
       j["links"].push_back(o);
     }
@@ -97,9 +110,10 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
       continue;
     }
     const double f = p->within / n;
-    std::string note = p->within == 0 ? "" : f >= 0.95 ? "always or nearly: adjacent, or a fit too loose?"
-                                          : f >= 0.5   ? "often"
-                                                       : "sometimes";
+    std::string note = p->within == 0 ? ""
+                       : f >= 0.95    ? "always or nearly: adjacent, or a fit too loose?"
+                       : f >= 0.5     ? "often"
+                                      : "sometimes";
     if (p->overlapping)
       note += (note.empty() ? "" : "; ") + std::string("volumes overlap in ") + std::to_string(p->overlapping) +
               " states, up to " + formatNumber(p->max_penetration, 3) + " m";
@@ -110,10 +124,10 @@ Exit runSurvey(const PairsArgs& args, const Model& m) {
       note += (note.empty() ? "" : "; ") + std::string("closest pieces ") + pairName(m, p->a, p->b) + " of " +
               std::to_string(p->body_pairs) + " piece pairs";
     std::cout << "  " << std::left << std::setw(42) << (m.bodies[p->a].linkName() + " - " + m.bodies[p->b].linkName())
-              << std::setw(16)
-              << (std::to_string(p->within) + " (" + formatNumber(100.0 * f, 3) + " %)") << std::setw(14)
-              << (std::isnan(p->min_distance) ? std::string("-") : formatNumber(p->min_distance, 4)) << std::setw(12)
-              << (std::isnan(p->min_time) ? std::string("-") : formatNumber(p->min_time, 6)) << note << "\n";
+              << std::setw(16) << (std::to_string(p->within) + " (" + formatNumber(100.0 * f, 3) + " %)")
+              << std::setw(14) << (std::isnan(p->min_distance) ? std::string("-") : formatNumber(p->min_distance, 4))
+              << std::setw(12) << (std::isnan(p->min_time) ? std::string("-") : formatNumber(p->min_time, 6)) << note
+              << "\n";
   }
   if (quiet_pairs > 0) std::cout << quiet_pairs << " pairs never within the margin (--all lists them)\n";
   std::cout << "A survey is evidence, not a proof: nothing is ignored from it. A pair within the margin in a run "
@@ -141,9 +155,9 @@ Exit runPairs(const PairsArgs& args) {
     j["margin"] = margin;
     j["pairs"] = nlohmann::json::array();
     for (const auto& r : reports) {
-      nlohmann::json o{{"a", m.bodies[r.a].name}, {"b", m.bodies[r.b].name}, {"frame", m.frameName(r.lca)},
-                       {"verdict", toString(r.verdict)}, {"adjacent", r.adjacent}, {"rigid", r.rigid},
-                       {"checked", r.checked}, {"boxes", r.boxes}};
+      nlohmann::json o{{"a", m.bodies[r.a].name},        {"b", m.bodies[r.b].name}, {"frame", m.frameName(r.lca)},
+                       {"verdict", toString(r.verdict)}, {"adjacent", r.adjacent},  {"rigid", r.rigid},
+                       {"checked", r.checked},           {"boxes", r.boxes}};
       if (!r.checked) o["ignored"] = modelling::currentIgnoreReason(m, r.a, r.b);
       if (const std::string why = modelling::plannedIgnoreReason(plan, m, r.a, r.b); !why.empty())
         o["ignore_reason"] = why;

@@ -39,7 +39,8 @@ double parseExact(const std::string& e, double margin) {
     if (used == e.size() && std::isfinite(d) && d >= 0.0 && d <= kMaxModelLength) return d;
   } catch (const std::exception&) {
   }
-  throw UsageError("--exact: expected band, margin, all, off or a distance from 0 to 1e6 m, got '" + printable(e) + "'");
+  throw UsageError("--exact: expected band, margin, all, off or a distance from 0 to 1e6 m, got '" + printable(e) +
+                   "'");
 }
 
 QueryType parseType(const std::string& t) {
@@ -118,16 +119,22 @@ Exit runQuery(const QueryArgs& args) {
     j["pairs"] = nlohmann::json::array();
     for (const PairDistance& pd : r.pairs) {
       const BodyPair& p = m.pairs[pd.pair];
-      nlohmann::json o{{"a", m.bodies[p.a].name}, {"b", m.bodies[p.b].name}, {"frame", m.frameName(p.lca)},
-                       {"distance", pd.distance}, {"fresh", pd.fresh}};
+      nlohmann::json o{{"a", m.bodies[p.a].name},
+                       {"b", m.bodies[p.b].name},
+                       {"frame", m.frameName(p.lca)},
+                       {"distance", pd.distance},
+                       {"fresh", pd.fresh}};
       if (pd.has_witness) {
         o["witness_a"] = vec3(pd.witness_a);
         o["witness_b"] = vec3(pd.witness_b);
       }
       j["pairs"].push_back(o);
     }
-    j["stats"] = {{"time_us", r.stats.time_us}, {"pairs_checked", r.stats.pairs_checked},
-                  {"gjk_calls", r.stats.gjk_calls}, {"exact_calls", r.stats.exact_calls}, {"split_pairs", r.stats.split_pairs},
+    j["stats"] = {{"time_us", r.stats.time_us},
+                  {"pairs_checked", r.stats.pairs_checked},
+                  {"gjk_calls", r.stats.gjk_calls},
+                  {"exact_calls", r.stats.exact_calls},
+                  {"split_pairs", r.stats.split_pairs},
                   {"volumes_swept", r.stats.volumes_swept},
                   {"budget_exhausted", r.stats.budget_exhausted}};
     if (explain) j["explain"] = explainJson(m, explained);
@@ -140,13 +147,13 @@ Exit runQuery(const QueryArgs& args) {
     for (const PairDistance& pd : r.pairs) {
       const BodyPair& p = m.pairs[pd.pair];
       std::cout << "  " << std::left << std::setw(40) << (m.bodies[p.a].name + " - " + m.bodies[p.b].name)
-                << std::setw(14) << pd.distance << "[" << m.frameName(p.lca) << "]" << (pd.fresh ? "" : " (carried over)")
-                << "\n";
+                << std::setw(14) << pd.distance << "[" << m.frameName(p.lca) << "]"
+                << (pd.fresh ? "" : " (carried over)") << "\n";
     }
     std::cout << "time " << r.stats.time_us << " us, " << r.stats.pairs_checked << " pairs checked, "
               << r.stats.gjk_calls << " GJK calls, " << r.stats.exact_calls << " exact-stage calls, "
-              << r.stats.split_pairs << " pairs split"
-              << (r.stats.budget_exhausted ? ", budget exhausted" : "") << "\n";
+              << r.stats.split_pairs << " pairs split" << (r.stats.budget_exhausted ? ", budget exhausted" : "")
+              << "\n";
     if (explain) printExplain(m, explained, r.margin);
   }
   if (r.status != Status::Ok) {
@@ -169,7 +176,9 @@ Runner addQuery(CLI::App& app) {
   sub->add_option("--state", args->state, "A single configuration (zero-width interval)");
   sub->add_option("--type", args->type, "collision | closest | distances | nclosest (cheapest first)")
       ->capture_default_str();
-  sub->add_option("--n", args->n, "Number of pairs for --type nclosest")->capture_default_str()->check(CLI::Range(1, 1000000));
+  sub->add_option("--n", args->n, "Number of pairs for --type nclosest")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000000));
   sub->add_option("--margin", args->margin, "Safety margin in metres (default: the model's)")
       ->check(finiteIn(0.0, kMaxModelLength));
   sub->add_option("--budget-us", args->budget_us, "Time budget in microseconds (default: unlimited)")

@@ -29,9 +29,9 @@ Exit runRender(const RenderArgs& args) {
   const Model m = loadOrExplain(args.model);
   const calib::Camera camera = calib::loadCamera(args.camera);
   checkOutputPath(args.output, "-o", ".png");
-  const StateBox box =
-      parseStateBox(m, args.state, args.lower, args.upper,
-                    "give the configuration with --state (static volumes) or --lower and --upper (swept volumes)", true);
+  const StateBox box = parseStateBox(
+      m, args.state, args.lower, args.upper,
+      "give the configuration with --state (static volumes) or --lower and --upper (swept volumes)", true);
   const std::vector<double>& lower = box.lower;
   const std::vector<double>& upper = box.upper;
   if (m.bodies.size() > 255) throw UsageError(args.model + ": more than 255 bodies do not fit an 8-bit mask");
@@ -73,9 +73,12 @@ Exit runRender(const RenderArgs& args) {
   for (std::size_t i = 0; i < m.bodies.size(); ++i) not_finite |= frame.visibility[i] == render::Visibility::NotFinite;
   auto drawnNote = [&](std::size_t i) -> std::string {
     switch (frame.visibility[i]) {
-      case render::Visibility::Drawn: return "";
-      case render::Visibility::FillsView: return " (contains the camera: fills the view)";
-      default: return std::string(" (not drawn: ") + render::toString(frame.visibility[i]) + ")";
+      case render::Visibility::Drawn:
+        return "";
+      case render::Visibility::FillsView:
+        return " (contains the camera: fills the view)";
+      default:
+        return std::string(" (not drawn: ") + render::toString(frame.visibility[i]) + ")";
     }
   };
   if (args.json) {
@@ -94,16 +97,22 @@ Exit runRender(const RenderArgs& args) {
     j["fills_view"] = nlohmann::json::array();
     for (std::size_t i = 0; i < m.bodies.size(); ++i) {
       const render::Visibility v = frame.visibility[i];
-      if (v == render::Visibility::FillsView) j["fills_view"].push_back(m.bodies[i].name);
+      if (v == render::Visibility::FillsView)
+        j["fills_view"].push_back(m.bodies[i].name);
       else if (v != render::Visibility::Drawn)
         j["not_drawn"].push_back({{"body", m.bodies[i].name}, {"reason", render::toString(v)}});
     }
     for (std::size_t i = 0; i < m.bodies.size(); ++i)
-      j["bodies"].push_back({{"name", m.bodies[i].name}, {"label", i + 1}, {"status", toString(body_status[i])},
-                             {"min_distance", number(nearest[i])}, {"pixels", frame.pixels[i]}});
+      j["bodies"].push_back({{"name", m.bodies[i].name},
+                             {"label", i + 1},
+                             {"status", toString(body_status[i])},
+                             {"min_distance", number(nearest[i])},
+                             {"pixels", frame.pixels[i]}});
     // How far from its centre a mask pixel's label may come from (null: no bound).
     j["mask_edge_px"] = number(frame.mask_edge_px);
-    j["stats"] = {{"frame_ms", frame_ms}, {"total_ms", total_ms}, {"triangles", frame.triangles},
+    j["stats"] = {{"frame_ms", frame_ms},
+                  {"total_ms", total_ms},
+                  {"triangles", frame.triangles},
                   {"meshes_built", frame.meshes_built}};
     std::cout << j.dump(2) << "\n";
   } else {
@@ -134,8 +143,9 @@ Exit runRender(const RenderArgs& args) {
 Runner addRender(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* sub = app.add_subcommand(
-      "render", "Off-screen image of the collision volumes as the camera sees them (static at --state, swept over "
-                "--lower/--upper)");
+      "render",
+      "Off-screen image of the collision volumes as the camera sees them (static at --state, swept over "
+      "--lower/--upper)");
   sub->add_option("model", args->model, "Model file (YAML, kccd: 1)")->required();
   sub->add_option("--camera", args->camera, "Camera file (OpenCV YAML: intrinsics, distortion, rvec/tvec)")->required();
   sub->add_option("-o,--output", args->output, "Output PNG (RGBA, straight alpha; with --mask an 8-bit label image)")
@@ -146,16 +156,19 @@ Runner addRender(CLI::App& app) {
   sub->add_flag("--mask", args->mask, "Write the label mask: 0 background, i + 1 for the nearest body i");
   sub->add_flag("--labels", args->labels, "Draw body names");
   sub->add_flag("--no-legend", args->no_legend, "No colour legend");
-  sub->add_option("--supersample", args->supersample, "Render the pinhole image (and the mask) this many times finer (1..4): thinner slivers survive the lens warp, and mask edges lie closer to the exact labels (--json: mask_edge_px)")
+  sub->add_option("--supersample", args->supersample,
+                  "Render the pinhole image (and the mask) this many times finer (1..4): thinner slivers survive the "
+                  "lens warp, and mask edges lie closer to the exact labels (--json: mask_edge_px)")
       ->capture_default_str()
       ->check(finiteIn(1.0, 4.0));
   sub->add_flag("--json", args->json, "Machine-readable summary");
-  sub->footer("Colours: green clear, amber within the safety margin, red colliding.\n"
-              "Volumes containing the camera fill the view; volumes behind the camera, farther than 1e6 m\n"
-              "or not finite are not drawn and are listed (text: 'not drawn: reason'; JSON: not_drawn).\n"
-              "GL: KCCD_GL=egl (EGL surfaceless, the default) or KCCD_GL=osmesa; KCCD_EGL_DEVICE=N uses EGL device N\n"
-              "(e.g. a GPU); the renderer string (--json: renderer) names the one in use.\n"
-              "Exit status: 0 written, 2 bad input, 3 unsafe query status or a non-finite volume (image still written).");
+  sub->footer(
+      "Colours: green clear, amber within the safety margin, red colliding.\n"
+      "Volumes containing the camera fill the view; volumes behind the camera, farther than 1e6 m\n"
+      "or not finite are not drawn and are listed (text: 'not drawn: reason'; JSON: not_drawn).\n"
+      "GL: KCCD_GL=egl (EGL surfaceless, the default) or KCCD_GL=osmesa; KCCD_EGL_DEVICE=N uses EGL device N\n"
+      "(e.g. a GPU); the renderer string (--json: renderer) names the one in use.\n"
+      "Exit status: 0 written, 2 bad input, 3 unsafe query status or a non-finite volume (image still written).");
   return [args] { return runRender(*args); };
 }
 

@@ -49,7 +49,8 @@ int main(int argc, char** argv) {
       known = known || sub->get_name() == argv[1];
       names += (names.empty() ? "" : ", ") + sub->get_name();
     }
-    if (!known) return fail(Exit::BadInput, "unknown subcommand '" + kccd::printable(argv[1], 40) + "' (" + names + ")");
+    if (!known)
+      return fail(Exit::BadInput, "unknown subcommand '" + kccd::printable(argv[1], 40) + "' (" + names + ")");
   }
   try {
     app.parse(argc, argv);

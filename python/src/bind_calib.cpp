@@ -73,8 +73,8 @@ cv::Mat maskOf(const py::handle& value, std::size_t index, const calib::Camera& 
     throw py::type_error(name + ": expected dtype uint8 or bool, got dtype " + py::str(a.dtype()).cast<std::string>());
   if (a.ndim() != 2) throw py::value_error(name + ": expected shape (H, W)");
   if (a.shape(0) != camera.height || a.shape(1) != camera.width)
-    throw py::value_error(name + ": " + std::to_string(a.shape(1)) + "x" + std::to_string(a.shape(0)) + " for a camera of " +
-                          std::to_string(camera.width) + "x" + std::to_string(camera.height));
+    throw py::value_error(name + ": " + std::to_string(a.shape(1)) + "x" + std::to_string(a.shape(0)) +
+                          " for a camera of " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
   const auto c = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(a);
   const cv::Mat view(camera.height, camera.width, CV_8UC1, const_cast<std::uint8_t*>(c.data()));
   cv::Mat mask = (view != 0);
@@ -96,19 +96,21 @@ py::array_t<double> covarianceArray(const cv::Matx66d& c) {
 // takes it.
 cv::Mat pictureOf(const py::handle& value, std::size_t index, const calib::Camera& camera) {
   const std::string name = "pictures[" + std::to_string(index) + "]";
-  cv::Mat grey = py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__")
-                           ? calib::readImageFile(py::str(py::module_::import("os").attr("fspath")(value)).cast<std::string>(),
-                                                  calib::ImageColour::Grey)
-                           : greyOf(value, name);
+  cv::Mat grey =
+      py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__")
+          ? calib::readImageFile(py::str(py::module_::import("os").attr("fspath")(value)).cast<std::string>(),
+                                 calib::ImageColour::Grey)
+          : greyOf(value, name);
   if (grey.cols != camera.width || grey.rows != camera.height)
-    throw py::value_error(name + ": " + std::to_string(grey.cols) + "x" + std::to_string(grey.rows) + " for a camera of " +
-                          std::to_string(camera.width) + "x" + std::to_string(camera.height));
+    throw py::value_error(name + ": " + std::to_string(grey.cols) + "x" + std::to_string(grey.rows) +
+                          " for a camera of " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
   return grey;
 }
 
 // `draw` checked: what a refinement draws of the robot.
 const std::string& drawOf(const std::string& draw) {
-  if (draw != "auto" && draw != "visuals" && draw != "volumes") throw py::value_error("draw: expected 'auto', 'visuals' or 'volumes'");
+  if (draw != "auto" && draw != "visuals" && draw != "volumes")
+    throw py::value_error("draw: expected 'auto', 'visuals' or 'volumes'");
   return draw;
 }
 
@@ -222,7 +224,8 @@ void bindTags(py::module_& m) {
           "order p0..p3, counter-clockwise as seen in the image, p0 at the tag frame's (-s/2, -s/2)")
       .def_readonly("hamming", &calib::TagDetection::hamming, "bits corrected in decoding (0 ... 2)")
       .def_readonly("decision_margin", &calib::TagDetection::decision_margin, "AprilTag's decoding quality")
-      .def("__repr__", [](const calib::TagDetection& d) { return "<kccd.TagDetection id " + std::to_string(d.id) + ">"; });
+      .def("__repr__",
+           [](const calib::TagDetection& d) { return "<kccd.TagDetection id " + std::to_string(d.id) + ">"; });
 
   m.def(
       "detect_tags",
@@ -240,13 +243,14 @@ void bindTags(py::module_& m) {
                   "Reads a tag layout file; raises InputError naming the file, line and field.")
       .def_static("from_yaml", &calib::parseTagLayout, py::arg("text"), py::arg("source") = "<string>",
                   "Parses tag layout text; `source` names it in errors.")
-      .def_property_readonly("ids",
-                             [](const calib::TagLayout& l) {
-                               std::vector<int> ids;
-                               for (const calib::Tag& t : l.tags) ids.push_back(t.id);
-                               return ids;
-                             },
-                             "The tag ids, in file order.")
+      .def_property_readonly(
+          "ids",
+          [](const calib::TagLayout& l) {
+            std::vector<int> ids;
+            for (const calib::Tag& t : l.tags) ids.push_back(t.id);
+            return ids;
+          },
+          "The tag ids, in file order.")
       .def(
           "corners",
           [](const calib::TagLayout& l, int id) {
@@ -286,14 +290,14 @@ void bindTags(py::module_& m) {
 // The pose solve and its status.
 void bindPose(py::module_& m) {
   py::list members;
-  const std::pair<const char*, calib::PoseStatus> statuses[] = {
-      {"SOLVED", calib::PoseStatus::Solved},
-      {"TOO_FEW_POINTS", calib::PoseStatus::TooFewPoints},
-      {"COLLINEAR", calib::PoseStatus::Collinear},
-      {"POOR_GEOMETRY", calib::PoseStatus::PoorGeometry},
-      {"TOO_FEW_INLIERS", calib::PoseStatus::TooFewInliers}};
+  const std::pair<const char*, calib::PoseStatus> statuses[] = {{"SOLVED", calib::PoseStatus::Solved},
+                                                                {"TOO_FEW_POINTS", calib::PoseStatus::TooFewPoints},
+                                                                {"COLLINEAR", calib::PoseStatus::Collinear},
+                                                                {"POOR_GEOMETRY", calib::PoseStatus::PoorGeometry},
+                                                                {"TOO_FEW_INLIERS", calib::PoseStatus::TooFewInliers}};
   for (const auto& [name, s] : statuses) members.append(py::make_tuple(name, static_cast<int>(s)));
-  py::object pose_status = py::module_::import("enum").attr("IntEnum")("PoseStatus", members, py::arg("module") = "kccd");
+  py::object pose_status =
+      py::module_::import("enum").attr("IntEnum")("PoseStatus", members, py::arg("module") = "kccd");
   pose_status.attr("__doc__") = "How a pose solve ended; only SOLVED comes with a camera.";
   m.attr("PoseStatus") = pose_status;
 
@@ -307,8 +311,8 @@ void bindPose(py::module_& m) {
           throw py::value_error("pixels, world: " + std::to_string(px.shape(0)) + " pixels but " +
                                 std::to_string(wd.shape(0)) + " world points");
         if (names && static_cast<py::ssize_t>(names->size()) != px.shape(0))
-          throw py::value_error("names: " + std::to_string(names->size()) + " names for " + std::to_string(px.shape(0)) +
-                                " points");
+          throw py::value_error("names: " + std::to_string(names->size()) + " names for " +
+                                std::to_string(px.shape(0)) + " points");
         if (!(threshold > 0.0)) throw py::value_error("ransac_threshold_px: must be > 0");
         if (min_inliers < 4) throw py::value_error("min_inliers: must be >= 4");
         std::vector<calib::Correspondence> points;
@@ -367,16 +371,16 @@ void bindRefine(py::module_& m) {
   m.def(
       "refine_to_masks",
       [](const calib::Camera& camera, const std::shared_ptr<ModelHandle>& h, const py::sequence& masks,
-         const py::handle& states, const std::optional<std::vector<std::string>>& bodies, const std::optional<bool>& start_is_prior,
-         const std::string& draw) {
+         const py::handle& states, const std::optional<std::vector<std::string>>& bodies,
+         const std::optional<bool>& start_is_prior, const std::string& draw) {
         if (py::isinstance<py::str>(masks) || py::isinstance<py::bytes>(masks))
           throw py::type_error("masks: a list of masks (one per frame), not one path");
         const Model& model = *h->model;
         const int n = model.stateSize();
         const auto st = stateMatrix(states, "states", n);
         if (static_cast<std::size_t>(st.shape(0)) != masks.size())
-          throw py::value_error("masks, states: " + std::to_string(masks.size()) + " masks but " + std::to_string(st.shape(0)) +
-                                " states");
+          throw py::value_error("masks, states: " + std::to_string(masks.size()) + " masks but " +
+                                std::to_string(st.shape(0)) + " states");
         if (masks.size() == 0) throw py::value_error("masks: give at least one");
         const overlay::RobotDrawing robot(model, bodyIndices(model, bodies), drawOf(draw));
         std::vector<calib::MaskFrame> frames;
@@ -394,8 +398,8 @@ void bindRefine(py::module_& m) {
         }
         return refinementDict(r, robot.drawn());
       },
-      py::arg("camera"), py::arg("model"), py::arg("masks"), py::arg("states"), py::kw_only(), py::arg("bodies") = py::none(),
-      py::arg("start_is_prior") = py::none(), py::arg("draw") = "auto",
+      py::arg("camera"), py::arg("model"), py::arg("masks"), py::arg("states"), py::kw_only(),
+      py::arg("bodies") = py::none(), py::arg("start_is_prior") = py::none(), py::arg("draw") = "auto",
       R"doc(The camera's pose refined so that the model's volumes, drawn through the lens at each frame's state,
 match robot masks of the frames, as `kccd calib --masks`: camera, a Camera with a start pose (a solve, or a rough
 pose some 10 deg / 10 cm off); masks, one per frame, each a path to an image (non-zero = robot) or a uint8 or
@@ -414,8 +418,8 @@ The GIL is released while refining.)doc");
   m.def(
       "refine_to_edges",
       [](const calib::Camera& camera, const std::shared_ptr<ModelHandle>& h, const py::sequence& pictures,
-         const py::handle& states, const std::optional<std::vector<std::string>>& bodies, const std::optional<bool>& start_is_prior,
-         const std::string& draw) {
+         const py::handle& states, const std::optional<std::vector<std::string>>& bodies,
+         const std::optional<bool>& start_is_prior, const std::string& draw) {
         if (py::isinstance<py::str>(pictures) || py::isinstance<py::bytes>(pictures))
           throw py::type_error("pictures: a list of pictures (one per frame), not one path");
         const Model& model = *h->model;
@@ -440,8 +444,8 @@ The GIL is released while refining.)doc");
         }
         return refinementDict(r, robot.drawn());
       },
-      py::arg("camera"), py::arg("model"), py::arg("pictures"), py::arg("states"), py::kw_only(), py::arg("bodies") = py::none(),
-      py::arg("start_is_prior") = py::none(), py::arg("draw") = "auto",
+      py::arg("camera"), py::arg("model"), py::arg("pictures"), py::arg("states"), py::kw_only(),
+      py::arg("bodies") = py::none(), py::arg("start_is_prior") = py::none(), py::arg("draw") = "auto",
       R"doc(The camera's pose refined so that the model's volumes' outline, drawn through the lens at each frame's
 state, lies on the pictures' own edges, as `kccd calib --refine edges` (no masks needed): camera, a Camera with a
 start pose a few degrees off at most (e.g. a solve from 4 rough labels); pictures, one per frame, each a path to

@@ -196,7 +196,8 @@ class PyChecker {
         for (int t = 1; t < used; ++t) checkers.push_back(std::make_unique<Checker>(m));
         auto range = [&](int t) { return std::pair<py::ssize_t, py::ssize_t>{rows * t / used, rows * (t + 1) / used}; };
         for (int t = 1; t < used; ++t)
-          pool.emplace_back([&, t] { run(*checkers[static_cast<std::size_t>(t - 1)], range(t).first, range(t).second); });
+          pool.emplace_back(
+              [&, t] { run(*checkers[static_cast<std::size_t>(t - 1)], range(t).first, range(t).second); });
         run(checker_, range(0).first, range(0).second);
         for (std::thread& th : pool) th.join();
       }
@@ -222,7 +223,8 @@ class PyChecker {
       bool expected = false;
       if (!busy.compare_exchange_strong(expected, true))
         throw std::runtime_error(
-            "kccd.Checker: used from two threads at once; give each thread its own Checker (or use query_many(threads=N))");
+            "kccd.Checker: used from two threads at once; give each thread its own Checker (or use "
+            "query_many(threads=N))");
     }
     ~Guard() { busy.store(false); }
     std::atomic<bool>& busy;
@@ -237,45 +239,60 @@ class PyChecker {
 
 void bindChecker(py::module_& m) {
   py::list members;
-  const std::pair<const char*, Status> names[] = {
-      {"OK", Status::Ok}, {"WRONG_STATE_SIZE", Status::WrongStateSize}, {"NON_FINITE_STATE", Status::NonFiniteState},
-      {"LOWER_ABOVE_UPPER", Status::LowerAboveUpper}, {"EXACT_NEEDS_POINT", Status::ExactNeedsPoint},
-      {"NUMERICAL_FAILURE", Status::NumericalFailure}};
+  const std::pair<const char*, Status> names[] = {{"OK", Status::Ok},
+                                                  {"WRONG_STATE_SIZE", Status::WrongStateSize},
+                                                  {"NON_FINITE_STATE", Status::NonFiniteState},
+                                                  {"LOWER_ABOVE_UPPER", Status::LowerAboveUpper},
+                                                  {"EXACT_NEEDS_POINT", Status::ExactNeedsPoint},
+                                                  {"NUMERICAL_FAILURE", Status::NumericalFailure}};
   for (const auto& [name, s] : names) members.append(py::make_tuple(name, static_cast<int>(s)));
   py::object status = py::module_::import("enum").attr("IntEnum")("Status", members, py::arg("module") = "kccd");
-  status.attr("__doc__") = "A query's outcome. Anything but OK means 'unsafe, stop' (the answer counts as a collision).";
+  status.attr("__doc__") =
+      "A query's outcome. Anything but OK means 'unsafe, stop' (the answer counts as a collision).";
   m.attr("Status") = status;
   for (const auto& [name, s] : names) g_status.push_back(status(static_cast<int>(s)).inc_ref().ptr());
 
   py::class_<PyResult>(m, "QueryResult", "One query's answer: every distance is a lower bound over the whole box.")
-      .def_property_readonly("status", [](const PyResult& r) { return statusObject(r.status); },
-                             "kccd.Status; anything but OK is unsafe")
-      .def_property_readonly("type", [](const PyResult& r) { return toString(r.type); },
-                             "'collision', 'closest', 'nclosest' or 'distances'")
-      .def_readonly("collision", &PyResult::collision, "Some pair's bound is within the margin (or the status is not OK).")
-      .def_readonly("min_distance", &PyResult::min_distance, "Smallest lower bound over all pairs (metres; inf without pairs).")
+      .def_property_readonly(
+          "status", [](const PyResult& r) { return statusObject(r.status); }, "kccd.Status; anything but OK is unsafe")
+      .def_property_readonly(
+          "type", [](const PyResult& r) { return toString(r.type); },
+          "'collision', 'closest', 'nclosest' or 'distances'")
+      .def_readonly("collision", &PyResult::collision,
+                    "Some pair's bound is within the margin (or the status is not OK).")
+      .def_readonly("min_distance", &PyResult::min_distance,
+                    "Smallest lower bound over all pairs (metres; inf without pairs).")
       .def_readonly("margin", &PyResult::margin, "The margin used (metres).")
-      .def_property_readonly("pair", [](PyResult& r) { return r.array(PyResult::kPair); },
-                             "int32 (N,): index into Model.pairs of each reported pair")
-      .def_property_readonly("body_a", [](PyResult& r) { return r.array(PyResult::kBodyA); }, "int32 (N,): index into Model.bodies")
-      .def_property_readonly("body_b", [](PyResult& r) { return r.array(PyResult::kBodyB); }, "int32 (N,): index into Model.bodies")
-      .def_property_readonly("distance", [](PyResult& r) { return r.array(PyResult::kDistance); },
-                             "float64 (N,): lower bound over the box (metres)")
-      .def_property_readonly("witness_a", [](PyResult& r) { return r.array(PyResult::kWitnessA); },
-                             "float64 (N, 3): closest points found, in the pair's common-ancestor frame (NaN without a witness)")
-      .def_property_readonly("witness_b", [](PyResult& r) { return r.array(PyResult::kWitnessB); },
-                             "float64 (N, 3): as witness_a, on body b")
-      .def_property_readonly("fresh", [](PyResult& r) { return r.array(PyResult::kFresh); },
-                             "bool (N,): recomputed in this query (else carried over from earlier ones)")
-      .def_property_readonly("has_witness", [](PyResult& r) { return r.array(PyResult::kHasWitness); },
-                             "bool (N,): witness points are valid")
-      .def_property_readonly("stats", [](const PyResult& r) { return statsDict(r.stats); },
-                             "time_us, pairs_checked, gjk_calls, exact_calls, split_pairs, volumes_swept, budget_exhausted")
+      .def_property_readonly(
+          "pair", [](PyResult& r) { return r.array(PyResult::kPair); },
+          "int32 (N,): index into Model.pairs of each reported pair")
+      .def_property_readonly(
+          "body_a", [](PyResult& r) { return r.array(PyResult::kBodyA); }, "int32 (N,): index into Model.bodies")
+      .def_property_readonly(
+          "body_b", [](PyResult& r) { return r.array(PyResult::kBodyB); }, "int32 (N,): index into Model.bodies")
+      .def_property_readonly(
+          "distance", [](PyResult& r) { return r.array(PyResult::kDistance); },
+          "float64 (N,): lower bound over the box (metres)")
+      .def_property_readonly(
+          "witness_a", [](PyResult& r) { return r.array(PyResult::kWitnessA); },
+          "float64 (N, 3): closest points found, in the pair's common-ancestor frame (NaN without a witness)")
+      .def_property_readonly(
+          "witness_b", [](PyResult& r) { return r.array(PyResult::kWitnessB); },
+          "float64 (N, 3): as witness_a, on body b")
+      .def_property_readonly(
+          "fresh", [](PyResult& r) { return r.array(PyResult::kFresh); },
+          "bool (N,): recomputed in this query (else carried over from earlier ones)")
+      .def_property_readonly(
+          "has_witness", [](PyResult& r) { return r.array(PyResult::kHasWitness); },
+          "bool (N,): witness points are valid")
+      .def_property_readonly(
+          "stats", [](const PyResult& r) { return statsDict(r.stats); },
+          "time_us, pairs_checked, gjk_calls, exact_calls, split_pairs, volumes_swept, budget_exhausted")
       .def("__len__", [](const PyResult& r) { return r.pairs.size(); })
       .def("__repr__", [](const PyResult& r) {
         return "<kccd.QueryResult " + py::str(statusObject(r.status).attr("name")).cast<std::string>() + " " +
-               toString(r.type) + (r.collision ? " collision" : " clear") + " min_distance=" + std::to_string(r.min_distance) +
-               " pairs=" + std::to_string(r.pairs.size()) + ">";
+               toString(r.type) + (r.collision ? " collision" : " clear") +
+               " min_distance=" + std::to_string(r.min_distance) + " pairs=" + std::to_string(r.pairs.size()) + ">";
       });
 
   py::class_<PyChecker>(m, "Checker", R"doc(
@@ -285,15 +302,17 @@ threads at once (that raises RuntimeError): one Checker per thread.)doc")
       .def(py::init<std::shared_ptr<ModelHandle>, py::object>(), py::arg("model"), py::arg("budget_us") = py::none(),
            "A checker for `model`; `budget_us`: time budget per query in microseconds (None: unlimited).")
       .def("query", &PyChecker::query, py::arg("lower"), py::arg("upper") = py::none(), py::kw_only(),
-           py::arg("type") = "collision", py::arg("n") = 1, py::arg("margin") = py::none(), py::arg("exact") = py::none(),
+           py::arg("type") = "collision", py::arg("n") = 1, py::arg("margin") = py::none(),
+           py::arg("exact") = py::none(),
            R"doc(One query over the box [lower, upper] (float64 (state_size,), radians / metres in Model.state_names
 order; upper None: the single configuration `lower`). type: 'collision' | 'closest' | 'nclosest' (n pairs) |
 'distances'. margin: metres (None: the model's). exact: which pairs the exact stage refines, as `kccd query
 --exact`: 'band' (default), 'margin', 'all', 'off' or metres. The GIL is released during the query.)doc")
-      .def("query_many", &PyChecker::queryMany, py::arg("lowers"), py::arg("uppers") = py::none(), py::kw_only(),
-           py::arg("type") = "collision", py::arg("n") = 1, py::arg("margin") = py::none(), py::arg("exact") = py::none(),
-           py::arg("threads") = 1, py::arg("reuse") = false,
-           R"doc(Queries M boxes (lowers, uppers: float64 (M, state_size)) in C++ with the GIL released; returns a dict of
+      .def(
+          "query_many", &PyChecker::queryMany, py::arg("lowers"), py::arg("uppers") = py::none(), py::kw_only(),
+          py::arg("type") = "collision", py::arg("n") = 1, py::arg("margin") = py::none(),
+          py::arg("exact") = py::none(), py::arg("threads") = 1, py::arg("reuse") = false,
+          R"doc(Queries M boxes (lowers, uppers: float64 (M, state_size)) in C++ with the GIL released; returns a dict of
 fresh arrays: 'status' int8 (M,) (kccd.Status values), 'collision' bool (M,), 'min_distance' float64 (M,).
 threads: split the rows over this many threads, each with its own Checker. reuse: keep bounds from row to
 row (consecutive cycles of one robot); False (default): every row answered as by a new Checker.)doc")
@@ -326,7 +345,8 @@ row (consecutive cycles of one robot); False (default): every row answered as by
         } else {
           ps = params.cast<std::vector<BrakingParams>>();
           if (static_cast<int>(ps.size()) != n)
-            throw py::value_error("params: expected one BrakingParams or one per state value (" + std::to_string(n) + ")");
+            throw py::value_error("params: expected one BrakingParams or one per state value (" + std::to_string(n) +
+                                  ")");
         }
         py::array_t<double> lower(n), upper(n);
         if (!brakingIntervals(model, qs, vs, ps, {lower.mutable_data(), static_cast<std::size_t>(n)},

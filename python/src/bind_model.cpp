@@ -6,8 +6,8 @@
 #include <cstdio>
 
 #include "bindings.hpp"
-#include "kccd/modelling/yaml_edit.hpp"
 #include "kccd/model.hpp"
+#include "kccd/modelling/yaml_edit.hpp"
 
 namespace kccd::python {
 
@@ -65,8 +65,8 @@ py::array_t<double, py::array::c_style> realMatrix(const py::handle& value, cons
                                                    const char* rows, const char* what) {
   const py::array a = realArray(value, name);
   if (a.ndim() != 2 || a.shape(1) != cols)
-    throw py::value_error(std::string(name) + ": expected shape (" + rows + ", " + std::to_string(cols) + ") (" +
-                          what + "), got " + shapeText(a));
+    throw py::value_error(std::string(name) + ": expected shape (" + rows + ", " + std::to_string(cols) + ") (" + what +
+                          "), got " + shapeText(a));
   return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
 }
 
@@ -96,17 +96,22 @@ Pickles through its YAML text (and the file it came from, against which mesh pat
       .def_static("from_yaml", &modelFromText, py::arg("text"), py::arg("source") = "<string>",
                   "Parses YAML text; `source` names it in error messages (and is where relative mesh paths resolve).")
       .def_property_readonly("name", [](const ModelHandle& h) { return h.model->name; })
-      .def_property_readonly("margin", [](const ModelHandle& h) { return h.model->safety_margin; },
-                             "The safety margin (metres): distances at most this count as a collision.")
+      .def_property_readonly(
+          "margin", [](const ModelHandle& h) { return h.model->safety_margin; },
+          "The safety margin (metres): distances at most this count as a collision.")
       .def_property_readonly("point_budget", [](const ModelHandle& h) { return h.model->point_budget; })
-      .def_property_readonly("state_size", [](const ModelHandle& h) { return h.model->stateSize(); },
-                             "Number of state values (the length of a state, lower or upper).")
-      .def_property_readonly("state_names", [](const ModelHandle& h) { return h.model->stateNames(); },
-                             "The state values in order (`shoulder`, `payload_pose.x`, ...).")
-      .def_property_readonly("joints", [](const ModelHandle& h) { return names(h.model->joints); },
-                             "Joint names, parents before children.")
-      .def_property_readonly("bodies", [](const ModelHandle& h) { return names(h.model->bodies); },
-                             "Body names; QueryResult.pairs' body_a / body_b index this list.")
+      .def_property_readonly(
+          "state_size", [](const ModelHandle& h) { return h.model->stateSize(); },
+          "Number of state values (the length of a state, lower or upper).")
+      .def_property_readonly(
+          "state_names", [](const ModelHandle& h) { return h.model->stateNames(); },
+          "The state values in order (`shoulder`, `payload_pose.x`, ...).")
+      .def_property_readonly(
+          "joints", [](const ModelHandle& h) { return names(h.model->joints); },
+          "Joint names, parents before children.")
+      .def_property_readonly(
+          "bodies", [](const ModelHandle& h) { return names(h.model->bodies); },
+          "Body names; QueryResult.pairs' body_a / body_b index this list.")
       .def_property_readonly(
           "pairs",
           [](const ModelHandle& h) {
@@ -117,15 +122,18 @@ Pickles through its YAML text (and the file it came from, against which mesh pat
             return out;
           },
           "The checked pairs (body names), in the order of QueryResult.pairs' pair indices.")
-      .def_property_readonly("yaml", [](const ModelHandle& h) { return h.text; }, "The YAML text it was read from.")
-      .def_property_readonly("source", [](const ModelHandle& h) { return h.source; },
-                             "The file it was read from (or the name given to from_yaml).")
+      .def_property_readonly(
+          "yaml", [](const ModelHandle& h) { return h.text; }, "The YAML text it was read from.")
+      .def_property_readonly(
+          "source", [](const ModelHandle& h) { return h.source; },
+          "The file it was read from (or the name given to from_yaml).")
       .def(
           "with_body_geometry",
           [](const ModelHandle& h, const std::string& body, const py::handle& points, double radius) {
             const auto p = pointMatrix(points, "points", 3);
             if (p.shape(0) < 1) throw py::value_error("points: expected at least one core point");
-            if (!(radius >= 0.0) || !std::isfinite(radius)) throw py::value_error("radius: must be a finite number >= 0 (metres)");
+            if (!(radius >= 0.0) || !std::isfinite(radius))
+              throw py::value_error("radius: must be a finite number >= 0 (metres)");
             // Every digit kept (17 significant digits read back exactly); the radius rounded up.
             std::string flow = "[";
             const auto v = p.unchecked<2>();

@@ -55,8 +55,8 @@ void bindFit(py::module_& m) {
   m.def(
       "fit",
       [](const std::string& path, int k, const std::string& part_name, bool merge, const std::array<double, 3>& scale,
-         int max_evaluations, std::uint64_t seed, bool exact_hull, const std::optional<double>& tolerance, const py::object& pieces,
-         double concavity, const py::object& progress) {
+         int max_evaluations, std::uint64_t seed, bool exact_hull, const std::optional<double>& tolerance,
+         const py::object& pieces, double concavity, const py::object& progress) {
         if (tolerance && exact_hull) throw py::value_error("tolerance: not with exact_hull (the hull has none)");
         const modelling::FitRequest request{.method = exact_hull  ? modelling::FitMethod::Hull
                                                       : tolerance ? modelling::FitMethod::Tolerance
@@ -122,7 +122,9 @@ void bindImport(py::module_& m) {
          const py::object& progress) {
         modelling::ImportOptions options;
         options.srdf = srdf;
-        options.fit = {.method = hulls ? modelling::FitMethod::Hull : k ? modelling::FitMethod::Points : modelling::FitMethod::Tolerance,
+        options.fit = {.method = hulls ? modelling::FitMethod::Hull
+                                 : k   ? modelling::FitMethod::Points
+                                       : modelling::FitMethod::Tolerance,
                        .points = k.value_or(8),
                        .tolerance = tolerance * 1e-3,
                        .max_pieces = piecesArgument(pieces),
@@ -169,9 +171,9 @@ void bindProve(py::module_& m) {
         ProgressRelay relay{progress, {}};
         std::vector<modelling::PairReport> reports;
         relay.run([&] {
-          reports = modelling::provePairs(model, {.margin = margin ? *margin : -1.0,
-                                                  .max_boxes = max_boxes,
-                                                  .progress = [&](double f) { relay(f); }});
+          reports = modelling::provePairs(
+              model,
+              {.margin = margin ? *margin : -1.0, .max_boxes = max_boxes, .progress = [&](double f) { relay(f); }});
         });
         const modelling::IgnorePlan plan = modelling::ignoreList(model, reports, {.keep_adjacent = keep_adjacent});
         py::list pairs;
@@ -185,10 +187,12 @@ void bindProve(py::module_& m) {
           o["rigid"] = r.rigid;
           o["checked"] = r.checked;
           o["boxes"] = r.boxes;
-          o["ignored"] = r.checked ? py::object(py::none()) : py::object(py::str(modelling::currentIgnoreReason(model, r.a, r.b)));
+          o["ignored"] =
+              r.checked ? py::object(py::none()) : py::object(py::str(modelling::currentIgnoreReason(model, r.a, r.b)));
           const std::string why = modelling::plannedIgnoreReason(plan, model, r.a, r.b);
           o["ignore_reason"] = why.empty() ? py::object(py::none()) : py::object(py::str(why));
-          o["bound"] = (r.verdict == modelling::Verdict::Never || r.rigid) ? py::object(py::float_(r.bound)) : py::object(py::none());
+          o["bound"] = (r.verdict == modelling::Verdict::Never || r.rigid) ? py::object(py::float_(r.bound))
+                                                                           : py::object(py::none());
           if (r.verdict == modelling::Verdict::Meets) {
             o["witness_state"] = floatArray(r.witness);
             o["witness_distance"] = r.witness_distance;

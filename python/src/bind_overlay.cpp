@@ -5,9 +5,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <cmath>
 #include <functional>
 #include <map>
 
@@ -16,20 +16,20 @@
 
 #include "arrays.hpp"
 #include "bindings.hpp"
-#include "progress_relay.hpp"
 #include "kccd/calib/camera.hpp"
 #include "kccd/input_error.hpp"
 #include "kccd/logs/bag_summary.hpp"
 #include "kccd/overlay/bags/bag_info.hpp"
 #include "kccd/overlay/bags/bag_recording.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
+#include "kccd/overlay/jobs/overlay_job.hpp"
 #include "kccd/overlay/recording/contact_sheet.hpp"
 #include "kccd/overlay/recording/mask_agreement.hpp"
-#include "kccd/overlay/jobs/overlay_job.hpp"
 #include "kccd/overlay/recording/overlay_recording.hpp"
-#include "kccd/overlay/common/staged_output.hpp"
-#include "kccd/overlay/synth/synth.hpp"
 #include "kccd/overlay/recording/video_sink.hpp"
+#include "kccd/overlay/synth/synth.hpp"
 #include "kccd/state_log.hpp"
+#include "progress_relay.hpp"
 
 namespace kccd::python {
 
@@ -52,8 +52,10 @@ overlay::OverlayRequest overlayRequest(const py::kwargs& kwargs) {
       {"fps", [&](const py::handle& v) { q.fps = v.cast<double>(); }},
       {"time_offset",
        [&](const py::handle& v) {
-         if (py::isinstance<py::str>(v)) overlay::parseTimeOffset(v.cast<std::string>(), q);
-         else q.time_offset = v.cast<double>();
+         if (py::isinstance<py::str>(v))
+           overlay::parseTimeOffset(v.cast<std::string>(), q);
+         else
+           q.time_offset = v.cast<double>();
        }},
       {"max_gap", [&](const py::handle& v) { q.max_gap = v.cast<double>(); }},
       {"swept", [&](const py::handle& v) { q.swept = v.cast<bool>(); }},
@@ -80,11 +82,13 @@ overlay::OverlayRequest overlayRequest(const py::kwargs& kwargs) {
     const std::string name = key.cast<std::string>();
     if (name == "progress" || name == "progress_every") continue;
     const auto f = fields.find(name);
-    if (f == fields.end()) throw py::type_error("overlay_recording() got an unexpected keyword argument '" + name + "'");
+    if (f == fields.end())
+      throw py::type_error("overlay_recording() got an unexpected keyword argument '" + name + "'");
     try {
       f->second(value);
     } catch (const py::cast_error&) {
-      throw py::type_error(name + ": expected " + (name == "time_offset" ? "seconds or 'auto:A:B'" : "a value of the default's type") +
+      throw py::type_error(name + ": expected " +
+                           (name == "time_offset" ? "seconds or 'auto:A:B'" : "a value of the default's type") +
                            ", got " + py::str(py::type::handle_of(value).attr("__name__")).cast<std::string>());
     }
   }
@@ -97,9 +101,10 @@ namespace {
 
 // kccd overlay's braking defaults and contact sheets from frames.
 void bindContactSheet(py::module_& m) {
-  m.def("overlay_braking", [] { return overlay::kOverlayBraking; },
-        "kccd overlay's braking for swept volumes, every joint (latency 0.01 s, deceleration 5): the default of "
-        "overlay_recording(braking=) and of kccd.batch. A fresh copy each call.");
+  m.def(
+      "overlay_braking", [] { return overlay::kOverlayBraking; },
+      "kccd overlay's braking for swept volumes, every joint (latency 0.01 s, deceleration 5): the default of "
+      "overlay_recording(braking=) and of kccd.batch. A fresh copy each call.");
   m.def(
       "contact_sheet",
       [](const std::vector<py::array>& frames, const std::vector<std::string>& captions, const std::string& output,
@@ -150,28 +155,31 @@ void bindOverlayJob(py::module_& m) {
         q.video = video;
         q.states = states;
         q.model_file = h->source;
-        const py::object progress = kwargs.contains("progress") ? py::object(kwargs["progress"]) : py::object(py::none());
+        const py::object progress =
+            kwargs.contains("progress") ? py::object(kwargs["progress"]) : py::object(py::none());
         const double progress_every = kwargs.contains("progress_every") ? kwargs["progress_every"].cast<double>() : 0.0;
         if (!(progress_every >= 0.0) || !std::isfinite(progress_every))
           throw py::value_error("progress_every: must be a finite number of seconds >= 0");
         overlay::OverlayJob job(q, *h->model, camera);
         for (const std::string& w : job.warnings())
-          if (PyErr_WarnEx(PyExc_UserWarning, ("bag " + q.bag + ": " + w).c_str(), 1) < 0) throw py::error_already_set();
+          if (PyErr_WarnEx(PyExc_UserWarning, ("bag " + q.bag + ": " + w).c_str(), 1) < 0)
+            throw py::error_already_set();
         ProgressRelay relay{progress, {}};
         nlohmann::json full;
         relay.run([&] {
-          full = job.run([&, last = std::chrono::steady_clock::time_point{}](const overlay::OverlayProgress& p) mutable {
-                       // Throttled before the GIL is asked for: each acquisition may wait for Python's
-                       // switch interval while other Python threads run (a Dask worker's event loop).
-                       const auto now = std::chrono::steady_clock::now();
-                       const bool last_frame = p.frames_expected > 0 && p.frames_done >= p.frames_expected;
-                       if (!last_frame && last.time_since_epoch().count() != 0 &&
-                           std::chrono::duration<double>(now - last).count() < progress_every)
-                         return;
-                       last = now;
-                       relay(p.frames_done, p.frames_expected, p.frames_per_second);
-                     })
-                     .json;
+          full =
+              job.run([&, last = std::chrono::steady_clock::time_point{}](const overlay::OverlayProgress& p) mutable {
+                   // Throttled before the GIL is asked for: each acquisition may wait for Python's
+                   // switch interval while other Python threads run (a Dask worker's event loop).
+                   const auto now = std::chrono::steady_clock::now();
+                   const bool last_frame = p.frames_expected > 0 && p.frames_done >= p.frames_expected;
+                   if (!last_frame && last.time_since_epoch().count() != 0 &&
+                       std::chrono::duration<double>(now - last).count() < progress_every)
+                     return;
+                   last = now;
+                   relay(p.frames_done, p.frames_expected, p.frames_per_second);
+                 })
+                  .json;
         });
         return toPython(full);
       },
@@ -205,7 +213,8 @@ show (default all). An unknown keyword raises TypeError; a bad value InputError 
 ("fps: must be in ..."), a bad file InputError naming the file and place.)doc");
   m.def(
       "check_overlay_request",
-      [](const std::shared_ptr<ModelHandle>& h, const std::string& video, const std::string& states, const py::kwargs& kwargs) {
+      [](const std::shared_ptr<ModelHandle>& h, const std::string& video, const std::string& states,
+         const py::kwargs& kwargs) {
         overlay::OverlayRequest q = overlayRequest(kwargs);
         q.video = video;
         q.states = states;
@@ -226,16 +235,20 @@ each recording of a manifest with it before any starts.)doc");
 void bindReadBag(py::module_& m) {
   m.def(
       "read_bag",
-      [](const std::string& path, const std::shared_ptr<ModelHandle>& h, const std::string& image_topic, const std::string& joint_topic,
-         const std::string& time_source, const std::string& joint_map, const std::vector<long>& frames) {
+      [](const std::string& path, const std::shared_ptr<ModelHandle>& h, const std::string& image_topic,
+         const std::string& joint_topic, const std::string& time_source, const std::string& joint_map,
+         const std::vector<long>& frames) {
         const std::optional<overlay::TimeSource> clock = overlay::timeSourceOf(time_source);
         if (!clock) throw py::value_error("time_source: expected 'header' or 'log'");
-        if (!h && (!joint_topic.empty() || !joint_map.empty())) throw py::value_error("joint_topic and joint_map need a model");
+        if (!h && (!joint_topic.empty() || !joint_map.empty()))
+          throw py::value_error("joint_topic and joint_map need a model");
         for (const long f : frames)
           if (f < 0) throw py::value_error("frames: indices from 0");
         py::dict d;
         const overlay::BagRecordingOptions o{
-            .bag = path, .joint_topic = joint_topic, .image_topic = image_topic,
+            .bag = path,
+            .joint_topic = joint_topic,
+            .image_topic = image_topic,
             .time_source = *clock,
             .joint_map = joint_map.empty() || !h ? overlay::JointMap{} : overlay::loadJointMap(joint_map, *h->model)};
         nlohmann::json info;
@@ -244,7 +257,8 @@ void bindReadBag(py::module_& m) {
         {
           py::gil_scoped_release release;
           info = overlay::bagInfoJson(logs::summarizeBag(path));
-          if (h || !frames.empty() || !image_topic.empty()) rec = h ? overlay::readBagRecording(o, *h->model) : overlay::readBagImages(o);
+          if (h || !frames.empty() || !image_topic.empty())
+            rec = h ? overlay::readBagRecording(o, *h->model) : overlay::readBagImages(o);
           images = overlay::framesAt(rec, frames, "frame");
           for (cv::Mat& image : images) cv::cvtColor(image, image, cv::COLOR_BGR2RGB);
         }
@@ -259,7 +273,8 @@ void bindReadBag(py::module_& m) {
           d["joint_topic"] = rec.joint_topic;
           d["state_names"] = rec.log.names;
           d["times"] = floatArray(rec.log.times);
-          py::array_t<double> states({static_cast<py::ssize_t>(rec.log.rows()), static_cast<py::ssize_t>(rec.log.stateSize())});
+          py::array_t<double> states(
+              {static_cast<py::ssize_t>(rec.log.rows()), static_cast<py::ssize_t>(rec.log.stateSize())});
           std::copy(rec.log.values.begin(), rec.log.values.end(), states.mutable_data());
           d["states"] = states;
         }
@@ -267,15 +282,17 @@ void bindReadBag(py::module_& m) {
           py::list list;
           for (const cv::Mat& img : images) {
             py::array_t<std::uint8_t> a({img.rows, img.cols, 3});
-            for (int y = 0; y < img.rows; ++y) std::memcpy(a.mutable_data(y, 0, 0), img.ptr(y), static_cast<std::size_t>(img.cols) * 3);
+            for (int y = 0; y < img.rows; ++y)
+              std::memcpy(a.mutable_data(y, 0, 0), img.ptr(y), static_cast<std::size_t>(img.cols) * 3);
             list.append(a);
           }
           d["images"] = list;
         }
         return d;
       },
-      py::arg("path"), py::arg("model") = nullptr, py::kw_only(), py::arg("image_topic") = "", py::arg("joint_topic") = "",
-      py::arg("time_source") = "header", py::arg("joint_map") = "", py::arg("frames") = std::vector<long>{},
+      py::arg("path"), py::arg("model") = nullptr, py::kw_only(), py::arg("image_topic") = "",
+      py::arg("joint_topic") = "", py::arg("time_source") = "header", py::arg("joint_map") = "",
+      py::arg("frames") = std::vector<long>{},
       R"doc(What a robot log (MCAP, rosbag2 .db3 or folder, ROS 1 .bag) holds, as `kccd bag info --json` under 'info'.
 With a model, also what `kccd overlay --bag` reads: 'state_names', 'times' (s, from 'origin_ns' on the chosen
 clock), 'states' (one row per joint state, the model's state values matched by name or by joint_map),
@@ -290,15 +307,19 @@ void bindSynth(py::module_& m) {
   m.def(
       "synthesize_recording",
       [](const std::string& model, const std::string& output, const std::string& camera, double seconds, double fps,
-         double log_rate, double time_offset, std::uint64_t seed, const std::string& codec, bool collision, bool replace,
-         const std::optional<int>& width, const std::optional<int>& height, const std::string& appearance,
+         double log_rate, double time_offset, std::uint64_t seed, const std::string& codec, bool collision,
+         bool replace, const std::optional<int>& width, const std::optional<int>& height, const std::string& appearance,
          const std::optional<double>& visible_scale, double blur, double noise, const py::object& progress) {
         overlay::SynthOptions o;
         o.width = width, o.height = height, o.visible_scale = visible_scale, o.blur = blur, o.noise = noise;
-        if (appearance == "auto") o.appearance = overlay::SynthAppearance::Auto;
-        else if (appearance == "volumes") o.appearance = overlay::SynthAppearance::Volumes;
-        else if (appearance == "visuals") o.appearance = overlay::SynthAppearance::Visuals;
-        else throw py::value_error("appearance: 'auto', 'volumes' or 'visuals', got '" + appearance + "'");
+        if (appearance == "auto")
+          o.appearance = overlay::SynthAppearance::Auto;
+        else if (appearance == "volumes")
+          o.appearance = overlay::SynthAppearance::Volumes;
+        else if (appearance == "visuals")
+          o.appearance = overlay::SynthAppearance::Visuals;
+        else
+          throw py::value_error("appearance: 'auto', 'volumes' or 'visuals', got '" + appearance + "'");
         o.model = model;
         o.output = output;
         o.camera = camera;
@@ -338,8 +359,8 @@ void bindSynth(py::module_& m) {
       py::arg("model"), py::arg("output"), py::kw_only(), py::arg("camera") = "", py::arg("seconds") = 5.0,
       py::arg("fps") = 25.0, py::arg("log_rate") = 125.0, py::arg("time_offset") = 0.137, py::arg("seed") = 1,
       py::arg("codec") = "ffv1", py::arg("collision") = true, py::arg("replace") = false, py::arg("width") = py::none(),
-      py::arg("height") = py::none(), py::arg("appearance") = "auto", py::arg("visible_scale") = py::none(), py::arg("blur") = 0.7,
-      py::arg("noise") = 2.5, py::arg("progress") = py::none(),
+      py::arg("height") = py::none(), py::arg("appearance") = "auto", py::arg("visible_scale") = py::none(),
+      py::arg("blur") = 0.7, py::arg("noise") = 2.5, py::arg("progress") = py::none(),
       R"doc(A synthetic recording with ground truth, as `kccd synth`: in the new folder `output`, the video, the state
 log states.csv, the true camera camera_true.yaml, tags, masks and synth.json (the folder appears only when
 complete). model: a model file. Every option of `kccd synth` under its own name: width and height (the default

@@ -37,18 +37,22 @@ metres), as `kccd calib` writes it. Load with Camera.load(path).)doc")
           py::arg("path"), py::arg("require_pose") = true,
           "Reads a camera file; raises InputError naming the file, line and field. require_pose=False also reads "
           "an intrinsics file without a pose (OpenCV's calibration output: rvec = tvec = 0), as solve_pose takes.")
-      .def("save", [](const calib::Camera& c, const std::string& path) { calib::saveCamera(c, path); }, py::arg("path"),
-           "Writes the camera file (under a temporary name, renamed when complete).")
+      .def(
+          "save", [](const calib::Camera& c, const std::string& path) { calib::saveCamera(c, path); }, py::arg("path"),
+          "Writes the camera file (under a temporary name, renamed when complete).")
       .def_readonly("width", &calib::Camera::width)
       .def_readonly("height", &calib::Camera::height)
-      .def_property_readonly("camera_matrix", [](const calib::Camera& c) { return matrix3(c.camera_matrix); },
-                             "float64 (3, 3): fx 0 cx; 0 fy cy; 0 0 1 (pixels)")
-      .def_property_readonly("distortion", [](const calib::Camera& c) { return c.distortion; },
-                             "OpenCV order: k1 k2 p1 p2 [k3 ...]")
-      .def_property_readonly("rvec", [](const calib::Camera& c) { return floatArray(c.rvec.val); },
-                             "float64 (3,): world -> camera rotation (Rodrigues vector, radians)")
-      .def_property_readonly("tvec", [](const calib::Camera& c) { return floatArray(c.tvec.val); },
-                             "float64 (3,): world -> camera translation (metres)")
+      .def_property_readonly(
+          "camera_matrix", [](const calib::Camera& c) { return matrix3(c.camera_matrix); },
+          "float64 (3, 3): fx 0 cx; 0 fy cy; 0 0 1 (pixels)")
+      .def_property_readonly(
+          "distortion", [](const calib::Camera& c) { return c.distortion; }, "OpenCV order: k1 k2 p1 p2 [k3 ...]")
+      .def_property_readonly(
+          "rvec", [](const calib::Camera& c) { return floatArray(c.rvec.val); },
+          "float64 (3,): world -> camera rotation (Rodrigues vector, radians)")
+      .def_property_readonly(
+          "tvec", [](const calib::Camera& c) { return floatArray(c.tvec.val); },
+          "float64 (3,): world -> camera translation (metres)")
       .def(
           "with_pose",
           [](const calib::Camera& c, const py::handle& rvec, const py::handle& tvec) {
@@ -88,7 +92,8 @@ metres), as `kccd calib` writes it. Load with Camera.load(path).)doc")
           lo = stateVector(lower, "lower", n);
           hi = stateVector(upper, "upper", n);
           if (st.empty())
-            for (int k = 0; k < n; ++k) st.push_back(0.5 * (lo[static_cast<std::size_t>(k)] + hi[static_cast<std::size_t>(k)]));
+            for (int k = 0; k < n; ++k)
+              st.push_back(0.5 * (lo[static_cast<std::size_t>(k)] + hi[static_cast<std::size_t>(k)]));
         }
         cv::Mat rgba, labels;
         std::vector<SafetyStatus> status;

@@ -45,7 +45,8 @@ void GlContext::describe(const std::string& who, const std::string& suffix) {
 std::unique_ptr<GlContext> GlContext::make(GlBackend backend) {
   if (!compiledIn(backend))
     throw GlContextError(std::string("KCCD_GL=") + toString(backend) + ": this build has no " +
-                         (backend == GlBackend::Egl ? "EGL (pkg-config egl was not found)" : "OSMesa (pkg-config osmesa was not found)"));
+                         (backend == GlBackend::Egl ? "EGL (pkg-config egl was not found)"
+                                                    : "OSMesa (pkg-config osmesa was not found)"));
 #ifdef KCCD_HAVE_EGL
   if (backend == GlBackend::Egl) return detail::makeEglContext();
 #endif
@@ -95,7 +96,8 @@ std::unique_ptr<GlContext> GlContext::make() {
       reasons += (reasons.empty() ? "" : "; ") + std::string(e.what());
     }
   }
-  throw GlContextError("GL: no off-screen context (" + (reasons.empty() ? std::string("no back end in this build") : reasons) + ")");
+  throw GlContextError("GL: no off-screen context (" +
+                       (reasons.empty() ? std::string("no back end in this build") : reasons) + ")");
 }
 
 }  // namespace kccd::render

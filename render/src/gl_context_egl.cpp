@@ -42,7 +42,8 @@ class EglContext final : public GlContext {
  public:
   EglContext() : GlContext(GlBackend::Egl) {
     const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-    if (client == nullptr) throw GlContextError("EGL: no client extensions (libEGL without EGL 1.5 / EGL_EXT_client_extensions)");
+    if (client == nullptr)
+      throw GlContextError("EGL: no client extensions (libEGL without EGL 1.5 / EGL_EXT_client_extensions)");
     auto get_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
     if (get_display == nullptr) throw GlContextError("EGL: no eglGetPlatformDisplayEXT (EGL_EXT_platform_base)");
     std::string where;
@@ -50,8 +51,10 @@ class EglContext final : public GlContext {
     const bool want_device = device_env != nullptr && *device_env != '\0';
     if (want_device || !hasExtension(client, "EGL_MESA_platform_surfaceless")) {
       if (!hasExtension(client, "EGL_EXT_device_enumeration") || !hasExtension(client, "EGL_EXT_platform_device"))
-        throw GlContextError(want_device ? "EGL: KCCD_EGL_DEVICE is set but EGL has no EGL_EXT_device_enumeration / EGL_EXT_platform_device"
-                                         : "EGL: neither EGL_MESA_platform_surfaceless nor EGL_EXT_platform_device is available");
+        throw GlContextError(
+            want_device
+                ? "EGL: KCCD_EGL_DEVICE is set but EGL has no EGL_EXT_device_enumeration / EGL_EXT_platform_device"
+                : "EGL: neither EGL_MESA_platform_surfaceless nor EGL_EXT_platform_device is available");
       auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
       EGLint count = 0;
       if (query_devices == nullptr || !query_devices(0, nullptr, &count) || count <= 0)
@@ -63,7 +66,8 @@ class EglContext final : public GlContext {
         char* end = nullptr;
         const long v = std::strtol(device_env, &end, 10);
         if (*end != '\0' || v < 0 || v >= count)
-          throw GlContextError("KCCD_EGL_DEVICE=" + std::string(device_env) + ": not a device index 0.." + std::to_string(count - 1));
+          throw GlContextError("KCCD_EGL_DEVICE=" + std::string(device_env) + ": not a device index 0.." +
+                               std::to_string(count - 1));
         index = static_cast<int>(v);
       }
       display_ = get_display(EGL_PLATFORM_DEVICE_EXT, devices[static_cast<std::size_t>(index)], nullptr);
@@ -76,7 +80,8 @@ class EglContext final : public GlContext {
     {
       const std::lock_guard lock(display_mutex);
       EGLint major = 0, minor = 0;
-      if (!eglInitialize(display_, &major, &minor)) throw GlContextError("EGL: " + where + ": " + eglError("eglInitialize"));
+      if (!eglInitialize(display_, &major, &minor))
+        throw GlContextError("EGL: " + where + ": " + eglError("eglInitialize"));
     }
     try {
       create(where);
@@ -97,7 +102,8 @@ class EglContext final : public GlContext {
     const char* ext = eglQueryString(display_, EGL_EXTENSIONS);
     if (!hasExtension(ext, "EGL_KHR_surfaceless_context"))
       throw GlContextError("EGL: " + where + " has no EGL_KHR_surfaceless_context");
-    if (!eglBindAPI(EGL_OPENGL_API)) throw GlContextError("EGL: " + where + ": desktop OpenGL: " + eglError("eglBindAPI"));
+    if (!eglBindAPI(EGL_OPENGL_API))
+      throw GlContextError("EGL: " + where + ": desktop OpenGL: " + eglError("eglBindAPI"));
     EGLConfig config = EGL_NO_CONFIG_KHR;
     if (!hasExtension(ext, "EGL_KHR_no_config_context") && !hasExtension(ext, "EGL_MESA_configless_context")) {
       const EGLint want[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
@@ -106,8 +112,13 @@ class EglContext final : public GlContext {
         throw GlContextError("EGL: " + where + ": no config for desktop OpenGL and no EGL_KHR_no_config_context");
     }
     // The renderer uses the fixed-function pipeline: a compatibility profile (Mesa gives its newest, 4.5 on llvmpipe).
-    const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 0, EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                              EGL_CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT, EGL_NONE};
+    const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                              3,
+                              EGL_CONTEXT_MINOR_VERSION,
+                              0,
+                              EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                              EGL_CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT,
+                              EGL_NONE};
     context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, attribs);
     if (context_ == EGL_NO_CONTEXT)
       throw GlContextError("EGL: " + where + ": a GL 3.0 compatibility context: " + eglError("eglCreateContext"));

@@ -1,7 +1,7 @@
 // GlContext on OSMesa (Mesa's llvmpipe, no display needed). Rendering goes to FBOs, so the
 // OSMesa colour buffer is only a tiny placeholder that makes the context current.
-#include <GL/osmesa.h>
 #include <GL/gl.h>
+#include <GL/osmesa.h>
 
 #include <array>
 
@@ -13,11 +13,21 @@ namespace {
 class OsMesaContext final : public GlContext {
  public:
   OsMesaContext() : GlContext(GlBackend::OsMesa) {
-    const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_STENCIL_BITS, 0,
-                           OSMESA_ACCUM_BITS, 0, OSMESA_PROFILE, OSMESA_COMPAT_PROFILE, 0};
+    const int attribs[] = {OSMESA_FORMAT,
+                           OSMESA_RGBA,
+                           OSMESA_DEPTH_BITS,
+                           24,
+                           OSMESA_STENCIL_BITS,
+                           0,
+                           OSMESA_ACCUM_BITS,
+                           0,
+                           OSMESA_PROFILE,
+                           OSMESA_COMPAT_PROFILE,
+                           0};
     ctx_ = OSMesaCreateContextAttribs(attribs, nullptr);
     if (ctx_ == nullptr) ctx_ = OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, nullptr);
-    if (ctx_ == nullptr) throw GlContextError("OSMesa: cannot create an off-screen GL context (OSMesaCreateContext failed)");
+    if (ctx_ == nullptr)
+      throw GlContextError("OSMesa: cannot create an off-screen GL context (OSMesaCreateContext failed)");
     try {
       makeCurrent();
       describe("OSMesa", "OSMesa");

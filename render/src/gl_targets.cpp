@@ -56,7 +56,8 @@ void check(GLuint fbo, const char* what) {
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE)
-    throw GlContextError(std::string("GL: ") + what + " framebuffer incomplete (status " + std::to_string(status) + ")");
+    throw GlContextError(std::string("GL: ") + what + " framebuffer incomplete (status " + std::to_string(status) +
+                         ")");
 }
 
 GLuint renderbuffer(GLenum format, int samples, int w, int h) {

@@ -20,7 +20,7 @@ class GlTargets {
 
   GLuint ms_fbo = 0, ms_colour = 0;
   GLuint resolve_fbo = 0, resolve_colour = 0, resolve_labels = 0;
-  GLuint ms_depth = 0, resolve_depth = 0;  // depth for the shaded (opaque) look
+  GLuint ms_depth = 0, resolve_depth = 0;                // depth for the shaded (opaque) look
   GLuint mask_fbo = 0, mask_labels = 0, mask_depth = 0;  // only with a separate mask scale
   GLuint program = 0;                                    // the label shader
   GLint label_location = -1, near_location = -1;         // its uniforms

@@ -12,10 +12,14 @@ namespace kccd::render {
 
 cv::Scalar statusColour(SafetyStatus status) {
   switch (status) {
-    case SafetyStatus::Clear: return {60, 200, 40};
-    case SafetyStatus::WithinMargin: return {0, 180, 255};
-    case SafetyStatus::Colliding: return {40, 40, 230};
-    case SafetyStatus::NoState: return {160, 160, 160};
+    case SafetyStatus::Clear:
+      return {60, 200, 40};
+    case SafetyStatus::WithinMargin:
+      return {0, 180, 255};
+    case SafetyStatus::Colliding:
+      return {40, 40, 230};
+    case SafetyStatus::NoState:
+      return {160, 160, 160};
   }
   return {255, 255, 255};
 }
@@ -78,7 +82,8 @@ cv::Rect Legend::draw(cv::Mat& bgra, std::span<const Volume> volumes, const std:
       if ((world_to_camera_ * centre).z() <= near_) continue;
       const Eigen::Vector2d px = projection_.project(centre);
       // Centres far outside the image have no visible label (and would overflow int).
-      if (!(px.x() > -bgra.cols && px.x() < 2.0 * bgra.cols && px.y() > -bgra.rows && px.y() < 2.0 * bgra.rows)) continue;
+      if (!(px.x() > -bgra.cols && px.x() < 2.0 * bgra.cols && px.y() > -bgra.rows && px.y() < 2.0 * bgra.rows))
+        continue;
       int baseline = 0;
       const cv::Size size = cv::getTextSize(v.label, font, scale, thick, &baseline);
       text(v.label, cv::Point(static_cast<int>(px.x()) - size.width / 2, static_cast<int>(px.y()) + size.height / 2));

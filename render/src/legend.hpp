@@ -20,7 +20,8 @@ class Legend {
   Legend(const Projection& projection, double near);
   /// Draws on `bgra` (the straight-alpha camera image) what `style` asks: the names of the drawn
   /// volumes (Style::labels) and the legend (Style::legend); returns the rectangle it drew in.
-  cv::Rect draw(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility, const Style& style);
+  cv::Rect draw(cv::Mat& bgra, std::span<const Volume> volumes, const std::vector<Visibility>& visibility,
+                const Style& style);
   /// Where the legend goes on an image of `size` (empty when the image shows none of it).
   cv::Rect legendBox(cv::Size size);
   /// Composites the legend over `bgr` (CV_8UC3) as draw() and compositeOver() would; returns its box.

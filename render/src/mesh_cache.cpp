@@ -24,8 +24,7 @@ void MeshCache::makeRoom() {
   if (entries_.size() >= capacity_) entries_.clear();
 }
 
-std::shared_ptr<const Mesh> MeshCache::get(std::span<const Vec3> points, double radius, int level,
-                                           double min_radius) {
+std::shared_ptr<const Mesh> MeshCache::get(std::span<const Vec3> points, double radius, int level, double min_radius) {
   const MeshRequest request{points, radius, level, min_radius};
   std::string k = key(request);
   auto it = entries_.find(k);

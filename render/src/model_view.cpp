@@ -41,9 +41,17 @@ ModelFrame ModelView::draw(const ModelViewRequest& request) {
   ModelFrame out = drawAnew(request);
   if (request.onto != nullptr && request.colour && !request.mask && renderer_.canRenderOntoAgain(request.style)) {
     const ModelViewRequest& r = request;
-    last_onto_ = LastOnto{{r.state.begin(), r.state.end()}, {r.lower.begin(), r.lower.end()}, {r.upper.begin(), r.upper.end()},
-                          {r.status.begin(), r.status.end()}, {r.colours.begin(), r.colours.end()}, r.radius_scale,
-                          r.tight_volumes, r.volumes, r.visuals, r.style, out};
+    last_onto_ = LastOnto{{r.state.begin(), r.state.end()},
+                          {r.lower.begin(), r.lower.end()},
+                          {r.upper.begin(), r.upper.end()},
+                          {r.status.begin(), r.status.end()},
+                          {r.colours.begin(), r.colours.end()},
+                          r.radius_scale,
+                          r.tight_volumes,
+                          r.volumes,
+                          r.visuals,
+                          r.style,
+                          out};
   }
   return out;
 }

@@ -85,7 +85,8 @@ void drawLabelTriangles(const GlTargets& gl, const std::vector<PreparedVolume>& 
   std::vector<const PreparedVolume*> order;
   for (const PreparedVolume& p : bodies)
     if (p.mesh) order.push_back(&p);
-  std::sort(order.begin(), order.end(), [](const PreparedVolume* a, const PreparedVolume* b) { return a->depth < b->depth; });
+  std::sort(order.begin(), order.end(),
+            [](const PreparedVolume* a, const PreparedVolume* b) { return a->depth < b->depth; });
   for (const PreparedVolume* p : order) {
     glUniform1ui(gl.label_location, static_cast<GLuint>(p->label));
     if (p->surface) glDisable(GL_CULL_FACE);
@@ -306,15 +307,17 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
   setCamera(projection, near, far);
   // Only the rectangle that will be read back is cleared and drawn (the labels are read whole):
   // the rasteriser leaves the other tiles alone.
-  out.parts = options.crop ? colourRects(projection, bodies, style, near)
-                           : std::vector<cv::Rect>{cv::Rect(0, 0, projection.pinhole().width, projection.pinhole().height)};
+  out.parts = options.crop
+                  ? colourRects(projection, bodies, style, near)
+                  : std::vector<cv::Rect>{cv::Rect(0, 0, projection.pinhole().width, projection.pinhole().height)};
   cv::Rect rect;
   for (const cv::Rect& r : out.parts) rect |= r;
   if (!with_labels) {
     glEnable(GL_SCISSOR_TEST);
     glScissor(rect.x, rect.y, rect.width, rect.height);
   }
-  if (out.cells_x != (w + ColourReadBack::kCell - 1) / ColourReadBack::kCell) {  // the first frame: the target is unknown
+  if (out.cells_x !=
+      (w + ColourReadBack::kCell - 1) / ColourReadBack::kCell) {  // the first frame: the target is unknown
     out.cells_x = (w + ColourReadBack::kCell - 1) / ColourReadBack::kCell;
     out.cells_y = (h + ColourReadBack::kCell - 1) / ColourReadBack::kCell;
     out.dirty.assign(static_cast<std::size_t>(out.cells_x) * static_cast<std::size_t>(out.cells_y), 1);
@@ -339,85 +342,88 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
       if (p.mesh) all.push_back(&p);
     drawShaded(all, style.ambient);
   } else {
-  glDisable(GL_DEPTH_TEST);
-  glEnable(GL_BLEND);
-  // Premultiplied result on a transparent clear; converted to straight alpha after read-back.
-  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-  // Back to front; back faces culled, so each convex volume tints a pixel once.
-  std::vector<const PreparedVolume*> order;
-  for (const PreparedVolume& p : bodies)
-    if (p.drawn()) order.push_back(&p);
-  std::sort(order.begin(), order.end(), [](const PreparedVolume* a, const PreparedVolume* b) { return a->depth > b->depth; });
-  // Whether the fill may be the silhouette polygon: a single loop whose vertices all lie beyond
-  // the near plane (then its projection is the convex outline of the front faces, unclipped).
-  auto polygonFill = [&](const PreparedVolume& p) {
-    if (!options.polygon_fill || p.fill.empty()) return false;
-    for (const std::uint32_t k : p.silhouette)
-      if (!(p.vertices[3 * k + 2] > near)) return false;
-    return true;
-  };
-  if (with_labels) {  // the labels of the nearest surfaces first (see kLabelFragmentShader), then the colour
-    drawBuffers(false, true);
-    drawLabelTriangles(gl, bodies, near);
-    drawBuffers(true, false);
+    glDisable(GL_DEPTH_TEST);
     glEnable(GL_BLEND);
-  }
-  // The tints as premultiplied colours (the blend then multiplies nothing by the source alpha:
-  // ~15 % less fill time on llvmpipe than blending straight colours).
-  glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-  // Consecutive outlined volumes are filled in one draw call (GL blends a call's triangles in
-  // their order, and a colour per volume's vertices is the colour glColor would give: the same
-  // pixels for a fraction of the per-call cost on llvmpipe).
-  OutlineBatch batch;
-  auto flushFills = [&] {
-    if (batch.indices.empty()) return;
-    glDisable(GL_CULL_FACE);  // the outline's winding is the image's, not the mesh's
-    batch.draw(GL_TRIANGLES);
-    glEnable(GL_CULL_FACE);
-    batch.clear();
-  };
-  for (const PreparedVolume* p : order) {
-    const cv::Scalar c = p->colour;  // BGR, drawn as GL's RGB (see the read-back)
-    const double fa = style.fill_alpha;
-    const std::array<float, 4> tint{static_cast<float>(fa * c[0] / 255.0), static_cast<float>(fa * c[1] / 255.0),
-                                    static_cast<float>(fa * c[2] / 255.0), static_cast<float>(fa)};
-    if (p->outlined()) {
-      ++frame.polygon_fills;
-      batch.add(p->outline_vertices, p->outline_fill, tint);
-      continue;
+    // Premultiplied result on a transparent clear; converted to straight alpha after read-back.
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    // Back to front; back faces culled, so each convex volume tints a pixel once.
+    std::vector<const PreparedVolume*> order;
+    for (const PreparedVolume& p : bodies)
+      if (p.drawn()) order.push_back(&p);
+    std::sort(order.begin(), order.end(),
+              [](const PreparedVolume* a, const PreparedVolume* b) { return a->depth > b->depth; });
+    // Whether the fill may be the silhouette polygon: a single loop whose vertices all lie beyond
+    // the near plane (then its projection is the convex outline of the front faces, unclipped).
+    auto polygonFill = [&](const PreparedVolume& p) {
+      if (!options.polygon_fill || p.fill.empty()) return false;
+      for (const std::uint32_t k : p.silhouette)
+        if (!(p.vertices[3 * k + 2] > near)) return false;
+      return true;
+    };
+    if (with_labels) {  // the labels of the nearest surfaces first (see kLabelFragmentShader), then the colour
+      drawBuffers(false, true);
+      drawLabelTriangles(gl, bodies, near);
+      drawBuffers(true, false);
+      glEnable(GL_BLEND);
+    }
+    // The tints as premultiplied colours (the blend then multiplies nothing by the source alpha:
+    // ~15 % less fill time on llvmpipe than blending straight colours).
+    glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    // Consecutive outlined volumes are filled in one draw call (GL blends a call's triangles in
+    // their order, and a colour per volume's vertices is the colour glColor would give: the same
+    // pixels for a fraction of the per-call cost on llvmpipe).
+    OutlineBatch batch;
+    auto flushFills = [&] {
+      if (batch.indices.empty()) return;
+      glDisable(GL_CULL_FACE);  // the outline's winding is the image's, not the mesh's
+      batch.draw(GL_TRIANGLES);
+      glEnable(GL_CULL_FACE);
+      batch.clear();
+    };
+    for (const PreparedVolume* p : order) {
+      const cv::Scalar c = p->colour;  // BGR, drawn as GL's RGB (see the read-back)
+      const double fa = style.fill_alpha;
+      const std::array<float, 4> tint{static_cast<float>(fa * c[0] / 255.0), static_cast<float>(fa * c[1] / 255.0),
+                                      static_cast<float>(fa * c[2] / 255.0), static_cast<float>(fa)};
+      if (p->outlined()) {
+        ++frame.polygon_fills;
+        batch.add(p->outline_vertices, p->outline_fill, tint);
+        continue;
+      }
+      flushFills();
+      glColor4f(tint[0], tint[1], tint[2], tint[3]);
+      if (!p->surface && polygonFill(*p)) {
+        ++frame.polygon_fills;
+        glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
+        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(p->fill.size()), GL_UNSIGNED_INT, p->fill.data());
+      } else {
+        drawTriangles(*p->mesh, p->vertices);
+      }
     }
     flushFills();
-    glColor4f(tint[0], tint[1], tint[2], tint[3]);
-    if (!p->surface && polygonFill(*p)) {
-      ++frame.polygon_fills;
-      glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
-      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(p->fill.size()), GL_UNSIGNED_INT, p->fill.data());
-    } else {
-      drawTriangles(*p->mesh, p->vertices);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE,
+                        GL_ONE_MINUS_SRC_ALPHA);  // smoothed lines: coverage in alpha
+    glLineWidth(static_cast<float>(style.outline_width * projection.supersample()));
+    glEnable(GL_LINE_SMOOTH);  // coverage in alpha, blended like the fill
+    glHint(GL_LINE_SMOOTH_HINT, GL_NICEST);
+    // Every volume's outline in one draw call, in the same order, each in its own colour.
+    for (const PreparedVolume* p : order) {
+      const cv::Scalar c = p->colour * 0.7;
+      const bool own = p->outlined();
+      batch.add(
+          own ? p->outline_vertices : p->vertices, own ? p->outline_lines : p->outline,
+          {static_cast<float>(c[0] / 255.0), static_cast<float>(c[1] / 255.0), static_cast<float>(c[2] / 255.0), 1.0f});
     }
-  }
-  flushFills();
-  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);  // smoothed lines: coverage in alpha
-  glLineWidth(static_cast<float>(style.outline_width * projection.supersample()));
-  glEnable(GL_LINE_SMOOTH);  // coverage in alpha, blended like the fill
-  glHint(GL_LINE_SMOOTH_HINT, GL_NICEST);
-  // Every volume's outline in one draw call, in the same order, each in its own colour.
-  for (const PreparedVolume* p : order) {
-    const cv::Scalar c = p->colour * 0.7;
-    const bool own = p->outlined();
-    batch.add(own ? p->outline_vertices : p->vertices, own ? p->outline_lines : p->outline,
-              {static_cast<float>(c[0] / 255.0), static_cast<float>(c[1] / 255.0), static_cast<float>(c[2] / 255.0), 1.0f});
-  }
-  batch.draw(GL_LINES);
-  glDisable(GL_LINE_SMOOTH);
-  // Volumes containing the camera tint the whole view, in front of everything else.
-  for (const PreparedVolume& p : bodies)
-    if (p.fills) {
-      const cv::Scalar c = p.colour;
-      glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
-      fillViewport();
-    }
-  glDisable(GL_BLEND);
+    batch.draw(GL_LINES);
+    glDisable(GL_LINE_SMOOTH);
+    // Volumes containing the camera tint the whole view, in front of everything else.
+    for (const PreparedVolume& p : bodies)
+      if (p.fills) {
+        const cv::Scalar c = p.colour;
+        glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
+        fillViewport();
+      }
+    glDisable(GL_BLEND);
   }
   glDisable(GL_SCISSOR_TEST);
   if (gl.samples > 1) {

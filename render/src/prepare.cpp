@@ -14,13 +14,20 @@ namespace kccd::render {
 
 const char* toString(Visibility visibility) {
   switch (visibility) {
-    case Visibility::Drawn: return "drawn";
-    case Visibility::FillsView: return "contains the camera";
-    case Visibility::Empty: return "no volume";
-    case Visibility::NotFinite: return "not finite";
-    case Visibility::BehindCamera: return "behind the camera";
-    case Visibility::BeyondFar: return "beyond far plane";
-    case Visibility::NoMesh: return "no mesh";
+    case Visibility::Drawn:
+      return "drawn";
+    case Visibility::FillsView:
+      return "contains the camera";
+    case Visibility::Empty:
+      return "no volume";
+    case Visibility::NotFinite:
+      return "not finite";
+    case Visibility::BehindCamera:
+      return "behind the camera";
+    case Visibility::BeyondFar:
+      return "beyond far plane";
+    case Visibility::NoMesh:
+      return "no mesh";
   }
   return "?";
 }
@@ -43,7 +50,8 @@ void silhouetteLoop(const Mesh& m, const std::vector<char>& front, const std::ve
   for (const auto& e : m.edges) {
     if (front[e[2]] == front[e[3]]) continue;
     const auto& t = m.triangles[front[e[2]] ? e[2] : e[3]];
-    const bool forward = (t[0] == e[0] && t[1] == e[1]) || (t[1] == e[0] && t[2] == e[1]) || (t[2] == e[0] && t[0] == e[1]);
+    const bool forward =
+        (t[0] == e[0] && t[1] == e[1]) || (t[1] == e[0] && t[2] == e[1]) || (t[2] == e[0] && t[0] == e[1]);
     next.emplace_back(forward ? e[0] : e[1], forward ? e[1] : e[0]);
   }
   std::sort(next.begin(), next.end());
@@ -88,7 +96,6 @@ void polygonTriangles(const std::vector<std::uint32_t>& loop, std::vector<std::u
   arc(arc, i, j);
   arc(arc, j, n);
 }
-
 
 // Distance from the origin to the triangle abc (closest point by the triangle's Voronoi regions).
 double originToTriangle(const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -183,7 +190,8 @@ PreparedFrame FramePreparer::prepare(std::span<const Volume> volumes, const Prep
     const double r = std::max(v.radius, options_.min_radius);
     double spread = 0.0;
     for (const Vec3& c : cam_points) spread = std::max(spread, (c - centre).norm());
-    if (!allFinite(cam_points) || !std::isfinite(v.radius) || !std::isfinite(spread + r) || !std::isfinite(centre.norm())) {
+    if (!allFinite(cam_points) || !std::isfinite(v.radius) || !std::isfinite(spread + r) ||
+        !std::isfinite(centre.norm())) {
       visibility = Visibility::NotFinite;
       continue;
     }
@@ -221,9 +229,11 @@ PreparedFrame FramePreparer::prepare(std::span<const Volume> volumes, const Prep
     p.level = level;
     // The outline straight from the core when the volume lies beyond the near plane; the mesh
     // when a mask or the shaded look needs it, or the outline cannot be had.
-    if (outlines && sschOutline(cam_points, r, OutlineOptions{.focal_px = focal, .tolerance_px = options_.tolerance_px,
-                                                              .min_depth = options_.near},
-                                p.outline_2d) &&
+    if (outlines &&
+        sschOutline(
+            cam_points, r,
+            OutlineOptions{.focal_px = focal, .tolerance_px = options_.tolerance_px, .min_depth = options_.near},
+            p.outline_2d) &&
         p.outline_2d.size() >= 3) {  // (fewer corners: an image thinner than the tolerance, drawn from the mesh)
       visibility = Visibility::Drawn;
       ++frame.outlines;
@@ -307,7 +317,8 @@ PreparedFrame FramePreparer::prepare(std::span<const Volume> volumes, const Prep
     std::vector<std::uint32_t> loop(n);
     for (std::size_t k = 0; k < n; ++k) {
       loop[k] = static_cast<std::uint32_t>(k);
-      p.outline_lines.insert(p.outline_lines.end(), {static_cast<std::uint32_t>(k), static_cast<std::uint32_t>((k + 1) % n)});
+      p.outline_lines.insert(p.outline_lines.end(),
+                             {static_cast<std::uint32_t>(k), static_cast<std::uint32_t>((k + 1) % n)});
     }
     polygonTriangles(loop, p.outline_fill);
     frame.triangles += static_cast<int>(p.outline_fill.size() / 3);

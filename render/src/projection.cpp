@@ -8,8 +8,7 @@
 
 namespace kccd::render {
 
-Projection::Projection(const Camera& camera, double supersample)
-    : camera_(camera), supersample_(supersample) {
+Projection::Projection(const Camera& camera, double supersample) : camera_(camera), supersample_(supersample) {
   camera_.validate("camera");
   world_to_camera_ = camera.worldToCamera();
   if (!(supersample >= 1.0 && supersample <= 4.0))

@@ -36,9 +36,9 @@ Renderer::Renderer(const Projection& projection, const RenderOptions& options)
   auto fits = [&](const Projection& p) { return p.pinhole().width <= max_w && p.pinhole().height <= max_h; };
   if (!fits(projection_)) {
     std::ostringstream msg;
-    msg << "the " << camera.width << "x" << camera.height << " image is drawn as a "
-        << projection_.pinhole().width << "x" << projection_.pinhole().height << " pinhole image (supersample "
-        << options.supersample << "), more than this GL allows (" << max_w << "x" << max_h << "): use a smaller supersample";
+    msg << "the " << camera.width << "x" << camera.height << " image is drawn as a " << projection_.pinhole().width
+        << "x" << projection_.pinhole().height << " pinhole image (supersample " << options.supersample
+        << "), more than this GL allows (" << max_w << "x" << max_h << "): use a smaller supersample";
     throw CameraError(InputLocation{"camera", 0, 0, "image_width"}, msg.str());
   }
   if (camera.distorted() && options.mask_supersample != options.supersample) {
@@ -113,7 +113,8 @@ void Renderer::blendOnto(cv::Mat& bgr, const Style& style, Frame& frame) {
   frame.times.decorate = std::chrono::duration<double>(Clock::now() - t_warped).count();
 }
 
-Frame Renderer::draw(std::span<const Volume> volumes, const Style& style, bool want_colour, bool want_mask, cv::Mat* onto) {
+Frame Renderer::draw(std::span<const Volume> volumes, const Style& style, bool want_colour, bool want_mask,
+                     cv::Mat* onto) {
   if (volumes.size() > 255) throw std::invalid_argument("Renderer: at most 255 volumes (8-bit mask labels)");
   const auto t_start = std::chrono::steady_clock::now();
   again_style_.reset();  // this draw replaces the layer
@@ -121,14 +122,17 @@ Frame Renderer::draw(std::span<const Volume> volumes, const Style& style, bool w
   // Outlines from the cores for the tinted look's colour layer; meshes for the labels, the
   // shaded look, and what the outlines cannot draw.
   const bool outlines = want_colour && !style.shaded && options_.polygon_fill && options_.outline_from_core;
-  PreparedFrame prepared = preparer_->prepare(volumes, PrepareNeeds{.outlines = outlines, .meshes = want_mask || !outlines, .mask = want_mask});
+  PreparedFrame prepared = preparer_->prepare(
+      volumes, PrepareNeeds{.outlines = outlines, .meshes = want_mask || !outlines, .mask = want_mask});
   const std::vector<PreparedVolume>& bodies = prepared.volumes;
   Frame frame = std::move(prepared.frame);
   // The mask from the colour pass when it can (the overlay look at the colour pass's scale).
   const bool same_pass = want_colour && want_mask && !style.shaded && gl_->samples <= 1 && !mask_projection_;
   cv::Mat labels;
   using Clock = std::chrono::steady_clock;
-  const auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
+  const auto seconds = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double>(b - a).count();
+  };
   Clock::time_point t = Clock::now();
   frame.times.prepare = seconds(t_start, t);
   if (want_colour) {
@@ -149,7 +153,8 @@ Frame Renderer::draw(std::span<const Volume> volumes, const Style& style, bool w
     t = Clock::now();
   }
   if (want_mask) {
-    cv::Mat pinhole_labels = same_pass ? labels : detail::drawMask(*gl_, maskProjection(), bodies, frame.near, frame.far);
+    cv::Mat pinhole_labels =
+        same_pass ? labels : detail::drawMask(*gl_, maskProjection(), bodies, frame.near, frame.far);
     // A volume containing the camera is the nearest everywhere.
     const auto fill = std::find_if(bodies.begin(), bodies.end(), [](const PreparedVolume& p) { return p.fills; });
     if (fill != bodies.end()) pinhole_labels.setTo(cv::Scalar::all(fill->label));
@@ -163,14 +168,16 @@ Frame Renderer::draw(std::span<const Volume> volumes, const Style& style, bool w
       if (p.mesh && !p.surface) mesh_error = std::max(mesh_error, p.mesh_error_px);
     frame.mask_edge_px += mesh_error;
     frame.pixels.assign(volumes.size(), 0);
-    for (std::size_t i = 0; i < volumes.size(); ++i) frame.pixels[i] = counts[static_cast<std::size_t>(bodies[i].label)];
+    for (std::size_t i = 0; i < volumes.size(); ++i)
+      frame.pixels[i] = counts[static_cast<std::size_t>(bodies[i].label)];
     frame.times.mask = seconds(t, Clock::now());
   }
   // KCCD_RENDER_PROFILE: each frame's stages on stderr (drawColour ends its drawing with glFinish).
   static const bool profile = std::getenv("KCCD_RENDER_PROFILE") != nullptr;
   if (profile) {
     const FrameTimes& ft = frame.times;
-    std::fprintf(stderr, "prepare %.2f ms  draw %.2f ms  read-back %.2f ms  warp %.2f ms  decorate %.2f ms  mask %.2f ms\n",
+    std::fprintf(stderr,
+                 "prepare %.2f ms  draw %.2f ms  read-back %.2f ms  warp %.2f ms  decorate %.2f ms  mask %.2f ms\n",
                  1e3 * ft.prepare, 1e3 * ft.draw, 1e3 * ft.read_back, 1e3 * ft.warp, 1e3 * ft.decorate, 1e3 * ft.mask);
   }
   return frame;

@@ -23,10 +23,11 @@ SpherePolytope makeSphere(int level) {
   SpherePolytope s;
   double max_angle = 0.0;
   for (const auto& t3 : ico.triangles) {
-    s.triangles.push_back({static_cast<std::uint32_t>(t3[0]), static_cast<std::uint32_t>(t3[1]),
-                           static_cast<std::uint32_t>(t3[2])});
+    s.triangles.push_back(
+        {static_cast<std::uint32_t>(t3[0]), static_cast<std::uint32_t>(t3[1]), static_cast<std::uint32_t>(t3[2])});
     const Vec3 n = (v[t3[1]] - v[t3[0]]).cross(v[t3[2]] - v[t3[0]]).normalized();
-    for (int k = 0; k < 3; ++k) max_angle = std::max(max_angle, std::acos(std::clamp(std::abs(n.dot(v[t3[k]])), -1.0, 1.0)));
+    for (int k = 0; k < 3; ++k)
+      max_angle = std::max(max_angle, std::acos(std::clamp(std::abs(n.dot(v[t3[k]])), -1.0, 1.0)));
   }
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> owner;  // directed edge -> triangle
   for (std::uint32_t t = 0; t < s.triangles.size(); ++t)
@@ -182,8 +183,7 @@ Mesh hullMesh(std::span<const Vec3> points, double radius, int level, double min
       const Vec3& normal = facet.normal;
       for (std::size_t k = 1; k + 1 < ids.size(); ++k) {
         std::array<std::uint32_t, 3> t{ids[0], ids[k], ids[k + 1]};
-        const Vec3 n3 =
-            (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+        const Vec3 n3 = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
         if (n3.dot(normal) < 0.0) std::swap(t[1], t[2]);
         mesh.triangles.push_back(t);
         mesh.normals.push_back(normal);
@@ -201,19 +201,20 @@ Mesh hullMesh(std::span<const Vec3> points, double radius, int level, double min
 // boundaries of its vertices' normal cones do not fall exactly on the axis-aligned directions
 // common in robot models (a tie there would make the direct construction fall back).
 struct TurnedSphere {
-  std::vector<Vec3> vertices;                          // on the unit sphere
+  std::vector<Vec3> vertices;                           // on the unit sphere
   std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from outside
-  std::vector<Vec3> normals;                           // outward unit face normals
-  std::vector<std::array<std::uint32_t, 4>> edges;     // u1, u2, triangle holding u1 -> u2, the other
-  std::vector<std::vector<std::uint32_t>> adjacent;    // vertices joined to each by an edge
+  std::vector<Vec3> normals;                            // outward unit face normals
+  std::vector<std::array<std::uint32_t, 4>> edges;      // u1, u2, triangle holding u1 -> u2, the other
+  std::vector<std::vector<std::uint32_t>> adjacent;     // vertices joined to each by an edge
 };
 
 const TurnedSphere& turnedSphere(int level) {
   static std::once_flag once;
   static std::vector<TurnedSphere> levels;
   std::call_once(once, [] {
-    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.6180339887498949, Vec3(0.2718281828, 0.5772156649, 0.7071067812).normalized())
-                                     .toRotationMatrix();
+    const Eigen::Matrix3d turn =
+        Eigen::AngleAxisd(0.6180339887498949, Vec3(0.2718281828, 0.5772156649, 0.7071067812).normalized())
+            .toRotationMatrix();
     for (int l = 0; l <= 5; ++l) {
       const SpherePolytope& s = spherePolytope(l);
       TurnedSphere q;
@@ -221,7 +222,8 @@ const TurnedSphere& turnedSphere(int level) {
       q.triangles = s.triangles;
       for (std::uint32_t t = 0; t < q.triangles.size(); ++t) {
         const auto& tri = q.triangles[t];
-        q.normals.push_back((q.vertices[tri[1]] - q.vertices[tri[0]]).cross(q.vertices[tri[2]] - q.vertices[tri[0]]).normalized());
+        q.normals.push_back(
+            (q.vertices[tri[1]] - q.vertices[tri[0]]).cross(q.vertices[tri[2]] - q.vertices[tri[0]]).normalized());
         for (int k = 0; k < 3; ++k)
           if (tri[k] < tri[(k + 1) % 3])  // each edge once, from the triangle holding it low -> high
             q.edges.push_back({tri[k], tri[(k + 1) % 3], t, s.neighbours[t][k]});

@@ -1,9 +1,9 @@
 #include "kccd/render/visuals.hpp"
 
 #include <cmath>
-#include <utility>
 #include <numbers>
 #include <string>
+#include <utility>
 
 #include "kccd/input_error.hpp"
 #include "kccd/kinematics.hpp"
@@ -59,7 +59,8 @@ std::vector<LoadedVisual> loadVisuals(const Model& model) {
         throw VisualError(what + ": " + e.what());
       }
       if (part.primitives > 0 || part.points.size() != 3 * static_cast<std::size_t>(part.triangles))
-        throw VisualError(what + ": " + v.mesh + ": only triangle meshes are drawn (use box, cylinder or sphere for primitives)");
+        throw VisualError(what + ": " + v.mesh +
+                          ": only triangle meshes are drawn (use box, cylinder or sphere for primitives)");
       soup = std::move(part.points);
       // A mirroring scale turns the triangles inside out: wind them back.
       if (v.scale.prod() < 0.0)
@@ -83,7 +84,7 @@ std::vector<LoadedVisual> loadVisuals(const Model& model) {
 }
 
 std::vector<Volume> visualVolumes(const Model& model, std::span<const LoadedVisual> visuals,
-                                          std::span<const double> state) {
+                                  std::span<const double> state) {
   std::vector<Pose> poses(model.joints.size());
   if (!framePoses(model, state, poses)) return {};
   std::vector<Volume> out;

@@ -22,7 +22,8 @@ std::vector<std::pair<int, int>> sourceRows(const cv::Mat& map_y, int source_row
       const float v = map_y.at<float>(y, x);
       if (v > -2.0f && v < static_cast<float>(source_rows) + 1.0f) lo = std::min(lo, v), hi = std::max(hi, v);
     }
-    if (lo <= hi) rows[static_cast<std::size_t>(y)] = {static_cast<int>(std::floor(lo)) - 1, static_cast<int>(std::floor(hi)) + 2};
+    if (lo <= hi)
+      rows[static_cast<std::size_t>(y)] = {static_cast<int>(std::floor(lo)) - 1, static_cast<int>(std::floor(hi)) + 2};
   }
   return rows;
 }
@@ -106,7 +107,9 @@ void straighten(cv::Mat rows) {
 }  // namespace
 
 TileMask::TileMask(int width, int height)
-    : width_(width), height_(height), tiles_x_((width + kTile - 1) / kTile),
+    : width_(width),
+      height_(height),
+      tiles_x_((width + kTile - 1) / kTile),
       on_(static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>((height + kTile - 1) / kTile), 0) {}
 
 cv::Rect TileMask::tile(int t) const {
@@ -149,7 +152,8 @@ std::vector<cv::Rect> ColourWarp::markTiles(std::span<const cv::Rect> drawn, Til
       // invert) read only the constant border and are left out.
       const cv::Mat& mx = projection_.mapX();
       const cv::Mat& my = projection_.mapY();
-      const float w = static_cast<float>(projection_.pinhole().width), h = static_cast<float>(projection_.pinhole().height);
+      const float w = static_cast<float>(projection_.pinhole().width),
+                  h = static_cast<float>(projection_.pinhole().height);
       for (int t = 0; t < tiles.tiles(); ++t) {
         const cv::Rect px = tiles.tile(t);
         float x0 = std::numeric_limits<float>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
@@ -173,7 +177,9 @@ std::vector<cv::Rect> ColourWarp::markTiles(std::span<const cv::Rect> drawn, Til
   const cv::Rect pinhole(0, 0, pw, ph);
   std::vector<int>& sums = grid_sums_;  // (gy + 1) x (gx + 1): cells marked above and left of each corner
   sums.assign(static_cast<std::size_t>(gx + 1) * static_cast<std::size_t>(gy + 1), 0);
-  const auto at = [&](int x, int y) -> int& { return sums[static_cast<std::size_t>(y) * static_cast<std::size_t>(gx + 1) + static_cast<std::size_t>(x)]; };
+  const auto at = [&](int x, int y) -> int& {
+    return sums[static_cast<std::size_t>(y) * static_cast<std::size_t>(gx + 1) + static_cast<std::size_t>(x)];
+  };
   bool any = false;
   for (const cv::Rect& d : drawn) {
     const cv::Rect r = d & pinhole;
@@ -205,7 +211,8 @@ cv::Mat ColourWarp::apply(const cv::Mat& premultiplied, std::span<const cv::Rect
       const cv::Rect& run = runs[static_cast<std::size_t>(i)];
       cv::Mat part = out(run);
       if (projection_.warps())
-        cv::remap(premultiplied, part, map_a_(run), map_b_(run), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+        cv::remap(premultiplied, part, map_a_(run), map_b_(run), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                  cv::Scalar::all(0));
       else
         premultiplied(run).copyTo(part);
       straighten(part);
@@ -227,7 +234,8 @@ void ColourWarp::blendOnto(cv::Mat& bgr, const cv::Mat& premultiplied, std::span
       cv::Mat part;
       if (projection_.warps()) {
         scratch.create(run.height, run.width, CV_8UC4);
-        cv::remap(premultiplied, scratch, map_a_(run), map_b_(run), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+        cv::remap(premultiplied, scratch, map_a_(run), map_b_(run), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                  cv::Scalar::all(0));
         part = scratch;
       } else {
         part = premultiplied(run);
@@ -275,14 +283,15 @@ cv::Mat LabelWarp::apply(const cv::Mat& pinhole_labels, std::array<int, 256>& co
   };
   cv::Mat out;
   if (projection_.warps()) {
-    warpByRows(pinhole_labels, out, map_, cv::Mat(), cv::INTER_NEAREST, source_rows_, [&](const cv::Mat& rows, bool warped) {
-      if (warped) {
-        count(rows);
-      } else {  // cleared: background
-        const std::lock_guard lock(counts_mutex);
-        counts[0] += rows.rows * rows.cols;
-      }
-    });
+    warpByRows(pinhole_labels, out, map_, cv::Mat(), cv::INTER_NEAREST, source_rows_,
+               [&](const cv::Mat& rows, bool warped) {
+                 if (warped) {
+                   count(rows);
+                 } else {  // cleared: background
+                   const std::lock_guard lock(counts_mutex);
+                   counts[0] += rows.rows * rows.cols;
+                 }
+               });
   } else {
     out = pinhole_labels;
     cv::parallel_for_(cv::Range(0, out.rows), [&](const cv::Range& r) { count(out.rowRange(r.start, r.end)); });

@@ -71,7 +71,7 @@ class LabelWarp {
 
  private:
   const Projection& projection_;
-  cv::Mat map_;                                    // nearest pinhole pixel per output pixel, as integers
+  cv::Mat map_;  // nearest pinhole pixel per output pixel, as integers
   std::vector<std::pair<int, int>> source_rows_;
 };
 

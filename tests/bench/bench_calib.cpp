@@ -24,13 +24,13 @@
 
 #include <opencv2/calib3d.hpp>
 
-#include "support/cameras.hpp"
 #include "kccd/calib/edge_refine.hpp"
 #include "kccd/calib/mask_refine.hpp"
 #include "kccd/calib/pose.hpp"
 #include "kccd/calib/silhouette.hpp"
 #include "kccd/calib/tag_detect.hpp"
 #include "kccd/model.hpp"
+#include "support/cameras.hpp"
 #include "support/silhouette.hpp"
 #include "support/tag_scene.hpp"
 
@@ -40,9 +40,7 @@ using namespace kccd;
 using namespace kccd::calib;
 constexpr double kPi = 3.141592653589793;
 
-Camera benchCamera() {
-  return kccd::testing::hdCamera(Vec3(2.0, 1.6, 1.35), Vec3(0.45, 0.45, 0.3));
-}
+Camera benchCamera() { return kccd::testing::hdCamera(Vec3(2.0, 1.6, 1.35), Vec3(0.45, 0.45, 0.3)); }
 
 // Three tags on the floor (z = 0), three on the wall x = 0, two on the wall y = 0; two tilted.
 TagLayout benchLayout() {
@@ -138,7 +136,8 @@ void BM_Solve(benchmark::State& state) {
 struct MaskScene {
   Model model = loadModel(std::string(KCCD_DATA_DIR) + "/demo_arm.yaml");
   std::vector<int> bodies = {0, 3, 4, 5, 6};
-  Camera truth = testing::lookAt(Vec3(1.25, -0.95, 0.9), Vec3(0.2, 0.0, 0.35), 960, 540, 780.0, {-0.08, 0.03, 0.0005, -0.0003, 0.0});
+  Camera truth = testing::lookAt(Vec3(1.25, -0.95, 0.9), Vec3(0.2, 0.0, 0.35), 960, 540, 780.0,
+                                 {-0.08, 0.03, 0.0005, -0.0003, 0.0});
   std::vector<MaskFrame> frames;
   std::vector<EdgeFrame> pictures;     // the robot in one shade on grey with boxes, blurred
   std::vector<Correspondence> labels;  // 4 per frame on the first 3 frames, 8 px off
@@ -174,7 +173,8 @@ struct MaskScene {
     cv::Matx33d r, d;
     cv::Rodrigues(truth.rvec, r);
     cv::Rodrigues(cv::Vec3d(0.6, -0.5, 0.62) * (10.0 * kPi / 180.0 / cv::norm(cv::Vec3d(0.6, -0.5, 0.62))), d);
-    const cv::Vec3d centre = testing::cameraCentre(truth) + cv::Vec3d(-0.5, 0.7, 0.5) * (0.10 / cv::norm(cv::Vec3d(-0.5, 0.7, 0.5)));
+    const cv::Vec3d centre =
+        testing::cameraCentre(truth) + cv::Vec3d(-0.5, 0.7, 0.5) * (0.10 / cv::norm(cv::Vec3d(-0.5, 0.7, 0.5)));
     rough = truth;
     cv::Rodrigues(d * r, rough.rvec);
     rough.tvec = -((d * r) * centre);
@@ -215,7 +215,8 @@ void refine(benchmark::State& state, const std::function<RefineResult()>& run) {
   addMaskErrors(state, maskScene().truth, r.camera);
   const bool edges = r.source == RefineSource::Edges;
   double agreement = 0.0;
-  for (const FrameAgreement& a : r.frames) agreement += (edges ? a.matched_after : a.iou_after) / static_cast<double>(r.frames.size());
+  for (const FrameAgreement& a : r.frames)
+    agreement += (edges ? a.matched_after : a.iou_after) / static_cast<double>(r.frames.size());
   state.counters[edges ? "edge_share" : "mean_iou"] = agreement;
   state.counters["frames"] = static_cast<double>(r.frames.size());
   state.counters["iterations"] = r.iterations;

@@ -8,9 +8,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cmath>
 #include <map>
 #include <memory>
 #include <random>
@@ -154,7 +154,8 @@ void BM_Query(benchmark::State& state) {
   }
   report(state, us);
   state.counters["collision_rate"] = static_cast<double>(collisions) / static_cast<double>(state.iterations());
-  state.SetLabel(std::string(kScenes[scene]) + " " + toString(mode) + " " + toString(type) + (warm ? " warm" : " cold"));
+  state.SetLabel(std::string(kScenes[scene]) + " " + toString(mode) + " " + toString(type) +
+                 (warm ? " warm" : " cold"));
 }
 
 // Dense sampling of a box with exact (point) queries: per pair, the smallest distance seen.
@@ -227,8 +228,10 @@ bool fclSampledCollision(int scene, const std::vector<double>& lo, const std::ve
     for (const BodyPair& p : m.pairs) {
       const Body& a = m.bodies[p.a];
       const Body& b = m.bodies[p.b];
-      const fcl::Transform3d ta = a.frame == kWorld ? fcl::Transform3d::Identity() : fcl::Transform3d(poses[a.frame].matrix());
-      const fcl::Transform3d tb = b.frame == kWorld ? fcl::Transform3d::Identity() : fcl::Transform3d(poses[b.frame].matrix());
+      const fcl::Transform3d ta =
+          a.frame == kWorld ? fcl::Transform3d::Identity() : fcl::Transform3d(poses[a.frame].matrix());
+      const fcl::Transform3d tb =
+          b.frame == kWorld ? fcl::Transform3d::Identity() : fcl::Transform3d(poses[b.frame].matrix());
       fcl::DistanceResultd result;
       const double d = fcl::distance(f.shapes[p.a].get(), ta, f.shapes[p.b].get(), tb, request, result);
       if (d - a.radius - b.radius <= m.safety_margin) return true;

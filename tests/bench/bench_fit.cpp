@@ -36,7 +36,8 @@ std::vector<std::array<Vec3, 3>> bumpyTriangles() {
     for (int j = 0; j < cols; ++j) {
       const double th = std::numbers::pi * i / rows, ph = 2 * std::numbers::pi * j / cols;
       const double r = 1.0 + 0.1 * std::sin(5 * ph) * std::sin(3 * th) + noise(rng);
-      v[i][j] = Vec3(0.3 * r * std::sin(th) * std::cos(ph), 0.15 * r * std::sin(th) * std::sin(ph), 0.1 * r * std::cos(th));
+      v[i][j] =
+          Vec3(0.3 * r * std::sin(th) * std::cos(ph), 0.15 * r * std::sin(th) * std::sin(ph), 0.1 * r * std::cos(th));
     }
   std::vector<std::array<Vec3, 3>> t;
   for (int i = 0; i < rows; ++i)
@@ -99,7 +100,8 @@ BENCHMARK(BM_ReadAndFitStl10k)->Unit(benchmark::kMillisecond);
 // against a plain transcode of the STL's bytes into points (the work the earlier hand-written
 // STL reader did) in the same run.
 std::string bumpyText(const char* extension) {
-  const std::string path = (std::filesystem::temp_directory_path() / (std::string("kccd_bench_bumpy") + extension)).string();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / (std::string("kccd_bench_bumpy") + extension)).string();
   const auto tris = bumpyTriangles();
   std::ofstream out(path);
   out.precision(9);
@@ -173,7 +175,8 @@ void BM_ProvePairs(benchmark::State& state, const char* file) {
   std::vector<km::PairReport> r;
   for (auto _ : state) r = km::provePairs(m);
   int never = 0, touching = 0;
-  for (const auto& p : r) never += p.verdict == km::Verdict::Never, touching += p.verdict == km::Verdict::AlwaysTouching;
+  for (const auto& p : r)
+    never += p.verdict == km::Verdict::Never, touching += p.verdict == km::Verdict::AlwaysTouching;
   state.counters["pairs"] = static_cast<double>(r.size());
   state.counters["never"] = never;
   state.counters["always_touching"] = touching;
@@ -214,7 +217,9 @@ void BM_PairLooseness(benchmark::State& state, const char* urdf) {
   const int k = static_cast<int>(state.range(0));
   auto load = [&](bool hulls) {
     km::ImportOptions o;
-    o.fit = {.method = hulls ? km::FitMethod::Hull : km::FitMethod::Points, .points = k, .max_pieces = 1};  // K points per link, whole
+    o.fit = {.method = hulls ? km::FitMethod::Hull : km::FitMethod::Points,
+             .points = k,
+             .max_pieces = 1};  // K points per link, whole
     o.visuals = false;
     o.packages["herb_description"] = std::filesystem::path(path).parent_path().string();
     kccd::Model m = kccd::parseModel(km::importUrdf(path, o), path);
@@ -268,9 +273,17 @@ void BM_PairLooseness(benchmark::State& state, const char* urdf) {
   state.counters["hull_query_x"] = hull_seconds / fit_seconds;
 }
 BENCHMARK_CAPTURE(BM_PairLooseness, kr5, "KR5/KR5 sixx R650.urdf")
-    ->Arg(8)->Arg(12)->Arg(16)->Iterations(1)->Unit(benchmark::kMillisecond);
+    ->Arg(8)
+    ->Arg(12)
+    ->Arg(16)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PairLooseness, wam, "wam/wam.urdf")
-    ->Arg(8)->Arg(12)->Arg(16)->Iterations(1)->Unit(benchmark::kMillisecond);
+    ->Arg(8)
+    ->Arg(12)
+    ->Arg(16)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
 
 // What the import's defaults cost and buy (kccd import: each link within --tolerance of its hull,
 // concave links in pieces) against the expert knob K = 8 and the exact hulls, on real robots, all
@@ -309,7 +322,8 @@ const kccd::Model& importedModel(const std::string& robot, int mode) {
     km::ImportOptions o;
     o.visuals = false;
     o.packages = r.packages;
-    if (const char* t = std::getenv("KCCD_BENCH_TOLERANCE_MM")) o.fit.tolerance = std::atof(t) * 1e-3;  // other defaults
+    if (const char* t = std::getenv("KCCD_BENCH_TOLERANCE_MM"))
+      o.fit.tolerance = std::atof(t) * 1e-3;  // other defaults
     if (const char* c = std::getenv("KCCD_BENCH_CONCAVITY_MM")) o.fit.concavity = std::atof(c) * 1e-3;
     if (mode == kEight) o.fit.method = km::FitMethod::Points, o.fit.max_pieces = 1;
     if (mode == kHulls) o.fit.method = km::FitMethod::Hull, o.fit.max_pieces = 1;
@@ -374,8 +388,10 @@ void BM_ImportCost(benchmark::State& state, const char* robot) {
           t_col8 += seconds([&] { benchmark::DoNotOptimize(c8.query(q, q, collision).min_distance); });
           t_dist8 += seconds([&] { benchmark::DoNotOptimize(c8.query(q, q, distances).min_distance); });
         };
-        if (first) mine(), theirs();
-        else theirs(), mine();
+        if (first)
+          mine(), theirs();
+        else
+          theirs(), mine();
       }
     for (const auto& q : states) {
       const auto dm = linkDistances(m, cm.query(q, q, distances));

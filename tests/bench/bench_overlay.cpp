@@ -38,9 +38,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench/bench_recording.hpp"
 #include "kccd/calib/camera.hpp"
 #include "kccd/model.hpp"
-#include "bench/bench_recording.hpp"
 
 namespace {
 
@@ -53,7 +53,8 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 double cpuSeconds(int who) {
   rusage r{};
   getrusage(who, &r);
-  return static_cast<double>(r.ru_utime.tv_sec + r.ru_stime.tv_sec) + 1e-6 * static_cast<double>(r.ru_utime.tv_usec + r.ru_stime.tv_usec);
+  return static_cast<double>(r.ru_utime.tv_sec + r.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(r.ru_utime.tv_usec + r.ru_stime.tv_usec);
 }
 
 // A command's (or the transcode's) fastest wall time, and its CPU time in that round.
@@ -189,12 +190,18 @@ int main(int argc, char** argv) {
   std::string dir = (fs::temp_directory_path() / "kccd_bench_overlay").string(), codec = "mp4v", baseline;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
-    if (k == "--frames") frames = std::stoi(v);
-    else if (k == "--repeat") repeat = std::max(1, std::stoi(v));
-    else if (k == "--jobs") jobs = std::stoi(v);
-    else if (k == "--dir") dir = v;
-    else if (k == "--codec") codec = v;
-    else if (k == "--baseline") baseline = v;
+    if (k == "--frames")
+      frames = std::stoi(v);
+    else if (k == "--repeat")
+      repeat = std::max(1, std::stoi(v));
+    else if (k == "--jobs")
+      jobs = std::stoi(v);
+    else if (k == "--dir")
+      dir = v;
+    else if (k == "--codec")
+      codec = v;
+    else if (k == "--baseline")
+      baseline = v;
   }
   try {
     fs::create_directories(dir);
@@ -209,7 +216,8 @@ int main(int argc, char** argv) {
     makeVideos(video, clip, codec, frames, clip_frames, fps);
 
     int plain_frames = 0, clip_plain_frames = 0;
-    const std::string common = " --camera " + camera + " --states " + log + " --quiet" + (jobs > 0 ? " --jobs " + std::to_string(jobs) : "");
+    const std::string common =
+        " --camera " + camera + " --states " + log + " --quiet" + (jobs > 0 ? " --jobs " + std::to_string(jobs) : "");
     const std::string args = " overlay " + model + " --video " + video + common;
     const std::string short_args = " overlay " + model + " --video " + clip + common;
     const std::string base = kccd + args;
@@ -232,7 +240,8 @@ int main(int argc, char** argv) {
       plain.keep(wall, cpuSeconds(RUSAGE_SELF) - c0);
       if (!baseline.empty()) run(stat_base, other + " -o " + dir + "/base_static" + ext + " --codec " + codec, nullptr);
       run(stat, base + " --timings --json -o " + dir + "/static" + ext + " --codec " + codec, &stat_json);
-      if (!baseline.empty()) run(swept_base, other + " --swept -o " + dir + "/base_swept" + ext + " --codec " + codec, nullptr);
+      if (!baseline.empty())
+        run(swept_base, other + " --swept -o " + dir + "/base_swept" + ext + " --codec " + codec, nullptr);
       run(swept, base + " --swept --timings --json -o " + dir + "/swept" + ext + " --codec " + codec, &swept_json);
       const double c1 = cpuSeconds(RUSAGE_SELF);
       const double clip_wall = transcode(clip, dir + "/plain_short" + ext, codec, clip_plain_frames);
@@ -254,40 +263,48 @@ int main(int argc, char** argv) {
                 frames, codec.c_str(), hw, jobs > 0 ? std::to_string(jobs).c_str() : "default");
     // CPU per frame: every thread's user + system time (a 2-core machine has 2 ms of CPU per ms of wall time).
     auto cpu = [](const Timed& t, int n) { return 1000.0 * t.cpu / n; };
-    std::printf("  plain transcode (decode + encode): %7.1f fps                          CPU %5.1f ms per frame\n", f_plain,
-                cpu(plain, plain_frames));
-    std::printf("  kccd overlay, static volumes:      %7.1f fps  (%3.0f %% of the transcode)  CPU %5.1f ms per frame\n", f_static,
-                100 * f_static / f_plain, cpu(stat, frames));
-    std::printf("  kccd overlay --swept:              %7.1f fps  (%3.0f %% of the transcode)  CPU %5.1f ms per frame\n", f_swept,
-                100 * f_swept / f_plain, cpu(swept, frames));
+    std::printf("  plain transcode (decode + encode): %7.1f fps                          CPU %5.1f ms per frame\n",
+                f_plain, cpu(plain, plain_frames));
+    std::printf("  kccd overlay, static volumes:      %7.1f fps  (%3.0f %% of the transcode)  CPU %5.1f ms per frame\n",
+                f_static, 100 * f_static / f_plain, cpu(stat, frames));
+    std::printf("  kccd overlay --swept:              %7.1f fps  (%3.0f %% of the transcode)  CPU %5.1f ms per frame\n",
+                f_swept, 100 * f_swept / f_plain, cpu(swept, frames));
     // Once started: what each further frame costs (a long recording's rate), and the fixed cost.
-    std::printf("  once started (frames %d..%d against the first %d alone), frames per second and fixed cost:\n", clip_frames,
-                frames, clip_frames);
-    std::printf("    plain transcode:                 %7.1f fps                          fixed %.3f s\n", s_plain.fps, s_plain.fixed);
-    std::printf("    kccd overlay, static volumes:    %7.1f fps  (%3.0f %% of the transcode)  fixed %.3f s\n", s_stat.fps,
-                100 * s_stat.fps / s_plain.fps, s_stat.fixed);
-    std::printf("    kccd overlay --swept:            %7.1f fps  (%3.0f %% of the transcode)  fixed %.3f s\n", s_swept.fps,
-                100 * s_swept.fps / s_plain.fps, s_swept.fixed);
+    std::printf("  once started (frames %d..%d against the first %d alone), frames per second and fixed cost:\n",
+                clip_frames, frames, clip_frames);
+    std::printf("    plain transcode:                 %7.1f fps                          fixed %.3f s\n", s_plain.fps,
+                s_plain.fixed);
+    std::printf("    kccd overlay, static volumes:    %7.1f fps  (%3.0f %% of the transcode)  fixed %.3f s\n",
+                s_stat.fps, 100 * s_stat.fps / s_plain.fps, s_stat.fixed);
+    std::printf("    kccd overlay --swept:            %7.1f fps  (%3.0f %% of the transcode)  fixed %.3f s\n",
+                s_swept.fps, 100 * s_swept.fps / s_plain.fps, s_swept.fixed);
     // Where the time went (each stage on its own thread: decoding, annotating and encoding overlap).
-    std::printf("  per frame, ms        static   swept   (set-up %.3f s and %.3f s)\n", stat_stages.setup, swept_stages.setup);
+    std::printf("  per frame, ms        static   swept   (set-up %.3f s and %.3f s)\n", stat_stages.setup,
+                swept_stages.setup);
     for (std::size_t k = 0; k < stat_stages.ms.size(); ++k)
-      std::printf("    %-12s    %7.2f %7.2f\n", stat_stages.ms[k].first.c_str(), stat_stages.ms[k].second, swept_stages.ms[k].second);
-    std::printf("    %-12s    %7.2f %7.2f\n", "transcode", 1000.0 * plain.wall / plain_frames, 1000.0 * plain.wall / plain_frames);
+      std::printf("    %-12s    %7.2f %7.2f\n", stat_stages.ms[k].first.c_str(), stat_stages.ms[k].second,
+                  swept_stages.ms[k].second);
+    std::printf("    %-12s    %7.2f %7.2f\n", "transcode", 1000.0 * plain.wall / plain_frames,
+                1000.0 * plain.wall / plain_frames);
     if (!baseline.empty()) {
       std::printf("  baseline %s, static volumes: %7.1f fps  (this build %.3f x as fast)  CPU %5.1f ms per frame\n",
                   baseline.c_str(), frames / stat_base.wall, stat_base.wall / stat.wall, cpu(stat_base, frames));
       std::printf("  baseline %s, --swept:        %7.1f fps  (this build %.3f x as fast)  CPU %5.1f ms per frame\n",
                   baseline.c_str(), frames / swept_base.wall, swept_base.wall / swept.wall, cpu(swept_base, frames));
     }
-    std::printf("{\"frames\": %d, \"codec\": \"%s\", \"plain_fps\": %.2f, \"static_fps\": %.2f, \"swept_fps\": %.2f, "
-                "\"static_ratio\": %.3f, \"swept_ratio\": %.3f, \"plain_cpu_ms\": %.2f, \"static_cpu_ms\": %.2f, \"swept_cpu_ms\": %.2f, "
-                "\"clip_frames\": %d, \"started_plain_fps\": %.2f, \"started_static_fps\": %.2f, \"started_swept_fps\": %.2f, "
-                "\"started_static_ratio\": %.3f, \"started_swept_ratio\": %.3f, \"fixed_plain_s\": %.3f, \"fixed_static_s\": %.3f, "
-                "\"fixed_swept_s\": %.3f}\n",
-                frames, codec.c_str(), f_plain, f_static, f_swept, f_static / f_plain, f_swept / f_plain, cpu(plain, plain_frames),
-                cpu(stat, frames), cpu(swept, frames), clip_frames, s_plain.fps, s_stat.fps, s_swept.fps,
-                s_stat.fps / s_plain.fps, s_swept.fps / s_plain.fps, s_plain.fixed, s_stat.fixed, s_swept.fixed);
-    if (plain_frames != frames) std::fprintf(stderr, "bench_overlay: the transcode saw %d frames, not %d\n", plain_frames, frames);
+    std::printf(
+        "{\"frames\": %d, \"codec\": \"%s\", \"plain_fps\": %.2f, \"static_fps\": %.2f, \"swept_fps\": %.2f, "
+        "\"static_ratio\": %.3f, \"swept_ratio\": %.3f, \"plain_cpu_ms\": %.2f, \"static_cpu_ms\": %.2f, "
+        "\"swept_cpu_ms\": %.2f, "
+        "\"clip_frames\": %d, \"started_plain_fps\": %.2f, \"started_static_fps\": %.2f, \"started_swept_fps\": %.2f, "
+        "\"started_static_ratio\": %.3f, \"started_swept_ratio\": %.3f, \"fixed_plain_s\": %.3f, \"fixed_static_s\": "
+        "%.3f, "
+        "\"fixed_swept_s\": %.3f}\n",
+        frames, codec.c_str(), f_plain, f_static, f_swept, f_static / f_plain, f_swept / f_plain,
+        cpu(plain, plain_frames), cpu(stat, frames), cpu(swept, frames), clip_frames, s_plain.fps, s_stat.fps,
+        s_swept.fps, s_stat.fps / s_plain.fps, s_swept.fps / s_plain.fps, s_plain.fixed, s_stat.fixed, s_swept.fixed);
+    if (plain_frames != frames)
+      std::fprintf(stderr, "bench_overlay: the transcode saw %d frames, not %d\n", plain_frames, frames);
   } catch (const std::exception& e) {
     std::cerr << "bench_overlay: " << e.what() << "\n";
     return 1;

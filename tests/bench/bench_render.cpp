@@ -17,10 +17,10 @@
 
 #include <opencv2/calib3d.hpp>
 
-#include "support/cameras.hpp"
 #include "kccd/checker.hpp"
 #include "kccd/render/renderer.hpp"
 #include "kccd/render/scene.hpp"
+#include "support/cameras.hpp"
 
 namespace {
 
@@ -92,8 +92,8 @@ void frame(benchmark::State& state, bool swept, bool moving, bool mask, SschMesh
   for (auto _ : state) {
     const auto& [lo, hi] = list[moving ? i++ % list.size() : 0];
     const QueryResult& q = checker.query(lo, hi, QueryOptions{.type = QueryType::Distances});
-    const std::vector<Volume> volumes = swept ? sceneVolumes(m, checker, bodyStatus(m, q))
-                                              : staticSceneVolumes(m, checker, lo, bodyStatus(m, q));
+    const std::vector<Volume> volumes =
+        swept ? sceneVolumes(m, checker, bodyStatus(m, q)) : staticSceneVolumes(m, checker, lo, bodyStatus(m, q));
     const Frame f = r.render(volumes, Style{}, true, mask);
     benchmark::DoNotOptimize(f.bgra.data);
     triangles += f.triangles;

@@ -80,14 +80,14 @@ int chainBin(int joints) { return std::min(joints / 3, kChainBins - 1); }
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-using bench::Oracle;
 using bench::Options;
+using bench::Oracle;
 using bench::parseOptions;
 
 // The measured queries' exact stage (--exact), the same for every setting; kExactAtMargin is
 // resolved to the model's margin.
 double g_exact_below = -1.0;
-int g_splits = QueryOptions{}.exact_splits;  // of the measured queries (--splits)
+int g_splits = QueryOptions{}.exact_splits;           // of the measured queries (--splits)
 double g_split_gap = QueryOptions{}.exact_split_gap;  // of the measured queries (--split-gap)
 double exactBelow(const Model& m) { return g_exact_below == bench::kExactAtMargin ? m.safety_margin : g_exact_below; }
 
@@ -202,7 +202,8 @@ double coldTime(Checker& checker, const Box& box, bool at_centre, QueryType type
   for (int r = 0; r < repeats; ++r) {
     checker.reset();
     const auto t0 = Clock::now();
-    const QueryResult& res = checker.query(lo, hi, {.type = type, .exact_below = exact_below, .exact_splits = g_splits, .exact_split_gap = g_split_gap});
+    const QueryResult& res = checker.query(
+        lo, hi, {.type = type, .exact_below = exact_below, .exact_splits = g_splits, .exact_split_gap = g_split_gap});
     const double us = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
     if (res.status != Status::Ok) fail(std::string("unexpected query status ") + toString(res.status));
     best = std::min(best, us);
@@ -214,7 +215,10 @@ double coldTime(Checker& checker, const Box& box, bool at_centre, QueryType type
 std::vector<double> distancesBounds(Checker& checker, const Box& box, bool at_centre) {
   checker.reset();
   const QueryResult& r = checker.query(at_centre ? box.centre : box.lower, at_centre ? box.centre : box.upper,
-                                       {.type = QueryType::Distances, .exact_below = exactBelow(checker.model()), .exact_splits = g_splits, .exact_split_gap = g_split_gap});
+                                       {.type = QueryType::Distances,
+                                        .exact_below = exactBelow(checker.model()),
+                                        .exact_splits = g_splits,
+                                        .exact_split_gap = g_split_gap});
   std::vector<double> out(checker.model().pairs.size(), 0.0);
   for (const PairDistance& p : r.pairs) out[static_cast<std::size_t>(p.pair)] = p.distance;
   return out;
@@ -229,13 +233,13 @@ struct Timing {
 };
 
 struct BoxRecord {
-  std::vector<Timing> times;                 // per setting
-  std::vector<std::vector<double>> bounds;   // per setting, per pair
-  Timing point;                              // exact query at the centre
-  std::vector<double> point_bounds;          // per pair
-  std::vector<double> found;                 // per pair; +inf when not searched (best bound >= kNear)
-  std::vector<double> centre_distance;       // per searched pair: nominal distance at the centre
-  bool within = false;                       // some found distance <= margin
+  std::vector<Timing> times;                // per setting
+  std::vector<std::vector<double>> bounds;  // per setting, per pair
+  Timing point;                             // exact query at the centre
+  std::vector<double> point_bounds;         // per pair
+  std::vector<double> found;                // per pair; +inf when not searched (best bound >= kNear)
+  std::vector<double> centre_distance;      // per searched pair: nominal distance at the centre
+  bool within = false;                      // some found distance <= margin
 };
 
 void measureBox(std::vector<Setting>& settings, Checker& exact, const Box& box, int repeats, BoxRecord& rec) {
@@ -263,7 +267,7 @@ struct SearchCheck {
   long pairs = 0, own_lower = 0, library_lower = 0;  // lower by more than 0.1 mm than the other
   double max_difference_mm = 0.0;
   long rechecked = 0, exact_above_found = 0;
-  double max_found_minus_exact_mm = 0.0;             // over pairs whose bodies have no error bound
+  double max_found_minus_exact_mm = 0.0;  // over pairs whose bodies have no error bound
 };
 
 struct Found {
@@ -438,8 +442,8 @@ struct Row {
   long band_pairs = 0;
   double bin_p90[kChainBins] = {kNaN, kNaN, kNaN, kNaN, kNaN}, bin_max[kChainBins] = {kNaN, kNaN, kNaN, kNaN, kNaN};
   long bin_pairs[kChainBins] = {0, 0, 0, 0, 0};
-  double verdict_us = kNaN;        // median verdict-only distances query
-  double over_verdict = kNaN;      // median distances / median verdict-only distances
+  double verdict_us = kNaN;    // median verdict-only distances query
+  double over_verdict = kNaN;  // median distances / median verdict-only distances
   double alarm_boxes_pct = kNaN, alarm_clear_pct = kNaN, alarm_pairs_pct = kNaN;
   long far_alarms = 0;  // pairs with found >= kNear (not near) whose bound is within the margin
   long violations = 0;
@@ -454,7 +458,7 @@ struct SetSummary {
   std::string scene, set;
   int boxes = 0, clear = 0, within = 0;
   long near_pairs = 0;
-  std::vector<Row> rows;               // per setting, then the point-state row
+  std::vector<Row> rows;  // per setting, then the point-state row
   std::vector<Violation> violations;
   SearchCheck check;
   long evaluations = 0;
@@ -527,7 +531,8 @@ Row summarise(const std::vector<BoxRecord>& recs, double margin, const std::vect
   if (!point) {
     row.alarm_boxes_pct = 100.0 * static_cast<double>(alarms) / static_cast<double>(recs.size());
     if (clear_boxes > 0) row.alarm_clear_pct = 100.0 * static_cast<double>(alarms) / static_cast<double>(clear_boxes);
-    if (clear_pairs > 0) row.alarm_pairs_pct = 100.0 * static_cast<double>(pair_alarms) / static_cast<double>(clear_pairs);
+    if (clear_pairs > 0)
+      row.alarm_pairs_pct = 100.0 * static_cast<double>(pair_alarms) / static_cast<double>(clear_pairs);
   }
   return row;
 }
@@ -606,25 +611,27 @@ std::string csvNum(double v, const char* fmt) { return std::isfinite(v) ? num(v,
 
 std::string setTitle(const SetSummary& s) {
   for (const BoxSet& b : kSets)
-    if (s.set == b.name) return s.scene + ", " + b.name + " boxes (revolute widths " + num(b.min_deg, "%g") + "-" +
-                                num(b.max_deg, "%g") + " deg)";
+    if (s.set == b.name)
+      return s.scene + ", " + b.name + " boxes (revolute widths " + num(b.min_deg, "%g") + "-" + num(b.max_deg, "%g") +
+             " deg)";
   return s.scene + ", " + s.set;
 }
 
 std::string markdownTable(const SetSummary& s, double margin) {
   std::ostringstream md;
   md << "### " << setTitle(s) << "\n\n"
-     << s.boxes << " boxes: " << s.clear << " truly clear, " << s.within << " within the margin (" << margin
-     << " m); " << s.near_pairs << " near pair-boxes (found < " << kNear << " m). Search: " << s.check.rechecked
+     << s.boxes << " boxes: " << s.clear << " truly clear, " << s.within << " within the margin (" << margin << " m); "
+     << s.near_pairs << " near pair-boxes (found < " << kNear << " m). Search: " << s.check.rechecked
      << " found configurations re-measured by the exact Checker, its bound above the found distance "
-     << s.check.exact_above_found << " times, found - exact bound at most " << num(s.check.max_found_minus_exact_mm, "%.6f")
-     << " mm (pairs without joint error bounds)";
+     << s.check.exact_above_found << " times, found - exact bound at most "
+     << num(s.check.max_found_minus_exact_mm, "%.6f") << " mm (pairs without joint error bounds)";
   if (s.check.pairs > 0)
     md << "; own search vs kccd::closestConfiguration over " << s.check.pairs << " pairs: own lower by > 0.1 mm "
        << s.check.own_lower << " times, library lower " << s.check.library_lower << " times, largest difference "
        << num(s.check.max_difference_mm, "%.3f") << " mm";
   md << ".\n\n"
-     << "| mode | budget | distances µs | / verdict-only | collision µs clear (med / p90) | collision µs within (med / p90) "
+     << "| mode | budget | distances µs | / verdict-only | collision µs clear (med / p90) | collision µs within (med / "
+        "p90) "
         "| clear / point state | looseness mm in band (p50 / p90 / max) | near-pair looseness mm (med / p90) "
         "| false alarms % boxes (of clear) | false alarms % pairs | flagged pairs found >= 0.3 m |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -632,11 +639,11 @@ std::string markdownTable(const SetSummary& s, double margin) {
     const bool point = r.mode.rfind("point", 0) == 0;
     md << "| " << r.mode << " | " << r.budget << " | " << num(r.distances_us) << " | "
        << (point ? std::string("-") : num(r.over_verdict, "%.2f")) << " | " << num(r.clear_med) << " / "
-       << num(r.clear_p90) << " | " << num(r.within_med) << " / " << num(r.within_p90) << " | "
-       << num(r.ratio, "%.2f") << " | " << num(r.band_med) << " / " << num(r.band_p90) << " / " << num(r.band_max) << " | "
-       << num(r.loose_med) << " / " << num(r.loose_p90) << " | "
-       << num(r.alarm_boxes_pct) << " (" << num(r.alarm_clear_pct) << ") | " << num(r.alarm_pairs_pct, "%.2f") << " | "
-       << (point ? std::string("-") : std::to_string(r.far_alarms)) << " |\n";
+       << num(r.clear_p90) << " | " << num(r.within_med) << " / " << num(r.within_p90) << " | " << num(r.ratio, "%.2f")
+       << " | " << num(r.band_med) << " / " << num(r.band_p90) << " / " << num(r.band_max) << " | " << num(r.loose_med)
+       << " / " << num(r.loose_p90) << " | " << num(r.alarm_boxes_pct) << " (" << num(r.alarm_clear_pct) << ") | "
+       << num(r.alarm_pairs_pct, "%.2f") << " | " << (point ? std::string("-") : std::to_string(r.far_alarms))
+       << " |\n";
   }
   md << "\nLooseness in band by swept joints between the two bodies, p90 / max mm (pair-boxes):\n\n| mode | budget |";
   for (const char* b : kChainBinNames) md << " " << b << " |";
@@ -647,7 +654,11 @@ std::string markdownTable(const SetSummary& s, double margin) {
     if (r.mode.rfind("point", 0) == 0) continue;
     md << "| " << r.mode << " | " << r.budget << " |";
     for (int b = 0; b < kChainBins; ++b)
-      md << " " << (r.bin_pairs[b] > 0 ? num(r.bin_p90[b]) + " / " + num(r.bin_max[b]) + " (" + std::to_string(r.bin_pairs[b]) + ")" : std::string("-")) << " |";
+      md << " "
+         << (r.bin_pairs[b] > 0
+                 ? num(r.bin_p90[b]) + " / " + num(r.bin_max[b]) + " (" + std::to_string(r.bin_pairs[b]) + ")"
+                 : std::string("-"))
+         << " |";
     md << "\n";
   }
   md << "\n";
@@ -658,26 +669,33 @@ std::string exactName(double below) {
   if (below == kInf) return "every pair (--exact all)";
   if (below == -kInf) return "off (--exact off)";
   if (below == bench::kExactAtMargin) return "pairs within the margin (--exact margin)";
-  if (below < 0.0) return "the library's default: collision queries pairs within the margin, distance queries pairs within " +
-                          num(kBand, "%g") + " m of it (QueryOptions::exact_band)";
+  if (below < 0.0)
+    return "the library's default: collision queries pairs within the margin, distance queries pairs within " +
+           num(kBand, "%g") + " m of it (QueryOptions::exact_band)";
   return "pairs within " + num(below, "%g") + " m (--exact " + num(below, "%g") + ")";
 }
 
 std::string markdownNotes(const Options& o) {
   std::ostringstream md;
   md << "Exact stage: " << exactName(o.exact_below) << "; box splitting (QueryOptions::exact_splits): "
-     << (o.splits > 1 ? "up to " + std::to_string(o.splits) + " sub-boxes per pair, split gap " + num(o.split_gap * 1e3, "%g") + " mm" : std::string("off"))
+     << (o.splits > 1 ? "up to " + std::to_string(o.splits) + " sub-boxes per pair, split gap " +
+                            num(o.split_gap * 1e3, "%g") + " mm"
+                      : std::string("off"))
      << ". \"/ verdict-only\": the median distances query over the median distances query whose exact stage "
         "refines only the pairs within the margin (the verdicts), measured interleaved on the same boxes. "
         "Looseness in band: found distance minus bound over every pair whose bound is within "
-     << num(kBand, "%g") << " m of the margin (found by the searches; whatever it is), overall and by the number "
+     << num(kBand, "%g")
+     << " m of the margin (found by the searches; whatever it is), overall and by the number "
         "of swept joints between the two bodies. For bodies behind a joint with error bounds (the cell's mock-up "
-        "pose) the searches also vary the pose within them, so a found distance is one the cell can have. Cold queries (table reset before each; the same box repeated, so CPU caches are warm), the fastest of "
-     << o.repeats << " runs per box, median / p90 over the boxes (nearest rank). "
+        "pose) the searches also vary the pose within them, so a found distance is one the cell can have. Cold queries "
+        "(table reset before each; the same box repeated, so CPU caches are warm), the fastest of "
+     << o.repeats
+     << " runs per box, median / p90 over the boxes (nearest rank). "
         "\"clear\"/\"within\": boxes whose closest found configuration is beyond / within the margin. "
         "\"clear / point state\": median collision query on the truly clear boxes over the median exact "
         "collision query at the same boxes' centres. Near-pair looseness: found distance minus bound over pairs "
-        "found near (found < 0.3 m, not touching; leaves out pairs found far whose bound is low); for the point-state row, the nominal distance at the centre minus "
+        "found near (found < 0.3 m, not touching; leaves out pairs found far whose bound is low); for the point-state "
+        "row, the nominal distance at the centre minus "
         "the exact bound there (the cost of joint error bounds). False alarms: boxes where some bound is "
         "within the margin but no found distance is, as % of all boxes (and of the truly clear ones); "
         "pairs: % of all checked pairs (of all boxes) that are clear of the margin and flagged within it "
@@ -694,17 +712,19 @@ std::string csvText(const std::vector<SetSummary>& sets) {
        "false_alarm_clear_boxes_pct,false_alarm_pairs_pct,false_alarm_far_pairs,violations,"
        "verdict_only_distances_us_median,distances_over_verdict_only,band_pairs,band_looseness_mm_p50,"
        "band_looseness_mm_p90,band_looseness_mm_max";
-  for (const char* b : kChainBinNames) c << ",band_p90_mm_joints_" << b << ",band_max_mm_joints_" << b << ",band_pairs_joints_" << b;
+  for (const char* b : kChainBinNames)
+    c << ",band_p90_mm_joints_" << b << ",band_max_mm_joints_" << b << ",band_pairs_joints_" << b;
   c << "\n";
   for (const SetSummary& s : sets)
     for (const Row& r : s.rows) {
-      c << s.scene << "," << s.set << "," << (r.mode.rfind("point", 0) == 0 ? "point_state" : r.mode) << ","
-        << r.budget << "," << s.boxes << "," << s.clear << "," << s.within << "," << s.near_pairs << ","
+      c << s.scene << "," << s.set << "," << (r.mode.rfind("point", 0) == 0 ? "point_state" : r.mode) << "," << r.budget
+        << "," << s.boxes << "," << s.clear << "," << s.within << "," << s.near_pairs << ","
         << csvNum(r.distances_us, "%.3f") << "," << csvNum(r.distances_clear_us, "%.3f") << ","
-        << csvNum(r.distances_within_us, "%.3f") << "," << csvNum(r.clear_med, "%.3f") << "," << csvNum(r.clear_p90, "%.3f") << ","
-        << csvNum(r.within_med, "%.3f") << "," << csvNum(r.within_p90, "%.3f") << "," << csvNum(r.ratio, "%.4f") << ","
-        << csvNum(r.loose_med, "%.4f") << "," << csvNum(r.loose_p90, "%.4f") << "," << csvNum(r.alarm_boxes_pct, "%.2f")
-        << "," << csvNum(r.alarm_clear_pct, "%.2f") << "," << csvNum(r.alarm_pairs_pct, "%.2f") << ","
+        << csvNum(r.distances_within_us, "%.3f") << "," << csvNum(r.clear_med, "%.3f") << ","
+        << csvNum(r.clear_p90, "%.3f") << "," << csvNum(r.within_med, "%.3f") << "," << csvNum(r.within_p90, "%.3f")
+        << "," << csvNum(r.ratio, "%.4f") << "," << csvNum(r.loose_med, "%.4f") << "," << csvNum(r.loose_p90, "%.4f")
+        << "," << csvNum(r.alarm_boxes_pct, "%.2f") << "," << csvNum(r.alarm_clear_pct, "%.2f") << ","
+        << csvNum(r.alarm_pairs_pct, "%.2f") << ","
         << (r.mode.rfind("point", 0) == 0 ? std::string() : std::to_string(r.far_alarms)) << "," << r.violations << ","
         << csvNum(r.verdict_us, "%.3f") << "," << csvNum(r.over_verdict, "%.4f") << "," << r.band_pairs << ","
         << csvNum(r.band_med, "%.4f") << "," << csvNum(r.band_p90, "%.4f") << "," << csvNum(r.band_max, "%.4f");
@@ -727,15 +747,16 @@ void writeFile(const std::string& path, const std::string& text) {
 
 void reportViolations(const SetSummary& s, const Model& m) {
   if (s.violations.empty()) return;
-  std::fprintf(stderr, "\n!!!!!!!! %zu BOUND VIOLATIONS in %s: a bound above a distance found inside the box !!!!!!!!\n",
+  std::fprintf(stderr,
+               "\n!!!!!!!! %zu BOUND VIOLATIONS in %s: a bound above a distance found inside the box !!!!!!!!\n",
                s.violations.size(), setTitle(s).c_str());
   for (std::size_t i = 0; i < std::min<std::size_t>(20, s.violations.size()); ++i) {
     const Violation& v = s.violations[i];
     const BodyPair& p = m.pairs[static_cast<std::size_t>(v.pair)];
     std::fprintf(stderr, "  box %d setting %s pair %s-%s: bound %.9f m > found %.9f m\n", v.box,
                  v.setting < 0 ? "point state" : s.rows[static_cast<std::size_t>(v.setting)].mode.c_str(),
-                 m.bodies[static_cast<std::size_t>(p.a)].name.c_str(), m.bodies[static_cast<std::size_t>(p.b)].name.c_str(),
-                 v.bound, v.found);
+                 m.bodies[static_cast<std::size_t>(p.a)].name.c_str(),
+                 m.bodies[static_cast<std::size_t>(p.b)].name.c_str(), v.bound, v.found);
   }
 }
 
@@ -761,7 +782,9 @@ void writePlot(const std::string& path, const std::vector<SetSummary>& sets, int
 #endif
 
 const char* oracleName(Oracle o) {
-  return o == Oracle::Own ? "own box search" : o == Oracle::Library ? "kccd::closestConfiguration" : "both (the smaller)";
+  return o == Oracle::Own       ? "own box search"
+         : o == Oracle::Library ? "kccd::closestConfiguration"
+                                : "both (the smaller)";
 }
 
 }  // namespace
@@ -783,11 +806,13 @@ int main(int argc, char** argv) try {
       std::fprintf(stderr, "bench_trade: %s: queries %.1f s, search %.1f s (%ld distance evaluations, %s)\n",
                    setTitle(s).c_str(), s.seconds_queries, s.seconds_search, s.evaluations, oracleName(o.oracle));
       if (o.oracle == Oracle::Both)
-        std::fprintf(stderr, "bench_trade:   searches compared over %ld pairs: own lower by > 0.1 mm %ld times, "
-                             "library lower %ld times, largest difference %.3f mm\n",
+        std::fprintf(stderr,
+                     "bench_trade:   searches compared over %ld pairs: own lower by > 0.1 mm %ld times, "
+                     "library lower %ld times, largest difference %.3f mm\n",
                      s.check.pairs, s.check.own_lower, s.check.library_lower, s.check.max_difference_mm);
-      std::fprintf(stderr, "bench_trade:   found configurations re-measured by the exact Checker: %ld, its bound above the "
-                           "found distance %ld times; found - exact bound at most %.6f mm (pairs without error bounds)\n",
+      std::fprintf(stderr,
+                   "bench_trade:   found configurations re-measured by the exact Checker: %ld, its bound above the "
+                   "found distance %ld times; found - exact bound at most %.6f mm (pairs without error bounds)\n",
                    s.check.rechecked, s.check.exact_above_found, s.check.max_found_minus_exact_mm);
       search_faults += s.check.exact_above_found;
       reportViolations(s, m);
@@ -799,8 +824,10 @@ int main(int argc, char** argv) try {
     }
   }
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  const std::string footer = "Search: " + std::string(oracleName(o.oracle)) + ". Violations (bound above a found "
-                             "distance): " + std::to_string(violations) + ". Run time " + num(seconds) + " s.\n";
+  const std::string footer = "Search: " + std::string(oracleName(o.oracle)) +
+                             ". Violations (bound above a found "
+                             "distance): " +
+                             std::to_string(violations) + ". Run time " + num(seconds) + " s.\n";
   std::cout << footer;
   md += footer;
   if (!o.markdown.empty()) writeFile(o.markdown, md);
@@ -809,8 +836,10 @@ int main(int argc, char** argv) try {
   if (!o.plot.empty()) writePlot(o.plot, sets, 2);
 #endif
   if (search_faults > 0)
-    std::fprintf(stderr, "\n!!!!!!!! bench_trade: %ld found distances below the exact bound at their own configuration: "
-                         "the search is wrong, the looseness figures are not trustworthy !!!!!!!!\n", search_faults);
+    std::fprintf(stderr,
+                 "\n!!!!!!!! bench_trade: %ld found distances below the exact bound at their own configuration: "
+                 "the search is wrong, the looseness figures are not trustworthy !!!!!!!!\n",
+                 search_faults);
   if (violations > 0) {
     std::fprintf(stderr, "\n!!!!!!!! bench_trade: %ld BOUND VIOLATIONS (see above) !!!!!!!!\n", violations);
     return 3;

@@ -39,10 +39,11 @@ Options parseOptions(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help") {
-      std::printf("bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]\n"
-                  "            [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]\n"
-                  "            [--exact default|margin|all|off|METRES] [--splits N] [--split-gap METRES]\n"
-                  "            [--markdown F] [--csv F] [--plot F.png]\n");
+      std::printf(
+          "bench_trade [--n N] [--quick] [--budgets 4,8,...] [--scenes humanoid,industrial_cell]\n"
+          "            [--repeats R] [--seed S] [--oracle own|library|both] [--search-effort K]\n"
+          "            [--exact default|margin|all|off|METRES] [--splits N] [--split-gap METRES]\n"
+          "            [--markdown F] [--csv F] [--plot F.png]\n");
       std::exit(0);
     }
     if (a == "--quick") {
@@ -69,21 +70,29 @@ Options parseOptions(int argc, char** argv) {
     } else if (a == "--seed") {
       o.seed = static_cast<std::uint64_t>(parseWhole(a, v, 0, 1L << 40));
     } else if (a == "--oracle") {
-      if (v == "own") o.oracle = Oracle::Own;
-      else if (v == "library") o.oracle = Oracle::Library;
-      else if (v == "both") o.oracle = Oracle::Both;
+      if (v == "own")
+        o.oracle = Oracle::Own;
+      else if (v == "library")
+        o.oracle = Oracle::Library;
+      else if (v == "both")
+        o.oracle = Oracle::Both;
       else {
         usageError("--oracle: expected own, library or both, got '" + v + "'");
       }
     } else if (a == "--exact") {
-      if (v == "default") o.exact_below = -1.0;
-      else if (v == "margin") o.exact_below = kExactAtMargin;
-      else if (v == "all") o.exact_below = kInf;
-      else if (v == "off") o.exact_below = -kInf;
+      if (v == "default")
+        o.exact_below = -1.0;
+      else if (v == "margin")
+        o.exact_below = kExactAtMargin;
+      else if (v == "all")
+        o.exact_below = kInf;
+      else if (v == "off")
+        o.exact_below = -kInf;
       else {
         char* end = nullptr;
         const double x = std::strtod(v.c_str(), &end);
-        if (v.empty() || *end != '\0' || !(x >= 0.0)) usageError("--exact: expected default, margin, all, off or a distance in metres, got '" + v + "'");
+        if (v.empty() || *end != '\0' || !(x >= 0.0))
+          usageError("--exact: expected default, margin, all, off or a distance in metres, got '" + v + "'");
         o.exact_below = x;
       }
     } else if (a == "--splits") {
@@ -91,7 +100,8 @@ Options parseOptions(int argc, char** argv) {
     } else if (a == "--split-gap") {
       char* end = nullptr;
       const double x = std::strtod(v.c_str(), &end);
-      if (v.empty() || *end != '\0' || !(x >= 0.0 && x <= 1e3)) usageError("--split-gap: expected metres >= 0, got '" + v + "'");
+      if (v.empty() || *end != '\0' || !(x >= 0.0 && x <= 1e3))
+        usageError("--split-gap: expected metres >= 0, got '" + v + "'");
       o.split_gap = x;
     } else if (a == "--markdown") {
       o.markdown = v;
@@ -108,6 +118,5 @@ Options parseOptions(int argc, char** argv) {
   }
   return o;
 }
-
 
 }  // namespace kccd::bench

@@ -28,7 +28,7 @@ struct Options {
   /// collision queries, the margin plus QueryOptions::exact_band for distance queries);
   /// kExactAtMargin the model's margin; +inf every pair; -inf off; else metres.
   double exact_below = -1.0;
-  int splits = kccd::QueryOptions{}.exact_splits;  ///< QueryOptions::exact_splits of the measured queries
+  int splits = kccd::QueryOptions{}.exact_splits;           ///< QueryOptions::exact_splits of the measured queries
   double split_gap = kccd::QueryOptions{}.exact_split_gap;  ///< QueryOptions::exact_split_gap of the measured queries
   std::string markdown, csv, plot;
 };

@@ -46,8 +46,8 @@ std::vector<int> BoxSearch::movingState(int pair) const {
 // Compass search: per moving coordinate try a step up and down, keep an improvement (and double
 // the step), otherwise halve it; until every step is below min_step or the evaluations run out.
 void BoxSearch::descend(int pair, const std::vector<int>& moving, std::span<const double> lower,
-                        std::span<const double> upper, int max_evaluations, double min_step,
-                        std::vector<double>& q, double& best, int& evaluations) {
+                        std::span<const double> upper, int max_evaluations, double min_step, std::vector<double>& q,
+                        double& best, int& evaluations) {
   std::vector<double> step(moving.size());
   for (std::size_t i = 0; i < moving.size(); ++i) {
     const auto s = static_cast<std::size_t>(moving[i]);

@@ -22,8 +22,8 @@ struct BoxSearchOptions {
 };
 
 struct BoxSearchResult {
-  double distance = 0.0;       ///< SSCH distance at `state` (nominal geometry)
-  std::vector<double> state;   ///< inside the box
+  double distance = 0.0;      ///< SSCH distance at `state` (nominal geometry)
+  std::vector<double> state;  ///< inside the box
   int evaluations = 0;
 };
 
@@ -43,9 +43,8 @@ class BoxSearch {
   // The state values that change the pair's distance: joints between each body and the pair's
   // common ancestor frame (joints above it move both bodies rigidly).
   std::vector<int> movingState(int pair) const;
-  void descend(int pair, const std::vector<int>& moving, std::span<const double> lower,
-               std::span<const double> upper, int max_evaluations, double min_step,
-               std::vector<double>& q, double& best, int& evaluations);
+  void descend(int pair, const std::vector<int>& moving, std::span<const double> lower, std::span<const double> upper,
+               int max_evaluations, double min_step, std::vector<double>& q, double& best, int& evaluations);
 
   const Model& model_;
   std::vector<Pose> poses_;

@@ -35,8 +35,8 @@ struct Axes {
   }
 };
 
-void text(cv::Mat& img, const std::string& s, cv::Point p, double scale, const cv::Scalar& colour,
-          bool centred = false, bool right = false) {
+void text(cv::Mat& img, const std::string& s, cv::Point p, double scale, const cv::Scalar& colour, bool centred = false,
+          bool right = false) {
   int base = 0;
   const cv::Size size = cv::getTextSize(s, kFont, scale, 1, &base);
   if (centred) p.x -= size.width / 2;
@@ -144,8 +144,8 @@ void drawCell(cv::Mat& img, cv::Rect cell, const TradeCell& c) {
 
 }  // namespace
 
-bool writeTradePlot(const std::string& path, const std::string& title, const std::vector<TradeCell>& cells,
-                    int columns, std::string& error) {
+bool writeTradePlot(const std::string& path, const std::string& title, const std::vector<TradeCell>& cells, int columns,
+                    std::string& error) {
   const int cw = 760, ch = 560, header = 44;
   const int rows = (static_cast<int>(cells.size()) + columns - 1) / columns;
   cv::Mat img(header + rows * ch, columns * cw, CV_8UC3, kWhite);

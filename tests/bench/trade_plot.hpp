@@ -17,18 +17,18 @@ struct TradePoint {
 };
 
 struct TradeSeries {
-  std::string label;             ///< e.g. the sweep mode
+  std::string label;  ///< e.g. the sweep mode
   std::vector<TradePoint> points;
 };
 
 struct TradeCell {
-  std::string title;             ///< scene and box set
+  std::string title;  ///< scene and box set
   std::vector<TradeSeries> series;
 };
 
 /// Draws `cells` in a grid `columns` wide and writes a PNG. Returns false with `error` set when
 /// the file cannot be written.
-bool writeTradePlot(const std::string& path, const std::string& title, const std::vector<TradeCell>& cells,
-                    int columns, std::string& error);
+bool writeTradePlot(const std::string& path, const std::string& title, const std::vector<TradeCell>& cells, int columns,
+                    std::string& error);
 
 }  // namespace kccd::bench

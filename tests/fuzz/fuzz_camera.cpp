@@ -9,8 +9,8 @@
 #include <unistd.h>
 
 #include "fuzz_support.hpp"
-#include "kccd/input_error.hpp"
 #include "kccd/calib/camera.hpp"
+#include "kccd/input_error.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string path = kccd::fuzz::writeInput("fuzz_camera", "camera.yaml", data, size);

@@ -15,7 +15,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static const std::string magic("SQLite format 3\0", 16);
   std::string bytes(reinterpret_cast<const char*>(data), size);
   if (bytes.compare(0, magic.size(), magic) != 0) bytes = magic + bytes;
-  const std::string path = kccd::fuzz::writeInput("fuzz_db3", "log.db3", reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
+  const std::string path =
+      kccd::fuzz::writeInput("fuzz_db3", "log.db3", reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
   kccd::fuzz::summarizeOrExplain(path);
   std::remove(path.c_str());
   return 0;

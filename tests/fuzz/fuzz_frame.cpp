@@ -18,7 +18,8 @@ namespace {
 
 const kccd::calib::TagLayout& layout() {
   static const kccd::calib::TagLayout l = kccd::calib::parseTagLayout(
-      "tags:\n  - {id: 0, size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n  - {id: 3, size: 0.1, xyz: [1, 0, 0], rpy: [0, 0, 0]}\n"
+      "tags:\n  - {id: 0, size: 0.1, xyz: [0, 0, 0], rpy: [0, 0, 0]}\n  - {id: 3, size: 0.1, xyz: [1, 0, 0], rpy: [0, "
+      "0, 0]}\n"
       "  - {id: 17, size: 0.2, xyz: [0, 1, 0], rpy: [1.57, 0, 0]}\n",
       "fuzz_frame layout");
   return l;

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "fuzz_support.hpp"
-#include "kccd/overlay/recording/frame_times.hpp"
 #include "kccd/input_error.hpp"
+#include "kccd/overlay/recording/frame_times.hpp"
 
 namespace {
 

@@ -19,9 +19,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::set<std::string> ids;
     if (m.cases.empty()) std::abort();
     for (const kccd::overlay::GoldenCase& c : m.cases) {
-      if (!ids.insert(c.id).second || c.id.empty() || c.id.find('/') != std::string::npos || c.id[0] == '.') std::abort();
+      if (!ids.insert(c.id).second || c.id.empty() || c.id.find('/') != std::string::npos || c.id[0] == '.')
+        std::abort();
       const int kinds = !c.state.empty() + !c.lower.empty() + c.hasVideo();
-      if (kinds != 1 || c.lower.size() != c.upper.size() || c.model.empty() || c.camera.empty() || c.outputs.empty()) std::abort();
+      if (kinds != 1 || c.lower.size() != c.upper.size() || c.model.empty() || c.camera.empty() || c.outputs.empty())
+        std::abort();
       for (std::size_t k = 0; k < c.lower.size(); ++k)
         if (!(c.lower[k] <= c.upper[k])) std::abort();
       if (c.hasVideo() && (c.frame < 0 || c.states.empty())) std::abort();

@@ -41,7 +41,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const kccd::overlay::JointSource& s = map.states[k];
       if (s.state != names[k]) std::abort();
       if (s.constant ? !std::isfinite(*s.constant) || !s.from.empty() : s.from.empty()) std::abort();
-      if (!std::isfinite(s.scale) || s.scale == 0.0 || std::abs(s.scale) > 1e6 || !std::isfinite(s.offset) || std::abs(s.offset) > 1e6)
+      if (!std::isfinite(s.scale) || s.scale == 0.0 || std::abs(s.scale) > 1e6 || !std::isfinite(s.offset) ||
+          std::abs(s.offset) > 1e6)
         std::abort();
     }
   } catch (const kccd::InputError& e) {

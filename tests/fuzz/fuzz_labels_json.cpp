@@ -20,7 +20,8 @@ bool same(const kccd::calib::Labels& a, const kccd::calib::Labels& b) {
   for (std::size_t i = 0; i < a.labels.size(); ++i) {
     const kccd::calib::Label& x = a.labels[i];
     const kccd::calib::Label& y = b.labels[i];
-    if (x.name != y.name || x.pixel != y.pixel || x.world != y.world || x.body != y.body || x.state != y.state) return false;
+    if (x.name != y.name || x.pixel != y.pixel || x.world != y.world || x.body != y.body || x.state != y.state)
+      return false;
     if (!x.world && x.point != y.point) return false;
   }
   return true;
@@ -33,7 +34,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (doc.is_discarded()) return 0;
   try {
     const kccd::calib::Labels labels = kccd::overlay::parseLabelsDocument(doc, "labels.yaml");
-    const kccd::calib::Labels again = kccd::overlay::parseLabelsDocument(kccd::overlay::labelsJson(labels), "labels.yaml");
+    const kccd::calib::Labels again =
+        kccd::overlay::parseLabelsDocument(kccd::overlay::labelsJson(labels), "labels.yaml");
     if (!same(labels, again)) std::abort();  // the round trip lost or changed something
   } catch (const kccd::calib::LabelsError&) {
     // rejected with a message: fine

@@ -20,7 +20,8 @@ inline void summarizeOrExplain(const std::string& path) {
     std::uint64_t n = 0;
     for (const auto& t : b.topics) {
       n += t.count;
-      if (t.count == 0 || t.first_log_time > t.last_log_time || t.stamped > t.count || t.zero_stamps > t.stamped) std::abort();
+      if (t.count == 0 || t.first_log_time > t.last_log_time || t.stamped > t.count || t.zero_stamps > t.stamped)
+        std::abort();
     }
     if (n != b.messages) std::abort();
   } catch (const kccd::InputError& e) {

@@ -12,8 +12,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // Every input is read as a ROS 1 bag: the magic first, so the fuzzer need not find it.
   std::string bytes = "#ROSBAG V2.0\n";
   bytes.append(reinterpret_cast<const char*>(data), size);
-  if (size >= 13 && std::string(reinterpret_cast<const char*>(data), 13) == "#ROSBAG V2.0\n") bytes.assign(reinterpret_cast<const char*>(data), size);
-  const std::string path = kccd::fuzz::writeInput("fuzz_ros1_bag", "log.bag", reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
+  if (size >= 13 && std::string(reinterpret_cast<const char*>(data), 13) == "#ROSBAG V2.0\n")
+    bytes.assign(reinterpret_cast<const char*>(data), size);
+  const std::string path = kccd::fuzz::writeInput("fuzz_ros1_bag", "log.bag",
+                                                  reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
   kccd::fuzz::summarizeOrExplain(path);
   return 0;
 }

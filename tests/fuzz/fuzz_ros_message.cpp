@@ -18,7 +18,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using namespace kccd::logs;
   if (size < 3) return 0;
   const Dialect dialect = (data[0] & 1) ? Dialect::Ros1 : Dialect::Ros2;
-  const std::size_t n = std::min<std::size_t>(size - 3, static_cast<std::size_t>(data[1]) | (static_cast<std::size_t>(data[2]) << 8));
+  const std::size_t n =
+      std::min<std::size_t>(size - 3, static_cast<std::size_t>(data[1]) | (static_cast<std::size_t>(data[2]) << 8));
   const std::string_view text(reinterpret_cast<const char*>(data + 3), n);
   const std::span<const std::uint8_t> message(data + 3 + n, size - 3 - n);
   std::optional<MessageDefinitions> types;

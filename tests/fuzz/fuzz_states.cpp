@@ -51,7 +51,8 @@ void checkLog(const kccd::StateLog& log) {
     check(std::isfinite(log.times[r]) && std::abs(log.times[r]) <= kccd::kMaxStateLogMagnitude, "time bound");
     check(r == 0 || log.times[r] > log.times[r - 1], "time order");
   }
-  for (const double v : log.values) check(std::isfinite(v) && std::abs(v) <= kccd::kMaxStateLogMagnitude, "value bound");
+  for (const double v : log.values)
+    check(std::isfinite(v) && std::abs(v) <= kccd::kMaxStateLogMagnitude, "value bound");
   for (std::size_t k = 0; k < log.velocities.size(); ++k)
     check(log.logged_velocity[k % n] ? std::abs(log.velocities[k]) <= kccd::kMaxStateLogMagnitude
                                      : std::isnan(log.velocities[k]),
@@ -88,7 +89,8 @@ void checkLog(const kccd::StateLog& log) {
         const double a = log.values[i], b = log.values[n + i];
         const double slack = 1e-12 * std::max(std::abs(a), std::abs(b)) + std::numeric_limits<double>::denorm_min();
         if (log.circular[i])
-          check(std::min(std::abs(state[i] - a), std::abs(state[i] - b)) <= 3.2 + slack, "unwrapped value near its samples");
+          check(std::min(std::abs(state[i] - a), std::abs(state[i] - b)) <= 3.2 + slack,
+                "unwrapped value near its samples");
         else
           check(state[i] >= std::min(a, b) - slack && state[i] <= std::max(a, b) + slack, "value between its samples");
       }

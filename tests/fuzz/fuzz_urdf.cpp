@@ -21,7 +21,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     // One core point and a 1 m tolerance: the fits stay quick (the simplified hull meets it with
     // four points, the K = 1 fit is tried); meshes are looked up next to the input (none there).
-    (void)kccd::modelling::importUrdf(path, {.fit = {.method = kccd::modelling::FitMethod::Tolerance, .points = 1, .tolerance = 1.0, .max_pieces = 8}});
+    (void)kccd::modelling::importUrdf(
+        path,
+        {.fit = {.method = kccd::modelling::FitMethod::Tolerance, .points = 1, .tolerance = 1.0, .max_pieces = 8}});
   } catch (const kccd::InputError& e) {
     kccd::fuzz::checkMessage(e.what(), path);
   }

@@ -4,6 +4,7 @@
 //   reader_bound_NAME [--bound SECONDS] FILE_OR_DIR...
 // A watchdog thread ends the process (exit 1, naming the input) the moment an input passes the
 // bound, so a hang is reported instead of stalling the suite. Prints the slowest inputs.
+#include <unistd.h>
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
@@ -17,7 +18,6 @@
 #include <random>
 #include <string>
 #include <thread>
-#include <unistd.h>
 #include <utility>
 #include <vector>
 
@@ -57,9 +57,12 @@ void derived(const std::string& name, const std::string& seed, std::vector<Input
   const std::size_t end = std::min(seed.find('\n', mid), seed.size() - 1) + 1;
   const std::string line = seed.substr(begin, end - begin);
   if (seed.size() < kMiB)
-    out.push_back({name + " with its middle line repeated to 1 MiB", seed.substr(0, begin) + tile(line, kMiB - seed.size()) + seed.substr(begin)});
-  out.push_back({name + " with 1 MiB of 'a' in its middle", seed.substr(0, mid) + std::string(kMiB, 'a') + seed.substr(mid)});
-  out.push_back({name + " with 1 MiB of '9' in its middle", seed.substr(0, mid) + std::string(kMiB, '9') + seed.substr(mid)});
+    out.push_back({name + " with its middle line repeated to 1 MiB",
+                   seed.substr(0, begin) + tile(line, kMiB - seed.size()) + seed.substr(begin)});
+  out.push_back(
+      {name + " with 1 MiB of 'a' in its middle", seed.substr(0, mid) + std::string(kMiB, 'a') + seed.substr(mid)});
+  out.push_back(
+      {name + " with 1 MiB of '9' in its middle", seed.substr(0, mid) + std::string(kMiB, '9') + seed.substr(mid)});
   out.push_back({name + " cut at 1/3", seed.substr(0, seed.size() / 3)});
   out.push_back({name + " cut at 2/3", seed.substr(0, 2 * seed.size() / 3)});
 }
@@ -74,13 +77,15 @@ void generic(std::vector<Input>& out) {
   out.push_back({"nested XML elements, 1 MiB", tile("<a>", half) + tile("</a>", half)});
   out.push_back({"nested YAML block lists, 1 MiB", [] {
                    std::string s;
-                   for (std::size_t depth = 0; s.size() < kMiB - 4096; ++depth) s += std::string(depth % 2000, ' ') + "- \n";
+                   for (std::size_t depth = 0; s.size() < kMiB - 4096; ++depth)
+                     s += std::string(depth % 2000, ' ') + "- \n";
                    return s;
                  }()});
   out.push_back({"YAML anchors and aliases, 1 MiB", [] {
                    std::string s = "a0: &a0 [1, 2]\n";
                    for (int i = 1; s.size() < kMiB - 64; ++i)
-                     s += "a" + std::to_string(i) + ": &a" + std::to_string(i) + " [*a" + std::to_string(i - 1) + ", *a" + std::to_string(i - 1) + "]\n";
+                     s += "a" + std::to_string(i) + ": &a" + std::to_string(i) + " [*a" + std::to_string(i - 1) +
+                          ", *a" + std::to_string(i - 1) + "]\n";
                    return s;
                  }()});
   out.push_back({"one key repeated, 1 MiB", tile("key: 1\n")});
@@ -121,8 +126,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> paths;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--bound" && i + 1 < argc) bound = std::atof(argv[++i]);
-    else paths.push_back(a);
+    if (a == "--bound" && i + 1 < argc)
+      bound = std::atof(argv[++i]);
+    else
+      paths.push_back(a);
   }
   const char* name = argv[0];
   if (const char* slash = std::strrchr(argv[0], '/')) name = slash + 1;
@@ -151,8 +158,8 @@ int main(int argc, char** argv) {
       const Input* watched = dog.current;
       const auto deadline = dog.started + std::chrono::duration<double>(bound);
       if (dog.cv.wait_until(lock, deadline, [&] { return dog.done || dog.current != watched; })) continue;
-      std::fprintf(stderr, "%s: FAILED: the reader ran past the bound of %g s on '%s' (%zu bytes): a hang\n", name, bound,
-                   watched->name.c_str(), watched->bytes.size());
+      std::fprintf(stderr, "%s: FAILED: the reader ran past the bound of %g s on '%s' (%zu bytes): a hang\n", name,
+                   bound, watched->name.c_str(), watched->bytes.size());
       std::fflush(stderr);
       std::_Exit(1);
     }
@@ -186,8 +193,10 @@ int main(int argc, char** argv) {
   dog.cv.notify_all();
   watcher.join();
   std::sort(times.begin(), times.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-  std::printf("%s: %zu inputs (up to 1 MiB) in %.3f s, each within the bound of %g s; slowest:\n", name, inputs.size(), total, bound);
+  std::printf("%s: %zu inputs (up to 1 MiB) in %.3f s, each within the bound of %g s; slowest:\n", name, inputs.size(),
+              total, bound);
   for (std::size_t i = 0; i < std::min<std::size_t>(3, times.size()); ++i)
-    std::printf("  %8.3f s  %s (%zu bytes)\n", times[i].first, times[i].second->name.c_str(), times[i].second->bytes.size());
+    std::printf("  %8.3f s  %s (%zu bytes)\n", times[i].first, times[i].second->name.c_str(),
+                times[i].second->bytes.size());
   return 0;
 }

@@ -73,7 +73,8 @@ inline cv::Vec3d cameraCentre(const Camera& c) {
 
 inline cv::Point2d cvProject(const Camera& c, const Vec3& p) {
   std::vector<cv::Point2d> out;
-  cv::projectPoints(std::vector<cv::Point3d>{{p.x(), p.y(), p.z()}}, c.rvec, c.tvec, c.camera_matrix, c.distortion, out);
+  cv::projectPoints(std::vector<cv::Point3d>{{p.x(), p.y(), p.z()}}, c.rvec, c.tvec, c.camera_matrix, c.distortion,
+                    out);
   return out[0];
 }
 

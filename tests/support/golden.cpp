@@ -51,8 +51,9 @@ void storeRenderer(const std::string& renderer) {
     return ::testing::AssertionSuccess();
   }
   const std::string stored = storedRenderer();
-  const std::string renderer_note =
-      stored == renderer ? "" : "\n[golden] warning: goldens were made with renderer '" + stored + "', this is '" + renderer + "'";
+  const std::string renderer_note = stored == renderer ? ""
+                                                       : "\n[golden] warning: goldens were made with renderer '" +
+                                                             stored + "', this is '" + renderer + "'";
   const cv::Mat golden = cv::imread(golden_path.string(), cv::IMREAD_UNCHANGED);
   fs::create_directories(kOutDir);
   const fs::path actual_path = kOutDir / (name + ".actual.png"), diff_path = kOutDir / (name + ".diff.png");

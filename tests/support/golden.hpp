@@ -20,9 +20,9 @@
 namespace kccd::testing {
 
 struct GoldenTolerance {
-  int threshold = 24;           ///< per-channel difference that counts a pixel as different
-  double max_fraction = 0.0025; ///< allowed fraction of different pixels
-  int min_pixels = 4;           ///< allowed different pixels at least
+  int threshold = 24;            ///< per-channel difference that counts a pixel as different
+  double max_fraction = 0.0025;  ///< allowed fraction of different pixels
+  int min_pixels = 4;            ///< allowed different pixels at least
 };
 
 /// Compares `actual` with the golden `name` (see above). `renderer` is the GL renderer string.

@@ -7,7 +7,9 @@
 namespace kccd::testing {
 namespace {
 
-double uniform(std::mt19937_64& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
 int uniformInt(std::mt19937_64& rng, int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); }
 
 Eigen::Matrix3d axisAngle(const Vec3& w) {
@@ -58,8 +60,11 @@ Model randomModel(std::mt19937_64& rng, int max_joints, int max_bodies, MobileBa
     j.name.insert(0, 1, 'j');
     j.parent = uniformInt(rng, -1, i - 1);
     const int t = uniformInt(rng, 0, 9);
-    j.type = t < 5 ? JointType::Revolute : t < 7 ? JointType::Prismatic : t < 8 ? JointType::Fixed
-           : t < 9 ? JointType::Translation3d : JointType::Rotation3d;
+    j.type = t < 5   ? JointType::Revolute
+             : t < 7 ? JointType::Prismatic
+             : t < 8 ? JointType::Fixed
+             : t < 9 ? JointType::Translation3d
+                     : JointType::Rotation3d;
     j.origin = Pose::Identity();
     j.origin.linear() = randomRotation(rng);
     j.origin.translation() = Vec3(uniform(rng, -0.4, 0.4), uniform(rng, -0.4, 0.4), uniform(rng, -0.4, 0.4));
@@ -119,7 +124,7 @@ Sample sampleBox(std::mt19937_64& rng, const Model& m, const std::vector<double>
     // Errors at their bound (the worst case) most of the time, inside it otherwise.
     const double fraction = uniform(rng, 0.0, 1.0) < 0.7 ? 1.0 : uniform(rng, 0.0, 1.0);
     s.translation_error.push_back(j.type == JointType::Translation3d ? Vec3(randomUnit(rng) * j.error * fraction)
-                                                                      : Vec3::Zero());
+                                                                     : Vec3::Zero());
     s.rotation_error.push_back(j.type == JointType::Rotation3d ? axisAngle(randomUnit(rng) * j.error * fraction)
                                                                : Eigen::Matrix3d::Identity());
     s.error_first.push_back(uniform(rng, 0.0, 1.0) < 0.5);
@@ -134,10 +139,17 @@ std::vector<Pose> jointPoses(const Model& m, const Sample& s) {
     const double* q = s.q.data() + j.state_offset;
     Pose motion = Pose::Identity();
     switch (j.type) {
-      case JointType::Fixed: break;
-      case JointType::Revolute: motion.linear() = Eigen::AngleAxisd(q[0], j.axis).toRotationMatrix(); break;
-      case JointType::Prismatic: motion.translation() = q[0] * j.axis; break;
-      case JointType::Translation3d: motion.translation() = Vec3(q[0], q[1], q[2]) + s.translation_error[i]; break;
+      case JointType::Fixed:
+        break;
+      case JointType::Revolute:
+        motion.linear() = Eigen::AngleAxisd(q[0], j.axis).toRotationMatrix();
+        break;
+      case JointType::Prismatic:
+        motion.translation() = q[0] * j.axis;
+        break;
+      case JointType::Translation3d:
+        motion.translation() = Vec3(q[0], q[1], q[2]) + s.translation_error[i];
+        break;
       case JointType::Rotation3d: {
         const Eigen::Matrix3d measured = axisAngle(Vec3(q[0], q[1], q[2]));
         motion.linear() = s.error_first[i] ? Eigen::Matrix3d(measured * s.rotation_error[i])

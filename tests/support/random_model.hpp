@@ -25,9 +25,9 @@ void randomBox(std::mt19937_64& rng, const Model& m, std::vector<double>& lower,
 /// One configuration drawn from the box, with a realisation of every joint's error bound.
 struct Sample {
   std::vector<double> q;
-  std::vector<Vec3> translation_error;   // per joint (translation3d)
+  std::vector<Vec3> translation_error;          // per joint (translation3d)
   std::vector<Eigen::Matrix3d> rotation_error;  // per joint (rotation3d)
-  std::vector<bool> error_first;          // rotation3d: apply the error before the measured rotation
+  std::vector<bool> error_first;                // rotation3d: apply the error before the measured rotation
 };
 
 /// Corners, edge points and uniform points of the box; errors on their bound's surface or inside.

@@ -9,8 +9,7 @@
 namespace kccd::testing {
 
 /// Distance between conv(a) and conv(b) (0 when they intersect), accurate to ~1e-15 relative.
-long double referenceHullDistance(const std::vector<Eigen::Vector3d>& a,
-                                  const std::vector<Eigen::Vector3d>& b);
+long double referenceHullDistance(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b);
 
 /// Distance between the SSCHs (a, ra) and (b, rb): max(0, hull distance - ra - rb).
 long double referenceSschDistance(const std::vector<Eigen::Vector3d>& a, double ra,

@@ -6,9 +6,9 @@
 namespace kccd::testing {
 
 struct Outcome {
-  int code = -1;     ///< exit status (-1 when the program did not exit normally)
-  std::string out;   ///< standard output (and standard error with merge_stderr)
-  std::string err;   ///< standard error
+  int code = -1;    ///< exit status (-1 when the program did not exit normally)
+  std::string out;  ///< standard output (and standard error with merge_stderr)
+  std::string err;  ///< standard error
 };
 
 /// Runs `command` through the shell. Standard error goes to a file of its own per call and

@@ -20,7 +20,8 @@ namespace kccd::testing {
 // This is the 7x image itself (kSilhouetteScale); cpuSilhouette below samples it at pixel centres.
 // A smaller `k` (odd) is faster and follows pixel centres to about 0.5 / k px.
 constexpr int kSilhouetteScale = 7;
-inline cv::Mat cpuSilhouetteFine(const calib::Camera& c, const std::vector<Vec3>& pts, double radius, int k = kSilhouetteScale) {
+inline cv::Mat cpuSilhouetteFine(const calib::Camera& c, const std::vector<Vec3>& pts, double radius,
+                                 int k = kSilhouetteScale) {
   cv::Mat big = cv::Mat::zeros(c.height * k, c.width * k, CV_8UC1);
   std::vector<Vec3> centres = pts;
   const double step = radius / 6.0;
@@ -45,8 +46,7 @@ inline cv::Mat cpuSilhouetteFine(const calib::Camera& c, const std::vector<Vec3>
   std::vector<cv::Point3d> world(sphere.size());
   std::vector<cv::Point2d> img;
   for (const Vec3& ce : centres) {
-    for (std::size_t i = 0; i < sphere.size(); ++i)
-      world[i] = cv::Point3d(ce.x(), ce.y(), ce.z()) + radius * sphere[i];
+    for (std::size_t i = 0; i < sphere.size(); ++i) world[i] = cv::Point3d(ce.x(), ce.y(), ce.z()) + radius * sphere[i];
     cv::projectPoints(world, c.rvec, c.tvec, c.camera_matrix, c.distortion, img);
     std::vector<cv::Point> fixed;
     for (const cv::Point2d& p : img)
@@ -60,7 +60,8 @@ inline cv::Mat cpuSilhouetteFine(const calib::Camera& c, const std::vector<Vec3>
 }
 
 // The silhouette at pixel centres (1 inside, 0 outside).
-inline cv::Mat cpuSilhouette(const calib::Camera& c, const std::vector<Vec3>& pts, double radius, int k = kSilhouetteScale) {
+inline cv::Mat cpuSilhouette(const calib::Camera& c, const std::vector<Vec3>& pts, double radius,
+                             int k = kSilhouetteScale) {
   const cv::Mat big = cpuSilhouetteFine(c, pts, radius, k);
   cv::Mat out(c.height, c.width, CV_8UC1);
   for (int y = 0; y < c.height; ++y)

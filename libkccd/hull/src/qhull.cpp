@@ -18,8 +18,8 @@ QhullResult convexHull3(std::span<double> coords) {
   QHULL_LIB_CHECK
   qh_zero(qh, devnull);
   char options[] = "qhull Qt";
-  result.code = qh_new_qhull(qh, 3, static_cast<int>(coords.size() / 3), coords.data(), False, options, nullptr,
-                             devnull);
+  result.code =
+      qh_new_qhull(qh, 3, static_cast<int>(coords.size() / 3), coords.data(), False, options, nullptr, devnull);
   if (result.code == 0) {
     facetT* facet;
     vertexT *vertex, **vertexp;

@@ -9,11 +9,11 @@ namespace kccd {
 
 /// Per-joint-value braking parameters (SI units: m or rad, per s, per s^2).
 struct BrakingParams {
-  double position_error = 0.0;   ///< e_q: bound on the position measurement error
-  double velocity_error = 0.0;   ///< e_v: bound on the velocity measurement error
-  double latency = 0.0;          ///< t_l: one full cycle plus delays, seconds
-  double max_acceleration = 0.0; ///< a_acc: worst-case acceleration during the latency
-  double deceleration = 1.0;     ///< a_brk: guaranteed braking deceleration (> 0)
+  double position_error = 0.0;    ///< e_q: bound on the position measurement error
+  double velocity_error = 0.0;    ///< e_v: bound on the velocity measurement error
+  double latency = 0.0;           ///< t_l: one full cycle plus delays, seconds
+  double max_acceleration = 0.0;  ///< a_acc: worst-case acceleration during the latency
+  double deceleration = 1.0;      ///< a_brk: guaranteed braking deceleration (> 0)
 };
 
 /// Distance travelled in the positive direction before standing still, starting at speed u:
@@ -27,7 +27,6 @@ void brakingInterval(double q, double v, const BrakingParams& params, double& lo
 /// per state value, clamped to the joint limits where the model has them. Returns false (and
 /// leaves the output untouched) on wrong lengths, non-finite input or a deceleration <= 0.
 bool brakingIntervals(const Model& model, std::span<const double> q, std::span<const double> v,
-                      std::span<const BrakingParams> params, std::span<double> lower,
-                      std::span<double> upper) noexcept;
+                      std::span<const BrakingParams> params, std::span<double> lower, std::span<double> upper) noexcept;
 
 }  // namespace kccd

@@ -49,16 +49,16 @@ class Checker {
 
  private:
   struct Volume {
-    int offset = 0;       // into points_
+    int offset = 0;  // into points_
     int capacity = 0;
     int count = 0;
     double radius = 0.0;
-    Sphere bound;          // around the points (valid with stamp)
-    Sphere swept_sphere;   // swept cheaply from the level below (valid with sphere_stamp)
+    Sphere bound;         // around the points (valid with stamp)
+    Sphere swept_sphere;  // swept cheaply from the level below (valid with sphere_stamp)
     std::uint64_t stamp = 0;
     std::uint64_t sphere_stamp = 0;
   };
-  struct Entry {           // the any-time table
+  struct Entry {  // the any-time table
     bool valid = false;
     double bound = 0.0;    // lower bound for the box stored in box_
     double current = 0.0;  // bound valid for this query's box
@@ -110,56 +110,56 @@ class Checker {
   const Sphere* sphere(int body, int level, Box box) noexcept;
 
   const Model& model_;
-  std::vector<Vec3> points_;                 // arena of every volume's points
-  std::vector<int> level_begin_;             // per body: index of its level-0 volume in volumes_
-  std::vector<int> levels_;                  // per body: number of levels
+  std::vector<Vec3> points_;      // arena of every volume's points
+  std::vector<int> level_begin_;  // per body: index of its level-0 volume in volumes_
+  std::vector<int> levels_;       // per body: number of levels
   std::vector<Volume> volumes_;
-  std::vector<int> path_;                    // per body and level: the joint swept from that level
-  std::vector<int> pair_level_;              // per pair: level of a, level of b
-  std::vector<int> reach_begin_;             // per pair: its range in reach_state_ / reach_
-  std::vector<int> reach_state_;             // state values that move the pair
-  std::vector<double> reach_;                // how far they move its core points per unit change
+  std::vector<int> path_;         // per body and level: the joint swept from that level
+  std::vector<int> pair_level_;   // per pair: level of a, level of b
+  std::vector<int> reach_begin_;  // per pair: its range in reach_state_ / reach_
+  std::vector<int> reach_state_;  // state values that move the pair
+  std::vector<double> reach_;     // how far they move its core points per unit change
   std::vector<Entry> table_;
-  std::vector<double> box_;                  // per reach entry: the stored bound's lower, upper
+  std::vector<double> box_;  // per reach entry: the stored bound's lower, upper
   std::vector<Vec3> scratch_;
   std::vector<double> scratch_dist_;
-  std::vector<Vec3> scratch_alt_;            // the other cover of a sweep
+  std::vector<Vec3> scratch_alt_;  // the other cover of a sweep
   std::vector<int> scratch_order_;
-  std::vector<detail::RevoluteTrig> trig_;   // per joint: its last interval's trigonometry
+  std::vector<detail::RevoluteTrig> trig_;  // per joint: its last interval's trigonometry
   // The exact stage: per joint its vertex maps for this query, per body and level the chain
   // level (variant 0: chords only; 1: each joint's own mode), and the search's scratch.
   std::vector<detail::JointMaps> joint_maps_;
   std::vector<std::uint64_t> joint_maps_stamp_;
   std::vector<detail::ChainLevel> chain_[2];
   std::vector<std::uint64_t> chain_stamp_[2];
-  std::vector<double> chain_radius_[2];      // per body and level: radius of the chain up to it
+  std::vector<double> chain_radius_[2];         // per body and level: radius of the chain up to it
   std::vector<std::uint8_t> chain_tangent_[2];  // per body and level: some level uses apexes
-  std::vector<Sphere> base_sphere_;          // per body: sphere around its core points
-  std::vector<Vec3> base_box_;               // per body: centre and half-sizes of their box
+  std::vector<Sphere> base_sphere_;             // per body: sphere around its core points
+  std::vector<Vec3> base_box_;                  // per body: centre and half-sizes of their box
   std::vector<detail::ChainEntry> chain_stack_;
   std::vector<int> chain_choice_, chain_best_;
   double exact_below_ = 0.0;
   bool tight_volumes_ = false;
   std::vector<int> order_;
   std::vector<PairDistance> out_;
-  std::vector<std::uint8_t> fresh_;          // per pair: recomputed in this query
+  std::vector<std::uint8_t> fresh_;  // per pair: recomputed in this query
   std::vector<double> nbest_;
-  std::vector<double> lower_, upper_;        // the box of the last query (for sweptVolume())
+  std::vector<double> lower_, upper_;  // the box of the last query (for sweptVolume())
   // Splitting a pair's box (splitPair): per sub-box its lower and upper ends; per side and level
   // the extent of the volume below the level's joint.
-  int splits_ = 0;                           // sub-boxes per split pair this query (0: none)
-  double split_gap_ = 0.0;                    // QueryOptions::exact_split_gap, resolved
-  bool in_sub_box_ = false;                   // the exact stage is refining a sub-box of a split
+  int splits_ = 0;           // sub-boxes per split pair this query (0: none)
+  double split_gap_ = 0.0;   // QueryOptions::exact_split_gap, resolved
+  bool in_sub_box_ = false;  // the exact stage is refining a sub-box of a split
   std::vector<double> split_box_;
   std::vector<double> split_extent_;
   std::vector<double> centre_;
-  std::vector<Vec3> centre_points_;          // the pair's two bodies posed at one configuration
-  std::vector<int> split_order_;             // sub-boxes in the order they are refined
-  std::vector<double> split_key_;            // per sub-box: the posed distance at its centre
-  std::vector<double> split_grad_;           // per state value: the posed distance's derivative
-  std::vector<Pose> split_frames_;           // per side and level: the joint frame, posed
-  std::uint64_t stamps_ = 1;                 // the last stamp handed out
-  std::uint64_t cycle_ = 1;                  // volumes stamped with it are current (0: never)
+  std::vector<Vec3> centre_points_;  // the pair's two bodies posed at one configuration
+  std::vector<int> split_order_;     // sub-boxes in the order they are refined
+  std::vector<double> split_key_;    // per sub-box: the posed distance at its centre
+  std::vector<double> split_grad_;   // per state value: the posed distance's derivative
+  std::vector<Pose> split_frames_;   // per side and level: the joint frame, posed
+  std::uint64_t stamps_ = 1;         // the last stamp handed out
+  std::uint64_t cycle_ = 1;          // volumes stamped with it are current (0: never)
   // Swept spheres, joint maps and chains stamped with it are current: the query's box, or a
   // sub-box of splitPair (which takes a stamp of its own and leaves a fresh one for the box).
   std::uint64_t geo_cycle_ = 1;

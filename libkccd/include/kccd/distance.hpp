@@ -20,7 +20,7 @@ enum class GjkStatus : std::uint8_t {
 
 /// Tuning of one distance call. The defaults give about 1e-12 relative accuracy.
 struct GjkOptions {
-  int max_iterations = 128;         ///< hard bound on the iteration count
+  int max_iterations = 128;           ///< hard bound on the iteration count
   double relative_tolerance = 1e-12;  ///< stop when (upper - lower) <= tol * upper
   /// Stop as soon as the SSCH distance is proven to be >= this (e.g. the safety margin).
   double stop_above = std::numeric_limits<double>::infinity();
@@ -54,7 +54,7 @@ DistanceResult distance(const SschView& a, const SschView& b, const GjkOptions& 
 /// Penetration estimate for overlapping volumes (libccd MPR), for reporting only.
 struct Penetration {
   bool overlapping = false;
-  double depth = 0.0;          ///< approximate depth; 0 when not overlapping
+  double depth = 0.0;             ///< approximate depth; 0 when not overlapping
   Vec3 direction = Vec3::Zero();  ///< unit direction to move b by `depth` to separate it
   Vec3 position = Vec3::Zero();   ///< a point in the overlap
 };

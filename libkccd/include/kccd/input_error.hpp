@@ -55,7 +55,9 @@ class InputError : public std::runtime_error {
 /// empty one leaves the field as it is (Python's keyword, a manifest's key).
 using FieldSpelling = std::function<std::string(const std::string& field)>;
 /// `field` as `spell` spells it.
-inline std::string spelledField(const FieldSpelling& spell, const std::string& field) { return spell ? spell(field) : field; }
+inline std::string spelledField(const FieldSpelling& spell, const std::string& field) {
+  return spell ? spell(field) : field;
+}
 
 /// A request's field out of range: "must be in [lo, hi], got value" (NaN refused), thrown as an
 /// InputError with the field and no source. Returns `value`.

@@ -28,15 +28,15 @@ enum class SweepMode : std::uint8_t { Exact, Accurate };
 /// zero state); its children and bodies move with it.
 struct Joint {
   std::string name;
-  int parent = kWorld;          ///< index of the parent joint, or kWorld
+  int parent = kWorld;  ///< index of the parent joint, or kWorld
   JointType type = JointType::Fixed;
   Pose origin = Pose::Identity();
-  Vec3 axis = Vec3::UnitZ();    ///< unit axis (revolute / prismatic)
+  Vec3 axis = Vec3::UnitZ();  ///< unit axis (revolute / prismatic)
   SweepMode sweep = SweepMode::Accurate;
   std::optional<std::array<double, 2>> limits;  ///< position limits (1-DOF joints)
-  double error = 0.0;           ///< translation3d: metres; rotation3d: radians
-  int state_offset = 0;         ///< first index of this joint's values in the state vector
-  int dof = 0;                  ///< number of state values (0, 1 or 3)
+  double error = 0.0;                           ///< translation3d: metres; rotation3d: radians
+  int state_offset = 0;                         ///< first index of this joint's values in the state vector
+  int dof = 0;                                  ///< number of state values (0, 1 or 3)
 };
 
 /// One rigid body: an SSCH in the frame of a joint (or the world).
@@ -61,10 +61,10 @@ struct Visual {
   enum class Shape : std::uint8_t { Mesh, Box, Cylinder, Sphere };
   int frame = kWorld;
   Shape shape = Shape::Mesh;
-  std::string mesh;                   ///< Mesh: the file (relative paths resolved against the model file's folder)
-  Vec3 scale = Vec3::Ones();          ///< Mesh: scale per axis, in the mesh's frame
-  Vec3 size = Vec3::Zero();           ///< Box: full sizes; Cylinder: radius, radius, length (along z); Sphere: radius in x
-  Pose origin = Pose::Identity();     ///< pose in the frame
+  std::string mesh;                ///< Mesh: the file (relative paths resolved against the model file's folder)
+  Vec3 scale = Vec3::Ones();       ///< Mesh: scale per axis, in the mesh's frame
+  Vec3 size = Vec3::Zero();        ///< Box: full sizes; Cylinder: radius, radius, length (along z); Sphere: radius in x
+  Pose origin = Pose::Identity();  ///< pose in the frame
   std::array<double, 4> colour{0.7, 0.7, 0.7, 1.0};  ///< RGBA, 0..1
 };
 
@@ -113,12 +113,12 @@ class Model {
  public:
   std::string name;
   double safety_margin = 0.0;
-  int point_budget = 32;        ///< max core points of any swept volume
-  std::vector<Joint> joints;    ///< parents always precede children
+  int point_budget = 32;      ///< max core points of any swept volume
+  std::vector<Joint> joints;  ///< parents always precede children
   std::vector<Body> bodies;
   std::vector<BodyPair> pairs;
   std::vector<IgnoredPair> ignored;  ///< the file's `pairs: ignore` entries, in file order
-  std::vector<Visual> visuals;  ///< appearance for drawing (optional)
+  std::vector<Visual> visuals;       ///< appearance for drawing (optional)
 
   /// Number of state values.
   int stateSize() const { return state_size_; }

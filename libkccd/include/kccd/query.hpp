@@ -14,11 +14,11 @@ namespace kccd {
 /// Outcome of a query. Anything but Ok must be treated as a collision.
 enum class Status : std::uint8_t {
   Ok,
-  WrongStateSize,     ///< lower/upper length differs from Model::stateSize()
-  NonFiniteState,     ///< NaN or infinite state value
-  LowerAboveUpper,    ///< an interval with lower > upper
-  ExactNeedsPoint,    ///< a joint with `sweep: exact` was given a non-zero-width interval
-  NumericalFailure,   ///< a swept volume became non-finite (e.g. overflow)
+  WrongStateSize,    ///< lower/upper length differs from Model::stateSize()
+  NonFiniteState,    ///< NaN or infinite state value
+  LowerAboveUpper,   ///< an interval with lower > upper
+  ExactNeedsPoint,   ///< a joint with `sweep: exact` was given a non-zero-width interval
+  NumericalFailure,  ///< a swept volume became non-finite (e.g. overflow)
 };
 const char* toString(Status status);
 
@@ -91,20 +91,20 @@ std::optional<double> exactBelowFromWord(std::string_view word, double margin);
 
 /// One pair in a result. `distance` is a lower bound over the whole interval box.
 struct PairDistance {
-  int pair = -1;            ///< index into Model::pairs
+  int pair = -1;  ///< index into Model::pairs
   double distance = 0.0;
-  bool fresh = false;       ///< recomputed in this query (else carried over from earlier ones)
-  bool has_witness = false; ///< fresh and computed by GJK: witness points are valid
+  bool fresh = false;             ///< recomputed in this query (else carried over from earlier ones)
+  bool has_witness = false;       ///< fresh and computed by GJK: witness points are valid
   Vec3 witness_a = Vec3::Zero();  ///< closest points found, in the pair's LCA frame
   Vec3 witness_b = Vec3::Zero();
 };
 
 struct QueryStats {
   double time_us = 0.0;
-  int pairs_checked = 0;    ///< pairs whose bound was recomputed
+  int pairs_checked = 0;  ///< pairs whose bound was recomputed
   int gjk_calls = 0;
-  int exact_calls = 0;      ///< distance computations of the exact stage
-  int split_pairs = 0;      ///< pairs whose box was split (QueryOptions::exact_splits)
+  int exact_calls = 0;  ///< distance computations of the exact stage
+  int split_pairs = 0;  ///< pairs whose box was split (QueryOptions::exact_splits)
   int volumes_swept = 0;
   bool budget_exhausted = false;  ///< a time or work budget stopped refinement (answer still conservative)
 };
@@ -114,8 +114,8 @@ struct QueryStats {
 struct QueryResult {
   Status status = Status::Ok;
   QueryType type = QueryType::Collision;
-  bool collision = true;          ///< some pair's bound is <= margin (or status is not Ok)
-  double min_distance = 0.0;      ///< smallest lower bound over all pairs (+inf without pairs)
+  bool collision = true;      ///< some pair's bound is <= margin (or status is not Ok)
+  double min_distance = 0.0;  ///< smallest lower bound over all pairs (+inf without pairs)
   double margin = 0.0;
   std::span<const PairDistance> pairs;  ///< per type: the colliding pair, the closest, the N closest, or all
   QueryStats stats;

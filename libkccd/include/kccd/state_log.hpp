@@ -32,14 +32,14 @@ inline constexpr double kStateTimeTolerance = 1e-9;
 
 /// A parsed log: samples in time order, values in the model's state order.
 struct StateLog {
-  std::vector<std::string> names;            ///< model.stateNames() at parse time
-  std::vector<std::uint8_t> circular;        ///< per value: 1 for a revolute joint without limits (unwrapped)
-  std::vector<std::uint8_t> logged_velocity; ///< per value: 1 when the log has its NAME.vel column
-  std::vector<double> times;                 ///< seconds, strictly increasing, at least one
-  std::vector<double> values;                ///< times.size() x names.size(), row-major
-  std::vector<double> velocities;            ///< same shape when any NAME.vel column was read (NaN where a
-                                             ///< value has none), otherwise empty
-  std::vector<std::string> ignored;          ///< the header's ignored columns, in file order
+  std::vector<std::string> names;             ///< model.stateNames() at parse time
+  std::vector<std::uint8_t> circular;         ///< per value: 1 for a revolute joint without limits (unwrapped)
+  std::vector<std::uint8_t> logged_velocity;  ///< per value: 1 when the log has its NAME.vel column
+  std::vector<double> times;                  ///< seconds, strictly increasing, at least one
+  std::vector<double> values;                 ///< times.size() x names.size(), row-major
+  std::vector<double> velocities;             ///< same shape when any NAME.vel column was read (NaN where a
+                                              ///< value has none), otherwise empty
+  std::vector<std::string> ignored;           ///< the header's ignored columns, in file order
 
   std::size_t rows() const { return times.size(); }
   std::size_t stateSize() const { return names.size(); }

@@ -38,9 +38,8 @@ Principal principal(std::span<const Vec3> points) {
 std::vector<int> hull2d(const std::vector<Eigen::Vector2d>& q) {
   std::vector<int> idx(q.size());
   for (std::size_t i = 0; i < q.size(); ++i) idx[i] = static_cast<int>(i);
-  std::sort(idx.begin(), idx.end(), [&](int a, int b) {
-    return q[a].x() < q[b].x() || (q[a].x() == q[b].x() && q[a].y() < q[b].y());
-  });
+  std::sort(idx.begin(), idx.end(),
+            [&](int a, int b) { return q[a].x() < q[b].x() || (q[a].x() == q[b].x() && q[a].y() < q[b].y()); });
   auto cross = [&](int o, int a, int b) {
     return (q[a] - q[o]).x() * (q[b] - q[o]).y() - (q[a] - q[o]).y() * (q[b] - q[o]).x();
   };

@@ -30,9 +30,7 @@ struct Grid {
   std::array<int, 3> size{0, 0, 0};
   std::vector<std::uint8_t> solid;
 
-  std::size_t index(int x, int y, int z) const {
-    return (static_cast<std::size_t>(z) * size[1] + y) * size[0] + x;
-  }
+  std::size_t index(int x, int y, int z) const { return (static_cast<std::size_t>(z) * size[1] + y) * size[0] + x; }
   Vec3 centre(int x, int y, int z) const { return origin + h * Vec3(x + 0.5, y + 0.5, z + 0.5); }
   std::array<int, 3> cell(const Vec3& p) const {
     std::array<int, 3> c;
@@ -116,8 +114,7 @@ void distanceTransform(std::vector<double>& d, const std::array<int, 3>& n) {
   std::vector<double> line, out;
   std::vector<int> v;
   std::vector<double> z;
-  const std::array<std::size_t, 3> stride{1, static_cast<std::size_t>(n[0]),
-                                          static_cast<std::size_t>(n[0]) * n[1]};
+  const std::array<std::size_t, 3> stride{1, static_cast<std::size_t>(n[0]), static_cast<std::size_t>(n[0]) * n[1]};
   for (int axis = 0; axis < 3; ++axis) {
     const int len = n[axis];
     line.resize(len);
@@ -242,7 +239,8 @@ Eigen::Matrix3d principalAxes(const Piece& p) {
 
 PieceSplit splitConcave(const Part& part, const PieceOptions& options) {
   if (options.max_pieces < 1 || options.max_pieces > 64)
-    throw std::invalid_argument("the number of pieces must be 1 ... 64 (got " + std::to_string(options.max_pieces) + ")");
+    throw std::invalid_argument("the number of pieces must be 1 ... 64 (got " + std::to_string(options.max_pieces) +
+                                ")");
   if (!(options.concavity > 0.0) || !std::isfinite(options.concavity))
     throw std::invalid_argument("the concavity must be a positive length");
   if (options.resolution < 8 || options.resolution > 256)

@@ -7,11 +7,11 @@
 #include <random>
 #include <stdexcept>
 
+#include "fit_seeds.hpp"
 #include "kccd/distance.hpp"
 #include "kccd/hull/principal.hpp"
 #include "kccd/modelling/convex_hull.hpp"
 #include "kccd/modelling/yaml_edit.hpp"
-#include "fit_seeds.hpp"
 
 namespace kccd::modelling {
 namespace {
@@ -344,8 +344,8 @@ namespace {
 
 FitResult fitWithHull(const Part& part, const FitOptions& options, const OutsideHull& h) {
   if (options.points < 1 || options.points > kMaxCorePoints)
-    throw std::invalid_argument("the number of core points must be 1 ... " + std::to_string(kMaxCorePoints) +
-                                " (got " + std::to_string(options.points) + ")");
+    throw std::invalid_argument("the number of core points must be 1 ... " + std::to_string(kMaxCorePoints) + " (got " +
+                                std::to_string(options.points) + ")");
   if (part.empty()) throw std::invalid_argument("the part has no geometry");
   FitResult result;
   const Cover cover = makeCover(part);
@@ -432,10 +432,10 @@ FitResult fitWithHull(const Part& part, const FitOptions& options, const Outside
     std::vector<Vec3> best;
     double best_value = INFINITY;
     for (int i = 0; i < runs; ++i) {
-      if (opt.progress)
-        share.progress = [&, i](double x) { opt.progress((i + x) / runs); };
+      if (opt.progress) share.progress = [&, i](double x) { opt.progress((i + x) / runs); };
       // Offset seeds start close to a good shape: half the budget each.
-      share.max_evaluations = static_cast<std::size_t>(i) < first_offset ? opt.max_evaluations : opt.max_evaluations / 2;
+      share.max_evaluations =
+          static_cast<std::size_t>(i) < first_offset ? opt.max_evaluations : opt.max_evaluations / 2;
       std::vector<Vec3> refined = patternSearch(starts[i].second, starts[i].first, c, f, share, rng);
       const double v = f(refined);
       if (v < best_value) best = std::move(refined), best_value = v;
@@ -521,7 +521,7 @@ FitResult simplifiedHull(const Part& part, const PolytopeHull& polytope, const s
     }
   for (Vec3& p : candidate)
     for (int a = 0; a < 3; ++a) p(a) = std::stod(yamlNumber(p(a)));  // as printed
-  std::vector<double> depth(n);  // signed distance of each candidate to H
+  std::vector<double> depth(n);                                      // signed distance of each candidate to H
   for (std::size_t i = 0; i < n; ++i) depth[i] = signedDistance(candidate[i], h);
   FitResult result;
   result.hull_vertices = static_cast<int>(n);
@@ -610,8 +610,8 @@ FitResult bestSimplifiedHull(const Part& part, const OutsideHull& h, double tole
     const bool meets = r.outside <= tolerance;
     const bool best_meets = have && best.outside <= tolerance;
     if (!have || (meets && !best_meets) ||
-        (meets == best_meets && (r.points.size() < best.points.size() ||
-                                 (r.points.size() == best.points.size() && r.volume < best.volume))))
+        (meets == best_meets &&
+         (r.points.size() < best.points.size() || (r.points.size() == best.points.size() && r.volume < best.volume))))
       best = std::move(r), have = true;
   }
   return best;

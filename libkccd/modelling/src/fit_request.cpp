@@ -13,14 +13,16 @@ namespace kccd::modelling {
 void checkFitRequest(const FitRequest& r) {
   const auto inRange = [](double v, double lo, double hi) { return v >= lo && v <= hi; };
   if (r.method != FitMethod::Hull && (r.points < 1 || r.points > kMaxCorePoints))
-    throw FitRequestError("points", "the number of core points K must be 1 ... " + std::to_string(kMaxCorePoints) + " (got " +
-                                        std::to_string(r.points) + ")");
+    throw FitRequestError("points", "the number of core points K must be 1 ... " + std::to_string(kMaxCorePoints) +
+                                        " (got " + std::to_string(r.points) + ")");
   if (r.method == FitMethod::Tolerance && !inRange(r.tolerance, 1e-9, 1e3))
     throw FitRequestError("tolerance", "must be a length of 1e-6 ... 1e6 mm");
   if (r.max_pieces < 1 || r.max_pieces > 64)
     throw FitRequestError("pieces", "must be 1 ... 64 pieces (got " + std::to_string(r.max_pieces) + ")");
-  if (r.max_pieces > 1 && !inRange(r.concavity, 1e-6, 1e3)) throw FitRequestError("concavity", "must be a length of 1e-3 ... 1e6 mm");
-  if (r.method != FitMethod::Hull && r.max_evaluations < 1) throw FitRequestError("max_evaluations", "must be 1 or more");
+  if (r.max_pieces > 1 && !inRange(r.concavity, 1e-6, 1e3))
+    throw FitRequestError("concavity", "must be a length of 1e-3 ... 1e6 mm");
+  if (r.method != FitMethod::Hull && r.max_evaluations < 1)
+    throw FitRequestError("max_evaluations", "must be 1 or more");
 }
 
 FittedPart fitPart(const Part& part, const FitRequest& request, const std::function<void(double)>& progress) {
@@ -42,9 +44,15 @@ FittedPart fitPart(const Part& part, const FitRequest& request, const std::funct
     const Part& piece = split.pieces[static_cast<std::size_t>(k)];
     FittedPiece p;
     switch (request.method) {
-      case FitMethod::Hull: p.fit = exactHull(piece); break;
-      case FitMethod::Tolerance: p.fit = fitToTolerance(piece, request.tolerance, options); break;
-      case FitMethod::Points: p.fit = fit(piece, options); break;
+      case FitMethod::Hull:
+        p.fit = exactHull(piece);
+        break;
+      case FitMethod::Tolerance:
+        p.fit = fitToTolerance(piece, request.tolerance, options);
+        break;
+      case FitMethod::Points:
+        p.fit = fit(piece, options);
+        break;
     }
     p.concavity = split.concavity[static_cast<std::size_t>(k)];
     out.pieces.push_back(std::move(p));
@@ -52,7 +60,9 @@ FittedPart fitPart(const Part& part, const FitRequest& request, const std::funct
   return out;
 }
 
-std::string pieceName(const std::string& name, int k, int count) { return count > 1 ? name + "/" + std::to_string(k + 1) : name; }
+std::string pieceName(const std::string& name, int k, int count) {
+  return count > 1 ? name + "/" + std::to_string(k + 1) : name;
+}
 
 std::string toleranceYaml(const FitResult& fit) { return yamlNumber(std::ceil(fit.outside * 1e6) / 1e6); }
 
@@ -70,8 +80,10 @@ nlohmann::json bodyJson(const FitResult& r, bool baselines) {
   j["hull_volume"] = hull;
   j["volume_ratio"] = ratio(r.volume);
   if (baselines)
-    j["baselines"] = {{"sphere_volume", r.sphere_volume}, {"sphere_ratio", ratio(r.sphere_volume)},
-                      {"capsule_volume", r.capsule_volume}, {"capsule_ratio", ratio(r.capsule_volume)}};
+    j["baselines"] = {{"sphere_volume", r.sphere_volume},
+                      {"sphere_ratio", ratio(r.sphere_volume)},
+                      {"capsule_volume", r.capsule_volume},
+                      {"capsule_ratio", ratio(r.capsule_volume)}};
   j["k"] = static_cast<int>(r.points.size());
   j["hull_vertices"] = r.hull_vertices;
   j["evaluations"] = r.evaluations;

@@ -10,20 +10,20 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <new>
-#include <cmath>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include <assimp/BaseImporter.h>
-#include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/scene.h>
+#include <assimp/Importer.hpp>
 
 #include "large_stack.hpp"
 #include "part_messages.hpp"
@@ -138,9 +138,9 @@ std::string plyHeaderProblem(const std::string& data) {
   std::string line;
   int number = 0;
   bool element = false, format = false;
-  static const std::set<std::string> types = {"char",  "uchar",  "short",   "ushort",  "int",    "uint",  "float",
-                                              "double", "int8", "uint8", "int16", "uint16", "int32", "uint32",
-                                              "float32", "float64"};
+  static const std::set<std::string> types = {"char",  "uchar",  "short",   "ushort", "int",   "uint",
+                                              "float", "double", "int8",    "uint8",  "int16", "uint16",
+                                              "int32", "uint32", "float32", "float64"};
   while (std::getline(in, line)) {
     ++number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -166,7 +166,8 @@ std::string plyHeaderProblem(const std::string& data) {
     } else if (w[0] == "property") {
       if (!element) return at + "a property before any element";
       const bool list = w.size() == 5 && w[1] == "list" && types.count(w[2]) && types.count(w[3]);
-      if (!list && !(w.size() == 3 && types.count(w[1]))) return at + "expected 'property TYPE NAME' or 'property list TYPE TYPE NAME'";
+      if (!list && !(w.size() == 3 && types.count(w[1])))
+        return at + "expected 'property TYPE NAME' or 'property list TYPE TYPE NAME'";
     } else {
       return at + "unknown keyword '" + printable(w[0].substr(0, 40)) + "'";
     }
@@ -273,7 +274,7 @@ bool writeAll(int fd, const void* data, std::size_t size) {
   }
   const rlim_t limit = static_cast<rlim_t>(pages) * static_cast<rlim_t>(sysconf(_SC_PAGESIZE)) +
                        static_cast<rlim_t>(options.mesh_memory_limit_mb) * (1u << 20);
-  const struct rlimit rl{limit, limit};
+  const struct rlimit rl { limit, limit };
   setrlimit(RLIMIT_AS, &rl);
 #endif
   bool ok = false;
@@ -283,7 +284,8 @@ bool writeAll(int fd, const void* data, std::size_t size) {
     ok = writeAll(fd, "P", 1) && writeAll(fd, counts, sizeof counts) &&
          writeAll(fd, part.points.data(), part.points.size() * sizeof(Vec3));
   } catch (const std::bad_alloc&) {
-    const std::string what = name + ": reading the mesh needs more than " + std::to_string(options.mesh_memory_limit_mb) + " MiB";
+    const std::string what =
+        name + ": reading the mesh needs more than " + std::to_string(options.mesh_memory_limit_mb) + " MiB";
     const std::uint64_t n = what.size();
     ok = writeAll(fd, "E", 1) && writeAll(fd, &n, sizeof n) && writeAll(fd, what.data(), what.size());
   } catch (const std::exception& e) {
@@ -305,7 +307,8 @@ Part readMesh(const std::string& data, const std::string& path, const std::strin
   // aborts and gigabyte allocations from kilobyte files): they run in a child process with a
   // time and a memory limit, and whatever happens there ends as a one-line error here.
   int fds[2];
-  if (::pipe2(fds, O_CLOEXEC) != 0) throw PartError(name + ": cannot start the mesh reader (" + std::strerror(errno) + ")");
+  if (::pipe2(fds, O_CLOEXEC) != 0)
+    throw PartError(name + ": cannot start the mesh reader (" + std::strerror(errno) + ")");
   const pid_t child = ::fork();
   if (child < 0) {
     ::close(fds[0]);
@@ -321,12 +324,15 @@ Part readMesh(const std::string& data, const std::string& path, const std::strin
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.mesh_time_limit_s);
   bool timed_out = false;
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) {
       timed_out = true;
       break;
     }
-    struct pollfd pfd{fds[0], POLLIN, 0};
+    struct pollfd pfd {
+      fds[0], POLLIN, 0
+    };
     const int ready = ::poll(&pfd, 1, static_cast<int>(std::min<long long>(left.count(), 1000)));
     if (ready < 0 && errno == EINTR) continue;
     if (ready <= 0) continue;
@@ -342,8 +348,8 @@ Part readMesh(const std::string& data, const std::string& path, const std::strin
   while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
   }
   if (timed_out)
-    throw PartError(name + ": reading the mesh took longer than " + std::to_string(static_cast<int>(options.mesh_time_limit_s)) +
-                    " s (a malformed file?)");
+    throw PartError(name + ": reading the mesh took longer than " +
+                    std::to_string(static_cast<int>(options.mesh_time_limit_s)) + " s (a malformed file?)");
   auto take = [&](std::size_t& at, void* out, std::size_t size) {
     if (answer.size() - at < size) return false;
     std::memcpy(out, answer.data() + at, size);

@@ -112,11 +112,18 @@ void carryModelEntries(const Model& m, const IgnoreOptions& options, bool keep_p
     bool keep = true;
     switch (p.reason) {
       case IgnoreReason::User:
-      case IgnoreReason::Srdf: break;
-      case IgnoreReason::Rigid: keep = connection(m, p.a, p.b) == Connection::Rigid; break;
-      case IgnoreReason::Adjacent: keep = adjacentByRule(m, p.a, p.b, options, true); break;
+      case IgnoreReason::Srdf:
+        break;
+      case IgnoreReason::Rigid:
+        keep = connection(m, p.a, p.b) == Connection::Rigid;
+        break;
+      case IgnoreReason::Adjacent:
+        keep = adjacentByRule(m, p.a, p.b, options, true);
+        break;
       case IgnoreReason::Never:
-      case IgnoreReason::AlwaysTouching: keep = keep_proofs; break;
+      case IgnoreReason::AlwaysTouching:
+        keep = keep_proofs;
+        break;
     }
     bool listed = false;
     for (const IgnoreEntry& e : plan.ignore) listed = listed || samePair(e, a, b);
@@ -128,11 +135,16 @@ void carryModelEntries(const Model& m, const IgnoreOptions& options, bool keep_p
 
 const char* toString(Verdict v) {
   switch (v) {
-    case Verdict::Never: return "never";
-    case Verdict::AlwaysTouching: return "always_touching";
-    case Verdict::Meets: return "meets";
-    case Verdict::Undecided: return "undecided";
-    case Verdict::Unbounded: return "unbounded";
+    case Verdict::Never:
+      return "never";
+    case Verdict::AlwaysTouching:
+      return "always_touching";
+    case Verdict::Meets:
+      return "meets";
+    case Verdict::Undecided:
+      return "undecided";
+    case Verdict::Unbounded:
+      return "unbounded";
   }
   return "?";
 }
@@ -168,9 +180,15 @@ std::vector<std::array<double, 2>> jointRanges(const Model& m) {
         case JointType::Revolute:  // limits a turn or more apart (files write +-3.4e38) allow every angle
           out = j.limits && (*j.limits)[1] - (*j.limits)[0] < 2 * kPi ? *j.limits : std::array<double, 2>{-kPi, kPi};
           break;
-        case JointType::Prismatic: out = j.limits ? *j.limits : std::array<double, 2>{nan, nan}; break;
-        case JointType::Rotation3d: out = {-kPi, kPi}; break;
-        default: out = {nan, nan}; break;
+        case JointType::Prismatic:
+          out = j.limits ? *j.limits : std::array<double, 2>{nan, nan};
+          break;
+        case JointType::Rotation3d:
+          out = {-kPi, kPi};
+          break;
+        default:
+          out = {nan, nan};
+          break;
       }
     }
   }

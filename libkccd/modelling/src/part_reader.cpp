@@ -1,5 +1,6 @@
 // Reading a rigid part with Coin3D: triangles of every shape in world (file) coordinates, and
 // spheres, cylinders and cones covered analytically instead of by Coin's inscribed tessellation.
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -12,7 +13,6 @@
 #include <sstream>
 #include <stdexcept>
 #include <utility>
-#include <algorithm>
 
 #include <Inventor/SbMatrix.h>
 #include <Inventor/SoDB.h>
@@ -29,11 +29,13 @@
 #include <Inventor/actions/SoCallbackAction.h>
 #include <Inventor/actions/SoSearchAction.h>
 #include <Inventor/annex/ForeignFiles/SoForeignFileKit.h>
-#include <Inventor/errors/SoDebugError.h>
 #include <Inventor/elements/SoCoordinateElement.h>
+#include <Inventor/errors/SoDebugError.h>
 #include <Inventor/errors/SoReadError.h>
+#include <Inventor/misc/SoChildList.h>
 #include <Inventor/nodekits/SoBaseKit.h>
 #include <Inventor/nodekits/SoNodeKit.h>
+#include <Inventor/nodes/SoArray.h>
 #include <Inventor/nodes/SoCone.h>
 #include <Inventor/nodes/SoCube.h>
 #include <Inventor/nodes/SoCylinder.h>
@@ -43,20 +45,18 @@
 #include <Inventor/nodes/SoIndexedNurbsSurface.h>
 #include <Inventor/nodes/SoIndexedShape.h>
 #include <Inventor/nodes/SoLineSet.h>
+#include <Inventor/nodes/SoMultipleCopy.h>
 #include <Inventor/nodes/SoNurbsCurve.h>
 #include <Inventor/nodes/SoNurbsSurface.h>
 #include <Inventor/nodes/SoPointSet.h>
 #include <Inventor/nodes/SoQuadMesh.h>
-#include <Inventor/nodes/SoTriangleStripSet.h>
-#include <Inventor/nodes/SoVertexProperty.h>
-#include <Inventor/nodes/SoWWWInline.h>
 #include <Inventor/nodes/SoScale.h>
 #include <Inventor/nodes/SoSeparator.h>
 #include <Inventor/nodes/SoShape.h>
 #include <Inventor/nodes/SoSphere.h>
-#include <Inventor/misc/SoChildList.h>
-#include <Inventor/nodes/SoArray.h>
-#include <Inventor/nodes/SoMultipleCopy.h>
+#include <Inventor/nodes/SoTriangleStripSet.h>
+#include <Inventor/nodes/SoVertexProperty.h>
+#include <Inventor/nodes/SoWWWInline.h>
 
 #include "kccd/file_reader.hpp"
 #include "kccd/format_number.hpp"
@@ -160,8 +160,8 @@ std::string checkIndices(const char* field, const SoMFInt32& indices, int count)
   const int32_t* v = indices.getValues(0);
   for (int i = 0; i < indices.getNum(); ++i)
     if (v[i] < -1 || v[i] >= count)
-      return std::string(field) + "[" + std::to_string(i) + "]: " + std::to_string(v[i]) + " is not a coordinate index (" +
-             std::to_string(count) + " coordinates)";
+      return std::string(field) + "[" + std::to_string(i) + "]: " + std::to_string(v[i]) +
+             " is not a coordinate index (" + std::to_string(count) + " coordinates)";
   return {};
 }
 
@@ -269,11 +269,10 @@ SoCallbackAction::Response shape(void* data, SoCallbackAction* action, const SoN
   } else if (node->isOfType(SoFaceSet::getClassTypeId()) || node->isOfType(SoLineSet::getClassTypeId()) ||
              node->isOfType(SoTriangleStripSet::getClassTypeId())) {
     const auto* s = static_cast<const SoNonIndexedShape*>(node);
-    const SoMFInt32& counts = node->isOfType(SoFaceSet::getClassTypeId())
-                                  ? static_cast<const SoFaceSet*>(node)->numVertices
-                                  : node->isOfType(SoLineSet::getClassTypeId())
-                                        ? static_cast<const SoLineSet*>(node)->numVertices
-                                        : static_cast<const SoTriangleStripSet*>(node)->numVertices;
+    const SoMFInt32& counts =
+        node->isOfType(SoFaceSet::getClassTypeId())   ? static_cast<const SoFaceSet*>(node)->numVertices
+        : node->isOfType(SoLineSet::getClassTypeId()) ? static_cast<const SoLineSet*>(node)->numVertices
+                                                      : static_cast<const SoTriangleStripSet*>(node)->numVertices;
     const int least = node->isOfType(SoLineSet::getClassTypeId()) ? 2 : 3;
     first({checkCounts(counts, s->startIndex.getValue(), inventorCoordinates(action, s), least)});
   } else if (node->isOfType(SoPointSet::getClassTypeId())) {
@@ -285,8 +284,7 @@ SoCallbackAction::Response shape(void* data, SoCallbackAction* action, const SoN
     const auto* s = static_cast<const SoQuadMesh*>(node);
     const long long rows = s->verticesPerColumn.getValue(), columns = s->verticesPerRow.getValue();
     const int count = inventorCoordinates(action, s);
-    if (rows < 0 || columns < 0 || s->startIndex.getValue() < 0 ||
-        s->startIndex.getValue() + rows * columns > count)
+    if (rows < 0 || columns < 0 || s->startIndex.getValue() < 0 || s->startIndex.getValue() + rows * columns > count)
       problem = "verticesPerColumn x verticesPerRow: " + std::to_string(rows) + " x " + std::to_string(columns) +
                 " vertices from index " + std::to_string(s->startIndex.getValue()) + " but only " +
                 std::to_string(count) + " coordinates";
@@ -394,8 +392,9 @@ Part readStl(const std::string& data, const std::string& path, const Vec3& scale
     const auto lineAt = [&](std::streamoff at) {
       // tellg() is -1 once the stream hit the end: the line of the text's end then.
       const auto end = std::max(counted, at < 0 ? data.size() : static_cast<std::size_t>(at));
-      line += static_cast<std::size_t>(std::count(data.begin() + static_cast<std::ptrdiff_t>(counted),
-                                                  data.begin() + static_cast<std::ptrdiff_t>(std::min(end, data.size())), '\n'));
+      line += static_cast<std::size_t>(
+          std::count(data.begin() + static_cast<std::ptrdiff_t>(counted),
+                     data.begin() + static_cast<std::ptrdiff_t>(std::min(end, data.size())), '\n'));
       counted = std::max(counted, std::min(end, data.size()));
       return line;
     };
@@ -433,13 +432,13 @@ void scanText(const std::string& data, const std::string& path) {
   std::string token, previous;
   auto endToken = [&] {
     if (token.empty()) return;
-    static const char* const includes[] = {"File",      "SoFile",      "Inline",       "VRMLInline",
+    static const char* const includes[] = {"File",         "SoFile",    "Inline",      "VRMLInline",
                                            "SoVRMLInline", "WWWInline", "SoWWWInline", "EXTERNPROTO"};
     if (previous != "DEF" && previous != "USE" && previous != "PROTO")
       for (const char* include : includes)
         if (token == include)
           throw PartError(path + ":" + std::to_string(line) + ": " + token +
-                                   ": includes are not supported (put the included geometry into this file)");
+                          ": includes are not supported (put the included geometry into this file)");
     previous = std::move(token);
     token.clear();
   };
@@ -460,13 +459,12 @@ void scanText(const std::string& data, const std::string& path) {
     } else if (ch == '{' || ch == '[') {
       endToken();
       if (++depth > kMaxNesting)
-        throw PartError(path + ":" + std::to_string(line) + ": nested deeper than " +
-                                 std::to_string(kMaxNesting) + " levels");
+        throw PartError(path + ":" + std::to_string(line) + ": nested deeper than " + std::to_string(kMaxNesting) +
+                        " levels");
       previous.assign(1, ch);
     } else if (ch == '}' || ch == ']') {
       endToken();
-      if (--depth < 0)
-        throw PartError(path + ":" + std::to_string(line) + ": '" + ch + "' closes nothing");
+      if (--depth < 0) throw PartError(path + ":" + std::to_string(line) + ": '" + ch + "' closes nothing");
       previous.assign(1, ch);
     } else if (std::isspace(static_cast<unsigned char>(ch)) || ch == ',') {
       endToken();
@@ -509,8 +507,9 @@ void checkNesting(SoNode* root, const std::string& path) {
       throw PartError(path + ": nested deeper than " + std::to_string(kMaxNesting) + " levels");
     visits += e.copies;
     if (visits > kMaxVisits)
-      throw PartError(path + ": the scene expands to more than 1000000 nodes (nodes used again with USE, or Array and "
-                             "MultipleCopy nodes, multiply): write the geometry out");
+      throw PartError(path +
+                      ": the scene expands to more than 1000000 nodes (nodes used again with USE, or Array and "
+                      "MultipleCopy nodes, multiply): write the geometry out");
     // Groups and node kits alike: every node with children (a kit's parts are traversed too).
     const SoChildList* children = e.node->getChildren();
     if (!children) continue;
@@ -546,7 +545,7 @@ void checkIncludes(SoNode* root, const std::string& path) {
     else if (node->isOfType(SoWWWInline::getClassTypeId()))
       target = static_cast<const SoWWWInline*>(node)->name.getValue().getString();
     throw PartError(path + ": " + nodeName(node) + " '" + printable(target) +
-                             "': includes are not supported (put the included geometry into this file)");
+                    "': includes are not supported (put the included geometry into this file)");
   }
 }
 
@@ -558,15 +557,15 @@ Part readScene(const std::string& data, const std::string& path, const ReadOptio
   const bool binary = header.find("binary") != std::string::npos;
   if (binary && data.size() > kMaxBinaryInventorBytes)
     throw PartError(path + ": binary Open Inventor files are read up to " +
-                             std::to_string(kMaxBinaryInventorBytes >> 20) + " MiB (this one has " +
-                             std::to_string(data.size()) + " bytes): convert it to ASCII");
+                    std::to_string(kMaxBinaryInventorBytes >> 20) + " MiB (this one has " +
+                    std::to_string(data.size()) + " bytes): convert it to ASCII");
   if (!binary) scanText(data, path);
   // Binary files name node types as length-prefixed strings: a File node would be read by Coin
   // (following cycles, devices and missing files) before any check of the scene.
   for (const std::string_view file : {std::string_view("\0\0\0\4File", 8), std::string_view("\0\0\0\6SoFile", 10)})
     if (binary && data.find(file) != std::string::npos)
       throw PartError(path + ": File node at byte " + std::to_string(data.find(file)) +
-                               ": includes are not supported (put the included geometry into this file)");
+                      ": includes are not supported (put the included geometry into this file)");
 
   std::lock_guard<std::mutex> lock(coin_mutex);
   Part result;
@@ -600,12 +599,12 @@ Part readScene(const std::string& data, const std::string& path, const ReadOptio
     if (!read_errors.first.empty()) {
       root->unref();
       throw PartError(path + (read_errors.line > 0 ? ":" + std::to_string(read_errors.line) : "") + ": " +
-                               read_errors.first);
+                      read_errors.first);
     }
     if (!ok || (root->getNumChildren() == 0 && !other_errors.first.empty())) {
       root->unref();
       throw PartError(path + ": not a readable Open Inventor, VRML or STL file" +
-                               (other_errors.first.empty() ? std::string() : " (" + other_errors.first + ")"));
+                      (other_errors.first.empty() ? std::string() : " (" + other_errors.first + ")"));
     }
     root->unrefNoDelete();
     RefGuard keep(root);
@@ -637,8 +636,8 @@ Part readScene(const std::string& data, const std::string& path, const ReadOptio
       search.apply(top);
       SoPath* found = search.getPath();
       if (!found)
-        throw PartError(path + ": no node named '" + printable(options.part) + "' (DEF " +
-                                 printable(options.part) + ")");
+        throw PartError(path + ": no node named '" + printable(options.part) + "' (DEF " + printable(options.part) +
+                        ")");
       SoPath* copy = found->copy();
       copy->ref();
       try {
@@ -697,12 +696,12 @@ Part readPart(const std::string& path, const ReadOptions& options) {
   const std::string data = readInputFile(path);
   // STL directly; Open Inventor and VRML (analytic primitives, scene graphs) through Coin3D;
   // other meshes (OBJ, COLLADA, PLY, glTF, ...) through Assimp.
-  Part part = extension == ".stl"                 ? readStl(data, name, options.scale)
+  Part part = extension == ".stl"              ? readStl(data, name, options.scale)
               : detail::readsAsMesh(extension) ? detail::readMesh(data, path, name, extension, options)
                                                : readScene(data, name, options);
   if (part.triangles == 0 && part.primitives == 0)
     throw PartError(name + (options.part.empty() ? "" : " (part " + printable(options.part) + ")") +
-                             ": no triangles or solid primitives (nothing to fit)");
+                    ": no triangles or solid primitives (nothing to fit)");
   // Every coordinate within what a model may hold (the fit's distances stay finite then).
   for (std::size_t i = 0; i < part.points.size(); ++i) {
     const Vec3& p = part.points[i];
@@ -724,8 +723,7 @@ Part readPart(const std::string& path, const ReadOptions& options) {
   for (const Sphere& b : part.balls) max_abs = std::max(max_abs, b.center.cwiseAbs().maxCoeff() + b.radius);
   // Coin and STL store single-precision coordinates (Coin its matrices too): cover their rounding.
   part.coordinate_guard = 1e-6 * max_abs;
-  if (!std::isfinite(part.coordinate_guard))
-    throw PartError(name + ": coordinates too large (their extent overflows)");
+  if (!std::isfinite(part.coordinate_guard)) throw PartError(name + ": coordinates too large (their extent overflows)");
   return part;
 }
 

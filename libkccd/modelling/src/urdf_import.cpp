@@ -6,10 +6,10 @@
 #include <cstdio>
 #include <deque>
 #include <filesystem>
-#include <set>
-#include <sstream>
 #include <mutex>
 #include <numbers>
+#include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include <console_bridge/console.h>
@@ -36,7 +36,8 @@ std::string vec(double x, double y, double z) {
 Eigen::Affine3d toEigen(const urdf::Pose& p) {
   Eigen::Affine3d t = Eigen::Affine3d::Identity();
   t.translation() = Vec3(p.position.x, p.position.y, p.position.z);
-  t.linear() = Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).normalized().toRotationMatrix();
+  t.linear() =
+      Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).normalized().toRotationMatrix();
   return t;
 }
 
@@ -50,8 +51,7 @@ std::string resolveMesh(const std::string& urdf_path, const std::string& link, c
     const std::string package = rest.substr(0, slash);
     auto it = options.packages.find(package);
     if (it == options.packages.end())
-      throw UrdfError(where + ": unknown package '" + package + "' (give --package-path " + package +
-                               "=DIR)");
+      throw UrdfError(where + ": unknown package '" + package + "' (give --package-path " + package + "=DIR)");
     return (fs::path(it->second) / (slash == std::string::npos ? "" : rest.substr(slash + 1))).string();
   }
   if (uri.rfind("file://", 0) == 0) return uri.substr(7);
@@ -101,8 +101,8 @@ Part linkPart(const std::string& urdf_path, const urdf::Link& link, const Import
 
 // The link's <visual> elements as `visuals:` entries in `frame` (mesh files resolved like the
 // collision meshes, written as absolute paths; the material's colour when it has one).
-void writeVisuals(std::ostringstream& out, const std::string& urdf_path, const urdf::Link& link, const std::string& frame,
-                  const ImportOptions& options) {
+void writeVisuals(std::ostringstream& out, const std::string& urdf_path, const urdf::Link& link,
+                  const std::string& frame, const ImportOptions& options) {
   for (const urdf::VisualSharedPtr& v : link.visual_array) {
     if (!v || !v->geometry) continue;
     const urdf::Pose& o = v->origin;
@@ -155,7 +155,7 @@ void writeVisuals(std::ostringstream& out, const std::string& urdf_path, const u
 void loadXml(tinyxml2::XMLDocument& doc, const std::string& text, const std::string& path) {
   if (doc.Parse(text.data(), text.size()) == tinyxml2::XML_SUCCESS) return;
   throw UrdfError(path + ":" + std::to_string(doc.ErrorLineNum()) + ": malformed XML (" +
-                           tinyxml2::XMLDocument::ErrorIDToName(doc.ErrorID()) + ")");
+                  tinyxml2::XMLDocument::ErrorIDToName(doc.ErrorID()) + ")");
 }
 
 // urdfdom reports through console_bridge, several lines on the console per problem: they are
@@ -225,7 +225,8 @@ std::vector<double> numbers(const Place& at, const tinyxml2::XMLElement* e, cons
     double v = 0;
     const char* begin = word.data() + (word[0] == '+' ? 1 : 0);
     const auto [end, ec] = std::from_chars(begin, word.data() + word.size(), v);
-    if (ec == std::errc::result_out_of_range || (ec == std::errc() && end == word.data() + word.size() && !std::isfinite(v)))
+    if (ec == std::errc::result_out_of_range ||
+        (ec == std::errc() && end == word.data() + word.size() && !std::isfinite(v)))
       throw at.error(e, name + ": '" + printable(word) + "' is not a finite number");
     if (ec != std::errc() || end != word.data() + word.size())
       throw at.error(e, name + ": '" + printable(word) + "' is not a number");
@@ -320,8 +321,8 @@ int collisionLine(const tinyxml2::XMLDocument& doc, const std::string& name) {
 }
 
 std::vector<IgnoreEntry> readSrdf(const tinyxml2::XMLDocument& doc, const std::string& path,
-                                                 const std::set<std::string>& links,
-                                                 const std::map<std::string, std::vector<std::string>>& bodies) {
+                                  const std::set<std::string>& links,
+                                  const std::map<std::string, std::vector<std::string>>& bodies) {
   const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
   if (!robot) throw UrdfError(path + ": not an SRDF file (no <robot> element)");
   std::vector<IgnoreEntry> out;
@@ -330,12 +331,10 @@ std::vector<IgnoreEntry> readSrdf(const tinyxml2::XMLDocument& doc, const std::s
     const char* a = e->Attribute("link1");
     const char* b = e->Attribute("link2");
     if (!a || !b)
-      throw UrdfError(path + ":" + std::to_string(e->GetLineNum()) +
-                               ": disable_collisions needs link1 and link2");
+      throw UrdfError(path + ":" + std::to_string(e->GetLineNum()) + ": disable_collisions needs link1 and link2");
     for (const char* l : {a, b})
       if (!links.count(l))
-        throw UrdfError(path + ":" + std::to_string(e->GetLineNum()) + ": link '" + l +
-                                 "' is not in the URDF");
+        throw UrdfError(path + ":" + std::to_string(e->GetLineNum()) + ": link '" + l + "' is not in the URDF");
     if (bodies.count(a) && bodies.count(b) && std::string(a) != b)
       for (const std::string& pa : bodies.at(a))  // every piece of one link against every piece of the other
         for (const std::string& pb : bodies.at(b)) out.push_back({pa, pb, IgnoreReason::Srdf});
@@ -369,19 +368,22 @@ FittedLinks fitLinks(const std::string& path, const std::vector<urdf::LinkConstS
     for (int k = 0; k < count; ++k) {
       const FitResult& r = f.pieces[static_cast<std::size_t>(k)].fit;
       const std::string name = pieceName(link->name, k, count);
-      const std::string how = options.fit.method == FitMethod::Hull        ? "the convex hull of the collision geometry"
-                              : options.fit.method == FitMethod::Tolerance ? std::string(r.method) + ", " + std::to_string(r.points.size()) + " points"
-                                                                           : "K = " + std::to_string(r.points.size()) + " fit";
-      bodies += bodyYaml({.name = name,
-                          .link = count > 1 ? link->name : std::string(),
-                          .frame = frame_of.at(link->name),
-                          .fit = &r,
-                          .link_comment = "piece " + std::to_string(k + 1) + " of " + std::to_string(count) + ", concavity about " +
-                                          yamlNumber(std::round(f.pieces[static_cast<std::size_t>(k)].concavity * 1e4) / 1e4) +
-                                          " m (the link's: " + yamlNumber(std::round(f.whole_concavity * 1e4) / 1e4) + " m)",
-                          .radius_comment = how + ": volume " + yamlNumber(r.volume) + " m^3, hull " + yamlNumber(r.hull_volume) + " m^3",
-                          .tolerance_comment = "at most this far outside the link's convex hull (m)"},
-                         "  ");
+      const std::string how = options.fit.method == FitMethod::Hull ? "the convex hull of the collision geometry"
+                              : options.fit.method == FitMethod::Tolerance
+                                  ? std::string(r.method) + ", " + std::to_string(r.points.size()) + " points"
+                                  : "K = " + std::to_string(r.points.size()) + " fit";
+      bodies += bodyYaml(
+          {.name = name,
+           .link = count > 1 ? link->name : std::string(),
+           .frame = frame_of.at(link->name),
+           .fit = &r,
+           .link_comment = "piece " + std::to_string(k + 1) + " of " + std::to_string(count) + ", concavity about " +
+                           yamlNumber(std::round(f.pieces[static_cast<std::size_t>(k)].concavity * 1e4) / 1e4) +
+                           " m (the link's: " + yamlNumber(std::round(f.whole_concavity * 1e4) / 1e4) + " m)",
+           .radius_comment =
+               how + ": volume " + yamlNumber(r.volume) + " m^3, hull " + yamlNumber(r.hull_volume) + " m^3",
+           .tolerance_comment = "at most this far outside the link's convex hull (m)"},
+          "  ");
       out.pieces_of[link->name].push_back(name);
       out.most_points = std::max(out.most_points, r.points.size());
     }
@@ -406,7 +408,7 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
   const urdf::ModelInterfaceSharedPtr& urdf = parsed.model;
   if (!urdf || !urdf->getRoot())
     throw UrdfError(path + ": not a valid URDF (" +
-                             (parsed.error.empty() ? std::string("urdfdom rejected it") : "urdfdom: " + parsed.error) + ")");
+                    (parsed.error.empty() ? std::string("urdfdom rejected it") : "urdfdom: " + parsed.error) + ")");
   // urdfdom drops every collision of a link when one of them does not parse: whatever slipped
   // through the checks above must not become a link without geometry.
   for (const auto& [name, count] : collisions) {
@@ -414,8 +416,8 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     const std::size_t kept = link ? link->collision_array.size() : 0;
     if (kept != static_cast<std::size_t>(count))
       throw UrdfError(path + ":" + std::to_string(collisionLine(doc, name)) + ": link '" + printable(name) +
-                               "': " + std::to_string(count) + " <collision> elements but urdfdom read " +
-                               std::to_string(kept) + (parsed.error.empty() ? "" : " (" + parsed.error + ")"));
+                      "': " + std::to_string(count) + " <collision> elements but urdfdom read " + std::to_string(kept) +
+                      (parsed.error.empty() ? "" : " (" + parsed.error + ")"));
   }
 
   std::ostringstream joints, bodies;
@@ -435,7 +437,8 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
       const urdf::Pose& o = j->parent_to_joint_origin_transform;
       double r, p, y;
       o.rotation.getRPY(r, p, y);
-      const std::string origin = "{xyz: " + vec(o.position.x, o.position.y, o.position.z) + ", rpy: " + vec(r, p, y) + "}";
+      const std::string origin =
+          "{xyz: " + vec(o.position.x, o.position.y, o.position.z) + ", rpy: " + vec(r, p, y) + "}";
       // One KCCD joint, or a chain of them, in the URDF joint's place; the child link hangs
       // from the last.
       std::string parent = frame_of.at(link->name);
@@ -462,7 +465,9 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
             joints << "    limits: [" << yamlNumber(j->limits->lower) << ", " << yamlNumber(j->limits->upper) << "]\n";
           break;
         }
-        case urdf::Joint::FIXED: emit(j->name, "fixed", origin, nullptr, ""); break;
+        case urdf::Joint::FIXED:
+          emit(j->name, "fixed", origin, nullptr, "");
+          break;
         case urdf::Joint::FLOATING:
           // A measured 6-DOF pose: position, then orientation as a rotation vector.
           emit(j->name, "translation3d", origin, nullptr, "URDF floating joint " + j->name + ": position (x, y, z)");
@@ -485,7 +490,8 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
           emit(j->name + "_yaw", "revolute", zero, &n, what + ": rotation about the plane's normal");
           break;
         }
-        default: throw UrdfError(path + ": joint " + j->name + " has an unknown type");
+        default:
+          throw UrdfError(path + ": joint " + j->name + " has an unknown type");
       }
       if (j->mimic) joints << "    # mimics " << j->mimic->joint_name << " in the URDF: checked as independent\n";
       frame_of[j->child_link_name] = parent;
@@ -508,9 +514,10 @@ std::string importUrdf(const std::string& path, const ImportOptions& options) {
     out << "# Imported from " << std::filesystem::path(path).filename().string()
         << (options.srdf.empty() ? "" : " and " + std::filesystem::path(options.srdf).filename().string())
         << " by kccd import ("
-        << (options.fit.method == FitMethod::Hull        ? std::string("convex hulls, no fit")
-            : options.fit.method == FitMethod::Tolerance ? "each link within " + yamlNumber(options.fit.tolerance * 1e3) + " mm of its hull"
-                                                         : std::to_string(options.fit.points) + " core points per link")
+        << (options.fit.method == FitMethod::Hull ? std::string("convex hulls, no fit")
+            : options.fit.method == FitMethod::Tolerance
+                ? "each link within " + yamlNumber(options.fit.tolerance * 1e3) + " mm of its hull"
+                : std::to_string(options.fit.points) + " core points per link")
         << (options.fit.max_pieces > 1
                 ? ", concave links in up to " + std::to_string(options.fit.max_pieces) + " pieces (concavity above " +
                       yamlNumber(options.fit.concavity * 1e3) + " mm)"

@@ -1,10 +1,10 @@
 #include "kccd/modelling/yaml_edit.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
-#include <vector>
+#include <cstdio>
 #include <stdexcept>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -58,12 +58,13 @@ std::size_t valueEnd(const std::string& t, const YAML::Node& value) {
   if (start < t.size() && (t[start] == '[' || t[start] == '{')) return flowEnd(t, start);
   if (value.IsScalar()) {
     std::size_t i = start;
-    if (t[i] == '"' || t[i] == '\'') return flowEnd(t, start) == t.size() ? t.size() : [&] {
-      const char q = t[i];
-      for (++i; i < t.size() && t[i] != q; ++i)
-        if (q == '"' && t[i] == '\\') ++i;
-      return i + 1;
-    }();
+    if (t[i] == '"' || t[i] == '\'')
+      return flowEnd(t, start) == t.size() ? t.size() : [&] {
+        const char q = t[i];
+        for (++i; i < t.size() && t[i] != q; ++i)
+          if (q == '"' && t[i] == '\\') ++i;
+        return i + 1;
+      }();
     while (i < t.size() && t[i] != '\n' && t[i] != ',' && t[i] != ']' && t[i] != '}' &&
            !(t[i] == '#' && std::isspace(static_cast<unsigned char>(t[i - 1]))))
       ++i;
@@ -107,9 +108,7 @@ bool findKey(const YAML::Node& map, const std::string& name, Found& out) {
 // Replaces the value of `key` (from just after its ':' to the end of the value) with `text`.
 std::string replaceValue(const std::string& t, const Found& f, const std::string& text) {
   const std::size_t colon = t.find(':', static_cast<std::size_t>(f.key.Mark().pos));
-  const std::size_t end = f.value.IsNull() && f.value.Mark().pos <= f.key.Mark().pos
-                              ? colon + 1
-                              : valueEnd(t, f.value);
+  const std::size_t end = f.value.IsNull() && f.value.Mark().pos <= f.key.Mark().pos ? colon + 1 : valueEnd(t, f.value);
   return t.substr(0, colon + 1) + " " + text + t.substr(end);
 }
 
@@ -186,7 +185,8 @@ std::string flowPairs(const std::vector<IgnoreEntry>& pairs, int indent) {
 }
 
 std::string withBodyGeometry(const std::string& text, const std::string& source, const std::string& body,
-                             const std::string& points_yaml, const std::string& radius_yaml, const std::string& tolerance_yaml) {
+                             const std::string& points_yaml, const std::string& radius_yaml,
+                             const std::string& tolerance_yaml) {
   const YAML::Node root = load(text, source);
   const YAML::Node bodies = root["bodies"];
   if (!bodies || !bodies.IsSequence()) throw EditError(source + ": no bodies list");
@@ -195,7 +195,7 @@ std::string withBodyGeometry(const std::string& text, const std::string& source,
     Found points, radius, tolerance;
     if (!findKey(b, "points", points) || !findKey(b, "radius", radius))
       throw EditError(source + ":" + std::to_string(b.Mark().line + 1) + ": body " + body +
-                               " has no points/radius to replace");
+                      " has no points/radius to replace");
     const bool has_tolerance = findKey(b, "tolerance", tolerance);
     const bool flow = text[static_cast<std::size_t>(b.Mark().pos)] == '{';
     // The edits as (start, end, new text), made from the last to the first so earlier positions
@@ -230,7 +230,10 @@ std::string withBodyGeometry(const std::string& text, const std::string& source,
     } else if (!tolerance_yaml.empty()) {
       const std::size_t at = valueEnd(text, radius.value);
       const int column = static_cast<int>(radius.key.Mark().column);
-      edits.push_back({at, at, flow ? ", tolerance: " + tolerance_yaml : "\n" + std::string(static_cast<std::size_t>(column), ' ') + "tolerance: " + tolerance_yaml});
+      edits.push_back(
+          {at, at,
+           flow ? ", tolerance: " + tolerance_yaml
+                : "\n" + std::string(static_cast<std::size_t>(column), ' ') + "tolerance: " + tolerance_yaml});
     }
     std::sort(edits.begin(), edits.end(), [](const Edit& x, const Edit& y) { return x.start > y.start; });
     std::string out = text;
@@ -241,8 +244,7 @@ std::string withBodyGeometry(const std::string& text, const std::string& source,
   throw EditError(source + ": no body named '" + body + "'");
 }
 
-std::string withIgnoreList(const std::string& text, const std::string& source,
-                           const std::vector<IgnoreEntry>& pairs) {
+std::string withIgnoreList(const std::string& text, const std::string& source, const std::vector<IgnoreEntry>& pairs) {
   const YAML::Node root = load(text, source);
   std::string out;
   Found section;

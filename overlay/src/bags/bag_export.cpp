@@ -41,7 +41,8 @@ using logs::Value;
 cv::Mat imageOf(const Value& msg, bool compressed, const std::string& at) {
   if (compressed) {
     const Value& data = fieldOf(msg, "data", at);
-    if (data.kind != Value::Kind::Bytes || data.bytes.empty()) throw InputError(at + ": a compressed image without data");
+    if (data.kind != Value::Kind::Bytes || data.bytes.empty())
+      throw InputError(at + ": a compressed image without data");
     // The suite's one image decoder: bounded sizes, damage told in one line, nothing on stderr.
     try {
       return calib::decodeImage(data.bytes, at, calib::ImageColour::Bgr);
@@ -50,27 +51,42 @@ cv::Mat imageOf(const Value& msg, bool compressed, const std::string& at) {
                        "') cannot be decoded: " + e.problem());
     }
   }
-  const double h = fieldOf(msg, "height", at).number(), w = fieldOf(msg, "width", at).number(), step = fieldOf(msg, "step", at).number();
+  const double h = fieldOf(msg, "height", at).number(), w = fieldOf(msg, "width", at).number(),
+               step = fieldOf(msg, "step", at).number();
   const std::string enc = fieldOf(msg, "encoding", at).s;
   const Value& data = fieldOf(msg, "data", at);
-  if (!(h >= 1 && w >= 1 && h <= 16384 && w <= 16384)) throw InputError(at + ": an image of " + formatNumber(w, 6) + "x" + formatNumber(h, 6) + " pixels");
+  if (!(h >= 1 && w >= 1 && h <= 16384 && w <= 16384))
+    throw InputError(at + ": an image of " + formatNumber(w, 6) + "x" + formatNumber(h, 6) + " pixels");
   const int rows = static_cast<int>(h), cols = static_cast<int>(w);
   int type = -1, code = -1;
-  if (enc == "bgr8") type = CV_8UC3;
-  else if (enc == "rgb8") type = CV_8UC3, code = cv::COLOR_RGB2BGR;
-  else if (enc == "bgra8") type = CV_8UC4, code = cv::COLOR_BGRA2BGR;
-  else if (enc == "rgba8") type = CV_8UC4, code = cv::COLOR_RGBA2BGR;
-  else if (enc == "mono8" || enc == "8UC1") type = CV_8UC1, code = cv::COLOR_GRAY2BGR;
-  else if (enc == "mono16" || enc == "16UC1") type = CV_16UC1;
-  else if (enc == "bayer_rggb8") type = CV_8UC1, code = cv::COLOR_BayerBG2BGR;  // OpenCV names the pattern from the second row
-  else if (enc == "bayer_bggr8") type = CV_8UC1, code = cv::COLOR_BayerRG2BGR;
-  else if (enc == "bayer_gbrg8") type = CV_8UC1, code = cv::COLOR_BayerGR2BGR;
-  else if (enc == "bayer_grbg8") type = CV_8UC1, code = cv::COLOR_BayerGB2BGR;
-  else throw InputError(at + ": image encoding '" + printable(enc, 40) + "' is not read (rgb8, bgr8, rgba8, bgra8, mono8, mono16, bayer_*8)");
+  if (enc == "bgr8")
+    type = CV_8UC3;
+  else if (enc == "rgb8")
+    type = CV_8UC3, code = cv::COLOR_RGB2BGR;
+  else if (enc == "bgra8")
+    type = CV_8UC4, code = cv::COLOR_BGRA2BGR;
+  else if (enc == "rgba8")
+    type = CV_8UC4, code = cv::COLOR_RGBA2BGR;
+  else if (enc == "mono8" || enc == "8UC1")
+    type = CV_8UC1, code = cv::COLOR_GRAY2BGR;
+  else if (enc == "mono16" || enc == "16UC1")
+    type = CV_16UC1;
+  else if (enc == "bayer_rggb8")
+    type = CV_8UC1, code = cv::COLOR_BayerBG2BGR;  // OpenCV names the pattern from the second row
+  else if (enc == "bayer_bggr8")
+    type = CV_8UC1, code = cv::COLOR_BayerRG2BGR;
+  else if (enc == "bayer_gbrg8")
+    type = CV_8UC1, code = cv::COLOR_BayerGR2BGR;
+  else if (enc == "bayer_grbg8")
+    type = CV_8UC1, code = cv::COLOR_BayerGB2BGR;
+  else
+    throw InputError(at + ": image encoding '" + printable(enc, 40) +
+                     "' is not read (rgb8, bgr8, rgba8, bgra8, mono8, mono16, bayer_*8)");
   const std::size_t row_bytes = static_cast<std::size_t>(cols) * CV_ELEM_SIZE(type);
   if (!(step >= static_cast<double>(row_bytes) && step < 1e9) || data.kind != Value::Kind::Bytes ||
       static_cast<double>(data.bytes.size()) < step * (rows - 1) + static_cast<double>(row_bytes))
-    throw InputError(at + ": the image's data (" + std::to_string(data.kind == Value::Kind::Bytes ? data.bytes.size() : 0) +
+    throw InputError(at + ": the image's data (" +
+                     std::to_string(data.kind == Value::Kind::Bytes ? data.bytes.size() : 0) +
                      " bytes) does not hold " + std::to_string(rows) + " rows of " + formatNumber(step, 10) + " bytes");
   const cv::Mat view(rows, cols, type, const_cast<std::uint8_t*>(data.bytes.data()), static_cast<std::size_t>(step));
   cv::Mat out;
@@ -98,11 +114,13 @@ cv::Mat imageOf(const Value& msg, bool compressed, const std::string& at) {
 BagExportReport exportBag(const BagExportOptions& o) {
   const auto named = [&](const std::string& field) { return spelledField(o.spell, field); };
   if (o.states.empty() && o.video.empty() && o.camera_info.empty())
-    throw InputError("nothing to write: give " + named("states") + ", " + named("video") + " (with " + named("frame_times") +
-                     ") or " + named("camera_info"));
+    throw InputError("nothing to write: give " + named("states") + ", " + named("video") + " (with " +
+                     named("frame_times") + ") or " + named("camera_info"));
   if (!o.video.empty() && o.frame_times.empty())
-    throw InputError(named("video") + " " + o.video + ": needs " + named("frame_times") + " (a bag's frames are not evenly spaced)");
-  if (!o.frame_times.empty() && o.video.empty()) throw InputError(named("frame_times") + " " + o.frame_times + ": needs " + named("video"));
+    throw InputError(named("video") + " " + o.video + ": needs " + named("frame_times") +
+                     " (a bag's frames are not evenly spaced)");
+  if (!o.frame_times.empty() && o.video.empty())
+    throw InputError(named("frame_times") + " " + o.frame_times + ": needs " + named("video"));
   if (!o.states.empty()) checkOutputPath(o.states, named("states"), ".csv");
   if (!o.frame_times.empty()) checkOutputPath(o.frame_times, named("frame_times"), ".csv");
   if (!o.camera_info.empty()) checkOutputPath(o.camera_info, named("camera_info"), ".yaml");
@@ -119,18 +137,31 @@ BagExportReport exportBag(const BagExportOptions& o) {
   const LogSource* joints = nullptr;
   const LogSource* images = nullptr;
   const LogSource* info = nullptr;
-  if (!o.states.empty()) joints = sourceOf(sources, report.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, named("joint_topic"), "sensor_msgs/JointState", o.bag));
-  if (!o.video.empty()) images = sourceOf(sources, report.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic, named("image_topic"), "sensor_msgs/Image or CompressedImage", o.bag));
-  if (!o.camera_info.empty()) info = sourceOf(sources, report.camera_info_topic = chooseTopic(sources, {LogKind::CameraInfo}, o.camera_info_topic, named("camera_info_topic"), "sensor_msgs/CameraInfo", o.bag));
+  if (!o.states.empty())
+    joints = sourceOf(sources, report.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic,
+                                                                named("joint_topic"), "sensor_msgs/JointState", o.bag));
+  if (!o.video.empty())
+    images = sourceOf(
+        sources, report.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic,
+                                                  named("image_topic"), "sensor_msgs/Image or CompressedImage", o.bag));
+  if (!o.camera_info.empty())
+    info = sourceOf(
+        sources, report.camera_info_topic = chooseTopic(sources, {LogKind::CameraInfo}, o.camera_info_topic,
+                                                        named("camera_info_topic"), "sensor_msgs/CameraInfo", o.bag));
   if (joints) {
-    if (joints->names.empty()) throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": the first joint state names no joint");
+    if (joints->names.empty())
+      throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": the first joint state names no joint");
     std::vector<std::string> sorted = joints->names;
     std::sort(sorted.begin(), sorted.end());
     for (std::size_t i = 0; i + 1 < sorted.size(); ++i)
-      if (sorted[i] == sorted[i + 1]) throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": joint '" + printable(sorted[i], 60) + "' is named twice");
+      if (sorted[i] == sorted[i + 1])
+        throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": joint '" + printable(sorted[i], 60) +
+                         "' is named twice");
     for (const std::string& n : joints->names)
-      if (n.empty() || n == "time" || n.find_first_of(",\"\r\n") != std::string::npos || (n.size() > 4 && n.compare(n.size() - 4, 4, ".vel") == 0))
-        throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": joint name '" + printable(n, 60) + "' cannot be a state log column");
+      if (n.empty() || n == "time" || n.find_first_of(",\"\r\n") != std::string::npos ||
+          (n.size() > 4 && n.compare(n.size() - 4, 4, ".vel") == 0))
+        throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": joint name '" + printable(n, 60) +
+                         "' cannot be a state log column");
     report.joints = joints->names;
     report.velocities = joints->all_velocities;
   }
@@ -165,9 +196,10 @@ BagExportReport exportBag(const BagExportOptions& o) {
   std::int64_t origin = std::numeric_limits<std::int64_t>::max();
   for (const LogSource* src : {joints, images})
     if (src) origin = std::min(origin, src->first);
-  report.origin_ns = o.origin_ns                                        ? *o.origin_ns
-                     : origin == std::numeric_limits<std::int64_t>::max() ? 0
-                                                                          : static_cast<std::uint64_t>(std::max<std::int64_t>(origin, 0));
+  report.origin_ns = o.origin_ns ? *o.origin_ns
+                     : origin == std::numeric_limits<std::int64_t>::max()
+                         ? 0
+                         : static_cast<std::uint64_t>(std::max<std::int64_t>(origin, 0));
   std::map<std::uint16_t, std::size_t> index;
   std::size_t zero = 0, extra_names = 0;
   IncreasingTimes state_times, frame_times;
@@ -190,16 +222,20 @@ BagExportReport exportBag(const BagExportOptions& o) {
         const std::string model = fieldOf(v, "distortion_model", at).s;
         if (kk.size() != 9) throw InputError(at + ": camera info without a 3x3 K");
         if (model != "plumb_bob" && model != "rational_polynomial" && !(model.empty() && dd.empty()))
-          throw InputError(at + ": distortion model '" + printable(model, 40) + "' is not OpenCV's (plumb_bob or rational_polynomial)");
+          throw InputError(at + ": distortion model '" + printable(model, 40) +
+                           "' is not OpenCV's (plumb_bob or rational_polynomial)");
         std::vector<double> dist = dd;
         if (dist.empty()) dist.assign(5, 0.0);
         if (dist.size() != 4 && dist.size() != 5 && dist.size() != 8 && dist.size() != 12 && dist.size() != 14)
-          throw InputError(at + ": " + std::to_string(dist.size()) + " distortion coefficients (OpenCV takes 4, 5, 8, 12 or 14)");
+          throw InputError(at + ": " + std::to_string(dist.size()) +
+                           " distortion coefficients (OpenCV takes 4, 5, 8, 12 or 14)");
         std::string t = "%YAML:1.0\n---\n";
-        t += "image_width: " + exactText(fieldOf(v, "width", at).number()) + "\nimage_height: " + exactText(fieldOf(v, "height", at).number()) + "\n";
+        t += "image_width: " + exactText(fieldOf(v, "width", at).number()) +
+             "\nimage_height: " + exactText(fieldOf(v, "height", at).number()) + "\n";
         t += "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ ";
         for (std::size_t i = 0; i < 9; ++i) t += exactText(kk[i]) + (i + 1 < 9 ? ", " : " ]\n");
-        t += "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: " + std::to_string(dist.size()) + "\n   dt: d\n   data: [ ";
+        t += "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: " + std::to_string(dist.size()) +
+             "\n   dt: d\n   data: [ ";
         for (std::size_t i = 0; i < dist.size(); ++i) t += exactText(dist[i]) + (i + 1 < dist.size() ? ", " : " ]\n");
         camera_text = t;
         continue;
@@ -213,7 +249,9 @@ BagExportReport exportBag(const BagExportOptions& o) {
           row = jointRow(v, at, report.joints, report.velocities, extra_names);
         } catch (const InputError& e) {
           const std::string what = e.what();
-          throw InputError(what.find("' is not given") != std::string::npos ? what + " (every message must name the first message's joints)" : what);
+          throw InputError(what.find("' is not given") != std::string::npos
+                               ? what + " (every message must name the first message's joints)"
+                               : what);
         }
         states_file << secondsText(time, report.origin_ns);
         for (const double x : row) states_file << "," << exactText(x);
@@ -226,8 +264,8 @@ BagExportReport exportBag(const BagExportOptions& o) {
           report.width = frame.cols, report.height = frame.rows;
           sink->begin(report.fps, frame.cols, frame.rows);
         } else if (frame.cols != report.width || frame.rows != report.height) {
-          throw InputError(at + ": the image is " + std::to_string(frame.cols) + "x" + std::to_string(frame.rows) + ", the first was " +
-                           std::to_string(report.width) + "x" + std::to_string(report.height));
+          throw InputError(at + ": the image is " + std::to_string(frame.cols) + "x" + std::to_string(frame.rows) +
+                           ", the first was " + std::to_string(report.width) + "x" + std::to_string(report.height));
         }
         sink->write(report.frames, frame);
         times_file << report.frames << "," << secondsText(time, report.origin_ns) << "\n";
@@ -236,14 +274,19 @@ BagExportReport exportBag(const BagExportOptions& o) {
     }
   }
   report.log_time_stamps = zero;
-  if (zero > 0) report.warnings.push_back(std::to_string(zero) + " messages have a zero header stamp: their log time is used");
-  if (extra_names > 0) report.warnings.push_back(std::to_string(extra_names) + " joint values of joints the first joint state did not name: left out");
+  if (zero > 0)
+    report.warnings.push_back(std::to_string(zero) + " messages have a zero header stamp: their log time is used");
+  if (extra_names > 0)
+    report.warnings.push_back(std::to_string(extra_names) +
+                              " joint values of joints the first joint state did not name: left out");
   report.dropped_states = state_times.dropped;
   report.dropped_frames = frame_times.dropped;
   if (state_times.dropped > 0) report.warnings.push_back(state_times.warning("joint states"));
   if (frame_times.dropped > 0) report.warnings.push_back(frame_times.warning("images"));
-  if (info && camera_text.empty()) throw InputError(o.bag + ": topic " + printable(info->topic, 60) + ": no camera info message");
-  if (joints && report.states == 0) throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": no joint state");
+  if (info && camera_text.empty())
+    throw InputError(o.bag + ": topic " + printable(info->topic, 60) + ": no camera info message");
+  if (joints && report.states == 0)
+    throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": no joint state");
   // All or nothing: every output in place only once all are written.
   if (states_file.is_open()) {
     states_file.close();

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -48,7 +48,7 @@ struct LogSource {
   std::size_t count = 0;
   std::vector<std::string> names;  // joints: the first message's
   bool all_velocities = true;
-  std::vector<std::int64_t> times;  // images: each message's chosen time
+  std::vector<std::int64_t> times;                                // images: each message's chosen time
   std::int64_t first = std::numeric_limits<std::int64_t>::max();  // the earliest chosen time
 };
 
@@ -61,10 +61,12 @@ inline LogSource logSourceOf(const std::string& bag, const logs::LogReader& read
   if (s.kind == LogKind::Other) return s;
   s.cdr = m.channel->message_encoding == "cdr";
   try {
-    s.types = logs::MessageDefinitions::parse(m.schema->name, m.schema->data, s.cdr ? logs::Dialect::Ros2 : logs::Dialect::Ros1);
+    s.types = logs::MessageDefinitions::parse(m.schema->name, m.schema->data,
+                                              s.cdr ? logs::Dialect::Ros2 : logs::Dialect::Ros1);
   } catch (const logs::DefinitionError& e) {
-    throw InputError(bag + ": " + reader.place(m.offset) + ": topic " + printable(s.topic, 60) + ": the definition of " +
-                     printable(m.schema->name, 60) + (e.line() ? " (line " + std::to_string(e.line()) + ")" : std::string()) + ": " +
+    throw InputError(bag + ": " + reader.place(m.offset) + ": topic " + printable(s.topic, 60) +
+                     ": the definition of " + printable(m.schema->name, 60) +
+                     (e.line() ? " (line " + std::to_string(e.line()) + ")" : std::string()) + ": " +
                      printable(e.what(), 200));
   }
   return s;
@@ -89,7 +91,8 @@ inline std::int64_t messageTime(const Value& v, const logs::LogMessage& m, TimeS
   return *stamp;
 }
 
-inline std::string messagePlace(const std::string& bag, const logs::LogReader& r, const logs::LogMessage& m, std::size_t index) {
+inline std::string messagePlace(const std::string& bag, const logs::LogReader& r, const logs::LogMessage& m,
+                                std::size_t index) {
   return bag + ": " + r.place(m.offset) + ": topic " + printable(m.channel->topic, 60) + ": message " +
          std::to_string(index + 1);
 }
@@ -98,16 +101,19 @@ inline Value decodeMessage(const LogSource& s, const logs::LogMessage& m, const 
   try {
     return s.cdr ? logs::decodeCdr(*s.types, m.data) : logs::decodeRos1(*s.types, m.data);
   } catch (const logs::DecodeError& e) {
-    throw InputError(at + " (" + printable(m.schema->name, 60) + ") does not decode: byte " + std::to_string(e.offset()) + " of its " +
-                     std::to_string(m.data.size()) + ": " + printable(e.what(), 200));
+    throw InputError(at + " (" + printable(m.schema->name, 60) + ") does not decode: byte " +
+                     std::to_string(e.offset()) + " of its " + std::to_string(m.data.size()) + ": " +
+                     printable(e.what(), 200));
   }
 }
 
-inline std::string chooseTopic(const std::map<std::uint16_t, LogSource>& sources, std::initializer_list<LogKind> kinds, const std::string& given,
-                   const std::string& option, const std::string& what, const std::string& bag) {
+inline std::string chooseTopic(const std::map<std::uint16_t, LogSource>& sources, std::initializer_list<LogKind> kinds,
+                               const std::string& given, const std::string& option, const std::string& what,
+                               const std::string& bag) {
   std::vector<std::string> fits;
   for (const auto& [id, s] : sources)
-    if (std::find(kinds.begin(), kinds.end(), s.kind) != kinds.end() && std::find(fits.begin(), fits.end(), s.topic) == fits.end())
+    if (std::find(kinds.begin(), kinds.end(), s.kind) != kinds.end() &&
+        std::find(fits.begin(), fits.end(), s.topic) == fits.end())
       fits.push_back(s.topic);
   if (!given.empty()) {
     if (std::find(fits.begin(), fits.end(), given) == fits.end())
@@ -143,7 +149,9 @@ struct IncreasingTimes {
   }
   // The warning for what was left out ("" when nothing was): `what` names the messages.
   std::string warning(const std::string& what) const {
-    return dropped == 0 ? std::string() : std::to_string(dropped) + " " + what + " left out: their time was not after the previous one's";
+    return dropped == 0
+               ? std::string()
+               : std::to_string(dropped) + " " + what + " left out: their time was not after the previous one's";
   }
 };
 
@@ -163,15 +171,15 @@ inline std::vector<double> numbersOf(const Value& v) {
   return out;
 }
 
-
 // Pass 1 over a log: every channel, and for those of the kinds read their definitions, message
 // count, first joint names, whether every joint state gives velocities, each image's time and the
 // earliest time on the chosen clock. `damage`: where the log was cut short, if it was.
 // `visit`, when given, sees every decoded joint state and image with its time and place.
-using MessageVisitor = std::function<void(const LogSource&, std::uint16_t channel, const Value&, std::int64_t time, const std::string& at)>;
+using MessageVisitor = std::function<void(const LogSource&, std::uint16_t channel, const Value&, std::int64_t time,
+                                          const std::string& at)>;
 
 inline std::map<std::uint16_t, LogSource> scanLog(const std::string& bag, TimeSource time_source, std::string& damage,
-                                                 const MessageVisitor& visit = {}) {
+                                                  const MessageVisitor& visit = {}) {
   std::map<std::uint16_t, LogSource> sources;
   std::size_t zero_probe = 0;
   const std::unique_ptr<logs::LogReader> log = logs::openLog(bag);
@@ -222,12 +230,13 @@ inline double nominalFps(const std::vector<std::int64_t>& times) {
 // A joint state's values in `columns` order: the positions, then (with `velocities`) the
 // velocities, NaN where the message gives none. Joints not in `columns` are counted in `extra`.
 // Throws InputError naming `at` for a column the message does not name or a value not finite.
-inline std::vector<double> jointRow(const Value& v, const std::string& at, const std::vector<std::string>& columns, bool velocities,
-                                    std::size_t& extra) {
+inline std::vector<double> jointRow(const Value& v, const std::string& at, const std::vector<std::string>& columns,
+                                    bool velocities, std::size_t& extra) {
   const Value& names = fieldOf(v, "name", at);
   const std::vector<double> pos = numbersOf(fieldOf(v, "position", at)), vel = numbersOf(fieldOf(v, "velocity", at));
   if (pos.size() != names.items.size())
-    throw InputError(at + ": " + std::to_string(names.items.size()) + " names but " + std::to_string(pos.size()) + " positions");
+    throw InputError(at + ": " + std::to_string(names.items.size()) + " names but " + std::to_string(pos.size()) +
+                     " positions");
   std::vector<double> row(columns.size() * (velocities ? 2 : 1), std::nan(""));
   for (std::size_t i = 0; i < names.items.size(); ++i) {
     const auto c = std::find(columns.begin(), columns.end(), names.items[i].s);
@@ -244,8 +253,9 @@ inline std::vector<double> jointRow(const Value& v, const std::string& at, const
       throw InputError(at + ": joint '" + printable(columns[col], 60) + "' is not given");
     if (col >= columns.size() && std::isnan(row[col])) continue;  // no velocity: the caller decides
     if (!std::isfinite(row[col]) || std::abs(row[col]) > 1e300)
-      throw InputError(at + ": joint '" + printable(columns[col % columns.size()], 60) + "': " + (col < columns.size() ? "position " : "velocity ") +
-                       formatNumber(row[col], 6) + " is not a finite number");
+      throw InputError(at + ": joint '" + printable(columns[col % columns.size()], 60) +
+                       "': " + (col < columns.size() ? "position " : "velocity ") + formatNumber(row[col], 6) +
+                       " is not a finite number");
   }
   return row;
 }

@@ -77,8 +77,14 @@ class OrderedJobs {
 class BagFrames final : public FrameSource {
  public:
   BagFrames(std::string bag, std::string topic, TimeSource clock, double fps, std::size_t frames)
-      : bag_(std::move(bag)), topic_(std::move(topic)), clock_(clock), fps_(fps), frames_(frames), reader_(logs::openLog(bag_)),
-        workers_(std::clamp(std::thread::hardware_concurrency(), 1u, 4u)), jobs_(workers_) {}
+      : bag_(std::move(bag)),
+        topic_(std::move(topic)),
+        clock_(clock),
+        fps_(fps),
+        frames_(frames),
+        reader_(logs::openLog(bag_)),
+        workers_(std::clamp(std::thread::hardware_concurrency(), 1u, 4u)),
+        jobs_(workers_) {}
   double fps() const override { return fps_; }
   std::size_t declaredFrames() const override { return frames_; }
   std::size_t nextIndex() const override { return next_; }
@@ -132,7 +138,8 @@ class BagFrames final : public FrameSource {
 void imageTimes(const BagRecordingOptions& o, const LogSource& images, BagRecording& rec) {
   IncreasingTimes used;
   for (const std::int64_t t : images.times)
-    if (used.accept(t)) rec.frame_times.push_back(static_cast<double>(t - static_cast<std::int64_t>(rec.origin_ns)) / 1e9);
+    if (used.accept(t))
+      rec.frame_times.push_back(static_cast<double>(t - static_cast<std::int64_t>(rec.origin_ns)) / 1e9);
   if (rec.frame_times.empty()) throw InputError(o.bag + ": topic " + printable(rec.image_topic, 60) + ": no image");
   if (used.dropped > 0) rec.warnings.push_back(used.warning("images"));
   rec.fps = nominalFps(images.times);
@@ -166,8 +173,9 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
   };
   std::map<std::uint16_t, Rows> rows;
   std::string damage;
-  const std::map<std::uint16_t, LogSource> sources =
-      scanLog(o.bag, o.time_source, damage, [&](const LogSource& s, std::uint16_t channel, const logs::Value& v, std::int64_t t, const std::string& at) {
+  const std::map<std::uint16_t, LogSource> sources = scanLog(
+      o.bag, o.time_source, damage,
+      [&](const LogSource& s, std::uint16_t channel, const logs::Value& v, std::int64_t t, const std::string& at) {
         if (s.kind != LogKind::Joints || !model) return;
         Rows& r = rows[channel];
         if (!r.problem.empty()) return;
@@ -181,15 +189,18 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
           r.problem = e.what();
         }
       });
-  rec.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic, spelledField(o.spell, "image_topic"), "sensor_msgs/Image or CompressedImage", o.bag);
+  rec.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic,
+                                spelledField(o.spell, "image_topic"), "sensor_msgs/Image or CompressedImage", o.bag);
   const LogSource& images = *sourceOf(sources, rec.image_topic);
   if (!model) {
     rec.origin_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(images.first, 0));
-    if (!damage.empty()) rec.warnings.push_back(damage + "; read up to it: " + std::to_string(images.times.size()) + " images");
+    if (!damage.empty())
+      rec.warnings.push_back(damage + "; read up to it: " + std::to_string(images.times.size()) + " images");
     imageTimes(o, images, rec);
     return rec;
   }
-  rec.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, spelledField(o.spell, "joint_topic"), "sensor_msgs/JointState", o.bag);
+  rec.joint_topic = chooseTopic(sources, {LogKind::Joints}, o.joint_topic, spelledField(o.spell, "joint_topic"),
+                                "sensor_msgs/JointState", o.bag);
   std::uint16_t joint_channel = 0;
   for (const auto& [id, src] : sources)
     if (src.topic == rec.joint_topic) joint_channel = id;
@@ -201,20 +212,25 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
       std::string have;
       for (const std::string& j : joints.names) have += (have.empty() ? "" : ", ") + printable(j, 40);
       const std::size_t q = r.problem.find("joint '");
-      const std::string name = q == std::string::npos ? std::string() : r.problem.substr(q + 7, r.problem.find('\'', q + 7) - q - 7);
+      const std::string name =
+          q == std::string::npos ? std::string() : r.problem.substr(q + 7, r.problem.find('\'', q + 7) - q - 7);
       std::string what = "the model's state value '" + name + "'";
       for (const JointSource& s : map.states)
         if (s.line > 0 && printable(s.from, 60) == name)
-          what = "'" + name + "', which " + map.source + " (line " + std::to_string(s.line) + ") reads '" + printable(s.state, 60) + "' from";
-      throw InputError(o.bag + ": topic " + printable(rec.joint_topic, 60) + ": the joint states do not name " + what + " (they name: " + have +
-                       ")" + (map.source.empty() ? "; " + spelledField(o.spell, "joint_map") + " can rename, scale or fix a state value" : std::string()));
+          what = "'" + name + "', which " + map.source + " (line " + std::to_string(s.line) + ") reads '" +
+                 printable(s.state, 60) + "' from";
+      throw InputError(o.bag + ": topic " + printable(rec.joint_topic, 60) + ": the joint states do not name " + what +
+                       " (they name: " + have + ")" +
+                       (map.source.empty()
+                            ? "; " + spelledField(o.spell, "joint_map") + " can rename, scale or fix a state value"
+                            : std::string()));
     }
     throw InputError(r.problem);
   }
   if (r.times.empty()) throw InputError(o.bag + ": topic " + printable(rec.joint_topic, 60) + ": no joint state");
   if (!damage.empty())
-    rec.warnings.push_back(damage + "; read up to it: " + std::to_string(images.times.size()) + " images and " + std::to_string(r.times.size()) +
-                           " joint states");
+    rec.warnings.push_back(damage + "; read up to it: " + std::to_string(images.times.size()) + " images and " +
+                           std::to_string(r.times.size()) + " joint states");
   const std::int64_t origin = std::min(images.first, joints.first);
   rec.origin_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(origin, 0));
   // The state log, as text the state log reader checks like a file.
@@ -222,7 +238,8 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
   std::vector<std::size_t> column(states.size(), 0);
   for (std::size_t k = 0; k < states.size(); ++k)
     if (!map.states[k].constant)
-      column[k] = static_cast<std::size_t>(std::find(wanted.begin(), wanted.end(), map.states[k].from) - wanted.begin());
+      column[k] =
+          static_cast<std::size_t>(std::find(wanted.begin(), wanted.end(), map.states[k].from) - wanted.begin());
   std::string text = "time";
   for (const std::string& n : states) text += "," + n;
   if (r.velocities)
@@ -233,8 +250,9 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
     for (std::size_t k = 0; k < states.size(); ++k) {
       const JointSource& s = map.states[k];
       text += ',';
-      text += exactText(s.constant ? *s.constant : s.scale == 1.0 && s.offset == 0.0 ? r.values[i][column[k]]
-                                                                                          : s.scale * r.values[i][column[k]] + s.offset);
+      text += exactText(s.constant                          ? *s.constant
+                        : s.scale == 1.0 && s.offset == 0.0 ? r.values[i][column[k]]
+                                                            : s.scale * r.values[i][column[k]] + s.offset);
     }
     if (r.velocities)
       for (std::size_t k = 0; k < states.size(); ++k) {
@@ -244,12 +262,15 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
       }
     text += "\n";
   }
-  rec.log = parseStateLog(text, spelledField(o.spell, "bag") + " " + o.bag + " (topic " + rec.joint_topic + ")", *model);
+  rec.log =
+      parseStateLog(text, spelledField(o.spell, "bag") + " " + o.bag + " (topic " + rec.joint_topic + ")", *model);
   if (r.extra > 0) {
     std::string left_out;
     for (const std::string& j : joints.names)
-      if (std::find(wanted.begin(), wanted.end(), j) == wanted.end()) left_out += (left_out.empty() ? "" : ", ") + printable(j, 40);
-    rec.warnings.push_back("logged joints the model does not read, left out: " + (left_out.empty() ? std::to_string(r.extra) + " values" : left_out));
+      if (std::find(wanted.begin(), wanted.end(), j) == wanted.end())
+        left_out += (left_out.empty() ? "" : ", ") + printable(j, 40);
+    rec.warnings.push_back("logged joints the model does not read, left out: " +
+                           (left_out.empty() ? std::to_string(r.extra) + " values" : left_out));
   }
   if (r.used.dropped > 0) rec.warnings.push_back(r.used.warning("joint states"));
   imageTimes(o, images, rec);
@@ -258,7 +279,9 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
 
 }  // namespace
 
-BagRecording readBagRecording(const BagRecordingOptions& options, const Model& model) { return readBag(options, &model); }
+BagRecording readBagRecording(const BagRecordingOptions& options, const Model& model) {
+  return readBag(options, &model);
+}
 
 std::vector<std::pair<std::string, std::string>> BagRecording::source() const {
   return {{"bag", bag},
@@ -275,7 +298,8 @@ std::vector<cv::Mat> framesAt(const BagRecording& rec, const std::vector<long>& 
   for (const long f : indices)
     if (f < 0 || static_cast<std::size_t>(f) >= n)
       throw InputError(option + " " + std::to_string(f) + ": " + rec.bag + " has " + std::to_string(n) + " images on " +
-                       printable(rec.image_topic, 60) + (n > 0 ? " (frames 0 ... " + std::to_string(n - 1) + ")" : std::string()));
+                       printable(rec.image_topic, 60) +
+                       (n > 0 ? " (frames 0 ... " + std::to_string(n - 1) + ")" : std::string()));
   const long last = *std::max_element(indices.begin(), indices.end());
   std::map<long, cv::Mat> kept;
   for (const long f : indices) kept[f];
@@ -283,7 +307,8 @@ std::vector<cv::Mat> framesAt(const BagRecording& rec, const std::vector<long>& 
   cv::Mat frame;
   for (long i = 0; i <= last; ++i) {
     if (!source->read(frame))
-      throw InputError(option + " " + std::to_string(i) + ": " + rec.bag + ": the image could not be read (the log ends before it)");
+      throw InputError(option + " " + std::to_string(i) + ": " + rec.bag +
+                       ": the image could not be read (the log ends before it)");
     if (kept.count(i)) kept[i] = frame.clone();
   }
   std::vector<cv::Mat> out;

@@ -31,9 +31,12 @@ JointMap parseJointMap(const std::string& text, const std::string& source, const
   if (!root.IsMap()) r.fail(root, "joint map", "expected a mapping with kccd_joint_map: 1 and joints");
   r.onlyKeys(root, "joint map", {"kccd_joint_map", "joints"});
   const YAML::Node version = r.require(root, "kccd_joint_map", "joint map");
-  if (!version.IsScalar() || version.Scalar() != "1") r.fail(version, "kccd_joint_map", "expected 1 (the joint map format's version)");
+  if (!version.IsScalar() || version.Scalar() != "1")
+    r.fail(version, "kccd_joint_map", "expected 1 (the joint map format's version)");
   const YAML::Node joints = r.require(root, "joints", "joint map");
-  if (!joints.IsMap()) r.fail(joints, "joints", "expected a mapping of the model's state values, e.g. elbow: {from: elbow_deg, degrees: true}");
+  if (!joints.IsMap())
+    r.fail(joints, "joints",
+           "expected a mapping of the model's state values, e.g. elbow: {from: elbow_deg, degrees: true}");
   const std::vector<std::string> names = model.stateNames();
   for (const auto& kv : joints) {
     const std::string state = r.text(kv.first, "joints");
@@ -68,7 +71,8 @@ JointMap parseJointMap(const std::string& text, const std::string& source, const
     }
     if (e["offset"]) s.offset = r.bounded(e["offset"], f + ".offset", kBound, "1e6");
     if (const YAML::Node d = e["degrees"]) {
-      if (!d.IsScalar() || (d.Scalar() != "true" && d.Scalar() != "false")) r.fail(d, f + ".degrees", "expected true or false");
+      if (!d.IsScalar() || (d.Scalar() != "true" && d.Scalar() != "false"))
+        r.fail(d, f + ".degrees", "expected true or false");
       if (d.Scalar() == "true") s.scale *= std::numbers::pi / 180.0;
     }
   }

@@ -71,8 +71,8 @@ CheckImage checkImage(const Gathered& g, const CalibSolution& s, std::size_t fra
   const std::vector<std::string> head{
       (g.points.empty() || !r.camera.reprojection_rms_px
            ? "kccd calib: the pose of " + options.pose_source + ", no points"
-           : "kccd calib: " + std::to_string(r.inliers) + " of " + std::to_string(g.points.size()) + " points agree, RMS " +
-                 messageNumber(*r.camera.reprojection_rms_px, 3) + " px") +
+           : "kccd calib: " + std::to_string(r.inliers) + " of " + std::to_string(g.points.size()) +
+                 " points agree, RMS " + messageNumber(*r.camera.reprojection_rms_px, 3) + " px") +
           (g.frames.size() > 1 ? " (frame " + std::to_string(frame + 1) + " of " + std::to_string(g.frames.size()) + ")"
                                : ""),
       "1 sigma: rotation " + messageNumber(*r.camera.rotation_sigma_deg, 3) + " deg, position " +

@@ -50,7 +50,8 @@ RecordingFrames readRecordingFrames(const std::string& path, const std::vector<i
   return out;
 }
 
-RecordingFrames sampleRecordingFrames(const std::string& path, std::size_t count, std::vector<int>& indices, const std::string& label) {
+RecordingFrames sampleRecordingFrames(const std::string& path, std::size_t count, std::vector<int>& indices,
+                                      const std::string& label) {
   const std::string name = label.empty() ? path : label;
   VideoSource video(path, label);
   RecordingFrames out;

@@ -24,7 +24,8 @@ std::optional<calib::Camera> roughPose(const calib::Camera& intrinsics, const Ga
   for (const calib::Correspondence& c : g.points) world.push_back(c.world), pixels.push_back(c.pixel);
   cv::Vec3d rvec, tvec;
   try {
-    if (!cv::solvePnP(world, pixels, intrinsics.camera_matrix, intrinsics.distortion, rvec, tvec, false, cv::SOLVEPNP_SQPNP))
+    if (!cv::solvePnP(world, pixels, intrinsics.camera_matrix, intrinsics.distortion, rvec, tvec, false,
+                      cv::SOLVEPNP_SQPNP))
       return std::nullopt;
   } catch (const cv::Exception&) {
     return std::nullopt;
@@ -44,9 +45,10 @@ std::optional<calib::Camera> roughPose(const calib::Camera& intrinsics, const Ga
 // rounds before the last are kept on any gain (their masks are rough); the last is held to the
 // refinement's gates. The result is the last round that improved the pose, with the gathered
 // frames' figures (IoUs before at `start`) and their masks in `out`.
-calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<calib::MaskFrame> frames, const Gathered& g,
-                                      std::span<const RecordingSample> recording, const RobotDrawing& robot, std::span<const int> bodies,
-                                      const Model& model, const calib::RefineOptions& options, const FieldSpelling& spell,
+calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<calib::MaskFrame> frames,
+                                      const Gathered& g, std::span<const RecordingSample> recording,
+                                      const RobotDrawing& robot, std::span<const int> bodies, const Model& model,
+                                      const calib::RefineOptions& options, const FieldSpelling& spell,
                                       Refinement& out) {
   const auto named = [&](const std::string& field) { return spelledField(spell, field); };
   const std::size_t gathered = frames.size();
@@ -56,11 +58,12 @@ calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<ca
   for (const GatheredFrame& f : g.frames) frame_volumes.push_back(calib::placeVolumes(model, f.state, bodies));
   for (const RecordingSample& s : recording) {
     if (s.bgr.type() != CV_8UC3 || s.bgr.cols != start.width || s.bgr.rows != start.height)
-      throw CalibInputError(named("masks") + " auto: the recording's frames are not 8-bit colour pictures of the camera's " +
+      throw CalibInputError(named("masks") +
+                            " auto: the recording's frames are not 8-bit colour pictures of the camera's " +
                             std::to_string(start.width) + "x" + std::to_string(start.height));
     if (static_cast<int>(s.state.size()) != model.stateSize())
-      throw CalibInputError(named("masks") + " auto: a frame of the recording without a state of the model's " + std::to_string(model.stateSize()) +
-                            " values");
+      throw CalibInputError(named("masks") + " auto: a frame of the recording without a state of the model's " +
+                            std::to_string(model.stateSize()) + " values");
     sample_volumes.push_back(calib::placeVolumes(model, s.state, bodies));
   }
   // The samples fitted with the gathered frames: 16 spread over the recording.
@@ -110,8 +113,8 @@ calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<ca
     double mean = 0.0;
     for (const calib::FrameAgreement& a : kept->frames) mean += a.iou_after / static_cast<double>(kept->frames.size());
     if (mean < options.min_iou || !(kept->camera.rotation_sigma_deg.value_or(90.0) <= options.max_rotation_sigma_deg)) {
-      last.message = "the drawn robot and the masks made from the recording agree too little (mean IoU " + formatNumber(mean, 3) +
-                     ", at least " + formatNumber(options.min_iou, 3) + " needed; rotation +-" +
+      last.message = "the drawn robot and the masks made from the recording agree too little (mean IoU " +
+                     formatNumber(mean, 3) + ", at least " + formatNumber(options.min_iou, 3) + " needed; rotation +-" +
                      formatNumber(kept->camera.rotation_sigma_deg.value_or(90.0), 3) +
                      " deg): is the camera fixed, and does the robot move over the recording? The start is kept";
       kept.reset();
@@ -134,7 +137,8 @@ calib::RefineResult refineToRecording(const calib::Camera& start, std::vector<ca
     if (!kept) result.frames[f].iou_after = result.frames[f].iou_before;
   }
   if (kept)
-    out.masks_from += " (the background known over " + formatNumber(100.0 * cv::countNonZero(known) / static_cast<double>(known.total()), 3) +
+    out.masks_from += " (the background known over " +
+                      formatNumber(100.0 * cv::countNonZero(known) / static_cast<double>(known.total()), 3) +
                       " % of the image)";
   return result;
 }
@@ -177,8 +181,9 @@ RobotDrawing::RobotDrawing(const Model& model, std::vector<int> bodies, const st
   if (!visuals_.empty()) {
     std::vector<int> shown;
     for (const int b : volume_bodies_)
-      if (std::any_of(visuals_.begin(), visuals_.end(),
-                      [&](const render::LoadedVisual& v) { return v.frame == model.bodies[static_cast<std::size_t>(b)].frame; }))
+      if (std::any_of(visuals_.begin(), visuals_.end(), [&](const render::LoadedVisual& v) {
+            return v.frame == model.bodies[static_cast<std::size_t>(b)].frame;
+          }))
         shown.push_back(b);
     if (!shown.empty()) volume_bodies_ = std::move(shown);
   }
@@ -208,20 +213,22 @@ std::vector<calib::PlacedMesh> RobotDrawing::meshes(std::span<const double> stat
   return out;
 }
 
-Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const calib::Camera& intrinsics, const Model& model,
-                             const RefineInputs& in, const calib::Camera* truth) {
+Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const calib::Camera& intrinsics,
+                             const Model& model, const RefineInputs& in, const calib::Camera* truth) {
   const auto named = [&](const std::string& field) { return spelledField(in.spell, field); };
   const bool edges = in.source == calib::RefineSource::Edges;
   const bool from_recording = !edges && in.masks.empty() && !in.recording.empty();
   if (!edges && !from_recording && in.masks.size() != g.frames.size())
-    throw CalibInputError(named("masks") + ": " + std::to_string(in.masks.size()) + " mask(s) for " + std::to_string(g.frames.size()) +
-                          " frame(s): give one mask per frame, in the same order");
+    throw CalibInputError(named("masks") + ": " + std::to_string(in.masks.size()) + " mask(s) for " +
+                          std::to_string(g.frames.size()) + " frame(s): give one mask per frame, in the same order");
   Refinement out;
   // Masks made from a recording hold only what moves.
   std::vector<int> bodies = in.bodies;
   if (from_recording) {
     bodies = movingBodies(model, in.bodies);
-    if (bodies.empty()) throw CalibInputError(named("masks") + " auto: no body of the model (of those the masks show) moves with a joint");
+    if (bodies.empty())
+      throw CalibInputError(named("masks") +
+                            " auto: no body of the model (of those the masks show) moves with a joint");
   }
   const RobotDrawing robot(model, bodies, in.draw);
   out.bodies = bodies;
@@ -233,14 +240,17 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
     const std::vector<double>& state = g.frames[f].state;
     if (static_cast<int>(state.size()) != model.stateSize())
       throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no state of the model's " +
-                            std::to_string(model.stateSize()) + " values: give " + named("state") + ", or " + named("states") + " with " + named("time"));
+                            std::to_string(model.stateSize()) + " values: give " + named("state") + ", or " +
+                            named("states") + " with " + named("time"));
     if ((edges || from_recording) && g.frames[f].bgr.empty())
       throw CalibInputError(what + ": frame " + std::to_string(f + 1) + " has no picture to find " +
                             (edges ? "edges" : "the robot") + " in: give " + named("image") + " or " + named("video"));
     std::vector<calib::PlacedMesh> meshes = robot.meshes(state);
     out.meshes.push_back(meshes);
-    if (edges) edge_frames.push_back({g.frames[f].bgr, robot.volumes(state), std::move(meshes)});
-    else mask_frames.push_back({from_recording ? cv::Mat() : in.masks[f], robot.volumes(state), std::move(meshes)});
+    if (edges)
+      edge_frames.push_back({g.frames[f].bgr, robot.volumes(state), std::move(meshes)});
+    else
+      mask_frames.push_back({from_recording ? cv::Mat() : in.masks[f], robot.volumes(state), std::move(meshes)});
   }
   calib::Camera start;
   if (solution.solved()) {
@@ -252,7 +262,8 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
     start.rvec = in.rough->rvec, start.tvec = in.rough->tvec;
     out.start = "camera";
   } else {
-    throw CalibInputError(what + ": no start for the pose: give 4 or more labels or tag corners, or " + named("camera") + " ROUGH.yaml");
+    throw CalibInputError(what + ": no start for the pose: give 4 or more labels or tag corners, or " +
+                          named("camera") + " ROUGH.yaml");
   }
   if (edges) {
     calib::EdgeOptions options;
@@ -261,7 +272,8 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
   } else {
     calib::RefineOptions options;
     options.start_is_prior = out.start == "solve";
-    out.result = from_recording ? refineToRecording(start, mask_frames, g, in.recording, robot, bodies, model, options, in.spell, out)
+    out.result = from_recording ? refineToRecording(start, mask_frames, g, in.recording, robot, bodies, model, options,
+                                                    in.spell, out)
                                 : calib::refineToMasks(start, mask_frames, options);
   }
   if (!out.result.improved) return out;
@@ -283,7 +295,8 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
     std::vector<cv::Point2d> px;
     cv::projectPoints(world, pose.camera.rvec, pose.camera.tvec, pose.camera.camera_matrix, pose.camera.distortion, px);
     std::vector<double> d(g.points.size());
-    for (std::size_t i = 0; i < g.points.size(); ++i) d[i] = std::hypot(px[i].x - g.points[i].pixel.x, px[i].y - g.points[i].pixel.y);
+    for (std::size_t i = 0; i < g.points.size(); ++i)
+      d[i] = std::hypot(px[i].x - g.points[i].pixel.x, px[i].y - g.points[i].pixel.y);
     // The median of the other points' residuals: a misclick does not raise its own limit.
     const auto othersMedian = [&d](std::size_t skip) {
       std::vector<double> others;
@@ -306,8 +319,10 @@ Refinement refineCalibration(CalibSolution& solution, const Gathered& g, const c
   double sse = 0.0;
   for (const calib::Residual& res : pose.residuals)
     if (res.inlier) sse += res.px * res.px;
-  if (pose.inliers > 0) pose.camera.reprojection_rms_px = std::sqrt(sse / pose.inliers);
-  else pose.camera.reprojection_rms_px.reset();
+  if (pose.inliers > 0)
+    pose.camera.reprojection_rms_px = std::sqrt(sse / pose.inliers);
+  else
+    pose.camera.reprojection_rms_px.reset();
   pose.message = out.result.message;
   if (!out.disagreeing.empty()) {
     pose.message += "; the image disagrees with";
@@ -327,10 +342,10 @@ std::string refinementText(const Refinement& m) {
     after += (f ? ", " : " ") + formatNumber(edges ? a.matched_after : a.iou_after, 6);
   }
   const std::string key = edges ? "edge_share" : "mask_iou";
-  return std::string("refinement: ") + (m.result.improved ? (edges ? "edges" : "masks") : "none") + "\nrefinement_start: " + m.start +
-         "\nrefinement_drawn: \"" + m.drawn + "\"\n" +
-         (m.masks_from.empty() ? std::string() : "refinement_masks: \"" + m.masks_from + "\"\n") + key + "_before: " + before +
-         " ]\n" + key + "_after: " + after + " ]\n";
+  return std::string("refinement: ") + (m.result.improved ? (edges ? "edges" : "masks") : "none") +
+         "\nrefinement_start: " + m.start + "\nrefinement_drawn: \"" + m.drawn + "\"\n" +
+         (m.masks_from.empty() ? std::string() : "refinement_masks: \"" + m.masks_from + "\"\n") + key +
+         "_before: " + before + " ]\n" + key + "_after: " + after + " ]\n";
 }
 
 nlohmann::json refinementJson(const Refinement& m) {
@@ -346,8 +361,10 @@ nlohmann::json refinementJson(const Refinement& m) {
   j["frames"] = nlohmann::json::array();
   for (const calib::FrameAgreement& a : m.result.frames) {
     nlohmann::json f = {{"rms_px", a.rms_px}, {"outline_points", a.outline_points}};
-    if (edges) f["edge_share_before"] = a.matched_before, f["edge_share_after"] = a.matched_after;
-    else f["iou_before"] = a.iou_before, f["iou_after"] = a.iou_after;
+    if (edges)
+      f["edge_share_before"] = a.matched_before, f["edge_share_after"] = a.matched_after;
+    else
+      f["iou_before"] = a.iou_before, f["iou_after"] = a.iou_after;
     j["frames"].push_back(f);
   }
   j["disagreeing"] = m.disagreeing;
@@ -358,16 +375,18 @@ nlohmann::json refinementJson(const Refinement& m) {
   return j;
 }
 
-void drawMaskAgreement(cv::Mat& bgr, const calib::Camera& camera, const cv::Mat& mask, std::span<const calib::PlacedVolume> volumes,
-                       std::span<const calib::PlacedMesh> meshes) {
+void drawMaskAgreement(cv::Mat& bgr, const calib::Camera& camera, const cv::Mat& mask,
+                       std::span<const calib::PlacedVolume> volumes, std::span<const calib::PlacedMesh> meshes) {
   if (bgr.empty()) return;
   const double sx = static_cast<double>(bgr.cols) / camera.width, sy = static_cast<double>(bgr.rows) / camera.height;
-  const int thick = std::max(1, static_cast<int>(std::lround(std::min(sx, sy) * std::max(camera.width, camera.height) / 640.0)));
+  const int thick =
+      std::max(1, static_cast<int>(std::lround(std::min(sx, sy) * std::max(camera.width, camera.height) / 640.0)));
   auto outline = [&](const cv::Mat& m, const cv::Scalar& colour) {
     std::vector<std::vector<cv::Point>> contours;
     cv::findContours(m.clone(), contours, cv::RETR_LIST, cv::CHAIN_APPROX_NONE);
     for (auto& c : contours)
-      for (cv::Point& p : c) p = cv::Point(static_cast<int>(std::lround(p.x * sx)), static_cast<int>(std::lround(p.y * sy)));
+      for (cv::Point& p : c)
+        p = cv::Point(static_cast<int>(std::lround(p.x * sx)), static_cast<int>(std::lround(p.y * sy)));
     cv::polylines(bgr, contours, true, colour, thick, cv::LINE_AA);
   };
   if (!mask.empty()) outline(mask != 0, cv::Scalar(0, 220, 255));

@@ -26,7 +26,8 @@ nlohmann::json calibReport(const Gathered& g, const CalibSolution& s, const Cali
                            {"unknown_tag_ids", f.unknown_ids}});
   if (!s.solved()) return j;
   j["output"] = outputs.camera;
-  j["reprojection_rms_px"] = r.camera.reprojection_rms_px ? nlohmann::json(*r.camera.reprojection_rms_px) : nlohmann::json(nullptr);
+  j["reprojection_rms_px"] =
+      r.camera.reprojection_rms_px ? nlohmann::json(*r.camera.reprojection_rms_px) : nlohmann::json(nullptr);
   j["rotation_sigma_deg"] = *r.camera.rotation_sigma_deg;
   j["position_sigma_m"] = *r.camera.position_sigma_m;
   j["volume_sigma_px"] = s.volume_sigma_px ? nlohmann::json(*s.volume_sigma_px) : nlohmann::json(nullptr);

@@ -56,7 +56,10 @@ unsigned plainCreateMode(bool folder) {
 }
 
 StagedOutput::StagedOutput(const fs::path& target, Kind kind, std::string label, Existing existing)
-    : target_(finalTarget(withoutTrailingSeparator(target))), label_(std::move(label)), kind_(kind), existing_(existing) {
+    : target_(finalTarget(withoutTrailingSeparator(target))),
+      label_(std::move(label)),
+      kind_(kind),
+      existing_(existing) {
   if (label_.empty()) label_ = target.string();
   const fs::path dir = folderOf(target_);
   std::error_code ec;
@@ -154,7 +157,8 @@ std::string lowerExtension(const std::string& path) {
 }
 
 void checkOutputPath(const std::string& path, const std::string& option, const std::string& extension) {
-  if (lowerExtension(path) != extension) throw OutputError(option + " " + path + ": the output must be a " + extension + " file");
+  if (lowerExtension(path) != extension)
+    throw OutputError(option + " " + path + ": the output must be a " + extension + " file");
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
   if (!dir.empty() && !std::filesystem::is_directory(dir))
     throw OutputError(option + " " + path + ": directory " + dir.string() + " does not exist");

@@ -39,9 +39,12 @@ const nlohmann::json& at(const nlohmann::json& j, const char* a, const char* b) 
 
 const char* goldenStatusName(GoldenStatus status) {
   switch (status) {
-    case GoldenStatus::Passed: return "passed";
-    case GoldenStatus::Failed: return "failed";
-    case GoldenStatus::Missing: return "missing";
+    case GoldenStatus::Passed:
+      return "passed";
+    case GoldenStatus::Failed:
+      return "failed";
+    case GoldenStatus::Missing:
+      return "missing";
   }
   return "?";
 }
@@ -53,21 +56,25 @@ bool CaseResult::passed() const {
   return true;
 }
 
-std::string goldenFolder(const GoldenManifest& manifest, const std::string& id) { return (fs::path(manifest.goldens) / id).string(); }
+std::string goldenFolder(const GoldenManifest& manifest, const std::string& id) {
+  return (fs::path(manifest.goldens) / id).string();
+}
 
 std::string likelyCause(const nlohmann::json& golden, const nlohmann::json& actual) {
   std::vector<std::string> changed;
   const auto differs = [&](const char* key) {
     const nlohmann::json& g = at(golden, "inputs", key);
     const nlohmann::json& a = at(actual, "inputs", key);
-    if (g.is_object() && a.is_object() && g.contains("sha256") && a.contains("sha256")) return g["sha256"] != a["sha256"];
+    if (g.is_object() && a.is_object() && g.contains("sha256") && a.contains("sha256"))
+      return g["sha256"] != a["sha256"];
     return g != a;
   };
   if (differs("model")) changed.push_back("the model changed (" + fileOf(actual, "model") + ")");
   if (differs("meshes")) changed.push_back("the model's meshes changed");
   if (differs("camera")) changed.push_back("the camera changed (" + fileOf(actual, "camera") + ")");
   if (differs("states")) changed.push_back("the state log changed (" + fileOf(actual, "states") + ")");
-  if (differs("video_frame")) changed.push_back("the video frame's pixels changed (" + fileOf(actual, "video") + ": re-encoded or replaced)");
+  if (differs("video_frame"))
+    changed.push_back("the video frame's pixels changed (" + fileOf(actual, "video") + ": re-encoded or replaced)");
   if (differs("video")) changed.push_back("the frame or time offset changed");
   if (differs("state")) changed.push_back("the state changed");
   if (differs("box")) changed.push_back("the box changed");
@@ -125,7 +132,8 @@ CaseResult checkCase(const GoldenCase& c, const GoldenRendering& rendering, cons
     if (!o.reason.empty()) {
       // the golden itself is unreadable: that is the reason
     } else if (!sidecar_problem.empty() || !have_sidecar) {
-      o.reason = sidecar_problem.empty() ? sidecar.string() + ": missing (it names the mask's bodies and the inputs)" : sidecar_problem;
+      o.reason = sidecar_problem.empty() ? sidecar.string() + ": missing (it names the mask's bodies and the inputs)"
+                                         : sidecar_problem;
     } else if (img.output == GoldenOutput::Mask) {
       const nlohmann::json& labels = at(golden, "outputs", "mask");
       std::vector<std::string> names;
@@ -139,8 +147,10 @@ CaseResult checkCase(const GoldenCase& c, const GoldenRendering& rendering, cons
           } catch (const std::exception&) {
             idx = 0;
           }
-          if (idx < 1 || idx > names.size() || !v.is_string()) ok = false;
-          else names[idx - 1] = v.get<std::string>();
+          if (idx < 1 || idx > names.size() || !v.is_string())
+            ok = false;
+          else
+            names[idx - 1] = v.get<std::string>();
         }
       }
       if (!ok) {

@@ -49,21 +49,24 @@ Comparison compareMasks(const cv::Mat& expected, const std::vector<std::string>&
     c.reason = "size: the golden is " + sizeText(expected) + ", the image " + sizeText(actual);
     return c;
   }
-  const std::set<std::string> want(expected_names.begin(), expected_names.end()), got(actual_names.begin(), actual_names.end());
+  const std::set<std::string> want(expected_names.begin(), expected_names.end()),
+      got(actual_names.begin(), actual_names.end());
   if (want != got) {
     std::string missing, added;
     for (const std::string& n : want)
       if (!got.count(n)) missing += (missing.empty() ? "'" : ", '") + n + "'";
     for (const std::string& n : got)
       if (!want.count(n)) added += (added.empty() ? "'" : ", '") + n + "'";
-    c.reason = "bodies:" + (missing.empty() ? std::string() : " missing " + missing) + (added.empty() ? std::string() : " new " + added);
+    c.reason = "bodies:" + (missing.empty() ? std::string() : " missing " + missing) +
+               (added.empty() ? std::string() : " new " + added);
     return c;
   }
   // The actual labels in the golden's numbering.
   std::array<std::uint8_t, 256> lut{};
   std::map<std::string, int> index;
   for (std::size_t k = 0; k < expected_names.size() && k < 255; ++k) index[expected_names[k]] = static_cast<int>(k) + 1;
-  for (std::size_t k = 0; k < actual_names.size() && k < 255; ++k) lut[k + 1] = static_cast<std::uint8_t>(index[actual_names[k]]);
+  for (std::size_t k = 0; k < actual_names.size() && k < 255; ++k)
+    lut[k + 1] = static_cast<std::uint8_t>(index[actual_names[k]]);
   cv::Mat renumbered;
   cv::LUT(actual, cv::Mat(1, 256, CV_8UC1, lut.data()), renumbered);
   cv::compare(renumbered, expected, c.changed, cv::CMP_NE);
@@ -82,8 +85,8 @@ Comparison compareMasks(const cv::Mat& expected, const std::vector<std::string>&
       const std::size_t le = pe[x], la = pa[x];
       if (le < n && le) {
         e[le].n += 1, e[le].x += x, e[le].y += y;
-        const bool edge = (x > 0 && pe[x - 1] != le) || (x + 1 < expected.cols && pe[x + 1] != le) || (up && up[x] != le) ||
-                          (down && down[x] != le);
+        const bool edge = (x > 0 && pe[x - 1] != le) || (x + 1 < expected.cols && pe[x + 1] != le) ||
+                          (up && up[x] != le) || (down && down[x] != le);
         boundary[le] += edge;
       }
       if (la < n && la) a[la].n += 1, a[la].x += x, a[la].y += y;
@@ -107,9 +110,10 @@ Comparison compareMasks(const cv::Mat& expected, const std::vector<std::string>&
       body_failure = "body '" + b.name + "': centroid moved " + formatNumber(b.centroid_shift_px, 3) + " px (allowed " +
                      formatNumber(tolerance.max_centroid_shift_px, 3) + ")";
     if (body_failure.empty() && area_change > b.allowed_area_change_px)
-      body_failure = "body '" + b.name + "': area changed by " + std::to_string(static_cast<long>(area_change)) + " px (allowed " +
-                     formatNumber(b.allowed_area_change_px, 3) + ": " + formatNumber(tolerance.max_area_change_per_boundary_px, 3) +
-                     " px per boundary pixel, " + std::to_string(b.boundary_px) + ")";
+      body_failure = "body '" + b.name + "': area changed by " + std::to_string(static_cast<long>(area_change)) +
+                     " px (allowed " + formatNumber(b.allowed_area_change_px, 3) + ": " +
+                     formatNumber(tolerance.max_area_change_per_boundary_px, 3) + " px per boundary pixel, " +
+                     std::to_string(b.boundary_px) + ")";
     c.bodies.push_back(std::move(b));
   }
   if (c.changed_px == 0) {
@@ -123,7 +127,8 @@ Comparison compareMasks(const cv::Mat& expected, const std::vector<std::string>&
   } else {
     c.passed = true;
     c.reason = "forgiven: " + std::to_string(c.changed_px) + " isolated pixel(s) changed (largest cluster " +
-               std::to_string(c.largest_cluster_px) + " px, centroids within " + formatNumber(c.worst_centroid_shift_px, 3) + " px)";
+               std::to_string(c.largest_cluster_px) + " px, centroids within " +
+               formatNumber(c.worst_centroid_shift_px, 3) + " px)";
   }
   return c;
 }
@@ -148,14 +153,16 @@ Comparison compareColour(const cv::Mat& expected, const cv::Mat& actual, const C
   cv::compare(largest, tolerance.channel_threshold, c.changed, cv::CMP_GT);
   measureClusters(c);
   if (c.largest_cluster_px > tolerance.max_cluster_px) {
-    c.reason = clusterText(c) + " (allowed " + std::to_string(tolerance.max_cluster_px) + "; a pixel changes when a channel moves by more than " +
-               std::to_string(tolerance.channel_threshold) + " grey levels)";
+    c.reason = clusterText(c) + " (allowed " + std::to_string(tolerance.max_cluster_px) +
+               "; a pixel changes when a channel moves by more than " + std::to_string(tolerance.channel_threshold) +
+               " grey levels)";
   } else if (c.changed_px > tolerance.max_diff_px) {
     c.reason = std::to_string(c.changed_px) + " changed pixels (allowed " + std::to_string(tolerance.max_diff_px) + ")";
   } else {
     c.passed = true;
-    c.reason = "forgiven: " + std::to_string(c.changed_px) + " pixel(s) beyond " + std::to_string(tolerance.channel_threshold) +
-               " grey levels (largest cluster " + std::to_string(c.largest_cluster_px) + " px)";
+    c.reason = "forgiven: " + std::to_string(c.changed_px) + " pixel(s) beyond " +
+               std::to_string(tolerance.channel_threshold) + " grey levels (largest cluster " +
+               std::to_string(c.largest_cluster_px) + " px)";
   }
   return c;
 }
@@ -175,7 +182,8 @@ cv::Mat falseColour(const cv::Mat& mask) {
 cv::Mat picture(const cv::Mat& image, bool mask) {
   if (mask) return falseColour(image);
   cv::Mat out;
-  if (image.channels() == 1) cv::cvtColor(image, out, cv::COLOR_GRAY2BGR);
+  if (image.channels() == 1)
+    cv::cvtColor(image, out, cv::COLOR_GRAY2BGR);
   else if (image.channels() == 4) {
     // Over a checkerboard, so transparency shows.
     out.create(image.size(), CV_8UC3);
@@ -183,9 +191,11 @@ cv::Mat picture(const cv::Mat& image, bool mask) {
       for (int x = 0; x < image.cols; ++x) {
         const cv::Vec4b p = image.at<cv::Vec4b>(y, x);
         const double bg = ((x / 8 + y / 8) % 2) ? 90 : 140, al = p[3] / 255.0;
-        for (int k = 0; k < 3; ++k) out.at<cv::Vec3b>(y, x)[k] = cv::saturate_cast<std::uint8_t>(p[k] * al + bg * (1 - al));
+        for (int k = 0; k < 3; ++k)
+          out.at<cv::Vec3b>(y, x)[k] = cv::saturate_cast<std::uint8_t>(p[k] * al + bg * (1 - al));
       }
-  } else out = image.clone();
+  } else
+    out = image.clone();
   return out;
 }
 

@@ -43,22 +43,27 @@ class ManifestReader {
     if (!root.IsMap()) r_.fail(root, "manifest", "expected a mapping with kccd_golden: 1, goldens and cases");
     r_.onlyKeys(root, "manifest", {"kccd_golden", "goldens", "defaults", "cases"});
     const YAML::Node version = r_.require(root, "kccd_golden", "manifest");
-    if (!version.IsScalar() || version.Scalar() != "1") r_.fail(version, "kccd_golden", "expected 1 (the manifest format's version)");
+    if (!version.IsScalar() || version.Scalar() != "1")
+      r_.fail(version, "kccd_golden", "expected 1 (the manifest format's version)");
     GoldenManifest m;
     m.path = r_.source();
     m.folder = folder_.empty() ? "." : folder_;
     m.goldens = root["goldens"] ? resolve(r_.text(root["goldens"], "goldens")) : resolve("goldens");
     Shared defaults;
     if (const YAML::Node d = root["defaults"]) {
-      if (!d.IsMap()) r_.fail(d, "defaults", "expected a mapping of model, camera, outputs, compare, states, video, bag, time_offset, supersample");
-      r_.onlyKeys(d, "defaults", {"model", "camera", "outputs", "compare", "states", "video", "bag", "image_topic", "joint_topic", "time_source",
-                                  "time_offset", "supersample"});
+      if (!d.IsMap())
+        r_.fail(d, "defaults",
+                "expected a mapping of model, camera, outputs, compare, states, video, bag, time_offset, supersample");
+      r_.onlyKeys(d, "defaults",
+                  {"model", "camera", "outputs", "compare", "states", "video", "bag", "image_topic", "joint_topic",
+                   "time_source", "time_offset", "supersample"});
       shared(d, "defaults", "defaults", defaults);
     }
     const YAML::Node cases = r_.require(root, "cases", "manifest");
     if (!cases.IsSequence()) r_.fail(cases, "cases", "expected a list of cases");
     if (cases.size() == 0) r_.fail(cases, "cases", "at least one case is needed");
-    if (cases.size() > kMaxGoldenCases) r_.fail(cases, "cases", "more than " + std::to_string(kMaxGoldenCases) + " cases");
+    if (cases.size() > kMaxGoldenCases)
+      r_.fail(cases, "cases", "more than " + std::to_string(kMaxGoldenCases) + " cases");
     std::map<std::string, std::size_t> ids;
     for (std::size_t i = 0; i < cases.size(); ++i) m.cases.push_back(readCase(cases[i], i, defaults, ids));
     return m;
@@ -67,7 +72,8 @@ class ManifestReader {
  private:
   std::string resolve(const std::string& p) const {
     const std::filesystem::path path(p);
-    return path.is_absolute() || folder_.empty() ? path.lexically_normal().string() : (std::filesystem::path(folder_) / path).lexically_normal().string();
+    return path.is_absolute() || folder_.empty() ? path.lexically_normal().string()
+                                                 : (std::filesystem::path(folder_) / path).lexically_normal().string();
   }
 
   std::vector<double> numbers(const YAML::Node& n, const std::string& field) const {
@@ -97,12 +103,15 @@ class ManifestReader {
     r_.onlyKeys(c, field, {"mask", "colour", "overlay"});
     if (const YAML::Node m = c["mask"]) {
       const std::string f = field + ".mask";
-      if (!m.IsMap()) r_.fail(m, f, "expected a mapping of max_cluster_px, max_centroid_shift_px, max_area_change_per_boundary_px");
+      if (!m.IsMap())
+        r_.fail(m, f, "expected a mapping of max_cluster_px, max_centroid_shift_px, max_area_change_per_boundary_px");
       r_.onlyKeys(m, f, {"max_cluster_px", "max_centroid_shift_px", "max_area_change_per_boundary_px"});
       if (m["max_cluster_px"]) s.mask.max_cluster_px = count(m["max_cluster_px"], f + ".max_cluster_px", 0, 1 << 30);
-      if (m["max_centroid_shift_px"]) s.mask.max_centroid_shift_px = amount(m["max_centroid_shift_px"], f + ".max_centroid_shift_px", 1e6);
+      if (m["max_centroid_shift_px"])
+        s.mask.max_centroid_shift_px = amount(m["max_centroid_shift_px"], f + ".max_centroid_shift_px", 1e6);
       if (m["max_area_change_per_boundary_px"])
-        s.mask.max_area_change_per_boundary_px = amount(m["max_area_change_per_boundary_px"], f + ".max_area_change_per_boundary_px", 1e6);
+        s.mask.max_area_change_per_boundary_px =
+            amount(m["max_area_change_per_boundary_px"], f + ".max_area_change_per_boundary_px", 1e6);
       s.source.mask = level;
     }
     for (const char* key : {"colour", "overlay"}) {
@@ -144,10 +153,14 @@ class ManifestReader {
         const std::string f = field + ".outputs[" + std::to_string(k) + "]";
         const std::string word = r_.text(o[k], f);
         GoldenOutput out;
-        if (word == "mask") out = GoldenOutput::Mask;
-        else if (word == "colour" || word == "color") out = GoldenOutput::Colour;
-        else if (word == "overlay") out = GoldenOutput::Overlay;
-        else r_.fail(o[k], f, "expected mask, colour or overlay, got '" + printable(word, 40) + "'");
+        if (word == "mask")
+          out = GoldenOutput::Mask;
+        else if (word == "colour" || word == "color")
+          out = GoldenOutput::Colour;
+        else if (word == "overlay")
+          out = GoldenOutput::Overlay;
+        else
+          r_.fail(o[k], f, "expected mask, colour or overlay, got '" + printable(word, 40) + "'");
         for (const GoldenOutput g : s.outputs)
           if (g == out) r_.fail(o[k], f, "'" + word + "' is listed twice");
         s.outputs.push_back(out);
@@ -156,17 +169,21 @@ class ManifestReader {
     if (n["compare"]) compare(n["compare"], field + ".compare", level, s);
   }
 
-  GoldenCase readCase(const YAML::Node& n, std::size_t i, const Shared& defaults, std::map<std::string, std::size_t>& ids) const {
+  GoldenCase readCase(const YAML::Node& n, std::size_t i, const Shared& defaults,
+                      std::map<std::string, std::size_t>& ids) const {
     std::string f = "cases[" + std::to_string(i) + "]";
     if (!n.IsMap()) r_.fail(n, f, "expected a mapping with id and state, lower/upper or video/frame");
-    r_.onlyKeys(n, f, {"id", "model", "camera", "outputs", "compare", "state", "lower", "upper", "video", "frame", "states", "bag", "image_topic",
-                       "joint_topic", "time_source", "time_offset", "supersample"});
+    r_.onlyKeys(n, f,
+                {"id", "model", "camera", "outputs", "compare", "state", "lower", "upper", "video", "frame", "states",
+                 "bag", "image_topic", "joint_topic", "time_source", "time_offset", "supersample"});
     GoldenCase c;
     c.where = r_.where(n);
     const YAML::Node id = r_.require(n, "id", f);
     c.id = r_.text(id, f + ".id");
     if (!validId(c.id))
-      r_.fail(id, f + ".id", "'" + printable(c.id, 40) + "' is not a folder name: letters, digits, '-', '_' and '.' (not first), at most 128");
+      r_.fail(id, f + ".id",
+              "'" + printable(c.id, 40) +
+                  "' is not a folder name: letters, digits, '-', '_' and '.' (not first), at most 128");
     if (const auto it = ids.find(c.id); it != ids.end())
       r_.fail(id, f + ".id", "'" + c.id + "' is given twice (also cases[" + std::to_string(it->second) + "])");
     ids.emplace(c.id, i);
@@ -184,16 +201,20 @@ class ManifestReader {
     c.tolerance_source = s.source;
     if (c.model.empty()) r_.fail(n, f + ".model", "no model (give one here or in defaults)");
     if (c.camera.empty()) r_.fail(n, f + ".camera", "no camera (give one here or in defaults)");
-    const bool state = n["state"].IsDefined(), box = n["lower"].IsDefined() || n["upper"].IsDefined(), frame = n["frame"].IsDefined();
-    if (state + box + frame != 1) r_.fail(n, f, "give exactly one of state, lower with upper, or frame (with video and states)");
+    const bool state = n["state"].IsDefined(), box = n["lower"].IsDefined() || n["upper"].IsDefined(),
+               frame = n["frame"].IsDefined();
+    if (state + box + frame != 1)
+      r_.fail(n, f, "give exactly one of state, lower with upper, or frame (with video and states)");
     if (state) c.state = numbers(n["state"], f + ".state");
     if (box) {
       c.lower = numbers(r_.require(n, "lower", f), f + ".lower");
       c.upper = numbers(r_.require(n, "upper", f), f + ".upper");
       if (c.lower.size() != c.upper.size())
-        r_.fail(n["upper"], f + ".upper", std::to_string(c.upper.size()) + " values, lower has " + std::to_string(c.lower.size()));
+        r_.fail(n["upper"], f + ".upper",
+                std::to_string(c.upper.size()) + " values, lower has " + std::to_string(c.lower.size()));
       for (std::size_t k = 0; k < c.lower.size(); ++k)
-        if (c.lower[k] > c.upper[k]) r_.fail(n["upper"][k], f + ".upper[" + std::to_string(k) + "]", "below lower[" + std::to_string(k) + "]");
+        if (c.lower[k] > c.upper[k])
+          r_.fail(n["upper"][k], f + ".upper[" + std::to_string(k) + "]", "below lower[" + std::to_string(k) + "]");
     }
     if (frame) {
       const double v = r_.number(n["frame"], f + ".frame");
@@ -206,7 +227,8 @@ class ManifestReader {
       if (c.bag.empty()) {
         c.video = s.video;
         c.states = s.states;
-        if (c.video.empty()) r_.fail(n, f + ".video", "a frame case needs the video and state log, or a bag (here or in defaults)");
+        if (c.video.empty())
+          r_.fail(n, f + ".video", "a frame case needs the video and state log, or a bag (here or in defaults)");
         if (c.states.empty()) r_.fail(n, f + ".states", "a frame case needs the state log (here or in defaults)");
       } else {
         c.image_topic = s.image_topic;
@@ -217,7 +239,8 @@ class ManifestReader {
       for (const char* key : {"video", "states", "bag", "image_topic", "joint_topic", "time_source"})
         if (n[key]) r_.fail(n[key], f + "." + key, std::string(key) + " belongs to a frame case (give frame)");
       for (const GoldenOutput o : c.outputs)
-        if (o == GoldenOutput::Overlay) r_.fail(n, f + ".outputs", "overlay needs a recorded frame (give frame, with video and states or a bag)");
+        if (o == GoldenOutput::Overlay)
+          r_.fail(n, f + ".outputs", "overlay needs a recorded frame (give frame, with video and states or a bag)");
     }
     return c;
   }
@@ -230,9 +253,12 @@ class ManifestReader {
 
 const char* goldenOutputName(GoldenOutput output) {
   switch (output) {
-    case GoldenOutput::Mask: return "mask";
-    case GoldenOutput::Colour: return "colour";
-    case GoldenOutput::Overlay: return "overlay";
+    case GoldenOutput::Mask:
+      return "mask";
+    case GoldenOutput::Colour:
+      return "colour";
+    case GoldenOutput::Overlay:
+      return "overlay";
   }
   return "?";
 }

@@ -61,14 +61,16 @@ render::RenderOptions renderOptions(const GoldenCase& c) {
 std::string sha256Hex(std::span<const unsigned char> bytes) {
   unsigned char digest[EVP_MAX_MD_SIZE];
   unsigned int n = 0;
-  if (EVP_Digest(bytes.data(), bytes.size(), digest, &n, EVP_sha256(), nullptr) != 1) throw std::runtime_error("SHA-256 failed");
+  if (EVP_Digest(bytes.data(), bytes.size(), digest, &n, EVP_sha256(), nullptr) != 1)
+    throw std::runtime_error("SHA-256 failed");
   return hex(digest, n);
 }
 
 std::vector<unsigned char> deterministicPng(const cv::Mat& image) {
   std::vector<unsigned char> out;
   // Fixed compression and strategy; OpenCV writes no time or text chunks.
-  if (!cv::imencode(".png", image, out, {cv::IMWRITE_PNG_COMPRESSION, 6, cv::IMWRITE_PNG_STRATEGY, cv::IMWRITE_PNG_STRATEGY_DEFAULT}))
+  if (!cv::imencode(".png", image, out,
+                    {cv::IMWRITE_PNG_COMPRESSION, 6, cv::IMWRITE_PNG_STRATEGY, cv::IMWRITE_PNG_STRATEGY_DEFAULT}))
     throw std::runtime_error("PNG encoding failed");
   return out;
 }
@@ -79,10 +81,10 @@ struct GoldenRenderer::Impl {
   const GoldenManifest& manifest;
   std::map<std::string, std::unique_ptr<Model>> models;
   std::map<std::string, calib::Camera> cameras;
-  std::map<std::pair<std::string, std::string>, std::unique_ptr<StateLog>> logs;  // (log, model)
+  std::map<std::pair<std::string, std::string>, std::unique_ptr<StateLog>> logs;      // (log, model)
   std::map<std::pair<std::string, std::string>, std::unique_ptr<BagRecording>> bags;  // (logKey, model)
-  std::map<std::size_t, LoadedFrame> frames;                                     // per frame case
-  std::map<std::string, std::string> hashes;                                     // path -> sha256
+  std::map<std::size_t, LoadedFrame> frames;                                          // per frame case
+  std::map<std::string, std::string> hashes;                                          // path -> sha256
   std::map<std::tuple<std::string, std::string, double>, std::unique_ptr<render::ModelView>> views;
   std::string renderer;
 
@@ -90,7 +92,9 @@ struct GoldenRenderer::Impl {
     auto it = hashes.find(path);
     if (it == hashes.end()) {
       const std::string bytes = readRegularFile(path, kMaxHashedBytes, "input");
-      it = hashes.emplace(path, sha256Hex(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size())))
+      it = hashes
+               .emplace(path, sha256Hex(std::span<const unsigned char>(
+                                  reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size())))
                .first;
     }
     return it->second;
@@ -110,14 +114,16 @@ struct GoldenRenderer::Impl {
   }
 };
 
-GoldenRenderer::GoldenRenderer(const GoldenManifest& manifest) : impl_(std::make_unique<Impl>(Impl{manifest, {}, {}, {}, {}, {}, {}, {}})) {
+GoldenRenderer::GoldenRenderer(const GoldenManifest& manifest)
+    : impl_(std::make_unique<Impl>(Impl{manifest, {}, {}, {}, {}, {}, {}, {}})) {
   Impl& s = *impl_;
   for (std::size_t i = 0; i < manifest.cases.size(); ++i) {
     const GoldenCase& c = manifest.cases[i];
     const std::string where = c.where + ": case '" + c.id + "'";
     if (!s.models.count(c.model)) s.models.emplace(c.model, std::make_unique<Model>(loadModel(c.model)));
     const Model& m = *s.models.at(c.model);
-    if (m.bodies.size() > 255) throw InputError(where + ".model: " + c.model + " has more than 255 bodies (an 8-bit mask)");
+    if (m.bodies.size() > 255)
+      throw InputError(where + ".model: " + c.model + " has more than 255 bodies (an 8-bit mask)");
     if (!s.cameras.count(c.camera)) s.cameras.emplace(c.camera, calib::loadCamera(c.camera));
     const calib::Camera& cam = s.cameras.at(c.camera);
     const std::size_t n = static_cast<std::size_t>(m.stateSize());
@@ -133,7 +139,9 @@ GoldenRenderer::GoldenRenderer(const GoldenManifest& manifest) : impl_(std::make
       if (it == s.bags.end()) {
         BagRecording rec;
         try {
-          rec = readBagRecording({.bag = c.bag, .joint_topic = c.joint_topic, .image_topic = c.image_topic,
+          rec = readBagRecording({.bag = c.bag,
+                                  .joint_topic = c.joint_topic,
+                                  .image_topic = c.image_topic,
                                   .time_source = c.log_time ? TimeSource::Log : TimeSource::Header},
                                  m);
         } catch (const InputError& e) {
@@ -154,7 +162,8 @@ GoldenRenderer::GoldenRenderer(const GoldenManifest& manifest) : impl_(std::make
       const auto key = std::make_pair(c.states, c.model);
       if (!s.logs.count(key)) s.logs.emplace(key, std::make_unique<StateLog>(loadStateLog(c.states, m)));
       RecordingFrames rf = readRecordingFrames(c.video, {static_cast<int>(c.frame)});
-      if (!(rf.fps > 0)) throw InputError(where + ".video: " + c.video + " declares no frame rate (a frame's time needs one)");
+      if (!(rf.fps > 0))
+        throw InputError(where + ".video: " + c.video + " declares no frame rate (a frame's time needs one)");
       LoadedFrame f;
       f.bgr = std::move(rf.frames.at(0));
       checkPicture(f.bgr, cam, c.video + "#" + std::to_string(c.frame), c.camera);
@@ -194,12 +203,16 @@ GoldenRendering GoldenRenderer::render(std::size_t index) {
     const StateLog& log = *s.logs.at({c.bag.empty() ? c.states : logKey(c), c.model});
     if (c.bag.empty()) {
       inputs["states"] = {{"file", relativeTo(c.states, s.manifest.folder)}, {"sha256", s.hash(c.states)}};
-      inputs["video"] = {{"file", relativeTo(c.video, s.manifest.folder)}, {"frame", c.frame}, {"time_offset", c.time_offset}};
+      inputs["video"] = {
+          {"file", relativeTo(c.video, s.manifest.folder)}, {"frame", c.frame}, {"time_offset", c.time_offset}};
     } else {
       const BagRecording& rec = *s.bags.at({logKey(c), c.model});
       // A log may be large (or a folder): its frame's pixels are hashed below, not the whole log.
-      inputs["bag"] = {{"file", relativeTo(c.bag, s.manifest.folder)}, {"frame", c.frame},
-                       {"image_topic", rec.image_topic}, {"joint_topic", rec.joint_topic}, {"time_source", toString(c.log_time ? TimeSource::Log : TimeSource::Header)},
+      inputs["bag"] = {{"file", relativeTo(c.bag, s.manifest.folder)},
+                       {"frame", c.frame},
+                       {"image_topic", rec.image_topic},
+                       {"joint_topic", rec.joint_topic},
+                       {"time_source", toString(c.log_time ? TimeSource::Log : TimeSource::Header)},
                        {"time_offset", c.time_offset}};
     }
     inputs["video_frame"] = {{"sha256", f.pixels_sha256}};
@@ -241,7 +254,8 @@ GoldenRendering GoldenRenderer::render(std::size_t index) {
     request.mask = want_mask;
     request.style.legend = false;
     drawn = s.view(c).draw(request);
-    if (drawn->query && drawn->query->status != Status::Ok && out.unsafe.empty()) out.unsafe = toString(drawn->query->status);
+    if (drawn->query && drawn->query->status != Status::Ok && out.unsafe.empty())
+      out.unsafe = toString(drawn->query->status);
   } else {
     (void)s.view(c);  // the renderer string, for the sidecar
   }

@@ -35,8 +35,10 @@ void parseTimeOffset(const std::string& text, OverlayRequest& r) {
     const std::string rest = text.substr(5);
     const std::size_t colon = rest.find(':');
     double lo = 0, hi = 0;
-    if (colon == std::string::npos || !seconds(rest.substr(0, colon), lo) || !seconds(rest.substr(colon + 1), hi) || !(lo < hi))
-      throw fieldError("time_offset", "expected auto:A:B with A < B (seconds, the range searched), got '" + printable(text) + "'");
+    if (colon == std::string::npos || !seconds(rest.substr(0, colon), lo) || !seconds(rest.substr(colon + 1), hi) ||
+        !(lo < hi))
+      throw fieldError("time_offset",
+                       "expected auto:A:B with A < B (seconds, the range searched), got '" + printable(text) + "'");
     r.time_offset_search = {lo, hi};
     return;
   }
@@ -69,18 +71,24 @@ struct Checker {
 // Which recording: a video with its log, or a robot log, and only the fields that go with it.
 void Checker::recording() const {
   if (!r.bag.empty()) {
-    for (const auto& [given, field] : {std::pair{!r.video.empty(), "video"}, {!r.states.empty(), "states"},
-                                       {!r.frame_times.empty(), "frame_times"}, {!r.ignore_columns.empty(), "ignore_columns"}})
-      if (given) throw problem(field, "not with " + named("bag") + " (the log gives the frames, their times and the states)");
+    for (const auto& [given, field] : {std::pair{!r.video.empty(), "video"},
+                                       {!r.states.empty(), "states"},
+                                       {!r.frame_times.empty(), "frame_times"},
+                                       {!r.ignore_columns.empty(), "ignore_columns"}})
+      if (given)
+        throw problem(field, "not with " + named("bag") + " (the log gives the frames, their times and the states)");
     if (r.fps != 0.0) throw problem("fps", "not with " + named("bag") + " (each frame has its own time)");
   } else {
     if (r.video.empty() || r.states.empty())
-      throw InputError("give " + named("video") + " and " + named("states") + ", or " + named("bag") + " (a robot log)");
-    for (const auto& [given, field] : {std::pair{!r.image_topic.empty(), "image_topic"}, {!r.joint_topic.empty(), "joint_topic"},
+      throw InputError("give " + named("video") + " and " + named("states") + ", or " + named("bag") +
+                       " (a robot log)");
+    for (const auto& [given, field] : {std::pair{!r.image_topic.empty(), "image_topic"},
+                                       {!r.joint_topic.empty(), "joint_topic"},
                                        {!r.joint_map.empty(), "joint_map"}})
       if (given) throw problem(field, "goes with " + named("bag"));
   }
-  if (!timeSourceOf(r.time_source)) throw problem("time_source", "expected 'header' or 'log', got '" + printable(r.time_source) + "'");
+  if (!timeSourceOf(r.time_source))
+    throw problem("time_source", "expected 'header' or 'log', got '" + printable(r.time_source) + "'");
 }
 
 // Every number and switch, in the order the fields are listed.
@@ -110,7 +118,8 @@ OverlayOptions Checker::options() const {
   o.plain = r.plain;
   if (r.visuals && model) {
     if (model->visuals.empty()) throw problem("visuals", "the model has no visuals:");
-    if (model->visuals.size() + model->bodies.size() > 255) throw problem("visuals", "more than 255 bodies and visuals to draw");
+    if (model->visuals.size() + model->bodies.size() > 255)
+      throw problem("visuals", "more than 255 bodies and visuals to draw");
   }
   o.visuals = r.visuals;
   if (r.masks.empty() && !r.mask_bodies.empty()) throw problem("mask_bodies", "goes with " + named("masks"));
@@ -162,8 +171,10 @@ struct OverlayJob::State {
   std::string named(const std::string& field) const { return spelledField(spell, field); }
 };
 
-OverlayJob::OverlayJob(const OverlayRequest& request, const Model& model, const calib::Camera& camera, FieldSpelling spell)
-    : s_(std::make_unique<State>(State{.request = request, .model = model, .camera = camera, .spell = std::move(spell)})) {
+OverlayJob::OverlayJob(const OverlayRequest& request, const Model& model, const calib::Camera& camera,
+                       FieldSpelling spell)
+    : s_(std::make_unique<State>(
+          State{.request = request, .model = model, .camera = camera, .spell = std::move(spell)})) {
   State& s = *s_;
   const OverlayRequest& r = s.request;
   const Checker check{r, &model, s.spell};
@@ -172,23 +183,26 @@ OverlayJob::OverlayJob(const OverlayRequest& request, const Model& model, const 
   const std::vector<int> mask_bodies = check.maskBodies();
 
   const std::string recording = r.bag.empty() ? r.video : r.bag;
-  s.outputs = OverlayOutputs{.video = r.output,
-                             .png_dir = r.png_dir,
-                             .report = r.report,
-                             .contact_sheet = r.contact_sheet,
-                             .video_option = s.named("output"),
-                             .report_option = s.named("report"),
-                             .contact_sheet_option = s.named("contact_sheet"),
-                             .frames_option = s.named("frames"),
-                             .timeline = r.timeline,
-                             .timeline_option = s.named("timeline"),
-                             .timeline_title = filename(recording) +
-                                               (r.model_file.empty() ? std::string() : "  (" + filename(r.model_file) + ")")};
-  checkOverlayOutputs(s.outputs, std::vector<std::string>{r.video, r.states, r.model_file, r.camera_file, r.frame_times, r.bag,
-                                                          r.joint_map});
+  s.outputs =
+      OverlayOutputs{.video = r.output,
+                     .png_dir = r.png_dir,
+                     .report = r.report,
+                     .contact_sheet = r.contact_sheet,
+                     .video_option = s.named("output"),
+                     .report_option = s.named("report"),
+                     .contact_sheet_option = s.named("contact_sheet"),
+                     .frames_option = s.named("frames"),
+                     .timeline = r.timeline,
+                     .timeline_option = s.named("timeline"),
+                     .timeline_title = filename(recording) +
+                                       (r.model_file.empty() ? std::string() : "  (" + filename(r.model_file) + ")")};
+  checkOverlayOutputs(s.outputs, std::vector<std::string>{r.video, r.states, r.model_file, r.camera_file, r.frame_times,
+                                                          r.bag, r.joint_map});
 
   if (!r.bag.empty()) {
-    s.bag = readBagRecording({.bag = r.bag, .joint_topic = r.joint_topic, .image_topic = r.image_topic,
+    s.bag = readBagRecording({.bag = r.bag,
+                              .joint_topic = r.joint_topic,
+                              .image_topic = r.image_topic,
                               .time_source = *timeSourceOf(r.time_source),
                               .joint_map = r.joint_map.empty() ? JointMap{} : loadJointMap(r.joint_map, model),
                               .spell = s.spell},
@@ -205,8 +219,10 @@ OverlayJob::OverlayJob(const OverlayRequest& request, const Model& model, const 
   }
   if (!r.masks.empty()) {
     const std::string label = s.named("masks") + " " + r.masks;
-    if (r.masks == "auto") s.masks.emplace(camera, model, mask_bodies, label);
-    else s.masks.emplace(r.masks, camera, model, mask_bodies, label);
+    if (r.masks == "auto")
+      s.masks.emplace(camera, model, mask_bodies, label);
+    else
+      s.masks.emplace(r.masks, camera, model, mask_bodies, label);
   }
 }
 
@@ -222,15 +238,24 @@ OverlayJob::Result OverlayJob::run(const std::function<void(const OverlayProgres
   if (s.ran) throw std::logic_error("OverlayJob::run: a job runs once");
   s.ran = true;
   const OverlayRequest& r = s.request;
-  OverlayInputs in{s.model, s.camera, s.log, s.bag ? r.bag : r.video, s.frame_times,
-                   s.bag ? s.named("bag") + " " + r.bag + " (topic " + s.bag->image_topic + ")" : s.named("video") + " " + r.video,
-                   r.camera_file.empty() ? s.named("camera") : r.camera_file, s.named("frame_times") + " " + r.frame_times};
+  OverlayInputs in{
+      s.model,
+      s.camera,
+      s.log,
+      s.bag ? r.bag : r.video,
+      s.frame_times,
+      s.bag ? s.named("bag") + " " + r.bag + " (topic " + s.bag->image_topic + ")" : s.named("video") + " " + r.video,
+      r.camera_file.empty() ? s.named("camera") : r.camera_file,
+      s.named("frame_times") + " " + r.frame_times};
   in.no_rate_hint = "give " + s.named("fps") + " or " + s.named("frame_times");
   if (s.bag) in.open_frames = s.bag->open_frames;
   if (s.masks) in.masks = &*s.masks;
 
-  VideoSink sink({.video = r.output, .codec = r.codec, .video_label = s.named("output") + " " + r.output,
-                  .png_dir = r.png_dir, .png_label = s.named("png_dir") + " " + r.png_dir});
+  VideoSink sink({.video = r.output,
+                  .codec = r.codec,
+                  .video_label = s.named("output") + " " + r.output,
+                  .png_dir = r.png_dir,
+                  .png_label = s.named("png_dir") + " " + r.png_dir});
   Result result;
   result.report = overlayRecording(in, s.options, sink.active() ? &sink : nullptr, progress);
   if (s.bag) result.report.source = s.bag->source();

@@ -26,8 +26,10 @@ int jsonDepth(const std::string& text) {
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
     if (in_string) {
-      if (c == '\\') ++i;
-      else if (c == '"') in_string = false;
+      if (c == '\\')
+        ++i;
+      else if (c == '"')
+        in_string = false;
     } else if (c == '"') {
       in_string = true;
     } else if (c == '[' || c == '{') {
@@ -131,7 +133,8 @@ struct LabelServer::Impl {
 
   void routes() {
     server.set_payload_max_length(options.max_request_bytes);
-    server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) { return screen(req, res); });
+    server.set_pre_routing_handler(
+        [this](const httplib::Request& req, httplib::Response& res) { return screen(req, res); });
     server.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
       if (log) log(req.method, req.path, res.status);
     });
@@ -148,8 +151,9 @@ struct LabelServer::Impl {
       std::string body, type;
       if (!webFile(req.path, body, type)) return sendError(res, 404, "no such page: " + req.path);
       res.set_header("Cache-Control", "no-store");
-      res.set_header("Content-Security-Policy",
-                     "default-src 'self'; img-src 'self' blob: data:; style-src 'self'; script-src 'self'; connect-src 'self'");
+      res.set_header(
+          "Content-Security-Policy",
+          "default-src 'self'; img-src 'self' blob: data:; style-src 'self'; script-src 'self'; connect-src 'self'");
       res.set_content(body, type.c_str());
     };
     server.Get("/", page);
@@ -175,8 +179,9 @@ struct LabelServer::Impl {
       }
       const std::lock_guard<std::mutex> lock(mutex);
       if (frame >= session.frameCount())
-        return sendError(res, 404, "frame " + std::to_string(frame) + ": the session has " + std::to_string(session.frameCount()) +
-                                       " frame(s)");
+        return sendError(res, 404,
+                         "frame " + std::to_string(frame) + ": the session has " +
+                             std::to_string(session.frameCount()) + " frame(s)");
       try {
         sendJson(res, 200, session.putLabels(frame, document));
       } catch (const InputError& e) {
@@ -191,7 +196,8 @@ struct LabelServer::Impl {
         char* end = nullptr;
         at[k] = v.empty() || v.size() > 32 ? NAN : std::strtod(v.c_str(), &end);
         if (!std::isfinite(at[k]) || end != v.c_str() + v.size())
-          return sendError(res, 400, std::string(names[k]) + ": expected a pixel coordinate, got '" + v.substr(0, 32) + "'");
+          return sendError(res, 400,
+                           std::string(names[k]) + ": expected a pixel coordinate, got '" + v.substr(0, 32) + "'");
       }
       const long i = req.has_param("frame") ? parseIndex(req.get_param_value("frame")) : 0;
       const std::lock_guard<std::mutex> lock(mutex);
@@ -220,10 +226,11 @@ struct LabelServer::Impl {
     server.Post("/api/save", [this](const httplib::Request&, httplib::Response& res) {
       const std::lock_guard<std::mutex> lock(mutex);
       const LabelSaved saved = session.save();
-      sendJson(res, 200,
-               nlohmann::json{{"labels", saved.labels},
-                              {"backups", saved.backups},
-                              {"camera", saved.camera.empty() ? nlohmann::json(nullptr) : nlohmann::json(saved.camera)}});
+      sendJson(
+          res, 200,
+          nlohmann::json{{"labels", saved.labels},
+                         {"backups", saved.backups},
+                         {"camera", saved.camera.empty() ? nlohmann::json(nullptr) : nlohmann::json(saved.camera)}});
     });
     server.Post("/api/quit", [this](const httplib::Request&, httplib::Response& res) {
       sendJson(res, 200, nlohmann::json{{"quitting", true}});
@@ -264,8 +271,9 @@ LabelServer::LabelServer(LabelSession& session, LabelServerOptions options)
     s.port = -1;
   }
   if (s.port <= 0)
-    throw LabelServerError(InputLocation{"--host " + host, 0, 0, ""},
-                           "cannot listen on port " + std::to_string(s.options.port) + " (in use, or not an address of this machine)");
+    throw LabelServerError(
+        InputLocation{"--host " + host, 0, 0, ""},
+        "cannot listen on port " + std::to_string(s.options.port) + " (in use, or not an address of this machine)");
   const std::string port = std::to_string(s.port);
   const bool v6 = host.find(':') != std::string::npos;
   s.hosts.insert((v6 ? "[" + host + "]" : host) + ":" + port);
@@ -297,6 +305,8 @@ void LabelServer::stop() {
   }
 }
 
-void LabelServer::onRequest(std::function<void(const std::string&, const std::string&, int)> log) { impl_->log = std::move(log); }
+void LabelServer::onRequest(std::function<void(const std::string&, const std::string&, int)> log) {
+  impl_->log = std::move(log);
+}
 
 }  // namespace kccd::overlay

@@ -13,9 +13,9 @@
 #include "kccd/overlay/calibration/calib_gather.hpp"
 #include "kccd/overlay/calibration/calib_report.hpp"
 #include "kccd/overlay/calibration/calib_solve.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/labelling/labelling_candidates.hpp"
 #include "kccd/overlay/labelling/labels_document.hpp"
-#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/render/model_view.hpp"
 
 namespace kccd::overlay {
@@ -27,7 +27,7 @@ struct LabelSession::Frame {
   nlohmann::json candidates;            // tags and corners (model points: per request)
   int overlay_revision = -1;            // the revision overlay_png and mask were drawn at
   std::vector<unsigned char> overlay_png;
-  cv::Mat mask;                         // body i + 1 where body i's volume is nearest; empty: none drawn
+  cv::Mat mask;                             // body i + 1 where body i's volume is nearest; empty: none drawn
   std::optional<nlohmann::json> recovered;  // the autosave found at the start, newer than the labels file
 };
 
@@ -156,8 +156,9 @@ void LabelSession::resolve() {
   nlohmann::json report = calibReport(gathered, s, {.camera = s.solved() ? in_.camera_output : std::string()});
   report["snap"] = {{"available", !in_.masks.empty()}, {"on", snap_}, {"message", snap_message}};
   if (refinement) report["refinement"] = refinementJson(*refinement);
-  report["rms_px"] = s.solved() && s.pose.camera.reprojection_rms_px ? nlohmann::json(*s.pose.camera.reprojection_rms_px)
-                                                                        : nlohmann::json(nullptr);
+  report["rms_px"] = s.solved() && s.pose.camera.reprojection_rms_px
+                         ? nlohmann::json(*s.pose.camera.reprojection_rms_px)
+                         : nlohmann::json(nullptr);
   report["revision"] = revision_;
   // Per point, its frame, where it was seen and, when solved, where the pose projects it (the page
   // draws the residual vectors).
@@ -197,7 +198,8 @@ nlohmann::json LabelSession::session() const {
                       {"labels_file", f.labels_path},
                       {"labels", frames_[i].document},
                       {"candidates", std::move(candidates)},
-                      {"recovered", frames_[i].recovered ? nlohmann::json{{"file", f.labels_path + ".bak"}, {"labels", *frames_[i].recovered}}
+                      {"recovered", frames_[i].recovered ? nlohmann::json{{"file", f.labels_path + ".bak"},
+                                                                          {"labels", *frames_[i].recovered}}
                                                          : nlohmann::json(nullptr)}});
   }
   nlohmann::json bodies = nlohmann::json::array();
@@ -206,7 +208,8 @@ nlohmann::json LabelSession::session() const {
       nlohmann::json pts = nlohmann::json::array();
       for (const Vec3& p : b.points) pts.push_back({p.x(), p.y(), p.z()});
       bodies.push_back({{"name", b.name},
-                        {"frame", b.frame == kWorld ? std::string("world") : in_.model->joints[static_cast<std::size_t>(b.frame)].name},
+                        {"frame", b.frame == kWorld ? std::string("world")
+                                                    : in_.model->joints[static_cast<std::size_t>(b.frame)].name},
                         {"world_fixed", b.frame == kWorld},
                         {"points", std::move(pts)}});
     }
@@ -329,8 +332,9 @@ const std::vector<unsigned char>& LabelSession::overlayPng(std::size_t frame) {
     if (refinement_ && frame < in_.masks.size()) {
       // The mask's outline and the drawn robot's, opaque over the volumes.
       cv::Mat lines = cv::Mat::zeros(layer.rows, layer.cols, CV_8UC3);
-      drawMaskAgreement(lines, *solved_, in_.masks[frame], calib::placeVolumes(*in_.model, *in.state, in_.mask_bodies),
-                        frame < refinement_->meshes.size() ? refinement_->meshes[frame] : std::vector<calib::PlacedMesh>{});
+      drawMaskAgreement(
+          lines, *solved_, in_.masks[frame], calib::placeVolumes(*in_.model, *in.state, in_.mask_bodies),
+          frame < refinement_->meshes.size() ? refinement_->meshes[frame] : std::vector<calib::PlacedMesh>{});
       for (int y = 0; y < lines.rows; ++y)
         for (int x = 0; x < lines.cols; ++x)
           if (const cv::Vec3b c = lines.at<cv::Vec3b>(y, x); c != cv::Vec3b(0, 0, 0)) {
@@ -340,7 +344,8 @@ const std::vector<unsigned char>& LabelSession::overlayPng(std::size_t frame) {
             cv::Vec4b& under = layer.at<cv::Vec4b>(y, x);
             const double ua = under[3] / 255.0, out_a = a + (1.0 - a) * ua;
             for (int k = 0; k < 3; ++k)
-              under[k] = cv::saturate_cast<unsigned char>((c[k] / std::max(a, 1e-9) * a + under[k] * ua * (1.0 - a)) / out_a);
+              under[k] =
+                  cv::saturate_cast<unsigned char>((c[k] / std::max(a, 1e-9) * a + under[k] * ua * (1.0 - a)) / out_a);
             under[3] = cv::saturate_cast<unsigned char>(255.0 * out_a);
           }
     }
@@ -373,7 +378,8 @@ LabelSaved LabelSession::save() {
     saved.labels.push_back(path);
   }
   if (solved_ && !in_.camera_output.empty()) {
-    writeFileAtomically(in_.camera_output, calib::cameraText(*solved_) + (refinement_ ? refinementText(*refinement_) : std::string()));
+    writeFileAtomically(in_.camera_output,
+                        calib::cameraText(*solved_) + (refinement_ ? refinementText(*refinement_) : std::string()));
     saved.camera = in_.camera_output;
   }
   dirty_ = false;

@@ -5,7 +5,9 @@ namespace {
 
 // A value as JSON text; a string that is not UTF-8 cannot come from a JSON parser, but is
 // written with replacement characters rather than thrown on.
-std::string flow(const nlohmann::json& value) { return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace); }
+std::string flow(const nlohmann::json& value) {
+  return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
 
 }  // namespace
 

@@ -7,12 +7,14 @@
 
 namespace kccd::overlay {
 
-ContactSheet::ContactSheet(std::size_t count, int tile_width) : count_(std::max<std::size_t>(1, count)), tile_width_(tile_width) {}
+ContactSheet::ContactSheet(std::size_t count, int tile_width)
+    : count_(std::max<std::size_t>(1, count)), tile_width_(tile_width) {}
 
 cv::Mat ContactSheet::thumbnail(const cv::Mat& frame) const {
   const double scale = static_cast<double>(tile_width_) / frame.cols;
   cv::Mat small;
-  cv::resize(frame, small, cv::Size(tile_width_, std::max(1, static_cast<int>(std::lround(frame.rows * scale)))), 0, 0, cv::INTER_AREA);
+  cv::resize(frame, small, cv::Size(tile_width_, std::max(1, static_cast<int>(std::lround(frame.rows * scale)))), 0, 0,
+             cv::INTER_AREA);
   return small;
 }
 
@@ -40,7 +42,8 @@ std::vector<const ContactSheet::Tile*> ContactSheet::pick() const {
     const std::size_t at = even == 1 ? 0 : k * (kept_.size() - 1) / (even - 1);
     if (pick.empty() || pick.back() != &kept_[at]) pick.push_back(&kept_[at]);
   }
-  if (has_critical_ && std::none_of(pick.begin(), pick.end(), [&](const Tile* t) { return t->index == critical_.index; }))
+  if (has_critical_ &&
+      std::none_of(pick.begin(), pick.end(), [&](const Tile* t) { return t->index == critical_.index; }))
     pick.push_back(&critical_);
   std::sort(pick.begin(), pick.end(), [](const Tile* a, const Tile* b) { return a->index < b->index; });
   return pick;
@@ -60,13 +63,15 @@ cv::Mat ContactSheet::compose() const {
   const int caption_h = 22, gap = 4;
   int tile_h = 0;  // the tallest tile: frames of several cameras may differ in aspect
   for (const Tile* t : pick) tile_h = std::max(tile_h, t->image.rows);
-  cv::Mat sheet(rows * (tile_h + caption_h + gap) + gap, cols * (tile_width_ + gap) + gap, CV_8UC3, cv::Scalar(40, 40, 40));
+  cv::Mat sheet(rows * (tile_h + caption_h + gap) + gap, cols * (tile_width_ + gap) + gap, CV_8UC3,
+                cv::Scalar(40, 40, 40));
   for (std::size_t i = 0; i < pick.size(); ++i) {
     const int r = static_cast<int>(i) / cols, c = static_cast<int>(i) % cols;
     const int x = gap + c * (tile_width_ + gap), y = gap + r * (tile_h + caption_h + gap);
     const cv::Mat& img = pick[i]->image;
     img.copyTo(sheet(cv::Rect(x, y, img.cols, img.rows)));
-    cv::putText(sheet, pick[i]->caption, {x + 2, y + tile_h + 16}, cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
+    cv::putText(sheet, pick[i]->caption, {x + 2, y + tile_h + 16}, cv::FONT_HERSHEY_SIMPLEX, 0.42,
+                cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
   }
   return sheet;
 }

@@ -54,7 +54,7 @@ void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
   rec.match = set.swept ? stateAt(scene_.log, t, set.max_gap, q_, v_) : stateAt(scene_.log, t, set.max_gap, q_);
   render::ModelViewRequest request;
   request.tight_volumes = true;
-  request.visuals = true;    // when the scene has visuals and a state is known: the robot's look at it
+  request.visuals = true;  // when the scene has visuals and a state is known: the robot's look at it
   request.mask = false;
   request.colour = rec.selected;  // not selected: the query alone
   request.style.labels = false;
@@ -100,7 +100,8 @@ void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
   }
   if (!rec.selected) return;
   const render::Frame& layer = drawn.images;
-  for (std::size_t i = 0; i < drawn.first_visual; ++i) rec.not_finite |= layer.visibility[i] == render::Visibility::NotFinite;
+  for (std::size_t i = 0; i < drawn.first_visual; ++i)
+    rec.not_finite |= layer.visibility[i] == render::Visibility::NotFinite;
   if (rec.not_finite) rec.status = SafetyStatus::Colliding;  // an overflowed volume is unsafe
   const Clock::time_point t_composite = Clock::now();
   if (!set.plain) drawStatusLine(bgr, rec);
@@ -118,7 +119,10 @@ void FrameAnnotator::drawStatusLine(cv::Mat& bgr, const FrameRecord& rec) const 
   } else {
     s << " (" << toString(rec.match) << ")" << (set.swept ? "  swept" : "");
     if (rec.unsafe()) {
-      s << "  UNSAFE: " << (rec.braking_failed ? "no braking box" : rec.not_finite ? "volume not finite" : toString(rec.query));
+      s << "  UNSAFE: "
+        << (rec.braking_failed ? "no braking box"
+            : rec.not_finite   ? "volume not finite"
+                               : toString(rec.query));
     } else {
       if (std::isfinite(rec.min_distance)) {
         std::snprintf(buf, sizeof buf, "  min distance %.4f m", rec.min_distance);
@@ -129,7 +133,8 @@ void FrameAnnotator::drawStatusLine(cv::Mat& bgr, const FrameRecord& rec) const 
       if (!rec.pairs.empty()) {
         s << "  within margin: ";
         const std::vector<std::array<std::string, 2>> links = linkPairs(scene_.model, rec.pairs);
-        for (std::size_t i = 0; i < links.size() && i < 3; ++i) s << (i ? ", " : "") << links[i][0] << "-" << links[i][1];
+        for (std::size_t i = 0; i < links.size() && i < 3; ++i)
+          s << (i ? ", " : "") << links[i][0] << "-" << links[i][1];
         if (links.size() > 3) s << " +" << links.size() - 3;
       }
     }
@@ -141,9 +146,9 @@ void FrameAnnotator::drawStatusLine(cv::Mat& bgr, const FrameRecord& rec) const 
   const std::string text = s.str();
   const cv::Size size = cv::getTextSize(text, font, scale, thick, &baseline);
   const int pad = std::max(3, size.height / 2);
-  const cv::Rect box =
-      cv::Rect(pad, bgr.rows - size.height - baseline - 3 * pad, size.width + 2 * pad, size.height + baseline + 2 * pad) &
-      cv::Rect(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect box = cv::Rect(pad, bgr.rows - size.height - baseline - 3 * pad, size.width + 2 * pad,
+                                size.height + baseline + 2 * pad) &
+                       cv::Rect(0, 0, bgr.cols, bgr.rows);
   if (box.empty()) return;
   // The background darkened (keeps the text readable on any frame): each byte times 0.35, rounded
   // as convertTo rounds, through a table made by convertTo itself (a table look-up per byte is
@@ -157,7 +162,8 @@ void FrameAnnotator::drawStatusLine(cv::Mat& bgr, const FrameRecord& rec) const 
   cv::Mat roi = bgr(box);
   cv::LUT(roi, darken, roi);
   const cv::Point at(box.x + pad, box.y + pad + size.height);
-  const cv::Scalar colour = rec.status == SafetyStatus::Clear ? cv::Scalar(255, 255, 255) : render::statusColour(rec.status);
+  const cv::Scalar colour =
+      rec.status == SafetyStatus::Clear ? cv::Scalar(255, 255, 255) : render::statusColour(rec.status);
   cv::putText(bgr, text, at, font, scale, colour, thick, cv::LINE_AA);
 }
 

@@ -5,8 +5,8 @@
 #include "kccd/overlay/recording/overlay_recording.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstdlib>
@@ -21,14 +21,14 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
-#include <opencv2/core/utils/logger.hpp>
 #include <nlohmann/json.hpp>
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "kccd/input_error.hpp"
+#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/recording/contact_sheet.hpp"
 #include "kccd/overlay/recording/timeline.hpp"
-#include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/recording/video_source.hpp"
 #include "kccd/render/projection.hpp"
 
@@ -160,7 +160,8 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   std::vector<render::LoadedVisual> visuals;
   if (opt.visuals) {
     if (model.visuals.empty()) throw InputError("visuals: the model has no visuals:");
-    if (model.visuals.size() + model.bodies.size() > 255) throw InputError("visuals: more than 255 bodies and visuals to draw");
+    if (model.visuals.size() + model.bodies.size() > 255)
+      throw InputError("visuals: more than 255 bodies and visuals to draw");
     visuals = render::loadVisuals(model);
   }
   AnnotatorSettings settings;
@@ -204,7 +205,8 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   if (in.masks && in.masks->fromRecording()) {
     learnt.emplace(*in.masks);
     const std::unique_ptr<FrameSource> sampling = open();
-    learnt->learnBackground(*sampling, [&](std::size_t i) { return clock(i) + report.time_offset; }, in.log, report.max_gap);
+    learnt->learnBackground(
+        *sampling, [&](std::size_t i) { return clock(i) + report.time_offset; }, in.log, report.max_gap);
   }
   const MaskAgreement* masks = learnt ? &*learnt : in.masks;
   const std::size_t expected = video.declaredFrames();
@@ -266,9 +268,12 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
                            std::to_string(camera.width) + "x" + std::to_string(camera.height));
         if (job.bgr.type() != CV_8UC3) {
           cv::Mat converted;
-          if (job.bgr.channels() == 1) cv::cvtColor(job.bgr, converted, cv::COLOR_GRAY2BGR);
-          else if (job.bgr.channels() == 4) cv::cvtColor(job.bgr, converted, cv::COLOR_BGRA2BGR);
-          else throw VideoError(video_label + ": frame " + count(index) + " is not an 8-bit colour image");
+          if (job.bgr.channels() == 1)
+            cv::cvtColor(job.bgr, converted, cv::COLOR_GRAY2BGR);
+          else if (job.bgr.channels() == 4)
+            cv::cvtColor(job.bgr, converted, cv::COLOR_BGRA2BGR);
+          else
+            throw VideoError(video_label + ": frame " + count(index) + " is not an 8-bit colour image");
           job.bgr = converted;
         }
         job.record.times.decode = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_decode).count();
@@ -310,7 +315,8 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
             job = std::move(todo.front());
             todo.pop_front();
           }
-          const cv::Mat picture = masks && masks->fromRecording() ? job.bgr.clone() : cv::Mat();  // before anything is drawn
+          const cv::Mat picture =
+              masks && masks->fromRecording() ? job.bgr.clone() : cv::Mat();  // before anything is drawn
           annotator->annotate(job.bgr, job.record);
           if (masks) job.record.mask_iou = masks->at(job.index, job.record.values, picture);
           std::lock_guard lock(mu);
@@ -353,7 +359,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
           // The most critical frame is always on the sheet: colliding first, then the nearest.
           const double priority = r.unsafe() || r.status == SafetyStatus::Colliding ? -1.0
                                   : std::isfinite(r.min_distance)                   ? r.min_distance
-                                                                                    : std::numeric_limits<double>::infinity();
+                                                                  : std::numeric_limits<double>::infinity();
           sheet.add(job.index, job.bgr, caption, priority);
         }
       }
@@ -420,7 +426,8 @@ nlohmann::json writeOverlayOutputs(const OverlayOutputs& out, const OverlayRepor
     j["contact_sheet"] = out.contact_sheet;
   }
   if (!out.timeline.empty()) {
-    writePngAtomically(out.timeline, drawTimeline(report, model, out.timeline_title.empty() ? out.timeline : out.timeline_title),
+    writePngAtomically(out.timeline,
+                       drawTimeline(report, model, out.timeline_title.empty() ? out.timeline : out.timeline_title),
                        out.timeline_option + " " + out.timeline);
     j["timeline"] = out.timeline;
   }

@@ -36,16 +36,26 @@ nlohmann::json reportJson(const OverlayReport& report, const Model& model, bool 
   }
   if (report.timings) {
     const StageTimes& t = report.stages;
-    j["timings"] = {{"setup", report.setup_seconds}, {"frames", report.seconds}, {"jobs", report.jobs}, {"reused", report.reused},
+    j["timings"] = {{"setup", report.setup_seconds},
+                    {"frames", report.seconds},
+                    {"jobs", report.jobs},
+                    {"reused", report.reused},
                     {"stage_seconds",
-                     {{"decode", t.decode}, {"state", t.state}, {"query", t.query}, {"render", t.render},
-                      {"read_back", t.read_back}, {"warp", t.warp}, {"composite", t.composite}, {"encode", t.encode}}}};
+                     {{"decode", t.decode},
+                      {"state", t.state},
+                      {"query", t.query},
+                      {"render", t.render},
+                      {"read_back", t.read_back},
+                      {"warp", t.warp},
+                      {"composite", t.composite},
+                      {"encode", t.encode}}}};
   }
   if (const AgreementSummary a = summariseAgreement(report.frames); a.frames > 0) {
     nlohmann::json low = nlohmann::json::array();
     for (std::size_t i = 0; i < std::min<std::size_t>(a.low.size(), 20); ++i) low.push_back(a.low[i]);
-    j["mask_agreement"] = {{"frames", a.frames}, {"mean_iou", a.mean},  {"median_iou", a.median}, {"min_iou", a.min},
-                           {"low_below", a.low_below}, {"low_frames", a.low.size()}, {"lowest", low}};
+    j["mask_agreement"] = {{"frames", a.frames}, {"mean_iou", a.mean},       {"median_iou", a.median},
+                           {"min_iou", a.min},   {"low_below", a.low_below}, {"low_frames", a.low.size()},
+                           {"lowest", low}};
   }
   if (!with_frames) return j;
   nlohmann::json frames = nlohmann::json::array();
@@ -61,7 +71,8 @@ nlohmann::json reportJson(const OverlayReport& report, const Model& model, bool 
     f["state_values"] = nlohmann::json::array();
     for (double v : r.values) f["state_values"].push_back(numberOrNull(v));
     f["pairs_within_margin"] = nlohmann::json::array();
-    for (const auto& p : r.pairs) f["pairs_within_margin"].push_back({model.bodies[p[0]].name, model.bodies[p[1]].name});
+    for (const auto& p : r.pairs)
+      f["pairs_within_margin"].push_back({model.bodies[p[0]].name, model.bodies[p[1]].name});
     f["links_within_margin"] = nlohmann::json::array();
     for (const auto& l : linkPairs(model, r.pairs)) f["links_within_margin"].push_back({l[0], l[1]});
     if (r.match != StateMatch::None) f["query_status"] = r.queryStatusText();

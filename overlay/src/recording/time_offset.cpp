@@ -50,9 +50,12 @@ TimeOffset findTimeOffset(FrameSource& video, const FrameClock& clock, const Sta
     }
     if (!got) break;
     const double t = clock(i);
-    if (frame.channels() == 3) cv::cvtColor(frame, grey, cv::COLOR_BGR2GRAY);
-    else if (frame.channels() == 4) cv::cvtColor(frame, grey, cv::COLOR_BGRA2GRAY);
-    else grey = frame;
+    if (frame.channels() == 3)
+      cv::cvtColor(frame, grey, cv::COLOR_BGR2GRAY);
+    else if (frame.channels() == 4)
+      cv::cvtColor(frame, grey, cv::COLOR_BGRA2GRAY);
+    else
+      grey = frame;
     cv::resize(grey, small, cv::Size(std::max(1, grey.cols / 8), std::max(1, grey.rows / 8)), 0, 0, cv::INTER_AREA);
     small.convertTo(small, CV_32F);
     if (!previous.empty() && previous.size() == small.size() && std::isfinite(t) && std::isfinite(previous_time)) {

@@ -15,7 +15,8 @@ namespace {
 
 // Colours (BGR) on a white page.
 const cv::Scalar kInk(40, 40, 40), kGrid(225, 225, 225), kCurve(150, 70, 20), kMarginLine(0, 110, 230);
-const cv::Scalar kCollidingFill(170, 170, 250), kWithinFill(150, 220, 255), kNoStateFill(215, 215, 215), kUnsafeFill(200, 140, 200);
+const cv::Scalar kCollidingFill(170, 170, 250), kWithinFill(150, 220, 255), kNoStateFill(215, 215, 215),
+    kUnsafeFill(200, 140, 200);
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr std::size_t kListed = 12;
 
@@ -23,17 +24,23 @@ constexpr std::size_t kListed = 12;
 int shadeOf(const FrameRecord& f) {
   if (f.unsafe()) return 4;
   switch (f.status) {
-    case SafetyStatus::WithinMargin: return 1;
-    case SafetyStatus::Colliding: return 2;
-    case SafetyStatus::NoState: return 3;
-    default: return 0;
+    case SafetyStatus::WithinMargin:
+      return 1;
+    case SafetyStatus::Colliding:
+      return 2;
+    case SafetyStatus::NoState:
+      return 3;
+    default:
+      return 0;
   }
 }
 const char* shadeWord(int s) {
   static const char* const w[] = {"clear", "within margin", "colliding", "no state", "unsafe"};
   return w[s];
 }
-cv::Scalar shadeFill(int s) { return s == 1 ? kWithinFill : s == 2 ? kCollidingFill : s == 3 ? kNoStateFill : kUnsafeFill; }
+cv::Scalar shadeFill(int s) {
+  return s == 1 ? kWithinFill : s == 2 ? kCollidingFill : s == 3 ? kNoStateFill : kUnsafeFill;
+}
 // Severity for the list's order: unsafe, colliding, within margin, no state.
 int severity(int s) { return s == 4 ? 0 : s == 2 ? 1 : s == 1 ? 2 : 3; }
 
@@ -56,12 +63,15 @@ int textWidth(const std::string& s, double scale, int thickness = 1) {
 constexpr int kAgreementHeight = 150;
 const cv::Scalar kAgreement(60, 140, 40), kLow(40, 40, 220);
 template <typename ToX>
-void drawAgreement(cv::Mat& img, const std::vector<FrameRecord>& frames, const AgreementSummary& a, ToX X, int x0, int x1, int y) {
+void drawAgreement(cv::Mat& img, const std::vector<FrameRecord>& frames, const AgreementSummary& a, ToX X, int x0,
+                   int x1, int y) {
   const int p0 = y + 34, p1 = y + kAgreementHeight - 16;
   auto Y = [&](double v) { return p1 - static_cast<int>(std::lround(std::clamp(v, 0.0, 1.0) * (p1 - p0))); };
-  text(img, "Robot masks: IoU with the drawn robot over " + std::to_string(a.frames) + " frames, mean " + formatNumber(a.mean, 3) +
-                ", smallest " + formatNumber(a.min, 3) + "; " + std::to_string(a.low.size()) + " frames below " +
-                formatNumber(a.low_below, 3) + " (0.8 x the median: the state and the video disagree there)",
+  text(img,
+       "Robot masks: IoU with the drawn robot over " + std::to_string(a.frames) + " frames, mean " +
+           formatNumber(a.mean, 3) + ", smallest " + formatNumber(a.min, 3) + "; " + std::to_string(a.low.size()) +
+           " frames below " + formatNumber(a.low_below, 3) +
+           " (0.8 x the median: the state and the video disagree there)",
        {x0, y + 18}, 0.45, kInk);
   for (double v : {0.0, 0.5, 1.0}) {
     cv::line(img, {x0, Y(v)}, {x1, Y(v)}, kGrid, 1);
@@ -97,7 +107,8 @@ struct Span {
 }  // namespace
 
 cv::Mat drawTimeline(const OverlayReport& report, const Model& model, const std::string& title, int width) {
-  if (width < 480 || width > 8192) throw InputError("timeline: width " + std::to_string(width) + " is not within 480 ... 8192 pixels");
+  if (width < 480 || width > 8192)
+    throw InputError("timeline: width " + std::to_string(width) + " is not within 480 ... 8192 pixels");
   const std::vector<FrameRecord>& frames = report.frames;
   if (frames.empty()) throw InputError("timeline: the run has no frame");
   const double margin = report.margin;
@@ -135,7 +146,8 @@ cv::Mat drawTimeline(const OverlayReport& report, const Model& model, const std:
   std::vector<const Span*> listed;
   for (const Span& sp : spans) listed.push_back(&sp);
   std::stable_sort(listed.begin(), listed.end(), [](const Span* a, const Span* b) {
-    return severity(a->shade) != severity(b->shade) ? severity(a->shade) < severity(b->shade) : a->min_distance < b->min_distance;
+    return severity(a->shade) != severity(b->shade) ? severity(a->shade) < severity(b->shade)
+                                                    : a->min_distance < b->min_distance;
   });
   const std::size_t shown = std::min(listed.size(), kListed);
 
@@ -149,19 +161,25 @@ cv::Mat drawTimeline(const OverlayReport& report, const Model& model, const std:
   auto Y = [&](double v) { return y1 - static_cast<int>(std::lround(std::clamp(v, 0.0, top) / top * (y1 - y0))); };
   // Each frame covers from the midpoint with its predecessor to the one with its successor.
   auto edgeBefore = [&](std::size_t i) { return i == 0 ? x0 : X(0.5 * (frames[i - 1].time + frames[i].time)); };
-  auto edgeAfter = [&](std::size_t i) { return i + 1 == frames.size() ? x1 : X(0.5 * (frames[i].time + frames[i + 1].time)); };
+  auto edgeAfter = [&](std::size_t i) {
+    return i + 1 == frames.size() ? x1 : X(0.5 * (frames[i].time + frames[i + 1].time));
+  };
 
   // Title and counts.
   text(img, title, {left, 26}, 0.62, kInk, 1);
-  std::string counts = std::to_string(frames.size()) + " frames over " + formatNumber(t1 - t0, 4) + " s:  " + std::to_string(report.clear) +
-                       " clear, " + std::to_string(report.within_margin) + " within margin (" + formatNumber(margin, 4) + " m), " +
-                       std::to_string(report.colliding) + " colliding, " + std::to_string(report.no_state) + " no state";
+  std::string counts = std::to_string(frames.size()) + " frames over " + formatNumber(t1 - t0, 4) +
+                       " s:  " + std::to_string(report.clear) + " clear, " + std::to_string(report.within_margin) +
+                       " within margin (" + formatNumber(margin, 4) + " m), " + std::to_string(report.colliding) +
+                       " colliding, " + std::to_string(report.no_state) + " no state";
   if (report.unsafe > 0) counts += ", " + std::to_string(report.unsafe) + " unsafe";
   if (report.swept) counts += ";  swept volumes";
   text(img, counts, {left, 50}, 0.45, kInk);
 
   // Shaded spans, grid, margin line, the curve.
-  for (const Span& sp : spans) cv::rectangle(img, cv::Point(edgeBefore(sp.first), y0), cv::Point(std::max(edgeAfter(sp.last), edgeBefore(sp.first) + 1), y1), shadeFill(sp.shade), cv::FILLED);
+  for (const Span& sp : spans)
+    cv::rectangle(img, cv::Point(edgeBefore(sp.first), y0),
+                  cv::Point(std::max(edgeAfter(sp.last), edgeBefore(sp.first) + 1), y1), shadeFill(sp.shade),
+                  cv::FILLED);
   for (double v = 0; v <= top + 1e-12; v += ystep) {
     cv::line(img, {x0, Y(v)}, {x1, Y(v)}, kGrid, 1);
     const std::string label = formatNumber(v, 4);
@@ -213,8 +231,10 @@ cv::Mat drawTimeline(const OverlayReport& report, const Model& model, const std:
   // The key and the list of spans.
   int ky = y1 + axis_h - 8, kx = x0;
   auto key = [&](const cv::Scalar& c, const std::string& s, bool line) {
-    if (line) cv::line(img, {kx, ky - 5}, {kx + 18, ky - 5}, c, 2, cv::LINE_AA);
-    else cv::rectangle(img, {kx, ky - 11}, {kx + 18, ky + 1}, c, cv::FILLED);
+    if (line)
+      cv::line(img, {kx, ky - 5}, {kx + 18, ky - 5}, c, 2, cv::LINE_AA);
+    else
+      cv::rectangle(img, {kx, ky - 11}, {kx + 18, ky + 1}, c, cv::FILLED);
     text(img, s, {kx + 24, ky}, 0.42, kInk);
     kx += 24 + textWidth(s, 0.42) + 22;
   };
@@ -233,21 +253,28 @@ cv::Mat drawTimeline(const OverlayReport& report, const Model& model, const std:
   if (spans.empty()) {
     text(img, "No frame within the margin, colliding or without a state.", {x0, ly}, 0.45, kInk);
   } else {
-    text(img, "Spans, the most severe first (number above the plot; time of the first and last frame; smallest bound; pair in most frames):",
+    text(img,
+         "Spans, the most severe first (number above the plot; time of the first and last frame; smallest bound; pair "
+         "in most frames):",
          {x0, ly}, 0.42, kInk);
     for (std::size_t k = 0; k < shown; ++k) {
       const Span& sp = *listed[k];
       ly += 22;
       cv::rectangle(img, {x0, ly - 12}, {x0 + 14, ly + 2}, shadeFill(sp.shade), cv::FILLED);
-      std::string line = std::to_string(k + 1) + "   " + formatNumber(frames[sp.first].time, 6) + " - " + formatNumber(frames[sp.last].time, 6) +
-                         (sp.first == sp.last ? " s (frame " + std::to_string(sp.first) : " s (frames " + std::to_string(sp.first) + "-" + std::to_string(sp.last)) + ")   " + shadeWord(sp.shade);
+      std::string line =
+          std::to_string(k + 1) + "   " + formatNumber(frames[sp.first].time, 6) + " - " +
+          formatNumber(frames[sp.last].time, 6) +
+          (sp.first == sp.last ? " s (frame " + std::to_string(sp.first)
+                               : " s (frames " + std::to_string(sp.first) + "-" + std::to_string(sp.last)) +
+          ")   " + shadeWord(sp.shade);
       if (std::isfinite(sp.min_distance)) line += "   " + formatNumber(sp.min_distance * 1000.0, 4) + " mm";
       if (!sp.pair.empty()) line += "   " + sp.pair;
       text(img, line, {x0 + 22, ly}, 0.45, kInk);
     }
     if (listed.size() > shown) {
       ly += 22;
-      text(img, "... and " + std::to_string(listed.size() - shown) + " more spans (see the report)", {x0 + 22, ly}, 0.45, kInk);
+      text(img, "... and " + std::to_string(listed.size() - shown) + " more spans (see the report)", {x0 + 22, ly},
+           0.45, kInk);
     }
   }
   if (agreement.frames > 0) drawAgreement(img, frames, agreement, X, x0, x1, head + plot_h + axis_h + list_h);

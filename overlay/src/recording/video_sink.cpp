@@ -17,9 +17,11 @@ int videoFourcc(const std::string& path, const std::string& codec) {
     // FourCC to a codec ignoring case, but a muxer that wants another spelling makes OpenCV print
     // a warning of its own on the way.
     std::string c = codec;
-    for (const char* known : {"MJPG", "FFV1", "mp4v", "XVID", "DIVX", "avc1", "H264", "hvc1", "HEVC", "VP80", "VP90", "FMP4"}) {
+    for (const char* known :
+         {"MJPG", "FFV1", "mp4v", "XVID", "DIVX", "avc1", "H264", "hvc1", "HEVC", "VP80", "VP90", "FMP4"}) {
       bool same = true;
-      for (std::size_t k = 0; k < 4; ++k) same = same && std::tolower(static_cast<unsigned char>(codec[k])) == std::tolower(known[k]);
+      for (std::size_t k = 0; k < 4; ++k)
+        same = same && std::tolower(static_cast<unsigned char>(codec[k])) == std::tolower(known[k]);
       if (same) c = known;
     }
     return cv::VideoWriter::fourcc(c[0], c[1], c[2], c[3]);

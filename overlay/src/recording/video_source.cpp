@@ -37,7 +37,8 @@ bool onePrintfNumber(const std::string& pattern) {
       continue;
     }
     std::size_t j = i + 1;
-    while (j < pattern.size() && (pattern[j] == '0' || pattern[j] == '-' || pattern[j] == ' ' || pattern[j] == '+')) ++j;
+    while (j < pattern.size() && (pattern[j] == '0' || pattern[j] == '-' || pattern[j] == ' ' || pattern[j] == '+'))
+      ++j;
     while (j < pattern.size() && pattern[j] >= '0' && pattern[j] <= '9') ++j;
     if (j >= pattern.size() || (pattern[j] != 'd' && pattern[j] != 'i')) return false;
     ++conversions;
@@ -66,8 +67,7 @@ VideoSource::VideoSource(const std::string& path, const std::string& label)
     return;
   }
   if (!std::filesystem::is_regular_file(path, ec))
-    throw VideoError(label_ + ": " +
-                     (std::filesystem::exists(path, ec) ? "not a regular file" : "no such file") +
+    throw VideoError(label_ + ": " + (std::filesystem::exists(path, ec) ? "not a regular file" : "no such file") +
                      " (a video file, or an image sequence such as frames/frame_%06d.png)");
   capture_ = std::make_unique<cv::VideoCapture>();
   try {
@@ -97,7 +97,8 @@ bool VideoSource::read(cv::Mat& frame) {
     try {
       frame = calib::readImageFile(sequenceFile(pattern_, first_ + next_), calib::ImageColour::Bgr);
     } catch (const calib::ImageError& e) {
-      throw VideoError(label_ + ": frame " + std::to_string(next_) + " cannot be decoded (" + printable(e.what(), 300) + ")");
+      throw VideoError(label_ + ": frame " + std::to_string(next_) + " cannot be decoded (" + printable(e.what(), 300) +
+                       ")");
     }
     ++next_;
     return true;
@@ -106,7 +107,8 @@ bool VideoSource::read(cv::Mat& frame) {
   try {
     got = capture_->read(frame);
   } catch (const cv::Exception& e) {
-    throw VideoError(label_ + ": frame " + std::to_string(next_) + " cannot be decoded (" + printable(e.what(), 200) + ")");
+    throw VideoError(label_ + ": frame " + std::to_string(next_) + " cannot be decoded (" + printable(e.what(), 200) +
+                     ")");
   }
   if (!got || frame.empty()) return false;
   ++next_;

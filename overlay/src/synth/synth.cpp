@@ -29,7 +29,9 @@ using Clock = std::chrono::steady_clock;
 double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 // An error about one of the options' fields (a front end names it in its own spelling).
-SynthError fieldError(const std::string& field, const std::string& problem) { return SynthError(InputLocation{{}, 0, 0, field}, problem); }
+SynthError fieldError(const std::string& field, const std::string& problem) {
+  return SynthError(InputLocation{{}, 0, 0, field}, problem);
+}
 
 // A number option within [lo, hi] (NaN refused).
 void checkRange(double value, double lo, double hi, const char* field) {
@@ -61,7 +63,8 @@ void checkOptions(const SynthOptions& o, const Model& m) {
   const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
   std::error_code ec;
   if (!fs::is_directory(parent, ec))
-    throw SynthError(spelledField(o.spell, "output") + " " + o.output + ": folder " + parent.string() + " does not exist");
+    throw SynthError(spelledField(o.spell, "output") + " " + o.output + ": folder " + parent.string() +
+                     " does not exist");
   if (fs::exists(out, ec) && !(fs::is_directory(out, ec) && fs::is_empty(out, ec)) && !o.replace)
     throw SynthError(spelledField(o.spell, "output") + " " + o.output + ": exists and is not an empty folder (" +
                      spelledField(o.spell, "replace") + " replaces it)");
@@ -93,18 +96,22 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
   const int height = o.height.value_or(SynthOptions::kDefaultHeight);
   if (!o.camera.empty()) {
     if (o.width || o.height)
-      throw fieldError(o.width ? "width" : "height", "shapes the default camera; the camera file " + o.camera + " fixes the size");
+      throw fieldError(o.width ? "width" : "height",
+                       "shapes the default camera; the camera file " + o.camera + " fixes the size");
     given = calib::loadCamera(o.camera);
   } else if (width < 64 || height < 64 || width > 4096 || height > 4096) {
     throw fieldError(width < 64 || width > 4096 ? "width" : "height", "must be 64 ... 4096 pixels");
   }
 
   const int frames = static_cast<int>(std::floor(o.seconds * o.fps + 1e-9));
-  const SynthMotion motion = searchMotion(
-      m,
-      TrajectorySearch{.model = o.model, .seconds = o.seconds, .fps = o.fps, .seed = o.seed, .collision = o.collision,
-                       .spell = o.spell},
-      frames, o.log_rate, o.time_offset);
+  const SynthMotion motion = searchMotion(m,
+                                          TrajectorySearch{.model = o.model,
+                                                           .seconds = o.seconds,
+                                                           .fps = o.fps,
+                                                           .seed = o.seed,
+                                                           .collision = o.collision,
+                                                           .spell = o.spell},
+                                          frames, o.log_rate, o.time_offset);
   const auto t_traj = Clock::now();
 
   SynthScene scene;
@@ -134,7 +141,8 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
   const auto t_bg = Clock::now();
 
   // Output folder, staged: an existing one is replaced only when the new one is complete.
-  StagedOutput staged(out, StagedOutput::Kind::Folder, spelledField(o.spell, "output") + " " + o.output, StagedOutput::Existing::ReplaceFolder);
+  StagedOutput staged(out, StagedOutput::Kind::Folder, spelledField(o.spell, "output") + " " + o.output,
+                      StagedOutput::Existing::ReplaceFolder);
   const fs::path dir = staged.path();
   const fs::path mask_dir = dir / "masks";
   fs::create_directory(mask_dir);
@@ -161,7 +169,8 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
       if (progress) progress(static_cast<double>(i + 1) / frames);
     }
     writer.finish();
-    if (!writer.error().empty()) throw SynthError(spelledField(o.spell, "output") + " " + o.output + ": " + writer.error());
+    if (!writer.error().empty())
+      throw SynthError(spelledField(o.spell, "output") + " " + o.output + ": " + writer.error());
     written = writer.written();
     run.writer_s = writer.stageSeconds();
   }

@@ -72,9 +72,10 @@ double DistanceProbe::operator()(std::span<const double> q, int* pair) {
   // stage could only repeat their distances (and the search asks for many thousands of states).
   // Without the pair the closest one is enough (the others are pruned by their bounding spheres);
   // with it, every distance, so that among equal ones the pair is the last, as always.
-  const QueryResult& r = checker_.query(
-      q, q, QueryOptions{.type = pair ? QueryType::Distances : QueryType::NClosest, .n = 1,
-                         .exact_below = -std::numeric_limits<double>::infinity()});
+  const QueryResult& r = checker_.query(q, q,
+                                        QueryOptions{.type = pair ? QueryType::Distances : QueryType::NClosest,
+                                                     .n = 1,
+                                                     .exact_below = -std::numeric_limits<double>::infinity()});
   if (r.status != Status::Ok) return -1.0;
   if (pair) {
     *pair = -1;
@@ -242,9 +243,8 @@ Trajectory searchTrajectory(const Model& m, const TrajectorySearch& a, double t0
     if (ok) return tr;
   }
   throw SynthError(a.model + ": found no trajectory with near-collisions" +
-                   std::string(a.collision ? " and one collision" : "") +
-                   " within the joint limits (try another " + spelledField(a.spell, "seed") + " or a longer " +
-                   spelledField(a.spell, "seconds") + ")");
+                   std::string(a.collision ? " and one collision" : "") + " within the joint limits (try another " +
+                   spelledField(a.spell, "seed") + " or a longer " + spelledField(a.spell, "seconds") + ")");
 }
 
 std::string stateLogText(const Model& m, const Trajectory& tr, double offset, double rate, double duration) {
@@ -306,8 +306,8 @@ SynthMotion searchMotion(const Model& m, const TrajectorySearch& search, int fra
     if (out.intervals.size() == (search.collision ? 1u : 0u)) break;
     if (round == 7)
       throw SynthError(search.model + ": the trajectories found have " + std::to_string(out.intervals.size()) +
-                       " collision intervals at this frame rate (try another " + spelledField(search.spell, "seed") + ", " +
-                       spelledField(search.spell, "fps") + " or " + spelledField(search.spell, "seconds") + ")");
+                       " collision intervals at this frame rate (try another " + spelledField(search.spell, "seed") +
+                       ", " + spelledField(search.spell, "fps") + " or " + spelledField(search.spell, "seconds") + ")");
   }
   return out;
 }

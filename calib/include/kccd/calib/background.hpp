@@ -18,15 +18,16 @@ namespace kccd::calib {
 /// One frame of the recording and where the robot may be in it.
 struct BackgroundSample {
   cv::Mat bgr;    ///< 8-bit BGR, every sample the same size
-  cv::Mat robot;  ///< CV_8UC1 of the same size: non-zero where the robot may be (its drawing, widened by the pose's uncertainty)
+  cv::Mat robot;  ///< CV_8UC1 of the same size: non-zero where the robot may be (its drawing, widened by the pose's
+                  ///< uncertainty)
 };
 
 /// The scene without the robot.
 struct Background {
-  cv::Mat bgr;     ///< CV_8UC3: each pixel's median colour over the samples that leave it free
-  cv::Mat spread;  ///< CV_32F: the robust spread (1.4826 x MAD) of those samples' colour distances to it
-  cv::Mat known;   ///< CV_8UC1: 255 where at least `min_samples` samples leave the pixel free, else 0
-  int samples = 0; ///< samples it was made from
+  cv::Mat bgr;      ///< CV_8UC3: each pixel's median colour over the samples that leave it free
+  cv::Mat spread;   ///< CV_32F: the robust spread (1.4826 x MAD) of those samples' colour distances to it
+  cv::Mat known;    ///< CV_8UC1: 255 where at least `min_samples` samples leave the pixel free, else 0
+  int samples = 0;  ///< samples it was made from
 };
 
 /// The background of `samples`. Pixels that fewer than `min_samples` samples leave free are
@@ -47,6 +48,7 @@ struct ForegroundOptions {
 /// The robot mask of `frame`: 255 where the frame differs from the background (after a global gain
 /// that matches their brightness away from `frame.robot`), opened over 1 px and closed over 3 px, else 0;
 /// 0 where the background is unknown. Throws InputError for a frame of another size or type.
-cv::Mat foregroundMask(const BackgroundSample& frame, const Background& background, const ForegroundOptions& options = {});
+cv::Mat foregroundMask(const BackgroundSample& frame, const Background& background,
+                       const ForegroundOptions& options = {});
 
 }  // namespace kccd::calib

@@ -24,22 +24,22 @@ class CameraError : public InputError {
 };
 
 /// Bounds of the cameras the suite accepts (checked by Camera::validate): what the renderer can draw.
-inline constexpr int kMaxImageSide = 8192;                ///< image_width, image_height
-inline constexpr long kMaxImagePixels = 1L << 24;         ///< width * height (4096 x 4096)
-inline constexpr int kMaxPinholeSide = 8192;              ///< the widened pinhole image at supersample 1
-inline constexpr double kMaxFocal = 1e6;                  ///< fx, fy in 1 .. kMaxFocal pixels
-inline constexpr double kMaxDistortion = 1e4;             ///< |k_i|, |p_i|, |s_i|; tilt |tx|, |ty| <= 1 rad
-inline constexpr double kMaxTranslation = 1e6;            ///< |tvec| in metres
+inline constexpr int kMaxImageSide = 8192;         ///< image_width, image_height
+inline constexpr long kMaxImagePixels = 1L << 24;  ///< width * height (4096 x 4096)
+inline constexpr int kMaxPinholeSide = 8192;       ///< the widened pinhole image at supersample 1
+inline constexpr double kMaxFocal = 1e6;           ///< fx, fy in 1 .. kMaxFocal pixels
+inline constexpr double kMaxDistortion = 1e4;      ///< |k_i|, |p_i|, |s_i|; tilt |tx|, |ty| <= 1 rad
+inline constexpr double kMaxTranslation = 1e6;     ///< |tvec| in metres
 inline constexpr std::size_t kMaxCameraFileBytes = 1 << 20;
 
 /// A calibrated camera in OpenCV's conventions (pixel centres at integer coordinates).
 struct Camera {
-  int width = 0;                   ///< image size in pixels
+  int width = 0;  ///< image size in pixels
   int height = 0;
   cv::Matx33d camera_matrix = cv::Matx33d::eye();  ///< fx 0 cx; 0 fy cy; 0 0 1 (no skew)
-  std::vector<double> distortion;  ///< OpenCV order: k1 k2 p1 p2 [k3 [k4 k5 k6 [s1 s2 s3 s4 [tx ty]]]]
-  cv::Vec3d rvec{0, 0, 0};         ///< world -> camera rotation (Rodrigues vector)
-  cv::Vec3d tvec{0, 0, 0};         ///< world -> camera translation (metres)
+  std::vector<double> distortion;                  ///< OpenCV order: k1 k2 p1 p2 [k3 [k4 k5 k6 [s1 s2 s3 s4 [tx ty]]]]
+  cv::Vec3d rvec{0, 0, 0};                         ///< world -> camera rotation (Rodrigues vector)
+  cv::Vec3d tvec{0, 0, 0};                         ///< world -> camera translation (metres)
   /// Quality of a calibrated pose, as calibration writes it (absent in a file: unknown).
   std::optional<double> reprojection_rms_px;
   std::optional<double> rotation_sigma_deg;

@@ -26,15 +26,15 @@ struct EdgeFrame {
 
 /// How the edge refinement runs.
 struct EdgeOptions {
-  double spacing_px = 2.0;   ///< outline samples' spacing
-  int max_iterations = 30;   ///< per stage
-  double match_px = 2.0;     ///< an outline point within this of an edge of its direction is "on an edge"
-  double min_matched = 0.35; ///< a refined pose with less of its outline on edges (mean over frames) is not a camera
+  double spacing_px = 2.0;    ///< outline samples' spacing
+  int max_iterations = 30;    ///< per stage
+  double match_px = 2.0;      ///< an outline point within this of an edge of its direction is "on an edge"
+  double min_matched = 0.35;  ///< a refined pose with less of its outline on edges (mean over frames) is not a camera
   /// nor one the edges pin down less well than this (measured when right: 0.02-0.11 deg on 4-6
   /// synthetic pictures, 0.07 deg on 10 real photos of 1280x720, 0.17 on 3 of them; when wrong:
   /// 0.37 deg for pictures of other states whose clutter happened to line up, 1.1 deg on 1 photo)
   double max_rotation_sigma_deg = 0.25;
-  double click_px = 8.0;     ///< how far off the clicks may be (their robust loss's scale)
+  double click_px = 8.0;  ///< how far off the clicks may be (their robust loss's scale)
   /// As RefineOptions::start_is_prior: a pose beyond 3 sigma of the start's for a gain in the
   /// matched share below 0.05 keeps the start.
   bool start_is_prior = false;

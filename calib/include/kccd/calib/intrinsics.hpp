@@ -45,20 +45,21 @@ struct Board {
 
   /// The correspondences of one image's detections (tagCorrespondences; unknown ids are left
   /// out). Throws TagDetectionError for a tag seen twice, `image` naming the image.
-  std::vector<Correspondence> correspondences(const std::vector<TagDetection>& detections, const std::string& image) const;
+  std::vector<Correspondence> correspondences(const std::vector<TagDetection>& detections,
+                                              const std::string& image) const;
 };
 
 /// The correspondences of one image of the board.
 struct IntrinsicsView {
-  std::string name;                     ///< unique, non-empty (an image file name); used in reports
-  std::vector<Correspondence> points;   ///< names unique within the view; world points on the board
+  std::string name;                    ///< unique, non-empty (an image file name); used in reports
+  std::vector<Correspondence> points;  ///< names unique within the view; world points on the board
 };
 
 /// Tuning of calibrateIntrinsics. The defaults suit detected tag corners (sub-pixel noise).
 struct IntrinsicsOptions {
-  bool fix_k3 = false;    ///< keep k3 at 0 (k1 k2 p1 p2 only; for lenses with little distortion)
-  bool rational = false;  ///< the rational model k1..k6 (8 coefficients; wide-angle lenses, many views)
-  int min_views = 3;      ///< fewer usable views -> TooFewViews; at least 3
+  bool fix_k3 = false;          ///< keep k3 at 0 (k1 k2 p1 p2 only; for lenses with little distortion)
+  bool rational = false;        ///< the rational model k1..k6 (8 coefficients; wide-angle lenses, many views)
+  int min_views = 3;            ///< fewer usable views -> TooFewViews; at least 3
   int min_points_per_view = 8;  ///< a view with fewer corners (2 tags) is not used; at least 6
   /// The focal length is observable only when some views see the board tilted: the largest view
   /// tilt (angle between the board normal and the optical axis) must reach this, else FrontoParallel.
@@ -87,10 +88,10 @@ enum class IntrinsicsStatus : std::uint8_t {
 struct IntrinsicsViewReport {
   std::string name;
   int points = 0;
-  bool used = false;  ///< in the final solve
-  double rms_px = std::numeric_limits<double>::quiet_NaN();    ///< under the final (or best) solution; NaN if not solved
+  bool used = false;                                         ///< in the final solve
+  double rms_px = std::numeric_limits<double>::quiet_NaN();  ///< under the final (or best) solution; NaN if not solved
   double tilt_deg = std::numeric_limits<double>::quiet_NaN();  ///< board normal vs optical axis; NaN if unknown
-  std::string note;   ///< why it is not used ("" when used)
+  std::string note;                                            ///< why it is not used ("" when used)
 };
 
 /// Standard deviations of the solved parameters (pixels, and unitless for distortion), from the

@@ -22,22 +22,22 @@ class LabelsError : public InputError {
   using InputError::InputError;
 };
 
-inline constexpr double kMaxLabelPixel = 1e6;               ///< |u|, |v| in pixels
-inline constexpr double kMaxLabelPoint = 1e6;               ///< |world[k]|, |point[k]| in metres (as model lengths)
-inline constexpr std::size_t kMaxLabelState = 4096;         ///< values in a label's state
-inline constexpr std::size_t kMaxLabelsBytes = 1 << 20;     ///< file size
+inline constexpr double kMaxLabelPixel = 1e6;            ///< |u|, |v| in pixels
+inline constexpr double kMaxLabelPoint = 1e6;            ///< |world[k]|, |point[k]| in metres (as model lengths)
+inline constexpr std::size_t kMaxLabelState = 4096;      ///< values in a label's state
+inline constexpr std::size_t kMaxLabelsBytes = 1 << 20;  ///< file size
 
 /// One labelled point: `world` set for a world point; otherwise `body` names a model body and
 /// `point` is in that body's frame, placed by `state` (absent: the state log's state at the
 /// frame's time gives it).
 struct Label {
   std::string name;
-  cv::Point2d pixel;                          ///< OpenCV convention: pixel centres at integers
-  std::optional<cv::Point3d> world;           ///< a world point
-  std::string body;                           ///< a body-fixed point: the body ...
-  cv::Point3d point;                          ///< ... and the point in its frame
-  std::optional<std::vector<double>> state;   ///< the state placing the body, when the file gives it
-  std::string where;                          ///< "file:line:col" of the label, for later messages
+  cv::Point2d pixel;                         ///< OpenCV convention: pixel centres at integers
+  std::optional<cv::Point3d> world;          ///< a world point
+  std::string body;                          ///< a body-fixed point: the body ...
+  cv::Point3d point;                         ///< ... and the point in its frame
+  std::optional<std::vector<double>> state;  ///< the state placing the body, when the file gives it
+  std::string where;                         ///< "file:line:col" of the label, for later messages
 
   bool bodyFixed() const { return !world.has_value(); }
 };

@@ -31,7 +31,8 @@ cv::Mat readMask(const std::string& path, int width, int height, bool robot_and_
 struct MaskFrame {
   cv::Mat mask;                       ///< CV_8UC1, the camera's size; non-zero = robot
   std::vector<PlacedVolume> volumes;  ///< world coordinates
-  std::vector<PlacedMesh> meshes;     ///< what the robot looks like (visual meshes); drawn instead of the volumes when given
+  std::vector<PlacedMesh>
+      meshes;  ///< what the robot looks like (visual meshes); drawn instead of the volumes when given
   /// CV_8UC1: non-zero where the mask says anything (empty: everywhere). Elsewhere (e.g. where a
   /// background estimate never saw the scene) outline points do not count and IoUs are not taken.
   cv::Mat known;
@@ -39,11 +40,11 @@ struct MaskFrame {
 
 /// How the refinement runs.
 struct RefineOptions {
-  double spacing_px = 2.0;  ///< outline samples' spacing
-  int max_iterations = 40;  ///< per stage of the robust scale
-  double min_iou = 0.6;     ///< a refined pose whose mean IoU stays below this is not a camera
+  double spacing_px = 2.0;              ///< outline samples' spacing
+  int max_iterations = 40;              ///< per stage of the robust scale
+  double min_iou = 0.6;                 ///< a refined pose whose mean IoU stays below this is not a camera
   double max_rotation_sigma_deg = 3.0;  ///< nor one this uncertain (the points' solve has the same gate)
-  double max_frame_drop = 0.02;  ///< nor one that lowers a frame's IoU by more than this
+  double max_frame_drop = 0.02;         ///< nor one that lowers a frame's IoU by more than this
   /// The start's sigmas (when it has them) are a prior: a pose more than 3 sigma from it for a mean
   /// IoU gain below 0.02 keeps the start (the masks and the volumes differ, not the start).
   bool start_is_prior = false;
@@ -52,12 +53,13 @@ struct RefineOptions {
 /// The agreement of one frame before and after (a refinement to masks fills the IoUs, one to
 /// edges the matched fractions).
 struct FrameAgreement {
-  double iou_before = 0.0;  ///< mask IoU at the start pose
-  double iou_after = 0.0;   ///< at the returned pose
+  double iou_before = 0.0;      ///< mask IoU at the start pose
+  double iou_after = 0.0;       ///< at the returned pose
   double matched_before = 0.0;  ///< share of the drawn outline on an image edge of its direction, at the start
   double matched_after = 0.0;   ///< at the returned pose
-  double rms_px = 0.0;      ///< outline points' distance to the mask's outline (or the edges) at the returned pose (robust rms)
-  int outline_points = 0;   ///< points of the drawn outline inside the image at the returned pose
+  double rms_px =
+      0.0;  ///< outline points' distance to the mask's outline (or the edges) at the returned pose (robust rms)
+  int outline_points = 0;  ///< points of the drawn outline inside the image at the returned pose
 };
 
 /// What a refinement was made to.

@@ -24,18 +24,19 @@ struct PlacedVolume {
 /// A triangle mesh placed in the world: what part of the robot looks like (a visual mesh at one
 /// state).
 struct PlacedMesh {
-  std::vector<Vec3> vertices;                          ///< world coordinates
+  std::vector<Vec3> vertices;                           ///< world coordinates
   std::vector<std::array<std::uint32_t, 3>> triangles;  ///< indices into vertices
 };
 
 /// The volumes of `bodies` (indices into model.bodies; all when empty) at `state`. Throws
 /// InputError for a state of the wrong size or a body index out of range.
-std::vector<PlacedVolume> placeVolumes(const Model& model, std::span<const double> state, std::span<const int> bodies = {});
+std::vector<PlacedVolume> placeVolumes(const Model& model, std::span<const double> state,
+                                       std::span<const int> bodies = {});
 
 /// A point of the silhouette's outline.
 struct OutlinePoint {
-  Vec3 world;        ///< the point of the volume whose image it is (first order: it moves with the pose)
-  cv::Point2d pixel; ///< where `camera` projects it
+  Vec3 world;          ///< the point of the volume whose image it is (first order: it moves with the pose)
+  cv::Point2d pixel;   ///< where `camera` projects it
   cv::Point2d normal;  ///< the outline's outward unit normal there, in the image
 };
 

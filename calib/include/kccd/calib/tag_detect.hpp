@@ -39,13 +39,15 @@ std::vector<TagDetection> detectTags(const cv::Mat& gray);
 
 /// The correspondences of detected tags that the layout places, and the ids it does not know.
 struct TagCorrespondences {
-  std::vector<Correspondence> points;  ///< 4 per known tag, in detection then corner order, named "tag3.c0" .. "tag3.c3"
-  std::vector<int> unknown_ids;        ///< detected ids not in the layout, ascending, each once
+  std::vector<Correspondence>
+      points;                    ///< 4 per known tag, in detection then corner order, named "tag3.c0" .. "tag3.c3"
+  std::vector<int> unknown_ids;  ///< detected ids not in the layout, ascending, each once
 };
 
 /// Pairs every detected corner of a layout tag with its world point (Tag::corners()). A tag id
 /// detected twice is a TagDetectionError ("image: tags: tag N is detected twice ..."), `image`
 /// naming the image in the message.
-TagCorrespondences tagCorrespondences(std::span<const TagDetection> detections, const TagLayout& layout, const std::string& image);
+TagCorrespondences tagCorrespondences(std::span<const TagDetection> detections, const TagLayout& layout,
+                                      const std::string& image);
 
 }  // namespace kccd::calib

@@ -20,10 +20,10 @@ class TagLayoutError : public InputError {
   using InputError::InputError;
 };
 
-inline constexpr int kMaxTagId = 586;                        ///< tag36h11 has ids 0..586
-inline constexpr double kMaxTagSize = 100.0;                 ///< edge of the black square, metres
-inline constexpr double kMaxTagPosition = 1e6;               ///< |xyz[k]| in metres (as model lengths)
-inline constexpr std::size_t kMaxTagLayoutBytes = 1 << 20;   ///< file size
+inline constexpr int kMaxTagId = 586;                       ///< tag36h11 has ids 0..586
+inline constexpr double kMaxTagSize = 100.0;                ///< edge of the black square, metres
+inline constexpr double kMaxTagPosition = 1e6;              ///< |xyz[k]| in metres (as model lengths)
+inline constexpr std::size_t kMaxTagLayoutBytes = 1 << 20;  ///< file size
 
 /// One tag: its id, the edge of its black square and the pose of its frame in the world.
 /// The tag frame has its origin at the tag centre, x to the right and y up as the printed tag is

@@ -35,9 +35,9 @@ struct BagSummary {
   std::string path, format;  ///< format: "MCAP" or "rosbag2 sqlite3"
   std::string profile, library;
   std::uint64_t messages = 0, first_log_time = 0, last_log_time = 0;
-  std::vector<TopicSummary> topics;  ///< by topic name
+  std::vector<TopicSummary> topics;   ///< by topic name
   std::map<std::string, int> chunks;  ///< chunks by compression
-  std::string damage;  ///< empty, or where the file was cut short (the messages before it are counted)
+  std::string damage;                 ///< empty, or where the file was cut short (the messages before it are counted)
 };
 
 /// Reads every message of the log at `path` (see openLog) once. Throws InputError for a file that is not

@@ -2,9 +2,9 @@
 // channels and schemas, and the damage that ended it early. openLog picks the reader by content.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <memory>
-#include <cstdint>
 #include <string>
 
 #include "kccd/logs/log_message.hpp"

@@ -20,8 +20,8 @@
 namespace kccd::logs {
 
 /// Streams one MCAP file's messages. Memory is bounded by the largest record or decompressed
-/// chunk (by the chunks open at once where chunks overlap in time), not by the file. Every length field is checked against the bytes that remain before
-/// anything is allocated for it.
+/// chunk (by the chunks open at once where chunks overlap in time), not by the file. Every length field is checked
+/// against the bytes that remain before anything is allocated for it.
 class McapReader final : public LogReader {
  public:
   /// Opens `path` and checks the leading magic; throws InputError naming the file otherwise.
@@ -60,8 +60,8 @@ class McapReader final : public LogReader {
   void openChunk(std::span<const std::uint8_t> content, std::uint64_t at);
   // The record at `pos` of a chunk's records (advancing `pos`): its opcode and content; fails
   // naming the chunk at `at` for one that runs past the end or does not belong in a chunk.
-  std::span<const std::uint8_t> chunkRecord(const std::vector<std::uint8_t>& records, std::size_t& pos, std::uint64_t at,
-                                            std::uint8_t& op) const;
+  std::span<const std::uint8_t> chunkRecord(const std::vector<std::uint8_t>& records, std::size_t& pos,
+                                            std::uint64_t at, std::uint8_t& op) const;
   void decompressChunk(std::span<const std::uint8_t> content, std::uint64_t at, std::vector<std::uint8_t>& out);
   struct Merge;
   bool readIndex();
@@ -73,9 +73,9 @@ class McapReader final : public LogReader {
   std::ifstream in_;
   std::uint64_t size_ = 0, pos_ = 0;
   std::uint64_t decompress_left_ = 0;  // what chunks may still decompress to (a bound on bombs)
-  std::uint32_t data_crc_ = 0;        // CRC-32 of every byte read before the Data End record
+  std::uint32_t data_crc_ = 0;         // CRC-32 of every byte read before the Data End record
   bool data_crc_on_ = true;
-  std::uint32_t summary_crc_ = 0;     // CRC-32 from the summary section's start
+  std::uint32_t summary_crc_ = 0;  // CRC-32 from the summary section's start
   bool in_summary_ = false, ended_ = false;
   std::string damage_, profile_, library_;
   std::map<std::uint16_t, Schema> schemas_;
@@ -84,9 +84,9 @@ class McapReader final : public LogReader {
   std::vector<std::uint8_t> record_;  // the current record's content
   std::vector<std::uint8_t> chunk_;   // the current chunk's records, decompressed
   std::uint64_t chunk_at_ = 0, chunk_pos_ = 0;
-  bool pending_ = false;              // handle() found a message for next() to return
+  bool pending_ = false;  // handle() found a message for next() to return
   LogMessage message_;
-  std::unique_ptr<Merge> merge_;      // chunks read by start time (overlapping chunks), else null
+  std::unique_ptr<Merge> merge_;  // chunks read by start time (overlapping chunks), else null
 };
 
 }  // namespace kccd::logs

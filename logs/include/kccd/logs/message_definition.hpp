@@ -13,7 +13,26 @@
 namespace kccd::logs {
 
 /// The built-in field types (ROS 1's time and duration are two 32-bit fields, seconds first).
-enum class Primitive { None, Bool, Byte, Char, Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Float32, Float64, String, WString, Time, Duration };
+enum class Primitive {
+  None,
+  Bool,
+  Byte,
+  Char,
+  Int8,
+  UInt8,
+  Int16,
+  UInt16,
+  Int32,
+  UInt32,
+  Int64,
+  UInt64,
+  Float32,
+  Float64,
+  String,
+  WString,
+  Time,
+  Duration
+};
 
 /// One field: its type (a primitive, or another message by full name), array shape and name.
 struct Field {
@@ -36,8 +55,7 @@ enum class Dialect { Ros1, Ros2 };
 /// A definition that cannot be read: the problem and its 1-based line in the definition text.
 class DefinitionError : public std::runtime_error {
  public:
-  DefinitionError(std::size_t line, const std::string& problem)
-      : std::runtime_error(problem), line_(line) {}
+  DefinitionError(std::size_t line, const std::string& problem) : std::runtime_error(problem), line_(line) {}
   std::size_t line() const { return line_; }
 
  private:

@@ -21,9 +21,9 @@ struct Value {
   std::uint64_t u = 0;
   double f = 0.0;
   std::string s;
-  std::span<const std::uint8_t> bytes;   ///< uint8/byte/char arrays: a view into the message's data
-  std::vector<Value> items;              ///< an array's elements, a structure's fields in order
-  const MessageType* type = nullptr;     ///< a structure's type (its field names)
+  std::span<const std::uint8_t> bytes;  ///< uint8/byte/char arrays: a view into the message's data
+  std::vector<Value> items;             ///< an array's elements, a structure's fields in order
+  const MessageType* type = nullptr;    ///< a structure's type (its field names)
 
   /// A structure's field of that name, or null.
   const Value* field(std::string_view name) const;

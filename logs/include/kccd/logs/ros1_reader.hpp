@@ -28,7 +28,8 @@ class Ros1Reader final : public LogReader {
   std::map<std::string, int> chunks() const override { return chunks_; }
 
  private:
-  bool record(std::span<const std::uint8_t> header, std::span<const std::uint8_t> data, std::uint64_t at, bool in_chunk);
+  bool record(std::span<const std::uint8_t> header, std::span<const std::uint8_t> data, std::uint64_t at,
+              bool in_chunk);
   [[noreturn]] void fail(std::uint64_t at, const std::string& problem) const;
 
   std::string path_, damage_;

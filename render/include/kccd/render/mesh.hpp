@@ -16,13 +16,14 @@ namespace kccd::render {
 struct Mesh {
   std::vector<Vec3> vertices;
   std::vector<std::array<std::uint32_t, 3>> triangles;
-  std::vector<Vec3> normals;                        ///< outward unit normal per triangle
+  std::vector<Vec3> normals;  ///< outward unit normal per triangle
   /// Every edge once: its two vertices and the two triangles that share it (empty for surfaces).
   std::vector<std::array<std::uint32_t, 4>> edges;
-  int level = 0;                                    ///< sphere tessellation level used
-  double mesh_radius = 0.0;                         ///< radius of the circumscribed sphere polytope (every vertex is this far from the core hull)
-  bool direct = false;                              ///< built from the core hull (false: the qhull construction)
-  int hull_input = 0;                               ///< points passed to qhull (the core hull; 0 for points, segments, flat sets)
+  int level = 0;  ///< sphere tessellation level used
+  double mesh_radius =
+      0.0;              ///< radius of the circumscribed sphere polytope (every vertex is this far from the core hull)
+  bool direct = false;  ///< built from the core hull (false: the qhull construction)
+  int hull_input = 0;   ///< points passed to qhull (the core hull; 0 for points, segments, flat sets)
 };
 
 /// A drawable mesh from a triangle soup (three points per triangle, as modelling::readPart

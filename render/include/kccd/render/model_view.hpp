@@ -54,8 +54,8 @@ struct ModelFrame {
   /// The renderer's frame. With ModelViewRequest::volumes, volume i is body i; the visuals follow
   /// from `first_visual` on.
   Frame images;
-  std::size_t first_visual = 0;        ///< index in `images` of the first visual
-  std::vector<SafetyStatus> status;    ///< per body, the status it is coloured by
+  std::size_t first_visual = 0;      ///< index in `images` of the first visual
+  std::vector<SafetyStatus> status;  ///< per body, the status it is coloured by
   /// Per body the smallest distance bound among its pairs (+inf: in none); empty without a query.
   std::vector<double> distances;
   /// The query's answer (its pairs view the checker: valid until the next draw); none without a state.

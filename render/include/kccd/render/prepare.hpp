@@ -23,33 +23,33 @@ namespace kccd::render {
 /// One volume ready to draw: its mesh and the mesh vertices in camera coordinates (float, as
 /// uploaded), the silhouette edges seen from the camera, or its outline computed from the core.
 struct PreparedVolume {
-  int index = 0;                                            ///< its place in the frame's volumes
-  SafetyStatus status = SafetyStatus::NoState;              ///< the volume's status
-  cv::Scalar colour;                                        ///< fill colour (BGR)
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();   ///< volume frame -> camera
-  std::shared_ptr<const Mesh> mesh;                         ///< its mesh (null: none drawn)
-  std::vector<float> vertices;                              ///< mesh vertices in camera coordinates, x y z each
-  std::vector<std::uint32_t> outline;                       ///< silhouette edges, two vertex indices each
+  int index = 0;                                           ///< its place in the frame's volumes
+  SafetyStatus status = SafetyStatus::NoState;             ///< the volume's status
+  cv::Scalar colour;                                       ///< fill colour (BGR)
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  ///< volume frame -> camera
+  std::shared_ptr<const Mesh> mesh;                        ///< its mesh (null: none drawn)
+  std::vector<float> vertices;                             ///< mesh vertices in camera coordinates, x y z each
+  std::vector<std::uint32_t> outline;                      ///< silhouette edges, two vertex indices each
   /// The silhouette edges as one closed loop, wound like the front faces (empty when they do not
   /// form a single simple loop).
   std::vector<std::uint32_t> silhouette;
-  std::vector<std::uint32_t> fill;                          ///< the silhouette polygon as triangles
+  std::vector<std::uint32_t> fill;  ///< the silhouette polygon as triangles
   /// The outline computed from the core (RenderOptions::outline_from_core), its corners in
   /// normalised image coordinates (empty: none).
   std::vector<Eigen::Vector2d> outline_2d;
-  std::vector<float> outline_vertices;                      ///< those corners in camera coordinates, on a plane between the clipping planes
-  std::vector<std::uint32_t> outline_lines;                 ///< the outline as line segments (index pairs)
-  std::vector<std::uint32_t> outline_fill;                  ///< the outline polygon as triangles
-  double depth = 0.0;                                       ///< distance from the camera to its centre (drawing order)
-  bool fills = false;                                       ///< contains the camera: drawn as a full-view fill, no mesh
-  int level = 0;                                            ///< sphere tessellation level
+  std::vector<float> outline_vertices;  ///< those corners in camera coordinates, on a plane between the clipping planes
+  std::vector<std::uint32_t> outline_lines;  ///< the outline as line segments (index pairs)
+  std::vector<std::uint32_t> outline_fill;   ///< the outline polygon as triangles
+  double depth = 0.0;                        ///< distance from the camera to its centre (drawing order)
+  bool fills = false;                        ///< contains the camera: drawn as a full-view fill, no mesh
+  int level = 0;                             ///< sphere tessellation level
   /// How far, at most, its mesh shows outside the true volume in the camera image, camera pixels
   /// (0 for surfaces, infinite when the volume reaches the camera's plane).
   double mesh_error_px = 0.0;
-  double clearance = 0.0;                                   ///< distance from the camera to the mesh (lower bound), when drawn
-  double reach = 0.0;                                       ///< distance from the camera to the farthest point of the mesh
-  bool surface = false;                                     ///< a Volume::surface: both sides drawn, no outline
-  int label = 0;                                            ///< mask label
+  double clearance = 0.0;  ///< distance from the camera to the mesh (lower bound), when drawn
+  double reach = 0.0;      ///< distance from the camera to the farthest point of the mesh
+  bool surface = false;    ///< a Volume::surface: both sides drawn, no outline
+  int label = 0;           ///< mask label
 
   /// Tint and outline come from the core's outline.
   bool outlined() const { return !outline_2d.empty(); }

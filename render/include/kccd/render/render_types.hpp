@@ -67,13 +67,13 @@ struct Style {
   /// Opaque, lit volumes instead of the tinted overlay look: depth-tested, smooth (Gouraud) Lambert
   /// shading by a light at the camera's upper left; fill_alpha and outline_width are not used.
   bool shaded = false;
-  double ambient = 0.35;       ///< shaded: the unlit fraction of the colour
+  double ambient = 0.35;  ///< shaded: the unlit fraction of the colour
   bool operator==(const Style&) const = default;
 };
 
 /// Renderer settings fixed at construction.
 struct RenderOptions {
-  double supersample = 1.0;    ///< pinhole image scale (1..4); > 1 keeps thin slivers through the warp
+  double supersample = 1.0;  ///< pinhole image scale (1..4); > 1 keeps thin slivers through the warp
   /// Pinhole scale of the mask when the camera distorts: the warp takes each label from the
   /// nearest pinhole pixel, which lies within sqrt(2)/2 pinhole pixels of the exact point, and the
   /// meshes for a mask are tessellated to tolerance_px / s (Frame::mask_edge_px is the bound that
@@ -84,7 +84,7 @@ struct RenderOptions {
   /// Multisampling of the colour layer (0 or 1: off; at most 4 on llvmpipe). Off by default:
   /// on llvmpipe 4x MSAA costs ~5x the frame time, and the outline, drawn as smoothed lines on
   /// top of the fill edges, already gives anti-aliased silhouettes.
-  int msaa_samples = 0;        ///< colour layer multisampling (0 or 1: off; at most 4 on llvmpipe)
+  int msaa_samples = 0;  ///< colour layer multisampling (0 or 1: off; at most 4 on llvmpipe)
   /// Fill each volume's tint as the polygon its silhouette edges bound (a few tens of triangles)
   /// instead of its front triangles (hundreds to thousands): the same pixels, since the
   /// silhouette of a convex mesh seen from a camera in front of it bounds exactly the projection
@@ -99,9 +99,9 @@ struct RenderOptions {
   /// Clear, draw, read back, warp and hand on (Frame::drawn) only the rectangles the volumes and
   /// the legend cover; the layer is the same bit for bit. Off: the whole image (for comparison).
   bool crop = true;
-  double tolerance_px = 0.5;   ///< largest outward error of the sphere tessellation, output pixels
-  int max_level = 3;           ///< finest sphere tessellation (level 3: 642 vertices, 0.3 % outward)
-  int mask_max_level = 4;      ///< finest tessellation when a mask is drawn (level 4: 2562 vertices, 0.08 % outward)
+  double tolerance_px = 0.5;  ///< largest outward error of the sphere tessellation, output pixels
+  int max_level = 3;          ///< finest sphere tessellation (level 3: 642 vertices, 0.3 % outward)
+  int mask_max_level = 4;     ///< finest tessellation when a mask is drawn (level 4: 2562 vertices, 0.08 % outward)
   double min_radius = kMinDrawRadius;  ///< volumes thinner than this are drawn this thick (metres)
   /// Clipping planes, metres along the optical axis. Per frame, the near plane moves closer
   /// when a volume comes nearer to the camera than this, and the far plane moves out to the
@@ -135,13 +135,14 @@ struct Frame {
   cv::Mat mask;
   std::vector<int> pixels;
   std::vector<Visibility> visibility;  ///< per volume
-  double near = 0.0, far = 0.0;       ///< the clipping planes used
-  int meshes_built = 0;   ///< meshes built in this frame (the others came from the cache)
-  int triangles = 0;      ///< triangles drawn: meshes (colour or labels) and outline polygons
+  double near = 0.0, far = 0.0;        ///< the clipping planes used
+  int meshes_built = 0;                ///< meshes built in this frame (the others came from the cache)
+  int triangles = 0;                   ///< triangles drawn: meshes (colour or labels) and outline polygons
   int polygon_fills = 0;  ///< volumes whose tint was drawn as their silhouette polygon (RenderOptions::polygon_fill)
-  int outlines = 0;       ///< of those, volumes drawn from their outline computed from the core (RenderOptions::outline_from_core)
-  int hull_input = 0;     ///< points passed to qhull for the meshes built in this frame
-  int max_level = 0;      ///< finest sphere tessellation used
+  int outlines =
+      0;  ///< of those, volumes drawn from their outline computed from the core (RenderOptions::outline_from_core)
+  int hull_input = 0;  ///< points passed to qhull for the meshes built in this frame
+  int max_level = 0;   ///< finest sphere tessellation used
   /// With a mask: how far from its centre, at most, the point lies whose label a mask pixel shows,
   /// camera pixels (the nearest pinhole sample through the warp, plus the meshes' outward error).
   /// Each label's region thus lies within this of the exact pixel-centre labels of the volumes as

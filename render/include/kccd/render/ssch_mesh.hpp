@@ -16,8 +16,8 @@ namespace kccd::render {
 /// 1 / (smallest distance from the centre to a face plane), computed from the mesh itself.
 struct SpherePolytope {
   std::vector<Vec3> vertices;
-  std::vector<std::array<std::uint32_t, 3>> triangles;  ///< counter-clockwise seen from outside
-  std::vector<std::array<std::uint32_t, 3>> neighbours; ///< triangle across edge k (vertices k, k + 1)
+  std::vector<std::array<std::uint32_t, 3>> triangles;   ///< counter-clockwise seen from outside
+  std::vector<std::array<std::uint32_t, 3>> neighbours;  ///< triangle across edge k (vertices k, k + 1)
   double scale = 1.0;
   /// 2 sin(θ / 2) for the largest angle θ between a vertex and its faces' normals: every
   /// direction in a vertex's normal cone lies within this distance of the vertex direction.

@@ -10,9 +10,9 @@ namespace kccd::hull {
 
 /// An icosahedron subdivided `levels` times with its vertices on the unit sphere.
 struct Icosphere {
-  std::vector<Vec3> vertices;                  ///< on the unit sphere
-  std::vector<std::array<int, 3>> triangles;   ///< counter-clockwise seen from outside
-  double min_plane = 1.0;                      ///< smallest distance from the centre to a face plane
+  std::vector<Vec3> vertices;                 ///< on the unit sphere
+  std::vector<std::array<int, 3>> triangles;  ///< counter-clockwise seen from outside
+  double min_plane = 1.0;                     ///< smallest distance from the centre to a face plane
 };
 
 /// The icosphere of `levels` subdivisions (level 0: the icosahedron's 12 vertices).

@@ -10,9 +10,9 @@
 namespace kccd::modelling {
 
 struct PieceOptions {
-  int max_pieces = 8;         ///< at most this many pieces (1: never split)
-  double concavity = 0.04;    ///< split while a piece's concavity exceeds this (metres)
-  int resolution = 64;        ///< voxels along the part's longest side for measuring concavity
+  int max_pieces = 8;       ///< at most this many pieces (1: never split)
+  double concavity = 0.04;  ///< split while a piece's concavity exceeds this (metres)
+  int resolution = 64;      ///< voxels along the part's longest side for measuring concavity
 };
 
 /// The pieces of a part and how concave each is.

@@ -15,20 +15,20 @@ namespace kccd::modelling {
 inline constexpr int kMaxCorePoints = 16;
 
 struct FitOptions {
-  int points = 8;                  ///< number of core points K (1 ... 16)
-  int max_evaluations = 4000;      ///< optimiser budget per start (volume evaluations)
-  std::uint64_t seed = 1;          ///< for the optimiser's random search directions
+  int points = 8;                        ///< number of core points K (1 ... 16)
+  int max_evaluations = 4000;            ///< optimiser budget per start (volume evaluations)
+  std::uint64_t seed = 1;                ///< for the optimiser's random search directions
   std::function<void(double)> progress;  ///< called with the fraction done (0 ... 1), optional
 };
 
 /// A fitted SSCH and what it costs: its volume against the part's hull and two simple baselines.
 struct FitResult {
-  std::vector<Vec3> points;      ///< rounded to 10 significant digits: printing them loses nothing
+  std::vector<Vec3> points;  ///< rounded to 10 significant digits: printing them loses nothing
   double radius = 0.0;
-  double volume = 0.0;           ///< of the SSCH (closed form)
-  double hull_volume = 0.0;      ///< of the part's convex hull
-  double sphere_volume = 0.0;    ///< baseline: smallest enclosing sphere found (K = 1)
-  double capsule_volume = 0.0;   ///< baseline: capsule on the principal axis (K = 2)
+  double volume = 0.0;          ///< of the SSCH (closed form)
+  double hull_volume = 0.0;     ///< of the part's convex hull
+  double sphere_volume = 0.0;   ///< baseline: smallest enclosing sphere found (K = 1)
+  double capsule_volume = 0.0;  ///< baseline: capsule on the principal axis (K = 2)
   int hull_vertices = 0;
   int evaluations = 0;
   /// Upper bound on how far the volume reaches outside the part's convex hull (metres): the

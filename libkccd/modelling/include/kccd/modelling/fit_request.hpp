@@ -28,7 +28,7 @@ struct FitRequest {
   FitMethod method = FitMethod::Points;
   int points = 8;                                 ///< `points`: K, 1 ... 16 (Points; Tolerance tries it first)
   double tolerance = kDefaultToleranceMm * 1e-3;  ///< `tolerance`: metres, 1e-9 ... 1e3 (Tolerance)
-  int max_pieces = 1;                             ///< `pieces`: a concave part splits into at most this many (1 ... 64; 1: whole)
+  int max_pieces = 1;  ///< `pieces`: a concave part splits into at most this many (1 ... 64; 1: whole)
   double concavity = kDefaultConcavityMm * 1e-3;  ///< `concavity`: metres, 1e-6 ... 1e3, above which it splits
   int max_evaluations = 4000;                     ///< `max_evaluations`: the optimiser's budget per start (>= 1)
   std::uint64_t seed = 1;                         ///< `seed`: of the optimiser's search directions
@@ -38,7 +38,8 @@ struct FitRequest {
 /// source), so a front end can say it in its own spelling (`--points`, `points=`).
 class FitRequestError : public InputError {
  public:
-  FitRequestError(const std::string& field, const std::string& problem) : InputError(InputLocation{{}, 0, 0, field}, problem) {}
+  FitRequestError(const std::string& field, const std::string& problem)
+      : InputError(InputLocation{{}, 0, 0, field}, problem) {}
 };
 
 /// Checks every field that the request's method uses; throws FitRequestError for the first out of

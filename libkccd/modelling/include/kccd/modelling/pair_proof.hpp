@@ -33,22 +33,22 @@ enum class Connection {
 Connection connection(const Model& model, int body_a, int body_b);
 
 struct PairReport {
-  int a = 0, b = 0;                 ///< body indices, a < b
+  int a = 0, b = 0;  ///< body indices, a < b
   int lca = kWorld;
   Verdict verdict = Verdict::Undecided;
-  bool adjacent = false;            ///< Connection::Adjacent
-  bool rigid = false;               ///< Connection::Rigid: decided exactly (Never or AlwaysTouching)
-  bool checked = false;             ///< currently in Model::pairs
-  double bound = 0.0;               ///< Never: smallest lower bound over the covering boxes; rigid: the
-                                    ///< constant distance (a lower bound, within 1e-9 relative)
-  int boxes = 0;                    ///< boxes queried
-  std::vector<double> witness;      ///< Meets: a state within the limits where they meet
-  double witness_distance = 0.0;    ///< Meets: distance bound at the witness state
+  bool adjacent = false;          ///< Connection::Adjacent
+  bool rigid = false;             ///< Connection::Rigid: decided exactly (Never or AlwaysTouching)
+  bool checked = false;           ///< currently in Model::pairs
+  double bound = 0.0;             ///< Never: smallest lower bound over the covering boxes; rigid: the
+                                  ///< constant distance (a lower bound, within 1e-9 relative)
+  int boxes = 0;                  ///< boxes queried
+  std::vector<double> witness;    ///< Meets: a state within the limits where they meet
+  double witness_distance = 0.0;  ///< Meets: distance bound at the witness state
 };
 
 struct ProofOptions {
-  double margin = -1.0;             ///< < 0: the model's safety margin
-  int max_boxes = 2000;             ///< per pair
+  double margin = -1.0;  ///< < 0: the model's safety margin
+  int max_boxes = 2000;  ///< per pair
   std::function<void(double)> progress;
 };
 

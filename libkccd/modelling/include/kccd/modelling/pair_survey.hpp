@@ -15,34 +15,34 @@ namespace kccd::modelling {
 
 /// One pair over the whole log.
 struct PairSurvey {
-  int a = 0, b = 0;                 ///< body indices
+  int a = 0, b = 0;  ///< body indices
   int lca = kWorld;
-  bool checked = true;              ///< in Model::pairs (false: an ignored pair, surveyed on request)
-  std::size_t within = 0;           ///< samples with the distance <= margin
-  std::size_t overlapping = 0;      ///< samples where the volumes overlap (distance 0)
-  double min_distance = 0.0;        ///< smallest distance over the samples (the engine's lower bound);
-                                    ///< NaN when no query ended Ok
-  double min_time = 0.0;            ///< time of that sample (log time - time_offset); NaN likewise
-  double first_within = 0.0;        ///< first and last time within the margin (when within > 0)
+  bool checked = true;          ///< in Model::pairs (false: an ignored pair, surveyed on request)
+  std::size_t within = 0;       ///< samples with the distance <= margin
+  std::size_t overlapping = 0;  ///< samples where the volumes overlap (distance 0)
+  double min_distance = 0.0;    ///< smallest distance over the samples (the engine's lower bound);
+                                ///< NaN when no query ended Ok
+  double min_time = 0.0;        ///< time of that sample (log time - time_offset); NaN likewise
+  double first_within = 0.0;    ///< first and last time within the margin (when within > 0)
   double last_within = 0.0;
-  double max_penetration = 0.0;     ///< deepest overlap, libccd's MPR estimate (reporting only, not a bound)
-  int body_pairs = 1;               ///< in Survey::links: the body pairs joined (pieces of concave links); a, b
-                                    ///< are then the closest pieces (at min_distance)
+  double max_penetration = 0.0;  ///< deepest overlap, libccd's MPR estimate (reporting only, not a bound)
+  int body_pairs = 1;            ///< in Survey::links: the body pairs joined (pieces of concave links); a, b
+                                 ///< are then the closest pieces (at min_distance)
 };
 
 struct SurveyOptions {
-  double margin = -1.0;             ///< < 0: the model's safety margin
-  double time_offset = 0.0;         ///< times reported as video times: log time - offset (as kccd overlay)
-  bool ignored_pairs = false;       ///< also survey the pairs the model ignores
+  double margin = -1.0;        ///< < 0: the model's safety margin
+  double time_offset = 0.0;    ///< times reported as video times: log time - offset (as kccd overlay)
+  bool ignored_pairs = false;  ///< also survey the pairs the model ignores
   std::function<void(double)> progress;
 };
 
 struct Survey {
   double margin = 0.0;
-  std::size_t samples = 0;          ///< log rows queried
-  std::size_t samples_within = 0;   ///< rows where some checked pair is within the margin (a red frame)
-  std::size_t unsafe = 0;           ///< rows whose query did not end Ok (counted as within)
-  std::vector<PairSurvey> pairs;    ///< checked pairs in Model::pairs order, then ignored ones
+  std::size_t samples = 0;         ///< log rows queried
+  std::size_t samples_within = 0;  ///< rows where some checked pair is within the margin (a red frame)
+  std::size_t unsafe = 0;          ///< rows whose query did not end Ok (counted as within)
+  std::vector<PairSurvey> pairs;   ///< checked pairs in Model::pairs order, then ignored ones
   /// The same per pair of links (Body::linkName: the pieces of a concave link are one link), in
   /// order of first appearance in `pairs`: within a sample a link pair is as close as its closest
   /// pieces. Equal to `pairs` for a model without pieces.

@@ -19,11 +19,11 @@ namespace kccd::modelling {
 struct Part {
   std::vector<Vec3> points;
   std::vector<Sphere> balls;
-  int triangles = 0;            ///< mesh triangles read
+  int triangles = 0;  ///< mesh triangles read
   /// The mesh triangles as indices into `points` (mesh readers fill it; primitives add none):
   /// what splitting a concave part into convex pieces cuts.
   std::vector<std::array<int, 3>> faces;
-  int primitives = 0;           ///< analytic spheres, cylinders and cones covered exactly
+  int primitives = 0;             ///< analytic spheres, cylinders and cones covered exactly
   double coordinate_guard = 0.0;  ///< extra radius for single-precision input (metres)
 
   bool empty() const { return points.empty() && balls.empty(); }
@@ -53,8 +53,8 @@ class PartError : public InputError {
 
 /// Which part of a file to read.
 struct ReadOptions {
-  std::string part;    ///< name of a DEF'd node to read alone; empty: the whole file
-  bool merge = false;  ///< accept several top-level parts as one rigid body
+  std::string part;                                 ///< name of a DEF'd node to read alone; empty: the whole file
+  bool merge = false;                               ///< accept several top-level parts as one rigid body
   Eigen::Vector3d scale = Eigen::Vector3d::Ones();  ///< applied in the file's frame (URDF mesh scale)
   /// Meshes read through Assimp are read in a child process (Assimp's readers are not hardened
   /// against malformed files): at most this long, and with at most this much memory beyond what
@@ -76,9 +76,9 @@ struct ReadOptions {
 /// and boxes; non-finite transforms or vertices; zero or non-finite `options.scale`.
 Part readPart(const std::string& path, const ReadOptions& options = {});
 
-inline constexpr std::uintmax_t kMaxInputBytes = 256ull << 20;           ///< any part or URDF file
-inline constexpr std::uintmax_t kMaxBinaryInventorBytes = 4ull << 20;    ///< see readPart
-inline constexpr int kMaxNesting = 256;                                  ///< braces and brackets, or groups
+inline constexpr std::uintmax_t kMaxInputBytes = 256ull << 20;         ///< any part or URDF file
+inline constexpr std::uintmax_t kMaxBinaryInventorBytes = 4ull << 20;  ///< see readPart
+inline constexpr int kMaxNesting = 256;                                ///< braces and brackets, or groups
 
 /// The whole content of an input file: regular files only (no directories, devices or FIFOs),
 /// at most `max_bytes`. Throws InputError naming the file.

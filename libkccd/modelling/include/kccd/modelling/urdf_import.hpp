@@ -19,7 +19,7 @@ class UrdfError : public InputError {
 
 /// How a URDF is imported (kccd import's defaults; docs/guides/import-robot.md says why).
 struct ImportOptions {
-  std::string srdf;                             ///< optional SRDF: disable_collisions -> ignore
+  std::string srdf;  ///< optional SRDF: disable_collisions -> ignore
   /// How each link (each piece of a concave one) is fitted: by default within 2 mm of its hull,
   /// concave links in up to 8 pieces. FitMethod::Hull: the links' convex hulls, a tight, slow
   /// reference to measure what a fit costs.

@@ -35,8 +35,7 @@ std::string withBodyGeometry(const std::string& text, const std::string& source,
                              const std::string& points_yaml, const std::string& radius_yaml,
                              const std::string& tolerance_yaml = "");
 /// Sets `pairs: ignore:` of model text to `pairs` (creating the keys if needed); same errors.
-std::string withIgnoreList(const std::string& text, const std::string& source,
-                           const std::vector<IgnoreEntry>& pairs);
+std::string withIgnoreList(const std::string& text, const std::string& source, const std::vector<IgnoreEntry>& pairs);
 /// A number as written into model files: 10 significant digits, rounded up when `up` (for radii,
 /// which must not shrink).
 std::string yamlNumber(double value, bool up = false);

@@ -52,7 +52,7 @@ struct BagExportReport {
   std::uint64_t origin_ns = 0;  ///< time 0 of the written files, nanoseconds on the chosen clock
   double fps = 0.0;             ///< the video's nominal rate (the median frame interval)
   int width = 0, height = 0;
-  std::string damage;           ///< where the log was cut short, if it was
+  std::string damage;                 ///< where the log was cut short, if it was
   std::vector<std::string> warnings;  ///< one line each
 };
 

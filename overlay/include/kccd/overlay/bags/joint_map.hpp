@@ -14,18 +14,18 @@ namespace kccd::overlay {
 
 /// Where one state value of the model comes from.
 struct JointSource {
-  std::string state;       ///< the model's state value
-  std::string from;        ///< the logged joint read (empty with a constant)
-  double scale = 1.0;      ///< value = scale * logged + offset; velocity = scale * logged velocity
+  std::string state;   ///< the model's state value
+  std::string from;    ///< the logged joint read (empty with a constant)
+  double scale = 1.0;  ///< value = scale * logged + offset; velocity = scale * logged velocity
   double offset = 0.0;
   std::optional<double> constant;  ///< a value the log does not give (velocity 0)
-  int line = 0;            ///< where the map gives it (0: not in the map, read by its own name)
+  int line = 0;                    ///< where the map gives it (0: not in the map, read by its own name)
 };
 
 /// Every state value of a model, in the model's order, with where it comes from.
 struct JointMap {
-  std::string source;                ///< the map file ("" when every value is read by its own name)
-  std::vector<JointSource> states;   ///< one per state value of the model, in order
+  std::string source;               ///< the map file ("" when every value is read by its own name)
+  std::vector<JointSource> states;  ///< one per state value of the model, in order
   /// The logged joints read, each once, in first-use order.
   std::vector<std::string> logged() const;
 };

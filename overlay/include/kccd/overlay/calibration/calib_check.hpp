@@ -16,8 +16,8 @@ namespace kccd::overlay {
 
 /// How check images are drawn.
 struct CheckImageOptions {
-  double magnify = 20.0;    ///< inliers' residual vectors are drawn this many times longer
-  std::string camera_name;  ///< names the camera in messages
+  double magnify = 20.0;                          ///< inliers' residual vectors are drawn this many times longer
+  std::string camera_name;                        ///< names the camera in messages
   std::string pose_source = "the robot's masks";  ///< what gave the pose when no points did
 };
 

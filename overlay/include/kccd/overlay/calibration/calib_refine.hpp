@@ -14,8 +14,8 @@
 #include <opencv2/core.hpp>
 
 #include "kccd/calib/edge_refine.hpp"
-#include "kccd/input_error.hpp"
 #include "kccd/calib/mask_refine.hpp"
+#include "kccd/input_error.hpp"
 #include "kccd/overlay/calibration/calib_gather.hpp"
 #include "kccd/overlay/calibration/calib_solve.hpp"
 #include "kccd/render/visuals.hpp"
@@ -53,21 +53,21 @@ std::vector<int> movingBodies(const Model& model, std::span<const int> bodies);
 
 /// A frame of a fixed camera's recording and the robot's state in it.
 struct RecordingSample {
-  cv::Mat bgr;                 ///< 8-bit BGR, the camera's size
-  std::vector<double> state;   ///< the model's state size
+  cv::Mat bgr;                ///< 8-bit BGR, the camera's size
+  std::vector<double> state;  ///< the model's state size
 };
 
 /// What the refinement is given beside the gathered frames.
 struct RefineInputs {
   calib::RefineSource source = calib::RefineSource::Masks;  ///< Edges: the gathered frames' pictures
-  std::vector<cv::Mat> masks;          ///< with Masks: one per gathered frame (calib::readMask), or none with `recording`
+  std::vector<cv::Mat> masks;  ///< with Masks: one per gathered frame (calib::readMask), or none with `recording`
   /// With Masks and no masks: frames of the recording the gathered frames are from (a fixed
   /// camera), spread over it; the masks are the gathered frames' pictures against the background
   /// estimated from these away from the drawn robot (calib/background.hpp), remade as the pose is
   /// refined.
   std::vector<RecordingSample> recording;
-  std::vector<std::string> mask_names; ///< as messages name them
-  std::vector<int> bodies;             ///< the model's bodies that are the robot (empty: all)
+  std::vector<std::string> mask_names;  ///< as messages name them
+  std::vector<int> bodies;              ///< the model's bodies that are the robot (empty: all)
   /// What is drawn: the model's visuals (what the robot looks like) when it has them and they can
   /// be read ("auto"), only the collision volumes ("volumes"), or the visuals or an error ("visuals").
   std::string draw = "auto";
@@ -77,13 +77,14 @@ struct RefineInputs {
 
 /// What the refinement did.
 struct Refinement {
-  std::string start;       ///< "solve" (the points' solve), "points" (a rough pose from them), "camera" (the given one)
-  std::vector<int> bodies; ///< the bodies drawn (with masks from a recording: those that move)
-  std::string drawn;       ///< what was drawn: "visual meshes", or "collision volumes" (and why, when the model has visuals)
+  std::string start;  ///< "solve" (the points' solve), "points" (a rough pose from them), "camera" (the given one)
+  std::vector<int> bodies;  ///< the bodies drawn (with masks from a recording: those that move)
+  std::string drawn;  ///< what was drawn: "visual meshes", or "collision volumes" (and why, when the model has visuals)
   calib::RefineResult result;
   std::vector<std::vector<calib::PlacedMesh>> meshes;  ///< per frame, the visuals drawn (empty: the volumes were)
-  std::vector<cv::Mat> masks;  ///< masks made from the recording: per frame, as last used (none with given masks or edges)
-  std::string masks_from;      ///< how they were made, one line (empty with given masks or edges)
+  std::vector<cv::Mat>
+      masks;               ///< masks made from the recording: per frame, as last used (none with given masks or edges)
+  std::string masks_from;  ///< how they were made, one line (empty with given masks or edges)
   /// Labelled points the refined pose puts farther from their click than 3 times the outline's
   /// robust rms, 3 times the other clicks' median residual and 4 px: the image disagrees with them.
   std::vector<std::string> disagreeing;
@@ -96,8 +97,8 @@ struct Refinement {
 /// size, the masks do not match the frames, (edges, masks from the recording) a frame has no
 /// picture, a recording's sample is not of the camera's size or state, or (draw "visuals") the
 /// model has no visuals or they cannot be read.
-Refinement refineCalibration(CalibSolution& solution, const Gathered& gathered, const calib::Camera& intrinsics, const Model& model,
-                             const RefineInputs& inputs, const calib::Camera* truth = nullptr);
+Refinement refineCalibration(CalibSolution& solution, const Gathered& gathered, const calib::Camera& intrinsics,
+                             const Model& model, const RefineInputs& inputs, const calib::Camera* truth = nullptr);
 
 /// The refinement's figures as lines the camera file ends with (keys OpenCV and the camera reader
 /// skip): refinement (masks, edges or none), refinement_start, refinement_drawn, refinement_masks
@@ -114,7 +115,7 @@ nlohmann::json refinementJson(const Refinement& refinement);
 /// Draws onto a check image of the camera's frame the mask's outline (yellow; none for an empty
 /// mask) and the robot's drawn outline at `camera` (magenta: the meshes when given, else the
 /// volumes), so where they part shows.
-void drawMaskAgreement(cv::Mat& bgr, const calib::Camera& camera, const cv::Mat& mask, std::span<const calib::PlacedVolume> volumes,
-                       std::span<const calib::PlacedMesh> meshes = {});
+void drawMaskAgreement(cv::Mat& bgr, const calib::Camera& camera, const cv::Mat& mask,
+                       std::span<const calib::PlacedVolume> volumes, std::span<const calib::PlacedMesh> meshes = {});
 
 }  // namespace kccd::overlay

@@ -38,15 +38,15 @@ struct BodyChange {
 /// How a comparison ended: passed or not, why (one line), and the measurements behind it.
 struct Comparison {
   bool passed = false;
-  bool identical = false;         ///< the same pixels (and for masks, the same bodies)
-  std::string reason;             ///< empty when identical; what failed, or what was forgiven
-  int changed_px = 0;             ///< pixels counted as changed
-  int largest_cluster_px = 0;     ///< the largest 8-connected cluster of them
-  cv::Rect largest_cluster;       ///< its bounding box (empty: none)
-  std::vector<BodyChange> bodies; ///< masks: per body of the golden
+  bool identical = false;          ///< the same pixels (and for masks, the same bodies)
+  std::string reason;              ///< empty when identical; what failed, or what was forgiven
+  int changed_px = 0;              ///< pixels counted as changed
+  int largest_cluster_px = 0;      ///< the largest 8-connected cluster of them
+  cv::Rect largest_cluster;        ///< its bounding box (empty: none)
+  std::vector<BodyChange> bodies;  ///< masks: per body of the golden
   double worst_centroid_shift_px = 0;
   double worst_area_change_ratio = 0;  ///< masks: the largest |area change| / allowed over the bodies
-  cv::Mat changed;                ///< CV_8UC1, 255 where a pixel counts as changed (empty: sizes differ)
+  cv::Mat changed;                     ///< CV_8UC1, 255 where a pixel counts as changed (empty: sizes differ)
 };
 
 /// Compares label masks (CV_8UC1; 0 background, k for body names[k - 1]) whose labels are matched

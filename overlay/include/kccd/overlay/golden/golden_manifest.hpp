@@ -25,18 +25,18 @@ struct ToleranceSource {
 
 /// One case of the manifest. Paths are as resolved against the manifest's folder.
 struct GoldenCase {
-  std::string id;      ///< unique; names the golden's folder
-  std::string where;   ///< "file:line:col" of the case, for messages
+  std::string id;     ///< unique; names the golden's folder
+  std::string where;  ///< "file:line:col" of the case, for messages
   std::string model, camera;
   std::vector<GoldenOutput> outputs;
-  std::vector<double> state;         ///< a configuration (static volumes), or
-  std::vector<double> lower, upper;  ///< a box (swept volumes), or
-  std::string video, states;         ///< a recorded frame composited, its state from the log, or
-  std::string bag;                   ///< a robot log's frame, its state from the log's joint states
+  std::vector<double> state;             ///< a configuration (static volumes), or
+  std::vector<double> lower, upper;      ///< a box (swept volumes), or
+  std::string video, states;             ///< a recorded frame composited, its state from the log, or
+  std::string bag;                       ///< a robot log's frame, its state from the log's joint states
   std::string image_topic, joint_topic;  ///< with bag: the topics (empty: the one of the fitting type)
-  bool log_time = false;             ///< with bag: the recorder's times, not the header stamps
+  bool log_time = false;                 ///< with bag: the recorder's times, not the header stamps
   std::int64_t frame = -1;
-  double time_offset = 0.0;          ///< added to the frame's time to get the log's time (s)
+  double time_offset = 0.0;  ///< added to the frame's time to get the log's time (s)
   /// Pinhole scale (1..4) of the mask and colour images: finer masks follow the volumes' edges
   /// closer (render::Frame::mask_edge_px).
   double supersample = 1.0;

@@ -28,7 +28,7 @@ std::vector<unsigned char> deterministicPng(const cv::Mat& image);
 /// One image a case made.
 struct GoldenImage {
   GoldenOutput output = GoldenOutput::Mask;
-  cv::Mat image;                    ///< mask CV_8UC1 (0 background, k: labels[k - 1]); colour CV_8UC4 BGRA; overlay CV_8UC3 BGR
+  cv::Mat image;  ///< mask CV_8UC1 (0 background, k: labels[k - 1]); colour CV_8UC4 BGRA; overlay CV_8UC3 BGR
   std::vector<std::string> labels;  ///< mask: the body name of each label
   std::vector<unsigned char> png;   ///< deterministicPng(image)
   std::string sha256;               ///< of png

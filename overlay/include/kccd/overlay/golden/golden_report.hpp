@@ -17,11 +17,11 @@ namespace kccd::overlay {
 /// One run, as the reports describe it.
 struct GoldenRun {
   const GoldenManifest* manifest = nullptr;
-  std::vector<std::size_t> cases;            ///< the manifest's cases run, in order
-  std::vector<GoldenRendering> renderings;   ///< per case run
-  std::vector<CaseResult> results;           ///< per case run
-  std::string renderer;                      ///< the GL renderer's name
-  double seconds = 0.0;                      ///< the run's wall time
+  std::vector<std::size_t> cases;           ///< the manifest's cases run, in order
+  std::vector<GoldenRendering> renderings;  ///< per case run
+  std::vector<CaseResult> results;          ///< per case run
+  std::string renderer;                     ///< the GL renderer's name
+  double seconds = 0.0;                     ///< the run's wall time
 };
 
 /// Writes the reports and evidence into `folder` (made when missing; files staged then renamed):

@@ -32,26 +32,26 @@ struct OverlayRequest {
   std::string time_source = "header";       ///< with bag: "header" or "log"
   std::string joint_map;                    ///< with bag: a joint map file
   // Frames against the log's clock.
-  double fps = 0.0;                         ///< the video's frame rate (0: its own)
-  double time_offset = 0.0;                 ///< log time = frame time + offset (s)
+  double fps = 0.0;                                             ///< the video's frame rate (0: its own)
+  double time_offset = 0.0;                                     ///< log time = frame time + offset (s)
   std::optional<std::pair<double, double>> time_offset_search;  ///< search [lo, hi] instead (parseTimeOffset)
-  double max_gap = 0.0;                     ///< largest log gap bridged (s; 0: 1.5 x the median period)
+  double max_gap = 0.0;  ///< largest log gap bridged (s; 0: 1.5 x the median period)
   // What is checked and drawn.
-  bool swept = false;                       ///< braking-interval volumes
-  std::optional<BrakingParams> braking;     ///< with swept, every joint (default kOverlayBraking)
-  bool plain = false;                       ///< volumes only: no legend, no status line
-  bool visuals = false;                     ///< also the model's visual geometry
-  std::string masks;                        ///< a folder of robot masks, or "auto"
-  std::vector<std::string> mask_bodies;     ///< the bodies the masks show (default all)
-  std::string frames;                       ///< "FIRST:END:STEP" drawn (all are checked)
-  int jobs = 0;                             ///< drawing threads, 0 ... 256 (0: every core)
-  bool timings = false;                     ///< where the time went, in the report
+  bool swept = false;                    ///< braking-interval volumes
+  std::optional<BrakingParams> braking;  ///< with swept, every joint (default kOverlayBraking)
+  bool plain = false;                    ///< volumes only: no legend, no status line
+  bool visuals = false;                  ///< also the model's visual geometry
+  std::string masks;                     ///< a folder of robot masks, or "auto"
+  std::vector<std::string> mask_bodies;  ///< the bodies the masks show (default all)
+  std::string frames;                    ///< "FIRST:END:STEP" drawn (all are checked)
+  int jobs = 0;                          ///< drawing threads, 0 ... 256 (0: every core)
+  bool timings = false;                  ///< where the time went, in the report
   // What is written (empty: not written), each staged and renamed when complete.
-  std::string output;                       ///< .mp4, .mkv or .avi
-  std::string codec;                        ///< its FourCC (default by extension)
-  std::string png_dir;                      ///< frame_NNNNNN.png into a new or empty folder
+  std::string output;                           ///< .mp4, .mkv or .avi
+  std::string codec;                            ///< its FourCC (default by extension)
+  std::string png_dir;                          ///< frame_NNNNNN.png into a new or empty folder
   std::string report, contact_sheet, timeline;  ///< .json, .png, .png
-  int contact_frames = 12;                  ///< frames on the contact sheet, 1 ... 64
+  int contact_frames = 12;                      ///< frames on the contact sheet, 1 ... 64
   // The model's and camera's files, when they came from files: no output may replace them.
   std::string model_file, camera_file;
 };

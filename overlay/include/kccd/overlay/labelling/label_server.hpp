@@ -22,10 +22,10 @@ class LabelServerError : public InputError {
 
 /// Where and how the server listens.
 struct LabelServerOptions {
-  std::string host = "127.0.0.1";            ///< the address bound (loopback unless asked otherwise)
-  int port = 0;                              ///< 0: any free port
-  std::size_t max_request_bytes = 1 << 20;   ///< a larger request body is refused (413)
-  std::string web_root;                      ///< serve the page's files from this folder instead of the built-in ones
+  std::string host = "127.0.0.1";           ///< the address bound (loopback unless asked otherwise)
+  int port = 0;                             ///< 0: any free port
+  std::size_t max_request_bytes = 1 << 20;  ///< a larger request body is refused (413)
+  std::string web_root;                     ///< serve the page's files from this folder instead of the built-in ones
 };
 
 /// The server. GET / (the page), GET /app.js, /app.css and the page's modules; GET /api/session;

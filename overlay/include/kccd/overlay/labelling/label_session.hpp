@@ -26,7 +26,7 @@ struct LabelFrame {
   std::string name;                          ///< names the picture (an image file, or "video.mkv#12")
   cv::Mat bgr;                               ///< the picture, 8-bit BGR, the camera's size
   std::optional<std::vector<double>> state;  ///< the robot's state in it (places body labels, draws the volumes)
-  std::string labels_path;                   ///< its labels file: read when it exists; with PATH.bak the only files written for it
+  std::string labels_path;  ///< its labels file: read when it exists; with PATH.bak the only files written for it
 };
 
 /// What a session is made of.
@@ -48,9 +48,9 @@ struct LabelSessionInputs {
 
 /// Where save() wrote.
 struct LabelSaved {
-  std::vector<std::string> labels;  ///< the labels files written (frames with at least one label)
-  std::vector<std::string> backups; ///< the previous versions kept (LABELS.yaml.bak)
-  std::string camera;               ///< the camera file written; empty: none (no -o, or not solved)
+  std::vector<std::string> labels;   ///< the labels files written (frames with at least one label)
+  std::vector<std::string> backups;  ///< the previous versions kept (LABELS.yaml.bak)
+  std::string camera;                ///< the camera file written; empty: none (no -o, or not solved)
 };
 
 /// The session. Not thread-safe: one caller at a time (the HTTP server holds a lock).
@@ -109,9 +109,9 @@ class LabelSession {
   /// one was asked for and the pose is solved. Not dirty afterwards.
   LabelSaved save();
 
-  std::size_t frameCount() const;  ///< the frames of the session
+  std::size_t frameCount() const;             ///< the frames of the session
   int revision() const { return revision_; }  ///< counts the accepted label edits and snap changes
-  bool dirty() const { return dirty_; }        ///< edits not saved yet
+  bool dirty() const { return dirty_; }       ///< edits not saved yet
 
  private:
   struct Frame;

@@ -39,20 +39,20 @@ struct StageTimes {
 
 /// What a run says about one input frame.
 struct FrameRecord {
-  double time = 0.0;                  ///< on the video's clock (index / fps, or the frame-times file)
+  double time = 0.0;                    ///< on the video's clock (index / fps, or the frame-times file)
   StateMatch match = StateMatch::None;  ///< how the state log gave the frame's state
   SafetyStatus status = SafetyStatus::NoState;
-  Status query = Status::Ok;          ///< the query's own status
-  bool braking_failed = false;        ///< a non-finite position or velocity: no braking box (unsafe)
-  bool not_finite = false;            ///< a volume could not be drawn (overflow): unsafe
+  Status query = Status::Ok;    ///< the query's own status
+  bool braking_failed = false;  ///< a non-finite position or velocity: no braking box (unsafe)
+  bool not_finite = false;      ///< a volume could not be drawn (overflow): unsafe
   double min_distance = std::numeric_limits<double>::quiet_NaN();  ///< the bound, NaN without one
   std::vector<std::array<int, 2>> pairs;  ///< body pairs within the margin (model body indices)
   std::vector<double> values;             ///< the state used (empty without one)
-  bool selected = false;              ///< drawn (and handed to the sink)
-  bool written = false;               ///< handed to a sink that keeps frames
-  bool reused = false;                ///< drawn by reusing the annotator's last answer and layer (the same state, bit for bit)
-  StageTimes times;                   ///< where its time went
-  std::optional<double> mask_iou;     ///< agreement with the frame's robot mask (OverlayInputs::masks), when it has one
+  bool selected = false;                  ///< drawn (and handed to the sink)
+  bool written = false;                   ///< handed to a sink that keeps frames
+  bool reused = false;  ///< drawn by reusing the annotator's last answer and layer (the same state, bit for bit)
+  StageTimes times;     ///< where its time went
+  std::optional<double> mask_iou;  ///< agreement with the frame's robot mask (OverlayInputs::masks), when it has one
   /// True when the frame's check cannot be trusted: treat the robot as unsafe.
   bool unsafe() const { return query != Status::Ok || braking_failed || not_finite; }
   /// The report's "query_status": "no_braking_box", "volume_not_finite" or the query's status word.
@@ -65,11 +65,11 @@ std::vector<std::array<std::string, 2>> linkPairs(const Model& model, const std:
 
 /// How every frame of a run is checked and drawn.
 struct AnnotatorSettings {
-  double time_offset = 0.0;  ///< added to a frame's time to get the state log's time (s)
-  double max_gap = 0.0;      ///< no state when no two samples this close bracket the time (s)
-  bool swept = false;        ///< braking-interval swept volumes instead of the static ones
+  double time_offset = 0.0;            ///< added to a frame's time to get the state log's time (s)
+  double max_gap = 0.0;                ///< no state when no two samples this close bracket the time (s)
+  bool swept = false;                  ///< braking-interval swept volumes instead of the static ones
   std::vector<BrakingParams> braking;  ///< per state value, with `swept`
-  bool plain = false;        ///< volumes only: no legend, no status line
+  bool plain = false;                  ///< volumes only: no legend, no status line
 };
 
 /// What every annotator of a run reads; it must outlive them.

@@ -1,7 +1,7 @@
 // A recording's robot masks (one image per frame, any segmentation tool's output) and each frame's
 // agreement with the robot drawn at its logged state: the IoU of the mask with the model's
-// silhouette through the camera (its visuals when it has them, as calibration draws it). A frame whose logged state does not match the video (a wrong
-// clock offset, a joint offset, a moved camera) stands out as low agreement.
+// silhouette through the camera (its visuals when it has them, as calibration draws it). A frame whose logged state
+// does not match the video (a wrong clock offset, a joint offset, a moved camera) stands out as low agreement.
 #pragma once
 
 #include <cstddef>
@@ -41,14 +41,15 @@ class MaskAgreement {
   /// with the robot's drawing widened by 1.5 % of the image's diagonal left out. Throws
   /// InputError naming the label when fewer than 8 of them have a state or they are not the
   /// camera's size.
-  void learnBackground(FrameSource& frames, const std::function<double(std::size_t)>& log_time, const StateLog& log, double max_gap);
+  void learnBackground(FrameSource& frames, const std::function<double(std::size_t)>& log_time, const StateLog& log,
+                       double max_gap);
   bool fromRecording() const { return folder_.empty(); }
 
   /// The IoU of frame `index`'s mask with the robot drawn at `state`; none when the frame has no
   /// mask file or `state` is empty. With masks made from the recording, the mask is `picture`'s
   /// (the frame, 8-bit BGR, before anything is drawn on it) against the background, and the IoU is
-  /// taken where the background is known (none when less than a quarter of the drawn robot is). Safe to call from several threads. Throws
-  /// calib::MaskError for a mask that cannot be read or is not the camera's size.
+  /// taken where the background is known (none when less than a quarter of the drawn robot is). Safe to call from
+  /// several threads. Throws calib::MaskError for a mask that cannot be read or is not the camera's size.
   std::optional<double> at(std::size_t index, std::span<const double> state, const cv::Mat& picture = cv::Mat()) const;
 
   /// How many frames have a mask file (with masks made from the recording: the frames the

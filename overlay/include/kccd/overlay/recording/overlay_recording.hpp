@@ -17,8 +17,8 @@
 #include "kccd/braking.hpp"
 #include "kccd/calib/camera.hpp"
 #include "kccd/model.hpp"
-#include "kccd/overlay/recording/frame_source.hpp"
 #include "kccd/overlay/recording/frame_annotator.hpp"
+#include "kccd/overlay/recording/frame_source.hpp"
 #include "kccd/overlay/recording/mask_agreement.hpp"
 #include "kccd/overlay/recording/time_offset.hpp"
 #include "kccd/overlay/recording/video_sink.hpp"
@@ -61,21 +61,21 @@ struct OverlayInputs {
 inline constexpr BrakingParams kOverlayBraking{.latency = 0.01, .deceleration = 5.0};
 
 struct OverlayOptions {
-  double time_offset = 0.0;            ///< log time = frame time + offset (s)
+  double time_offset = 0.0;  ///< log time = frame time + offset (s)
   /// Search [lo, hi] for the offset instead (findTimeOffset; a first pass over the video).
   std::optional<std::pair<double, double>> time_offset_search;
-  std::string time_offset_label;       ///< names the search in errors (e.g. "--time-offset auto:0:1")
-  double max_gap = 0.0;                ///< the largest log gap bridged (s); <= 0: 1.5 x the median period
-  double fps = 0.0;                    ///< the video's frame rate; <= 0: as the video declares
-  bool swept = false;                  ///< braking-interval swept volumes (BrakingParams per joint)
+  std::string time_offset_label;            ///< names the search in errors (e.g. "--time-offset auto:0:1")
+  double max_gap = 0.0;                     ///< the largest log gap bridged (s); <= 0: 1.5 x the median period
+  double fps = 0.0;                         ///< the video's frame rate; <= 0: as the video declares
+  bool swept = false;                       ///< braking-interval swept volumes (BrakingParams per joint)
   BrakingParams braking = kOverlayBraking;  ///< every state value's braking, with `swept`
-  bool plain = false;                  ///< volumes only: no legend, no status line
-  bool visuals = false;                ///< also draw the model's visual geometry at the logged state
-  FrameRange frames;                   ///< the frames drawn and handed on
-  int jobs = 0;                        ///< annotator threads (each with a GL context); <= 0: hardware threads
-  std::size_t contact_frames = 0;      ///< frames on the contact sheet (0: none)
-  int contact_tile_width = 320;        ///< pixels per contact sheet tile
-  bool timings = false;                ///< the report's JSON gives where the time went ("timings")
+  bool plain = false;                       ///< volumes only: no legend, no status line
+  bool visuals = false;                     ///< also draw the model's visual geometry at the logged state
+  FrameRange frames;                        ///< the frames drawn and handed on
+  int jobs = 0;                             ///< annotator threads (each with a GL context); <= 0: hardware threads
+  std::size_t contact_frames = 0;           ///< frames on the contact sheet (0: none)
+  int contact_tile_width = 320;             ///< pixels per contact sheet tile
+  bool timings = false;                     ///< the report's JSON gives where the time went ("timings")
 };
 
 /// A run's progress, given after every frame in order.
@@ -89,20 +89,21 @@ struct OverlayProgress {
 struct OverlayReport {
   std::vector<FrameRecord> frames;  ///< every decoded frame, in order
   std::size_t written = 0, clear = 0, within_margin = 0, colliding = 0, no_state = 0, unsafe = 0;
-  double time_offset = 0.0;         ///< the offset used (found, with a search)
+  double time_offset = 0.0;                                     ///< the offset used (found, with a search)
   std::optional<std::pair<double, double>> time_offset_search;  ///< the range searched, if any
-  TimeOffset time_offset_found;     ///< what the search found (with a search)
-  double max_gap = 0.0;             ///< the largest log gap bridged (s)
-  double fps = 0.0;                 ///< the frame rate used (0 with frame times and no declared rate)
-  double margin = 0.0;              ///< the model's safety margin
+  TimeOffset time_offset_found;                                 ///< what the search found (with a search)
+  double max_gap = 0.0;                                         ///< the largest log gap bridged (s)
+  double fps = 0.0;     ///< the frame rate used (0 with frame times and no declared rate)
+  double margin = 0.0;  ///< the model's safety margin
   bool swept = false;
   int jobs = 0;
-  double seconds = 0.0;             ///< the frame loop's wall time
-  double setup_seconds = 0.0;       ///< before the first frame: inputs checked, lens maps, first pass
-  StageTimes stages;                ///< every frame's StageTimes summed
-  std::size_t reused = 0;           ///< drawn frames whose state (and box) equalled their annotator's last: answer and layer reused
-  bool timings = false;             ///< OverlayOptions::timings: reportJson gives setup_seconds and stages
-  cv::Mat contact_sheet;            ///< selected frames, captioned (empty when none was asked or drawn)
+  double seconds = 0.0;        ///< the frame loop's wall time
+  double setup_seconds = 0.0;  ///< before the first frame: inputs checked, lens maps, first pass
+  StageTimes stages;           ///< every frame's StageTimes summed
+  std::size_t reused =
+      0;  ///< drawn frames whose state (and box) equalled their annotator's last: answer and layer reused
+  bool timings = false;   ///< OverlayOptions::timings: reportJson gives setup_seconds and stages
+  cv::Mat contact_sheet;  ///< selected frames, captioned (empty when none was asked or drawn)
   std::vector<std::size_t> contact_sheet_frames;  ///< the indices of the frames on it, in order
   /// How the recording was read (e.g. a robot log's file, topics, clock and time 0), written as
   /// the report's "source" object when not empty; empty values are left out.
@@ -130,7 +131,7 @@ struct OverlayOutputs {
   std::string frames_option = "--frames";  ///< named when no frame was drawn for the contact sheet
   std::string timeline;                    ///< .png: drawTimeline of the run (timeline.hpp)
   std::string timeline_option = "--timeline";
-  std::string timeline_title;              ///< its caption (e.g. the recording's name)
+  std::string timeline_title;  ///< its caption (e.g. the recording's name)
 };
 /// Checks the outputs before a run: each one's extension and folder (checkOutputPath), and that
 /// neither the video nor the report is one of `inputs` (sameFile: no output may replace an input).

@@ -35,11 +35,11 @@ int videoFourcc(const std::string& path, const std::string& codec = "");
 
 /// What a VideoSink writes. Empty paths are not written; labels name the outputs in errors.
 struct VideoSinkOptions {
-  std::string video;                    ///< a .mp4, .mkv or .avi file (see videoFourcc)
-  std::string codec;                    ///< a FourCC, or empty for the extension's default
-  std::string video_label;              ///< e.g. "-o out.mp4" (default: the path)
-  std::string png_dir;                  ///< a new or empty folder of frame_%06d.png (input indices)
-  std::string png_label;                ///< e.g. "--png-dir frames" (default: the path)
+  std::string video;        ///< a .mp4, .mkv or .avi file (see videoFourcc)
+  std::string codec;        ///< a FourCC, or empty for the extension's default
+  std::string video_label;  ///< e.g. "-o out.mp4" (default: the path)
+  std::string png_dir;      ///< a new or empty folder of frame_%06d.png (input indices)
+  std::string png_label;    ///< e.g. "--png-dir frames" (default: the path)
 };
 
 /// A video file and/or a PNG folder written under temporary names; commit() moves them into

@@ -52,8 +52,8 @@ class VideoSource final : public FrameSource {
   std::unique_ptr<cv::VideoCapture> capture_;  ///< a video file
   std::string label_;
   bool sequence_ = false;
-  std::string pattern_;                        ///< an image sequence: its printf pattern,
-  std::size_t first_ = 0, length_ = 0;         ///< first number and frame count
+  std::string pattern_;                 ///< an image sequence: its printf pattern,
+  std::size_t first_ = 0, length_ = 0;  ///< first number and frame count
   std::size_t next_ = 0;
 };
 

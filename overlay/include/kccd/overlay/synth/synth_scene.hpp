@@ -10,14 +10,14 @@
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/calib/tag_layout.hpp"
-#include "kccd/model.hpp"
 #include "kccd/calib/tag_scene.hpp"
+#include "kccd/model.hpp"
 #include "kccd/ssch.hpp"
 #include "kccd/state_log.hpp"
 
 namespace kccd::overlay {
 
-using calib::SceneLight;    // the room drawn by calibration's tag scene renderer
+using calib::SceneLight;  // the room drawn by calibration's tag scene renderer
 using calib::SceneSurface;
 
 /// An axis-aligned box (empty until something is added).
