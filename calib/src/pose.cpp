@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <unordered_set>
 
@@ -156,6 +157,172 @@ std::string rejectedText(const std::vector<Correspondence>& pts, const std::vect
   return s;
 }
 
+// The options, the intrinsics (their pose cleared) and every correspondence checked: throws InputError.
+Camera checkedPoseInput(const Camera& intrinsics, const std::vector<Correspondence>& points,
+                        const PoseOptions& options) {
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!positive(options.ransac_threshold_px) || options.min_inliers < 4 || !positive(options.min_spread_ratio) ||
+      !(options.noise_floor_px >= 0) || !positive(options.max_rotation_sigma_deg) ||
+      !positive(options.max_position_sigma_ratio) || !(options.min_mirror_separation >= 0) ||
+      !std::isfinite(options.noise_floor_px) || !std::isfinite(options.min_mirror_separation))
+    throw InputError("pose options: a threshold is not a positive finite number or min_inliers < 4");
+  Camera cam = intrinsics;
+  cam.rvec = cv::Vec3d(0, 0, 0);
+  cam.tvec = cv::Vec3d(0, 0, 0);
+  cam.reprojection_rms_px.reset();
+  cam.rotation_sigma_deg.reset();
+  cam.position_sigma_m.reset();
+  cam.validate("intrinsics");
+
+  std::unordered_set<std::string> names;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Correspondence& c = points[i];
+    const std::string where = "correspondence " + std::to_string(i + 1);
+    if (c.name.empty()) throw InputError(where + ": name: empty");
+    if (!names.insert(c.name).second) throw InputError(where + ": name: '" + printable(c.name) + "' given twice");
+    if (!std::isfinite(c.pixel.x) || !std::isfinite(c.pixel.y))
+      throw InputError(where + " (" + printable(c.name) + "): pixel: not a finite number");
+    if (!std::isfinite(c.world.x) || !std::isfinite(c.world.y) || !std::isfinite(c.world.z))
+      throw InputError(where + " (" + printable(c.name) + "): world: not a finite number");
+  }
+  return cam;
+}
+
+// The best pose of P3P on triples of `candidates` (all of them, or kMaxTriples drawn with an early
+// stop), scored by the count within `thr_n` (normalised units), then by the truncated squared error.
+struct P3PBest {
+  int count = -1;  // -1: no triple gave a pose
+  double cost = std::numeric_limits<double>::infinity();
+  cv::Vec3d r, t;
+};
+P3PBest ransacP3P(const std::vector<cv::Point3d>& world, const std::vector<cv::Point2d>& norm,
+                  const std::vector<int>& candidates, double thr_n) {
+  const int m = static_cast<int>(candidates.size());
+  std::vector<std::array<int, 3>> triples;
+  const double total = static_cast<double>(m) * (m - 1) * (m - 2) / 6.0;
+  const bool sampled = total > kMaxTriples;
+  if (!sampled) {
+    for (int a = 0; a < m; ++a)
+      for (int b = a + 1; b < m; ++b)
+        for (int c = b + 1; c < m; ++c) triples.push_back({a, b, c});
+  } else {
+    std::mt19937_64 rng(12345);
+    std::uniform_int_distribution<int> u(0, m - 1);
+    while (triples.size() < kMaxTriples) {
+      const int a = u(rng), b = u(rng), c = u(rng);
+      if (a != b && b != c && a != c) triples.push_back({a, b, c});
+    }
+  }
+  P3PBest best;
+  for (std::size_t tried = 0; tried < triples.size(); ++tried) {
+    // Sampled triples stop early once, at the best inlier ratio w so far, a triple of inliers
+    // would have been drawn with probability 1 - 1e-6 (at least kMinTriples are always tried).
+    if (sampled && tried >= kMinTriples && best.count > 0) {
+      const double w = static_cast<double>(best.count) / m;
+      const double p = w * w * w;
+      if (p >= 1.0 || static_cast<double>(tried) >= std::log(1e-6) / std::log1p(-p)) break;
+    }
+    const auto& tri = triples[tried];
+    std::vector<cv::Point3d> w3;
+    std::vector<cv::Point2d> i3;
+    for (int k : tri) w3.push_back(world[candidates[k]]), i3.push_back(norm[candidates[k]]);
+    std::vector<cv::Mat> rs, ts;
+    try {
+      cv::solveP3P(w3, i3, cv::Matx33d::eye(), cv::noArray(), rs, ts, cv::SOLVEPNP_AP3P);
+    } catch (const cv::Exception&) {
+      continue;
+    }
+    for (std::size_t s = 0; s < rs.size(); ++s) {
+      const cv::Vec3d rv(rs[s].ptr<double>()), tv(ts[s].ptr<double>());
+      if (!std::isfinite(cv::norm(rv)) || !std::isfinite(cv::norm(tv))) continue;
+      cv::Matx33d r;
+      cv::Rodrigues(rv, r);
+      int count = 0;
+      double cost = 0;
+      for (int i : candidates) {
+        const cv::Vec3d x = r * cv::Vec3d(world[i].x, world[i].y, world[i].z) + tv;
+        double e2 = thr_n * thr_n;
+        if (x[2] > 0) {
+          const double dx = x[0] / x[2] - norm[i].x, dy = x[1] / x[2] - norm[i].y;
+          e2 = std::min(e2, dx * dx + dy * dy);
+          if (dx * dx + dy * dy <= thr_n * thr_n) ++count;
+        }
+        cost += e2;
+      }
+      if (count > best.count || (count == best.count && cost < best.cost)) best = {count, cost, rv, tv};
+    }
+  }
+  return best;
+}
+
+// SQPnP and LM on the inliers `in`, re-selected among `candidates` by their true pixel residual
+// (within `threshold_px`) until stable (at most 6 rounds, or until fewer than `need` agree):
+// `rvec`, `tvec`, every point's residual `res` and `in` as they end.
+void settleInliers(const Camera& cam, const std::vector<cv::Point3d>& world, const std::vector<cv::Point2d>& pixel,
+                   const std::vector<cv::Point2d>& norm, const std::vector<int>& candidates, double threshold_px,
+                   int need, cv::Vec3d& rvec, cv::Vec3d& tvec, std::vector<double>& res, std::vector<char>& in) {
+  std::vector<int> idx;
+  const int n = static_cast<int>(world.size());
+  for (int iter = 0; iter < 6; ++iter) {
+    idx.clear();
+    for (int i = 0; i < n; ++i)
+      if (in[i]) idx.push_back(i);
+    if (static_cast<int>(idx.size()) < need) return;  // the caller finds too few
+    const auto wi = pick(world, idx);
+    const auto pi = pick(pixel, idx);
+    // SQPnP start (global minimum of the algebraic error) vs the current pose: keep the better after LM.
+    cv::Vec3d r1 = rvec, t1 = tvec;
+    refineLM(cam, wi, pi, r1, t1);
+    double e1 = sumSquares(pixelResiduals(cam, r1, t1, wi, pi));
+    try {
+      cv::Mat r2m, t2m;
+      if (cv::solvePnP(wi, pick(norm, idx), cv::Matx33d::eye(), cv::noArray(), r2m, t2m, false, cv::SOLVEPNP_SQPNP)) {
+        cv::Vec3d r2(r2m.ptr<double>()), t2(t2m.ptr<double>());
+        refineLM(cam, wi, pi, r2, t2);
+        const double e2 = sumSquares(pixelResiduals(cam, r2, t2, wi, pi));
+        if (e2 < e1) r1 = r2, t1 = t2, e1 = e2;
+      }
+    } catch (const cv::Exception&) {
+    }
+    rvec = r1, tvec = t1;
+    res = pixelResiduals(cam, rvec, tvec, world, pixel);
+    std::vector<char> next(n, 0);
+    for (int i : candidates) next[i] = res[i] <= threshold_px;
+    if (next == in) break;
+    in = next;
+  }
+}
+
+// Nearly planar points (`wi` at `pi`, `wn` normalised) have two poses that fit: the angle of the
+// other one, IPPE's second solution refined, when it is more than `same_deg` from `rvec` and fits
+// with a squared error below `worst_sse`; else none.
+std::optional<double> mirroredPose(const Camera& cam, const std::vector<cv::Point3d>& wi,
+                                   const std::vector<cv::Point2d>& pi, const std::vector<cv::Point2d>& wn,
+                                   const cv::Vec3d& rvec, double same_deg, double worst_sse) {
+  const Spread sp = spread3(wi);
+  if (!(sp.s[2] < 0.1 * sp.s[0])) return std::nullopt;
+  std::vector<cv::Point3d> flat;
+  for (const auto& p : wi) {
+    const cv::Vec3d v(p.x, p.y, p.z);
+    const cv::Vec3d q = v - sp.normal * (v - sp.centroid).dot(sp.normal);
+    flat.emplace_back(q[0], q[1], q[2]);
+  }
+  std::vector<cv::Mat> rs, ts;
+  try {
+    cv::solvePnPGeneric(flat, wn, cv::Matx33d::eye(), cv::noArray(), rs, ts, false, cv::SOLVEPNP_IPPE);
+  } catch (const cv::Exception&) {
+    rs.clear();
+  }
+  for (std::size_t s = 0; s < rs.size(); ++s) {
+    cv::Vec3d r2(rs[s].ptr<double>()), t2(ts[s].ptr<double>());
+    refineLM(cam, wi, pi, r2, t2);
+    const double ang = rotationAngleDeg(r2, rvec);
+    if (ang < same_deg) continue;  // the same pose
+    if (sumSquares(pixelResiduals(cam, r2, t2, wi, pi)) < worst_sse) return ang;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 const char* toString(PoseStatus status) {
@@ -194,33 +361,7 @@ std::pair<double, double> poseSigmas(const cv::Vec3d& rvec, const cv::Vec3d& tve
 }
 
 PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>& points, const PoseOptions& options) {
-  // ---- input
-  const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
-  if (!positive(options.ransac_threshold_px) || options.min_inliers < 4 || !positive(options.min_spread_ratio) ||
-      !(options.noise_floor_px >= 0) || !positive(options.max_rotation_sigma_deg) ||
-      !positive(options.max_position_sigma_ratio) || !(options.min_mirror_separation >= 0) ||
-      !std::isfinite(options.noise_floor_px) || !std::isfinite(options.min_mirror_separation))
-    throw InputError("pose options: a threshold is not a positive finite number or min_inliers < 4");
-  Camera cam = intrinsics;
-  cam.rvec = cv::Vec3d(0, 0, 0);
-  cam.tvec = cv::Vec3d(0, 0, 0);
-  cam.reprojection_rms_px.reset();
-  cam.rotation_sigma_deg.reset();
-  cam.position_sigma_m.reset();
-  cam.validate("intrinsics");
-
-  std::unordered_set<std::string> names;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Correspondence& c = points[i];
-    const std::string where = "correspondence " + std::to_string(i + 1);
-    if (c.name.empty()) throw InputError(where + ": name: empty");
-    if (!names.insert(c.name).second) throw InputError(where + ": name: '" + printable(c.name) + "' given twice");
-    if (!std::isfinite(c.pixel.x) || !std::isfinite(c.pixel.y))
-      throw InputError(where + " (" + printable(c.name) + "): pixel: not a finite number");
-    if (!std::isfinite(c.world.x) || !std::isfinite(c.world.y) || !std::isfinite(c.world.z))
-      throw InputError(where + " (" + printable(c.name) + "): world: not a finite number");
-  }
-
+  const Camera cam = checkedPoseInput(intrinsics, points, options);
   PoseResult result;
   result.camera = cam;
   const int n = static_cast<int>(points.size());
@@ -271,65 +412,9 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   }
 
   // ---- RANSAC: P3P on triples of undistorted points, scored by inliers then truncated squared error
-  const int m = static_cast<int>(candidates.size());
-  std::vector<std::array<int, 3>> triples;
-  const double total = static_cast<double>(m) * (m - 1) * (m - 2) / 6.0;
-  const bool sampled = total > kMaxTriples;
-  if (!sampled) {
-    for (int a = 0; a < m; ++a)
-      for (int b = a + 1; b < m; ++b)
-        for (int c = b + 1; c < m; ++c) triples.push_back({a, b, c});
-  } else {
-    std::mt19937_64 rng(12345);
-    std::uniform_int_distribution<int> u(0, m - 1);
-    while (triples.size() < kMaxTriples) {
-      const int a = u(rng), b = u(rng), c = u(rng);
-      if (a != b && b != c && a != c) triples.push_back({a, b, c});
-    }
-  }
-  const double thr_n = options.ransac_threshold_px / f;  // in normalised units
-  int best_count = -1;
-  double best_cost = std::numeric_limits<double>::infinity();
-  cv::Vec3d best_r, best_t;
-  for (std::size_t tried = 0; tried < triples.size(); ++tried) {
-    // Sampled triples stop early once, at the best inlier ratio w so far, a triple of inliers
-    // would have been drawn with probability 1 - 1e-6 (at least kMinTriples are always tried).
-    if (sampled && tried >= kMinTriples && best_count > 0) {
-      const double w = static_cast<double>(best_count) / m;
-      const double p = w * w * w;
-      if (p >= 1.0 || static_cast<double>(tried) >= std::log(1e-6) / std::log1p(-p)) break;
-    }
-    const auto& tri = triples[tried];
-    std::vector<cv::Point3d> w3;
-    std::vector<cv::Point2d> i3;
-    for (int k : tri) w3.push_back(world[candidates[k]]), i3.push_back(norm[candidates[k]]);
-    std::vector<cv::Mat> rs, ts;
-    try {
-      cv::solveP3P(w3, i3, cv::Matx33d::eye(), cv::noArray(), rs, ts, cv::SOLVEPNP_AP3P);
-    } catch (const cv::Exception&) {
-      continue;
-    }
-    for (std::size_t s = 0; s < rs.size(); ++s) {
-      const cv::Vec3d rv(rs[s].ptr<double>()), tv(ts[s].ptr<double>());
-      if (!std::isfinite(cv::norm(rv)) || !std::isfinite(cv::norm(tv))) continue;
-      cv::Matx33d r;
-      cv::Rodrigues(rv, r);
-      int count = 0;
-      double cost = 0;
-      for (int i : candidates) {
-        const cv::Vec3d x = r * cv::Vec3d(world[i].x, world[i].y, world[i].z) + tv;
-        double e2 = thr_n * thr_n;
-        if (x[2] > 0) {
-          const double dx = x[0] / x[2] - norm[i].x, dy = x[1] / x[2] - norm[i].y;
-          e2 = std::min(e2, dx * dx + dy * dy);
-          if (dx * dx + dy * dy <= thr_n * thr_n) ++count;
-        }
-        cost += e2;
-      }
-      if (count > best_count || (count == best_count && cost < best_cost))
-        best_count = count, best_cost = cost, best_r = rv, best_t = tv;
-    }
-  }
+  const P3PBest best = ransacP3P(world, norm, candidates, options.ransac_threshold_px / f);
+  const int best_count = best.count;
+  const cv::Vec3d best_r = best.r, best_t = best.t;
 
   const auto fillResiduals = [&](const std::vector<double>& res, const std::vector<char>& in) {
     result.residuals.clear();
@@ -363,35 +448,8 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   std::vector<double> res = pixelResiduals(cam, rvec, tvec, world, pixel);
   std::vector<char> in(n, 0);
   for (int i : candidates) in[i] = res[i] <= options.ransac_threshold_px;
+  settleInliers(cam, world, pixel, norm, candidates, options.ransac_threshold_px, need, rvec, tvec, res, in);
   std::vector<int> idx;
-  for (int iter = 0; iter < 6; ++iter) {
-    idx.clear();
-    for (int i = 0; i < n; ++i)
-      if (in[i]) idx.push_back(i);
-    if (static_cast<int>(idx.size()) < need) return tooFewInliers(static_cast<int>(idx.size()), res, in);
-    const auto wi = pick(world, idx);
-    const auto pi = pick(pixel, idx);
-    // SQPnP start (global minimum of the algebraic error) vs the current pose: keep the better after LM.
-    cv::Vec3d r1 = rvec, t1 = tvec;
-    refineLM(cam, wi, pi, r1, t1);
-    double e1 = sumSquares(pixelResiduals(cam, r1, t1, wi, pi));
-    try {
-      cv::Mat r2m, t2m;
-      if (cv::solvePnP(wi, pick(norm, idx), cv::Matx33d::eye(), cv::noArray(), r2m, t2m, false, cv::SOLVEPNP_SQPNP)) {
-        cv::Vec3d r2(r2m.ptr<double>()), t2(t2m.ptr<double>());
-        refineLM(cam, wi, pi, r2, t2);
-        const double e2 = sumSquares(pixelResiduals(cam, r2, t2, wi, pi));
-        if (e2 < e1) r1 = r2, t1 = t2, e1 = e2;
-      }
-    } catch (const cv::Exception&) {
-    }
-    rvec = r1, tvec = t1;
-    res = pixelResiduals(cam, rvec, tvec, world, pixel);
-    std::vector<char> next(n, 0);
-    for (int i : candidates) next[i] = res[i] <= options.ransac_threshold_px;
-    if (next == in) break;
-    in = next;
-  }
   idx.clear();
   for (int i = 0; i < n; ++i)
     if (in[i]) idx.push_back(i);
@@ -466,34 +524,13 @@ PoseResult solvePose(const Camera& intrinsics, const std::vector<Correspondence>
   }
 
   // ---- mirror (Necker) ambiguity of a nearly planar set: the other IPPE solution, refined
-  const Spread sp = spread3(wi);
-  if (sp.s[2] < 0.1 * sp.s[0]) {
-    std::vector<cv::Point3d> flat;
-    for (const auto& p : wi) {
-      const cv::Vec3d v(p.x, p.y, p.z);
-      const cv::Vec3d q = v - sp.normal * (v - sp.centroid).dot(sp.normal);
-      flat.emplace_back(q[0], q[1], q[2]);
-    }
-    std::vector<cv::Mat> rs, ts;
-    try {
-      cv::solvePnPGeneric(flat, pick(norm, idx), cv::Matx33d::eye(), cv::noArray(), rs, ts, false, cv::SOLVEPNP_IPPE);
-    } catch (const cv::Exception&) {
-      rs.clear();
-    }
-    for (std::size_t s = 0; s < rs.size(); ++s) {
-      cv::Vec3d r2(rs[s].ptr<double>()), t2(ts[s].ptr<double>());
-      refineLM(cam, wi, pi, r2, t2);
-      const double ang = rotationAngleDeg(r2, rvec);
-      if (ang < 3 * rot_gate + 0.5) continue;  // the same pose
-      const double e2 = sumSquares(pixelResiduals(cam, r2, t2, wi, pi));
-      if ((e2 - sse_in) / gate2 < options.min_mirror_separation) {
-        result.status = PoseStatus::PoorGeometry;
-        result.message = "a mirrored pose " + formatNumber(ang, 3) +
-                         " deg away fits these nearly planar points almost as well" + at_noise +
-                         ": add points off their plane or spread wider across the view" + rejected;
-        return result;
-      }
-    }
+  if (const std::optional<double> ang = mirroredPose(cam, wi, pi, pick(norm, idx), rvec, 3 * rot_gate + 0.5,
+                                                     sse_in + options.min_mirror_separation * gate2)) {
+    result.status = PoseStatus::PoorGeometry;
+    result.message = "a mirrored pose " + formatNumber(*ang, 3) +
+                     " deg away fits these nearly planar points almost as well" + at_noise +
+                     ": add points off their plane or spread wider across the view" + rejected;
+    return result;
   }
 
   result.status = PoseStatus::Solved;

@@ -111,7 +111,10 @@ cv::Mat imageOf(const Value& msg, bool compressed, const std::string& at) {
   return out;
 }
 
-BagExportReport exportBag(const BagExportOptions& o) {
+namespace {
+
+// What is asked of an export, and each output's extension and folder, before the log is read.
+void checkExportOutputs(const BagExportOptions& o) {
   const auto named = [&](const std::string& field) { return spelledField(o.spell, field); };
   if (o.states.empty() && o.video.empty() && o.camera_info.empty())
     throw InputError("nothing to write: give " + named("states") + ", " + named("video") + " (with " +
@@ -130,6 +133,31 @@ BagExportReport exportBag(const BagExportOptions& o) {
       throw OutputError(named("video") + " " + o.video + ": the output must be a .mp4, .mkv or .avi file");
     checkOutputPath(o.video, named("video"), ext);
   }
+}
+
+// The joint names of the first joint state, as state log columns: some, none twice, none that a
+// log cannot hold (time, NAME.vel, a comma, a quote, a line end).
+void checkJointNames(const LogSource& joints, const std::string& bag) {
+  if (joints.names.empty())
+    throw InputError(bag + ": topic " + printable(joints.topic, 60) + ": the first joint state names no joint");
+  std::vector<std::string> sorted = joints.names;
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t i = 0; i + 1 < sorted.size(); ++i)
+    if (sorted[i] == sorted[i + 1])
+      throw InputError(bag + ": topic " + printable(joints.topic, 60) + ": joint '" + printable(sorted[i], 60) +
+                       "' is named twice");
+  for (const std::string& n : joints.names)
+    if (n.empty() || n == "time" || n.find_first_of(",\"\r\n") != std::string::npos ||
+        (n.size() > 4 && n.compare(n.size() - 4, 4, ".vel") == 0))
+      throw InputError(bag + ": topic " + printable(joints.topic, 60) + ": joint name '" + printable(n, 60) +
+                       "' cannot be a state log column");
+}
+
+}  // namespace
+
+BagExportReport exportBag(const BagExportOptions& o) {
+  const auto named = [&](const std::string& field) { return spelledField(o.spell, field); };
+  checkExportOutputs(o);
   BagExportReport report;
   // Pass 1: which topics there are, and what the chosen ones hold.
   std::map<std::uint16_t, LogSource> sources = scanLog(o.bag, o.time_source, report.damage);
@@ -149,19 +177,7 @@ BagExportReport exportBag(const BagExportOptions& o) {
         sources, report.camera_info_topic = chooseTopic(sources, {LogKind::CameraInfo}, o.camera_info_topic,
                                                         named("camera_info_topic"), "sensor_msgs/CameraInfo", o.bag));
   if (joints) {
-    if (joints->names.empty())
-      throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": the first joint state names no joint");
-    std::vector<std::string> sorted = joints->names;
-    std::sort(sorted.begin(), sorted.end());
-    for (std::size_t i = 0; i + 1 < sorted.size(); ++i)
-      if (sorted[i] == sorted[i + 1])
-        throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": joint '" + printable(sorted[i], 60) +
-                         "' is named twice");
-    for (const std::string& n : joints->names)
-      if (n.empty() || n == "time" || n.find_first_of(",\"\r\n") != std::string::npos ||
-          (n.size() > 4 && n.compare(n.size() - 4, 4, ".vel") == 0))
-        throw InputError(o.bag + ": topic " + printable(joints->topic, 60) + ": joint name '" + printable(n, 60) +
-                         "' cannot be a state log column");
+    checkJointNames(*joints, o.bag);
     report.joints = joints->names;
     report.velocities = joints->all_velocities;
   }
