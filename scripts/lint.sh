@@ -32,8 +32,6 @@ if [ ${#sources[@]} -gt 0 ]; then
   echo "== clang-tidy: ${#sources[@]} source file(s)"
   cmake -S . -B build-lint -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_EXPORT_COMPILE_COMMANDS=ON \
     -DKCCD_UNITY_BUILD=OFF -DKCCD_BUILD_TESTS=OFF -DKCCD_BUILD_BENCHMARKS=OFF >/dev/null
-  # Generated sources a file may include (the labelling page's embedded files).
-  ninja -C build-lint -t targets all | grep -o '^[^:]*web_files.cpp' | xargs -r ninja -C build-lint >/dev/null
   for f in "${sources[@]}"; do
     if ! clang-tidy -p build-lint --quiet "$f" 2>/dev/null; then
       echo "$f: clang-tidy findings above"
