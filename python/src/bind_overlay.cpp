@@ -184,11 +184,7 @@ void bindOverlayJob(py::module_& m) {
         return toPython(full);
       },
       py::arg("model"), py::arg("camera"), py::arg("video") = "", py::arg("states") = "",
-      R"doc(overlay_recording(model, camera, video='', states='', *, bag='', image_topic='', joint_topic='',
-time_source='header', joint_map='', frame_times='', ignore_columns=[], fps=0.0, time_offset=0.0, max_gap=0.0,
-swept=False, braking=None, plain=False, visuals=False, masks='', mask_bodies=[], frames='', jobs=0,
-timings=False, output='', codec='', png_dir='', report='', contact_sheet='', timeline='', contact_frames=12,
-progress=None, progress_every=0.0)
+      R"doc(overlay_recording(model, camera, video='', states='', *, bag='', image_topic='', joint_topic='', time_source='header', joint_map='', frame_times='', ignore_columns=[], fps=0.0, time_offset=0.0, max_gap=0.0, swept=False, braking=None, plain=False, visuals=False, masks='', mask_bodies=[], frames='', jobs=0, timings=False, output='', codec='', png_dir='', report='', contact_sheet='', timeline='', contact_frames=12, progress=None, progress_every=0.0)
 
 The main job, as `kccd overlay` (every option of it under its own name, with its default and its checks):
 every frame of `video` (a file or an image-sequence pattern) checked at the state the log `states` (CSV)

@@ -97,6 +97,168 @@ void lowerThreadPriority(int steps) {
   if (errno == 0) (void)::setpriority(PRIO_PROCESS, tid, std::min(19, now + steps));
 }
 
+// One run's frames between its three stages, under one mutex: the reader decodes them in order
+// (at most `max_in_flight` at a time), the annotators check and draw them in any order, the writer
+// (the calling thread) takes them back in input order. The first error stops every stage.
+struct Pipeline {
+  const OverlayInputs& in;
+  const OverlayOptions& opt;
+  FrameSource& video;
+  const FrameClock& clock;
+  const std::string& video_label;
+  const std::string& camera_label;
+  std::size_t expected;  // frames the video declares (0: unknown)
+  std::size_t max_in_flight;
+
+  std::mutex mu;
+  std::condition_variable wake;
+  std::deque<FrameJob> todo;
+  std::map<std::size_t, FrameJob> done;
+  std::vector<cv::Mat> spare;  // handed-on frames' buffers, decoded into again (no allocation per frame)
+  std::size_t in_flight = 0, decoded = 0;
+  bool reader_done = false, abort = false;
+  std::exception_ptr error;
+
+  void fail(const std::exception_ptr& e) {
+    std::lock_guard lock(mu);
+    if (!error) error = e;
+    abort = true;
+    wake.notify_all();
+  }
+
+  // Frame `index` decoded into job.bgr (8-bit BGR of the camera's size) with its time; false at
+  // the video's end. Throws when the end comes early or a frame does not fit.
+  bool decode(std::size_t index, FrameJob& job) {
+    const auto count = [](std::size_t n) { return std::to_string(n); };
+    const auto t_decode = std::chrono::steady_clock::now();
+    if (!video.read(job.bgr)) {
+      if (index == 0) throw VideoError(video_label + ": no frame could be decoded");
+      if (expected > 0 && index < expected)
+        throw VideoError(video_label + ": the video ends after " + count(index) + " of the " + count(expected) +
+                         " frames its header declares (truncated or damaged)");
+      if (!in.frame_times.empty() && index < in.frame_times.size())
+        throw InputError(in.frame_times_label + ": lists frames up to " + count(in.frame_times.size() - 1) +
+                         " but the video ends after " + count(index) + " frames");
+      return false;
+    }
+    const calib::Camera& camera = in.camera;
+    if (job.bgr.cols != camera.width || job.bgr.rows != camera.height)
+      throw VideoError(video_label + ": frame " + count(index) + " is " + std::to_string(job.bgr.cols) + "x" +
+                       std::to_string(job.bgr.rows) + " but " + camera_label + " is calibrated for " +
+                       std::to_string(camera.width) + "x" + std::to_string(camera.height));
+    if (job.bgr.type() != CV_8UC3) {
+      cv::Mat converted;
+      if (job.bgr.channels() == 1)
+        cv::cvtColor(job.bgr, converted, cv::COLOR_GRAY2BGR);
+      else if (job.bgr.channels() == 4)
+        cv::cvtColor(job.bgr, converted, cv::COLOR_BGRA2BGR);
+      else
+        throw VideoError(video_label + ": frame " + count(index) + " is not an 8-bit colour image");
+      job.bgr = converted;
+    }
+    job.record.times.decode = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_decode).count();
+    job.record.time = clock(index);
+    if (clock.fromFrameTimes() && !std::isfinite(job.record.time))
+      throw InputError(in.frame_times_label + ": no time for frame " + count(index));
+    job.record.selected = opt.frames.contains(index);
+    return true;
+  }
+
+  // The reader thread: every frame decoded and queued for the annotators.
+  void read() {
+    try {
+      for (std::size_t index = 0;; ++index) {
+        FrameJob job;
+        job.index = index;
+        {
+          std::unique_lock lock(mu);
+          wake.wait(lock, [&] { return abort || in_flight < max_in_flight; });
+          if (abort) return;
+          if (!spare.empty()) {
+            job.bgr = std::move(spare.back());
+            spare.pop_back();
+          }
+        }
+        if (!decode(index, job)) break;
+        std::lock_guard lock(mu);
+        todo.push_back(std::move(job));
+        ++in_flight;
+        decoded = index + 1;
+        wake.notify_all();
+      }
+      std::lock_guard lock(mu);
+      reader_done = true;
+      wake.notify_all();
+    } catch (...) {
+      fail(std::current_exception());
+    }
+  }
+
+  // An annotator thread (its own GL context): queued frames checked and drawn until none is left.
+  void annotate(const AnnotatorScene& scene, const MaskAgreement* masks) {
+    try {
+      lowerThreadPriority(kAnnotatorNice);
+      std::optional<FrameAnnotator> annotator;
+      try {
+        annotator.emplace(scene);
+      } catch (const calib::CameraError& e) {
+        throw InputError(e.messageFrom(camera_label));
+      }
+      for (;;) {
+        FrameJob job;
+        {
+          std::unique_lock lock(mu);
+          wake.wait(lock, [&] { return abort || !todo.empty() || reader_done; });
+          if (abort || todo.empty()) return;
+          job = std::move(todo.front());
+          todo.pop_front();
+        }
+        const cv::Mat picture =
+            masks && masks->fromRecording() ? job.bgr.clone() : cv::Mat();  // before anything is drawn
+        annotator->annotate(job.bgr, job.record);
+        if (masks) job.record.mask_iou = masks->at(job.index, job.record.values, picture);
+        std::lock_guard lock(mu);
+        done.emplace(job.index, std::move(job));
+        wake.notify_all();
+      }
+    } catch (...) {
+      fail(std::current_exception());
+    }
+  }
+
+  // The writer: frame `index` once drawn, into `job`; false when every frame was handed on or a
+  // stage failed.
+  bool next(std::size_t index, FrameJob& job) {
+    std::unique_lock lock(mu);
+    wake.wait(lock, [&] { return abort || done.count(index) > 0 || (reader_done && index >= decoded); });
+    if (abort || done.count(index) == 0) return false;
+    job = std::move(done.at(index));
+    done.erase(index);
+    return true;
+  }
+
+  // A frame handed on: its buffer decoded into again when nothing else holds it.
+  void handedOn(cv::Mat&& bgr) {
+    std::lock_guard lock(mu);
+    if (bgr.u != nullptr && bgr.u->refcount == 1) spare.push_back(std::move(bgr));
+    --in_flight;
+    wake.notify_all();
+  }
+};
+
+// A drawn frame on the contact sheet, captioned; the most critical frame always makes it there:
+// colliding first, then the nearest.
+void addToSheet(ContactSheet& sheet, const FrameJob& job) {
+  const FrameRecord& r = job.record;
+  std::string caption = "#" + std::to_string(job.index) + "  " + messageNumber(r.time, 4) + " s  " + toString(r.status);
+  if (std::isfinite(r.min_distance)) caption += "  " + messageNumber(r.min_distance * 1000, 3) + " mm";
+  if (r.mask_iou) caption += "  IoU " + messageNumber(*r.mask_iou, 3);
+  const double priority = r.unsafe() || r.status == SafetyStatus::Colliding ? -1.0
+                          : std::isfinite(r.min_distance)                   ? r.min_distance
+                                                                            : std::numeric_limits<double>::infinity();
+  sheet.add(job.index, job.bgr, caption, priority);
+}
+
 }  // namespace
 
 bool FrameRange::contains(std::size_t i) const {
@@ -215,134 +377,20 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   const AnnotatorScene scene{model, in.log, *projection, render_options, visuals, settings};
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
   report.jobs = opt.jobs > 0 ? opt.jobs : static_cast<int>(hw);
-  const std::size_t max_in_flight = 2 * static_cast<std::size_t>(report.jobs) + 2;
 
-  // Shared between the reader, the annotators and the writer (this thread), under one mutex.
-  std::mutex mu;
-  std::condition_variable cv;
-  std::deque<FrameJob> todo;
-  std::map<std::size_t, FrameJob> done;
-  std::vector<cv::Mat> spare;  // handed-on frames' buffers, decoded into again (no allocation per frame)
-  std::size_t in_flight = 0, decoded = 0;
-  bool reader_done = false, abort = false;
-  std::exception_ptr error;
-  auto fail = [&](const std::exception_ptr& e) {
-    std::lock_guard lock(mu);
-    if (!error) error = e;
-    abort = true;
-    cv.notify_all();
-  };
-  const auto count = [](std::size_t n) { return std::to_string(n); };
-
-  std::thread reader([&] {
-    try {
-      for (std::size_t index = 0;; ++index) {
-        {
-          std::unique_lock lock(mu);
-          cv.wait(lock, [&] { return abort || in_flight < max_in_flight; });
-          if (abort) return;
-        }
-        FrameJob job;
-        job.index = index;
-        {
-          std::lock_guard lock(mu);
-          if (!spare.empty()) {
-            job.bgr = std::move(spare.back());
-            spare.pop_back();
-          }
-        }
-        const auto t_decode = std::chrono::steady_clock::now();
-        if (!video.read(job.bgr)) {
-          if (index == 0) throw VideoError(video_label + ": no frame could be decoded");
-          if (expected > 0 && index < expected)
-            throw VideoError(video_label + ": the video ends after " + count(index) + " of the " + count(expected) +
-                             " frames its header declares (truncated or damaged)");
-          if (!in.frame_times.empty() && index < in.frame_times.size())
-            throw InputError(in.frame_times_label + ": lists frames up to " + count(in.frame_times.size() - 1) +
-                             " but the video ends after " + count(index) + " frames");
-          break;
-        }
-        if (job.bgr.cols != camera.width || job.bgr.rows != camera.height)
-          throw VideoError(video_label + ": frame " + count(index) + " is " + std::to_string(job.bgr.cols) + "x" +
-                           std::to_string(job.bgr.rows) + " but " + camera_label + " is calibrated for " +
-                           std::to_string(camera.width) + "x" + std::to_string(camera.height));
-        if (job.bgr.type() != CV_8UC3) {
-          cv::Mat converted;
-          if (job.bgr.channels() == 1)
-            cv::cvtColor(job.bgr, converted, cv::COLOR_GRAY2BGR);
-          else if (job.bgr.channels() == 4)
-            cv::cvtColor(job.bgr, converted, cv::COLOR_BGRA2BGR);
-          else
-            throw VideoError(video_label + ": frame " + count(index) + " is not an 8-bit colour image");
-          job.bgr = converted;
-        }
-        job.record.times.decode = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_decode).count();
-        job.record.time = clock(index);
-        if (clock.fromFrameTimes() && !std::isfinite(job.record.time))
-          throw InputError(in.frame_times_label + ": no time for frame " + count(index));
-        job.record.selected = opt.frames.contains(index);
-        std::lock_guard lock(mu);
-        todo.push_back(std::move(job));
-        ++in_flight;
-        decoded = index + 1;
-        cv.notify_all();
-      }
-      std::lock_guard lock(mu);
-      reader_done = true;
-      cv.notify_all();
-    } catch (...) {
-      fail(std::current_exception());
-    }
-  });
-
+  Pipeline pipe{in,          opt,          video,    clock,
+                video_label, camera_label, expected, 2 * static_cast<std::size_t>(report.jobs) + 2};
+  std::thread reader([&] { pipe.read(); });
   std::vector<std::thread> annotators;
-  for (int w = 0; w < report.jobs; ++w)
-    annotators.emplace_back([&] {
-      try {
-        lowerThreadPriority(kAnnotatorNice);
-        std::optional<FrameAnnotator> annotator;
-        try {
-          annotator.emplace(scene);
-        } catch (const calib::CameraError& e) {
-          throw InputError(e.messageFrom(camera_label));
-        }
-        for (;;) {
-          FrameJob job;
-          {
-            std::unique_lock lock(mu);
-            cv.wait(lock, [&] { return abort || !todo.empty() || reader_done; });
-            if (abort || todo.empty()) return;
-            job = std::move(todo.front());
-            todo.pop_front();
-          }
-          const cv::Mat picture =
-              masks && masks->fromRecording() ? job.bgr.clone() : cv::Mat();  // before anything is drawn
-          annotator->annotate(job.bgr, job.record);
-          if (masks) job.record.mask_iou = masks->at(job.index, job.record.values, picture);
-          std::lock_guard lock(mu);
-          done.emplace(job.index, std::move(job));
-          cv.notify_all();
-        }
-      } catch (...) {
-        fail(std::current_exception());
-      }
-    });
+  for (int w = 0; w < report.jobs; ++w) annotators.emplace_back([&] { pipe.annotate(scene, masks); });
 
   // The writer: frames in input order.
   ContactSheet sheet(std::max<std::size_t>(opt.contact_frames, 1), opt.contact_tile_width);
   const auto t_frames = std::chrono::steady_clock::now();
   report.setup_seconds = std::chrono::duration<double>(t_frames - t_setup).count();
   try {
-    for (std::size_t next = 0;; ++next) {
-      FrameJob job;
-      {
-        std::unique_lock lock(mu);
-        cv.wait(lock, [&] { return abort || done.count(next) > 0 || (reader_done && next >= decoded); });
-        if (abort) break;
-        if (done.count(next) == 0) break;  // every frame handed on
-        job = std::move(done.at(next));
-        done.erase(next);
-      }
+    FrameJob job;
+    for (std::size_t next = 0; pipe.next(next, job); ++next) {
       FrameRecord& r = job.record;
       if (r.selected) {
         if (sink) {
@@ -352,35 +400,21 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
           r.written = true;
           ++report.written;
         }
-        if (opt.contact_frames > 0) {
-          std::string caption = "#" + count(job.index) + "  " + messageNumber(r.time, 4) + " s  " + toString(r.status);
-          if (std::isfinite(r.min_distance)) caption += "  " + messageNumber(r.min_distance * 1000, 3) + " mm";
-          if (r.mask_iou) caption += "  IoU " + messageNumber(*r.mask_iou, 3);
-          // The most critical frame is always on the sheet: colliding first, then the nearest.
-          const double priority = r.unsafe() || r.status == SafetyStatus::Colliding ? -1.0
-                                  : std::isfinite(r.min_distance)                   ? r.min_distance
-                                                                  : std::numeric_limits<double>::infinity();
-          sheet.add(job.index, job.bgr, caption, priority);
-        }
+        if (opt.contact_frames > 0) addToSheet(sheet, job);
       }
       report.frames.push_back(std::move(job.record));
-      {
-        std::lock_guard lock(mu);
-        if (job.bgr.u != nullptr && job.bgr.u->refcount == 1) spare.push_back(std::move(job.bgr));
-        --in_flight;
-        cv.notify_all();
-      }
+      pipe.handedOn(std::move(job.bgr));
       if (progress) {
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_frames).count();
         progress(OverlayProgress{next + 1, expected, elapsed > 0 ? static_cast<double>(next + 1) / elapsed : 0.0});
       }
     }
   } catch (...) {
-    fail(std::current_exception());
+    pipe.fail(std::current_exception());
   }
   reader.join();
   for (std::thread& t : annotators) t.join();
-  if (error) std::rethrow_exception(error);
+  if (pipe.error) std::rethrow_exception(pipe.error);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_frames).count();
   for (const FrameRecord& r : report.frames) {
     report.no_state += r.status == SafetyStatus::NoState;
