@@ -53,11 +53,9 @@ InputError::InputError(InputLocation where, const std::string& problem)
     : std::runtime_error(joined(where.text(), problem)),
       data_(std::make_shared<const Data>(Data{std::move(where), problem})) {}
 
-double checkFieldRange(double value, double lo, double hi, const std::string& field) {
-  if (!(value >= lo && value <= hi))
-    throw InputError(InputLocation{{}, 0, 0, field},
-                     "must be in [" + messageNumber(lo) + ", " + messageNumber(hi) + "], got " + messageNumber(value));
-  return value;
+std::optional<std::string> rangeProblem(double value, double lo, double hi) {
+  if (value >= lo && value <= hi) return std::nullopt;
+  return "must be in [" + messageNumber(lo) + ", " + messageNumber(hi) + "], got " + messageNumber(value);
 }
 
 std::string InputError::messageFrom(std::string_view source) const {

@@ -1,10 +1,8 @@
 // `kccd overlay MODEL --camera CAM.yaml --video IN --states LOG.csv -o OUT`: the collision volumes
 // at each frame's logged state, coloured by the library's query, composited onto a recorded video
-// (kccd::overlay::overlayRecording does the work; this file reads the options and prints).
+// (kccd::overlay::OverlayJob does the work; this file reads the options into its request and prints).
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
-#include <filesystem>
 #include <iostream>
 #include <optional>
 
@@ -14,8 +12,6 @@
 #include "commands.hpp"
 #include "kccd/overlay/jobs/overlay_job.hpp"
 #include "kccd/overlay/recording/overlay_recording.hpp"
-#include "kccd/overlay/recording/video_sink.hpp"
-#include "kccd/state_log.hpp"
 
 namespace kccd::cli {
 namespace {

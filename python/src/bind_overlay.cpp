@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <functional>
 #include <map>
 
@@ -24,11 +23,8 @@
 #include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/jobs/overlay_job.hpp"
 #include "kccd/overlay/recording/contact_sheet.hpp"
-#include "kccd/overlay/recording/mask_agreement.hpp"
 #include "kccd/overlay/recording/overlay_recording.hpp"
-#include "kccd/overlay/recording/video_sink.hpp"
 #include "kccd/overlay/synth/synth.hpp"
-#include "kccd/state_log.hpp"
 #include "progress_relay.hpp"
 
 namespace kccd::python {

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -59,9 +60,9 @@ inline std::string spelledField(const FieldSpelling& spell, const std::string& f
   return spell ? spell(field) : field;
 }
 
-/// A request's field out of range: "must be in [lo, hi], got value" (NaN refused), thrown as an
-/// InputError with the field and no source. Returns `value`.
-double checkFieldRange(double value, double lo, double hi, const std::string& field);
+/// What is wrong with a request's number `value` that must lie in [lo, hi]: "must be in [lo, hi],
+/// got value" (NaN is outside), or none. The one wording of every front end's range checks.
+std::optional<std::string> rangeProblem(double value, double lo, double hi);
 
 /// `value` as messages print it: printf's %g with `digits` significant digits (formatNumber).
 inline std::string messageNumber(double value, int digits = 10) { return formatNumber(value, digits); }

@@ -57,11 +57,8 @@ struct Checker {
   std::string named(const std::string& field) const { return spelledField(spell, field); }
   InputError problem(const std::string& field, const std::string& text) const { return fieldError(named(field), text); }
   double range(double value, double lo, double hi, const std::string& field) const {
-    try {
-      return checkFieldRange(value, lo, hi, field);
-    } catch (const InputError& e) {
-      throw problem(field, e.problem());
-    }
+    if (const std::optional<std::string> wrong = rangeProblem(value, lo, hi)) throw problem(field, *wrong);
+    return value;
   }
   void recording() const;
   OverlayOptions options() const;

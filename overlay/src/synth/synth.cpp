@@ -35,11 +35,7 @@ SynthError fieldError(const std::string& field, const std::string& problem) {
 
 // A number option within [lo, hi] (NaN refused).
 void checkRange(double value, double lo, double hi, const char* field) {
-  try {
-    checkFieldRange(value, lo, hi, field);
-  } catch (const InputError& e) {
-    throw fieldError(field, e.problem());
-  }
+  if (const std::optional<std::string> wrong = rangeProblem(value, lo, hi)) throw fieldError(field, *wrong);
 }
 
 // Every option that does not need the model's motion, in the order `kccd synth` has always checked
