@@ -26,7 +26,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 # The slowest first, so that the jobs end together.
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_urdf fuzz_part fuzz_model fuzz_states fuzz_frame_times fuzz_camera fuzz_tags fuzz_labels fuzz_labels_json fuzz_golden_manifest fuzz_frame fuzz_mask fuzz_video fuzz_mcap fuzz_ros_message fuzz_ros1_bag fuzz_db3 fuzz_joint_map)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_urdf fuzz_part fuzz_model fuzz_states fuzz_frame_times fuzz_camera fuzz_tags fuzz_labels fuzz_labels_json fuzz_golden_manifest fuzz_frame fuzz_mask fuzz_video fuzz_mcap fuzz_ros_message fuzz_ros1_bag fuzz_db3 fuzz_parquet fuzz_lerobot fuzz_joint_map)
 bash scripts/install-deps.sh --fuzz
 # -O1 with line tables only: the fuzzers' stacks keep files and lines, and the build is much shorter.
 CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -55,6 +55,8 @@ ci_runs() {  # inputs per target in --ci mode (15-40 s each on this project's ma
     fuzz_ros_message) echo 200000 ;;
     fuzz_ros1_bag) echo 40000 ;;
     fuzz_db3) echo 4000 ;;    # about 120 inputs/s: each input is opened by SQLite
+    fuzz_parquet) echo 80000 ;;  # about 3,500 inputs/s on a core of its own
+    fuzz_lerobot) echo 20000 ;;
     fuzz_joint_map) echo 100000 ;;
   esac
 }
@@ -78,6 +80,8 @@ seeds() {  # extra seed files from data/ per target
     fuzz_ros_message) ;;
     fuzz_ros1_bag) ;;
     fuzz_db3) ;;
+    fuzz_parquet) ;;
+    fuzz_lerobot) ;;
     fuzz_joint_map) ;;
   esac
 }

@@ -10,7 +10,7 @@ packages=(
   libcoin-dev inventor-data liburdfdom-dev libassimp-dev
   libosmesa6-dev libgl-dev libegl-dev libopengl-dev libegl-mesa0
   libopencv-dev libpng-dev libjpeg62-turbo-dev libtinyxml2-dev libapriltag-dev
-  zlib1g-dev libzstd-dev liblz4-dev libbz2-dev libsqlite3-dev
+  zlib1g-dev libzstd-dev liblz4-dev libbz2-dev libsqlite3-dev libsnappy-dev
   python3-dev pybind11-dev python3-numpy
   python3-yaml python3-distributed python3-dask
 )
@@ -21,6 +21,8 @@ packages=(
 #            pytest, mypy and typeshed's stubs (PyYAML's, for mypy --strict on kccd.batch); and the
 #            robot-log tests' fixture writers: ROS 1's rosbag with its sensor_msgs and lz4
 #            (python3-rosbag, python3-sensor-msgs, python3-roslz4), npm's @mcap/core (tests/bags);
+#            the dataset tests' writers: npm's parquet-wasm, apache-arrow and hyparquet-writer
+#            (tests/datasets) and Debian's FFmpeg (AV1, h264 and mpeg4 videos);
 #            and clang-format and clang-tidy (scripts/lint.sh).
 #   --docs   also what scripts/docs.sh builds the site with: Sphinx, MyST (Markdown pages), Breathe
 #            on Doxygen's XML (the C++ API), the Furo theme
@@ -29,7 +31,7 @@ for arg in "$@"; do
   case "$arg" in
     --fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;
     --docs) packages+=(python3-sphinx python3-myst-parser python3-breathe doxygen furo) ;;
-    --tests) tests=1; packages+=(chromium python3-pytest python3-matplotlib mypy python3-typeshed python3-rosbag python3-sensor-msgs python3-roslz4 clang-format clang-tidy) ;;
+    --tests) tests=1; packages+=(chromium python3-pytest python3-matplotlib mypy python3-typeshed python3-rosbag python3-sensor-msgs python3-roslz4 clang-format clang-tidy ffmpeg) ;;
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 2 ;;
   esac
 done
@@ -54,6 +56,11 @@ e2e() {  # from npm: the browser test's driver (the browser itself is Debian's c
   if [ ! -d "$root/tests/bags/node_modules/@mcap/core" ]; then
     echo "install-deps: npm ci in tests/bags (@mcap/core, @foxglove/rosmsg2-serialization)"
     (cd "$root/tests/bags" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+  fi
+  # The dataset tests' Parquet writers (arrow-rs compiled to wasm, hyparquet-writer).
+  if [ ! -d "$root/tests/datasets/node_modules/parquet-wasm" ]; then
+    echo "install-deps: npm ci in tests/datasets (parquet-wasm, apache-arrow, hyparquet-writer)"
+    (cd "$root/tests/datasets" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
   fi
 }
 if [ ${#missing[@]} -eq 0 ]; then

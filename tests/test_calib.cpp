@@ -57,6 +57,26 @@ TEST(CalibCamera, RoundTripsThroughSave) {
   pinhole.distortion.clear();
   saveCamera(pinhole, path);
   EXPECT_EQ(loadCamera(path).distortion, std::vector<double>(5, 0.0));
+  EXPECT_EQ(loadCamera(path).frame, "");
+  // A camera fixed to the robot keeps its frame; a frame that is not a name is refused at its line.
+  Camera wrist = c;
+  wrist.frame = "panda_hand";
+  saveCamera(wrist, path);
+  EXPECT_EQ(loadCamera(path).frame, "panda_hand");
+  std::ofstream(path)
+      << "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n"
+         "camera_matrix: !!opencv-matrix {rows: 3, cols: 3, dt: d, data: [500, 0, 320, 0, 500, 240, 0, 0, 1]}\n"
+         "distortion_coefficients: !!opencv-matrix {rows: 1, cols: 5, dt: d, data: [0, 0, 0, 0, 0]}\n"
+         "rvec: !!opencv-matrix {rows: 3, cols: 1, dt: d, data: [0, 0, 0]}\n"
+         "tvec: !!opencv-matrix {rows: 3, cols: 1, dt: d, data: [0, 0, 1]}\n"
+         "frame: [1, 2]\n";
+  try {
+    loadCamera(path);
+    ADD_FAILURE() << "a list as the frame loaded";
+  } catch (const CameraError& e) {
+    EXPECT_NE(std::string(e.what()).find("frame: expected the name of a joint, body or link"), std::string::npos)
+        << e.what();
+  }
 }
 
 // The reader is yaml-cpp, the writer OpenCV: files go both ways. A camera written by saveCamera

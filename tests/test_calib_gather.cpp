@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -413,3 +414,69 @@ TEST_F(CalibLibrary, LabellingCandidatesAsData) {
 }
 
 }  // namespace
+
+namespace {
+
+// A camera fixed to joint frame `frame` with pose `mount_to_camera`, as a world camera at state `q`.
+calib::Camera worldCameraAt(const Model& m, calib::Camera c, int frame, const Pose& mount_to_camera,
+                            const std::vector<double>& q) {
+  std::vector<Pose> poses(m.joints.size());
+  EXPECT_TRUE(framePoses(m, q, poses));
+  const Pose world_to_camera = mount_to_camera * framePose(poses, frame).inverse();
+  cv::Matx33d r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r(i, j) = world_to_camera.linear()(i, j);
+  cv::Rodrigues(r, c.rvec);
+  c.tvec = cv::Vec3d(world_to_camera.translation().x(), world_to_camera.translation().y(),
+                     world_to_camera.translation().z());
+  return c;
+}
+
+}  // namespace
+
+// A camera on the robot solved from world points seen at several states (inMountFrame): the mount
+// -> camera pose it was made with, to float precision; a frame without a state is refused.
+TEST(CalibMount, ACameraOnTheRobotIsSolvedInItsFrame) {
+  const Model m = loadModel(std::string(KCCD_DATA_DIR) + "/demo_arm.yaml");
+  const int frame = m.jointIndex("shoulder_pitch");
+  calib::Camera intrinsics = calib::loadCamera(std::string(KCCD_DATA_DIR) + "/demo_camera.yaml");
+  // The true mount -> camera pose: 0.4 m out along the arm's x, looking back at the world's origin area.
+  const calib::Camera looking = intrinsics;  // the sample camera's view of the world at the zero state
+  std::vector<Pose> zero(m.joints.size());
+  ASSERT_TRUE(framePoses(m, std::vector<double>(3, 0.0), zero));
+  const Pose mount_to_camera = looking.worldToCamera() * framePose(zero, frame);
+  Gathered g;
+  const std::vector<std::vector<double>> states = {{0.0, 0.0, 0.0}, {0.15, -0.1, 0.3}, {-0.2, 0.12, 0.5}};
+  for (std::size_t f = 0; f < states.size(); ++f) {
+    char name[32];
+    std::snprintf(name, sizeof name, "f%zu", f);
+    g.frames.push_back(GatheredFrame{.image = name, .state = states[f]});
+    const calib::Camera at = worldCameraAt(m, intrinsics, frame, mount_to_camera, states[f]);
+    for (int i = 0; i < 12; ++i) {  // points on the floor and the wall in front of the robot
+      const cv::Point3d w(0.3 + 0.1 * (i % 4), -0.3 + 0.2 * (i / 4), i % 2 == 0 ? 0.0 : 0.4);
+      std::vector<cv::Point2d> px;
+      cv::projectPoints(std::vector<cv::Point3d>{w}, at.rvec, at.tvec, at.camera_matrix, at.distortion, px);
+      std::snprintf(name, sizeof name, "f%zu/p%d", f, i);
+      g.points.push_back({name, px[0], w});
+      g.sources.push_back({.frame = f});
+    }
+  }
+  const Gathered mounted = inMountFrame(g, m, frame, "--camera-frame shoulder_pitch");
+  const calib::PoseResult r = calib::solvePose(intrinsicsOf(intrinsics), mounted.points);
+  ASSERT_EQ(r.status, calib::PoseStatus::Solved) << r.message;
+  const Pose solved = r.camera.worldToCamera();
+  EXPECT_LT((solved.translation() - mount_to_camera.translation()).norm(), 1e-6);
+  EXPECT_LT((solved.linear() - mount_to_camera.linear()).norm(), 1e-6);
+  // The world camera of one state does not explain the others' points: the mount frame is what fits.
+  const calib::PoseResult wrong = calib::solvePose(intrinsicsOf(intrinsics), g.points);
+  EXPECT_TRUE(wrong.status != calib::PoseStatus::Solved || wrong.rejected.size() > 6);
+  Gathered stateless = g;
+  stateless.frames[1].state.clear();
+  try {
+    inMountFrame(stateless, m, frame, "--camera-frame shoulder_pitch");
+    ADD_FAILURE() << "a frame without a state was placed";
+  } catch (const CalibInputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("--camera-frame shoulder_pitch: frame 2 (f1) has no state", 0), 0u)
+        << e.what();
+  }
+}

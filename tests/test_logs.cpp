@@ -14,7 +14,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <numeric>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -210,6 +212,11 @@ TEST_F(McapFixtures, BagInfoMatchesTheWriter) {
       EXPECT_EQ(t["stamped"], w["count"]);
       EXPECT_EQ(t["zero_stamps"], 0);
       for (const char* k : {"min", "median", "max"}) EXPECT_NEAR(t["skew_s"][k].get<double>(), skew, 1e-6) << k;
+      // One channel, one publisher: its row is the topic's.
+      ASSERT_EQ(t["publishers"].size(), 1u);
+      for (const char* k : {"type", "count", "first_log_time_ns", "last_log_time_ns", "rate_hz", "stamped", "skew_s"})
+        EXPECT_EQ(t["publishers"][0][k], t[k]) << k;
+      EXPECT_EQ(t["publishers"][0]["metadata"], nlohmann::json::object());
     }
   }
   // The text form names both topics with their types and the skews in milliseconds.
@@ -608,6 +615,8 @@ TEST_F(McapFixtures, Ros1BagsReadAsTheSameRecording) {
         EXPECT_EQ(t["definition"], "stored");
         t["type"] = kccd::logs::normalTypeName(t["type"].get<std::string>());  // ROS 1 names have no "/msg/"
         t.erase("schema_encoding"), t.erase("message_encoding");
+        EXPECT_EQ(t["publishers"].size(), 1u);  // a connection per topic: the publisher's row is the topic's
+        t.erase("publishers");
       }
     EXPECT_EQ(a["topics"], b["topics"]);
     // Every cut reads a prefix of the messages (by topic and time) with the warning.
@@ -919,7 +928,7 @@ TEST_F(McapFixtures, OverlayOfABagIsTheOverlayOfItsExportedFiles) {
   const std::string other = kccd::testing::writeScratch("test_logs", "elbow.yaml", renamed);
   const Case cases[] = {
       {base + " --bag " + file("joint_zstd.mcap") + " --video x.mkv --report r.json", "--video: not with --bag"},
-      {base + " --report r.json", "give --video and --states, or --bag"},
+      {base + " --report r.json", "give --video and --states, --bag (a robot log) or --lerobot"},
       {std::string(KCCD_CLI) + " overlay " + other + " --camera " + camera_path + " --bag " + file("joint_zstd.mcap") +
            " --report " + (out / "e.json").string(),
        "the joint states do not name the model's state value 'elbow' (they name: joint1, joint2, joint3, joint4, "
@@ -1133,6 +1142,283 @@ TEST_F(McapFixtures, ChunksThatOverlapInTimeAreMergedByLogTime) {
   const auto info_b = runProgram(std::string(KCCD_CLI) + " bag info " + file("joint_overlap.mcap") + " --json");
   EXPECT_EQ(nlohmann::json::parse(info_a.out)["topics"], nlohmann::json::parse(info_b.out)["topics"]);
   EXPECT_EQ(exportOf(file("joint_overlap.mcap"), "overlap"), exportOf(file("joint_zstd.mcap"), "mcap"));
+}
+
+// What a reader streams, copied out of its views (which last until its next message).
+struct Read {
+  std::string topic;
+  std::uint16_t channel = 0;
+  std::uint64_t log_time = 0, offset = 0;
+  std::vector<std::uint8_t> bytes;
+};
+
+std::vector<Read> readAll(LogReader& r) {
+  std::vector<Read> out;
+  LogMessage m;
+  while (r.next(m))
+    out.push_back(Read{m.channel->topic, m.channel->id, m.log_time, m.offset, {m.data.begin(), m.data.end()}});
+  return out;
+}
+
+nlohmann::json infoJson(const std::string& bag) {
+  const auto r = runProgram(std::string(KCCD_CLI) + " bag info " + bag + " --json");
+  EXPECT_EQ(r.code, 0) << r.err;
+  return r.code == 0 ? nlohmann::json::parse(r.out) : nlohmann::json();
+}
+
+// A topic several nodes publish (a ROS 1 connection each, as `rosbag record` writes a PR2's /tf;
+// an MCAP channel each) is one row of bag info with its publishers' rows under it: the topics'
+// rows are those of the same log with one publisher per topic, each publisher's those of its own
+// messages (joint state k came from publisher k mod 3).
+TEST_F(McapFixtures, ATopicOfSeveralPublishersIsOneRow) {
+  const char* const callers[] = {"/arm_controller", "/gripper_controller", "/joint_state_publisher"};
+  const nlohmann::json& joints = truth_["joint_states"];
+  for (const auto& [name, single] :
+       {std::pair{"ros1_publishers.bag", "ros1_none.bag"}, std::pair{"joint_publishers.mcap", "joint_zstd.mcap"}}) {
+    SCOPED_TRACE(name);
+    nlohmann::json a = infoJson(file(name)), b = infoJson(file(single));
+    ASSERT_EQ(a["topics"].size(), 3u);
+    for (const nlohmann::json& t : a["topics"]) {
+      if (t["topic"] != "/joint_states") {
+        EXPECT_EQ(t["publishers"].size(), 1u) << t["topic"];
+        continue;
+      }
+      const nlohmann::json& pubs = t["publishers"];
+      ASSERT_EQ(pubs.size(), 3u);
+      for (std::size_t p = 0; p < 3; ++p) {
+        SCOPED_TRACE(callers[p]);
+        const std::size_t n = (joints.size() + 2 - p) / 3;
+        EXPECT_EQ(pubs[p]["metadata"]["callerid"], callers[p]);
+        EXPECT_EQ(pubs[p]["type"], t["type"]);
+        EXPECT_EQ(pubs[p]["count"], n);
+        EXPECT_EQ(pubs[p]["first_log_time_ns"], joints[p]["log_time_ns"]);
+        EXPECT_EQ(pubs[p]["last_log_time_ns"], joints[p + 3 * (n - 1)]["log_time_ns"]);
+        EXPECT_NEAR(pubs[p]["rate_hz"].get<double>(), 1000.0 / 3, 1e-6);  // 3 ms apart
+        EXPECT_EQ(pubs[p]["stamped"], n);
+        EXPECT_NEAR(pubs[p]["skew_s"]["median"].get<double>(), 0.002, 1e-6);
+      }
+    }
+    for (nlohmann::json* j : {&a, &b})
+      for (nlohmann::json& t : (*j)["topics"]) t.erase("publishers");
+    EXPECT_EQ(a["topics"], b["topics"]);
+    EXPECT_EQ(a["messages"], b["messages"]);
+    // The text: one line for the topic, with its publisher count.
+    const auto text = runProgram(std::string(KCCD_CLI) + " bag info " + file(name));
+    ASSERT_EQ(text.code, 0) << text.err;
+    std::size_t lines = 0;
+    for (std::size_t at = 0; (at = text.out.find("\n  /joint_states  ", at)) != std::string::npos; ++at) ++lines;
+    EXPECT_EQ(lines, 1u) << text.out;
+    EXPECT_NE(text.out.find("  200 messages (3 publishers) from 0.000 to 0.199 s, 1000.0 Hz, skew 2.000 / 2.000 / "
+                            "2.000 ms\n"),
+              std::string::npos)
+        << text.out;
+    EXPECT_EQ(text.out.find("publisher)"), std::string::npos) << text.out;  // one publisher: no count
+  }
+}
+
+// A rosbag2 bag split into MCAP files (11, listed in its metadata.yaml, each giving the topics other
+// channel ids) reads as one log: the messages of the one-file log in the same order, one channel
+// per topic, places naming the file; bag info and the export as the one file's. A file cut short
+// loses its own tail only; a file missing, or files of two storages, are errors naming them.
+TEST_F(McapFixtures, ABagSplitIntoMcapFilesReadsAsOneLog) {
+  McapReader one(file("joint_zstd.mcap"));
+  const std::vector<Read> want = readAll(one);
+  const std::unique_ptr<LogReader> r = openLog(file("split_mcap"));
+  EXPECT_EQ(r->format(), "MCAP");
+  const std::vector<Read> got = readAll(*r);
+  EXPECT_TRUE(r->damage().empty()) << r->damage();
+  EXPECT_EQ(r->profile(), truth_["profile"]);
+  EXPECT_EQ(r->library(), truth_["library"]);
+  ASSERT_EQ(got.size(), want.size());
+  std::map<std::string, std::uint16_t> channel_of;
+  for (std::size_t k = 0; k < got.size(); ++k) {
+    EXPECT_EQ(got[k].topic, want[k].topic) << k;
+    EXPECT_EQ(got[k].log_time, want[k].log_time) << k;
+    EXPECT_EQ(got[k].bytes, want[k].bytes) << k;
+    const auto [it, fresh] = channel_of.try_emplace(got[k].topic, got[k].channel);
+    EXPECT_EQ(it->second, got[k].channel) << k << " " << got[k].topic;
+  }
+  std::set<std::uint16_t> ids;
+  for (const auto& [topic, id] : channel_of) ids.insert(id);
+  EXPECT_EQ(ids.size(), 3u);
+  const std::size_t first3 = 3 * want.size() / 11;  // the writer's division
+  EXPECT_EQ(r->place(got[first3].offset).rfind("rec_3.mcap byte ", 0), 0u) << r->place(got[first3].offset);
+  EXPECT_EQ(r->place(got[first3 - 1].offset).rfind("rec_2.mcap byte ", 0), 0u) << r->place(got[first3 - 1].offset);
+  int chunks = 0;
+  for (int k = 0; k < 11; ++k) {
+    McapReader part(file("split_mcap/rec_" + std::to_string(k) + ".mcap"));
+    all(part);
+    chunks += part.chunks().at("zstd");
+  }
+  EXPECT_EQ(r->chunks().at("zstd"), chunks);
+  // bag info: the one file's topics; the chunks of all files.
+  const nlohmann::json a = infoJson(file("split_mcap")), b = infoJson(file("joint_zstd.mcap"));
+  EXPECT_EQ(a["format"], "MCAP");
+  EXPECT_EQ(a["topics"], b["topics"]);
+  EXPECT_EQ(a["messages"], b["messages"]);
+  EXPECT_EQ(a["chunks"]["zstd"], chunks);
+  EXPECT_EQ(exportOf(file("split_mcap"), "split_mcap"), exportOf(file("joint_zstd.mcap"), "mcap"));
+
+  // rec_5 cut at half: rec_0 to rec_4 whole, a prefix of rec_5, rec_6 on whole, with a warning.
+  const fs::path cut = dir_ / "split_mcap_cut";
+  fs::create_directories(cut);
+  fs::copy(dir_ / "split_mcap", cut, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+  const std::string five = readText((cut / "rec_5.mcap").string());
+  std::ofstream((cut / "rec_5.mcap").string(), std::ios::binary) << five.substr(0, five.size() / 2);
+  const std::unique_ptr<LogReader> c = openLog(cut.string());
+  const std::vector<Read> part = readAll(*c);
+  EXPECT_EQ(c->damage().rfind("rec_5.mcap: cut short at byte ", 0), 0u) << c->damage();
+  const std::size_t first5 = 5 * want.size() / 11, first6 = 6 * want.size() / 11;
+  ASSERT_LT(part.size(), want.size());
+  const std::size_t lost = want.size() - part.size();
+  EXPECT_LE(lost, first6 - first5);
+  for (std::size_t k = 0; k < part.size(); ++k) {
+    const std::size_t w = k < first6 - lost ? k : k + lost;
+    EXPECT_EQ(part[k].log_time, want[w].log_time) << k;
+    EXPECT_EQ(part[k].bytes, want[w].bytes) << k;
+  }
+  const auto warned = runProgram(std::string(KCCD_CLI) + " bag info " + cut.string());
+  EXPECT_EQ(warned.code, 0) << warned.err;
+  EXPECT_NE(warned.err.find("warning: " + cut.string() + ": rec_5.mcap: cut short at byte "), std::string::npos)
+      << warned.err;
+
+  // A file the metadata lists that is not there; an MCAP file listed with a .db3 file.
+  const auto folder = [&](const std::string& name, const std::vector<std::string>& files) {
+    const fs::path d = dir_ / name;
+    fs::create_directories(d);
+    std::string meta =
+        "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  relative_file_paths:\n";
+    for (const std::string& f : files) {
+      meta += "    - " + f + "\n";
+      for (const fs::path& from : {dir_ / "split_mcap" / f, dir_ / "split" / f})
+        if (fs::exists(from)) fs::copy_file(from, d / f, fs::copy_options::overwrite_existing);
+    }
+    std::ofstream((d / "metadata.yaml").string()) << meta;
+    return d.string();
+  };
+  const std::string missing = folder("split_missing", {"rec_0.mcap", "rec_99.mcap"});
+  try {
+    openLog(missing);
+    ADD_FAILURE() << "a missing file read";
+  } catch (const kccd::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("rec_99.mcap: file: listed in the folder's metadata.yaml, but not a file"),
+              std::string::npos)
+        << e.what();
+  }
+  const std::string mixed = folder("split_mixed", {"rec_0.mcap", "split_1.db3"});
+  try {
+    openLog(mixed);
+    ADD_FAILURE() << "MCAP and sqlite3 files read as one log";
+  } catch (const kccd::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("MCAP files and files of another kind"), std::string::npos) << e.what();
+  }
+}
+
+// A ROS 1 bag cut inside an uncompressed chunk: a 100 Hz log of 4 MB in rosbag's default chunks of
+// 768 KiB, cut at points inside its first chunk (at 300 kB, as a copy stopped early, it read no
+// message before): exactly the messages whose records end before the cut (the writer found each
+// record's end by its bytes), in order, each as in the whole bag; the damage names the cut chunk.
+TEST_F(McapFixtures, ARos1BagCutInsideAnUncompressedChunkKeepsItsWholeRecords) {
+  const nlohmann::json big = nlohmann::json::parse(readText(file("big_truth.json")));
+  const std::unique_ptr<LogReader> whole = openLog(file("ros1_big_none.bag"));
+  const std::vector<Read> full = readAll(*whole);
+  EXPECT_TRUE(whole->damage().empty()) << whole->damage();
+  ASSERT_EQ(full.size(), big["messages"].size());
+  std::vector<std::uint64_t> ends;
+  for (std::size_t k = 0; k < full.size(); ++k) {
+    EXPECT_EQ(full[k].log_time, ns(big["messages"][k]["log_time_ns"])) << k;
+    ends.push_back(big["messages"][k]["record_end"].get<std::uint64_t>());
+  }
+  const nlohmann::json& bag = big["bags"]["ros1_big_none.bag"];
+  const std::uint64_t chunk = bag["chunks"][0], next_chunk = bag["chunks"][1];
+  ASSERT_GT(next_chunk - chunk, 768u * 1024);
+  const std::string bytes = readText(file("ros1_big_none.bag"));
+  // The first chunk's record ends with its last message's (index records follow it).
+  const auto in_first = static_cast<std::size_t>(
+      std::count_if(ends.begin(), ends.end(), [&](std::uint64_t e) { return e < next_chunk; }));
+  const std::uint64_t chunk_end = ends[in_first - 1];
+  std::vector<std::uint64_t> cuts = {chunk + 100, ends[0] - 1,   ends[0],   ends[0] + 1,
+                                     300000,      ends[400] - 1, ends[400], chunk_end - 1};
+  for (std::uint64_t c = chunk + 50000; c < chunk_end; c += 97003) cuts.push_back(c);
+  for (const std::uint64_t cut : cuts) {
+    SCOPED_TRACE("cut at " + std::to_string(cut));
+    const auto want =
+        static_cast<std::size_t>(std::count_if(ends.begin(), ends.end(), [&](auto e) { return e <= cut; }));
+    const std::string path = kccd::testing::writeScratch("test_logs", "cut_big.bag", bytes.substr(0, cut));
+    const std::unique_ptr<LogReader> r = openLog(path);
+    std::vector<Read> got;
+    ASSERT_NO_THROW(got = readAll(*r));
+    ASSERT_EQ(got.size(), want);
+    for (std::size_t k = 0; k < got.size(); ++k) {
+      EXPECT_EQ(got[k].log_time, full[k].log_time) << k;
+      EXPECT_EQ(got[k].bytes, full[k].bytes) << k;
+    }
+    EXPECT_NE(r->damage().find("cut short at byte " + std::to_string(chunk) + " of " + std::to_string(cut) +
+                               " (inside a record's "),
+              std::string::npos)
+        << r->damage();
+    EXPECT_NE(r->damage().find(": an uncompressed chunk: its records whole before the cut are read)"),
+              std::string::npos)
+        << r->damage();
+  }
+  // At 300 kB of the 4 MB: hundreds of messages, and bag info says so with one warning.
+  const auto at300k =
+      static_cast<std::size_t>(std::count_if(ends.begin(), ends.end(), [](auto e) { return e <= 300000; }));
+  EXPECT_GT(at300k, 250u);
+  const std::string path = kccd::testing::writeScratch("test_logs", "cut_300k.bag", bytes.substr(0, 300000));
+  const auto info = runProgram(std::string(KCCD_CLI) + " bag info " + path + " --json");
+  ASSERT_EQ(info.code, 0) << info.err;
+  EXPECT_EQ(nlohmann::json::parse(info.out)["messages"], at300k);
+  EXPECT_EQ(std::count(info.err.begin(), info.err.end(), '\n'), 1) << info.err;
+  EXPECT_NE(info.err.find("warning: " + path + ": cut short at byte " + std::to_string(chunk)), std::string::npos)
+      << info.err;
+}
+
+// A ROS 1 bag cut inside a compressed chunk (bz2, lz4; 2 MiB chunks of random image bytes, so
+// several compressed blocks each): what the bytes before the cut decompress to is read, the
+// messages whose records are whole in it, exactly as Python's streaming decoders make of the same
+// bytes (the writer's figures); where nothing decompresses (a cut inside the first block), no
+// message, and the damage says which.
+TEST_F(McapFixtures, ARos1BagCutInsideACompressedChunkKeepsWhatDecompresses) {
+  const nlohmann::json big = nlohmann::json::parse(readText(file("big_truth.json")));
+  for (const char* name : {"ros1_big_bz2.bag", "ros1_big_lz4.bag"}) {
+    SCOPED_TRACE(name);
+    const std::string compression = std::string(name).substr(9, 3);
+    const std::unique_ptr<LogReader> whole = openLog(file(name));
+    const std::vector<Read> full = readAll(*whole);
+    ASSERT_EQ(full.size(), big["messages"].size());
+    const std::string bytes = readText(file(name));
+    const std::string chunk = std::to_string(big["bags"][name]["chunks"][0].get<std::uint64_t>());
+    std::size_t kept = 0;
+    for (const nlohmann::json& c : big["bags"][name]["cuts"]) {
+      const auto cut = c["cut"].get<std::size_t>();
+      SCOPED_TRACE("cut at " + std::to_string(cut));
+      const std::string path = kccd::testing::writeScratch("test_logs", "cut_big." + compression, bytes.substr(0, cut));
+      const std::unique_ptr<LogReader> r = openLog(path);
+      std::vector<Read> got;
+      ASSERT_NO_THROW(got = readAll(*r));
+      ASSERT_EQ(got.size(), c["messages"].get<std::size_t>());
+      for (std::size_t k = 0; k < got.size(); ++k) {
+        EXPECT_EQ(got[k].log_time, full[k].log_time) << k;
+        EXPECT_EQ(got[k].bytes, full[k].bytes) << k;
+      }
+      const std::string& d = r->damage();
+      EXPECT_EQ(d.rfind("cut short at byte " + chunk + " of " + std::to_string(cut) + " (inside a record's ", 0), 0u)
+          << d;
+      if (c["decompressed"] == 0) {
+        EXPECT_NE(d.find(": a chunk compressed with " + compression + " of which nothing decompresses before the cut"),
+                  std::string::npos)
+            << d;
+      } else {
+        EXPECT_NE(d.find(": a chunk compressed with " + compression + " whose first " + c["decompressed"].dump() +
+                         " of " + c["chunk_size"].dump() + " bytes decompress before the cut"),
+                  std::string::npos)
+            << d;
+      }
+      kept = std::max(kept, got.size());
+    }
+    EXPECT_GT(kept, 800u);  // a whole block's messages at least
+  }
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/checker.hpp"
+#include "kccd/kinematics.hpp"
 #include "kccd/render/model_view.hpp"
 #include "kccd/render/scene.hpp"
 #include "kccd/render/visuals.hpp"
@@ -417,3 +418,73 @@ TEST(RenderVisuals, AMeshFileThatCannotBeReadNamesTheVisual) {
 }
 
 }  // namespace
+
+namespace {
+
+// The camera `c` (fixed in the world) as a camera fixed to joint frame `frame` at state `q`: the
+// same view there, moving with the frame at other states.
+calib::Camera mountedAt(const Model& m, calib::Camera c, const std::string& frame, const std::vector<double>& q) {
+  std::vector<Pose> poses(m.joints.size());
+  EXPECT_TRUE(framePoses(m, q, poses));
+  const Pose mount_to_camera = c.worldToCamera() * framePose(poses, m.jointIndex(frame));
+  cv::Matx33d r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r(i, j) = mount_to_camera.linear()(i, j);
+  cv::Rodrigues(r, c.rvec);
+  c.tvec = cv::Vec3d(mount_to_camera.translation().x(), mount_to_camera.translation().y(),
+                     mount_to_camera.translation().z());
+  c.frame = frame;
+  return c;
+}
+
+}  // namespace
+
+// A camera on the robot (Camera::frame): at the state it was placed at, the world camera's picture;
+// at another state the bodies on its own link stay where they were in the picture while the world
+// moves; with no state nothing is drawn; a frame the model lacks is one CameraError.
+TEST_F(ModelViewTest, ACameraOnTheRobotSeesFromItsLink) {
+  const Model& m = *model_;
+  const std::vector<double> q = {0.3, 0.4, 0.6}, q2 = {-0.2, 0.1, 0.9};
+  const calib::Camera world = smallCamera(), mounted = mountedAt(m, world, "shoulder_pitch", q);
+  ModelView fixed(m, world), moving(m, mounted);
+  ModelViewRequest request;
+  request.state = q;
+  const ModelFrame a = fixed.draw(request), b = moving.draw(request);
+  // The same picture up to float rounding of the composed pose: the same labels in every pixel but a few on edges.
+  ASSERT_EQ(a.images.mask.size(), b.images.mask.size());
+  cv::Mat differ;
+  cv::compare(a.images.mask, b.images.mask, differ, cv::CMP_NE);
+  EXPECT_LT(cv::countNonZero(differ), 20);
+  EXPECT_GT(cv::countNonZero(b.images.mask), 1000);
+  // At q2 the upper arm (on shoulder_pitch) is where it was; the pedestal (world) is not.
+  request.state = q2;
+  const ModelFrame c = moving.draw(request);
+  const auto labelOf = [&](const std::string& body) { return static_cast<uchar>(m.bodyIndex(body) + 1); };
+  cv::Mat before, after;
+  cv::compare(b.images.mask, labelOf("upper_arm"), before, cv::CMP_EQ);
+  cv::compare(c.images.mask, labelOf("upper_arm"), after, cv::CMP_EQ);
+  EXPECT_GT(cv::countNonZero(before), 100);
+  cv::Mat moved;
+  cv::bitwise_xor(before, after, moved);
+  EXPECT_LT(cv::countNonZero(moved), cv::countNonZero(before) / 10);
+  cv::compare(b.images.mask, labelOf("pedestal"), before, cv::CMP_EQ);
+  cv::compare(c.images.mask, labelOf("pedestal"), after, cv::CMP_EQ);
+  cv::bitwise_xor(before, after, moved);
+  EXPECT_GT(cv::countNonZero(moved), cv::countNonZero(before) / 10);
+  // No state: the camera cannot be placed, nothing is drawn.
+  request.state = {};
+  EXPECT_EQ(cv::countNonZero(moving.draw(request).images.mask), 0);
+  calib::Camera lost = mounted;
+  lost.frame = "wrist_cam";
+  EXPECT_THROW(ModelView(m, lost), calib::CameraError);
+  try {
+    cameraFrame(m, lost, "cam.yaml");
+  } catch (const calib::CameraError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("cam.yaml: frame: 'wrist_cam' is neither a joint nor a body", 0), 0u)
+        << e.what();
+  }
+  EXPECT_EQ(cameraFrame(m, mounted), m.jointIndex("shoulder_pitch"));
+  calib::Camera by_body = mounted;
+  by_body.frame = "upper_arm";
+  EXPECT_EQ(cameraFrame(m, by_body), m.bodies[static_cast<std::size_t>(m.bodyIndex("upper_arm"))].frame);
+}

@@ -136,7 +136,7 @@ class CameraNodes {
       failAtNode(node, field,
                  std::to_string(*r) + "x" + std::to_string(*c) + " is not a camera matrix size (rows and cols in 1.." +
                      std::to_string(kMaxMatrixSide) + ")");
-    const std::string type = dt.Scalar();
+    const std::string& type = dt.Scalar();
     if (type.size() != 1 || std::string("ucwsifd").find(type[0]) == std::string::npos)
       failAtNode(dt, field, "dt '" + printable(type, 20) + "' is not one of u, c, w, s, i, f, d");
     if (data.size() != static_cast<std::size_t>(*r * *c))
@@ -224,7 +224,9 @@ void undistortPixels(const Camera& camera, const cv::Mat& pixels, cv::Mat& norma
                y_hi = (camera.height - cy - 0.5) / fy + camera.height / fy;
   valid.assign(n, 0);
   for (int i = 0; i < n; ++i) {
-    const cv::Vec2d p = normal.at<cv::Vec2d>(i), b = back.at<cv::Vec2d>(i), u = pixels.at<cv::Vec2d>(i);
+    const cv::Vec2d& p = normal.at<cv::Vec2d>(i);
+    const cv::Vec2d& b = back.at<cv::Vec2d>(i);
+    const cv::Vec2d& u = pixels.at<cv::Vec2d>(i);
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || std::hypot(b[0] - u[0], b[1] - u[1]) > 1e-3) continue;
     if (p[0] < x_lo || p[0] > x_hi || p[1] < y_lo || p[1] > y_hi) continue;
     valid[i] = 1;
@@ -334,6 +336,11 @@ Camera loadCamera(const std::string& path, CameraPose pose) {
       c.rvec = nodes.vec3(root, "rvec");
       c.tvec = nodes.vec3(root, "tvec");
     }
+    if (const YAML::Node f = root["frame"]) {
+      if (!f.IsScalar() || f.Scalar().empty() || f.Scalar().size() > 256 || printable(f.Scalar()) != f.Scalar())
+        nodes.failAtNode(f, "frame", "expected the name of a joint, body or link of the model (the camera's mount)");
+      c.frame = f.Scalar();
+    }
     c.reprojection_rms_px = nodes.quality(root, "reprojection_rms_px");
     c.rotation_sigma_deg = nodes.quality(root, "rotation_sigma_deg");
     c.position_sigma_m = nodes.quality(root, "position_sigma_m");
@@ -357,6 +364,7 @@ std::string cameraText(const Camera& camera) {
   const std::vector<double> distortion = camera.distortion.empty() ? std::vector<double>(5, 0.0) : camera.distortion;
   fs << "distortion_coefficients" << cv::Mat(distortion).reshape(1, 1);
   fs << "rvec" << cv::Mat(camera.rvec) << "tvec" << cv::Mat(camera.tvec);
+  if (!camera.frame.empty()) fs << "frame" << camera.frame;
   if (camera.reprojection_rms_px) fs << "reprojection_rms_px" << *camera.reprojection_rms_px;
   if (camera.rotation_sigma_deg) fs << "rotation_sigma_deg" << *camera.rotation_sigma_deg;
   if (camera.position_sigma_m) fs << "position_sigma_m" << *camera.position_sigma_m;

@@ -1,5 +1,6 @@
-// Decompressing a chunk of a log (internal): zstd, LZ4 frames and bzip2 into a buffer that grows
-// with what the data really holds, never past the size the log declares for it.
+// Decompressing a chunk of a log or a page of a Parquet file (internal): zstd, LZ4 frames, bzip2,
+// gzip (or zlib) and snappy into a buffer that grows with what the data really holds, never past
+// the size the file declares for it.
 #pragma once
 
 #include <algorithm>
@@ -10,11 +11,12 @@
 
 namespace kccd::logs::detail {
 
-/// Decompresses `in` (`compression`: "zstd", "lz4" (frame format) or "bz2") into `out`, which must
-/// end up exactly `size` bytes. Returns "" or the problem ("does not decompress: ...", "decompresses
-/// to N bytes, not the M it declares").
+/// Decompresses `in` (`compression`: "zstd", "lz4" (frame format), "bz2", "gzip" (gzip or zlib
+/// streams, members one after another) or "snappy" (raw, unframed)) into `out`, which must end up
+/// exactly `size` bytes. Returns "" or the problem, naming the data as `unit` ("the zstd chunk
+/// does not decompress: ...", "the snappy page decompresses to N bytes, not the M it declares").
 std::string decompress(const std::string& compression, std::span<const std::uint8_t> in, std::uint64_t size,
-                       std::vector<std::uint8_t>& out);
+                       std::vector<std::uint8_t>& out, const char* unit = "chunk");
 
 /// The bytes a log's chunks may decompress to in all: 256 MiB plus 256 times the file's size. Far
 /// above what real logs compress by (images hardly compress, joint states some tens of times),

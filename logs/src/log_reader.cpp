@@ -69,9 +69,10 @@ std::unique_ptr<LogReader> openLog(const std::string& path) {
     const auto is_mcap = [](const std::string& f) { return f.size() >= 5 && f.compare(f.size() - 5, 5, ".mcap") == 0; };
     const auto mcaps = std::count_if(files.begin(), files.end(), is_mcap);
     if (mcaps == 1 && files.size() == 1) return std::make_unique<McapReader>(files.front());
+    if (mcaps == static_cast<std::ptrdiff_t>(files.size())) return std::make_unique<SplitMcapReader>(files, path);
     if (mcaps > 0)
       throw InputError(InputLocation{path, 0, 0, "folder"},
-                       "a bag split into several MCAP files: give them one at a time");
+                       "its metadata.yaml lists MCAP files and files of another kind (a bag has one storage)");
     return std::make_unique<Db3Reader>(files, path);
   }
   // Only a regular file is opened: a FIFO would block the open itself.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 
 #include <zlib.h>
@@ -518,6 +519,107 @@ bool McapReader::next(LogMessage& out) {
       return false;
     }
   }
+}
+
+namespace {
+
+constexpr std::uint64_t kByteBits = 48;  // a split bag's offsets: the file's index above, the byte below
+
+// `s` with its length in front: pieces joined this way cannot run into one another.
+void appendPiece(std::string& key, const std::string& s) {
+  key += std::to_string(s.size());
+  key += ':';
+  key += s;
+}
+
+}  // namespace
+
+SplitMcapReader::SplitMcapReader(std::vector<std::string> files, std::string label)
+    : files_(std::move(files)), label_(std::move(label)) {
+  if (files_.empty()) throw InputError(InputLocation{label_, 0, 0, "folder"}, "no MCAP file");
+  // Every file before the first message: a missing one is an error now, not after part of the log.
+  for (const std::string& f : files_) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(f, ec))
+      throw InputError(InputLocation{f, 0, 0, "file"}, "listed in the folder's metadata.yaml, but not a file there");
+  }
+  open(0);
+}
+
+SplitMcapReader::~SplitMcapReader() = default;
+
+void SplitMcapReader::open(std::size_t file) {
+  if (file == 1) profile_ = reader_->profile(), library_ = reader_->library();
+  if (reader_)
+    for (const auto& [compression, n] : reader_->chunks()) chunks_[compression] += n;
+  reader_.reset();  // one file open at a time
+  file_ = file;
+  file_channels_.clear();
+  reader_ = std::make_unique<McapReader>(files_[file]);
+}
+
+std::string SplitMcapReader::profile() const { return file_ == 0 ? reader_->profile() : profile_; }
+std::string SplitMcapReader::library() const { return file_ == 0 ? reader_->library() : library_; }
+
+std::map<std::string, int> SplitMcapReader::chunks() const {
+  std::map<std::string, int> all = chunks_;
+  for (const auto& [compression, n] : reader_->chunks()) all[compression] += n;
+  return all;
+}
+
+std::string SplitMcapReader::place(std::uint64_t offset) const {
+  const std::uint64_t file = offset >> kByteBits, byte = offset & ((std::uint64_t{1} << kByteBits) - 1);
+  return std::filesystem::path(files_[std::min<std::size_t>(file, files_.size() - 1)]).filename().string() + " byte " +
+         std::to_string(byte);
+}
+
+const Channel& SplitMcapReader::channelOf(const LogMessage& m) {
+  if (const auto it = file_channels_.find(m.channel->id); it != file_channels_.end()) return channels_.at(it->second);
+  std::string key;
+  for (const std::string* piece : {&m.channel->topic, &m.channel->message_encoding}) appendPiece(key, *piece);
+  for (const auto& [k, v] : m.channel->metadata) appendPiece(key, k), appendPiece(key, v);
+  key += m.schema ? "schema" : "none";
+  if (m.schema)
+    for (const std::string* piece : {&m.schema->name, &m.schema->encoding, &m.schema->data}) appendPiece(key, *piece);
+  auto [it, fresh] = channel_of_key_.try_emplace(key, static_cast<std::uint16_t>(channels_.size() + 1));
+  if (fresh) {
+    if (channels_.size() >= 65000)
+      throw InputError(InputLocation{files_[file_], 0, 0, "byte " + std::to_string(m.offset)},
+                       "more than 65000 channels in the bag's files");
+    Channel c = *m.channel;
+    c.id = c.schema_id = it->second;
+    if (m.schema) {
+      Schema s = *m.schema;
+      s.id = c.id;
+      schemas_[s.id] = std::move(s);
+    } else {
+      c.schema_id = 0;
+    }
+    channels_[c.id] = std::move(c);
+  }
+  file_channels_[m.channel->id] = it->second;
+  return channels_.at(it->second);
+}
+
+bool SplitMcapReader::next(LogMessage& out) {
+  while (!done_) {
+    if (reader_->next(out)) {
+      const Channel& c = channelOf(out);
+      out.channel = &c;
+      out.schema = c.schema_id ? &schemas_.at(c.schema_id) : nullptr;
+      out.offset =
+          (static_cast<std::uint64_t>(file_) << kByteBits) | (out.offset & ((std::uint64_t{1} << kByteBits) - 1));
+      return true;
+    }
+    if (!reader_->damage().empty())
+      damage_ += (damage_.empty() ? "" : "; ") + std::filesystem::path(files_[file_]).filename().string() + ": " +
+                 reader_->damage();
+    if (file_ + 1 < files_.size())
+      open(file_ + 1);
+    else
+      done_ = true;
+  }
+  return false;
 }
 
 }  // namespace kccd::logs

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cstring>
 
+#include <bzlib.h>
+#include <lz4frame.h>
+
 #include "decompress.hpp"
 #include "kccd/input_error.hpp"
 
@@ -59,6 +62,58 @@ bool numberOf(const std::map<std::string, std::string>& f, const char* name, T& 
   for (std::size_t k = 0; k < sizeof(T); ++k)
     out |= static_cast<T>(static_cast<T>(static_cast<std::uint8_t>(it->second[k])) << (8 * k));
   return true;
+}
+
+// What the bytes of a compressed chunk cut short decompress to: the longest prefix the streaming
+// decoder gives (at most `size` bytes: the chunk's declared size), so a reader keeps the records
+// it holds whole. LZ4 frames give each whole block, bzip2 each whole block of up to 900 kB; a
+// stream that does not decode gives nothing, since a bad block's bytes may already be out.
+std::vector<std::uint8_t> lz4Prefix(std::span<const std::uint8_t> in, std::uint64_t size) {
+  constexpr std::size_t kStep = std::size_t{1} << 20;
+  std::vector<std::uint8_t> out;
+  LZ4F_dctx* z = nullptr;
+  if (LZ4F_isError(LZ4F_createDecompressionContext(&z, LZ4F_VERSION))) return out;
+  // Called on with no input left too: a block decoded from the last bytes may still be flushing.
+  for (std::size_t used = 0; out.size() < size;) {
+    const std::size_t have = out.size();
+    std::size_t made = static_cast<std::size_t>(std::min<std::uint64_t>(size - have, kStep)), took = in.size() - used;
+    out.resize(have + made);
+    const std::size_t ret = LZ4F_decompress(z, out.data() + have, &made, in.data() + used, &took, nullptr);
+    if (LZ4F_isError(ret)) {
+      out.clear();
+      break;
+    }
+    out.resize(have + made);
+    used += took;
+    if (ret == 0 || (took == 0 && made == 0)) break;
+  }
+  LZ4F_freeDecompressionContext(z);
+  return out;
+}
+
+std::vector<std::uint8_t> bz2Prefix(std::span<const std::uint8_t> in, std::uint64_t size) {
+  constexpr std::size_t kStep = std::size_t{1} << 20;
+  std::vector<std::uint8_t> out;
+  bz_stream s{};
+  if (BZ2_bzDecompressInit(&s, 0, 0) != BZ_OK) return out;
+  s.next_in = const_cast<char*>(reinterpret_cast<const char*>(in.data()));
+  s.avail_in = static_cast<unsigned>(std::min<std::size_t>(in.size(), 0xffffffffu));
+  while (out.size() < size) {
+    const std::size_t have = out.size();
+    const std::size_t room = static_cast<std::size_t>(std::min<std::uint64_t>(size - have, kStep));
+    out.resize(have + room);
+    s.next_out = reinterpret_cast<char*>(out.data() + have);
+    s.avail_out = static_cast<unsigned>(room);
+    const int ret = BZ2_bzDecompress(&s);
+    out.resize(have + room - s.avail_out);
+    if (ret != BZ_OK && ret != BZ_STREAM_END) {
+      out.clear();
+      break;
+    }
+    if (ret == BZ_STREAM_END || (s.avail_out == room && s.avail_in == 0)) break;
+  }
+  BZ2_bzDecompressEnd(&s);
+  return out;
 }
 
 }  // namespace
@@ -158,6 +213,7 @@ bool Ros1Reader::record(std::span<const std::uint8_t> header, std::span<const st
       ++chunks_[comp->second];
       chunk_at_ = at;
       chunk_pos_ = 0;
+      chunk_cut_ = false;
       break;
     }
     case kOpBagHeader:
@@ -174,16 +230,57 @@ bool Ros1Reader::record(std::span<const std::uint8_t> header, std::span<const st
   return false;
 }
 
+std::string Ros1Reader::openCutChunk(std::uint64_t at, std::uint32_t declared) {
+  std::string problem;
+  const auto f = fieldsOf(header_, problem);
+  std::uint8_t op = 0;
+  std::uint32_t size = 0;
+  const auto comp = f.find("compression");
+  if (!problem.empty() || !numberOf(f, "op", op) || op != kOpChunk || comp == f.end() || !numberOf(f, "size", size) ||
+      size > kMaxRos1Chunk || !detail::takeFromBudget(decompress_left_, size).empty())
+    return {};  // not a chunk, or one that says nothing this reader believes
+  const std::string& compression = comp->second;
+  if (compression != "none" && compression != "bz2" && compression != "lz4") return {};
+  if (compression == "none" && size != declared) return {};
+  data_.resize(static_cast<std::size_t>(size_ - pos_ - 8 - header_.size()));
+  in_.read(reinterpret_cast<char*>(data_.data()), static_cast<std::streamsize>(data_.size()));
+  data_.resize(static_cast<std::size_t>(std::max<std::streamsize>(in_.gcount(), 0)));
+  if (compression == "none")
+    chunk_ = data_;
+  else
+    chunk_ = compression == "lz4" ? lz4Prefix(data_, size) : bz2Prefix(data_, size);
+  chunk_at_ = at;
+  chunk_pos_ = 0;
+  chunk_cut_ = true;
+  if (compression == "none") {
+    ++chunks_[compression];
+    return ": an uncompressed chunk: its records whole before the cut are read";
+  }
+  // Decoders give whole blocks only (LZ4 frames' of up to 4 MB, bzip2's of up to 900 kB).
+  if (chunk_.empty())
+    return ": a chunk compressed with " + compression + " of which nothing decompresses before the cut, " +
+           compression + " giving whole blocks only: none of its messages are read";
+  ++chunks_[compression];
+  return ": a chunk compressed with " + compression + " whose first " + std::to_string(chunk_.size()) + " of " +
+         std::to_string(size) + " bytes decompress before the cut, " + compression +
+         " giving whole blocks: the records whole in them are read";
+}
+
 bool Ros1Reader::next(LogMessage& out) {
   for (;;) {
     // The open chunk's records first.
     while (chunk_pos_ < chunk_.size()) {
       const std::size_t left = chunk_.size() - chunk_pos_;
+      const std::uint32_t hl = left < 4 ? 0 : le32(chunk_.data() + chunk_pos_);
+      const bool whole = left >= 4 && hl <= left - 4 && left - 4 - hl >= 4 &&
+                         le32(chunk_.data() + chunk_pos_ + 4 + hl) <= left - 8 - hl;
+      if (!whole && chunk_cut_) {  // the rest of a chunk cut short: past the cut
+        chunk_pos_ = chunk_.size();
+        break;
+      }
       if (left < 4) fail(chunk_at_, "the chunk ends inside a record's header length");
-      const std::uint32_t hl = le32(chunk_.data() + chunk_pos_);
-      if (hl > left - 4 || left - 4 - hl < 4) fail(chunk_at_, "a record inside the chunk runs past its end");
+      if (!whole) fail(chunk_at_, "a record inside the chunk runs past its end");
       const std::uint32_t dl = le32(chunk_.data() + chunk_pos_ + 4 + hl);
-      if (dl > left - 8 - hl) fail(chunk_at_, "a record inside the chunk runs past its end");
       const std::span<const std::uint8_t> h(chunk_.data() + chunk_pos_ + 4, hl),
           d(chunk_.data() + chunk_pos_ + 8 + hl, dl);
       chunk_pos_ += 8 + hl + dl;
@@ -229,8 +326,8 @@ bool Ros1Reader::next(LogMessage& out) {
     }
     const std::uint32_t dl = le32(len);
     if (dl > size_ - pos_ - 8 - hl) {
-      cut("inside a record's " + std::to_string(dl) + " bytes of data");
-      return false;
+      cut("inside a record's " + std::to_string(dl) + " bytes of data" + openCutChunk(at, dl));
+      continue;  // the whole records of a chunk cut short, then the end
     }
     data_.resize(dl);
     in_.read(reinterpret_cast<char*>(data_.data()), dl);

@@ -161,6 +161,45 @@ std::vector<std::string> splitCommas(const std::string& text) {
   return out;
 }
 
+void addBrakingOptions(CLI::App& sub, BrakingParams& braking) {
+  sub.add_option("--latency", braking.latency,
+                 "Braking (with --swept): reaction latency t_l (s, 0 ... 1e3), every joint")
+      ->capture_default_str();
+  sub.add_option("--deceleration", braking.deceleration,
+                 "Braking: guaranteed deceleration (rad/s^2 or m/s^2, 1e-9 ... 1e9), every joint")
+      ->capture_default_str();
+  sub.add_option("--max-acceleration", braking.max_acceleration,
+                 "Braking: worst-case acceleration during the latency (0 ... 1e9)")
+      ->capture_default_str();
+  sub.add_option("--position-error", braking.position_error, "Braking: position measurement error bound (0 ... 1e3)")
+      ->capture_default_str();
+  sub.add_option("--velocity-error", braking.velocity_error, "Braking: velocity measurement error bound (0 ... 1e6)")
+      ->capture_default_str();
+}
+
+bool brakingGiven(const CLI::App& sub) {
+  for (const char* name : {"--latency", "--deceleration", "--max-acceleration", "--position-error", "--velocity-error"})
+    if (sub.get_option(name)->count() > 0) return true;
+  return false;
+}
+
+void addLerobotOptions(CLI::App& sub, std::string& dataset, long& episode, std::string& state_key,
+                       std::string* frame_by) {
+  sub.add_option("--lerobot", dataset,
+                 "A LeRobot dataset's folder (v2.0, v2.1 or v3.0, as downloaded) instead of --video and --states: "
+                 "one episode's state rows and camera frames (see kccd dataset info)");
+  sub.add_option("--episode", episode, "With --lerobot: the episode (its episode_index; -1: none given)")
+      ->capture_default_str();
+  sub.add_option("--state-key", state_key, "With --lerobot: the vector feature read as the state")
+      ->capture_default_str();
+  if (!frame_by) return;
+  sub.add_option("--frame-by", *frame_by,
+                 "With --lerobot: how a row finds its video frame: timestamp (the nearest frame within 1e-4 s, as "
+                 "LeRobot's loader does), index (frame_index) or auto (timestamp when every row is on the "
+                 "frame grid, else index with a warning)")
+      ->capture_default_str();
+}
+
 void addPieceOptions(CLI::App& sub, std::string& pieces, double& concavity_mm, const std::string& what) {
   sub.add_option("--pieces", pieces,
                  what +

@@ -8,6 +8,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "kccd/braking.hpp"
+
 #include "kccd/input_error.hpp"
 #include "kccd/model.hpp"
 #include "kccd/modelling/fit_request.hpp"
@@ -63,5 +65,16 @@ int piecesOption(const std::string& text);
 
 /// Adds `--pieces auto|N` and `--concavity MM` (kccd fit and kccd import); `what` opens --pieces' help.
 void addPieceOptions(CLI::App& sub, std::string& pieces, double& concavity_mm, const std::string& what);
+
+/// Adds the braking options (--latency, --deceleration, --max-acceleration, --position-error,
+/// --velocity-error: every joint's, with --swept) into `braking` (kccd overlay and kccd check).
+void addBrakingOptions(CLI::App& sub, BrakingParams& braking);
+/// True when any braking option was given on the command line.
+bool brakingGiven(const CLI::App& sub);
+
+/// Adds `--lerobot DIR`, `--episode N`, `--state-key KEY` and, when `frame_by` is given,
+/// `--frame-by auto|timestamp|index` (kccd overlay and kccd check: a LeRobot dataset's episode).
+void addLerobotOptions(CLI::App& sub, std::string& dataset, long& episode, std::string& state_key,
+                       std::string* frame_by = nullptr);
 
 }  // namespace kccd::cli

@@ -55,6 +55,7 @@ Exit runBagInfo(const BagInfoArgs& args) {
   for (const logs::TopicSummary& t : b.topics) {
     std::cout << "  " << t.topic << "  " << (t.type.empty() ? "(no schema)" : t.type) << "  " << t.count
               << (t.count == 1 ? " message" : " messages");
+    if (t.publishers.size() > 1) std::cout << " (" << t.publishers.size() << " publishers)";
     std::cout << (t.count == 1 ? " at " : " from ") << fixed(seconds(t.first_log_time - b.first_log_time), 3);
     if (t.count > 1) std::cout << " to " << fixed(seconds(t.last_log_time - b.first_log_time), 3);
     std::cout << " s";
@@ -106,10 +107,12 @@ Runner addBag(CLI::App& app) {
   CLI::App* info = bag->add_subcommand(
       "info",
       "Topics of a robot log: type, message count, first and last log time, rate, and per topic how far the "
-      "messages' header stamps lie behind their log times (decoded from the definitions the log stores). Reads "
-      "MCAP (ROS 2 CDR and ROS 1 messages; chunks none, zstd or lz4), rosbag2 sqlite3 (a .db3 file or a bag "
-      "folder with its metadata.yaml) and ROS 1 bags (format 2.0; chunks none, bz2 or lz4). A log cut short is read up "
-      "to the damage, with a warning naming where.");
+      "messages' header stamps lie behind their log times (decoded from the definitions the log stores). A topic "
+      "several nodes publish is one row with its publisher count (--json lists each publisher). Reads "
+      "MCAP (ROS 2 CDR and ROS 1 messages; chunks none, zstd or lz4), rosbag2 sqlite3 (.db3) and ROS 1 bags (format "
+      "2.0; chunks none, bz2 or lz4); a rosbag2 bag folder (with its metadata.yaml) of .db3 or MCAP files is read as "
+      "one log, its split files in the order it lists. A log cut short is read up to the damage, with a warning naming "
+      "where.");
   info->add_option("bag", args->bag, "The log: an .mcap, .db3 or .bag file, or a rosbag2 folder")->required();
   info->add_flag("--json", args->json, "Machine-readable output (times in nanoseconds as decimal strings)");
   auto ex = std::make_shared<BagExportArgs>();

@@ -18,6 +18,7 @@
 #include "kccd/overlay/calibration/calib_refine.hpp"
 #include "kccd/overlay/calibration/calib_report.hpp"
 #include "kccd/overlay/calibration/calib_solve.hpp"
+#include "kccd/render/model_view.hpp"
 #include "kccd/state_log.hpp"
 
 namespace kccd::cli {
@@ -25,6 +26,7 @@ namespace {
 
 struct CalibArgs : FrameOptions {
   std::string intrinsics, tags, model, output, check, truth, rough_camera, mask_bodies, refine, draw = "auto";
+  std::string camera_frame;  ///< a camera fixed to this frame of the model (a wrist or head camera)
   std::vector<std::string> labels, masks;
   double threshold = 8.0, magnify = 20.0;
   int min_inliers = 6;
@@ -135,14 +137,31 @@ Exit runCalib(const CalibArgs& a) {
   if (!a.model.empty()) model = loadOrExplain(a.model);
   std::optional<overlay::RefineInputs> refine_inputs = refineInputs(a, intrinsics, model);
   std::vector<overlay::RecordingSample> recording;
-  const overlay::Gathered g = overlay::gatherCorrespondences(gatherInputs(a, intrinsics, model, recording));
+  if (!a.camera_frame.empty()) {
+    if (!model) throw UsageError("--camera-frame: needs --model (the robot the camera is fixed to)");
+    if (refine_inputs)
+      throw UsageError("--camera-frame: not with --masks or --refine (they refine a camera fixed in the world)");
+    calib::Camera mount;
+    mount.frame = a.camera_frame;
+    render::cameraFrame(*model, mount, "--camera-frame");  // a frame of the model, before any picture is read
+  }
+  overlay::Gathered g = overlay::gatherCorrespondences(gatherInputs(a, intrinsics, model, recording));
   if (refine_inputs) refine_inputs->recording = std::move(recording);
+  if (!a.camera_frame.empty()) {
+    calib::Camera mount;
+    mount.frame = a.camera_frame;
+    // Every point in the mount's frame at its frame's state: the pose solved is mount -> camera.
+    g = overlay::inMountFrame(std::move(g), *model, render::cameraFrame(*model, mount, "--camera-frame"),
+                              "--camera-frame " + a.camera_frame);
+  }
 
   calib::PoseOptions options;
   options.ransac_threshold_px = a.threshold;
   options.min_inliers = a.min_inliers;
-  overlay::CalibSolution s =
-      overlay::solveCalibration(intrinsics, g, options, model ? &*model : nullptr, truth ? &*truth : nullptr);
+  // The model's uncertainty figure places its points in the world: not for a camera on the robot.
+  overlay::CalibSolution s = overlay::solveCalibration(
+      intrinsics, g, options, model && a.camera_frame.empty() ? &*model : nullptr, truth ? &*truth : nullptr);
+  s.pose.camera.frame = a.camera_frame;
   std::optional<overlay::Refinement> refinement;
   if (refine_inputs) {
     refinement = overlay::refineCalibration(s, g, intrinsics, *model, *refine_inputs, truth ? &*truth : nullptr);
@@ -252,6 +271,10 @@ Runner addCalib(CLI::App& app) {
          "one frame and the others used by --masks or --refine edges only)")
       ->allow_extra_args(false);
   sub->add_option("--model", a->model, "Model file placing the body labels (and drawn in the check image)");
+  sub->add_option("--camera-frame", a->camera_frame,
+                  "The camera is fixed to this joint, body or link of --model (a wrist or head camera): every "
+                  "frame's points are placed in that frame at the frame's state (--state, --states or --bag), the pose "
+                  "solved is that frame -> camera, and the camera file says frame: NAME");
   sub->add_option(
          "--state", a->states,
          "The robot's state in the frames (comma-separated; once for all frames, or once per frame) for body labels "

@@ -52,7 +52,7 @@ Exit runOverlay(OverlayArgs& a) {
   // Every input and option is checked before any frame is decoded.
   overlay::OverlayJob job(q, model, camera, spelled);
   for (const std::string& w : job.warnings())
-    std::cerr << "kccd overlay: warning: --bag " << q.bag << ": " << w << "\n";
+    std::cerr << "kccd overlay: warning: " << (q.bag.empty() ? "" : "--bag " + q.bag + ": ") << w << "\n";
 
   // Outputs under temporary names, moved into place only when every frame is done.
   Progress progress("overlay", a.quiet);
@@ -147,10 +147,14 @@ Runner addOverlay(CLI::App& app) {
                   "With --bag: header (the messages' header stamps; the log time where one is zero) or log (the "
                   "recorder's times)")
       ->capture_default_str();
+  addLerobotOptions(*sub, a->request.lerobot, a->request.episode, a->request.state_key, &a->request.frame_by);
+  sub->add_option("--camera-key", a->request.camera_key,
+                  "With --lerobot: the camera feature drawn on (default: the dataset's only camera)");
   sub->add_option(
       "--joint-map", a->request.joint_map,
-      "With --bag: YAML (kccd_joint_map: 1) saying which logged joint each state value is read from, with a scale, "
-      "an offset or degrees, or a constant (see docs/formats.md); values it does not list are read by their own name");
+      "With --bag or --lerobot: YAML (kccd_joint_map: 1) saying which logged joint each state value is read from, "
+      "with a scale, an offset, degrees or a range (LeRobot's -100 ... 100), or a constant (see docs/formats.md); "
+      "values it does not list are read by their own name (or NAME.pos)");
   sub->add_option("-o,--output", a->request.output,
                   "Output video (.mp4: mp4v, .mkv: FFV1 lossless, .avi: MJPG; see --codec)");
   sub->add_option("--png-dir", a->request.png_dir,
@@ -186,21 +190,7 @@ Runner addOverlay(CLI::App& app) {
   sub->add_flag(
       "--swept", a->request.swept,
       "Draw the braking-interval swept volumes (from logged or differenced velocities) instead of the static ones");
-  sub->add_option("--latency", a->braking.latency,
-                  "Braking (with --swept): reaction latency t_l (s, 0 ... 1e3), every joint")
-      ->capture_default_str();
-  sub->add_option("--deceleration", a->braking.deceleration,
-                  "Braking: guaranteed deceleration (rad/s^2 or m/s^2, 1e-9 ... 1e9), every joint")
-      ->capture_default_str();
-  sub->add_option("--max-acceleration", a->braking.max_acceleration,
-                  "Braking: worst-case acceleration during the latency (0 ... 1e9)")
-      ->capture_default_str();
-  sub->add_option("--position-error", a->braking.position_error,
-                  "Braking: position measurement error bound (0 ... 1e3)")
-      ->capture_default_str();
-  sub->add_option("--velocity-error", a->braking.velocity_error,
-                  "Braking: velocity measurement error bound (0 ... 1e6)")
-      ->capture_default_str();
+  addBrakingOptions(*sub, a->braking);
   sub->add_flag("--plain", a->request.plain, "Volumes only: no legend, no status line");
   sub->add_flag("--visuals", a->request.visuals,
                 "Also draw the model's visual geometry (visuals:) at the logged state, tinted in its own colours: "
@@ -235,9 +225,7 @@ Runner addOverlay(CLI::App& app) {
       "Exit status: 0 written, 2 bad input (nothing written), 3 a frame's query status is unsafe (everything still "
       "written).");
   return [a, sub] {
-    for (const char* name :
-         {"--latency", "--deceleration", "--max-acceleration", "--position-error", "--velocity-error"})
-      a->braking_given = a->braking_given || sub->get_option(name)->count() > 0;
+    a->braking_given = brakingGiven(*sub);
     return runOverlay(*a);
   };
 }

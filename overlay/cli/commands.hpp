@@ -33,6 +33,10 @@ Runner addOverlay(CLI::App& app);
 Runner addGolden(CLI::App& app);
 /// `kccd bag info` (cmd_bag.cpp).
 Runner addBag(CLI::App& app);
+/// `kccd check` (cmd_check.cpp).
+Runner addCheck(CLI::App& app);
+/// `kccd dataset info` (cmd_dataset.cpp).
+Runner addDataset(CLI::App& app);
 /// `sheet`, registered on the `calib` subcommand app.
 Runner addCalibSheet(CLI::App& calib);
 /// `kccd calib label`: the labelling page (cmd_calib_label.cpp).

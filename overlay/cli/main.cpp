@@ -40,8 +40,10 @@ int main(int argc, char** argv) {
   add(kccd::cli::addCalib);
   add(kccd::cli::addSynth);
   add(kccd::cli::addOverlay);
+  add(kccd::cli::addCheck);
   add(kccd::cli::addGolden);
   add(kccd::cli::addBag);
+  add(kccd::cli::addDataset);
   if (argc > 1 && argv[1][0] != '-') {  // CLI11 would only say that a subcommand is required
     std::string names;
     bool known = false;

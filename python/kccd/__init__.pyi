@@ -20,9 +20,11 @@ from ._kccd import fit as fit
 from ._kccd import import_urdf as import_urdf
 from ._kccd import overlay_braking as overlay_braking
 from ._kccd import overlay_recording as overlay_recording
+from ._kccd import check_log as check_log
 from ._kccd import check_overlay_request as check_overlay_request
 from ._kccd import prove_pairs as prove_pairs
 from ._kccd import read_bag as read_bag
+from ._kccd import read_lerobot as read_lerobot
 from ._kccd import read_frame as read_frame
 from ._kccd import read_frames as read_frames
 from ._kccd import read_image as read_image
@@ -54,9 +56,11 @@ __all__ = [
     "import_urdf",
     "overlay_braking",
     "overlay_recording",
+    "check_log",
     "check_overlay_request",
     "prove_pairs",
     "read_bag",
+    "read_lerobot",
     "read_frame",
     "read_frames",
     "read_image",

@@ -178,12 +178,12 @@ def _publish(message: dict[str, Any]) -> None:
         pass  # not on a Dask worker (run_recording called directly)
 
 
-def colliding_intervals(report: dict[str, Any]) -> list[dict[str, Any]]:
-    """Runs of consecutive colliding frames of an overlay report: first and last frame index and
-    their video times (seconds)."""
+def colliding_intervals(report: dict[str, Any], status: str = "colliding") -> list[dict[str, Any]]:
+    """Runs of consecutive frames of an overlay report with `status` (colliding, or within_margin):
+    first and last frame index and their video times (seconds)."""
     out: list[dict[str, Any]] = []
     for fr in report.get("frames", []):
-        if fr.get("status") != "colliding":
+        if fr.get("status") != status:
             continue
         if out and out[-1]["last_frame"] == fr["index"] - 1:
             out[-1]["last_frame"] = fr["index"]
@@ -208,6 +208,7 @@ def recording_summary(rec_id: str, report: dict[str, Any]) -> dict[str, Any]:
         "no_state": report["no_state"],
         "unsafe": report.get("unsafe", 0),
         "colliding_intervals": colliding_intervals(report),
+        "margin_intervals": colliding_intervals(report, "within_margin"),
     }
 
 
@@ -367,16 +368,18 @@ def summary_markdown(summary: dict[str, Any]) -> str:
     else:
         lines += ["Nothing needs a look: no recording failed and no frame collides.", ""]
     lines += ["## Recordings", "",
-              "| id | status | frames | clear | within margin | colliding | no state | colliding intervals (video time) |",
-              "|---|---|---|---|---|---|---|---|"]
+              "| id | status | frames | clear | within margin | colliding | no state | colliding intervals (video time) "
+              "| within-margin intervals |",
+              "|---|---|---|---|---|---|---|---|---|"]
     for r in summary["recordings"]:
         if r["status"] == "failed":
-            lines += [f"| {r['id']} | failed | | | | | | {r['reason'].replace('|', '/')} |"]
+            lines += [f"| {r['id']} | failed | | | | | | {r['reason'].replace('|', '/')} | |"]
             continue
-        spans = "; ".join(f"{_clock(c['start_s'])}–{_clock(c['end_s'])}" for c in r["colliding_intervals"])
+        spans, margin = ("; ".join(f"{_clock(c['start_s'])}–{_clock(c['end_s'])}" for c in r.get(key, []))
+                         for key in ("colliding_intervals", "margin_intervals"))
         lines += [f"| [{r['id']}]({r['id']}/report.json) | done{' (kept)' if r.get('skipped') else ''} | "
                   f"{r['frames_total']} | {r['clear']} | {r['within_margin']} | {r['colliding']} | {r['no_state']} | "
-                  f"{spans or '–'} |"]
+                  f"{spans or '–'} | {margin or '–'} |"]
     run = summary["run"]
     lines += ["", f"Run: {run['workers']} workers, {run['elapsed_s']:.1f} s, {run['frames_per_second']:.1f} frames/s "
               f"over the cluster; kccd {summary['kccd_version']}.", ""]
@@ -512,7 +515,7 @@ def _locked_batch(recordings: list[Recording], out_dir: str, client: Any, schedu
                     else:
                         records[r.id] = {"id": r.id, "status": "failed", "reason": _reason(fut), "frames_total": 0,
                                          "clear": 0, "within_margin": 0, "colliding": 0, "no_state": 0,
-                                         "unsafe": 0, "colliding_intervals": []}
+                                         "unsafe": 0, "colliding_intervals": [], "margin_intervals": []}
                         state.failed += 1
                         failed.add(r.id)
                         frames.pop(r.id, None)

@@ -22,8 +22,12 @@ _RESERVED = ("summary.json", "summary.md", "colliding_frames.png")
 _ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,127}")
 _BAG_KEYS = ("image_topic", "joint_topic", "time_source", "joint_map")
 #: More of kccd.overlay_recording's keywords, under their own names (checked by kccd.check_overlay_request).
-OVERLAY_KEYS = ("frame_times", "ignore_columns", "fps", "max_gap", "plain", "visuals", "masks", "mask_bodies", "frames")
-_RECORDING_KEYS = ("id", "video", "states", "bag", "model", "camera", "time_offset", "swept", "braking") + _BAG_KEYS + OVERLAY_KEYS
+OVERLAY_KEYS = ("frame_times", "ignore_columns", "fps", "max_gap", "plain", "visuals", "masks", "mask_bodies", "frames",
+                "camera_key", "state_key", "frame_by")
+#: A LeRobot dataset's recording: its folder and which episodes ("all", a list, or "FIRST:END").
+_LEROBOT_KEYS = ("lerobot", "episodes")
+_RECORDING_KEYS = ("id", "video", "states", "bag", "model", "camera", "time_offset", "swept", "braking") + _BAG_KEYS + \
+    _LEROBOT_KEYS + OVERLAY_KEYS
 _DEFAULT_KEYS = ("model", "camera", "time_offset", "swept", "braking") + _BAG_KEYS + OVERLAY_KEYS
 #: The braking of swept volumes unless a manifest says otherwise (kccd overlay's defaults).
 DEFAULT_BRAKING = {field: float(getattr(_core.overlay_braking(), field))
@@ -53,12 +57,21 @@ class Recording:
     time_source: str = "header"
     joint_map: str = ""
     frame_times: str = ""  #: with a video: each frame's time
+    lerobot: str = ""  #: a LeRobot dataset's folder instead (one episode of it)
+    episode: int = -1  #: with lerobot: its episode_index
+    #: With lerobot: the files the episode is read from (meta/info.json, its table, its camera's video).
+    lerobot_info: str = ""
+    lerobot_data: str = ""
+    lerobot_video: str = ""
     #: The other keywords of kccd.overlay_recording given (OVERLAY_KEYS but frame_times), lists as tuples.
     options: tuple[tuple[str, Any], ...] = ()
 
     def input_keys(self) -> tuple[str, ...]:
         """The fields naming this recording's input files."""
-        recording = ("bag",) if self.bag else ("video", "states") + (("frame_times",) if self.frame_times else ())
+        if self.lerobot:
+            recording: tuple[str, ...] = ("lerobot_info", "lerobot_data") + (("lerobot_video",) if self.lerobot_video else ())
+        else:
+            recording = ("bag",) if self.bag else ("video", "states") + (("frame_times",) if self.frame_times else ())
         return recording + ("model", "camera") + (("joint_map",) if self.joint_map else ())
 
     def keywords(self) -> dict[str, Any]:
@@ -69,6 +82,8 @@ class Recording:
         if self.bag:
             kw.update(bag=self.bag, image_topic=self.image_topic, joint_topic=self.joint_topic,
                       time_source=self.time_source, joint_map=self.joint_map)
+        elif self.lerobot:
+            kw.update(lerobot=self.lerobot, episode=self.episode, joint_map=self.joint_map)
         elif self.frame_times:
             kw["frame_times"] = self.frame_times
         kw.update({k: list(v) if isinstance(v, tuple) else v for k, v in self.options})
@@ -248,14 +263,20 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
         rec = mapping(item, name, _RECORDING_KEYS)
         if "id" not in rec:
             raise fail(item, f"{name}.id", "missing")
-        if "bag" in rec:
+        if "bag" in rec and "lerobot" in rec:
+            raise fail(rec["lerobot"], f"{name}.lerobot", "not with bag (one recording)")
+        if "bag" in rec or "lerobot" in rec:
+            what = "bag" if "bag" in rec else "lerobot"
             for key in ("video", "states"):
                 if key in rec:
-                    raise fail(rec[key], f"{name}.{key}", "not with bag (the robot log gives the frames and the states)")
+                    raise fail(rec[key], f"{name}.{key}", f"not with {what} (the {'robot log' if what == 'bag' else 'dataset'} "
+                               "gives the frames and the states)")
         else:
             for key in ("video", "states"):
                 if key not in rec:
-                    raise fail(item, f"{name}.{key}", "missing (give video and states, or bag)")
+                    raise fail(item, f"{name}.{key}", "missing (give video and states, bag, or lerobot)")
+        if "episodes" in rec and "lerobot" not in rec:
+            raise fail(rec["episodes"], f"{name}.episodes", "goes with lerobot")
         rid = text_field(rec["id"], f"{name}.id")
         if not _ID.fullmatch(rid):
             raise fail(rec["id"], f"{name}.id", f"'{rid}' is not a folder name (letters, digits, '.', '_', '-'; "
@@ -273,13 +294,14 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
         for key in ("model", "camera"):
             if key not in merged:
                 raise fail(item, f"{name}.{key}", "missing (give it here or in defaults)")
-        keys = ("bag", "joint_map", "model", "camera") if "bag" in rec else ("video", "states", "frame_times", "model", "camera")
+        keys = ("bag", "joint_map", "model", "camera") if "bag" in rec else \
+            ("lerobot", "joint_map", "model", "camera") if "lerobot" in rec else ("video", "states", "frame_times", "model", "camera")
         paths = {key: resolve(merged[key], where(key)) for key in keys if key in merged}
         inputs += [(key, paths[key], merged[key], where(key)) for key in paths]
         if "bag" not in rec:
             for key in _BAG_KEYS:
-                if key in rec:
-                    raise fail(rec[key], f"{name}.{key}", "goes with bag")
+                if key in rec and not (key == "joint_map" and "lerobot" in rec):
+                    raise fail(rec[key], f"{name}.{key}", "goes with bag" + (" or lerobot" if key == "joint_map" else ""))
         elif "frame_times" in rec:
             raise fail(rec["frame_times"], f"{name}.frame_times", "not with bag (each frame has its own time)")
         topics = {key: text_field(merged[key], where(key)) for key in ("image_topic", "joint_topic") if key in merged and "bag" in rec}
@@ -294,25 +316,34 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
                 return merged[key], where(key) + dot + rest
             return item, f"{name}.{field}" if field else name
 
-        nodes.append(node_of)
-        out.append(Recording(
-            id=rid,
-            video=paths.get("video", ""),
-            states=paths.get("states", ""),
-            model=paths["model"],
-            camera=paths["camera"],
-            bag=paths.get("bag", ""),
-            joint_map=paths.get("joint_map", "") if "bag" in rec else "",
-            time_source=time_source,
-            **topics,
-            time_offset=time_offset_field(merged["time_offset"], where("time_offset")) if "time_offset" in merged else 0.0,
-            frame_times=paths.get("frame_times", ""),
-            options=tuple(overlay_options(merged, where).items()),
-            swept=bool_field(merged["swept"], where("swept")) if "swept" in merged else False,
-            line=item.start_mark.line + 1,
-            braking=braking_field(merged["braking"], where("braking"))
-            if "braking" in merged else tuple(DEFAULT_BRAKING.items()),
-        ))
+        episodes: list[tuple[str, int, dict[str, str]]] = [(rid, -1, {})]
+        if "lerobot" in rec:
+            episodes = _episodes(paths["lerobot"], rec, merged, name, rid, fail, scalar, where, first_line)
+        for eid, episode, files in episodes:
+            nodes.append(node_of)
+            out.append(Recording(
+                id=eid,
+                lerobot=paths.get("lerobot", ""),
+                episode=episode,
+                lerobot_info=files.get("info", ""),
+                lerobot_data=files.get("data", ""),
+                lerobot_video=files.get("video", ""),
+                video=paths.get("video", ""),
+                states=paths.get("states", ""),
+                model=paths["model"],
+                camera=paths["camera"],
+                bag=paths.get("bag", ""),
+                joint_map=paths.get("joint_map", ""),
+                time_source=time_source,
+                **topics,
+                time_offset=time_offset_field(merged["time_offset"], where("time_offset")) if "time_offset" in merged else 0.0,
+                frame_times=paths.get("frame_times", ""),
+                options=tuple(overlay_options(merged, where).items()),
+                swept=bool_field(merged["swept"], where("swept")) if "swept" in merged else False,
+                line=item.start_mark.line + 1,
+                braking=braking_field(merged["braking"], where("braking"))
+                if "braking" in merged else tuple(DEFAULT_BRAKING.items()),
+            ))
 
     def check_options(models: dict[str, Any]) -> None:
         # The overlay's own checks of every option (kccd.check_overlay_request), each named by its node.
@@ -338,6 +369,8 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
                     raise fail(node, field, f"{p}: not an image-sequence pattern ({_one_line(str(e))})") from None
                 if not frames:
                     raise fail(node, field, f"{p}: no image of the sequence (numbered from 0 or 1) exists")
+            elif key == "lerobot":
+                pass  # read when its episodes were listed
             elif key == "bag" and os.path.isdir(p):
                 if not os.path.isfile(os.path.join(p, "metadata.yaml")) and not any(f.endswith(".mcap") for f in os.listdir(p)):
                     raise fail(node, field, f"{p}: a folder without metadata.yaml (not a rosbag2 bag)")
@@ -353,6 +386,61 @@ def read_manifest(path: str, check_inputs: bool = True) -> list[Recording]:
                 except _core.InputError as e:
                     raise fail(node, field, _one_line(str(e))) from None
         check_options(models)
+    return out
+
+
+def _episodes(path: str, rec: dict[str, yaml.Node], merged: dict[str, yaml.Node], name: str, rid: str, fail: Any,
+              scalar: Any, where: Any, first_line: dict[str, int]) -> list[tuple[str, int, dict[str, str]]]:
+    """A lerobot recording's episodes, each as (id, episode_index, its files): every episode of the
+    dataset, or those `episodes` lists ([0, 3, 7] or "FIRST:END"); ids ``<id>-<episode, 6 digits>``."""
+    try:
+        info = _core.read_lerobot(path)["info"]
+    except _core.InputError as err:
+        raise fail(rec["lerobot"], f"{name}.lerobot", _one_line(str(err))) from None
+    listed = {int(entry["episode"]): entry for entry in info["episode_list"]}
+    span = f"{min(listed)} ... {max(listed)}" if listed else "none"
+    chosen: list[int] = sorted(listed)
+    if "episodes" in rec:
+        node = rec["episodes"]
+        if isinstance(node, yaml.SequenceNode) and node.value:
+            chosen = []
+            for k, v in enumerate(node.value):
+                index = scalar(v, f"{name}.episodes[{k}]")
+                if isinstance(index, bool) or not isinstance(index, int) or index not in listed:
+                    raise fail(v, f"{name}.episodes[{k}]", f"{index!r} is not an episode of {path} (its episodes: {span})")
+                chosen.append(index)
+        else:
+            text = scalar(node, f"{name}.episodes")
+            m = re.fullmatch(r"(\d*):(\d*)", text) if isinstance(text, str) else None
+            if text == "all":
+                pass
+            elif m:
+                lo, hi = int(m.group(1) or 0), int(m.group(2)) if m.group(2) else max(listed, default=0) + 1
+                chosen = [index for index in sorted(listed) if lo <= index < hi]
+            else:
+                raise fail(node, f"{name}.episodes", "expected all, a list of episode indices, or FIRST:END")
+        if not chosen:
+            raise fail(node, f"{name}.episodes", f"no episode of {path} chosen (its episodes: {span})")
+    key = str(scalar(merged["camera_key"], where("camera_key"))) if "camera_key" in merged else ""
+    cameras = [c["key"] for c in info["cameras"]]
+    if key and key not in cameras:
+        raise fail(merged["camera_key"], where("camera_key"),
+                   f"'{key}' is not a camera of {path} (its cameras: {', '.join(cameras) or 'none'})")
+    if not key and len(cameras) == 1:
+        key = cameras[0]
+    out: list[tuple[str, int, dict[str, str]]] = []
+    for index in chosen:
+        eid = f"{rid}-{index:06d}"
+        if eid in first_line:
+            raise fail(rec["id"], f"{name}.id", f"'{eid}' (episode {index}) is also the id on line {first_line[eid]}")
+        first_line[eid] = rec["id"].start_mark.line + 1
+        files = listed[index]["files"]
+        video = files["videos"].get(key, "") if key else ""
+        if video and not os.path.isfile(video):
+            raise fail(rec.get("episodes", rec["lerobot"]), f"{name}.episodes",
+                       f"episode {index}'s video {video} is not on disk (list the episodes to overlay)")
+        out.append((eid, index, {"info": os.path.join(path, "meta", "info.json"), "data": files["data"] or "",
+                                 "video": video}))
     return out
 
 

@@ -18,9 +18,13 @@
 #include "kccd/calib/camera.hpp"
 #include "kccd/input_error.hpp"
 #include "kccd/logs/bag_summary.hpp"
+#include "kccd/logs/lerobot_dataset.hpp"
 #include "kccd/overlay/bags/bag_info.hpp"
 #include "kccd/overlay/bags/bag_recording.hpp"
 #include "kccd/overlay/common/staged_output.hpp"
+#include "kccd/overlay/datasets/dataset_info.hpp"
+#include "kccd/overlay/datasets/lerobot_recording.hpp"
+#include "kccd/overlay/jobs/check_job.hpp"
 #include "kccd/overlay/jobs/overlay_job.hpp"
 #include "kccd/overlay/recording/contact_sheet.hpp"
 #include "kccd/overlay/recording/overlay_recording.hpp"
@@ -43,6 +47,11 @@ overlay::OverlayRequest overlayRequest(const py::kwargs& kwargs) {
       {"joint_topic", [&](const py::handle& v) { q.joint_topic = v.cast<std::string>(); }},
       {"time_source", [&](const py::handle& v) { q.time_source = v.cast<std::string>(); }},
       {"joint_map", [&](const py::handle& v) { q.joint_map = v.cast<std::string>(); }},
+      {"lerobot", [&](const py::handle& v) { q.lerobot = v.cast<std::string>(); }},
+      {"episode", [&](const py::handle& v) { q.episode = v.cast<long>(); }},
+      {"camera_key", [&](const py::handle& v) { q.camera_key = v.cast<std::string>(); }},
+      {"state_key", [&](const py::handle& v) { q.state_key = v.cast<std::string>(); }},
+      {"frame_by", [&](const py::handle& v) { q.frame_by = v.cast<std::string>(); }},
       {"frame_times", [&](const py::handle& v) { q.frame_times = v.cast<std::string>(); }},
       {"ignore_columns", [&](const py::handle& v) { q.ignore_columns = v.cast<std::vector<std::string>>(); }},
       {"fps", [&](const py::handle& v) { q.fps = v.cast<double>(); }},
@@ -180,7 +189,7 @@ void bindOverlayJob(py::module_& m) {
         return toPython(full);
       },
       py::arg("model"), py::arg("camera"), py::arg("video") = "", py::arg("states") = "",
-      R"doc(overlay_recording(model, camera, video='', states='', *, bag='', image_topic='', joint_topic='', time_source='header', joint_map='', frame_times='', ignore_columns=[], fps=0.0, time_offset=0.0, max_gap=0.0, swept=False, braking=None, plain=False, visuals=False, masks='', mask_bodies=[], frames='', jobs=0, timings=False, output='', codec='', png_dir='', report='', contact_sheet='', timeline='', contact_frames=12, progress=None, progress_every=0.0)
+      R"doc(overlay_recording(model, camera, video='', states='', *, bag='', image_topic='', joint_topic='', time_source='header', joint_map='', lerobot='', episode=-1, camera_key='', state_key='observation.state', frame_by='auto', frame_times='', ignore_columns=[], fps=0.0, time_offset=0.0, max_gap=0.0, swept=False, braking=None, plain=False, visuals=False, masks='', mask_bodies=[], frames='', jobs=0, timings=False, output='', codec='', png_dir='', report='', contact_sheet='', timeline='', contact_frames=12, progress=None, progress_every=0.0)
 
 The main job, as `kccd overlay` (every option of it under its own name, with its default and its checks):
 every frame of `video` (a file or an image-sequence pattern) checked at the state the log `states` (CSV)
@@ -198,7 +207,9 @@ with the GIL held (progress_every: at most once per that many seconds, and after
 the report as a dict (with per-frame records under 'frames'). Instead of video and states, bag: a robot
 log (MCAP, rosbag2 .db3 or folder, ROS 1 .bag) whose image topic gives the frames at their own times and
 whose joint states give the states, as `kccd overlay --bag` (image_topic, joint_topic: default the only
-one of the type; time_source 'header' or 'log'; joint_map: a joint map file; warnings as UserWarning).
+one of the type; time_source 'header' or 'log'; joint_map: a joint map file; warnings as UserWarning). Or
+lerobot: a LeRobot dataset's folder with episode (its episode_index), as `kccd overlay --lerobot` (camera_key:
+default its only camera; state_key: the vector feature read; frame_by 'auto', 'timestamp' or 'index').
 masks: a folder of robot masks (frame_000000.png, ...) or 'auto' (made from the recording's own
 background): each frame's 'mask_iou' and the report's 'mask_agreement'; mask_bodies: the bodies the masks
 show (default all). An unknown keyword raises TypeError; a bad value InputError naming the keyword
@@ -294,6 +305,104 @@ interval's rate), 'warnings'. frames: indices of the image topic's frames return
 naming the file, topic and place.)doc");
 }
 
+// What a LeRobot dataset holds, and what kccd overlay --lerobot reads of an episode.
+void bindReadLerobot(py::module_& m) {
+  m.def(
+      "read_lerobot",
+      [](const std::string& path, const std::shared_ptr<ModelHandle>& h, long episode, const std::string& state_key,
+         const std::string& frame_by, const std::string& joint_map) {
+        const std::optional<overlay::FrameBy> by = overlay::frameByOf(frame_by);
+        if (!by) throw py::value_error("frame_by: expected 'auto', 'timestamp' or 'index'");
+        if (!h && (episode != -1 || !joint_map.empty())) throw py::value_error("episode and joint_map need a model");
+        if (h && episode < 0) throw py::value_error("episode: give the episode (its episode_index) with a model");
+        py::dict d;
+        nlohmann::json info;
+        overlay::LerobotRecording rec;
+        {
+          py::gil_scoped_release release;
+          info = overlay::datasetInfoJson(logs::openLerobotDataset(path));
+          if (h)
+            rec = overlay::readLerobotRecording(
+                {.dataset = path,
+                 .episode = episode,
+                 .state_key = state_key,
+                 .frame_by = *by,
+                 .joint_map = joint_map.empty() ? overlay::JointMap{} : overlay::loadJointMap(joint_map, *h->model),
+                 .frames = false},
+                *h->model);
+        }
+        d["info"] = toPython(info);
+        if (!h) return d;
+        d["state_names"] = rec.log.names;
+        d["times"] = floatArray(rec.log.times);
+        py::array_t<double> states(
+            {static_cast<py::ssize_t>(rec.log.rows()), static_cast<py::ssize_t>(rec.log.stateSize())});
+        std::copy(rec.log.values.begin(), rec.log.values.end(), states.mutable_data());
+        d["states"] = states;
+        d["frame_by"] = rec.frame_by == overlay::FrameBy::Index ? "index" : "timestamp";
+        d["data_file"] = rec.data_file;
+        d["warnings"] = rec.warnings;
+        return d;
+      },
+      py::arg("path"), py::arg("model") = nullptr, py::kw_only(), py::arg("episode") = -1,
+      py::arg("state_key") = "observation.state", py::arg("frame_by") = "auto", py::arg("joint_map") = "",
+      R"doc(What a LeRobot dataset (v2.0, v2.1 or v3.0 folder) holds, as `kccd dataset info --json` under 'info'.
+With a model and an episode, also what `kccd overlay --lerobot` reads of it: 'state_names', 'times' (s: each
+row's frame time, by timestamp or frame_index as 'frame_by' says), 'states' (one row per dataset row, the model's
+state values matched by name, NAME.pos or joint_map), 'data_file', 'warnings'. Raises InputError naming the
+file and place.)doc");
+}
+
+// A joint log checked without a camera (kccd check).
+void bindCheckLog(py::module_& m) {
+  m.def(
+      "check_log",
+      [](const std::shared_ptr<ModelHandle>& h, const std::string& states, const std::string& bag,
+         const std::string& lerobot, long episode, const std::string& state_key, const std::string& joint_topic,
+         const std::string& time_source, const std::string& joint_map, const std::vector<std::string>& ignore_columns,
+         double rate, double max_gap, const std::string& query, bool swept, const std::optional<BrakingParams>& braking,
+         int jobs, const std::string& report, const std::string& timeline) {
+        const overlay::CheckRequest q{.states = states,
+                                      .ignore_columns = ignore_columns,
+                                      .bag = bag,
+                                      .joint_topic = joint_topic,
+                                      .time_source = time_source,
+                                      .joint_map = joint_map,
+                                      .lerobot = lerobot,
+                                      .episode = episode,
+                                      .state_key = state_key,
+                                      .rate = rate,
+                                      .max_gap = max_gap,
+                                      .query = query,
+                                      .swept = swept,
+                                      .braking = braking,
+                                      .jobs = jobs,
+                                      .report = report,
+                                      .timeline = timeline,
+                                      .model_file = h->source};
+        overlay::CheckResult result;
+        {
+          py::gil_scoped_release release;
+          result = overlay::runCheck(q, *h->model);
+        }
+        for (const std::string& w : result.warnings) PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1);
+        return toPython(result.json);
+      },
+      py::arg("model"), py::arg("states") = "", py::kw_only(), py::arg("bag") = "", py::arg("lerobot") = "",
+      py::arg("episode") = -1, py::arg("state_key") = "observation.state", py::arg("joint_topic") = "",
+      py::arg("time_source") = "header", py::arg("joint_map") = "",
+      py::arg("ignore_columns") = std::vector<std::string>{}, py::arg("rate") = 0.0, py::arg("max_gap") = 0.0,
+      py::arg("query") = "distances", py::arg("swept") = false, py::arg("braking") = std::nullopt, py::arg("jobs") = 0,
+      py::arg("report") = "", py::arg("timeline") = "",
+      R"doc(A joint log checked without a camera, as `kccd check`: every sample of `states` (CSV), of a robot log's
+joint states (bag) or of a LeRobot episode (lerobot, episode) queried (rate: a grid of that many samples per
+second instead), static or swept (braking: a BrakingParams for every joint, None: kccd overlay's defaults);
+query 'distances' (the overlay's) or 'collision' (faster). Writes report (.json, the overlay's format) and
+timeline (.png) when given, staged. Returns the summary as a dict ('samples', 'clear', 'within_margin',
+'colliding', 'no_state', 'unsafe', ...); the log's warnings as UserWarning. Raises InputError naming the
+keyword or the file and place.)doc");
+}
+
 // Synthetic recordings with ground truth (kccd synth).
 void bindSynth(py::module_& m) {
   m.def(
@@ -369,6 +478,8 @@ void bindOverlay(py::module_& m) {
   bindContactSheet(m);
   bindOverlayJob(m);
   bindReadBag(m);
+  bindReadLerobot(m);
+  bindCheckLog(m);
   bindSynth(m);
 }
 

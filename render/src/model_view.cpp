@@ -6,17 +6,36 @@
 #include <stdexcept>
 #include <utility>
 
+#include "kccd/kinematics.hpp"
 #include "kccd/render/scene.hpp"
 
 namespace kccd::render {
 
+int cameraFrame(const Model& model, const Camera& camera, const std::string& source) {
+  if (camera.frame.empty() || camera.frame == "world") return kWorld;
+  if (const int j = model.jointIndex(camera.frame); j >= 0) return j;
+  for (const Body& b : model.bodies)
+    if (b.name == camera.frame || b.linkName() == camera.frame) return b.frame;
+  throw CameraError(InputLocation{source, 0, 0, "frame"}, "'" + printable(camera.frame, 60) +
+                                                              "' is neither a joint nor a body or link of " +
+                                                              model.name + " (the frame the camera is fixed to)");
+}
+
 ModelView::ModelView(const Model& model, const Camera& camera, const RenderOptions& options,
                      std::vector<LoadedVisual> visuals)
-    : model_(model), checker_(model), renderer_(camera, options), visuals_(std::move(visuals)) {}
+    : model_(model),
+      checker_(model),
+      renderer_(camera, options),
+      visuals_(std::move(visuals)),
+      camera_frame_(cameraFrame(model, camera)) {}
 
 ModelView::ModelView(const Model& model, const Projection& projection, const RenderOptions& options,
                      std::vector<LoadedVisual> visuals)
-    : model_(model), checker_(model), renderer_(projection, options), visuals_(std::move(visuals)) {}
+    : model_(model),
+      checker_(model),
+      renderer_(projection, options),
+      visuals_(std::move(visuals)),
+      camera_frame_(cameraFrame(model, projection.camera())) {}
 
 bool ModelView::sameAsLastOnto(const ModelViewRequest& r) const {
   if (!last_onto_ || r.onto == nullptr || !r.colour || r.mask) return false;
@@ -54,6 +73,20 @@ ModelFrame ModelView::draw(const ModelViewRequest& request) {
                           out};
   }
   return out;
+}
+
+bool ModelView::placeInCameraFrame(const ModelViewRequest& request, std::vector<Volume>& volumes) const {
+  // The renderer's world is the camera's frame: every volume is moved from the world into it, at
+  // the state (or the box's middle) the frame is at.
+  std::vector<double> at(request.state.begin(), request.state.end());
+  if (at.empty())
+    for (std::size_t i = 0; i < request.lower.size() && i < request.upper.size(); ++i)
+      at.push_back(0.5 * (request.lower[i] + request.upper[i]));
+  std::vector<Pose> poses(model_.joints.size());
+  if (at.empty() || !framePoses(model_, at, poses)) return false;
+  const Pose to_frame = framePose(poses, camera_frame_).inverse();
+  for (Volume& v : volumes) v.pose = to_frame * v.pose;
+  return true;
 }
 
 ModelFrame ModelView::drawAnew(const ModelViewRequest& request) {
@@ -100,6 +133,7 @@ ModelFrame ModelView::drawAnew(const ModelViewRequest& request) {
     out.query_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   if (!drawn) return out;
+  if (camera_frame_ != kWorld && !placeInCameraFrame(request, volumes)) volumes.clear();
   for (std::size_t i = 0; i < volumes.size(); ++i) {
     if (request.radius_scale != 1.0) volumes[i].radius *= request.radius_scale;
     if (!request.colours.empty()) volumes[i].colour = request.colours[i];
@@ -107,6 +141,7 @@ ModelFrame ModelView::drawAnew(const ModelViewRequest& request) {
   out.first_visual = volumes.size();
   if (request.visuals && !request.state.empty() && !visuals_.empty()) {
     std::vector<Volume> look = visualVolumes(model_, visuals_, request.state);
+    if (camera_frame_ != kWorld && !placeInCameraFrame(request, look)) look.clear();
     volumes.insert(volumes.end(), std::make_move_iterator(look.begin()), std::make_move_iterator(look.end()));
   }
   out.images = request.onto && request.colour && !request.mask

@@ -12,6 +12,8 @@
 //   joint_chunked_none.mcap   chunked (4 KiB), no compression
 //   joint_overlap.mcap        the same messages topic by topic in zstd chunks: chunk time
 //                             ranges overlap (not in truth.json: its file order differs)
+//   joint_publishers.mcap     the same messages, /joint_states on three channels (callerids)
+//   split_mcap/               the same messages as a rosbag2 folder of 11 MCAP files (zstd)
 // plus truth.json: what each file holds and every decoded message, for the tests.
 // Content: 200 sensor_msgs/msg/JointState on /joint_states at 1 kHz, one CameraInfo and 10
 // sensor_msgs/msg/Image (64x48 rgb8) on /camera/image_raw at 30 Hz, interleaved by
@@ -127,19 +129,28 @@ const FILES = {
   "joint_chunked_none.mcap": { compression: "", opts: { chunkSize: CHUNK, compressChunk: compressNone } },
 };
 
-async function writeFile(name, opts, order = records) {
+// `order`: the records to write. `rotate`: the topics registered from this one on (other channel
+// and schema ids). `publishers`: per topic, the callerids of the channels that share it (a channel
+// each, its metadata naming it; message k of the topic on channel k mod their number).
+async function writeFile(name, opts, order = records, { rotate = 0, publishers = {} } = {}) {
   const parts = [];
   let pos = 0n;
   const writable = { position: () => pos, write: async (b) => { parts.push(Buffer.from(b)); pos += BigInt(b.byteLength); } };
   const w = new McapWriter({ writable, ...opts });
   await w.start({ profile: "ros2", library: LIBRARY_IDENTIFIER });
   const channels = [];
-  for (const t of TOPICS) {
+  for (let k = 0; k < TOPICS.length; k++) {
+    const ti = (k + rotate) % TOPICS.length, t = TOPICS[ti];
     const schemaId = await w.registerSchema({ name: t.schema_name, encoding: "ros2msg", data: new TextEncoder().encode(t.def) });
-    channels.push(await w.registerChannel({ topic: t.topic, schemaId, messageEncoding: "cdr", metadata: new Map() }));
+    channels[ti] = [];
+    for (const caller of publishers[t.topic] ?? [null]) {
+      const metadata = new Map(caller ? [["callerid", caller]] : []);
+      channels[ti].push(await w.registerChannel({ topic: t.topic, schemaId, messageEncoding: "cdr", metadata }));
+    }
   }
   for (const r of order) {
-    await w.addMessage({ channelId: channels[r.ti], sequence: r.seq, logTime: r.log, publishTime: r.log, data: r.data });
+    const ids = channels[r.ti];
+    await w.addMessage({ channelId: ids[r.seq % ids.length], sequence: r.seq, logTime: r.log, publishTime: r.log, data: r.data });
   }
   await w.end();
   fs.writeFileSync(path.join(outDir, name), Buffer.concat(parts));
@@ -152,6 +163,27 @@ for (const [name, f] of Object.entries(FILES)) await writeFile(name, f.opts);
 // reader's to restore (from the summary's chunk index). Not in truth.json: its file order differs.
 const byTopic = [...records].sort((a, b) => a.ti - b.ti || (a.log < b.log ? -1 : a.log > b.log ? 1 : 0));
 await writeFile("joint_overlap.mcap", { chunkSize: CHUNK, compressChunk: compressZstd }, byTopic);
+
+// The same messages with /joint_states on three channels, one per publisher (as an MCAP file
+// converted from a ROS 1 bag has a channel per connection): message k on channel k mod 3. Not in
+// truth.json: bag info gives one row for the topic, with its publishers.
+const PUBLISHERS = ["/arm_controller", "/gripper_controller", "/joint_state_publisher"];
+await writeFile("joint_publishers.mcap", { chunkSize: CHUNK, compressChunk: compressZstd }, records,
+  { publishers: { "/joint_states": PUBLISHERS } });
+// The same messages as a rosbag2 bag split into 11 MCAP files (split_mcap/rec_0.mcap ... rec_10.mcap,
+// listed in that order in its metadata.yaml; by name rec_10 would sort before rec_2), each file
+// registering the topics in another order, so that a channel's id differs from file to file.
+const SPLIT = 11;
+const splitNames = [];
+fs.mkdirSync(path.join(outDir, "split_mcap"), { recursive: true });
+for (let k = 0; k < SPLIT; k++) {
+  const part = records.slice(Math.floor((k * records.length) / SPLIT), Math.floor(((k + 1) * records.length) / SPLIT));
+  splitNames.push(`rec_${k}.mcap`);
+  await writeFile(path.join("split_mcap", splitNames[k]), { chunkSize: CHUNK, compressChunk: compressZstd }, part, { rotate: k });
+}
+fs.writeFileSync(path.join(outDir, "split_mcap", "metadata.yaml"),
+  "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  relative_file_paths:\n" +
+  splitNames.map((n) => `    - ${n}\n`).join("") + `  message_count: ${records.length}\n`);
 
 // ---- truth.json
 const topicInfo = TOPICS.map((t) => ({

@@ -79,7 +79,7 @@ def test_overlay_of_a_bag_from_python_is_the_commands(cli, bags: pathlib.Path, t
     assert mine["source"]["time_source"] == "log" and (tmp_path / "timeline.png").stat().st_size > 1000
     with pytest.raises(ValueError, match="^video: not with bag "):
         kccd.overlay_recording(model, camera, "v.mkv", "s.csv", bag=str(bags / "joint_lz4.mcap"))
-    with pytest.raises(ValueError, match="^give video and states, or bag"):
+    with pytest.raises(ValueError, match="^give video and states, bag \\(a robot log\\) or lerobot"):
         kccd.overlay_recording(model, camera, "v.mkv")
     with pytest.raises(ValueError, match="^time_source: expected 'header' or 'log', got 'wall'"):
         kccd.overlay_recording(model, camera, bag=str(bags / "joint_lz4.mcap"), time_source="wall")

@@ -217,7 +217,7 @@ BRAKING_SPELLED = ", ".join(sorted(BRAKING_OPTIONS, key=["--latency", "--deceler
 def _overlay_keywords() -> dict[str, str]:
     signature = " ".join(kccd.overlay_recording.__doc__.split("\n\n")[0].split())
     assert signature.startswith("overlay_recording(model, camera, video='', states='', *,"), signature
-    return dict(re.findall(r"(\w+)=('[^']*'|\[\]|[\w.]+)", signature))
+    return dict(re.findall(r"(\w+)=('[^']*'|\[\]|-?[\w.]+)", signature))
 
 
 def _python_default(text: str) -> object:
@@ -284,6 +284,10 @@ def test_overlay_messages_are_the_same_from_both_front_ends(cli, arm: kccd.Model
         (["--timeline", str(tmp_path / "no" / "t.png")], {"timeline": str(tmp_path / "no" / "t.png")}),
         (["--frame-times", str(tmp_path / "none.csv")], {"frame_times": str(tmp_path / "none.csv")}),
         (["--ignore-columns", "time"], {"ignore_columns": ["time"]}),
+        (["--episode", "3"], {"episode": 3}),
+        (["--frame-by", "index"], {"frame_by": "index"}),
+        (["--camera-key", "observation.images.top"], {"camera_key": "observation.images.top"}),
+        (["--lerobot", str(tmp_path)], {"lerobot": str(tmp_path)}),
     ]
     base = [str(cli), "overlay", str(DATA / "demo_arm.yaml"), "--camera", s["camera"], "--video", s["video"],
             "--states", s["states"], "--report", str(tmp_path / "r.json")]

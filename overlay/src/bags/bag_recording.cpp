@@ -189,9 +189,14 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
           r.problem = e.what();
         }
       });
-  rec.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic,
-                                spelledField(o.spell, "image_topic"), "sensor_msgs/Image or CompressedImage", o.bag);
-  const LogSource& images = *sourceOf(sources, rec.image_topic);
+  const LogSource* image_source = nullptr;
+  if (o.frames || !model) {
+    rec.image_topic = chooseTopic(sources, {LogKind::Image, LogKind::Compressed}, o.image_topic,
+                                  spelledField(o.spell, "image_topic"), "sensor_msgs/Image or CompressedImage", o.bag);
+    image_source = sourceOf(sources, rec.image_topic);
+  }
+  const LogSource none{};
+  const LogSource& images = image_source ? *image_source : none;
   if (!model) {
     rec.origin_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(images.first, 0));
     if (!damage.empty())
@@ -229,9 +234,10 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
   }
   if (r.times.empty()) throw InputError(o.bag + ": topic " + printable(rec.joint_topic, 60) + ": no joint state");
   if (!damage.empty())
-    rec.warnings.push_back(damage + "; read up to it: " + std::to_string(images.times.size()) + " images and " +
+    rec.warnings.push_back(damage + "; read up to it: " +
+                           (image_source ? std::to_string(images.times.size()) + " images and " : std::string()) +
                            std::to_string(r.times.size()) + " joint states");
-  const std::int64_t origin = std::min(images.first, joints.first);
+  const std::int64_t origin = image_source ? std::min(images.first, joints.first) : joints.first;
   rec.origin_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(origin, 0));
   // The state log, as text the state log reader checks like a file.
   // Each state value from its logged joint (scaled, offset) or constant, in the model's order.
@@ -273,7 +279,7 @@ BagRecording readBag(const BagRecordingOptions& o, const Model* model) {
                            (left_out.empty() ? std::to_string(r.extra) + " values" : left_out));
   }
   if (r.used.dropped > 0) rec.warnings.push_back(r.used.warning("joint states"));
-  imageTimes(o, images, rec);
+  if (image_source) imageTimes(o, images, rec);
   return rec;
 }
 

@@ -1,11 +1,13 @@
 #include "kccd/overlay/calibration/calib_gather.hpp"
 
 #include <algorithm>
+#include <optional>
 
 #include <opencv2/imgproc.hpp>
 
 #include "kccd/calib/image_file.hpp"
 #include "kccd/calib/tag_detect.hpp"
+#include "kccd/kinematics.hpp"
 #include "kccd/overlay/recording/video_source.hpp"
 
 namespace kccd::overlay {
@@ -134,6 +136,25 @@ Gathered gatherCorrespondences(const GatherInputs& in) {
     g.unknown_tag_ids.insert(g.unknown_tag_ids.end(), fr.unknown_ids.begin(), fr.unknown_ids.end());
   std::sort(g.unknown_tag_ids.begin(), g.unknown_tag_ids.end());
   g.unknown_tag_ids.erase(std::unique(g.unknown_tag_ids.begin(), g.unknown_tag_ids.end()), g.unknown_tag_ids.end());
+  return g;
+}
+
+Gathered inMountFrame(Gathered g, const Model& model, int frame, const std::string& label) {
+  std::vector<std::optional<Pose>> to_mount(g.frames.size());
+  std::vector<Pose> poses(model.joints.size());
+  for (std::size_t f = 0; f < g.frames.size(); ++f) {
+    if (g.frames[f].state.empty() || !framePoses(model, g.frames[f].state, poses))
+      throw CalibInputError(label + ": frame " + std::to_string(f + 1) +
+                            (g.frames[f].image.empty() ? "" : " (" + g.frames[f].image + ")") +
+                            " has no state: a camera fixed to the robot is placed by each frame's state (give --state, "
+                            "--states with --time, or a robot log)");
+    to_mount[f] = framePose(poses, frame).inverse();
+  }
+  for (std::size_t i = 0; i < g.points.size(); ++i) {
+    calib::Correspondence& c = g.points[i];
+    const Vec3 p = *to_mount[g.sources[i].frame] * Vec3(c.world.x, c.world.y, c.world.z);
+    c.world = cv::Point3d(p.x(), p.y(), p.z());
+  }
   return g;
 }
 

@@ -7,9 +7,11 @@
 
 #include "kccd/input_error.hpp"
 #include "kccd/overlay/bags/bag_recording.hpp"
+#include "kccd/overlay/datasets/lerobot_recording.hpp"
 #include "kccd/overlay/recording/frame_times.hpp"
 #include "kccd/overlay/recording/mask_agreement.hpp"
 #include "kccd/overlay/recording/video_sink.hpp"
+#include "kccd/render/model_view.hpp"
 #include "kccd/state_log.hpp"
 
 namespace kccd::overlay {
@@ -65,25 +67,45 @@ struct Checker {
   std::vector<int> maskBodies() const;
 };
 
-// Which recording: a video with its log, or a robot log, and only the fields that go with it.
+// Which recording: a video with its log, a robot log or a dataset's episode, and only the fields
+// that go with it.
 void Checker::recording() const {
-  if (!r.bag.empty()) {
-    for (const auto& [given, field] : {std::pair{!r.video.empty(), "video"},
-                                       {!r.states.empty(), "states"},
-                                       {!r.frame_times.empty(), "frame_times"},
-                                       {!r.ignore_columns.empty(), "ignore_columns"}})
-      if (given)
-        throw problem(field, "not with " + named("bag") + " (the log gives the frames, their times and the states)");
-    if (r.fps != 0.0) throw problem("fps", "not with " + named("bag") + " (each frame has its own time)");
-  } else {
-    if (r.video.empty() || r.states.empty())
-      throw InputError("give " + named("video") + " and " + named("states") + ", or " + named("bag") +
-                       " (a robot log)");
-    for (const auto& [given, field] : {std::pair{!r.image_topic.empty(), "image_topic"},
-                                       {!r.joint_topic.empty(), "joint_topic"},
-                                       {!r.joint_map.empty(), "joint_map"}})
-      if (given) throw problem(field, "goes with " + named("bag"));
+  const std::vector<std::pair<bool, const char*>> video_fields{{!r.video.empty(), "video"},
+                                                               {!r.states.empty(), "states"},
+                                                               {!r.frame_times.empty(), "frame_times"},
+                                                               {!r.ignore_columns.empty(), "ignore_columns"}};
+  const std::vector<std::pair<bool, const char*>> bag_fields{{!r.image_topic.empty(), "image_topic"},
+                                                             {!r.joint_topic.empty(), "joint_topic"}};
+  const std::vector<std::pair<bool, const char*>> lerobot_fields{{r.episode != -1, "episode"},
+                                                                 {!r.camera_key.empty(), "camera_key"},
+                                                                 {r.state_key != "observation.state", "state_key"},
+                                                                 {r.frame_by != "auto", "frame_by"}};
+  const auto refuse = [&](const std::vector<std::pair<bool, const char*>>& fields, const std::string& why) {
+    for (const auto& [given, field] : fields)
+      if (given) throw problem(field, why);
+  };
+  if (!r.bag.empty() && !r.lerobot.empty()) throw problem("lerobot", "not with " + named("bag") + " (one recording)");
+  if (!r.bag.empty() || !r.lerobot.empty()) {
+    const std::string what = r.bag.empty() ? "lerobot" : "bag";
+    refuse(video_fields, "not with " + named(what) + " (the " + (r.bag.empty() ? "dataset" : "log") +
+                             " gives the frames, their times and the states)");
+    if (r.fps != 0.0) throw problem("fps", "not with " + named(what) + " (each frame has its own time)");
+  } else if (r.video.empty() || r.states.empty()) {
+    throw InputError("give " + named("video") + " and " + named("states") + ", " + named("bag") + " (a robot log) or " +
+                     named("lerobot") + " (a LeRobot dataset)");
+  } else if (!r.joint_map.empty()) {
+    throw problem("joint_map", "goes with " + named("bag") + " or " + named("lerobot"));
   }
+  if (r.bag.empty()) refuse(bag_fields, "goes with " + named("bag"));
+  if (r.lerobot.empty()) refuse(lerobot_fields, "goes with " + named("lerobot"));
+  if (!r.lerobot.empty()) {
+    if (r.episode < 0)
+      throw problem("episode", r.episode == -1 ? "give the episode (its episode_index)" : "must be >= 0");
+    if (r.state_key.empty()) throw problem("state_key", "must name a feature");
+    if (!frameByOf(r.frame_by))
+      throw problem("frame_by", "expected 'auto', 'timestamp' or 'index', got '" + printable(r.frame_by) + "'");
+  }
+  if (r.time_source != "header" && r.bag.empty()) throw problem("time_source", "goes with " + named("bag"));
   if (!timeSourceOf(r.time_source))
     throw problem("time_source", "expected 'header' or 'log', got '" + printable(r.time_source) + "'");
 }
@@ -159,9 +181,13 @@ struct OverlayJob::State {
   FieldSpelling spell;
   OverlayOutputs outputs;
   OverlayOptions options;
-  std::optional<BagRecording> bag;
+  // The recording as read: its state log, frames and how it was read (a robot log's or a dataset's).
   StateLog log;
   std::vector<double> frame_times;
+  std::function<std::unique_ptr<FrameSource>()> open_frames;  ///< a robot log's or a dataset's frames
+  std::string recording_label;                                ///< how errors name the frames
+  std::vector<std::pair<std::string, std::string>> source;    ///< the report's "source"
+  std::vector<std::string> warnings;
   std::optional<MaskAgreement> masks;
   bool ran = false;
 
@@ -178,8 +204,18 @@ OverlayJob::OverlayJob(const OverlayRequest& request, const Model& model, const 
   check.recording();
   s.options = check.options();
   const std::vector<int> mask_bodies = check.maskBodies();
+  // A camera fixed to the robot names a frame of this model; its masks cannot be compared (they
+  // are drawn from a camera fixed in the world).
+  try {
+    render::cameraFrame(model, camera, r.camera_file.empty() ? s.named("camera") : r.camera_file);
+  } catch (const calib::CameraError& e) {
+    throw InputError(e.what());
+  }
+  if (!camera.frame.empty() && !r.masks.empty())
+    throw check.problem(
+        "masks", "not with a camera fixed to the robot (the camera file's frame: " + printable(camera.frame, 60) + ")");
 
-  const std::string recording = r.bag.empty() ? r.video : r.bag;
+  const std::string recording = !r.bag.empty() ? r.bag : !r.lerobot.empty() ? r.lerobot : r.video;
   s.outputs =
       OverlayOutputs{.video = r.output,
                      .png_dir = r.png_dir,
@@ -194,18 +230,40 @@ OverlayJob::OverlayJob(const OverlayRequest& request, const Model& model, const 
                      .timeline_title = filename(recording) +
                                        (r.model_file.empty() ? std::string() : "  (" + filename(r.model_file) + ")")};
   checkOverlayOutputs(s.outputs, std::vector<std::string>{r.video, r.states, r.model_file, r.camera_file, r.frame_times,
-                                                          r.bag, r.joint_map});
+                                                          r.bag, r.joint_map, r.lerobot});
 
+  const JointMap joint_map = r.joint_map.empty() ? JointMap{} : loadJointMap(r.joint_map, model);
   if (!r.bag.empty()) {
-    s.bag = readBagRecording({.bag = r.bag,
-                              .joint_topic = r.joint_topic,
-                              .image_topic = r.image_topic,
-                              .time_source = *timeSourceOf(r.time_source),
-                              .joint_map = r.joint_map.empty() ? JointMap{} : loadJointMap(r.joint_map, model),
-                              .spell = s.spell},
-                             model);
-    s.log = std::move(s.bag->log);
-    s.frame_times = s.bag->frame_times;
+    BagRecording bag = readBagRecording({.bag = r.bag,
+                                         .joint_topic = r.joint_topic,
+                                         .image_topic = r.image_topic,
+                                         .time_source = *timeSourceOf(r.time_source),
+                                         .joint_map = joint_map,
+                                         .spell = s.spell},
+                                        model);
+    s.log = std::move(bag.log);
+    s.frame_times = bag.frame_times;
+    s.open_frames = bag.open_frames;
+    s.recording_label = s.named("bag") + " " + r.bag + " (topic " + bag.image_topic + ")";
+    s.source = bag.source();
+    s.warnings = bag.warnings;
+  } else if (!r.lerobot.empty()) {
+    LerobotRecording episode = readLerobotRecording({.dataset = r.lerobot,
+                                                     .episode = r.episode,
+                                                     .camera_key = r.camera_key,
+                                                     .state_key = r.state_key,
+                                                     .frame_by = *frameByOf(r.frame_by),
+                                                     .joint_map = joint_map,
+                                                     .spell = s.spell},
+                                                    model);
+    s.log = std::move(episode.log);
+    s.frame_times = episode.frame_times;
+    s.open_frames = episode.open_frames;
+    s.recording_label = s.named("lerobot") + " " + r.lerobot + " episode " + std::to_string(r.episode) + " (" +
+                        episode.camera_key + ")";
+    s.source = episode.source();
+    s.source.insert(s.source.begin(), {{"lerobot", r.lerobot}, {"episode", std::to_string(r.episode)}});
+    s.warnings = episode.warnings;
   } else {
     s.log = loadStateLog(r.states, model, r.ignore_columns);
     if (!r.frame_times.empty()) try {
@@ -213,6 +271,7 @@ OverlayJob::OverlayJob(const OverlayRequest& request, const Model& model, const 
       } catch (const FrameTimesError& e) {
         throw InputError(s.named("frame_times") + " " + e.what());
       }
+    s.recording_label = s.named("video") + " " + r.video;
   }
   if (!r.masks.empty()) {
     const std::string label = s.named("masks") + " " + r.masks;
@@ -225,27 +284,23 @@ OverlayJob::OverlayJob(const OverlayRequest& request, const Model& model, const 
 
 OverlayJob::~OverlayJob() = default;
 
-const std::vector<std::string>& OverlayJob::warnings() const {
-  static const std::vector<std::string> none;
-  return s_->bag ? s_->bag->warnings : none;
-}
+const std::vector<std::string>& OverlayJob::warnings() const { return s_->warnings; }
 
 OverlayJob::Result OverlayJob::run(const std::function<void(const OverlayProgress&)>& progress) {
   State& s = *s_;
   if (s.ran) throw std::logic_error("OverlayJob::run: a job runs once");
   s.ran = true;
   const OverlayRequest& r = s.request;
-  OverlayInputs in{
-      s.model,
-      s.camera,
-      s.log,
-      s.bag ? r.bag : r.video,
-      s.frame_times,
-      s.bag ? s.named("bag") + " " + r.bag + " (topic " + s.bag->image_topic + ")" : s.named("video") + " " + r.video,
-      r.camera_file.empty() ? s.named("camera") : r.camera_file,
-      s.named("frame_times") + " " + r.frame_times};
+  OverlayInputs in{s.model,
+                   s.camera,
+                   s.log,
+                   r.video,
+                   s.frame_times,
+                   s.recording_label,
+                   r.camera_file.empty() ? s.named("camera") : r.camera_file,
+                   s.named("frame_times") + " " + r.frame_times};
   in.no_rate_hint = "give " + s.named("fps") + " or " + s.named("frame_times");
-  if (s.bag) in.open_frames = s.bag->open_frames;
+  in.open_frames = s.open_frames;
   if (s.masks) in.masks = &*s.masks;
 
   VideoSink sink({.video = r.output,
@@ -255,7 +310,7 @@ OverlayJob::Result OverlayJob::run(const std::function<void(const OverlayProgres
                   .png_label = s.named("png_dir") + " " + r.png_dir});
   Result result;
   result.report = overlayRecording(in, s.options, sink.active() ? &sink : nullptr, progress);
-  if (s.bag) result.report.source = s.bag->source();
+  result.report.source = s.source;
   result.json = writeOverlayOutputs(s.outputs, result.report, s.model, sink);
   return result;
 }

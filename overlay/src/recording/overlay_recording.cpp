@@ -22,7 +22,6 @@
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
-#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "kccd/input_error.hpp"
@@ -34,46 +33,6 @@
 
 namespace kccd::overlay {
 namespace {
-
-// FFmpeg's and OpenCV's own log lines silenced while runs are under way (errors are reported once,
-// by the caller; set OPENCV_FFMPEG_LOGLEVEL to see FFmpeg's), the process's settings restored when
-// the last run in it ends. FFmpeg reads videos, OpenCV's image reader sequences.
-class QuietOpenCv {
- public:
-  QuietOpenCv() {
-    const std::lock_guard lock(mu());
-    if (users()++ > 0) return;
-    level() = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
-    set_env() = std::getenv("OPENCV_FFMPEG_LOGLEVEL") == nullptr;
-    if (set_env()) setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
-  }
-  ~QuietOpenCv() {
-    const std::lock_guard lock(mu());
-    if (--users() > 0) return;
-    cv::utils::logging::setLogLevel(level());
-    if (set_env()) unsetenv("OPENCV_FFMPEG_LOGLEVEL");
-  }
-  QuietOpenCv(const QuietOpenCv&) = delete;
-  QuietOpenCv& operator=(const QuietOpenCv&) = delete;
-
- private:
-  static std::mutex& mu() {
-    static std::mutex m;
-    return m;
-  }
-  static int& users() {
-    static int n = 0;
-    return n;
-  }
-  static cv::utils::logging::LogLevel& level() {
-    static cv::utils::logging::LogLevel l = cv::utils::logging::LOG_LEVEL_INFO;
-    return l;
-  }
-  static bool& set_env() {
-    static bool b = false;
-    return b;
-  }
-};
 
 struct FrameJob {
   std::size_t index = 0;
@@ -332,7 +291,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   settings.plain = opt.plain;
   if (opt.swept) settings.braking.assign(static_cast<std::size_t>(model.stateSize()), opt.braking);
 
-  const QuietOpenCv quiet;
+  const QuietVideoLogs quiet;
   // No mask is drawn: its finer pinhole image (and its per-pixel distortion map) is not built. The
   // colour pass's map is built once here for every annotator.
   render::RenderOptions render_options;

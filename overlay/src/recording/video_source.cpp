@@ -2,15 +2,52 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <mutex>
 #include <vector>
 
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "kccd/calib/image_file.hpp"
 
 namespace kccd::overlay {
+
+namespace {
+
+// QuietVideoLogs' process-wide state.
+struct QuietState {
+  std::mutex mu;
+  int users = 0;
+  cv::utils::logging::LogLevel level = cv::utils::logging::LOG_LEVEL_INFO;
+  bool set_env = false;
+};
+QuietState& quietState() {
+  static QuietState s;
+  return s;
+}
+
+}  // namespace
+
+QuietVideoLogs::QuietVideoLogs() {
+  QuietState& q = quietState();
+  const std::lock_guard lock(q.mu);
+  if (q.users++ > 0) return;
+  q.level = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  q.set_env = std::getenv("OPENCV_FFMPEG_LOGLEVEL") == nullptr;
+  if (q.set_env) setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
+}
+
+QuietVideoLogs::~QuietVideoLogs() {
+  QuietState& q = quietState();
+  const std::lock_guard lock(q.mu);
+  if (--q.users > 0) return;
+  cv::utils::logging::setLogLevel(q.level);
+  if (q.set_env) unsetenv("OPENCV_FFMPEG_LOGLEVEL");
+}
 
 namespace {
 
@@ -83,6 +120,17 @@ double VideoSource::fps() const {
   if (sequence_) return 0.0;
   const double fps = capture_->get(cv::CAP_PROP_FPS);
   return std::isfinite(fps) && fps > 0.0 && fps < 1e6 ? fps : 0.0;
+}
+
+std::string VideoSource::codec() const {
+  if (sequence_) return {};
+  const auto fourcc = static_cast<std::uint32_t>(capture_->get(cv::CAP_PROP_FOURCC));
+  std::string out;
+  for (int i = 0; i < 4; ++i) {
+    const char c = static_cast<char>((fourcc >> (8 * i)) & 0xFF);
+    if (c > ' ' && c < 127) out += c;
+  }
+  return out;
 }
 
 std::size_t VideoSource::declaredFrames() const {

@@ -95,6 +95,9 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
       throw fieldError(o.width ? "width" : "height",
                        "shapes the default camera; the camera file " + o.camera + " fixes the size");
     given = calib::loadCamera(o.camera);
+    if (!given->frame.empty())
+      throw SynthError(o.camera + ": frame: synth films with a camera fixed in the world (this one is fixed to " +
+                       printable(given->frame, 60) + ")");
   } else if (width < 64 || height < 64 || width > 4096 || height > 4096) {
     throw fieldError(width < 64 || width > 4096 ? "width" : "height", "must be 64 ... 4096 pixels");
   }

@@ -40,6 +40,10 @@ struct Camera {
   std::vector<double> distortion;                  ///< OpenCV order: k1 k2 p1 p2 [k3 [k4 k5 k6 [s1 s2 s3 s4 [tx ty]]]]
   cv::Vec3d rvec{0, 0, 0};                         ///< world -> camera rotation (Rodrigues vector)
   cv::Vec3d tvec{0, 0, 0};                         ///< world -> camera translation (metres)
+  /// The model frame the camera is fixed to (a wrist or head camera): a joint's, body's or link's
+  /// name; rvec/tvec are then that frame -> camera, and the camera moves with the robot's state.
+  /// Empty: fixed in the world.
+  std::string frame;
   /// Quality of a calibrated pose, as calibration writes it (absent in a file: unknown).
   std::optional<double> reprojection_rms_px;
   std::optional<double> rotation_sigma_deg;

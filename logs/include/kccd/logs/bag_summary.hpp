@@ -1,15 +1,18 @@
 // What a robot log holds, per topic: type, message count, first and last log time, rate, and how
-// far each message's header stamp lies behind its log time (`kccd bag info`).
+// far each message's header stamp lies behind its log time (`kccd bag info`); per topic also its
+// publishers (a ROS 1 bag's connections, an MCAP file's channels), one row each.
 #pragma once
 
 #include <cstdint>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace kccd::logs {
 
-/// One topic of a log.
+/// One topic of a log, or one publisher of a topic (see `publishers`). A topic's text fields are
+/// its publishers', with ", " between values that differ (a topic two nodes publish in two types).
 struct TopicSummary {
   std::string topic;
   std::string type;              ///< the schema's name, e.g. "sensor_msgs/msg/JointState" ("" without a schema)
@@ -26,6 +29,14 @@ struct TopicSummary {
   std::string no_stamps;
   /// Where the definition came from: "stored" (in the log), "built in" (the log stores none), "none".
   std::string definition = "none";
+  /// A publisher's channel metadata (a ROS 1 connection's callerid, md5sum, latching); empty in a
+  /// topic's row.
+  std::vector<std::pair<std::string, std::string>> metadata;
+  /// The topic's publishers: each channel on it (a ROS 1 connection, an MCAP channel) as a row of
+  /// its own messages, in the order the log defines them (one for a topic of one channel). A
+  /// recorder opens a connection per publishing node, so a busy topic such as /tf has many; the
+  /// topic's row sums them. Empty in a publisher's row.
+  std::vector<TopicSummary> publishers;
   /// Messages per second between the first and the last (0 for fewer than two).
   double rate() const;
 };

@@ -19,7 +19,7 @@ class LogReader {
   virtual bool next(LogMessage& out) = 0;
   /// Empty, or why the stream ended before the log's proper end.
   virtual const std::string& damage() const = 0;
-  /// "MCAP" or "rosbag2 sqlite3".
+  /// "MCAP", "rosbag2 sqlite3" or "ROS 1 bag".
   virtual std::string format() const = 0;
   /// The writer's profile and library (empty when the format has none).
   virtual std::string profile() const { return {}; }
@@ -31,8 +31,9 @@ class LogReader {
   virtual std::string place(std::uint64_t offset) const { return "byte " + std::to_string(offset); }
 };
 
-/// Opens a log by what it holds: an MCAP file, a rosbag2 sqlite3 file (.db3), or a rosbag2 folder
-/// (metadata.yaml and its files, in the order it lists them). Throws InputError naming the path.
+/// Opens a log by what it holds: an MCAP file, a rosbag2 sqlite3 file (.db3), a ROS 1 bag, or a
+/// rosbag2 folder (metadata.yaml and its .db3 or .mcap files, read as one log in the order it lists
+/// them). Throws InputError naming the path.
 std::unique_ptr<LogReader> openLog(const std::string& path);
 
 }  // namespace kccd::logs

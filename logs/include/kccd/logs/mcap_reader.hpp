@@ -3,7 +3,8 @@
 // checked where the writer recorded them. A linear scan needs no index, so a recording that crashed
 // before writing its summary reads the same as a finished one. Where the summary's chunk index
 // shows chunks whose time ranges overlap (messages written out of time order), the chunks are read
-// by start time instead and their messages merged by log time.
+// by start time instead and their messages merged by log time. SplitMcapReader reads a rosbag2
+// folder of several MCAP files as one log.
 #pragma once
 
 #include <cstdint>
@@ -87,6 +88,44 @@ class McapReader final : public LogReader {
   bool pending_ = false;  // handle() found a message for next() to return
   LogMessage message_;
   std::unique_ptr<Merge> merge_;  // chunks read by start time (overlapping chunks), else null
+};
+
+/// Streams a rosbag2 bag split into several MCAP files (the relative_file_paths of its
+/// metadata.yaml) as one log, as Db3Reader reads a split .db3 bag: the files in that order, one
+/// open at a time, each in its own log-time order (a recorder splits its log by size or time, so
+/// that order is the log's). A channel is one channel across the files (the same topic, encoding,
+/// metadata and schema), whatever id each file gives it. A file cut short ends its own part, its
+/// damage named with the file's name, and the next file is read.
+class SplitMcapReader final : public LogReader {
+ public:
+  /// Opens the first file after checking that every file is there; `label` names the log (the
+  /// folder). Throws InputError naming the file.
+  SplitMcapReader(std::vector<std::string> files, std::string label);
+  ~SplitMcapReader() override;
+
+  bool next(LogMessage& out) override;
+  const std::string& damage() const override { return damage_; }
+  std::string format() const override { return "MCAP"; }
+  /// The first file's.
+  std::string profile() const override;
+  std::string library() const override;
+  std::map<std::string, int> chunks() const override;
+  /// "NAME byte N": the file's name and the byte in it.
+  std::string place(std::uint64_t offset) const override;
+
+ private:
+  void open(std::size_t file);
+  const Channel& channelOf(const LogMessage& m);
+  std::vector<std::string> files_;
+  std::string label_, damage_, profile_, library_;
+  std::size_t file_ = 0;
+  bool done_ = false;
+  std::unique_ptr<McapReader> reader_;
+  std::map<std::string, int> chunks_;                     // of the files read to their end
+  std::map<std::string, std::uint16_t> channel_of_key_;   // across files: a channel's identity -> its id
+  std::map<std::uint16_t, std::uint16_t> file_channels_;  // this file's channel ids -> ours
+  std::map<std::uint16_t, Channel> channels_;
+  std::map<std::uint16_t, Schema> schemas_;  // by the id of the channel that uses it
 };
 
 }  // namespace kccd::logs

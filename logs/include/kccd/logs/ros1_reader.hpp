@@ -31,6 +31,11 @@ class Ros1Reader final : public LogReader {
   bool record(std::span<const std::uint8_t> header, std::span<const std::uint8_t> data, std::uint64_t at,
               bool in_chunk);
   [[noreturn]] void fail(std::uint64_t at, const std::string& problem) const;
+  // The bytes of a chunk record at `at` that the file cuts short (its header read, `declared`
+  // bytes of data of which fewer remain) as the open chunk: plain, or what of it decompresses.
+  // Returns what the damage adds (": an uncompressed chunk, ..."), "" for a record that is no
+  // chunk this reader takes.
+  std::string openCutChunk(std::uint64_t at, std::uint32_t declared);
 
   std::string path_, damage_;
   std::ifstream in_;
@@ -39,6 +44,7 @@ class Ros1Reader final : public LogReader {
   std::vector<std::uint8_t> header_, data_, chunk_;
   std::size_t chunk_pos_ = 0;
   std::uint64_t chunk_at_ = 0;
+  bool chunk_cut_ = false;  // the open chunk was cut short: its last record may be part of one
   bool ended_ = false, have_header_ = false;
   std::uint64_t index_pos_ = 0;  // the bag header's: where the index section starts (0: not closed)
   std::uint32_t chunk_count_ = 0, chunk_infos_ = 0;

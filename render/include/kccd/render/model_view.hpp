@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -68,10 +69,18 @@ struct ModelFrame {
 
 /// Draws one model for one camera; owns the checker, the renderer (a GL context: one view per
 /// thread) and the model's loaded visuals.
+/// The model frame a camera is fixed to (Camera::frame): a joint's name, or a body's or link's (its
+/// frame); kWorld for an empty name or "world". Throws CameraError "SOURCE: frame: ..." naming the
+/// joints and bodies when the model has no such frame.
+int cameraFrame(const Model& model, const Camera& camera, const std::string& source = "camera");
+
 class ModelView {
  public:
   /// For `model` (which must outlive the view) seen by `camera`; throws what Renderer's constructor
-  /// throws (GlContextError, CameraError). `visuals` (see loadVisuals) are drawn when asked.
+  /// throws (GlContextError, CameraError) and cameraFrame's CameraError. `visuals` (see
+  /// loadVisuals) are drawn when asked. A camera fixed to a frame of the model sees from where that
+  /// frame is at the request's state (the box's middle when only a box is given); with no state
+  /// nothing can be placed and nothing is drawn.
   ModelView(const Model& model, const Camera& camera, const RenderOptions& options = {},
             std::vector<LoadedVisual> visuals = {});
   /// The same with the colour pass's projection made once elsewhere (see Renderer).
@@ -94,10 +103,15 @@ class ModelView {
   const Renderer& renderer() const { return renderer_; }
 
  private:
+  // Moves `volumes` from the world into the camera's frame at the request's state; false when the
+  // state (or box) cannot place it.
+  bool placeInCameraFrame(const ModelViewRequest& request, std::vector<Volume>& volumes) const;
+
   const Model& model_;
   Checker checker_;
   Renderer renderer_;
   std::vector<LoadedVisual> visuals_;
+  int camera_frame_ = kWorld;  // cameraFrame(): where the camera is fixed
   // The last request drawn onto an image, and what it gave (no images): reused when the next is equal.
   struct LastOnto {
     std::vector<double> state, lower, upper;

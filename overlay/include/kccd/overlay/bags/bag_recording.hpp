@@ -25,6 +25,7 @@ struct BagRecordingOptions {
   /// Where each state value comes from; empty (no states): every state value by its own name.
   JointMap joint_map;
   FieldSpelling spell;  ///< how messages name these fields (e.g. "--joint-topic"; default: as they are)
+  bool frames = true;   ///< false: the joint states alone (kccd check), no image topic chosen
 };
 
 /// The recording: what OverlayInputs takes, and what was found.

@@ -111,4 +111,10 @@ struct Gathered {
 /// calib::LabelsError.
 Gathered gatherCorrespondences(const GatherInputs& inputs);
 
+/// The gathered points moved from the world into the model's frame `frame` (a joint's; a camera
+/// fixed to it, Camera::frame) at each point's frame's state: a pose solved from them is that
+/// frame -> camera, one pose for every frame. Throws CalibInputError naming `label` and the first
+/// frame without a state (each frame's state comes from --state, --states or a robot log).
+Gathered inMountFrame(Gathered gathered, const Model& model, int frame, const std::string& label);
+
 }  // namespace kccd::overlay

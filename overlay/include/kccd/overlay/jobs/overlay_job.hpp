@@ -22,15 +22,20 @@ namespace kccd::overlay {
 /// Everything an overlay run is asked, under the names every front end uses (Python's keywords).
 /// Empty strings and zeros mean "not given"; the defaults are the command line's.
 struct OverlayRequest {
-  // The recording: a video with its state log, or a robot log.
-  std::string video;                        ///< a video file or image-sequence pattern (with states)
-  std::string states;                       ///< the state log, CSV (with video)
-  std::vector<std::string> ignore_columns;  ///< state log columns skipped (each must exist)
-  std::string frame_times;                  ///< CSV 'frame,time' (with video; default index / fps)
-  std::string bag;                          ///< a robot log instead of video, states and frame_times
-  std::string image_topic, joint_topic;     ///< with bag (default: the only one of its type)
-  std::string time_source = "header";       ///< with bag: "header" or "log"
-  std::string joint_map;                    ///< with bag: a joint map file
+  // The recording: a video with its state log, a robot log, or a dataset's episode.
+  std::string video;                            ///< a video file or image-sequence pattern (with states)
+  std::string states;                           ///< the state log, CSV (with video)
+  std::vector<std::string> ignore_columns;      ///< state log columns skipped (each must exist)
+  std::string frame_times;                      ///< CSV 'frame,time' (with video; default index / fps)
+  std::string bag;                              ///< a robot log instead of video, states and frame_times
+  std::string image_topic, joint_topic;         ///< with bag (default: the only one of its type)
+  std::string time_source = "header";           ///< with bag: "header" or "log"
+  std::string joint_map;                        ///< with bag or lerobot: a joint map file
+  std::string lerobot;                          ///< a LeRobot dataset's folder instead (with episode)
+  long episode = -1;                            ///< with lerobot: the episode_index
+  std::string camera_key;                       ///< with lerobot: its camera (default: the only one)
+  std::string state_key = "observation.state";  ///< with lerobot: the vector feature read as the state
+  std::string frame_by = "auto";                ///< with lerobot: auto, timestamp or index (lerobot_recording.hpp)
   // Frames against the log's clock.
   double fps = 0.0;                                             ///< the video's frame rate (0: its own)
   double time_offset = 0.0;                                     ///< log time = frame time + offset (s)

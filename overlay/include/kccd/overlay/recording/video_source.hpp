@@ -23,6 +23,17 @@ class VideoError : public InputError {
   using InputError::InputError;
 };
 
+/// While one lives, FFmpeg's and OpenCV's own log lines are silenced (errors are reported once, by
+/// the caller; set OPENCV_FFMPEG_LOGLEVEL to see FFmpeg's); the process's settings come back when the
+/// last one ends. Thread-safe; hold one around opening and reading recordings.
+class QuietVideoLogs {
+ public:
+  QuietVideoLogs();
+  ~QuietVideoLogs();
+  QuietVideoLogs(const QuietVideoLogs&) = delete;
+  QuietVideoLogs& operator=(const QuietVideoLogs&) = delete;
+};
+
 /// A recording's frames, read in order (seeking is not reliable in every codec). A path with a
 /// '%' is an image sequence named by a printf pattern (`frames/frame_%06d.png`, numbered from 0,
 /// or from 1 when there is no frame 0, up to the first missing number; each file read by
@@ -42,6 +53,9 @@ class VideoSource final : public FrameSource {
   double fps() const override;
   /// The number of frames the recording declares, or 0 when unknown.
   std::size_t declaredFrames() const override;
+  /// The FourCC the video file declares for its codec ("av01", "avc1", "mp4v", ...; "" for an
+  /// image sequence or when it declares none).
+  std::string codec() const;
   /// Reads the next frame into `frame` (BGR as decoded); false at the end. Throws VideoError
   /// naming the frame's index when the decoder fails on it.
   bool read(cv::Mat& frame) override;
