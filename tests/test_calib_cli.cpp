@@ -779,3 +779,58 @@ TEST_F(CalibCli, BodyLabelsPlacedByTheStateLogAtTheFrameTime) {
 }
 
 }  // namespace
+
+// A camera on the robot (--camera-frame): world labels seen from a camera fixed to the arm's
+// shoulder at three states give the shoulder -> camera pose it was made with, and its camera file
+// says frame: shoulder_pitch; `kccd render` then draws from the arm at each state.
+TEST_F(CalibCli, ACameraOnTheRobotIsSolvedFromSeveralStates) {
+  const int frame = model_.jointIndex("shoulder_pitch");
+  std::vector<kccd::Pose> poses(model_.joints.size());
+  ASSERT_TRUE(kccd::framePoses(model_, std::vector<double>(3, 0.0), poses));
+  const kccd::Pose mount_to_camera = truth_.worldToCamera() * kccd::framePose(poses, frame);
+  const std::vector<std::vector<double>> states = {{0.0, 0.0, 0.0}, {0.2, -0.1, 0.4}, {-0.25, 0.1, 0.8}};
+  std::string labels_args, state_args;
+  for (std::size_t f = 0; f < states.size(); ++f) {
+    ASSERT_TRUE(kccd::framePoses(model_, states[f], poses));
+    kccd::calib::Camera at = truth_;
+    const kccd::Pose w2c = mount_to_camera * kccd::framePose(poses, frame).inverse();
+    cv::Matx33d r;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) r(i, j) = w2c.linear()(i, j);
+    cv::Rodrigues(r, at.rvec);
+    at.tvec = cv::Vec3d(w2c.translation().x(), w2c.translation().y(), w2c.translation().z());
+    std::ofstream labels(out("labels_" + std::to_string(f) + ".yaml"));
+    labels << "labels:\n";
+    for (int i = 0; i < 10; ++i) {  // corners of the table and the wall's marks
+      const cv::Point3d w(0.2 + 0.15 * (i % 5), -0.3 + 0.6 * (i / 5), i % 2 == 0 ? 0.0 : 0.3);
+      const cv::Point2d px = project(at, w);
+      labels << "  - {name: p" << i << ", pixel: [" << fmt(px.x) << ", " << fmt(px.y) << "], world: [" << fmt(w.x)
+             << ", " << fmt(w.y) << ", " << fmt(w.z) << "]}\n";
+    }
+    labels_args += " --labels " + out("labels_" + std::to_string(f) + ".yaml");
+    state_args += " --state " + fmt(states[f][0]) + "," + fmt(states[f][1]) + "," + fmt(states[f][2]);
+  }
+  const Outcome r = runKccd("calib --intrinsics " + kCamera + " --model " + kDemo + " --camera-frame shoulder_pitch" +
+                            labels_args + state_args + " -o " + out("wrist.yaml") + " -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const kccd::calib::Camera solved = kccd::calib::loadCamera(out("wrist.yaml"));
+  EXPECT_EQ(solved.frame, "shoulder_pitch");
+  const kccd::Pose got = solved.worldToCamera();
+  EXPECT_LT((got.translation() - mount_to_camera.translation()).norm(), 1e-4);
+  EXPECT_LT((got.linear() - mount_to_camera.linear()).norm(), 1e-4);
+  // Without the states the camera cannot be placed: one line, nothing written.
+  const Outcome stateless = runKccd("calib --intrinsics " + kCamera + " --model " + kDemo +
+                                    " --camera-frame shoulder_pitch" + labels_args + " -o " + out("none.yaml"));
+  EXPECT_EQ(stateless.code, 2);
+  EXPECT_NE(stateless.err.find("has no state: a camera fixed to the robot"), std::string::npos) << stateless.err;
+  EXPECT_FALSE(fs::exists(out("none.yaml")));
+  const Outcome unknown = runKccd("calib --intrinsics " + kCamera + " --model " + kDemo + " --camera-frame wrist_cam" +
+                                  labels_args + state_args + " -o " + out("none.yaml"));
+  EXPECT_EQ(unknown.code, 2);
+  EXPECT_NE(unknown.err.find("--camera-frame: frame: 'wrist_cam' is neither a joint nor a body"), std::string::npos)
+      << unknown.err;
+  // The camera file draws from the arm: kccd render at the second state sees what the world camera did.
+  const Outcome drawn =
+      runKccd("render " + kDemo + " --camera " + out("wrist.yaml") + " --state 0.2,-0.1,0.4 -o " + out("wrist.png"));
+  EXPECT_EQ(drawn.code, 0) << drawn.err;
+}

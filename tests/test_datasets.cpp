@@ -22,7 +22,10 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include <opencv2/calib3d.hpp>
+
 #include "kccd/calib/camera.hpp"
+#include "kccd/kinematics.hpp"
 #include "kccd/model.hpp"
 #include "kccd/overlay/datasets/lerobot_recording.hpp"
 #include "support/run_program.hpp"
@@ -381,3 +384,87 @@ TEST_F(Datasets, CheckReadsTheEpisodeAloneAtARate) {
 }
 
 }  // namespace
+
+namespace {
+
+std::string num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6f", v);
+  return buf;
+}
+
+cv::Point2d projected(const kccd::calib::Camera& c, const kccd::Vec3& p) {
+  std::vector<cv::Point2d> out;
+  cv::projectPoints(std::vector<cv::Point3d>{{p.x(), p.y(), p.z()}}, c.rvec, c.tvec, c.camera_matrix, c.distortion,
+                    out);
+  return out[0];
+}
+
+}  // namespace
+
+// An episode's frames calibrate like a video's: --lerobot --episode --frame, each frame's state
+// from its row placing the body labels; the camera it was filmed with comes back.
+TEST_F(Datasets, CalibrationTakesAnEpisodesFrames) {
+  const kccd::Model model = kccd::loadModel(kDemo);
+  const kccd::calib::Camera camera = kccd::calib::loadCamera(fx->camera);
+  const std::string ds = fx->dataset("v21_av1").string();
+  const kccd::overlay::LerobotRecording rec =
+      kccd::overlay::readLerobotRecording({.dataset = ds, .episode = 1, .frames = false}, model);
+  std::string args;
+  for (const int frame : {2, 5}) {
+    std::vector<kccd::Pose> poses(model.joints.size());
+    ASSERT_TRUE(kccd::framePoses(model, rec.log.row(static_cast<std::size_t>(frame)), poses));
+    const std::string path = out("labels_" + std::to_string(frame) + ".yaml").string();
+    std::ofstream labels(path);
+    labels << "labels:\n";
+    for (int i = 0; i < 8; ++i) {
+      const kccd::Vec3 w(0.1 + 0.15 * (i % 4), -0.3 + 0.6 * (i / 4), 0.05 * (i % 3));
+      const cv::Point2d px = projected(camera, w);
+      labels << "  - {name: w" << i << ", pixel: [" << num(px.x) << ", " << num(px.y) << "], world: [" << num(w.x())
+             << ", " << num(w.y()) << ", " << num(w.z()) << "]}\n";
+    }
+    const kccd::Body& forearm = model.bodies[static_cast<std::size_t>(model.bodyIndex("forearm"))];
+    const kccd::Vec3 tip = kccd::framePose(poses, forearm.frame) * forearm.points.back();
+    const cv::Point2d px = projected(camera, tip);
+    labels << "  - {name: tip, pixel: [" << num(px.x) << ", " << num(px.y) << "], body: forearm, point: ["
+           << num(forearm.points.back().x()) << ", " << num(forearm.points.back().y()) << ", "
+           << num(forearm.points.back().z()) << "]}\n";
+    args += " --frame " + std::to_string(frame) + " --labels " + path;
+  }
+  const Outcome r = kccdRun("calib --intrinsics " + fx->camera + " --model " + kDemo + " --lerobot " + ds +
+                            " --episode 1" + args + " -o " + out("cam.yaml").string() + " --json -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const kccd::calib::Camera solved = kccd::calib::loadCamera(out("cam.yaml").string());
+  EXPECT_LT(cv::norm(solved.rvec - camera.rvec), 1e-4);
+  EXPECT_LT(cv::norm(solved.tvec - camera.tvec), 1e-4);
+  const Outcome beyond =
+      kccdRun("calib --intrinsics " + fx->camera + " --model " + kDemo + " --lerobot " + ds +
+              " --episode 1 --frame 40 --labels " + out("labels_2.yaml").string() + " -o " + out("none.yaml").string());
+  EXPECT_EQ(beyond.code, 2);
+  EXPECT_NE(beyond.err.find("--frame 40: the episode has 12 frames (0 ... 11)"), std::string::npos) << beyond.err;
+  EXPECT_FALSE(fs::exists(out("none.yaml")));
+}
+
+// A golden case on an episode's frame: updated, then run against itself; a case without its
+// episode is a manifest error at its line.
+TEST_F(Datasets, GoldenCasesTakeAnEpisodesFrame) {
+  const std::string ds = fx->dataset("v30_h264").string();
+  const fs::path manifest = out("golden.yaml");
+  std::ofstream(manifest) << "kccd_golden: 1\ngoldens: goldens\ndefaults: {model: " << kDemo
+                          << ", camera: " << fx->camera << "}\ncases:\n  - {id: ep2-f3, lerobot: " << ds
+                          << ", episode: 2, frame: 3, outputs: [overlay, mask]}\n";
+  const Outcome update = kccdRun("golden update " + manifest.string() + " -q");
+  ASSERT_EQ(update.code, 0) << update.err << update.out;
+  const json sidecar = json::parse(readText(out("goldens") / "ep2-f3" / "golden.json"));
+  EXPECT_EQ(sidecar["inputs"]["lerobot"]["episode"], 2);
+  EXPECT_EQ(sidecar["inputs"]["lerobot"]["frame"], 3);
+  const Outcome again = kccdRun("golden run " + manifest.string() + " --out " + out("golden_run").string() + " -q");
+  EXPECT_EQ(again.code, 0) << again.err << again.out;
+  std::ofstream(manifest) << "kccd_golden: 1\ndefaults: {model: " << kDemo << ", camera: " << fx->camera
+                          << "}\ncases:\n  - {id: x, lerobot: " << ds << ", frame: 3}\n";
+  const Outcome bad = kccdRun("golden run " + manifest.string() + " --out " + out("golden_bad").string());
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("golden.yaml:4:5: case 'x'.episode: a lerobot frame case needs its episode"),
+            std::string::npos)
+      << bad.err;
+}

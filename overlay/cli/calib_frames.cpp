@@ -6,6 +6,7 @@
 #include "cli_output.hpp"
 #include "kccd/overlay/bags/bag_recording.hpp"
 #include "kccd/overlay/calibration/calib_gather.hpp"
+#include "kccd/overlay/datasets/lerobot_recording.hpp"
 #include "kccd/state_log.hpp"
 
 namespace kccd::cli {
@@ -51,6 +52,36 @@ std::vector<overlay::RecordingSample> recordingSamples(const FrameOptions& a, co
   return out;
 }
 
+// --lerobot's --frame N of --episode E: the pictures, their names and times on the episode's clock,
+// and the episode's rows as the state log (with --model).
+StateLog lerobotFrames(const FrameOptions& a, const std::optional<Model>& model, std::vector<cv::Mat>& pictures,
+                       std::vector<std::string>& names, std::vector<double>& times,
+                       std::vector<std::string>& warnings) {
+  if (!a.images.empty() || !a.video.empty() || !a.bag.empty())
+    throw UsageError("--lerobot: give --image files, --video, --bag or --lerobot, one of them");
+  if (a.video_frames.empty())
+    throw UsageError("--lerobot: say which frames of the episode with --frame N (repeat for several)");
+  if (!a.state_log.empty() || !a.times.empty() || !a.ignore_columns.empty())
+    throw UsageError("--states, --time and --ignore-columns: not with --lerobot (its rows give each frame's state)");
+  if (!model) throw UsageError("--lerobot: needs --model (the episode's rows are read as the model's states)");
+  if (!a.image_topic.empty() || !a.joint_topic.empty())
+    throw UsageError("--image-topic and --joint-topic go with --bag");
+  const overlay::LerobotRecording rec = overlay::readLerobotRecording(
+      {.dataset = a.lerobot,
+       .episode = a.episode,
+       .camera_key = a.camera_key,
+       .state_key = a.state_key,
+       .joint_map = a.joint_map.empty() ? overlay::JointMap{} : overlay::loadJointMap(a.joint_map, *model),
+       .spell = [](const std::string& field) { return optionSpelling(field); }},
+      *model);
+  for (const std::string& w : rec.warnings) warnings.push_back(w);
+  pictures =
+      overlay::lerobotFramesAt(rec, std::vector<long>(a.video_frames.begin(), a.video_frames.end()), "--frame", times);
+  for (const int f : a.video_frames)
+    names.push_back(a.lerobot + "#" + std::to_string(a.episode) + "/" + std::to_string(f));
+  return rec.log;
+}
+
 }  // namespace
 
 GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, const std::optional<Model>& model,
@@ -60,6 +91,8 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
   std::vector<double> times = a.times;
   std::optional<overlay::BagRecording> bag;
   std::vector<std::string> warnings;
+  bool episode = false;  // --lerobot: the episode's states are in `log`
+  std::optional<StateLog> episode_log;
   if (!a.bag.empty()) {
     if (!a.images.empty() || !a.video.empty())
       throw UsageError("--bag: give --image files, --video or --bag, one of them");
@@ -86,9 +119,15 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
       picture_names.push_back(a.bag + "#" + std::to_string(f));
       if (bag->log.rows() > 0) times.push_back(bag->frame_times[static_cast<std::size_t>(f)]);
     }
+  } else if (!a.lerobot.empty()) {
+    if (a.episode < 0) throw UsageError("--lerobot: give --episode N (its episode_index)");
+    episode_log = lerobotFrames(a, model, video_pictures, picture_names, times, warnings);
+    episode = true;
   } else if (!a.image_topic.empty() || !a.joint_topic.empty() || !a.joint_map.empty()) {
     throw UsageError("--image-topic, --joint-topic and --joint-map go with --bag");
   }
+  if (a.lerobot.empty() && (a.episode != -1 || !a.camera_key.empty() || a.state_key != "observation.state"))
+    throw UsageError("--episode, --camera-key and --state-key go with --lerobot");
   if (!a.video.empty()) {
     if (!a.images.empty()) throw UsageError("--video: give --image files or --video with --frame, not both");
     if (a.video_frames.empty()) throw UsageError("--video: say which frames with --frame N (repeat for several)");
@@ -100,8 +139,8 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
         throw UsageError("--video " + a.video + ": no frame rate: give each frame's time with --time");
       for (int f : a.video_frames) times.push_back(f / recording.fps);
     }
-  } else if (!a.video_frames.empty() && a.bag.empty()) {
-    throw UsageError("--frame: needs --video or --bag");
+  } else if (!a.video_frames.empty() && a.bag.empty() && !episode) {
+    throw UsageError("--frame: needs --video, --bag or --lerobot");
   }
   const std::size_t n = picture_names.empty() ? labels : picture_names.size();
   if (n == 0)
@@ -121,7 +160,7 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
   if (!a.states.empty() && !model) throw UsageError("--state: needs --model");
   if (!a.state_log.empty() && !model) throw UsageError("--states: needs --model");
   if (!a.state_log.empty() && !a.states.empty()) throw UsageError("--state and --states: give one of them");
-  if (a.state_log.empty() != times.empty() && !bag)
+  if (a.state_log.empty() != times.empty() && !bag && !episode)
     throw UsageError(a.state_log.empty() ? "--time: needs --states LOG.csv"
                                          : "--states: give each frame's time with --time");
   if (!times.empty() && times.size() != n)
@@ -131,8 +170,9 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
   double max_gap = a.max_gap;
   if (!a.state_log.empty()) log = loadStateLog(a.state_log, *model, splitCommas(a.ignore_columns));
   if (bag && bag->log.rows() > 0) log = std::move(bag->log);
+  if (episode_log && a.states.empty()) log = std::move(episode_log);
   if (log && max_gap == 0.0) max_gap = 1.5 * log->medianPeriod();
-  const std::string log_name = bag ? "--bag " + a.bag : a.state_log;
+  const std::string log_name = bag ? "--bag " + a.bag : episode ? "--lerobot " + a.lerobot : a.state_log;
 
   GivenFrames out;
   if (a.recording_samples > 0)
@@ -148,11 +188,11 @@ GivenFrames givenFrames(const FrameOptions& a, std::size_t labels, bool tags, co
     } else if (log) {
       std::vector<double> state(static_cast<std::size_t>(model->stateSize()), 0.0);
       if (stateAt(*log, times[f], max_gap, state) == StateMatch::None)
-        throw UsageError((bag ? "--frame " + std::to_string(a.video_frames[f]) + " (at " + format(times[f]) + " s)"
-                              : "--time " + format(times[f])) +
-                         ": " + log_name + " has no sample within --max-gap " + format(max_gap) +
-                         " s of it (the log covers " + format(log->times.front()) + " ... " +
-                         format(log->times.back()) + " s)");
+        throw UsageError(
+            (bag || episode ? "--frame " + std::to_string(a.video_frames[f]) + " (at " + format(times[f]) + " s)"
+                            : "--time " + format(times[f])) +
+            ": " + log_name + " has no sample within --max-gap " + format(max_gap) + " s of it (the log covers " +
+            format(log->times.front()) + " ... " + format(log->times.back()) + " s)");
       out.states[f] = std::move(state);
     }
   }
@@ -174,7 +214,15 @@ void addBagOptions(CLI::App& command, FrameOptions& o) {
       ->check(CLI::IsMember({"header", "log"}))
       ->default_str("header");
   command.add_option("--joint-map", o.joint_map,
-                     "With --bag: which logged joint each state value is read from (see kccd overlay --help)");
+                     "With --bag or --lerobot: which logged joint each state value is read from (see kccd overlay "
+                     "--help)");
+  command.add_option("--lerobot", o.lerobot,
+                     "A LeRobot dataset's folder: --frame N of --episode's camera are the frames, its rows (read "
+                     "against --model) each frame's state");
+  command.add_option("--episode", o.episode, "With --lerobot: the episode (its episode_index)");
+  command.add_option("--camera-key", o.camera_key, "With --lerobot: the camera feature (default: the only one)");
+  command.add_option("--state-key", o.state_key, "With --lerobot: the vector feature read as the state")
+      ->capture_default_str();
 }
 
 }  // namespace kccd::cli

@@ -1,7 +1,7 @@
 // The frames of a calibration as the command line gives them: pictures (--image files, or --frame
-// of --video or of a robot log's --bag) and each frame's state (--state, --states at --time, or the
-// bag's joint states at the frame's time). Shared by `kccd calib` and `kccd calib label`, so both
-// read the same options the same way.
+// of --video, of a robot log's --bag or of a LeRobot --episode) and each frame's state (--state, --states at --time, or
+// the bag's joint states at the frame's time). Shared by `kccd calib` and `kccd calib label`, so both read the same
+// options the same way.
 #pragma once
 
 #include <cstddef>
@@ -22,6 +22,8 @@ struct FrameOptions {
   std::vector<std::string> images, states;
   std::string state_log, ignore_columns, video;
   std::string bag, image_topic, joint_topic, joint_map, time_source = "header";  ///< --bag and its options
+  std::string lerobot, camera_key, state_key = "observation.state";              ///< --lerobot and its options
+  long episode = -1;
   std::vector<double> times;
   std::vector<int> video_frames;
   double max_gap = 0.0;  ///< 0: 1.5 x the log's median period
@@ -39,7 +41,8 @@ struct GivenFrames {
   std::vector<overlay::RecordingSample> recording;  ///< with recording_samples: those of them the log has a state for
 };
 
-/// Adds --bag, --image-topic, --joint-topic, --time-source and --joint-map to `command`.
+/// Adds --bag, --image-topic, --joint-topic, --time-source and --joint-map to `command`, and
+/// --lerobot, --episode, --camera-key and --state-key (a LeRobot episode's frames and states).
 void addBagOptions(CLI::App& command, FrameOptions& o);
 
 /// Checks the options against each other (`labels` labels files and `tags` a tag layout given)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -161,6 +162,33 @@ std::optional<FrameBy> frameByOf(const std::string& word) {
   if (word == "timestamp") return FrameBy::Timestamp;
   if (word == "index") return FrameBy::Index;
   return std::nullopt;
+}
+
+std::vector<cv::Mat> lerobotFramesAt(const LerobotRecording& rec, const std::vector<long>& indices,
+                                     const std::string& option, std::vector<double>& times) {
+  times.clear();
+  if (indices.empty()) return {};
+  const long last = *std::max_element(indices.begin(), indices.end());
+  std::map<long, cv::Mat> wanted;
+  for (const long i : indices) {
+    if (i < 0) throw InputError(option + " " + std::to_string(i) + ": frames are numbered from 0");
+    wanted[i];
+  }
+  const std::unique_ptr<FrameSource> frames = rec.open_frames();
+  cv::Mat frame;
+  long k = 0;
+  for (; k <= last && frames->read(frame); ++k)
+    if (const auto it = wanted.find(k); it != wanted.end()) it->second = frame.clone();
+  if (k <= last)
+    throw InputError(option + " " + std::to_string(last) + ": the episode has " + std::to_string(k) +
+                     " frames (0 ... " + std::to_string(k - 1) + ")");
+  std::vector<cv::Mat> out;
+  for (const long i : indices) {
+    out.push_back(wanted.at(i));
+    times.push_back(rec.frame_times.empty() ? static_cast<double>(i) / rec.fps
+                                            : rec.frame_times[static_cast<std::size_t>(i)]);
+  }
+  return out;
 }
 
 std::vector<std::pair<std::string, std::string>> LerobotRecording::source() const {

@@ -24,7 +24,8 @@ bool validId(const std::string& id) {
 
 // The values shared by the cases: the defaults block, then each case on top of it.
 struct Shared {
-  std::string model, camera, states, video, bag, image_topic, joint_topic;
+  std::string model, camera, states, video, bag, image_topic, joint_topic, lerobot, camera_key;
+  long episode = -1;
   bool log_time = false;
   double time_offset = 0.0;
   double supersample = 1.0;
@@ -56,7 +57,7 @@ class ManifestReader {
                 "expected a mapping of model, camera, outputs, compare, states, video, bag, time_offset, supersample");
       r_.onlyKeys(d, "defaults",
                   {"model", "camera", "outputs", "compare", "states", "video", "bag", "image_topic", "joint_topic",
-                   "time_source", "time_offset", "supersample"});
+                   "time_source", "time_offset", "supersample", "lerobot", "episode", "camera_key"});
       shared(d, "defaults", "defaults", defaults);
     }
     const YAML::Node cases = r_.require(root, "cases", "manifest");
@@ -136,6 +137,13 @@ class ManifestReader {
     if (n["bag"]) s.bag = resolve(r_.text(n["bag"], field + ".bag"));
     if (n["image_topic"]) s.image_topic = r_.text(n["image_topic"], field + ".image_topic");
     if (n["joint_topic"]) s.joint_topic = r_.text(n["joint_topic"], field + ".joint_topic");
+    if (n["lerobot"]) s.lerobot = resolve(r_.text(n["lerobot"], field + ".lerobot"));
+    if (n["camera_key"]) s.camera_key = r_.text(n["camera_key"], field + ".camera_key");
+    if (const YAML::Node e = n["episode"]) {
+      const double v = r_.number(e, field + ".episode");
+      if (v != std::floor(v) || v < 0 || v > 1e12) r_.fail(e, field + ".episode", "expected an episode index from 0");
+      s.episode = static_cast<long>(v);
+    }
     if (const YAML::Node t = n["time_source"]) {
       const std::string word = r_.text(t, field + ".time_source");
       if (word != "header" && word != "log") r_.fail(t, field + ".time_source", "expected header or log");
@@ -173,9 +181,9 @@ class ManifestReader {
                       std::map<std::string, std::size_t>& ids) const {
     std::string f = "cases[" + std::to_string(i) + "]";
     if (!n.IsMap()) r_.fail(n, f, "expected a mapping with id and state, lower/upper or video/frame");
-    r_.onlyKeys(n, f,
-                {"id", "model", "camera", "outputs", "compare", "state", "lower", "upper", "video", "frame", "states",
-                 "bag", "image_topic", "joint_topic", "time_source", "time_offset", "supersample"});
+    r_.onlyKeys(n, f, {"id",          "model",       "camera",      "outputs", "compare", "state",       "lower",
+                       "upper",       "video",       "frame",       "states",  "bag",     "image_topic", "joint_topic",
+                       "time_source", "time_offset", "supersample", "lerobot", "episode", "camera_key"});
     GoldenCase c;
     c.where = r_.where(n);
     const YAML::Node id = r_.require(n, "id", f);
@@ -220,11 +228,18 @@ class ManifestReader {
       const double v = r_.number(n["frame"], f + ".frame");
       if (v != std::floor(v) || v < 0 || v > 1e9) r_.fail(n["frame"], f + ".frame", "expected a frame index from 0");
       c.frame = static_cast<std::int64_t>(v);
-      // A case's own video or bag replaces the other given in defaults.
-      const bool own_bag = n["bag"].IsDefined(), own_video = n["video"].IsDefined() || n["states"].IsDefined();
-      if (own_bag && own_video) r_.fail(n["bag"], f + ".bag", "give video and states, or bag, not both");
-      c.bag = own_video ? std::string() : s.bag;
-      if (c.bag.empty()) {
+      // A case's own video, bag or dataset replaces the others given in defaults.
+      const bool own_bag = n["bag"].IsDefined(), own_video = n["video"].IsDefined() || n["states"].IsDefined(),
+                 own_lerobot = n["lerobot"].IsDefined();
+      if (own_bag + own_video + own_lerobot > 1)
+        r_.fail(n, f, "give video and states, a bag, or a lerobot dataset, one of them");
+      c.lerobot = own_video || own_bag ? std::string() : s.lerobot;
+      c.bag = own_video || !c.lerobot.empty() ? std::string() : s.bag;
+      if (!c.lerobot.empty()) {
+        c.episode = s.episode;
+        c.camera_key = s.camera_key;
+        if (c.episode < 0) r_.fail(n, f + ".episode", "a lerobot frame case needs its episode (here or in defaults)");
+      } else if (c.bag.empty()) {
         c.video = s.video;
         c.states = s.states;
         if (c.video.empty())
@@ -236,11 +251,13 @@ class ManifestReader {
         c.log_time = s.log_time;
       }
     } else {
-      for (const char* key : {"video", "states", "bag", "image_topic", "joint_topic", "time_source"})
+      for (const char* key :
+           {"video", "states", "bag", "image_topic", "joint_topic", "time_source", "lerobot", "episode", "camera_key"})
         if (n[key]) r_.fail(n[key], f + "." + key, std::string(key) + " belongs to a frame case (give frame)");
       for (const GoldenOutput o : c.outputs)
         if (o == GoldenOutput::Overlay)
-          r_.fail(n, f + ".outputs", "overlay needs a recorded frame (give frame, with video and states or a bag)");
+          r_.fail(n, f + ".outputs",
+                  "overlay needs a recorded frame (give frame, with video and states, a bag or a lerobot dataset)");
     }
     return c;
   }

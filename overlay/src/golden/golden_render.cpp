@@ -15,6 +15,7 @@
 #include "kccd/model.hpp"
 #include "kccd/overlay/bags/bag_recording.hpp"
 #include "kccd/overlay/calibration/calib_gather.hpp"
+#include "kccd/overlay/datasets/lerobot_recording.hpp"
 #include "kccd/overlay/recording/frame_annotator.hpp"
 #include "kccd/render/model_view.hpp"
 #include "kccd/render/projection.hpp"
@@ -25,6 +26,7 @@ namespace {
 
 // What names a bag's state log in the renderer's caches: the bag, its topics and clock.
 std::string logKey(const GoldenCase& c) {
+  if (!c.lerobot.empty()) return "lerobot\n" + c.lerobot + "\n" + std::to_string(c.episode) + "\n" + c.camera_key;
   return "bag\n" + c.bag + "\n" + c.image_topic + "\n" + c.joint_topic + "\n" + (c.log_time ? "log" : "header");
 }
 
@@ -81,10 +83,11 @@ struct GoldenRenderer::Impl {
   const GoldenManifest& manifest;
   std::map<std::string, std::unique_ptr<Model>> models;
   std::map<std::string, calib::Camera> cameras;
-  std::map<std::pair<std::string, std::string>, std::unique_ptr<StateLog>> logs;      // (log, model)
-  std::map<std::pair<std::string, std::string>, std::unique_ptr<BagRecording>> bags;  // (logKey, model)
-  std::map<std::size_t, LoadedFrame> frames;                                          // per frame case
-  std::map<std::string, std::string> hashes;                                          // path -> sha256
+  std::map<std::pair<std::string, std::string>, std::unique_ptr<StateLog>> logs;              // (log, model)
+  std::map<std::pair<std::string, std::string>, std::unique_ptr<BagRecording>> bags;          // (logKey, model)
+  std::map<std::pair<std::string, std::string>, std::unique_ptr<LerobotRecording>> episodes;  // (logKey, model)
+  std::map<std::size_t, LoadedFrame> frames;                                                  // per frame case
+  std::map<std::string, std::string> hashes;                                                  // path -> sha256
   std::map<std::tuple<std::string, std::string, double>, std::unique_ptr<render::ModelView>> views;
   std::string renderer;
 
@@ -158,6 +161,28 @@ GoldenRenderer::GoldenRenderer(const GoldenManifest& manifest)
       const cv::Mat flat = f.bgr.isContinuous() ? f.bgr : f.bgr.clone();
       f.pixels_sha256 = sha256Hex(std::span<const unsigned char>(flat.data, flat.total() * flat.elemSize()));
       s.frames.emplace(i, std::move(f));
+    } else if (!c.lerobot.empty()) {
+      // The episode's rows as the state log (read once per episode, camera and model), and the frame.
+      const auto key = std::make_pair(logKey(c), c.model);
+      auto it = s.episodes.find(key);
+      if (it == s.episodes.end()) {
+        LerobotRecording rec;
+        try {
+          rec = readLerobotRecording({.dataset = c.lerobot, .episode = c.episode, .camera_key = c.camera_key}, m);
+        } catch (const InputError& e) {
+          throw InputError(where + ".lerobot: " + e.what());
+        }
+        it = s.episodes.emplace(key, std::make_unique<LerobotRecording>(std::move(rec))).first;
+        s.logs.emplace(key, std::make_unique<StateLog>(it->second->log));
+      }
+      LoadedFrame f;
+      std::vector<double> times;
+      f.bgr = lerobotFramesAt(*it->second, {static_cast<long>(c.frame)}, where + ".frame:", times).front();
+      checkPicture(f.bgr, cam, c.lerobot + "#" + std::to_string(c.episode) + "/" + std::to_string(c.frame), c.camera);
+      f.time = times.front();
+      const cv::Mat flat = f.bgr.isContinuous() ? f.bgr : f.bgr.clone();
+      f.pixels_sha256 = sha256Hex(std::span<const unsigned char>(flat.data, flat.total() * flat.elemSize()));
+      s.frames.emplace(i, std::move(f));
     } else if (c.hasVideo()) {
       const auto key = std::make_pair(c.states, c.model);
       if (!s.logs.count(key)) s.logs.emplace(key, std::make_unique<StateLog>(loadStateLog(c.states, m)));
@@ -200,8 +225,17 @@ GoldenRendering GoldenRenderer::render(std::size_t index) {
   std::optional<cv::Mat> overlay;
   if (c.hasVideo()) {
     const LoadedFrame& f = s.frames.at(index);
-    const StateLog& log = *s.logs.at({c.bag.empty() ? c.states : logKey(c), c.model});
-    if (c.bag.empty()) {
+    const StateLog& log = *s.logs.at({c.bag.empty() && c.lerobot.empty() ? c.states : logKey(c), c.model});
+    if (!c.lerobot.empty()) {
+      const LerobotRecording& rec = *s.episodes.at({logKey(c), c.model});
+      // The frame's pixels are hashed below; the episode's table is hashed as its state log.
+      inputs["lerobot"] = {{"dataset", relativeTo(c.lerobot, s.manifest.folder)},
+                           {"episode", c.episode},
+                           {"camera_key", rec.camera_key},
+                           {"frame", c.frame},
+                           {"table_sha256", s.hash(rec.data_file)},
+                           {"time_offset", c.time_offset}};
+    } else if (c.bag.empty()) {
       inputs["states"] = {{"file", relativeTo(c.states, s.manifest.folder)}, {"sha256", s.hash(c.states)}};
       inputs["video"] = {
           {"file", relativeTo(c.video, s.manifest.folder)}, {"frame", c.frame}, {"time_offset", c.time_offset}};

@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include <opencv2/core/mat.hpp>
+
 #include "kccd/input_error.hpp"
 #include "kccd/logs/lerobot_dataset.hpp"
 #include "kccd/model.hpp"
@@ -52,6 +54,12 @@ struct LerobotRecording {
   /// How the recording was read, as the overlay report's "source".
   std::vector<std::pair<std::string, std::string>> source() const;
 };
+
+/// The episode's frames at `indices` (from 0, any order, repeats allowed), in that order, with
+/// their times on the state log's clock in `times`: one pass over the frames up to the last index.
+/// Throws InputError "`option` N: the episode has K frames (0 ... K-1)" for an index beyond them.
+std::vector<cv::Mat> lerobotFramesAt(const LerobotRecording& recording, const std::vector<long>& indices,
+                                     const std::string& option, std::vector<double>& times);
 
 /// Reads episode `options.episode`: its rows, its camera's video (or images in the table), and
 /// checks that the video holds a frame for every row. Throws InputError naming the file and

@@ -35,6 +35,9 @@ struct GoldenCase {
   std::string bag;                       ///< a robot log's frame, its state from the log's joint states
   std::string image_topic, joint_topic;  ///< with bag: the topics (empty: the one of the fitting type)
   bool log_time = false;                 ///< with bag: the recorder's times, not the header stamps
+  std::string lerobot;                   ///< a LeRobot dataset's episode frame, its state from the episode's row
+  long episode = -1;                     ///< with lerobot: the episode_index
+  std::string camera_key;                ///< with lerobot: the camera (empty: the only one)
   std::int64_t frame = -1;
   double time_offset = 0.0;  ///< added to the frame's time to get the log's time (s)
   /// Pinhole scale (1..4) of the mask and colour images: finer masks follow the volumes' edges
@@ -43,8 +46,8 @@ struct GoldenCase {
   MaskTolerance mask;
   ColourTolerance colour, overlay;
   ToleranceSource tolerance_source;
-  /// A case on a recorded frame (of a video or of a bag).
-  bool hasVideo() const { return !video.empty() || !bag.empty(); }
+  /// A case on a recorded frame (of a video, a bag or a dataset).
+  bool hasVideo() const { return !video.empty() || !bag.empty() || !lerobot.empty(); }
 };
 
 /// A manifest: where its goldens live and its cases in order.
