@@ -28,6 +28,7 @@
 #include "kccd/kinematics.hpp"
 #include "kccd/model.hpp"
 #include "kccd/overlay/datasets/lerobot_recording.hpp"
+#include "support/cameras.hpp"
 #include "support/run_program.hpp"
 
 namespace {
@@ -77,12 +78,7 @@ class Datasets : public ::testing::Test {
     fs::create_directories(fx->dir / "frames");
     // The camera: the demo camera at a quarter of its size (320 x 180).
     kccd::calib::Camera c = kccd::calib::loadCamera(std::string(KCCD_SOURCE_DIR) + "/data/demo_camera.yaml");
-    c.width = 320;
-    c.height = 180;
-    c.camera_matrix(0, 0) /= 4;
-    c.camera_matrix(1, 1) /= 4;
-    c.camera_matrix(0, 2) = (c.camera_matrix(0, 2) + 0.5) / 4 - 0.5;
-    c.camera_matrix(1, 2) = (c.camera_matrix(1, 2) + 0.5) / 4 - 0.5;
+    c = kccd::testing::quarterSized(c);
     fx->camera = (fx->dir / "camera.yaml").string();
     kccd::calib::saveCamera(c, fx->camera);
     // The states: the demo arm swinging (one row per frame), the elbow close to the base at the end.

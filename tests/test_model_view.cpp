@@ -35,12 +35,7 @@ const std::string kData = KCCD_DATA_DIR;
 // The sample camera at a quarter of its size (320 x 180), as the golden images use it.
 calib::Camera smallCamera() {
   calib::Camera c = calib::loadCamera(kData + "/demo_camera.yaml");
-  c.width = 320;
-  c.height = 180;
-  c.camera_matrix(0, 0) /= 4;
-  c.camera_matrix(1, 1) /= 4;
-  c.camera_matrix(0, 2) = (c.camera_matrix(0, 2) + 0.5) / 4 - 0.5;
-  c.camera_matrix(1, 2) = (c.camera_matrix(1, 2) + 0.5) / 4 - 0.5;
+  c = kccd::testing::quarterSized(c);
   return c;
 }
 

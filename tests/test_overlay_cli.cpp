@@ -23,6 +23,7 @@
 #include "kccd/calib/camera.hpp"
 #include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/render/composite.hpp"
+#include "support/cameras.hpp"
 #include "support/golden.hpp"
 #include "support/run_program.hpp"
 
@@ -88,12 +89,7 @@ class OverlayCli : public ::testing::Test {
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     kccd::calib::Camera c = kccd::calib::loadCamera(kData + "/demo_camera.yaml");
-    c.width = kW;
-    c.height = kH;
-    c.camera_matrix(0, 0) /= 4;
-    c.camera_matrix(1, 1) /= 4;
-    c.camera_matrix(0, 2) = (c.camera_matrix(0, 2) + 0.5) / 4 - 0.5;
-    c.camera_matrix(1, 2) = (c.camera_matrix(1, 2) + 0.5) / 4 - 0.5;
+    c = kccd::testing::quarterSized(c);
     camera_ = out("camera.yaml");
     kccd::calib::saveCamera(c, camera_);
     video_ = out("in.mkv");

@@ -19,6 +19,7 @@
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/render/projection.hpp"
+#include "support/cameras.hpp"
 #include "support/run_program.hpp"
 
 namespace {
@@ -39,12 +40,7 @@ class RenderCli : public ::testing::Test {
     fs::create_directories(dir_);
     // A small version of the sample camera keeps the runs short (the distortion map is per pixel).
     kccd::calib::Camera c = kccd::calib::loadCamera(kData + "/demo_camera.yaml");
-    c.width = 320;
-    c.height = 180;
-    c.camera_matrix(0, 0) /= 4;
-    c.camera_matrix(1, 1) /= 4;
-    c.camera_matrix(0, 2) = (c.camera_matrix(0, 2) + 0.5) / 4 - 0.5;
-    c.camera_matrix(1, 2) = (c.camera_matrix(1, 2) + 0.5) / 4 - 0.5;
+    c = kccd::testing::quarterSized(c);
     camera_ = (dir_ / "camera.yaml").string();
     kccd::calib::saveCamera(c, camera_);
   }

@@ -2,8 +2,22 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
+
+#include "kccd/input_error.hpp"
 
 namespace kccd {
+
+std::optional<std::pair<std::string, std::string>> brakingRangeProblem(const BrakingParams& b) {
+  const std::tuple<const char*, double, double, double> ranges[] = {{"latency", b.latency, 0, 1e3},
+                                                                    {"deceleration", b.deceleration, 1e-9, 1e9},
+                                                                    {"max_acceleration", b.max_acceleration, 0, 1e9},
+                                                                    {"position_error", b.position_error, 0, 1e3},
+                                                                    {"velocity_error", b.velocity_error, 0, 1e6}};
+  for (const auto& [field, value, lo, hi] : ranges)
+    if (const std::optional<std::string> wrong = rangeProblem(value, lo, hi)) return std::pair{field, *wrong};
+  return std::nullopt;
+}
 
 double stoppingDistance(double u, const BrakingParams& p) noexcept {
   const double t = p.latency;

@@ -37,6 +37,15 @@ namespace {
 
 py::object toPython(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
+// A recording's state log into `d`: 'state_names', 'times' and 'states' (rows x state values).
+void addStateLog(py::dict& d, const StateLog& log) {
+  d["state_names"] = log.names;
+  d["times"] = floatArray(log.times);
+  py::array_t<double> states({static_cast<py::ssize_t>(log.rows()), static_cast<py::ssize_t>(log.stateSize())});
+  std::copy(log.values.begin(), log.values.end(), states.mutable_data());
+  d["states"] = states;
+}
+
 // The keywords of overlay_recording after video and states: the request's fields under their own
 // names (and progress, progress_every, read by the caller). An unknown keyword is a TypeError.
 overlay::OverlayRequest overlayRequest(const py::kwargs& kwargs) {
@@ -274,12 +283,7 @@ void bindReadBag(py::module_& m) {
         d["warnings"] = rec.warnings;
         if (h) {
           d["joint_topic"] = rec.joint_topic;
-          d["state_names"] = rec.log.names;
-          d["times"] = floatArray(rec.log.times);
-          py::array_t<double> states(
-              {static_cast<py::ssize_t>(rec.log.rows()), static_cast<py::ssize_t>(rec.log.stateSize())});
-          std::copy(rec.log.values.begin(), rec.log.values.end(), states.mutable_data());
-          d["states"] = states;
+          addStateLog(d, rec.log);
         }
         if (!frames.empty()) {
           py::list list;
@@ -333,12 +337,7 @@ void bindReadLerobot(py::module_& m) {
         }
         d["info"] = toPython(info);
         if (!h) return d;
-        d["state_names"] = rec.log.names;
-        d["times"] = floatArray(rec.log.times);
-        py::array_t<double> states(
-            {static_cast<py::ssize_t>(rec.log.rows()), static_cast<py::ssize_t>(rec.log.stateSize())});
-        std::copy(rec.log.values.begin(), rec.log.values.end(), states.mutable_data());
-        d["states"] = states;
+        addStateLog(d, rec.log);
         d["frame_by"] = rec.frame_by == overlay::FrameBy::Index ? "index" : "timestamp";
         d["data_file"] = rec.data_file;
         d["warnings"] = rec.warnings;

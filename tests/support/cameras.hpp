@@ -14,6 +14,17 @@ namespace kccd::testing {
 
 using calib::Camera;
 
+// The sample camera `c` at a quarter of its size (1280 x 720 -> 320 x 180, the same view): short runs.
+inline Camera quarterSized(Camera c) {
+  c.width /= 4;
+  c.height /= 4;
+  c.camera_matrix(0, 0) /= 4;
+  c.camera_matrix(1, 1) /= 4;
+  c.camera_matrix(0, 2) = (c.camera_matrix(0, 2) + 0.5) / 4 - 0.5;
+  c.camera_matrix(1, 2) = (c.camera_matrix(1, 2) + 0.5) / 4 - 0.5;
+  return c;
+}
+
 // `c` with its pose set to look from `eye` at `target` (z up in the world), OpenCV axes, turned
 // by `roll` radians about the viewing direction.
 inline Camera placedAt(Camera c, const Vec3& eye, const Vec3& target, double roll = 0.0) {

@@ -1,7 +1,10 @@
 // Braking intervals (docs/algorithms.md section 8): where each joint can stop if braking starts now.
 #pragma once
 
+#include <optional>
 #include <span>
+#include <string>
+#include <utility>
 
 #include "kccd/model.hpp"
 
@@ -15,6 +18,11 @@ struct BrakingParams {
   double max_acceleration = 0.0;  ///< a_acc: worst-case acceleration during the latency
   double deceleration = 1.0;      ///< a_brk: guaranteed braking deceleration (> 0)
 };
+
+/// The first value of `params` outside the ranges every front end accepts (latency 0 ... 1e3 s,
+/// deceleration 1e-9 ... 1e9, max_acceleration 0 ... 1e9, position_error 0 ... 1e3,
+/// velocity_error 0 ... 1e6): its field ("latency", ...) and rangeProblem's wording; none when all fit.
+std::optional<std::pair<std::string, std::string>> brakingRangeProblem(const BrakingParams& params);
 
 /// Distance travelled in the positive direction before standing still, starting at speed u:
 /// S(u) = max(0, u t_l + a_acc t_l^2 / 2 + max(0, u + a_acc t_l)^2 / (2 a_brk)).

@@ -139,12 +139,8 @@ void checkCheckRequest(const CheckRequest& r, const FieldSpelling& spell) {
     throw fieldError(spell, "query", "expected 'distances' or 'collision', got '" + printable(r.query) + "'");
   if (r.braking) {
     if (!r.swept) throw fieldError(spell, "braking", "only with " + named("swept") + " (static volumes do not brake)");
-    const BrakingParams& b = *r.braking;
-    range(b.latency, 0, 1e3, "braking.latency");
-    range(b.deceleration, 1e-9, 1e9, "braking.deceleration");
-    range(b.max_acceleration, 0, 1e9, "braking.max_acceleration");
-    range(b.position_error, 0, 1e3, "braking.position_error");
-    range(b.velocity_error, 0, 1e6, "braking.velocity_error");
+    if (const auto wrong = brakingRangeProblem(*r.braking))
+      throw fieldError(spell, "braking." + wrong->first, wrong->second);
   }
   range(r.jobs, 0, 256, "jobs");
 }

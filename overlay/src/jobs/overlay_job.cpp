@@ -127,11 +127,7 @@ OverlayOptions Checker::options() const {
   if (r.braking) {
     if (!r.swept) throw problem("braking", "only with " + named("swept") + " (static volumes do not brake)");
     const BrakingParams& b = *r.braking;
-    range(b.latency, 0, 1e3, "braking.latency");
-    range(b.deceleration, 1e-9, 1e9, "braking.deceleration");
-    range(b.max_acceleration, 0, 1e9, "braking.max_acceleration");
-    range(b.position_error, 0, 1e3, "braking.position_error");
-    range(b.velocity_error, 0, 1e6, "braking.velocity_error");
+    if (const auto wrong = brakingRangeProblem(b)) throw problem("braking." + wrong->first, wrong->second);
     o.braking = b;
   }
   o.plain = r.plain;
@@ -192,6 +188,16 @@ struct OverlayJob::State {
   bool ran = false;
 
   std::string named(const std::string& field) const { return spelledField(spell, field); }
+  // A robot log's or a dataset's recording as the job reads it.
+  template <class Recording>
+  void take(Recording& recording, std::string label) {
+    log = std::move(recording.log);
+    frame_times = recording.frame_times;
+    open_frames = recording.open_frames;
+    recording_label = std::move(label);
+    source = recording.source();
+    warnings = recording.warnings;
+  }
 };
 
 OverlayJob::OverlayJob(const OverlayRequest& request, const Model& model, const calib::Camera& camera,
@@ -241,12 +247,7 @@ OverlayJob::OverlayJob(const OverlayRequest& request, const Model& model, const 
                                          .joint_map = joint_map,
                                          .spell = s.spell},
                                         model);
-    s.log = std::move(bag.log);
-    s.frame_times = bag.frame_times;
-    s.open_frames = bag.open_frames;
-    s.recording_label = s.named("bag") + " " + r.bag + " (topic " + bag.image_topic + ")";
-    s.source = bag.source();
-    s.warnings = bag.warnings;
+    s.take(bag, s.named("bag") + " " + r.bag + " (topic " + bag.image_topic + ")");
   } else if (!r.lerobot.empty()) {
     LerobotRecording episode = readLerobotRecording({.dataset = r.lerobot,
                                                      .episode = r.episode,
@@ -256,14 +257,9 @@ OverlayJob::OverlayJob(const OverlayRequest& request, const Model& model, const 
                                                      .joint_map = joint_map,
                                                      .spell = s.spell},
                                                     model);
-    s.log = std::move(episode.log);
-    s.frame_times = episode.frame_times;
-    s.open_frames = episode.open_frames;
-    s.recording_label = s.named("lerobot") + " " + r.lerobot + " episode " + std::to_string(r.episode) + " (" +
-                        episode.camera_key + ")";
-    s.source = episode.source();
+    s.take(episode, s.named("lerobot") + " " + r.lerobot + " episode " + std::to_string(r.episode) + " (" +
+                        episode.camera_key + ")");
     s.source.insert(s.source.begin(), {{"lerobot", r.lerobot}, {"episode", std::to_string(r.episode)}});
-    s.warnings = episode.warnings;
   } else {
     s.log = loadStateLog(r.states, model, r.ignore_columns);
     if (!r.frame_times.empty()) try {
