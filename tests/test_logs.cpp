@@ -1116,7 +1116,8 @@ TEST_F(McapFixtures, AGoldenCaseOnABagFrameIsTheOverlaysFrame) {
       runProgram(std::string(KCCD_CLI) + " golden run " + manifest + " --out " + (out / "r3").string() + " -q");
   EXPECT_EQ(both.code, 2);
   EXPECT_NE(both.err.find("manifest.yaml:4:"), std::string::npos) << both.err;
-  EXPECT_NE(both.err.find("give video and states, or bag, not both"), std::string::npos) << both.err;
+  EXPECT_NE(both.err.find("give video and states, a bag, or a lerobot dataset, one of them"), std::string::npos)
+      << both.err;
 }
 
 // The same messages written topic by topic (tests/bags/write_mcap.mjs: joint_overlap.mcap, zstd

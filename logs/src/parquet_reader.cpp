@@ -361,7 +361,8 @@ struct Leaf {
   int maxDef = 0, maxRep = 0;
   int listDef = 0;  // the definition level at which the list holds an element
   bool isUnsigned = false;
-  double divisor = 1;  // a decimal's 10^scale
+  double divisor = 1;   // a decimal's 10^scale
+  std::string refused;  // why this reader does not read the column (said when it is read), or ""
   bool isBytes() const { return type == kByteArray || type == kFixedLenByteArray; }
 };
 
@@ -397,9 +398,6 @@ class SchemaWalk {
     if (e.repetition == kRepeated) ++rep, listDef = def;
     if (e.repetition < kRequired || e.repetition > kRepeated)
       fail("field " + printable(name) + " has the unknown repetition " + std::to_string(e.repetition));
-    if (rep > 1)
-      fail("column " + printable(name) + " is a list of lists (" + std::to_string(rep) +
-           " repetition levels), which this reader does not read");
     if (e.numChildren < 0) return leaf(i, name, def, rep, listDef);
     if (e.numChildren == 0) fail("group " + printable(name) + " has no fields");
     std::size_t next = i + 1;
@@ -425,7 +423,6 @@ class SchemaWalk {
   std::size_t leaf(std::size_t i, const std::string& name, int def, int rep, int listDef) {
     const SchemaElement& e = s_[i];
     const std::string column = "column " + printable(name);
-    if (e.type == kInt96) fail(column + " is INT96 (a legacy timestamp), which this reader does not read");
     if (e.type < kBoolean || e.type > kFixedLenByteArray)
       fail(column + " has the unknown physical type " + std::to_string(e.type));
     if (e.type == kFixedLenByteArray && e.typeLength <= 0)
@@ -439,6 +436,12 @@ class SchemaWalk {
     l.listDef = listDef;
     l.isUnsigned = e.isUnsigned;
     if (e.decimal && (e.type == kInt32 || e.type == kInt64)) l.divisor = std::pow(10.0, static_cast<double>(e.scale));
+    // Refused when read, not when the file is opened: a table's other columns stay readable
+    // (LeRobot v3.0's episode tables hold image statistics as lists of lists).
+    if (e.type == kInt96) l.refused = column + " is INT96 (a legacy timestamp), which this reader does not read";
+    if (rep > 1)
+      l.refused = column + " is a list of lists (" + std::to_string(rep) +
+                  " repetition levels), which this reader does not read";
     leaves_.push_back(std::move(l));
     return i + 1;
   }
@@ -966,6 +969,7 @@ std::optional<std::pair<std::int64_t, std::int64_t>> integerRange(const FileData
 
 ParquetColumn readColumn(const FileData& m, const std::string& name, const std::vector<std::size_t>& groups) {
   const std::size_t leaf = m.leafIndex(name);
+  if (!m.leaves[leaf].refused.empty()) m.fail(m.leaves[leaf].refused);
   std::vector<std::size_t> order = groups;
   if (order.empty())
     for (std::size_t g = 0; g < m.groups.size(); ++g) order.push_back(g);

@@ -186,8 +186,8 @@ bool brakingGiven(const CLI::App& sub) {
 void addLerobotOptions(CLI::App& sub, std::string& dataset, long& episode, std::string& state_key,
                        std::string* frame_by) {
   sub.add_option("--lerobot", dataset,
-                 "A LeRobot dataset's folder (v2.0, v2.1 or v3.0, as downloaded) instead of --video and --states: "
-                 "one episode's state rows and camera frames (see kccd dataset info)");
+                 "A LeRobot dataset's folder (v2.0, v2.1 or v3.0, as downloaded): one episode (--episode) is the "
+                 "recording, its rows the states and its camera the frames (see kccd dataset info)");
   sub.add_option("--episode", episode, "With --lerobot: the episode (its episode_index; -1: none given)")
       ->capture_default_str();
   sub.add_option("--state-key", state_key, "With --lerobot: the vector feature read as the state")

@@ -74,12 +74,12 @@ for (const name of Object.keys(truth.files)) {
       console.log(`check_parquet: ${name}: metadata ${key} differs`);
     }
   }
-  if (file.refusedAtOpen) {
+  if (file.refusedLayout) {
     // Files kccd must refuse whole: their footers parse, and hold what kccd refuses.
     const repeated = meta.schema.filter((e) => e.repetition_type === "REPEATED").length;
-    const holds = file.refusedAtOpen === "INT96" ? meta.schema.some((e) => e.type === "INT96") : repeated >= 2;
+    const holds = file.refusedLayout === "INT96" ? meta.schema.some((e) => e.type === "INT96") : repeated >= 2;
     if (!holds) failed++;
-    console.log(`check_parquet: ${name}: ${holds ? "holds" : "MISMATCH: does not hold"} ${file.refusedAtOpen}`);
+    console.log(`check_parquet: ${name}: ${holds ? "holds" : "MISMATCH: does not hold"} ${file.refusedLayout}`);
     continue;
   }
   const readers = [];

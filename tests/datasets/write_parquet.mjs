@@ -318,8 +318,10 @@ if (wanted("hy_legacy_lists.parquet")) {
 }
 if (wanted("hy_refused_int96.parquet")) {
   // INT96 (a legacy timestamp): the index column's type changed in the footer, its pages left.
-  const bytes = writeHyColumns([{ name: "index", data: col("index").map(BigInt) }],
-    [{ name: "root", num_children: 1 }, { name: "index", type: "INT64", repetition_type: "REQUIRED" }]);
+  // A second column stays readable: the refusal is the INT96 column's alone.
+  const bytes = writeHyColumns([{ name: "index", data: col("index").map(BigInt) }, { name: "frame_index", data: col("frame_index").map(BigInt) }],
+    [{ name: "root", num_children: 2 }, { name: "index", type: "INT64", repetition_type: "REQUIRED" },
+      { name: "frame_index", type: "INT64", repetition_type: "REQUIRED" }]);
   rewriteFooter("hy_refused_int96.parquet", bytes, (meta) => {
     meta.schema[1].type = "INT96";
     for (const g of meta.row_groups) {
@@ -327,19 +329,21 @@ if (wanted("hy_refused_int96.parquet")) {
       delete g.columns[0].meta_data.statistics;
     }
   });
-  truth.files["hy_refused_int96.parquet"] = { writer: "hyparquet-writer", refusedAtOpen: "INT96", columns: [], metadata: {} };
+  truth.files["hy_refused_int96.parquet"] = { writer: "hyparquet-writer", refusedLayout: "INT96", columns: [], metadata: {} };
 }
 if (wanted("hy_refused_list_of_lists.parquet")) {
-  const bytes = writeHyColumns([{ name: "nested", data: rows.map((_, i) => [[i, i + 1], [], [i * 2]]) }], [
-    { name: "root", num_children: 1 },
+  const bytes = writeHyColumns([{ name: "nested", data: rows.map((_, i) => [[i, i + 1], [], [i * 2]]) },
+    { name: "frame_index", data: col("frame_index").map(BigInt) }], [
+    { name: "root", num_children: 2 },
     { name: "nested", repetition_type: "OPTIONAL", converted_type: "LIST", num_children: 1 },
     { name: "list", repetition_type: "REPEATED", num_children: 1 },
     { name: "element", repetition_type: "OPTIONAL", converted_type: "LIST", num_children: 1 },
     { name: "list", repetition_type: "REPEATED", num_children: 1 },
     { name: "element", type: "INT32", repetition_type: "OPTIONAL" },
+    { name: "frame_index", type: "INT64", repetition_type: "REQUIRED" },
   ]);
   fs.writeFileSync(path.join(outDir, "hy_refused_list_of_lists.parquet"), bytes);
-  truth.files["hy_refused_list_of_lists.parquet"] = { writer: "hyparquet-writer", refusedAtOpen: "list of lists", columns: [], metadata: {} };
+  truth.files["hy_refused_list_of_lists.parquet"] = { writer: "hyparquet-writer", refusedLayout: "list of lists", columns: [], metadata: {} };
 }
 fs.writeFileSync(path.join(outDir, "truth.json"), JSON.stringify(truth, null, 1));
 console.log(`write_parquet: ${Object.keys(truth.files).length} files in ${outDir}`);

@@ -245,8 +245,11 @@ LerobotRecording readLerobotRecording(const LerobotRecordingOptions& o, const Mo
     rec.warnings.push_back(span.file + ": the video declares " + messageNumber(probe.fps()) + " fps, the dataset " +
                            messageNumber(d.fps) + ": frames are timed at the dataset's");
   const auto first = static_cast<std::size_t>(std::max(0L, std::lround(span.from * vfps)));
-  const std::size_t count =
-      span.to > span.from ? static_cast<std::size_t>(std::max(0L, std::lround((span.to - span.from) * vfps))) : 0;
+  // A v3.0 video holds other episodes after this one: without its end, the episode's rows say how many.
+  const std::size_t count = span.to > span.from
+                                ? static_cast<std::size_t>(std::max(0L, std::lround((span.to - span.from) * vfps)))
+                            : span.from > 0 || d.isV3() ? static_cast<std::size_t>(std::max<std::int64_t>(e.length, 0))
+                                                        : 0;
   const std::size_t declared = probe.declaredFrames() > first ? probe.declaredFrames() - first : 0;
   const std::size_t held = count > 0 && (declared == 0 || count < declared) ? count : declared;
   if (held > 0 && static_cast<std::size_t>(k.back()) >= held)

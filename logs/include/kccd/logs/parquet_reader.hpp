@@ -4,8 +4,9 @@
 // RLE/bit-packed levels, one level of lists (Arrow's three-level LIST, fixed-size lists, legacy
 // two-level repeated fields), structs, int32/int64/float/double/boolean/byte-array/string leaves,
 // data pages v1 and v2, and snappy, zstd, gzip or no compression. Anything else (another encoding,
-// a list of lists, INT96, LZ4, BROTLI, encryption) is refused by name in one line. Only the row
-// groups and columns asked for are read from disk.
+// a list of lists, INT96, LZ4, BROTLI, encryption) is refused by name in one line: a column's
+// layout when that column is read (the file's other columns still read). Only the row groups and
+// columns asked for are read from disk.
 #pragma once
 
 #include <cstddef>
@@ -45,7 +46,8 @@ struct ParquetRowGroup {
 class ParquetFile {
  public:
   /// Opens `path` and reads its footer; throws InputError ("FILE: problem") when the file is not
-  /// Parquet, is cut short, or its schema holds a type or layout this reader refuses.
+  /// Parquet, is cut short, or its schema is malformed (a column of a layout this reader refuses,
+  /// INT96 or a list of lists, is refused when read).
   explicit ParquetFile(const std::string& path);
   ~ParquetFile();
   ParquetFile(ParquetFile&&) noexcept;
