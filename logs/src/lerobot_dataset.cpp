@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <set>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "kccd/file_reader.hpp"
 #include "kccd/input_error.hpp"
 #include "kccd/logs/parquet_reader.hpp"
 
@@ -20,16 +19,15 @@ using nlohmann::json;
 
 constexpr std::uintmax_t kMaxMetaBytes = std::uintmax_t{64} << 20;
 
+// A metadata file whole (regular, at most 64 MiB; a FIFO or device refused without blocking). A
+// missing one says what the folder was taken for.
 std::string readText(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw InputError(path.string() + ": not found (is this a LeRobot dataset?)");
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec || size > kMaxMetaBytes) throw InputError(path.string() + ": larger than 64 MiB");
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in && !in.eof()) throw InputError(path.string() + ": cannot be read");
-  return text.str();
+  try {
+    return readRegularFile(path.string(), kMaxMetaBytes, "LeRobot metadata file");
+  } catch (const FileError& e) {
+    if (e.kind() == FileProblem::Missing) throw InputError(path.string() + ": not found (is this a LeRobot dataset?)");
+    throw;
+  }
 }
 
 // The line and column of byte `at` of `text`, as "LINE:COL".

@@ -60,6 +60,12 @@ inline std::string spelledField(const FieldSpelling& spell, const std::string& f
   return spell ? spell(field) : field;
 }
 
+/// A problem with a request's field `spelled` (as the front end spells it): an InputError with that
+/// field and no source.
+inline InputError requestFieldError(const std::string& spelled, const std::string& problem) {
+  return InputError(InputLocation{{}, 0, 0, spelled}, problem);
+}
+
 /// What is wrong with a request's number `value` that must lie in [lo, hi]: "must be in [lo, hi],
 /// got value" (NaN is outside), or none. The one wording of every front end's range checks.
 std::optional<std::string> rangeProblem(double value, double lo, double hi);

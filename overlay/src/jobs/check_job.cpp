@@ -4,8 +4,10 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <exception>
 #include <filesystem>
+#include <mutex>
 #include <thread>
 
 #include "kccd/checker.hpp"
@@ -19,7 +21,7 @@ namespace kccd::overlay {
 namespace {
 
 InputError fieldError(const FieldSpelling& spell, const std::string& field, const std::string& problem) {
-  return InputError(InputLocation{{}, 0, 0, spelledField(spell, field)}, problem);
+  return requestFieldError(spelledField(spell, field), problem);
 }
 
 // The most samples one check queries (a 1 kHz log of about 28 hours).
@@ -68,7 +70,6 @@ struct Worker {
     Checker checker(model);
     const std::size_t n = static_cast<std::size_t>(model.stateSize());
     std::vector<double> q(n), v(n), lo(n), hi(n);
-    const std::vector<SafetyStatus> none;
     const bool distances = request.query != "collision";
     const QueryOptions options{.type = distances ? QueryType::Distances : QueryType::Collision, .tight_volumes = true};
     FrameRecord scratch;
@@ -86,21 +87,11 @@ struct Worker {
         // state, whichever thread had the sample before); warm from the last sample for a collision check.
         if (distances) checker.reset();
         const QueryResult& r = request.swept && box_ok ? checker.query(lo, hi, options) : checker.query(q, q, options);
-        rec.query = r.status;
         rec.braking_failed = !box_ok;
-        if (r.status == Status::Ok && box_ok) rec.min_distance = r.min_distance;
-        if (keep) {
-          rec.values.assign(q.begin(), q.end());
-          for (const PairDistance& pd : r.pairs)
-            if (pd.distance <= r.margin) rec.pairs.push_back({model.pairs[pd.pair].a, model.pairs[pd.pair].b});
-        }
-        rec.status = box_ok ? safetyStatus(r) : SafetyStatus::Colliding;
+        if (keep) rec.values.assign(q.begin(), q.end());
+        recordAnswer(model, r, box_ok, rec, keep);
       }
-      counts.no_state += rec.status == SafetyStatus::NoState;
-      counts.colliding += rec.status == SafetyStatus::Colliding;
-      counts.within_margin += rec.status == SafetyStatus::WithinMargin;
-      counts.clear += rec.status == SafetyStatus::Clear;
-      counts.unsafe += rec.unsafe();
+      counts.count(rec);
       if ((i & 1023) == 1023) done += 1024;
     }
   }
@@ -194,7 +185,9 @@ CheckResult runCheck(const CheckRequest& r, const Model& model, const FieldSpell
   std::vector<OverlayReport> counts(jobs);
   std::vector<std::exception_ptr> errors(jobs);
   std::atomic<std::size_t> done{0};
-  std::atomic<std::size_t> running{jobs};
+  std::mutex mu;  // guards running
+  std::condition_variable finished;
+  std::size_t running = jobs;
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::thread> threads;
   for (std::size_t j = 0; j < jobs; ++j) {
@@ -207,12 +200,19 @@ CheckResult runCheck(const CheckRequest& r, const Model& model, const FieldSpell
       } catch (...) {
         errors[j] = std::current_exception();
       }
-      --running;
+      const std::lock_guard lock(mu);
+      if (--running == 0) finished.notify_all();
     });
   }
-  while (running > 0) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    if (progress) progress(std::min(done.load(), times.size()), times.size());
+  {
+    // Progress every 0.1 s while the workers run; a short log returns as soon as they are done.
+    std::unique_lock lock(mu);
+    while (!finished.wait_for(lock, std::chrono::milliseconds(100), [&] { return running == 0; }))
+      if (progress) {
+        lock.unlock();
+        progress(std::min(done.load(), times.size()), times.size());
+        lock.lock();
+      }
   }
   for (std::thread& t : threads) t.join();
   for (const std::exception_ptr& e : errors)

@@ -17,11 +17,6 @@
 namespace kccd::overlay {
 namespace {
 
-// A problem with one field, spelled as the front end spells it.
-InputError fieldError(const std::string& spelled, const std::string& problem) {
-  return InputError(InputLocation{{}, 0, 0, spelled}, problem);
-}
-
 bool seconds(const std::string& text, double& out) {
   char* end = nullptr;
   out = std::strtod(text.c_str(), &end);
@@ -39,13 +34,13 @@ void parseTimeOffset(const std::string& text, OverlayRequest& r) {
     double lo = 0, hi = 0;
     if (colon == std::string::npos || !seconds(rest.substr(0, colon), lo) || !seconds(rest.substr(colon + 1), hi) ||
         !(lo < hi))
-      throw fieldError("time_offset",
-                       "expected auto:A:B with A < B (seconds, the range searched), got '" + printable(text) + "'");
+      throw requestFieldError(
+          "time_offset", "expected auto:A:B with A < B (seconds, the range searched), got '" + printable(text) + "'");
     r.time_offset_search = {lo, hi};
     return;
   }
   if (!seconds(text, r.time_offset))
-    throw fieldError("time_offset", "expected seconds or auto:A:B, got '" + printable(text) + "'");
+    throw requestFieldError("time_offset", "expected seconds or auto:A:B, got '" + printable(text) + "'");
 }
 
 namespace {
@@ -57,7 +52,9 @@ struct Checker {
   const FieldSpelling& spell;
 
   std::string named(const std::string& field) const { return spelledField(spell, field); }
-  InputError problem(const std::string& field, const std::string& text) const { return fieldError(named(field), text); }
+  InputError problem(const std::string& field, const std::string& text) const {
+    return requestFieldError(named(field), text);
+  }
   double range(double value, double lo, double hi, const std::string& field) const {
     if (const std::optional<std::string> wrong = rangeProblem(value, lo, hi)) throw problem(field, *wrong);
     return value;

@@ -44,6 +44,16 @@ FrameAnnotator::FrameAnnotator(const AnnotatorScene& scene)
 
 FrameAnnotator::~FrameAnnotator() = default;
 
+void recordAnswer(const Model& m, const QueryResult& r, bool box_ok, FrameRecord& rec, bool pairs) {
+  rec.query = r.status;
+  // A bound only for the box the run is about: none for an unsafe status or a missing braking box.
+  if (r.status == Status::Ok && box_ok) rec.min_distance = r.min_distance;
+  if (pairs)
+    for (const PairDistance& pd : r.pairs)
+      if (pd.distance <= r.margin) rec.pairs.push_back({m.pairs[pd.pair].a, m.pairs[pd.pair].b});
+  rec.status = box_ok ? safetyStatus(r) : SafetyStatus::Colliding;
+}
+
 void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
   const Model& m = scene_.model;
   const AnnotatorSettings& set = scene_.settings;
@@ -89,15 +99,7 @@ void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
   rec.times.render = ft.prepare + ft.draw;
   rec.times.read_back = ft.read_back;
   rec.times.warp = ft.warp + ft.decorate;
-  if (drawn.query) {
-    const QueryResult& r = *drawn.query;
-    rec.query = r.status;
-    // A bound only for the box the run is about: none for an unsafe status or a missing braking box.
-    if (r.status == Status::Ok && box_ok) rec.min_distance = r.min_distance;
-    for (const PairDistance& pd : r.pairs)
-      if (pd.distance <= r.margin) rec.pairs.push_back({m.pairs[pd.pair].a, m.pairs[pd.pair].b});
-    rec.status = box_ok ? safetyStatus(r) : SafetyStatus::Colliding;
-  }
+  if (drawn.query) recordAnswer(m, *drawn.query, box_ok, rec);
   if (!rec.selected) return;
   const render::Frame& layer = drawn.images;
   for (std::size_t i = 0; i < drawn.first_visual; ++i)

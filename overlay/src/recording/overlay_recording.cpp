@@ -257,6 +257,14 @@ FrameRange parseFrameRange(const std::string& text, const std::string& label) {
   return s;
 }
 
+void OverlayReport::count(const FrameRecord& r) {
+  no_state += r.status == SafetyStatus::NoState;
+  colliding += r.status == SafetyStatus::Colliding;
+  within_margin += r.status == SafetyStatus::WithinMargin;
+  clear += r.status == SafetyStatus::Clear;
+  unsafe += r.unsafe();
+}
+
 std::optional<std::size_t> OverlayReport::firstUnsafe() const {
   for (std::size_t i = 0; i < frames.size(); ++i)
     if (frames[i].unsafe()) return i;
@@ -376,11 +384,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   if (pipe.error) std::rethrow_exception(pipe.error);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_frames).count();
   for (const FrameRecord& r : report.frames) {
-    report.no_state += r.status == SafetyStatus::NoState;
-    report.colliding += r.status == SafetyStatus::Colliding;
-    report.within_margin += r.status == SafetyStatus::WithinMargin;
-    report.clear += r.status == SafetyStatus::Clear;
-    report.unsafe += r.unsafe();
+    report.count(r);
     report.stages += r.times;
     report.reused += r.reused;
   }

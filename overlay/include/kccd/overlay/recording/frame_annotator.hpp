@@ -59,6 +59,12 @@ struct FrameRecord {
   const char* queryStatusText() const;
 };
 
+/// Fills `record` from the query's answer for its state or box: the query's status, the bound (none
+/// for an unsafe status or without a braking box, `box_ok` false), the body pairs within the
+/// margin (with `pairs`) and the safety status (colliding without a braking box). What the
+/// overlay and the check job say of a frame or a sample.
+void recordAnswer(const Model& model, const QueryResult& answer, bool box_ok, FrameRecord& record, bool pairs = true);
+
 /// The links (Body::linkName) of body pairs, each link pair once, in order: the pieces of a
 /// concave link are one link to the user.
 std::vector<std::array<std::string, 2>> linkPairs(const Model& model, const std::vector<std::array<int, 2>>& pairs);

@@ -108,6 +108,8 @@ struct OverlayReport {
   /// How the recording was read (e.g. a robot log's file, topics, clock and time 0), written as
   /// the report's "source" object when not empty; empty values are left out.
   std::vector<std::pair<std::string, std::string>> source;
+  /// Counts `record` in clear, within_margin, colliding, no_state and unsafe.
+  void count(const FrameRecord& record);
   /// Index of the first unsafe frame, if any.
   std::optional<std::size_t> firstUnsafe() const;
 };
