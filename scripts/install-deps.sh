@@ -24,12 +24,15 @@ packages=(
 #            the dataset tests' writers: npm's parquet-wasm, apache-arrow and hyparquet-writer
 #            (tests/datasets) and Debian's FFmpeg (AV1, h264 and mpeg4 videos);
 #            and clang-format and clang-tidy (scripts/lint.sh).
+#   --package  also what scripts/package.sh makes Debian packages with: dpkg-shlibdeps (dpkg-dev),
+#            help2man (the manual page) and lintian to check them
 #   --docs   also what scripts/docs.sh builds the site with: Sphinx, MyST (Markdown pages), Breathe
 #            on Doxygen's XML (the C++ API), the Furo theme
 tests=0
 for arg in "$@"; do
   case "$arg" in
     --fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;
+    --package) packages+=(dpkg-dev lintian help2man) ;;
     --docs) packages+=(python3-sphinx python3-myst-parser python3-breathe doxygen furo) ;;
     --tests) tests=1; packages+=(chromium python3-pytest python3-matplotlib mypy python3-typeshed python3-rosbag python3-sensor-msgs python3-roslz4 clang-format clang-tidy ffmpeg) ;;
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 2 ;;

@@ -12,15 +12,19 @@
 #   --no-sanitize   skip the sanitizer build
 #   --sanitize-only run only the sanitizer build and its tests, then the fuzz targets
 #   --no-fuzz       skip the fuzz targets (scripts/fuzz.sh)
+#   --packages      also build the Debian packages from the Release build (scripts/package.sh),
+#                   install them on this machine, use them and remove them (scripts/package_test.sh;
+#                   as root or through sudo: CI does it on its own machine)
 # Environment: KCCD_JOBS (default 2), KCCD_SOAK=N for a long property-test soak.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-release=1 sanitize=1 fuzz=1
+release=1 sanitize=1 fuzz=1 packages=0
 for arg in "$@"; do
   case "$arg" in
     --no-sanitize) sanitize=0 ;;
     --sanitize-only) release=0 ;;
     --no-fuzz) fuzz=0 ;;
+    --packages) packages=1 ;;
     *) echo "test.sh: unknown option $arg" >&2; exit 2 ;;
   esac
 done
@@ -53,6 +57,10 @@ if [ $release -eq 1 ]; then
   stage "Lint: the last commit's C++ files (clang-format, clang-tidy)" bash scripts/lint.sh
   stage "Release tests" ctest --test-dir build -j "$jobs" --output-on-failure
   stage "Documentation site (warnings are errors)" bash scripts/docs.sh build
+  if [ $packages -eq 1 ]; then
+    stage "Debian packages (scripts/package.sh)" bash scripts/package.sh build
+    stage "Packages installed, used as a user would, removed" bash scripts/package_test.sh
+  fi
 fi
 if [ $sanitize -eq 1 ]; then
   stage "ASan + UBSan build" cmake_build build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKCCD_SANITIZE=ON \

@@ -730,6 +730,76 @@ TEST_F(CalibCli, SheetNumbersCandidatesAndWritesAFillableTemplate) {
   EXPECT_FALSE(fs::exists(out("s.png")));
 }
 
+// `calib sheet --video V --frame N`: the frame `calib --video V --frame N` reads. The sheet and
+// template of frame 3 of a recording are those of the same picture given as --image (the template
+// naming it V#3); frame 0, a different picture, gives a different sheet. Exactly one of --image
+// and --video; bad combinations are one line, exit 2, nothing written.
+TEST_F(CalibCli, SheetOfARecordingsFrame) {
+  const std::vector<cv::Point> squares{{200, 150}, {900, 500}, {400, 550}};
+  {
+    cv::VideoWriter video(out("rec.mkv"), cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 10.0,
+                          cv::Size(truth_.width, truth_.height));
+    ASSERT_TRUE(video.isOpened());
+    for (int f = 0; f < 5; ++f) {
+      cv::Mat frame(truth_.height, truth_.width, CV_8UC3, cv::Scalar(200, 200, 200));
+      for (const cv::Point& p : squares)
+        cv::rectangle(frame, p + cv::Point(10 * f, 0), p + cv::Point(10 * f + 60, 60), cv::Scalar(20, 20, 20),
+                      cv::FILLED);
+      video.write(frame);
+    }
+  }
+  // Frame 3 as OpenCV decodes it, as an image file.
+  cv::VideoCapture cap(out("rec.mkv"));
+  cv::Mat picture;
+  for (int f = 0; f <= 3; ++f) ASSERT_TRUE(cap.read(picture)) << f;
+  ASSERT_TRUE(cv::imwrite(out("frame3.png"), picture));
+  const std::string tail = " --model " + kDemo + " --camera " + kCamera + " --state 0.3,0.4,0.6";
+  const Outcome v = runKccd("calib sheet --video " + out("rec.mkv") + " --frame 3" + tail + " -o " + out("sv.png") +
+                            " --template " + out("lv.yaml"));
+  ASSERT_EQ(v.code, 0) << v.err;
+  EXPECT_EQ(v.err, "");
+  const Outcome i = runKccd("calib sheet --image " + out("frame3.png") + tail + " -o " + out("si.png") +
+                            " --template " + out("li.yaml"));
+  ASSERT_EQ(i.code, 0) << i.err;
+  EXPECT_EQ(kccd::testing::readText(out("sv.png")), kccd::testing::readText(out("si.png")));
+  const std::string lv = kccd::testing::readText(out("lv.yaml")), li = kccd::testing::readText(out("li.yaml"));
+  EXPECT_EQ(lv.rfind("# Labels for " + out("rec.mkv") + "#3 (made by kccd calib sheet", 0), 0u) << lv;
+  ASSERT_NE(lv.find('\n'), std::string::npos);
+  EXPECT_EQ(lv.substr(lv.find('\n')), li.substr(li.find('\n')));  // the same candidates
+  EXPECT_NE(lv.find("pixel: ["), std::string::npos) << lv;
+  // The summary line counts what the image's does.
+  const auto counts = [](const std::string& line) {
+    return line.substr(line.find(':'), line.find(';') - line.find(':'));
+  };
+  EXPECT_EQ(counts(v.out), counts(i.out));
+  EXPECT_NE(v.out.find("12 candidate points, 18 model points"), std::string::npos) << v.out;
+  const Outcome first = runKccd("calib sheet --video " + out("rec.mkv") + " --frame 0 -o " + out("s0.png"));
+  ASSERT_EQ(first.code, 0) << first.err;
+  EXPECT_NE(kccd::testing::readText(out("s0.png")), kccd::testing::readText(out("sv.png")));
+  // Bad combinations.
+  const std::string video = " --video " + out("rec.mkv");
+  const struct {
+    std::string args, says;
+  } cases[] = {
+      {" --image " + out("frame3.png") + video + " --frame 3", "--image and --video: give one of them"},
+      {"", "give the frame: --image FILE, or --video FILE with --frame N"},
+      {video, "--video: say which frame with --frame N"},
+      {" --image " + out("frame3.png") + " --frame 3", "--frame: goes with --video"},
+      {video + " --frame 5", "--video " + out("rec.mkv") + ": frame 5: the recording has only 5 readable frames"},
+      {video + " --frame -1", "--frame"},
+      {" --video " + out("none.mkv") + " --frame 0", out("none.mkv")},
+  };
+  for (const auto& c : cases) {
+    const Outcome r = runKccd("calib sheet" + c.args + " -o " + out("s.png") + " --template " + out("l.yaml"));
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("kccd: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out("s.png")));
+    EXPECT_FALSE(fs::exists(out("l.yaml")));
+  }
+}
+
 }  // namespace
 
 namespace {

@@ -184,6 +184,46 @@ TEST(Cli, HelpExplainsEverySubcommand) {
   EXPECT_NE(runKccd("").code, 0);  // a subcommand is required
 }
 
+// `kccd` runs --version, info and query itself, loading only the checker's libraries, and hands
+// every other subcommand to kccd-all: both must print the same bytes and exit the same way.
+TEST(Cli, LightCommandsRunWithoutTheWholeProgramAndAgreeWithIt) {
+  const Outcome libs = kccd::testing::runProgram(std::string("ldd ") + KCCD_CLI);
+  ASSERT_EQ(libs.code, 0) << libs.err;
+  for (const char* heavy : {"opencv", "gdal", "avcodec", "OSMesa", "Coin", "assimp", "gstreamer"})
+    EXPECT_EQ(libs.out.find(heavy), std::string::npos) << heavy << " is loaded by kccd:\n" << libs.out;
+  const auto whole = [](const std::string& args) {  // kccd-all under the launcher's name (argv[0])
+    return kccd::testing::runProgram(std::string("bash -c 'exec -a ") + KCCD_CLI + " " + KCCD_ALL + " " + args + "'",
+                                     true);
+  };
+  const std::string box = " --lower -0.5,0,0 --upper 0.5,0,0";
+  for (const std::string& args :
+       {std::string("--version"), std::string("info --help"), std::string("query --help"), "info " + kDemo,
+        "info " + kDemo + " --json", "query " + kDemo + box + " --type distances --json",
+        "query " + kDemo + box + " --explain", "query " + kDemo + " --state 1", "query " + kDemo + " --bogus",
+        std::string("info /nonexistent.yaml"), std::string("info"), std::string("render --help"),
+        std::string("nosuch")}) {
+    Outcome light = runKccd(args, true), all = whole(args);
+    for (Outcome* o : {&light, &all}) {  // the query's own time differs from run to run
+      auto& s = o->out;
+      for (const std::string key : {"\"time_us\": ", "time "})
+        for (std::size_t at = s.find(key); at != std::string::npos; at = s.find(key, at + 1)) {
+          const std::size_t end = s.find_first_of(",\n ", at + key.size());
+          s.erase(at + key.size(), end - at - key.size());
+        }
+    }
+    EXPECT_EQ(light.code, all.code) << args;
+    EXPECT_EQ(light.out, all.out) << args;
+  }
+  // Without kccd-all beside it (nor in ../libexec/kccd), only the light subcommands remain.
+  const std::filesystem::path dir = kccd::testing::scratchFolder("kccd_launcher_alone");
+  std::filesystem::copy_file(KCCD_CLI, dir / "kccd");
+  EXPECT_EQ(kccd::testing::runProgram((dir / "kccd").string() + " info " + kDemo).code, 0);
+  const Outcome alone = kccd::testing::runProgram((dir / "kccd").string() + " render --help");
+  EXPECT_EQ(alone.code, 1);
+  EXPECT_NE(alone.err.find("kccd-all"), std::string::npos) << alone.err;
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 
 namespace {

@@ -10,6 +10,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -48,7 +50,7 @@ class Synth : public ::testing::Test {
     root_ = new fs::path(fs::path(::testing::TempDir()) / ("kccd_synth_" + std::to_string(getpid())));
     fs::create_directories(*root_);
     run_ = new Outcome(runKccd("synth " + kHumanoid + " -o " + dir("a") + " --seconds " + std::to_string(kSeconds) +
-                               " --fps 25 --seed 3 -q"));
+                               " --fps 25 --seed 3 --bag -q"));
   }
   static void TearDownTestSuite() {
     fs::remove_all(*root_);
@@ -73,7 +75,8 @@ std::vector<cv::Mat> readVideo(const std::string& path) {
 }
 
 TEST_F(Synth, WritesEveryFile) {
-  for (const char* f : {"video.mkv", "states.csv", "camera_true.yaml", "intrinsics.yaml", "tags.yaml", "synth.json"})
+  for (const char* f :
+       {"video.mkv", "states.csv", "states.mcap", "camera_true.yaml", "intrinsics.yaml", "tags.yaml", "synth.json"})
     EXPECT_TRUE(fs::is_regular_file(dir("a") + "/" + f)) << f;
   const json j = summary();
   const int frames = j["video"]["frames"];
@@ -320,6 +323,267 @@ TEST_F(Synth, ARecordingAsABagCalibratesAndOverlaysAsItsFiles) {
   EXPECT_GE(with_state, 9);
 }
 
+// --bag: states.mcap holds states.csv as a ROS 2 bag. Read back by the suite's reader (`kccd bag
+// export`), it is states.csv, every sample (times to the nanosecond, values and velocities
+// exactly); `bag info` lists its two topics, every row and every frame; `check --bag` reports what
+// `check --states` reports. (Other projects' readers: BagHoldsTheFramesOnTheLogClock.)
+TEST_F(Synth, StateLogAsABagIsStatesCsv) {
+  const std::string bag = dir("a") + "/states.mcap";
+  const kccd::Model m = kccd::loadModel(kHumanoid);
+  const kccd::StateLog csv = kccd::loadStateLog(dir("a") + "/states.csv", m);
+  ASSERT_EQ(csv.times.front(), 0.0);  // the log starts at log time 0: the bag's first stamp
+  const json truth = summary()["state_log"]["bag"];
+  EXPECT_EQ(truth["file"], "states.mcap");
+  EXPECT_EQ(truth["topic"], "/joint_states");
+  EXPECT_EQ(truth["type"], "sensor_msgs/msg/JointState");
+  EXPECT_EQ(truth["origin_ns"], "1700000000000000000");
+  // The suite's own reader.
+  const Outcome exported = runKccd("bag export " + bag + " --states " + dir("bagcsv.csv") + " -q");
+  ASSERT_EQ(exported.code, 0) << exported.err;
+  EXPECT_EQ(exported.err, "");
+  const kccd::StateLog back = kccd::loadStateLog(dir("bagcsv.csv"), m);
+  ASSERT_EQ(back.rows(), csv.rows());
+  for (std::size_t i = 0; i < csv.rows(); ++i) ASSERT_NEAR(back.times[i], csv.times[i], 0.5e-9) << i;
+  EXPECT_EQ(back.values, csv.values);
+  EXPECT_EQ(back.velocities, csv.velocities);
+  // bag info: JointState with every row, CompressedImage with every frame; all messages stamped
+  // at their log times (no skew), from the first row's time to the last row's.
+  const Outcome info = runKccd("bag info " + bag + " --json");
+  ASSERT_EQ(info.code, 0) << info.err;
+  const json ij = json::parse(info.out);
+  EXPECT_TRUE(ij.at("damage").is_null()) << info.out;
+  const std::size_t frames = summary()["video"]["frames"];
+  EXPECT_EQ(ij.at("messages"), csv.rows() + frames);
+  EXPECT_EQ(ij.at("first_log_time_ns"), "1700000000000000000");
+  EXPECT_EQ(ij.at("last_log_time_ns"),
+            std::to_string(1'700'000'000'000'000'000 + std::llround(csv.times.back() * 1e9)));
+  std::map<std::string, json> topics;
+  for (const json& t : ij.at("topics")) topics[t.at("topic")] = t;
+  ASSERT_EQ(topics.size(), 2u) << info.out;
+  const json& joints = topics["/joint_states"];
+  const json& images = topics["/camera/image_raw/compressed"];
+  EXPECT_EQ(joints.at("type"), "sensor_msgs/msg/JointState");
+  EXPECT_EQ(joints.at("count"), csv.rows());
+  EXPECT_EQ(images.at("type"), "sensor_msgs/msg/CompressedImage");
+  EXPECT_EQ(images.at("count"), frames);
+  for (const json* t : {&joints, &images}) {
+    EXPECT_EQ(t->at("stamped"), t->at("count"));
+    EXPECT_EQ(t->at("skew_s").at("max"), 0.0);
+    EXPECT_EQ(t->at("skew_s").at("min"), 0.0);
+  }
+  EXPECT_NEAR(images.at("rate_hz").get<double>(), kFps, 1e-6);
+  // check --bag reports what check --states reports.
+  const Outcome by_bag = runKccd("check " + kHumanoid + " --bag " + bag + " --report " + dir("check_bag.json") + " -q");
+  const Outcome by_csv =
+      runKccd("check " + kHumanoid + " --states " + dir("a") + "/states.csv --report " + dir("check_csv.json") + " -q");
+  ASSERT_EQ(by_bag.code, by_csv.code) << by_bag.err << by_csv.err;
+  EXPECT_EQ(by_bag.err, "");
+  const json rb = json::parse(kccd::testing::readText(dir("check_bag.json"))).at("frames");
+  const json rc = json::parse(kccd::testing::readText(dir("check_csv.json"))).at("frames");
+  ASSERT_EQ(rb.size(), csv.rows());
+  ASSERT_EQ(rb.size(), rc.size());
+  for (std::size_t i = 0; i < rb.size(); ++i) {
+    EXPECT_EQ(rb[i].at("status"), rc[i].at("status")) << i;
+    EXPECT_EQ(rb[i].at("min_distance"), rc[i].at("min_distance")) << i;
+  }
+}
+
+// Mean absolute difference of two images of one size and type, per channel value, over the pixels
+// where `where` is not 0 (all when empty).
+double meanAbsDiff(const cv::Mat& a, const cv::Mat& b, const cv::Mat& where = {}) {
+  cv::Mat d;
+  cv::absdiff(a, b, d);
+  const cv::Scalar m = cv::mean(d, where);
+  return (m[0] + m[1] + m[2]) / 3.0;
+}
+
+// --bag: the frames are in states.mcap as a robot's camera driver publishes them — JPEG
+// CompressedImages stamped on the log's clock, frame i at origin + its log time (synth.json), in
+// log-time order with the joint states. The suite's decoder (`kccd bag export --video`, lossless)
+// gives every video frame at its log time (up to JPEG's loss; where the robot moved, it is that
+// frame and not the one before); other projects' readers (tests/bags/check_mcap.mjs: @mcap/core's stream reader with
+// CRCs validated and log-time order checked across topics, its indexed reader of the summary,
+// @foxglove/rosmsg2-serialization's CDR decoder) find every joint state as states.csv says and
+// every frame's header and format, and the JPEG bytes they take out decode to the same pixels.
+TEST_F(Synth, BagHoldsTheFramesOnTheLogClock) {
+  const std::string bag = dir("a") + "/states.mcap";
+  const json j = summary();
+  const json images = j["state_log"]["bag"]["images"];
+  EXPECT_EQ(images["topic"], "/camera/image_raw/compressed");
+  EXPECT_EQ(images["type"], "sensor_msgs/msg/CompressedImage");
+  EXPECT_EQ(images["format"], "bgr8; jpeg compressed bgr8");
+  EXPECT_EQ(images["frame_id"], "camera");
+  EXPECT_EQ(images["jpeg_quality"], 90);
+  const int frames = j["video"]["frames"];
+  EXPECT_EQ(images["count"], frames);
+  const std::int64_t origin = 1'700'000'000'000'000'000;
+  std::vector<std::int64_t> stamps;
+  for (const json& f : j["frames"]) stamps.push_back(origin + std::llround(f["log_time"].get<double>() * 1e9));
+  ASSERT_EQ(stamps.size(), static_cast<std::size_t>(frames));
+  EXPECT_EQ(stamps[0], origin + 137'000'000);  // frame 0 at video time 0 = log time 0.137 s
+  // The suite's decoder: every frame, at its log time, showing the video's frame.
+  fs::create_directories(dir("bagframes"));
+  const Outcome exported =
+      runKccd("bag export " + bag + " --states " + dir("bagframes") + "/states.csv --video " + dir("bagframes") +
+              "/frames.mkv --frame-times " + dir("bagframes") + "/times.csv -q");
+  ASSERT_EQ(exported.code, 0) << exported.err;
+  EXPECT_EQ(exported.err, "");
+  std::istringstream times(kccd::testing::readText(dir("bagframes") + "/times.csv"));
+  std::string line;
+  std::getline(times, line);
+  EXPECT_EQ(line, "frame,time");
+  for (int i = 0; std::getline(times, line); ++i) {
+    ASSERT_LT(i, frames);
+    const std::string want =
+        std::to_string(i) + "," + kccd::shortestNumber(static_cast<double>(stamps[i] - origin) / 1e9);
+    EXPECT_EQ(line, want);
+    EXPECT_NEAR(std::stod(line.substr(line.find(',') + 1)), j["frames"][i]["log_time"].get<double>(), 1e-9) << i;
+  }
+  const std::vector<cv::Mat> video = readVideo(dir("a") + "/video.mkv");
+  const std::vector<cv::Mat> decoded = readVideo(dir("bagframes") + "/frames.mkv");
+  ASSERT_EQ(video.size(), static_cast<std::size_t>(frames));
+  ASSERT_EQ(decoded.size(), video.size());
+  // Where the robot moved between frame i and the one before (their masks differ), the bag's frame
+  // i is video frame i, not the one before; and everywhere it is frame i up to JPEG's loss.
+  const auto mask = [&](std::size_t i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/masks/frame_%06zu.png", i);
+    return cv::imread(dir("a") + name, cv::IMREAD_UNCHANGED);
+  };
+  double worst = 0, moved_self = 0, moved_other = 1e9;
+  int compared = 0;
+  for (std::size_t i = 0; i < video.size(); ++i) {
+    ASSERT_EQ(decoded[i].size(), video[i].size()) << i;
+    worst = std::max(worst, meanAbsDiff(decoded[i], video[i]));
+    if (i == 0) continue;
+    const cv::Mat moved = mask(i) != mask(i - 1);
+    if (cv::countNonZero(moved) < 200) continue;
+    const double self = meanAbsDiff(decoded[i], video[i], moved), other = meanAbsDiff(decoded[i], video[i - 1], moved);
+    EXPECT_LT(2 * self, other) << "frame " << i << " looks like video frame " << i - 1 << " where the robot moved";
+    moved_self = std::max(moved_self, self), moved_other = std::min(moved_other, other);
+    ++compared;
+  }
+  std::printf(
+      "bag frames against the video: mean |difference| at most %.3f; where the robot moved at most %.3f, "
+      "against the frame before at least %.3f (%d frames)\n",
+      worst, moved_self, moved_other, compared);
+  EXPECT_LT(worst, 3.0);
+  EXPECT_GT(compared, frames / 2);
+  // Other projects' readers, against what states.csv and synth.json say the messages hold.
+  const kccd::Model m = kccd::loadModel(kHumanoid);
+  const kccd::StateLog csv = kccd::loadStateLog(dir("a") + "/states.csv", m);
+  fs::create_directories(dir("bagcheck"));
+  fs::copy_file(bag, dir("bagcheck") + "/states.mcap", fs::copy_options::overwrite_existing);
+  json messages = json::array(), jpegs = json::array();
+  for (std::size_t i = 0; i < csv.rows(); ++i) {
+    const std::int64_t t = origin + std::llround(csv.times[i] * 1e9);
+    const auto row = csv.row(i);
+    messages.push_back(
+        {{"log_time_ns", std::to_string(t)},
+         {"stamp_sec", t / 1'000'000'000},
+         {"stamp_nanosec", t % 1'000'000'000},
+         {"frame_id", ""},
+         {"name", csv.names},
+         {"position", std::vector<double>(row.begin(), row.end())},
+         {"velocity",
+          std::vector<double>(csv.velocities.begin() + static_cast<std::ptrdiff_t>(i * csv.stateSize()),
+                              csv.velocities.begin() + static_cast<std::ptrdiff_t>((i + 1) * csv.stateSize()))},
+         {"effort", json::array()}});
+  }
+  for (const std::int64_t t : stamps)
+    jpegs.push_back({{"log_time_ns", std::to_string(t)},
+                     {"stamp_sec", t / 1'000'000'000},
+                     {"stamp_nanosec", t % 1'000'000'000},
+                     {"frame_id", "camera"},
+                     {"format", "bgr8; jpeg compressed bgr8"},
+                     {"data_ends", {0xFF, 0xD8, 0xFF, 0xD9}}});  // a JPEG's SOI and EOI markers
+  const auto topic = [](const std::string& name, const std::string& type, const json& msgs) {
+    return json{{"topic", name},
+                {"schema_name", type},
+                {"schema_encoding", "ros2msg"},
+                {"message_encoding", "cdr"},
+                {"count", msgs.size()},
+                {"first_log_time_ns", msgs.front()["log_time_ns"]},
+                {"last_log_time_ns", msgs.back()["log_time_ns"]}};
+  };
+  const json want = {{"profile", "ros2"},
+                     {"library", "kccd"},
+                     {"files",
+                      {{"states.mcap",
+                        {{"compression", nullptr},
+                         {"topics",
+                          {topic("/joint_states", "sensor_msgs/msg/JointState", messages),
+                           topic("/camera/image_raw/compressed", "sensor_msgs/msg/CompressedImage", jpegs)}}}}}},
+                     {"joint_states", messages},
+                     {"compressed_images", jpegs},
+                     {"dump_images", "jpeg"},
+                     {"images", json::array()},
+                     {"camera_infos", json::array()}};
+  std::ofstream(dir("bagcheck") + "/truth.json") << want.dump();
+  const Outcome independent = kccd::testing::runProgram(
+      std::string(KCCD_NODE) + " " + KCCD_SOURCE_DIR + "/tests/bags/check_mcap.mjs " + dir("bagcheck"), true);
+  EXPECT_EQ(independent.code, 0) << "@mcap/core's readers (npm ci in tests/bags?): " << independent.out;
+  EXPECT_NE(independent.out.find("OK: all files match truth.json"), std::string::npos) << independent.out;
+  for (int i = 0; i < frames; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/jpeg/%06d.jpg", i);
+    const cv::Mat f = cv::imread(dir("bagcheck") + name, cv::IMREAD_COLOR);
+    ASSERT_FALSE(f.empty()) << name;
+    EXPECT_EQ(cv::norm(f, decoded[static_cast<std::size_t>(i)], cv::NORM_INF), 0.0) << name;
+  }
+}
+
+// overlay --bag on states.mcap: the camera's frames with the joint states at their own times, no
+// clock offset given, show what the overlay of video.mkv and states.csv shows at the true offset
+// (synth.json's): per frame the same state, bound and status, and the colliding frames are
+// synth.json's. The files at no offset do not: the bag's clock is the log's.
+TEST_F(Synth, OverlayOnTheBagIsTheOverlayOfTheFiles) {
+  const json j = summary();
+  const double offset = j["state_log"]["time_offset"];
+  const std::string camera = dir("a") + "/camera_true.yaml";
+  fs::create_directories(dir("bagoverlay"));
+  const std::string out = dir("bagoverlay");
+  const Outcome a = runKccd("overlay " + kHumanoid + " --camera " + camera + " --bag " + dir("a") + "/states.mcap -o " +
+                            out + "/bag.mp4 --report " + out + "/bag.json -q");
+  const Outcome b = runKccd("overlay " + kHumanoid + " --camera " + camera + " --video " + dir("a") +
+                            "/video.mkv --states " + dir("a") + "/states.csv --time-offset " +
+                            kccd::shortestNumber(offset) + " --report " + out + "/files.json -q");
+  const Outcome c = runKccd("overlay " + kHumanoid + " --camera " + camera + " --video " + dir("a") +
+                            "/video.mkv --states " + dir("a") + "/states.csv --report " + out + "/no_offset.json -q");
+  ASSERT_EQ(a.code, b.code) << a.err << b.err;
+  EXPECT_EQ(a.err, "");
+  EXPECT_TRUE(fs::is_regular_file(out + "/bag.mp4"));
+  const json bag = json::parse(kccd::testing::readText(out + "/bag.json"));
+  const json ra = bag.at("frames");
+  const json rb = json::parse(kccd::testing::readText(out + "/files.json")).at("frames");
+  const json rc = json::parse(kccd::testing::readText(out + "/no_offset.json")).at("frames");
+  EXPECT_EQ(bag.at("source").at("image_topic"), "/camera/image_raw/compressed");
+  EXPECT_EQ(bag.at("source").at("joint_topic"), "/joint_states");
+  EXPECT_EQ(bag.at("source").at("origin_ns"), "1700000000000000000");
+  const json& truth = j["frames"];
+  ASSERT_EQ(ra.size(), truth.size());
+  ASSERT_EQ(rb.size(), truth.size());
+  std::vector<int> colliding;
+  int differ_without_offset = 0;
+  for (std::size_t i = 0; i < ra.size(); ++i) {
+    EXPECT_NEAR(ra[i].at("time").get<double>(), truth[i]["log_time"].get<double>(), 1e-9) << i;
+    EXPECT_EQ(ra[i].at("status"), rb[i].at("status")) << i;
+    EXPECT_EQ(ra[i].at("status"), truth[i]["status"]) << i;
+    EXPECT_EQ(ra[i].at("state"), rb[i].at("state")) << i;
+    ASSERT_NE(ra[i].at("state"), "none") << i;
+    const std::vector<double> p = ra[i].at("state_values"), q = rb[i].at("state_values");
+    ASSERT_EQ(p.size(), q.size());
+    for (std::size_t k = 0; k < p.size(); ++k) EXPECT_NEAR(p[k], q[k], 1e-7) << i << " " << k;
+    EXPECT_NEAR(ra[i].at("min_distance").get<double>(), rb[i].at("min_distance").get<double>(), 1e-7) << i;
+    if (ra[i].at("status") == "colliding") colliding.push_back(static_cast<int>(i));
+    differ_without_offset += ra[i].at("status") != rc[i].at("status");
+  }
+  EXPECT_FALSE(colliding.empty());
+  EXPECT_EQ(colliding, j["collision"]["frames"].get<std::vector<int>>());
+  EXPECT_EQ(bag.at("colliding"), colliding.size());
+  EXPECT_GT(differ_without_offset, 0);
+}
+
 // Two runs with one seed write the same bytes: a short recording each (the fixture's is long
 // enough for a collision; determinism does not need one), so the check costs little.
 // kccd overlay --masks: the recording's own masks (drawn by the GL renderer at 0.8 of the volumes'
@@ -353,10 +617,10 @@ TEST_F(Synth, OverlayMasksAgreeAtTheTrueClockAndNotAtAWrongOne) {
 
 TEST_F(Synth, SameSeedSameFiles) {
   for (const char* name : {"b1", "b2"}) {
-    const Outcome r = runKccd("synth " + kHumanoid + " -o " + dir(name) + " --seconds 0.6 --fps 10 --seed 3 -q");
+    const Outcome r = runKccd("synth " + kHumanoid + " -o " + dir(name) + " --seconds 0.6 --fps 10 --seed 3 --bag -q");
     ASSERT_EQ(r.code, 0) << r.err;
   }
-  for (const char* f : {"states.csv", "camera_true.yaml", "intrinsics.yaml", "tags.yaml"})
+  for (const char* f : {"states.csv", "states.mcap", "camera_true.yaml", "intrinsics.yaml", "tags.yaml"})
     EXPECT_EQ(kccd::testing::readText(dir("b1") + "/" + f), kccd::testing::readText(dir("b2") + "/" + f)) << f;
   json ja = summary("b1"), jb = summary("b2");
   ja.erase("timing"), jb.erase("timing");

@@ -5,32 +5,14 @@
 #include <filesystem>
 #include <limits>
 
-#include <zlib.h>
-
 #include "decompress.hpp"
 #include "kccd/input_error.hpp"
+#include "mcap_format.hpp"
 
 namespace kccd::logs {
 namespace {
 
-constexpr std::uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
-enum Op : std::uint8_t {
-  kHeader = 0x01,
-  kFooter = 0x02,
-  kSchema = 0x03,
-  kChannel = 0x04,
-  kMessage = 0x05,
-  kChunk = 0x06,
-  kMessageIndex = 0x07,
-  kChunkIndex = 0x08,
-  kAttachment = 0x09,
-  kAttachmentIndex = 0x0A,
-  kStatistics = 0x0B,
-  kMetadata = 0x0C,
-  kMetadataIndex = 0x0D,
-  kSummaryOffset = 0x0E,
-  kDataEnd = 0x0F,
-};
+using namespace detail::mcap;  // the magic, the opcodes, the CRC
 // A decompressed chunk may be larger than the file, but not without limit.
 constexpr std::uint64_t kMaxChunk = std::uint64_t{1} << 31;
 
@@ -89,15 +71,6 @@ std::uint64_t le64(const std::uint8_t* p) {
   std::uint64_t v = 0;
   for (int i = 0; i < 8; ++i) v |= static_cast<std::uint64_t>(p[i]) << (8 * i);
   return v;
-}
-
-std::uint32_t crc32Of(std::uint32_t crc, const std::uint8_t* p, std::size_t n) {
-  while (n > 0) {  // zlib takes 32-bit lengths
-    const std::size_t step = std::min<std::size_t>(n, 1u << 30);
-    crc = static_cast<std::uint32_t>(crc32(crc, p, static_cast<uInt>(step)));
-    p += step, n -= step;
-  }
-  return crc;
 }
 
 }  // namespace

@@ -12,7 +12,6 @@
 
 #include "kccd/input_error.hpp"
 #include "kccd/model.hpp"
-#include "kccd/modelling/fit_request.hpp"
 
 namespace kccd::cli {
 
@@ -55,16 +54,6 @@ StateBox parseStateBox(const Model& m, const std::string& state, const std::stri
 /// last '.': "braking.latency" is --latency), unless `spelling` names it otherwise ("output": "-o").
 std::string optionSpelling(const std::string& field, const std::map<std::string, std::string>& spelling = {});
 [[noreturn]] void rethrowAsOption(const InputError& e, const std::map<std::string, std::string>& spelling = {});
-
-/// Checks a fit request built from the options; a field out of range is a UsageError naming its
-/// option (--points, --tolerance, --pieces, --concavity, --evaluations, --seed).
-void checkFitOptions(const modelling::FitRequest& request);
-
-/// `--pieces auto|N`: the most convex pieces a concave link may split into (auto: 8); N in 1 ... 64.
-int piecesOption(const std::string& text);
-
-/// Adds `--pieces auto|N` and `--concavity MM` (kccd fit and kccd import); `what` opens --pieces' help.
-void addPieceOptions(CLI::App& sub, std::string& pieces, double& concavity_mm, const std::string& what);
 
 /// Adds the braking options (--latency, --deceleration, --max-acceleration, --position-error,
 /// --velocity-error: every joint's, with --swept) into `braking` (kccd overlay and kccd check).

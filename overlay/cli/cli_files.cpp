@@ -16,16 +16,6 @@
 
 namespace kccd::cli {
 
-Model loadOrExplain(const std::string& path, std::string* text) {
-  try {
-    if (text == nullptr) return loadModel(path);
-    *text = readModelText(path);
-    return parseModel(*text, path);
-  } catch (const InputError& e) {
-    throw UsageError(e.what());
-  }
-}
-
 void editFile(const std::string& path, const std::function<std::string(const std::string&)>& edit,
               const std::string* expected) {
   // A symbolic link: its target is locked (open and stat follow it) and replaced.

@@ -1,5 +1,5 @@
-// Files the kccd subcommands read and write: models with one-line errors, outputs renamed into
-// place, locked in-place edits.
+// Files the kccd subcommands write: outputs renamed into place, locked in-place edits (models:
+// cli_model.hpp).
 #pragma once
 
 #include <functional>
@@ -7,14 +7,9 @@
 
 #include <opencv2/core.hpp>
 
-#include "kccd/model.hpp"
 #include "kccd/overlay/common/staged_output.hpp"
 
 namespace kccd::cli {
-
-/// Loads a model, turning every failure into one line on stderr (throws UsageError); with `text`,
-/// also returns the file's text as it was read.
-Model loadOrExplain(const std::string& path, std::string* text = nullptr);
 
 /// Files are written through kccd::overlay's staged outputs (one temporary name, one rename), and
 /// output paths checked by its checkOutputPath and sameFile.

@@ -11,6 +11,7 @@
 #include "calib_frames.hpp"
 #include "cli_args.hpp"
 #include "cli_files.hpp"
+#include "cli_model.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/overlay/calibration/calib_check.hpp"

@@ -12,6 +12,7 @@
 #include "cli_args.hpp"
 #include "cli_files.hpp"
 #include "cli_output.hpp"
+#include "cli_progress.hpp"
 #include "commands.hpp"
 #include "kccd/calib/board_views.hpp"
 #include "kccd/calib/intrinsics.hpp"

@@ -15,6 +15,7 @@
 #include "calib_frames.hpp"
 #include "cli_args.hpp"
 #include "cli_files.hpp"
+#include "cli_model.hpp"
 #include "commands.hpp"
 #include "kccd/calib/image_file.hpp"
 #include "kccd/calib/mask_refine.hpp"

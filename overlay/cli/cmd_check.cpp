@@ -7,7 +7,9 @@
 
 #include "cli_args.hpp"
 #include "cli_files.hpp"
+#include "cli_model.hpp"
 #include "cli_output.hpp"
+#include "cli_progress.hpp"
 #include "commands.hpp"
 #include "kccd/overlay/jobs/check_job.hpp"
 #include "kccd/overlay/recording/overlay_recording.hpp"

@@ -10,7 +10,9 @@
 
 #include "cli_args.hpp"
 #include "cli_files.hpp"
+#include "cli_fit_args.hpp"
 #include "cli_output.hpp"
+#include "cli_progress.hpp"
 #include "commands.hpp"
 #include "kccd/modelling/convex_hull.hpp"
 #include "kccd/modelling/fit_request.hpp"

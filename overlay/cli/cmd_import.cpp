@@ -4,7 +4,9 @@
 
 #include "cli_args.hpp"
 #include "cli_files.hpp"
+#include "cli_fit_args.hpp"
 #include "cli_output.hpp"
+#include "cli_progress.hpp"
 #include "commands.hpp"
 #include "kccd/model.hpp"
 #include "kccd/modelling/pair_proof.hpp"

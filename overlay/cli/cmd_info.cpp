@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "cli_args.hpp"
-#include "cli_files.hpp"
+#include "cli_model.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
 

@@ -8,7 +8,9 @@
 
 #include "cli_args.hpp"
 #include "cli_files.hpp"
+#include "cli_model.hpp"
 #include "cli_output.hpp"
+#include "cli_progress.hpp"
 #include "commands.hpp"
 #include "kccd/overlay/jobs/overlay_job.hpp"
 #include "kccd/overlay/recording/overlay_recording.hpp"
@@ -192,6 +194,12 @@ Runner addOverlay(CLI::App& app) {
       "Draw the braking-interval swept volumes (from logged or differenced velocities) instead of the static ones");
   addBrakingOptions(*sub, a->braking);
   sub->add_flag("--plain", a->request.plain, "Volumes only: no legend, no status line");
+  sub->add_option("--legend", a->request.legend,
+                  "Where the colour legend goes: auto (the corner of the picture where it hides the fewest pixels of "
+                  "the volumes drawn; it moves only when another corner has been clearer for 8 frames), top-left, "
+                  "top-right, bottom-left, bottom-right, outside (a strip under the picture that also holds the status "
+                  "line: the output frames are taller than the input) or off")
+      ->capture_default_str();
   sub->add_flag("--visuals", a->request.visuals,
                 "Also draw the model's visual geometry (visuals:) at the logged state, tinted in its own colours: "
                 "where it misses the robot in the video, the camera, the log's clock or the model is off");
@@ -221,6 +229,8 @@ Runner addOverlay(CLI::App& app) {
       "(exact), a linear interpolation between two samples at most --max-gap apart, or no state. Without a state only\n"
       "the bodies fixed in the world are drawn (grey); the frame is counted and reported as no_state.\n"
       "Colours: green clear, amber within the safety margin, red colliding or unsafe, grey no state.\n"
+      "Text, legend and status line scale with the frame's height; a status line too wide for the frame drops its\n"
+      "least important parts first (the state's match, swept, the time, then the pairs within the margin).\n"
       "Outputs are written under temporary names and moved into place only when every frame is done.\n"
       "Exit status: 0 written, 2 bad input (nothing written), 3 a frame's query status is unsafe (everything still "
       "written).");

@@ -9,7 +9,9 @@
 
 #include "cli_args.hpp"
 #include "cli_files.hpp"
+#include "cli_model.hpp"
 #include "cli_output.hpp"
+#include "cli_progress.hpp"
 #include "commands.hpp"
 #include "kccd/modelling/pair_proof.hpp"
 #include "kccd/modelling/pair_survey.hpp"

@@ -5,7 +5,7 @@
 #include <memory>
 
 #include "cli_args.hpp"
-#include "cli_files.hpp"
+#include "cli_model.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/checker.hpp"

@@ -10,6 +10,7 @@
 
 #include "cli_args.hpp"
 #include "cli_files.hpp"
+#include "cli_model.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "kccd/render/model_view.hpp"

@@ -6,6 +6,7 @@
 
 #include "cli_args.hpp"
 #include "cli_output.hpp"
+#include "cli_progress.hpp"
 #include "commands.hpp"
 #include "kccd/overlay/synth/synth.hpp"
 
@@ -32,8 +33,9 @@ Exit runSynth(const overlay::SynthOptions& o, bool quiet) {
   progress.finish();
   if (!quiet) {
     std::cout << "wrote " << o.output << ": " << r.frames << " frames " << r.width << "x" << r.height << " at " << r.fps
-              << " fps (" << r.video_file << "), states.csv at " << r.log_rate << " Hz (log time = video time + "
-              << r.time_offset << " s), " << r.tags << " tags, in " << format(r.seconds, 3) << " s\n";
+              << " fps (" << r.video_file << "), states.csv" << (r.bag_file.empty() ? "" : " and " + r.bag_file)
+              << " at " << r.log_rate << " Hz (log time = video time + " << r.time_offset << " s), " << r.tags
+              << " tags, in " << format(r.seconds, 3) << " s\n";
     if (!r.collision_intervals.empty())
       std::cout << "collision: frames " << r.collision_intervals[0][0] << "-" << r.collision_intervals[0][1] << "; "
                 << r.near_frames.size() << " frames within the margin\n";
@@ -93,6 +95,9 @@ Runner addSynth(CLI::App& app) {
       ->capture_default_str()
       ->check(finiteIn(0, 50));
   sub->add_flag("--no-collision", a->no_collision, "Only near-collisions, no real one");
+  sub->add_flag("--bag", a->options.bag,
+                "Also write DIR/states.mcap: the recording as a ROS 2 bag, its joint states and camera frames (for "
+                "kccd overlay --bag, check --bag, calib --bag, bag info, bag export)");
   sub->add_flag("--force", a->options.replace, "Replace an existing output folder");
   sub->add_flag("-q,--quiet", a->quiet, "No progress and no summary line");
   sub->footer(
@@ -101,6 +106,14 @@ Runner addSynth(CLI::App& app) {
       "mask of the visible geometry: 0 background, i + 1 body i; a visual counts for the first body in its\n"
       "frame, 0 when there is none) and DIR/synth.json (the truth: camera,\n"
       "clock offset, rates, per-frame state and smallest distance, collision frames).\n"
+      "With --bag also DIR/states.mcap, the recording as a robot's log (MCAP, ROS 2 CDR): every row of\n"
+      "states.csv as a sensor_msgs/msg/JointState on /joint_states (names the state values, positions,\n"
+      "velocities), and every video frame as a sensor_msgs/msg/CompressedImage (JPEG, quality 90,\n"
+      "format 'bgr8; jpeg compressed bgr8', frame_id camera) on /camera/image_raw/compressed, in\n"
+      "log-time order. All on the log's clock from 1700000000 s (2023-11-14 22:13:20 UTC): a row at its\n"
+      "time, frame i at i / fps + --time-offset (header stamp = log time = publish time), so the bag has\n"
+      "no clock offset to find. E.g.: kccd synth arm.yaml -o rec --bag &&\n"
+      "kccd overlay arm.yaml --camera rec/camera_true.yaml --bag rec/states.mcap -o out.mp4\n"
       "Collision means a smallest distance bound <= 0 at the logged state of the frame.\n"
       "Exit status: 0 written, 2 bad input (or no trajectory found for this model and seed).");
   return [a, width, height, shrink] {

@@ -20,7 +20,7 @@ A recording is a video with its state log, or a robot log (``bag``: MCAP, rosbag
 ROS 1 .bag) read as ``kccd overlay --bag`` reads it (``image_topic``, ``joint_topic``,
 ``time_source`` and ``joint_map`` here or in defaults). The overlay's other options are keys too,
 under :func:`kccd.overlay_recording`'s names (``frame_times``, ``ignore_columns``, ``fps``,
-``max_gap``, ``plain``, ``visuals``, ``masks``, ``mask_bodies``, ``frames``; ``time_offset`` may be
+``max_gap``, ``plain``, ``legend``, ``visuals``, ``masks``, ``mask_bodies``, ``frames``; ``time_offset`` may be
 ``auto:A:B``), each checked by the overlay's own checks (:func:`kccd.check_overlay_request`) before
 anything starts.
 """

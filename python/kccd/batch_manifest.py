@@ -22,8 +22,8 @@ _RESERVED = ("summary.json", "summary.md", "colliding_frames.png")
 _ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,127}")
 _BAG_KEYS = ("image_topic", "joint_topic", "time_source", "joint_map")
 #: More of kccd.overlay_recording's keywords, under their own names (checked by kccd.check_overlay_request).
-OVERLAY_KEYS = ("frame_times", "ignore_columns", "fps", "max_gap", "plain", "visuals", "masks", "mask_bodies", "frames",
-                "camera_key", "state_key", "frame_by")
+OVERLAY_KEYS = ("frame_times", "ignore_columns", "fps", "max_gap", "plain", "legend", "visuals", "masks", "mask_bodies",
+                "frames", "camera_key", "state_key", "frame_by")
 #: A LeRobot dataset's recording: its folder and which episodes ("all", a list, or "FIRST:END").
 _LEROBOT_KEYS = ("lerobot", "episodes")
 _RECORDING_KEYS = ("id", "video", "states", "bag", "model", "camera", "time_offset", "swept", "braking") + _BAG_KEYS + \

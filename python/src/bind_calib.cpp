@@ -212,7 +212,7 @@ void bindImages(py::module_& m) {
 // AprilTags: detections, layouts and their correspondences.
 void bindTags(py::module_& m) {
   py::class_<calib::TagDetection>(m, "TagDetection", "One detected AprilTag (family tag36h11).")
-      .def_readonly("id", &calib::TagDetection::id)
+      .def_readonly("id", &calib::TagDetection::id, "The tag's id in the tag36h11 family (0 ... 586).")
       .def_property_readonly(
           "corners",
           [](const calib::TagDetection& d) {

@@ -317,8 +317,10 @@ fresh arrays: 'status' int8 (M,) (kccd.Status values), 'collision' bool (M,), 'm
 threads: split the rows over this many threads, each with its own Checker. reuse: keep bounds from row to
 row (consecutive cycles of one robot); False (default): every row answered as by a new Checker.)doc")
       .def("reset", &PyChecker::reset, "Forgets every stored bound: the next answer is exactly a new Checker's.")
-      .def_property_readonly("model", &PyChecker::model)
-      .def_property_readonly("budget_us", &PyChecker::budget);
+      .def_property_readonly("model", &PyChecker::model, "The Model this checker queries.")
+      .def_property_readonly("budget_us", &PyChecker::budget,
+                             "The time budget per query in microseconds, or None when unlimited. A query whose "
+                             "budget runs out is still conservative: pairs it never computed count as 0.");
 
   py::class_<BrakingParams>(m, "BrakingParams", "Braking of one state value (SI units: m or rad, per s, per s^2).")
       .def(py::init([](double position_error, double velocity_error, double latency, double max_acceleration,
@@ -327,11 +329,17 @@ row (consecutive cycles of one robot); False (default): every row answered as by
            }),
            py::kw_only(), py::arg("position_error") = 0.0, py::arg("velocity_error") = 0.0, py::arg("latency") = 0.0,
            py::arg("max_acceleration") = 0.0, py::arg("deceleration") = 1.0)
-      .def_readwrite("position_error", &BrakingParams::position_error)
-      .def_readwrite("velocity_error", &BrakingParams::velocity_error)
-      .def_readwrite("latency", &BrakingParams::latency)
-      .def_readwrite("max_acceleration", &BrakingParams::max_acceleration)
-      .def_readwrite("deceleration", &BrakingParams::deceleration);
+      .def_readwrite("position_error", &BrakingParams::position_error,
+                     "Bound on the position measurement error (m or rad; 0 ... 1e3).")
+      .def_readwrite("velocity_error", &BrakingParams::velocity_error,
+                     "Bound on the velocity measurement error (m/s or rad/s; 0 ... 1e6).")
+      .def_readwrite(
+          "latency", &BrakingParams::latency,
+          "Reaction latency in seconds (0 ... 1e3): one full control cycle plus delays, before braking starts.")
+      .def_readwrite("max_acceleration", &BrakingParams::max_acceleration,
+                     "Worst-case acceleration during the latency (m/s^2 or rad/s^2; 0 ... 1e9).")
+      .def_readwrite("deceleration", &BrakingParams::deceleration,
+                     "Guaranteed braking deceleration (m/s^2 or rad/s^2; 1e-9 ... 1e9, more than 0).");
 
   m.def(
       "braking_intervals",

@@ -95,11 +95,15 @@ Pickles through its YAML text (and the file it came from, against which mesh pat
           py::arg("path"), "Reads a `kccd: 1` YAML model file; raises InputError naming the file, line and field.")
       .def_static("from_yaml", &modelFromText, py::arg("text"), py::arg("source") = "<string>",
                   "Parses YAML text; `source` names it in error messages (and is where relative mesh paths resolve).")
-      .def_property_readonly("name", [](const ModelHandle& h) { return h.model->name; })
+      .def_property_readonly(
+          "name", [](const ModelHandle& h) { return h.model->name; }, "The model's `name:` from its file.")
       .def_property_readonly(
           "margin", [](const ModelHandle& h) { return h.model->safety_margin; },
           "The safety margin (metres): distances at most this count as a collision.")
-      .def_property_readonly("point_budget", [](const ModelHandle& h) { return h.model->point_budget; })
+      .def_property_readonly(
+          "point_budget", [](const ModelHandle& h) { return h.model->point_budget; },
+          "The most core points of a first-stage swept volume (`point_budget:`, default 32): it bounds a "
+          "query's time; the exact stage refines flagged pairs without it.")
       .def_property_readonly(
           "state_size", [](const ModelHandle& h) { return h.model->stateSize(); },
           "Number of state values (the length of a state, lower or upper).")

@@ -78,6 +78,7 @@ overlay::OverlayRequest overlayRequest(const py::kwargs& kwargs) {
          if (!v.is_none()) q.braking = v.cast<BrakingParams>();
        }},
       {"plain", [&](const py::handle& v) { q.plain = v.cast<bool>(); }},
+      {"legend", [&](const py::handle& v) { q.legend = v.cast<std::string>(); }},
       {"visuals", [&](const py::handle& v) { q.visuals = v.cast<bool>(); }},
       {"masks", [&](const py::handle& v) { q.masks = v.cast<std::string>(); }},
       {"mask_bodies", [&](const py::handle& v) { q.mask_bodies = v.cast<std::vector<std::string>>(); }},
@@ -198,7 +199,7 @@ void bindOverlayJob(py::module_& m) {
         return toPython(full);
       },
       py::arg("model"), py::arg("camera"), py::arg("video") = "", py::arg("states") = "",
-      R"doc(overlay_recording(model, camera, video='', states='', *, bag='', image_topic='', joint_topic='', time_source='header', joint_map='', lerobot='', episode=-1, camera_key='', state_key='observation.state', frame_by='auto', frame_times='', ignore_columns=[], fps=0.0, time_offset=0.0, max_gap=0.0, swept=False, braking=None, plain=False, visuals=False, masks='', mask_bodies=[], frames='', jobs=0, timings=False, output='', codec='', png_dir='', report='', contact_sheet='', timeline='', contact_frames=12, progress=None, progress_every=0.0)
+      R"doc(overlay_recording(model, camera, video='', states='', *, bag='', image_topic='', joint_topic='', time_source='header', joint_map='', lerobot='', episode=-1, camera_key='', state_key='observation.state', frame_by='auto', frame_times='', ignore_columns=[], fps=0.0, time_offset=0.0, max_gap=0.0, swept=False, braking=None, plain=False, legend='auto', visuals=False, masks='', mask_bodies=[], frames='', jobs=0, timings=False, output='', codec='', png_dir='', report='', contact_sheet='', timeline='', contact_frames=12, progress=None, progress_every=0.0)
 
 The main job, as `kccd overlay` (every option of it under its own name, with its default and its checks):
 every frame of `video` (a file or an image-sequence pattern) checked at the state the log `states` (CSV)
@@ -209,8 +210,10 @@ of the inputs) and each written under a temporary name and renamed when complete
 .avi; codec: a FourCC), `png_dir` (frame_NNNNNN.png), `report` (.json, the format of `kccd overlay
 --report`), `contact_sheet` (.png of contact_frames frames), `timeline` (.png of the run over time).
 swept: braking-interval volumes, with `braking` (a BrakingParams for every joint; None: kccd overlay's
-defaults, latency 0.01 s and deceleration 5). plain: no legend or status line; visuals: the model's
-visual geometry too. jobs: drawing threads (0: all cores). frames: 'FIRST:END:STEP' of the frames drawn
+defaults, latency 0.01 s and deceleration 5). plain: no legend or status line; legend: where the legend
+goes, 'auto' (the corner hiding the fewest volume pixels), 'top-left', 'top-right', 'bottom-left',
+'bottom-right', 'outside' (a strip under the picture with the status line: taller frames) or 'off';
+visuals: the model's visual geometry too. jobs: drawing threads (0: all cores). frames: 'FIRST:END:STEP' of the frames drawn
 (all are checked). progress(frames_done, frames_expected, frames_per_second) is called after each frame
 with the GIL held (progress_every: at most once per that many seconds, and after the last frame). Returns
 the report as a dict (with per-frame records under 'frames'). Instead of video and states, bag: a robot
@@ -408,8 +411,9 @@ void bindSynth(py::module_& m) {
       "synthesize_recording",
       [](const std::string& model, const std::string& output, const std::string& camera, double seconds, double fps,
          double log_rate, double time_offset, std::uint64_t seed, const std::string& codec, bool collision,
-         bool replace, const std::optional<int>& width, const std::optional<int>& height, const std::string& appearance,
-         const std::optional<double>& visible_scale, double blur, double noise, const py::object& progress) {
+         bool replace, bool bag, const std::optional<int>& width, const std::optional<int>& height,
+         const std::string& appearance, const std::optional<double>& visible_scale, double blur, double noise,
+         const py::object& progress) {
         overlay::SynthOptions o;
         o.width = width, o.height = height, o.visible_scale = visible_scale, o.blur = blur, o.noise = noise;
         if (appearance == "auto")
@@ -431,6 +435,7 @@ void bindSynth(py::module_& m) {
         o.codec = codec;
         o.collision = collision;
         o.replace = replace;
+        o.bag = bag;
         o.spell = [](const std::string& field) -> std::string {
           return field == "collision" ? "collision=False" : field == "replace" ? "replace=True" : field;
         };
@@ -442,6 +447,7 @@ void bindSynth(py::module_& m) {
         d["video"] = (r.folder / r.video_file).string();
         d["states"] = (r.folder / "states.csv").string();
         d["camera"] = (r.folder / "camera_true.yaml").string();
+        d["bag"] = r.bag_file.empty() ? py::object(py::none()) : py::str((r.folder / r.bag_file).string());
         d["frames"] = r.frames;
         d["width"] = r.width;
         d["height"] = r.height;
@@ -458,17 +464,20 @@ void bindSynth(py::module_& m) {
       },
       py::arg("model"), py::arg("output"), py::kw_only(), py::arg("camera") = "", py::arg("seconds") = 5.0,
       py::arg("fps") = 25.0, py::arg("log_rate") = 125.0, py::arg("time_offset") = 0.137, py::arg("seed") = 1,
-      py::arg("codec") = "ffv1", py::arg("collision") = true, py::arg("replace") = false, py::arg("width") = py::none(),
-      py::arg("height") = py::none(), py::arg("appearance") = "auto", py::arg("visible_scale") = py::none(),
-      py::arg("blur") = 0.7, py::arg("noise") = 2.5, py::arg("progress") = py::none(),
+      py::arg("codec") = "ffv1", py::arg("collision") = true, py::arg("replace") = false, py::arg("bag") = false,
+      py::arg("width") = py::none(), py::arg("height") = py::none(), py::arg("appearance") = "auto",
+      py::arg("visible_scale") = py::none(), py::arg("blur") = 0.7, py::arg("noise") = 2.5,
+      py::arg("progress") = py::none(),
       R"doc(A synthetic recording with ground truth, as `kccd synth`: in the new folder `output`, the video, the state
 log states.csv, the true camera camera_true.yaml, tags, masks and synth.json (the folder appears only when
 complete). model: a model file. Every option of `kccd synth` under its own name: width and height (the default
 camera's image size, not with camera), appearance ('auto', 'volumes' or 'visuals'), visible_scale (the volumes'
-drawn radius fraction), blur and noise (sigmas). An option out of range raises InputError naming it ("fps: must be
-1 ... 240"). progress(fraction) is called after each frame with the GIL held. Returns
-a dict with the files' paths and the truth: per-frame 'min_distance' (metres), 'colliding_frames',
-'near_frames', 'collision_intervals' ([first, last] frames).)doc");
+drawn radius fraction), blur and noise (sigmas), bag (also states.mcap: the recording as a ROS 2 bag, JointState
+on /joint_states and each frame as a JPEG CompressedImage on /camera/image_raw/compressed, both on the log's
+clock, so overlay_recording(..., bag=...) pairs them with no time_offset). An option out of range raises
+InputError naming it ("fps: must be 1 ... 240"). progress(fraction) is called after each frame with the GIL
+held. Returns a dict with the files' paths ('bag': None without bag) and the truth: per-frame 'min_distance'
+(metres), 'colliding_frames', 'near_frames', 'collision_intervals' ([first, last] frames).)doc");
 }
 
 }  // namespace

@@ -40,8 +40,8 @@ metres), as `kccd calib` writes it. Load with Camera.load(path).)doc")
       .def(
           "save", [](const calib::Camera& c, const std::string& path) { calib::saveCamera(c, path); }, py::arg("path"),
           "Writes the camera file (under a temporary name, renamed when complete).")
-      .def_readonly("width", &calib::Camera::width)
-      .def_readonly("height", &calib::Camera::height)
+      .def_readonly("width", &calib::Camera::width, "Image width in pixels (`image_width`).")
+      .def_readonly("height", &calib::Camera::height, "Image height in pixels (`image_height`).")
       .def_property_readonly(
           "camera_matrix", [](const calib::Camera& c) { return matrix3(c.camera_matrix); },
           "float64 (3, 3): fx 0 cx; 0 fy cy; 0 0 1 (pixels)")
@@ -72,9 +72,13 @@ metres), as `kccd calib` writes it. Load with Camera.load(path).)doc")
           py::arg("rvec"), py::arg("tvec"),
           "A copy with the pose (world -> camera) set to rvec, tvec (float64 (3,) each; a rough start for "
           "refine_to_masks, say) and no quality figures.")
-      .def_readonly("reprojection_rms_px", &calib::Camera::reprojection_rms_px)
-      .def_readonly("rotation_sigma_deg", &calib::Camera::rotation_sigma_deg)
-      .def_readonly("position_sigma_m", &calib::Camera::position_sigma_m)
+      .def_readonly("reprojection_rms_px", &calib::Camera::reprojection_rms_px,
+                    "Calibration quality: RMS distance in pixels between the points seen and their projections, "
+                    "or None when the file has none.")
+      .def_readonly("rotation_sigma_deg", &calib::Camera::rotation_sigma_deg,
+                    "Calibration quality: 1 sigma of the camera's rotation in degrees, or None when the file has none.")
+      .def_readonly("position_sigma_m", &calib::Camera::position_sigma_m,
+                    "Calibration quality: 1 sigma of the camera's position in metres, or None when the file has none.")
       .def("__repr__", [](const calib::Camera& c) {
         return "<kccd.Camera " + std::to_string(c.width) + "x" + std::to_string(c.height) + ">";
       });

@@ -1,5 +1,7 @@
 #include "kccd/render/projection.hpp"
 
+#include "kccd/render/lens_inverse.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -40,28 +42,12 @@ Projection::Projection(const Camera& camera, double supersample) : camera_(camer
     }
     return;
   }
-  // Normalised coordinates of every output pixel centre (the inverse of the distortion model).
-  // In blocks of rows: the temporaries of the inversion stay small for large images.
+  // Normalised coordinates of every output pixel centre (the inverse of the distortion model),
+  // computed once per lens and kept in the lens cache.
   const int n = camera.width * camera.height;
-  cv::Mat normal(n, 1, CV_64FC2);
-  std::vector<unsigned char> valid(n, 0);
-  // The blocks are independent: inverted in parallel (the set-up of a long recording's run), each
-  // a few thousand pixels, so that the lens's slow corners spread over the threads.
-  const int block_rows = std::max(1, (1 << 12) / camera.width);
-  const int blocks = (camera.height + block_rows - 1) / block_rows;
-  cv::parallel_for_(cv::Range(0, blocks), [&](const cv::Range& range) {
-    for (int b = range.start; b < range.end; ++b) {
-      const int v0 = b * block_rows;
-      const int rows = std::min(block_rows, camera.height - v0), m = rows * camera.width, first = v0 * camera.width;
-      cv::Mat pixels(m, 1, CV_64FC2), block_normal;
-      for (int v = v0, i = 0; v < v0 + rows; ++v)
-        for (int u = 0; u < camera.width; ++u, ++i) pixels.at<cv::Vec2d>(i) = cv::Vec2d(u, v);
-      std::vector<unsigned char> block_valid;
-      calib::undistortPixels(camera, pixels, block_normal, block_valid);
-      block_normal.copyTo(normal.rowRange(first, first + m));
-      std::copy(block_valid.begin(), block_valid.end(), valid.begin() + first);
-    }
-  });
+  const LensInverse inverse = lensInverse(camera);
+  const cv::Mat& normal = inverse.normal;
+  const std::vector<unsigned char>& valid = inverse.valid;
   double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
   for (int i = 0; i < n; ++i)
     if (valid[i]) {

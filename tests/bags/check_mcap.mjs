@@ -8,6 +8,10 @@
 // index, statistics). Decodes each CDR message with @foxglove/rosmsg2-serialization and
 // compares header, schemas, channels, chunk compression, per-topic counts/times and every
 // message field with truth.json. Prints a line per file; exits 1 on any mismatch.
+// CompressedImages (/camera/image_raw/compressed, truth.compressed_images) are compared by their
+// header, format and the JPEG's first and last two bytes (SOI, EOI); with truth.dump_images (a
+// folder name in OUT_DIR), each one's data is written there as 000000.jpg, 000001.jpg, ... for
+// the caller to decode.
 import fs from "node:fs";
 import path from "node:path";
 import { isDeepStrictEqual } from "node:util";
@@ -49,12 +53,21 @@ const plain = {
     is_bigendian: m.is_bigendian, step: m.step,
     data_sum: m.data.reduce((a, b) => a + b, 0), data_first8: Array.from(m.data.slice(0, 8)),
   }),
+  "/camera/image_raw/compressed": (m, log) => ({
+    log_time_ns: String(log), stamp_sec: m.header.stamp.sec, stamp_nanosec: m.header.stamp.nanosec,
+    frame_id: m.header.frame_id, format: m.format,
+    data_ends: [m.data[0], m.data[1], m.data[m.data.length - 2], m.data[m.data.length - 1]],
+  }),
   "/camera/camera_info": (m, log) => ({
     log_time_ns: String(log), width: m.width, height: m.height, distortion_model: m.distortion_model,
     d: Array.from(m.d), k: Array.from(m.k),
   }),
 };
-const wantMsgs = { "/joint_states": truth.joint_states, "/camera/image_raw": truth.images, "/camera/camera_info": truth.camera_infos };
+const wantMsgs = { "/joint_states": truth.joint_states, "/camera/image_raw": truth.images,
+                   "/camera/image_raw/compressed": truth.compressed_images, "/camera/camera_info": truth.camera_infos };
+const dumpDir = truth.dump_images ? path.join(dir, truth.dump_images) : null;
+if (dumpDir) fs.mkdirSync(dumpDir, { recursive: true });
+let dumped = 0;
 
 for (const [file, want] of Object.entries(truth.files)) {
   const buf = fs.readFileSync(path.join(dir, file));
@@ -78,7 +91,10 @@ for (const [file, want] of Object.entries(truth.files)) {
       lastLog = rec.logTime;
       expect(file, "publish_time", rec.publishTime, rec.logTime);
       const t = topics.get(rec.channelId);
-      t.msgs.push(plain[t.info.topic](t.reader.readMessage(rec.data), rec.logTime));
+      const m = t.reader.readMessage(rec.data);
+      t.msgs.push(plain[t.info.topic](m, rec.logTime));
+      if (dumpDir && t.info.topic === "/camera/image_raw/compressed")
+        fs.writeFileSync(path.join(dumpDir, `${String(dumped++).padStart(6, "0")}.jpg`), m.data);
     }
   }
   expect(file, "stream complete", stream.done(), true);

@@ -244,6 +244,10 @@ def test_resume_runs_only_what_is_missing(fleet: pathlib.Path, client, tmp_path:
     ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml}\nrecordings:\n"
      "  - {id: x, video: a/video.mkv, states: a/states.csv, max_gap: 1e400}\n",
      "4: recordings[0].max_gap: expected a finite number"),
+    ("kccd_batch: 1\ndefaults: {model: arm.yaml, camera: a/camera_true.yaml, legend: left}\nrecordings:\n"
+     "  - {id: x, video: a/video.mkv, states: a/states.csv}\n",
+     "2: defaults.legend: expected 'auto', 'outside', 'off', 'top-left', 'top-right', 'bottom-left' or "
+     "'bottom-right', got 'left'"),
 ])
 def test_manifest_mistakes(fleet: pathlib.Path, tmp_path: pathlib.Path, body: str, where: str) -> None:
     manifest = fleet / f"bad-{abs(hash(body))}.yaml"

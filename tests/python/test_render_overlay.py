@@ -160,7 +160,7 @@ def test_overlay_braking_is_the_commands() -> None:
 SYNTH_OPTIONS = {"--camera": "camera", "--seconds": "seconds", "--fps": "fps", "--width": "width", "--height": "height",
                  "--seed": "seed", "--codec": "codec", "--log-rate": "log_rate", "--time-offset": "time_offset",
                  "--visible-scale": "visible_scale", "--appearance": "appearance", "--blur": "blur", "--noise": "noise",
-                 "--no-collision": "collision", "--force": "replace", "--output": "output"}
+                 "--no-collision": "collision", "--force": "replace", "--bag": "bag", "--output": "output"}
 
 
 def test_every_synth_option_has_its_python_argument(cli, tmp_path: pathlib.Path) -> None:
@@ -179,8 +179,19 @@ def test_every_synth_option_has_its_python_argument(cli, tmp_path: pathlib.Path)
     with pytest.raises(kccd.InputError, match=r"^blur: must be in \[0, 10\]"):
         kccd.synthesize_recording(model, str(tmp_path / "b"), blur=11)
     s = kccd.synthesize_recording(model, str(tmp_path / "c"), seconds=0.2, width=640, height=400, appearance="volumes",
-                                  visible_scale=0.5, noise=0)
+                                  visible_scale=0.5, noise=0, bag=True)
     assert s["width"] == 640 and s["height"] == 400
+    # bag=True: the state log and the frames as a bag beside it, read as the same samples; its frames on
+    # the log's clock overlay as the video does at the recording's time offset.
+    assert s["bag"] == str(tmp_path / "c" / "states.mcap")
+    arm = kccd.Model.load(model)
+    assert kccd.check_log(arm, bag=s["bag"])["samples"] == kccd.check_log(arm, s["states"])["samples"] == s["log_rows"]
+    camera = kccd.Camera.load(s["camera"])
+    by_bag = kccd.overlay_recording(arm, camera, bag=s["bag"])["frames"]
+    by_files = kccd.overlay_recording(arm, camera, s["video"], s["states"], time_offset=s["time_offset"])["frames"]
+    assert len(by_bag) == len(by_files) == s["frames"]
+    assert [f["status"] for f in by_bag] == [f["status"] for f in by_files]
+    assert all(f["time"] == pytest.approx(i / s["fps"] + s["time_offset"], abs=1e-9) for i, f in enumerate(by_bag))
 
 
 def test_overlay_masks_equal_cli(cli, arm: kccd.Model, tmp_path: pathlib.Path) -> None:
@@ -270,6 +281,8 @@ def test_overlay_messages_are_the_same_from_both_front_ends(cli, arm: kccd.Model
         (["--time-offset", "soon"], {"time_offset": "soon"}),
         (["--time-offset", "2e9"], {"time_offset": 2e9}),
         (["--codec", "xx"], {"codec": "xx"}),
+        (["--legend", "left"], {"legend": "left"}),
+        (["--plain", "--legend", "outside"], {"plain": True, "legend": "outside"}),
         (["--frames", "5:2"], {"frames": "5:2"}),
         (["--mask-bodies", "upper_arm"], {"mask_bodies": ["upper_arm"]}),
         (["--masks", "auto", "--mask-bodies", "arm"], {"masks": "auto", "mask_bodies": ["arm"]}),

@@ -17,6 +17,8 @@
 #include "kccd/overlay/calibration/calib_gather.hpp"
 #include "kccd/overlay/datasets/lerobot_recording.hpp"
 #include "kccd/overlay/recording/frame_annotator.hpp"
+#include "kccd/overlay/recording/frame_decoration.hpp"
+#include "kccd/overlay/recording/legend_corner.hpp"
 #include "kccd/render/model_view.hpp"
 #include "kccd/render/projection.hpp"
 #include "kccd/state_log.hpp"
@@ -254,14 +256,20 @@ GoldenRendering GoldenRenderer::render(std::size_t index) {
     AnnotatorSettings settings;
     settings.time_offset = c.time_offset;
     settings.max_gap = 1.5 * log.medianPeriod();
+    // As kccd overlay draws the frame: its legend where it hides the fewest volume pixels.
+    const FrameDecoration decoration(f.bgr.size(), LegendPlace::Auto, true);
+    settings.legend_corners = decoration.corners();
     const AnnotatorScene scene{m, log, projection, renderOptions(c), {}, settings};
     FrameAnnotator annotator(scene);
     FrameRecord record;
     record.time = f.time;
     record.selected = true;
-    cv::Mat bgr = f.bgr.clone();
+    cv::Mat bgr = f.bgr.clone(), tall;
     annotator.annotate(bgr, record);
-    overlay = bgr;
+    const std::size_t corners = settings.legend_corners.size();
+    const int corner =
+        corners > 1 ? LegendCorner(decoration.corners().front().area()).next({record.legend_cover.data(), corners}) : 0;
+    overlay = decorateFrame(bgr, tall, decoration, record, m, settings, corner);
     state = record.values;
     inputs["state"] = record.values.empty() ? nlohmann::json(nullptr) : nlohmann::json(record.values);
     if (record.unsafe()) out.unsafe = record.queryStatusText();

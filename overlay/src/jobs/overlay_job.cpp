@@ -128,6 +128,11 @@ OverlayOptions Checker::options() const {
     o.braking = b;
   }
   o.plain = r.plain;
+  const std::optional<LegendPlace> legend = legendPlaceOf(r.legend);
+  if (!legend) throw problem("legend", "expected " + legendPlaceWords() + ", got '" + printable(r.legend) + "'");
+  if (r.plain && *legend != LegendPlace::Auto)
+    throw problem("legend", "not with " + named("plain") + " (volumes only: no legend is drawn)");
+  o.legend = *legend;
   if (r.visuals && model) {
     if (model->visuals.empty()) throw problem("visuals", "the model has no visuals:");
     if (model->visuals.size() + model->bodies.size() > 255)

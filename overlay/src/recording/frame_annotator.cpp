@@ -2,14 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
-#include <cstdio>
-#include <sstream>
 #include <string>
 
-#include <opencv2/imgproc.hpp>
-
-#include "kccd/input_error.hpp"
+#include <opencv2/core.hpp>
 
 namespace kccd::overlay {
 
@@ -68,8 +63,8 @@ void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
   request.mask = false;
   request.colour = rec.selected;  // not selected: the query alone
   request.style.labels = false;
-  request.style.legend = !set.plain;
-  request.onto = &bgr;  // the layer composited in the warp's pass
+  request.style.legend = false;  // the legend and the status line are drawn by FrameDecoration
+  request.onto = &bgr;           // the layer composited in the warp's pass
   bool box_ok = true;
   if (rec.match == StateMatch::None) {
     // No state: only the bodies fixed in the world are known; they are drawn grey.
@@ -91,6 +86,9 @@ void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
     }
   }
   rec.times.state = since(t_state);
+  under_legend_.resize(set.legend_corners.size());
+  if (rec.selected)
+    for (std::size_t i = 0; i < set.legend_corners.size(); ++i) bgr(set.legend_corners[i]).copyTo(under_legend_[i]);
   // The view queries from scratch every frame: the answer does not depend on which annotator had which frame.
   const render::ModelFrame drawn = view_.draw(request);
   const render::FrameTimes& ft = drawn.images.times;
@@ -105,68 +103,13 @@ void FrameAnnotator::annotate(cv::Mat& bgr, FrameRecord& rec) {
   for (std::size_t i = 0; i < drawn.first_visual; ++i)
     rec.not_finite |= layer.visibility[i] == render::Visibility::NotFinite;
   if (rec.not_finite) rec.status = SafetyStatus::Colliding;  // an overflowed volume is unsafe
-  const Clock::time_point t_composite = Clock::now();
-  if (!set.plain) drawStatusLine(bgr, rec);
-  rec.times.composite = since(t_composite);
-}
-
-void FrameAnnotator::drawStatusLine(cv::Mat& bgr, const FrameRecord& rec) const {
-  const AnnotatorSettings& set = scene_.settings;
-  std::ostringstream s;
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "t %.3f s", rec.time + set.time_offset);
-  s << buf;
-  if (rec.match == StateMatch::None) {
-    s << "  NO STATE (outside the log or in a gap longer than " << messageNumber(set.max_gap, 3) << " s)";
-  } else {
-    s << " (" << toString(rec.match) << ")" << (set.swept ? "  swept" : "");
-    if (rec.unsafe()) {
-      s << "  UNSAFE: "
-        << (rec.braking_failed ? "no braking box"
-            : rec.not_finite   ? "volume not finite"
-                               : toString(rec.query));
-    } else {
-      if (std::isfinite(rec.min_distance)) {
-        std::snprintf(buf, sizeof buf, "  min distance %.4f m", rec.min_distance);
-        s << buf;
-      } else {
-        s << "  no checked pairs";
-      }
-      if (!rec.pairs.empty()) {
-        s << "  within margin: ";
-        const std::vector<std::array<std::string, 2>> links = linkPairs(scene_.model, rec.pairs);
-        for (std::size_t i = 0; i < links.size() && i < 3; ++i)
-          s << (i ? ", " : "") << links[i][0] << "-" << links[i][1];
-        if (links.size() > 3) s << " +" << links.size() - 3;
-      }
-    }
+  // The pixels the volumes changed under each legend corner: the one changed least hides least.
+  for (std::size_t i = 0; i < set.legend_corners.size() && i < rec.legend_cover.size(); ++i) {
+    const cv::Mat now = bgr(set.legend_corners[i]);
+    cv::absdiff(now, under_legend_[i], difference_);
+    cv::inRange(difference_, cv::Scalar::all(0), cv::Scalar::all(0), unchanged_);
+    rec.legend_cover[i] = static_cast<int>(now.total()) - cv::countNonZero(unchanged_);
   }
-  const int font = cv::FONT_HERSHEY_SIMPLEX;
-  const double scale = std::clamp(bgr.rows / 900.0, 0.35, 1.0);
-  const int thick = std::max(1, static_cast<int>(std::lround(scale * 2)));
-  int baseline = 0;
-  const std::string text = s.str();
-  const cv::Size size = cv::getTextSize(text, font, scale, thick, &baseline);
-  const int pad = std::max(3, size.height / 2);
-  const cv::Rect box = cv::Rect(pad, bgr.rows - size.height - baseline - 3 * pad, size.width + 2 * pad,
-                                size.height + baseline + 2 * pad) &
-                       cv::Rect(0, 0, bgr.cols, bgr.rows);
-  if (box.empty()) return;
-  // The background darkened (keeps the text readable on any frame): each byte times 0.35, rounded
-  // as convertTo rounds, through a table made by convertTo itself (a table look-up per byte is
-  // several times faster than convertTo's arithmetic on a strip of the image).
-  static const cv::Mat darken = [] {
-    cv::Mat ramp(1, 256, CV_8U), out;
-    for (int i = 0; i < 256; ++i) ramp.at<uchar>(i) = static_cast<uchar>(i);
-    ramp.convertTo(out, -1, 0.35, 0);
-    return out;
-  }();
-  cv::Mat roi = bgr(box);
-  cv::LUT(roi, darken, roi);
-  const cv::Point at(box.x + pad, box.y + pad + size.height);
-  const cv::Scalar colour =
-      rec.status == SafetyStatus::Clear ? cv::Scalar(255, 255, 255) : render::statusColour(rec.status);
-  cv::putText(bgr, text, at, font, scale, colour, thick, cv::LINE_AA);
 }
 
 }  // namespace kccd::overlay

@@ -27,6 +27,7 @@
 #include "kccd/input_error.hpp"
 #include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/recording/contact_sheet.hpp"
+#include "kccd/overlay/recording/legend_corner.hpp"
 #include "kccd/overlay/recording/timeline.hpp"
 #include "kccd/overlay/recording/video_source.hpp"
 #include "kccd/render/projection.hpp"
@@ -207,7 +208,7 @@ struct Pipeline {
 
 // A drawn frame on the contact sheet, captioned; the most critical frame always makes it there:
 // colliding first, then the nearest.
-void addToSheet(ContactSheet& sheet, const FrameJob& job) {
+void addToSheet(ContactSheet& sheet, const FrameJob& job, const cv::Mat& frame) {
   const FrameRecord& r = job.record;
   std::string caption = "#" + std::to_string(job.index) + "  " + messageNumber(r.time, 4) + " s  " + toString(r.status);
   if (std::isfinite(r.min_distance)) caption += "  " + messageNumber(r.min_distance * 1000, 3) + " mm";
@@ -215,7 +216,7 @@ void addToSheet(ContactSheet& sheet, const FrameJob& job) {
   const double priority = r.unsafe() || r.status == SafetyStatus::Colliding ? -1.0
                           : std::isfinite(r.min_distance)                   ? r.min_distance
                                                                             : std::numeric_limits<double>::infinity();
-  sheet.add(job.index, job.bgr, caption, priority);
+  sheet.add(job.index, frame, caption, priority);
 }
 
 }  // namespace
@@ -296,7 +297,11 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   AnnotatorSettings settings;
   settings.max_gap = report.max_gap;
   settings.swept = opt.swept;
-  settings.plain = opt.plain;
+  // The status line and the legend, drawn by the writer; the annotators count the volumes' pixels
+  // under each corner the legend may take.
+  const FrameDecoration decoration(cv::Size(camera.width, camera.height), opt.plain ? LegendPlace::Off : opt.legend,
+                                   !opt.plain);
+  if (decoration.corners().size() > 1) settings.legend_corners = decoration.corners();
   if (opt.swept) settings.braking.assign(static_cast<std::size_t>(model.stateSize()), opt.braking);
 
   const QuietVideoLogs quiet;
@@ -339,7 +344,7 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   }
   const MaskAgreement* masks = learnt ? &*learnt : in.masks;
   const std::size_t expected = video.declaredFrames();
-  if (sink) sink->begin(clock.nominalFps(), camera.width, camera.height);
+  if (sink) sink->begin(clock.nominalFps(), decoration.frameSize().width, decoration.frameSize().height);
 
   const AnnotatorScene scene{model, in.log, *projection, render_options, visuals, settings};
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
@@ -355,19 +360,26 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   ContactSheet sheet(std::max<std::size_t>(opt.contact_frames, 1), opt.contact_tile_width);
   const auto t_frames = std::chrono::steady_clock::now();
   report.setup_seconds = std::chrono::duration<double>(t_frames - t_setup).count();
+  LegendCorner corner(decoration.corners().empty() ? 1 : decoration.corners().front().area());
+  cv::Mat tall;  // a frame with the strip under the picture (LegendPlace::Outside)
   try {
     FrameJob job;
     for (std::size_t next = 0; pipe.next(next, job); ++next) {
       FrameRecord& r = job.record;
       if (r.selected) {
+        const auto t_decorate = std::chrono::steady_clock::now();
+        const std::size_t corners = settings.legend_corners.size();
+        const int at = corners > 1 ? corner.next(std::span<const int>(r.legend_cover.data(), corners)) : 0;
+        const cv::Mat& frame = decorateFrame(job.bgr, tall, decoration, r, model, settings, at);
+        r.times.composite = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_decorate).count();
         if (sink) {
           const auto t_encode = std::chrono::steady_clock::now();
-          sink->write(job.index, job.bgr);
+          sink->write(job.index, frame);
           r.times.encode = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_encode).count();
           r.written = true;
           ++report.written;
         }
-        if (opt.contact_frames > 0) addToSheet(sheet, job);
+        if (opt.contact_frames > 0) addToSheet(sheet, job, frame);
       }
       report.frames.push_back(std::move(job.record));
       pipe.handedOn(std::move(job.bgr));

@@ -1,7 +1,8 @@
 // A synthetic recording with ground truth (kccd/overlay/synth/synth.hpp): the options checked, then the
 // motion (synth_trajectory), the scene (synth_scene), the frames through the sensor model
-// (synth_sensor) and the truth (synth_truth), all written into a staged folder that is renamed into
-// place when complete.
+// (synth_sensor) and the truth (synth_truth), and on request the recording as a bag, its samples and
+// frames (bags/state_log_bag), all written into a staged folder that is renamed into place when
+// complete.
 #include "kccd/overlay/synth/synth.hpp"
 
 #include <chrono>
@@ -12,6 +13,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "kccd/calib/camera.hpp"
+#include "kccd/overlay/bags/state_log_bag.hpp"
 #include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/overlay/synth/synth_scene.hpp"
 #include "kccd/overlay/synth/synth_sensor.hpp"
@@ -25,6 +27,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+constexpr char kBagFile[] = "states.mcap";
 
 double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
@@ -152,13 +155,22 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
 
   SynthRun run;
   run.video_file = format.file;
+  if (o.bag) run.bag_file = kBagFile;
   run.visuals = use_visuals;
   run.supersample = painter->renderOptions().supersample;
   run.mask_supersample = painter->renderOptions().mask_supersample;
+  // The bag: the state log's samples, and each frame as the video gets it, stamped at its log time
+  // (a robot's log has the camera and the joints on one clock: no offset to find).
+  std::optional<StateLogBagWriter> bag;
+  if (o.bag)
+    bag.emplace(motion.log, dir / run.bag_file,
+                StateLogBagOptions{.label = spelledField(o.spell, "output") + " " + o.output + ": " + run.bag_file});
   int written = 0;
   {
     SensorWriter writer(video, mask_dir.string(), o.blur, o.noise, o.seed);
     writer.setVignette(vignetteGain(scene.camera));
+    if (bag)
+      writer.setFrameSink([&bag, &o](int i, const cv::Mat& frame) { bag->addImage(i / o.fps + o.time_offset, frame); });
     for (int i = 0; i < frames; ++i) {
       const auto r0 = Clock::now();
       cv::Mat mask;
@@ -177,6 +189,8 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
   if (written != frames)
     throw std::runtime_error("synth: wrote " + std::to_string(written) + " of " + std::to_string(frames) + " frames");
 
+  if (bag) bag->finish();  // the samples after the last frame
+
   // Text outputs, then the truth.
   writeRecordingFiles(dir, motion, scene);
   const auto t_end = Clock::now();
@@ -190,6 +204,7 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
   SynthResult r;
   r.folder = o.output;
   r.video_file = format.file;
+  r.bag_file = run.bag_file;
   r.frames = frames;
   r.width = scene.camera.width, r.height = scene.camera.height;
   r.fps = o.fps, r.log_rate = o.log_rate, r.time_offset = o.time_offset;

@@ -117,6 +117,10 @@ struct SensorWriter::Impl {
     const std::lock_guard<std::mutex> lock(mutex_);
     vignette_ = std::move(gain);
   }
+  void setFrameSink(std::function<void(int, const cv::Mat&)> sink) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    sink_ = std::move(sink);
+  }
   void finish() {
     {
       const std::lock_guard<std::mutex> lock(mutex_);
@@ -149,7 +153,7 @@ struct SensorWriter::Impl {
       }
     }
   }
-  // Vignetting, blur and noise, then the video frame and the mask file.
+  // Vignetting, blur and noise, then the video frame, the mask file and the frame sink.
   void process(Item& item) {
     const auto t0 = Clock::now();
     cv::Mat f = item.frame;
@@ -192,6 +196,7 @@ struct SensorWriter::Impl {
     if (!ok) error_ = std::string("cannot write mask ") + name;
     if (!error_.empty()) return;
     const auto t4 = Clock::now();
+    if (sink_) sink_(item.index, f);
     stage_s_[0] += sensorSeconds(t0, t1), stage_s_[1] += sensorSeconds(t1, t2), stage_s_[2] += sensorSeconds(t2, t3),
         stage_s_[3] += sensorSeconds(t3, t4);
     ++written_;
@@ -199,6 +204,7 @@ struct SensorWriter::Impl {
   cv::VideoWriter& video_;
   std::string mask_dir_;
   cv::Mat vignette_, noise_field_;
+  std::function<void(int, const cv::Mat&)> sink_;
   std::array<double, 4> stage_s_{};
   double blur_, noise_;
   std::uint64_t seed_;
@@ -215,6 +221,7 @@ SensorWriter::SensorWriter(cv::VideoWriter& video, std::string mask_dir, double 
     : impl_(std::make_unique<Impl>(video, std::move(mask_dir), blur, noise, seed)) {}
 SensorWriter::~SensorWriter() { impl_->finish(); }
 void SensorWriter::setVignette(cv::Mat gain) { impl_->setVignette(std::move(gain)); }
+void SensorWriter::setFrameSink(std::function<void(int, const cv::Mat&)> sink) { impl_->setFrameSink(std::move(sink)); }
 void SensorWriter::push(int index, cv::Mat frame, cv::Mat mask) {
   impl_->push(index, std::move(frame), std::move(mask));
 }

@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core/persistence.hpp>
 
+#include "kccd/logs/joint_state_cdr.hpp"
+#include "kccd/overlay/bags/state_log_bag.hpp"
 #include "kccd/overlay/common/staged_output.hpp"
 #include "kccd/safety_status.hpp"
 
@@ -69,6 +71,24 @@ std::string truthText(const SynthOptions& o, const Model& m, const SynthMotion& 
   j["state_log"] = {{"file", "states.csv"},         {"rate_hz", o.log_rate},
                     {"rows", motion.log.rows()},    {"velocity_columns", true},
                     {"time_offset", o.time_offset}, {"clock", "log time = video time + time_offset"}};
+  if (!run.bag_file.empty()) {
+    const StateLogBagOptions bag;
+    j["state_log"]["bag"] = {{"file", run.bag_file},
+                             {"topic", bag.topic},
+                             {"type", logs::kJointStateSchemaName},
+                             {"origin_ns", std::to_string(bag.origin_ns)},
+                             {"clock", "header stamp = log time = origin_ns + states.csv time (ns)"},
+                             {"images",
+                              {{"topic", bag.image_topic},
+                               {"type", logs::kCompressedImageSchemaName},
+                               {"format", kBagImageFormat},
+                               {"frame_id", bag.image_frame_id},
+                               {"jpeg_quality", bag.jpeg_quality},
+                               {"count", motion.frames},
+                               {"clock",
+                                "header stamp = log time = origin_ns + frame log_time (ns): the robot's clock, "
+                                "no offset to find"}}}};
+  }
   const Pose c2w = scene.camera.worldToCamera().inverse();
   j["camera"] = {{"file", "camera_true.yaml"},         {"intrinsics_file", "intrinsics.yaml"},
                  {"given", !o.camera.empty()},         {"rvec", vecJson(scene.camera.rvec)},

@@ -25,7 +25,8 @@ struct Pinhole {
 /// How a Camera is drawn with GL: a pinhole image (the camera's intrinsics scaled by
 /// `supersample`, widened so that the distorted frame is covered), then — when the camera
 /// distorts or supersamples — a warp to the camera image through a per-pixel map
-/// (output pixel centre -> pinhole pixel), computed once with cv::undistortPoints (iterated to convergence).
+/// (output pixel centre -> pinhole pixel), computed once with cv::undistortPoints (iterated to
+/// convergence) per lens: kept between runs in the lens cache (lens_inverse.hpp).
 class Projection {
  public:
   explicit Projection(const Camera& camera, double supersample = 1.0);

@@ -45,6 +45,7 @@ struct OverlayRequest {
   bool swept = false;                    ///< braking-interval volumes
   std::optional<BrakingParams> braking;  ///< with swept, every joint (default kOverlayBraking)
   bool plain = false;                    ///< volumes only: no legend, no status line
+  std::string legend = "auto";           ///< auto, outside, off or a corner (legendPlaceOf; not with plain)
   bool visuals = false;                  ///< also the model's visual geometry
   std::string masks;                     ///< a folder of robot masks, or "auto"
   std::vector<std::string> mask_bodies;  ///< the bodies the masks show (default all)

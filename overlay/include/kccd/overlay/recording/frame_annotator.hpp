@@ -31,8 +31,8 @@ struct StageTimes {
   double query = 0.0;      ///< the distance query and the volumes to draw
   double render = 0.0;     ///< meshes, outlines and GL drawing
   double read_back = 0.0;  ///< the drawn pixels out of GL
-  double warp = 0.0;       ///< the lens warp, straight alpha and the legend
-  double composite = 0.0;  ///< the layer blended onto the frame and the status line
+  double warp = 0.0;       ///< the lens warp, straight alpha and the layer blended onto the frame
+  double composite = 0.0;  ///< the status line and the legend (FrameDecoration, on the writing thread)
   double encode = 0.0;     ///< the frame handed to the output (encoded)
   StageTimes& operator+=(const StageTimes& o);
 };
@@ -53,6 +53,8 @@ struct FrameRecord {
   bool reused = false;  ///< drawn by reusing the annotator's last answer and layer (the same state, bit for bit)
   StageTimes times;     ///< where its time went
   std::optional<double> mask_iou;  ///< agreement with the frame's robot mask (OverlayInputs::masks), when it has one
+  /// Per AnnotatorSettings::legend_corners box, the picture's pixels the volumes changed (when selected).
+  std::array<int, 4> legend_cover{};
   /// True when the frame's check cannot be trusted: treat the robot as unsafe.
   bool unsafe() const { return query != Status::Ok || braking_failed || not_finite; }
   /// The report's "query_status": "no_braking_box", "volume_not_finite" or the query's status word.
@@ -75,7 +77,8 @@ struct AnnotatorSettings {
   double max_gap = 0.0;                ///< no state when no two samples this close bracket the time (s)
   bool swept = false;                  ///< braking-interval swept volumes instead of the static ones
   std::vector<BrakingParams> braking;  ///< per state value, with `swept`
-  bool plain = false;                  ///< volumes only: no legend, no status line
+  /// Boxes (at most 4) under which FrameRecord::legend_cover counts the pixels the volumes change.
+  std::vector<cv::Rect> legend_corners;
 };
 
 /// What every annotator of a run reads; it must outlive them.
@@ -99,16 +102,16 @@ class FrameAnnotator {
   FrameAnnotator& operator=(const FrameAnnotator&) = delete;
 
   /// Fills `record` from its time (state, query, status) and, when it is selected, composites
-  /// the volumes (and the status line unless plain) onto `bgr` (8-bit BGR, the camera's size).
+  /// the volumes onto `bgr` (8-bit BGR, the camera's size) and counts the legend's cover.
   void annotate(cv::Mat& bgr, FrameRecord& record);
 
  private:
-  void drawStatusLine(cv::Mat& bgr, const FrameRecord& record) const;
-
   const AnnotatorScene& scene_;
   render::ModelView view_;
   std::vector<double> q_, v_, lo_, hi_;
   std::vector<SafetyStatus> all_colliding_;
+  std::vector<cv::Mat> under_legend_;  // the picture under each legend corner before drawing
+  cv::Mat difference_, unchanged_;     // their comparison after drawing
 };
 
 }  // namespace kccd::overlay

@@ -18,6 +18,7 @@
 #include "kccd/calib/camera.hpp"
 #include "kccd/model.hpp"
 #include "kccd/overlay/recording/frame_annotator.hpp"
+#include "kccd/overlay/recording/frame_decoration.hpp"
 #include "kccd/overlay/recording/frame_source.hpp"
 #include "kccd/overlay/recording/mask_agreement.hpp"
 #include "kccd/overlay/recording/time_offset.hpp"
@@ -70,6 +71,7 @@ struct OverlayOptions {
   bool swept = false;                       ///< braking-interval swept volumes (BrakingParams per joint)
   BrakingParams braking = kOverlayBraking;  ///< every state value's braking, with `swept`
   bool plain = false;                       ///< volumes only: no legend, no status line
+  LegendPlace legend = LegendPlace::Auto;   ///< where the legend goes (Outside: the frames handed on are taller)
   bool visuals = false;                     ///< also draw the model's visual geometry at the logged state
   FrameRange frames;                        ///< the frames drawn and handed on
   int jobs = 0;                             ///< annotator threads (each with a GL context); <= 0: hardware threads
@@ -115,8 +117,9 @@ struct OverlayReport {
 };
 
 /// Checks, draws and hands on every frame of a recording. Every input is checked before a frame is
-/// decoded; frames are decoded by one thread, annotated by `jobs` threads and handed to `sink` in
-/// input order on the calling thread, with at most 2 x jobs + 2 frames in memory. `sink` may be
+/// decoded; frames are decoded by one thread, annotated by `jobs` threads and decorated
+/// (decorateFrame: the legend's corner chosen in input order) and handed to `sink` in input order
+/// on the calling thread, with at most 2 x jobs + 2 frames in memory. `sink` may be
 /// null: the frames are then only checked, reported and put on the contact sheet. `progress` is
 /// called after each frame. Throws an InputError-derived error naming the input and place (the
 /// sink is left uncommitted: committing is the caller's), render::GlContextError without a GL context.

@@ -1,7 +1,8 @@
 // Synthetic recordings with ground truth (`kccd synth`): the robot's visible geometry moving along a
 // smooth trajectory with near-collisions and one real collision, in a room with AprilTags, seen
 // through a distorting camera with blur and noise; written as a folder with the video, the state
-// log, the true camera, the intrinsics, the tag layout, per-frame masks and the truth (synth.json).
+// log (also, with the frames, as a ROS 2 bag on request), the true camera, the intrinsics, the tag
+// layout, per-frame masks and the truth (synth.json).
 //
 // The job's parts, one unit each: the trajectory search (synth_trajectory.hpp), the room, its tags
 // and the default camera (synth_scene.hpp), the sensor model and frame drawing (synth_sensor.hpp),
@@ -58,6 +59,9 @@ struct SynthOptions {
   std::string codec = "ffv1";  ///< ffv1 (video.mkv, lossless), mjpg (video.avi) or mp4v (video.mp4)
   bool collision = true;       ///< one real collision (false: only near-collisions)
   bool replace = false;        ///< replace an existing non-empty output folder
+  /// Also states.mcap: the state log and the frames as a ROS 2 bag (StateLogBagWriter's defaults; frame
+  /// i stamped at log time i / fps + time_offset, on the log's clock).
+  bool bag = false;
   /// How hints name these fields ("seed" -> "--seed", "collision" -> "--no-collision"; default: as they are).
   FieldSpelling spell;
 };
@@ -66,6 +70,7 @@ struct SynthOptions {
 struct SynthResult {
   std::filesystem::path folder;  ///< the output folder (SynthOptions::output)
   std::string video_file;        ///< the video's name in the folder (video.mkv, .avi, .mp4)
+  std::string bag_file;          ///< "states.mcap" with SynthOptions::bag, else empty
   int frames = 0, width = 0, height = 0;
   double fps = 0, log_rate = 0, time_offset = 0;
   std::size_t log_rows = 0;                             ///< rows of states.csv
@@ -81,8 +86,8 @@ struct SynthResult {
 using SynthProgress = std::function<void(double fraction)>;
 
 /// Makes the recording described by `options` in `options.output` (built under a temporary name
-/// beside it and renamed into place at the end: see StagedOutput): video, states.csv,
-/// camera_true.yaml, intrinsics.yaml, tags.yaml, masks/frame_%06d.png and synth.json. Throws
+/// beside it and renamed into place at the end: see StagedOutput): video, states.csv (and with
+/// `bag` states.mcap), camera_true.yaml, intrinsics.yaml, tags.yaml, masks/frame_%06d.png and synth.json. Throws
 /// SynthError (or another InputError: the model, camera or a visual's mesh cannot be read) for
 /// input that cannot make a recording, OutputError when the folder cannot be written; nothing is
 /// left at the target then.

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -73,7 +74,8 @@ cv::Mat vignetteGain(const calib::Camera& camera);
 /// The sensor model and the writer: each pushed frame is vignetted, blurred (sigma `blur`, px) and
 /// given Gaussian noise (sigma `noise` grey levels: one field drawn from `seed`, each frame taking
 /// it at an offset and sign seeded by the seed and its index), then written to `video`, and its
-/// mask to `mask_dir`/frame_%06d.png, in push order, on a thread of its own.
+/// mask to `mask_dir`/frame_%06d.png, in push order, on a thread of its own; a frame sink, when
+/// set, gets each frame too.
 class SensorWriter {
  public:
   SensorWriter(cv::VideoWriter& video, std::string mask_dir, double blur, double noise, std::uint64_t seed);
@@ -83,6 +85,10 @@ class SensorWriter {
 
   /// Lens vignetting (vignetteGain), applied before blur and noise; set before the first push.
   void setVignette(cv::Mat gain);
+  /// Called on the writer's thread with each frame as the video got it (after the sensor model),
+  /// in push order, once its mask is written; what it throws is that frame's error. Set before
+  /// the first push.
+  void setFrameSink(std::function<void(int index, const cv::Mat& frame)> sink);
   /// Queues frame `index` (BGR) and its label mask (CV_8UC1); waits while two are queued.
   void push(int index, cv::Mat frame, cv::Mat mask);
   /// Writes what is queued and stops the thread.

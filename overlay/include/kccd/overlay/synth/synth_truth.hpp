@@ -25,6 +25,7 @@ std::string intrinsicsText(const calib::Camera& camera);
 /// How the frames were made and how long each part took, for synth.json.
 struct SynthRun {
   std::string video_file;                            ///< name in the folder (videoFormat)
+  std::string bag_file;                              ///< the state log's bag in the folder; empty: none
   bool visuals = false;                              ///< drawn with the model's visuals (else its shrunken volumes)
   double supersample = 1.0, mask_supersample = 1.0;  ///< the renderer's options
   std::string renderer;                              ///< the GL renderer's name
