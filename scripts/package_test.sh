@@ -7,6 +7,8 @@
 #   sample data, its colliding frames equal to the recording's truth;
 #   the examples built against the installed libkccd-dev (find_package(kccd ...)) and run;
 #   `import kccd` in Debian's python3 with nothing on PYTHONPATH, and a query through it;
+#   the shell blocks of the Quickstart and of every guide that needs nothing of the repository,
+#   as written, on the installed files (tests/docs/run_guides.py);
 #   after removal no kccd file is left.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -76,8 +78,15 @@ assert r.collision, "the demo arm's swing must hit the pole"
 print("kccd", kccd.__version__, "from", kccd.__file__, "- the swing collides:", r.collision)
 PY
 
-step "dpkg -r leaves no kccd file"
+step "the Quickstart's and the guides' commands with only the installed files"
 cd "$root"
+# Every page whose commands need nothing of the repository (not its tests/ folder) runs as written
+# with /usr/bin/kccd, the installed sample data and Debian's python3 with nothing on PYTHONPATH.
+pages=$(grep -L 'KCCD_DATA/\.\./tests' docs/getting-started.md docs/guides/*.md)
+mkdir -p "$work/empty"
+clean /usr/bin/python3 tests/docs/run_guides.py /usr/bin/kccd /usr/share/kccd/data "$work/empty" $pages
+
+step "dpkg -r leaves no kccd file"
 "${sudo_cmd[@]}" dpkg -r python3-kccd libkccd-dev kccd >/dev/null
 left=$(ls -d /usr/bin/kccd /usr/libexec/kccd /usr/include/kccd /usr/lib/cmake/kccd /usr/share/kccd \
   /usr/lib/python3/dist-packages/kccd 2>/dev/null || true)
