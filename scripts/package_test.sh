@@ -88,7 +88,8 @@ clean /usr/bin/python3 tests/docs/run_guides.py /usr/bin/kccd /usr/share/kccd/da
 
 step "dpkg -r leaves no kccd file"
 "${sudo_cmd[@]}" dpkg -r python3-kccd libkccd-dev kccd >/dev/null
-left=$(ls -d /usr/bin/kccd /usr/libexec/kccd /usr/include/kccd /usr/lib/cmake/kccd /usr/share/kccd \
-  /usr/lib/python3/dist-packages/kccd 2>/dev/null || true)
+left=$(ls -d /usr/bin/kccd /usr/libexec/kccd /usr/include/kccd /usr/lib/*/cmake/kccd /usr/lib/*/libkccd*.a \
+  /usr/share/kccd /usr/share/doc/libkccd-dev /usr/share/man/man1/kccd.1.gz /usr/lib/python3/dist-packages/kccd \
+  2>/dev/null || true)
 [ -z "$left" ] || { echo "left after removal: $left" >&2; exit 1; }
 echo "package_test.sh: installed, used and removed"
