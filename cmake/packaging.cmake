@@ -51,6 +51,9 @@ set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME kccd)
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGE_VENDOR "the KCCD developers")
+# Each package's synopsis is the first line of its own description (CPACK_DEBIAN_<C>_DESCRIPTION);
+# CPack would put the project's summary before it unless that summary is CPack's default.
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "kccd built using CMake")
 set(CPACK_PACKAGE_CONTACT "${KCCD_DEB_MAINTAINER}")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_PACKAGE_DIRECTORY ${PROJECT_BINARY_DIR}/packages)
@@ -95,6 +98,11 @@ and the parts of the tool suite (modelling, calib, logs, render, overlay).")
 set(CPACK_DEBIAN_PYTHON_PACKAGE_NAME python3-kccd)
 set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)
 set(CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS "python3 (>= 3.11), python3 (<< 3.12), python3-numpy, python3-yaml")
+# Byte-compiled on install and cleaned on removal (py3compile, py3clean), as dh_python3 does.
+configure_file(${PROJECT_SOURCE_DIR}/cmake/debian/python3-kccd.postinst ${_kccd_deb_dir}/python/postinst COPYONLY)
+configure_file(${PROJECT_SOURCE_DIR}/cmake/debian/python3-kccd.prerm ${_kccd_deb_dir}/python/prerm COPYONLY)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_CONTROL_EXTRA "${_kccd_deb_dir}/python/postinst;${_kccd_deb_dir}/python/prerm")
+set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
 set(CPACK_DEBIAN_PYTHON_PACKAGE_SUGGESTS "kccd, python3-distributed, python3-dask")  # kccd.batch on a cluster
 set(CPACK_DEBIAN_PYTHON_DESCRIPTION "strictly conservative continuous collision detection for robots (Python)
 The kccd Python package: models, queries whose distances are lower bounds
