@@ -74,8 +74,9 @@ FrameDecoration::FrameDecoration(cv::Size picture, LegendPlace place, bool statu
     // The strip: the status line, then the legend in as few rows as the width allows.
     const int room = picture.width - 2 * m;
     int columns = 4;
-    while (columns > 1 && render::statusLegend(text_, columns).cols > room) columns /= 2;
-    legend_ = fitted(render::statusLegend(text_, columns), {room, INT_MAX});
+    cv::Mat legend = render::statusLegend(text_, columns);
+    while (columns > 1 && legend.cols > room) legend = render::statusLegend(text_, columns /= 2);
+    legend_ = fitted(legend, {room, INT_MAX});
     int strip = m + status_band + (legend_.empty() ? 0 : legend_.rows + m);
     strip += strip % 2;
     frame_.height += strip;
