@@ -81,6 +81,13 @@ Around the checker: importing URDFs and fitting CAD parts, proving which
 pairs never meet, calibrating a camera, and drawing the checked volumes over
 recorded video, robot logs (MCAP, rosbag2, ROS 1) and LeRobot datasets.")
 
+# OpenCV's imgcodecs is loaded at run time, for images other than PNG and JPEG (calib's
+# image_file.cpp): dpkg-shlibdeps cannot see it, so its package is recommended by name.
+string(REGEX REPLACE "^libopencv_imgcodecs\\.so\\.(.+)$" "libopencv-imgcodecs\\1" _kccd_imgcodecs_package
+       "${KCCD_OPENCV_IMGCODECS_SONAME}")
+set(CPACK_DEBIAN_CLI_PACKAGE_RECOMMENDS "${_kccd_imgcodecs_package}")
+set(CPACK_DEBIAN_PYTHON_PACKAGE_RECOMMENDS "${_kccd_imgcodecs_package}")
+
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME libkccd-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
 set(CPACK_DEBIAN_DEV_PACKAGE_ARCHITECTURE amd64)
@@ -88,7 +95,8 @@ set(CPACK_DEBIAN_DEV_PACKAGE_ARCHITECTURE amd64)
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "cmake (>= 3.20), libeigen3-dev (>= 3.4), libccd-dev, libyaml-cpp-dev, \
 libqhull-dev, libcoin-dev, libassimp-dev, liburdfdom-dev, libtinyxml2-dev, libopencv-dev (>= 4.6), libpng-dev, \
 libjpeg-dev, libapriltag-dev, zlib1g-dev, libzstd-dev, liblz4-dev, libbz2-dev, libsqlite3-dev, libsnappy-dev, \
-libosmesa6-dev, libegl-dev, libgl-dev, libopengl-dev, nlohmann-json3-dev, libcpp-httplib-dev, libssl-dev")
+libosmesa6-dev, libegl-dev, libgl-dev, libopengl-dev, nlohmann-json3-dev, libcpp-httplib-dev, libssl-dev, \
+libavformat-dev, libavcodec-dev, libavutil-dev, libswscale-dev")
 set(CPACK_DEBIAN_DEV_DESCRIPTION "strictly conservative continuous collision detection for robots (C++)
 The KCCD C++ libraries (static), their headers and their CMake package:
 find_package(kccd COMPONENTS ...) gives kccd::kccd, the collision checker a

@@ -9,7 +9,7 @@ packages=(
   libfcl-dev libqhull-dev
   libcoin-dev inventor-data liburdfdom-dev libassimp-dev
   libosmesa6-dev libgl-dev libegl-dev libopengl-dev libegl-mesa0
-  libopencv-dev libpng-dev libjpeg62-turbo-dev libtinyxml2-dev libapriltag-dev
+  libopencv-dev libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libpng-dev libjpeg62-turbo-dev libtinyxml2-dev libapriltag-dev
   zlib1g-dev libzstd-dev liblz4-dev libbz2-dev libsqlite3-dev libsnappy-dev
   python3-dev pybind11-dev python3-numpy
   python3-yaml python3-distributed python3-dask

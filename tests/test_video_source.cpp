@@ -117,7 +117,8 @@ TEST_F(VideoSourceTest, UnreadableRecordingsAreOneLineNamingThem) {
             "--video seq: not a regular file (a video file, or an image sequence such as frames/frame_%06d.png)");
   std::ofstream(path("junk.mp4")) << "not a video\n";
   EXPECT_EQ(errorOf(path("junk.mp4"), "--video junk.mp4"),
-            "--video junk.mp4: cannot open the video (not a video OpenCV reads)");
+            "--video junk.mp4: cannot open the video: not a video FFmpeg reads (Invalid data found when processing "
+            "input)");
   EXPECT_EQ(errorOf(path("seq/none_%06d.png"), "--video none"),
             "--video none: no image of the sequence can be read (no file " + path("seq/none_000000.png") + " or " +
                 path("seq/none_000001.png") + ")");

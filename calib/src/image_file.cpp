@@ -10,6 +10,8 @@
 #include <mutex>
 #include <sstream>
 
+#include <dlfcn.h>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -20,6 +22,33 @@
 namespace kccd::calib {
 
 namespace {
+
+// OpenCV's imdecode, for the formats other than PNG and JPEG, from its library loaded the first
+// time one is met: linked, that library loads GDAL's tree of libraries (~0.1 s) into every
+// process of the suite, for pictures it rarely meets. Null (with `why` set) when it cannot be
+// loaded. The declaration in the header is the one this pointer's type must match.
+using Imdecode = cv::Mat (*)(cv::InputArray, int);
+static_assert(sizeof(static_cast<Imdecode>(&cv::imdecode)) > 0, "cv::imdecode's signature");
+
+Imdecode otherFormats(std::string& why) {
+  static std::string problem;
+  static const Imdecode decode = []() -> Imdecode {
+    void* library = dlopen(KCCD_OPENCV_IMGCODECS_SONAME, RTLD_NOW | RTLD_LOCAL);
+    if (library == nullptr) {
+      problem = "formats other than PNG and JPEG need " KCCD_OPENCV_IMGCODECS_SONAME ", which cannot be loaded";
+      return nullptr;
+    }
+    // cv::imdecode(cv::InputArray, int), by its (Itanium C++ ABI) name.
+    void* symbol = dlsym(library, "_ZN2cv8imdecodeERKNS_11_InputArrayEi");
+    if (symbol == nullptr) {
+      problem = KCCD_OPENCV_IMGCODECS_SONAME " has no cv::imdecode";
+      return nullptr;
+    }
+    return reinterpret_cast<Imdecode>(symbol);
+  }();
+  why = problem;
+  return decode;
+}
 
 // A picture no camera file can describe (kMaxImageSide a side, kMaxImagePixels in all): the
 // problem in words, else empty.
@@ -148,7 +177,10 @@ cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& sour
       const Swap swap(caught.rdbuf());
       try {
         const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
-        img = cv::imdecode(encoded, colour == ImageColour::Grey  ? cv::IMREAD_GRAYSCALE
+        std::string unavailable;
+        const Imdecode imdecode = otherFormats(unavailable);
+        if (imdecode == nullptr) fail(unavailable);
+        img = imdecode(encoded, colour == ImageColour::Grey  ? cv::IMREAD_GRAYSCALE
                                     : colour == ImageColour::Bgr ? cv::IMREAD_COLOR
                                                                  : cv::IMREAD_UNCHANGED);
       } catch (const cv::Exception&) {

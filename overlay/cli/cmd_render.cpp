@@ -6,7 +6,6 @@
 #include <iostream>
 #include <memory>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "cli_args.hpp"
 #include "cli_files.hpp"

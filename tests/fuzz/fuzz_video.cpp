@@ -1,5 +1,5 @@
 // libFuzzer target: recordings as `kccd overlay` and `kccd calib --video` open them
-// (kccd::overlay::VideoSource over OpenCV's FFmpeg back end). Any input must open and decode, or
+// (kccd::overlay::VideoSource over FFmpeg: overlay::VideoFileReader). Any input must open and decode, or
 // be rejected with kccd::InputError (overlay::VideoError) naming the recording on one line; any
 // other exception, a crash, a hang or a sanitizer report is a finding.
 #include <cstddef>

@@ -8,7 +8,6 @@
 #include <memory>
 #include <optional>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "kccd/calib/image_file.hpp"

@@ -1,3 +1,4 @@
+#include "kccd/calib/image_encode.hpp"
 #include "kccd/overlay/bags/state_log_bag.hpp"
 
 #include <cerrno>
@@ -9,7 +10,6 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "kccd/format_number.hpp"
 #include "kccd/logs/joint_state_cdr.hpp"
@@ -119,9 +119,13 @@ void StateLogBagWriter::addImage(double time, const cv::Mat& bgr) {
     s.image_channel = s.writer.addChannel(
         s.writer.addSchema(logs::kCompressedImageSchemaName, "ros2msg", logs::compressedImageDefinition()),
         s.options.image_topic, "cdr");
-  if (!cv::imencode(".jpg", bgr, s.jpeg, {cv::IMWRITE_JPEG_QUALITY, s.options.jpeg_quality}))
+  try {
+    const std::vector<std::uint8_t> jpeg = calib::encodeJpeg(bgr, s.options.jpeg_quality);
+    s.jpeg.assign(jpeg.begin(), jpeg.end());
+  } catch (const calib::ImageEncodeError& e) {
     throw OutputError(s.label + ": the frame at log time " + formatNumber(time, 17) +
-                      " s could not be encoded as JPEG");
+                      " s could not be encoded as JPEG (" + e.what() + ")");
+  }
   s.samplesUpTo(stamp);
   const auto t = static_cast<std::uint64_t>(stamp);
   s.writer.write(

@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <map>
 
-#include <opencv2/imgcodecs.hpp>
 
+#include "kccd/calib/image_file.hpp"
 #include "kccd/overlay/recording/video_source.hpp"
 
 namespace kccd::overlay {
@@ -57,8 +57,15 @@ class TableFrames final : public FrameSource {
   bool read(cv::Mat& frame) override {
     if (next_ >= images_->size()) return false;
     const std::string& bytes = (*images_)[next_];
-    const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data()));
-    frame = bytes.empty() ? cv::Mat() : cv::imdecode(encoded, cv::IMREAD_COLOR);
+    frame.release();
+    if (!bytes.empty()) {
+      try {
+        frame = calib::decodeImage({reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()}, label_,
+                                   calib::ImageColour::Bgr);
+      } catch (const calib::ImageError&) {
+        frame.release();
+      }
+    }
     if (frame.empty())
       throw VideoError(label_ + ": row " + std::to_string(next_) +
                        ": the image does not decode (PNG or JPEG expected)");

@@ -1,3 +1,4 @@
+#include "kccd/calib/image_encode.hpp"
 #include "kccd/overlay/golden/golden_render.hpp"
 
 #include <cmath>
@@ -8,7 +9,6 @@
 #include <tuple>
 
 #include <openssl/evp.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/file_reader.hpp"
@@ -71,12 +71,9 @@ std::string sha256Hex(std::span<const unsigned char> bytes) {
 }
 
 std::vector<unsigned char> deterministicPng(const cv::Mat& image) {
-  std::vector<unsigned char> out;
-  // Fixed compression and strategy; OpenCV writes no time or text chunks.
-  if (!cv::imencode(".png", image, out,
-                    {cv::IMWRITE_PNG_COMPRESSION, 6, cv::IMWRITE_PNG_STRATEGY, cv::IMWRITE_PNG_STRATEGY_DEFAULT}))
-    throw std::runtime_error("PNG encoding failed");
-  return out;
+  // Fixed compression and strategy; no time or text chunks.
+  const std::vector<std::uint8_t> png = calib::encodePng(image, 6);
+  return {png.begin(), png.end()};
 }
 
 const char* kccdVersion() { return KCCD_VERSION_STRING; }

@@ -1,3 +1,4 @@
+#include "kccd/calib/image_encode.hpp"
 #include "kccd/overlay/labelling/label_session.hpp"
 
 #include <algorithm>
@@ -7,7 +8,6 @@
 #include <utility>
 
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "kccd/file_reader.hpp"
 #include "kccd/overlay/calibration/calib_gather.hpp"
@@ -75,9 +75,8 @@ std::optional<nlohmann::json> newerAutosave(const std::string& path) {
 }
 
 std::vector<unsigned char> encodePng(const cv::Mat& image) {
-  std::vector<unsigned char> bytes;
-  if (!cv::imencode(".png", image, bytes)) throw std::runtime_error("PNG encoding failed");
-  return bytes;
+  const std::vector<std::uint8_t> png = calib::encodePng(image);
+  return {png.begin(), png.end()};
 }
 
 }  // namespace

@@ -9,45 +9,10 @@
 #include <mutex>
 #include <vector>
 
-#include <opencv2/core/utils/logger.hpp>
-#include <opencv2/videoio.hpp>
-
 #include "kccd/calib/image_file.hpp"
+#include "kccd/overlay/recording/video_file.hpp"
 
 namespace kccd::overlay {
-
-namespace {
-
-// QuietVideoLogs' process-wide state.
-struct QuietState {
-  std::mutex mu;
-  int users = 0;
-  cv::utils::logging::LogLevel level = cv::utils::logging::LOG_LEVEL_INFO;
-  bool set_env = false;
-};
-QuietState& quietState() {
-  static QuietState s;
-  return s;
-}
-
-}  // namespace
-
-QuietVideoLogs::QuietVideoLogs() {
-  QuietState& q = quietState();
-  const std::lock_guard lock(q.mu);
-  if (q.users++ > 0) return;
-  q.level = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
-  q.set_env = std::getenv("OPENCV_FFMPEG_LOGLEVEL") == nullptr;
-  if (q.set_env) setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
-}
-
-QuietVideoLogs::~QuietVideoLogs() {
-  QuietState& q = quietState();
-  const std::lock_guard lock(q.mu);
-  if (--q.users > 0) return;
-  cv::utils::logging::setLogLevel(q.level);
-  if (q.set_env) unsetenv("OPENCV_FFMPEG_LOGLEVEL");
-}
 
 namespace {
 
@@ -106,37 +71,28 @@ VideoSource::VideoSource(const std::string& path, const std::string& label)
   if (!std::filesystem::is_regular_file(path, ec))
     throw VideoError(label_ + ": " + (std::filesystem::exists(path, ec) ? "not a regular file" : "no such file") +
                      " (a video file, or an image sequence such as frames/frame_%06d.png)");
-  capture_ = std::make_unique<cv::VideoCapture>();
   try {
-    capture_->open(path, cv::CAP_FFMPEG);
-  } catch (const cv::Exception&) {
+    file_ = std::make_unique<VideoFileReader>(path);
+  } catch (const VideoFileError& e) {
+    throw VideoError(label_ + ": cannot open the video: " + printable(e.what(), 200));
   }
-  if (!capture_->isOpened()) throw VideoError(label_ + ": cannot open the video (not a video OpenCV reads)");
 }
 
 VideoSource::~VideoSource() = default;
 
 double VideoSource::fps() const {
   if (sequence_) return 0.0;
-  const double fps = capture_->get(cv::CAP_PROP_FPS);
-  return std::isfinite(fps) && fps > 0.0 && fps < 1e6 ? fps : 0.0;
+  return file_->fps();
 }
 
 std::string VideoSource::codec() const {
   if (sequence_) return {};
-  const auto fourcc = static_cast<std::uint32_t>(capture_->get(cv::CAP_PROP_FOURCC));
-  std::string out;
-  for (int i = 0; i < 4; ++i) {
-    const char c = static_cast<char>((fourcc >> (8 * i)) & 0xFF);
-    if (c > ' ' && c < 127) out += c;
-  }
-  return out;
+  return file_->fourcc();
 }
 
 std::size_t VideoSource::declaredFrames() const {
   if (sequence_) return length_;
-  const double n = capture_->get(cv::CAP_PROP_FRAME_COUNT);
-  return n > 0 && n < 1e9 ? static_cast<std::size_t>(std::llround(n)) : 0;
+  return file_->declaredFrames();
 }
 
 bool VideoSource::read(cv::Mat& frame) {
@@ -153,8 +109,8 @@ bool VideoSource::read(cv::Mat& frame) {
   }
   bool got = false;
   try {
-    got = capture_->read(frame);
-  } catch (const cv::Exception& e) {
+    got = file_->read(frame);
+  } catch (const VideoFileError& e) {
     throw VideoError(label_ + ": frame " + std::to_string(next_) + " cannot be decoded (" + printable(e.what(), 200) +
                      ")");
   }

@@ -10,7 +10,6 @@
 #include <optional>
 #include <stdexcept>
 
-#include <opencv2/videoio.hpp>
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/overlay/bags/state_log_bag.hpp"
@@ -148,10 +147,12 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
   const fs::path dir = staged.path();
   const fs::path mask_dir = dir / "masks";
   fs::create_directory(mask_dir);
-  cv::VideoWriter video;
-  video.open((dir / format.file).string(), cv::CAP_FFMPEG, format.fourcc, o.fps,
-             cv::Size(scene.camera.width, scene.camera.height), true);
-  if (!video.isOpened()) throw fieldError("codec", o.codec + ": OpenCV cannot write this video here");
+  std::optional<VideoFileWriter> video;
+  try {
+    video.emplace((dir / format.file).string(), format.fourcc, o.fps, scene.camera.width, scene.camera.height);
+  } catch (const VideoFileError& e) {
+    throw fieldError("codec", o.codec + ": this video cannot be written here (" + e.what() + ")");
+  }
 
   SynthRun run;
   run.video_file = format.file;
@@ -167,7 +168,7 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
                 StateLogBagOptions{.label = spelledField(o.spell, "output") + " " + o.output + ": " + run.bag_file});
   int written = 0;
   {
-    SensorWriter writer(video, mask_dir.string(), o.blur, o.noise, o.seed);
+    SensorWriter writer(*video, mask_dir.string(), o.blur, o.noise, o.seed);
     writer.setVignette(vignetteGain(scene.camera));
     if (bag)
       writer.setFrameSink([&bag, &o](int i, const cv::Mat& frame) { bag->addImage(i / o.fps + o.time_offset, frame); });
@@ -185,7 +186,11 @@ SynthResult synthesizeRecording(const SynthOptions& o, const SynthProgress& prog
     written = writer.written();
     run.writer_s = writer.stageSeconds();
   }
-  video.release();
+  try {
+    video->finish();
+  } catch (const VideoFileError& e) {
+    throw SynthError(spelledField(o.spell, "output") + " " + o.output + ": " + format.file + ": " + e.what());
+  }
   if (written != frames)
     throw std::runtime_error("synth: wrote " + std::to_string(written) + " of " + std::to_string(frames) + " frames");
 

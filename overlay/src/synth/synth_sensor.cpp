@@ -1,5 +1,6 @@
 // Frames of a synthetic recording (kccd/overlay/synth/synth_sensor.hpp): the robot drawn over the
 // background, the sensor model and the writer thread.
+#include "kccd/calib/image_encode.hpp"
 #include "kccd/overlay/synth/synth_sensor.hpp"
 
 #include <algorithm>
@@ -11,9 +12,7 @@
 #include <thread>
 #include <utility>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "kccd/overlay/synth/synth.hpp"
 #include "kccd/render/composite.hpp"
@@ -29,9 +28,9 @@ double sensorSeconds(Clock::time_point a, Clock::time_point b) { return std::chr
 }  // namespace
 
 VideoFormat videoFormat(const std::string& codec) {
-  if (codec == "ffv1") return {"video.mkv", cv::VideoWriter::fourcc('F', 'F', 'V', '1')};
-  if (codec == "mjpg") return {"video.avi", cv::VideoWriter::fourcc('M', 'J', 'P', 'G')};
-  if (codec == "mp4v") return {"video.mp4", cv::VideoWriter::fourcc('m', 'p', '4', 'v')};
+  if (codec == "ffv1") return {"video.mkv", "FFV1"};
+  if (codec == "mjpg") return {"video.avi", "MJPG"};
+  if (codec == "mp4v") return {"video.mp4", "mp4v"};
   throw SynthError(InputLocation{{}, 0, 0, "codec"}, "expected ffv1, mjpg or mp4v, got '" + codec + "'");
 }
 
@@ -103,7 +102,7 @@ cv::Mat vignetteGain(const calib::Camera& camera) {
 // The frame pipeline's second stage (vignetting, blur, noise, encoding) runs on its own thread
 // while the next frame renders.
 struct SensorWriter::Impl {
-  Impl(cv::VideoWriter& video, std::string mask_dir, double blur, double noise, std::uint64_t seed)
+  Impl(VideoFileWriter& video, std::string mask_dir, double blur, double noise, std::uint64_t seed)
       : video_(video), mask_dir_(std::move(mask_dir)), blur_(blur), noise_(noise), seed_(seed), thread_([this] {
           loop();
         }) {}
@@ -180,12 +179,19 @@ struct SensorWriter::Impl {
       noisy.convertTo(f, CV_8UC3);
     }
     const auto t2 = Clock::now();
-    video_.write(f);
+    try {
+      video_.write(f);
+    } catch (const VideoFileError& e) {
+      error_ = std::string("cannot write the video (") + e.what() + ")";
+      return;
+    }
     const auto t3 = Clock::now();
     char name[32];
     std::snprintf(name, sizeof name, "frame_%06d.png", item.index);
-    std::vector<uchar> png;
-    if (!cv::imencode(".png", item.mask, png, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+    std::vector<std::uint8_t> png;
+    try {
+      png = calib::encodePng(item.mask, 1);
+    } catch (const calib::ImageEncodeError&) {
       error_ = std::string("cannot encode mask ") + name;
       return;
     }
@@ -201,7 +207,7 @@ struct SensorWriter::Impl {
         stage_s_[3] += sensorSeconds(t3, t4);
     ++written_;
   }
-  cv::VideoWriter& video_;
+  VideoFileWriter& video_;
   std::string mask_dir_;
   cv::Mat vignette_, noise_field_;
   std::function<void(int, const cv::Mat&)> sink_;
@@ -217,7 +223,7 @@ struct SensorWriter::Impl {
   std::thread thread_;  // last: started once every other member is ready
 };
 
-SensorWriter::SensorWriter(cv::VideoWriter& video, std::string mask_dir, double blur, double noise, std::uint64_t seed)
+SensorWriter::SensorWriter(VideoFileWriter& video, std::string mask_dir, double blur, double noise, std::uint64_t seed)
     : impl_(std::make_unique<Impl>(video, std::move(mask_dir), blur, noise, seed)) {}
 SensorWriter::~SensorWriter() { impl_->finish(); }
 void SensorWriter::setVignette(cv::Mat gain) { impl_->setVignette(std::move(gain)); }

@@ -10,10 +10,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "kccd/overlay/common/staged_output.hpp"
-
-namespace cv {
-class VideoWriter;
-}
+#include "kccd/overlay/recording/video_file.hpp"
 
 namespace kccd::overlay {
 
@@ -31,7 +28,7 @@ class FrameSink {
 
 /// The FourCC a video file gets by default from its extension: FFV1 (lossless) for .mkv, MJPG for
 /// .avi, mp4v otherwise; a 4-character `codec` overrides it.
-int videoFourcc(const std::string& path, const std::string& codec = "");
+std::string videoFourcc(const std::string& path, const std::string& codec = "");
 
 /// What a VideoSink writes. Empty paths are not written; labels name the outputs in errors.
 struct VideoSinkOptions {
@@ -67,7 +64,7 @@ class VideoSink final : public FrameSink {
   VideoSinkOptions options_;
   int width_ = 0, height_ = 0;
   std::optional<StagedOutput> video_, png_;
-  std::unique_ptr<cv::VideoWriter> writer_;
+  std::unique_ptr<VideoFileWriter> writer_;
 };
 
 /// Encodes `image` as PNG in memory and writes it through writeFileAtomically. Throws

@@ -9,10 +9,7 @@
 
 #include "kccd/input_error.hpp"
 #include "kccd/overlay/recording/frame_source.hpp"
-
-namespace cv {
-class VideoCapture;
-}
+#include "kccd/overlay/recording/video_file.hpp"
 
 namespace kccd::overlay {
 
@@ -23,22 +20,11 @@ class VideoError : public InputError {
   using InputError::InputError;
 };
 
-/// While one lives, FFmpeg's and OpenCV's own log lines are silenced (errors are reported once, by
-/// the caller; set OPENCV_FFMPEG_LOGLEVEL to see FFmpeg's); the process's settings come back when the
-/// last one ends. Thread-safe; hold one around opening and reading recordings.
-class QuietVideoLogs {
- public:
-  QuietVideoLogs();
-  ~QuietVideoLogs();
-  QuietVideoLogs(const QuietVideoLogs&) = delete;
-  QuietVideoLogs& operator=(const QuietVideoLogs&) = delete;
-};
-
 /// A recording's frames, read in order (seeking is not reliable in every codec). A path with a
 /// '%' is an image sequence named by a printf pattern (`frames/frame_%06d.png`, numbered from 0,
 /// or from 1 when there is no frame 0, up to the first missing number; each file read by
-/// calib::readImageFile); any other path must be a regular file that OpenCV's FFmpeg back end
-/// decodes.
+/// calib::readImageFile); any other path must be a regular file that FFmpeg decodes
+/// (VideoFileReader).
 class VideoSource final : public FrameSource {
  public:
   /// Opens `path`. `label` names it in errors (default: the path). Throws VideoError.
@@ -63,7 +49,7 @@ class VideoSource final : public FrameSource {
   std::size_t nextIndex() const override { return next_; }
 
  private:
-  std::unique_ptr<cv::VideoCapture> capture_;  ///< a video file
+  std::unique_ptr<VideoFileReader> file_;  ///< a video file
   std::string label_;
   bool sequence_ = false;
   std::string pattern_;                 ///< an image sequence: its printf pattern,

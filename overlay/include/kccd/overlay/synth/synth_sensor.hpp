@@ -17,11 +17,8 @@
 #include "kccd/calib/camera.hpp"
 #include "kccd/model.hpp"
 #include "kccd/render/model_view.hpp"
+#include "kccd/overlay/recording/video_file.hpp"
 #include "kccd/render/visuals.hpp"
-
-namespace cv {
-class VideoWriter;
-}
 
 namespace kccd::overlay {
 
@@ -29,7 +26,7 @@ namespace kccd::overlay {
 /// mp4v -> video.mp4. Throws SynthError for another name.
 struct VideoFormat {
   std::string file;
-  int fourcc = 0;
+  std::string fourcc;
 };
 VideoFormat videoFormat(const std::string& codec);
 
@@ -78,7 +75,7 @@ cv::Mat vignetteGain(const calib::Camera& camera);
 /// set, gets each frame too.
 class SensorWriter {
  public:
-  SensorWriter(cv::VideoWriter& video, std::string mask_dir, double blur, double noise, std::uint64_t seed);
+  SensorWriter(VideoFileWriter& video, std::string mask_dir, double blur, double noise, std::uint64_t seed);
   ~SensorWriter();
   SensorWriter(const SensorWriter&) = delete;
   SensorWriter& operator=(const SensorWriter&) = delete;
