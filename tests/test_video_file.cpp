@@ -61,9 +61,9 @@ struct Case {
 
 // mp4v in .mp4, Motion JPEG in .avi, FFV1 in .mkv; rates whole and not (29.97 is 2997/100);
 // sizes that are and are not multiples of 16.
-const Case kCases[] = {{"a.mp4", "mp4v", 30.0, 320, 240},   {"b.avi", "MJPG", 25.0, 200, 150},
-                       {"c.mkv", "FFV1", 12.5, 96, 64},     {"d.mp4", "mp4v", 29.97, 176, 100},
-                       {"e.avi", "XVID", 15.0, 160, 120},   {"f.mkv", "FFV1", 60.0, 130, 66}};
+const Case kCases[] = {{"a.mp4", "mp4v", 30.0, 320, 240}, {"b.avi", "MJPG", 25.0, 200, 150},
+                       {"c.mkv", "FFV1", 12.5, 96, 64},   {"d.mp4", "mp4v", 29.97, 176, 100},
+                       {"e.avi", "XVID", 15.0, 160, 120}, {"f.mkv", "FFV1", 60.0, 130, 66}};
 
 TEST_F(VideoFileTest, WritesTheBytesOpenCVsWriterWrites) {
   for (const Case& c : kCases) {
@@ -135,8 +135,10 @@ TEST_F(VideoFileTest, ReadsThePixelsRateCountAndCodecOpenCVsCaptureReads) {
 TEST_F(VideoFileTest, ReadsH264WithACodedSizeLargerThanThePictureAsOpenCVDoes) {
   if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0) GTEST_SKIP() << "no ffmpeg program";
   const std::string p = path("h.mp4");
-  const std::string cmd = "ffmpeg -v error -y -f lavfi -i testsrc2=size=640x360:rate=24 -frames:v 30 -c:v libx264 "
-                          "-pix_fmt yuv420p -g 10 -bf 2 " + p;
+  const std::string cmd =
+      "ffmpeg -v error -y -f lavfi -i testsrc2=size=640x360:rate=24 -frames:v 30 -c:v libx264 "
+      "-pix_fmt yuv420p -g 10 -bf 2 " +
+      p;
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   VideoFileReader ours(p);
   cv::VideoCapture theirs(p, cv::CAP_FFMPEG);
@@ -169,11 +171,10 @@ TEST_F(VideoFileTest, TurnsARotatedVideoAsFfmpegDoes) {
   ASSERT_EQ(std::system(("ffmpeg -v error -y -i " + flat + " -c:v mpeg4 -q:v 1 " + stored).c_str()), 0);
   for (const int angle : {90, 180, 270}) {
     SCOPED_TRACE(angle);
-    const std::string tag = "ffmpeg -v error -y -i " + stored + " -c copy -metadata:s:v:0 rotate=" +
-                            std::to_string(angle) + " " + turned;
+    const std::string tag =
+        "ffmpeg -v error -y -i " + stored + " -c copy -metadata:s:v:0 rotate=" + std::to_string(angle) + " " + turned;
     ASSERT_EQ(std::system(tag.c_str()), 0);
-    const std::string decode =
-        "ffmpeg -v error -y -i " + turned + " -frames:v 1 -f rawvideo -pix_fmt bgr24 " + raw;
+    const std::string decode = "ffmpeg -v error -y -i " + turned + " -frames:v 1 -f rawvideo -pix_fmt bgr24 " + raw;
     ASSERT_EQ(std::system(decode.c_str()), 0);
     const cv::Size size = angle == 180 ? cv::Size(120, 80) : cv::Size(80, 120);
     std::string bytes = bytesOf(raw);

@@ -9,6 +9,7 @@
 #include <memory>
 #include <mutex>
 #include <sstream>
+#include <type_traits>
 
 #include <dlfcn.h>
 
@@ -28,7 +29,7 @@ namespace {
 // process of the suite, for pictures it rarely meets. Null (with `why` set) when it cannot be
 // loaded. The declaration in the header is the one this pointer's type must match.
 using Imdecode = cv::Mat (*)(cv::InputArray, int);
-static_assert(sizeof(static_cast<Imdecode>(&cv::imdecode)) > 0, "cv::imdecode's signature");
+static_assert(std::is_same_v<decltype(static_cast<Imdecode>(&cv::imdecode)), Imdecode>, "cv::imdecode's signature");
 
 Imdecode otherFormats(std::string& why) {
   static std::string problem;
@@ -181,8 +182,8 @@ cv::Mat decodeImage(std::span<const std::uint8_t> bytes, const std::string& sour
         const Imdecode imdecode = otherFormats(unavailable);
         if (imdecode == nullptr) fail(unavailable);
         img = imdecode(encoded, colour == ImageColour::Grey  ? cv::IMREAD_GRAYSCALE
-                                    : colour == ImageColour::Bgr ? cv::IMREAD_COLOR
-                                                                 : cv::IMREAD_UNCHANGED);
+                                : colour == ImageColour::Bgr ? cv::IMREAD_COLOR
+                                                             : cv::IMREAD_UNCHANGED);
       } catch (const cv::Exception&) {
         img.release();
       } catch (const std::bad_alloc&) {

@@ -6,7 +6,6 @@
 #include <iostream>
 #include <memory>
 
-
 #include "cli_args.hpp"
 #include "cli_files.hpp"
 #include "cli_model.hpp"

@@ -1,5 +1,5 @@
-#include "kccd/calib/image_encode.hpp"
 #include "kccd/overlay/bags/state_log_bag.hpp"
+#include "kccd/calib/image_encode.hpp"
 
 #include <cerrno>
 #include <cmath>

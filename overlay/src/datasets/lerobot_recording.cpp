@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <map>
 
-
 #include "kccd/calib/image_file.hpp"
 #include "kccd/overlay/recording/video_source.hpp"
 

@@ -1,5 +1,5 @@
-#include "kccd/calib/image_encode.hpp"
 #include "kccd/overlay/golden/golden_render.hpp"
+#include "kccd/calib/image_encode.hpp"
 
 #include <cmath>
 #include <filesystem>

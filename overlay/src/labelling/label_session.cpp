@@ -1,5 +1,5 @@
-#include "kccd/calib/image_encode.hpp"
 #include "kccd/overlay/labelling/label_session.hpp"
+#include "kccd/calib/image_encode.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -48,7 +48,7 @@ int requestedLogLevel(int otherwise) {
   char* end = nullptr;
   const long level = std::strtol(v, &end, 10);
   return end != v && *end == '\0' && level >= AV_LOG_QUIET && level <= AV_LOG_TRACE ? static_cast<int>(level)
-                                                                                     : otherwise;
+                                                                                    : otherwise;
 }
 
 // FFmpeg's own log lines stay unprinted (the suite reports each failure once, in its own words)
@@ -77,7 +77,8 @@ std::string fourccText(std::uint32_t tag) {
 AVCodecID codecOf(const std::string& four) {
   std::string lower;
   for (const char c : four) lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (lower == "mp4v" || lower == "xvid" || lower == "divx" || lower == "fmp4" || lower == "dx50") return AV_CODEC_ID_MPEG4;
+  if (lower == "mp4v" || lower == "xvid" || lower == "divx" || lower == "fmp4" || lower == "dx50")
+    return AV_CODEC_ID_MPEG4;
   if (lower == "mjpg") return AV_CODEC_ID_MJPEG;
   if (lower == "ffv1") return AV_CODEC_ID_FFV1;
   if (lower == "avc1" || lower == "h264" || lower == "x264") return AV_CODEC_ID_H264;
@@ -183,7 +184,8 @@ VideoFileReader::VideoFileReader(const std::string& path) : impl_(std::make_uniq
   if (m.stream < 0) throw VideoFileError("no video stream");
   const AVStream* st = m.format->streams[m.stream];
   const AVCodec* codec = avcodec_find_decoder(st->codecpar->codec_id);
-  if (codec == nullptr) throw VideoFileError("no decoder for its codec (" + std::string(avcodec_get_name(st->codecpar->codec_id)) + ")");
+  if (codec == nullptr)
+    throw VideoFileError("no decoder for its codec (" + std::string(avcodec_get_name(st->codecpar->codec_id)) + ")");
   m.decoder = avcodec_alloc_context3(codec);
   m.packet = av_packet_alloc();
   m.frame = av_frame_alloc();
@@ -193,7 +195,8 @@ VideoFileReader::VideoFileReader(const std::string& path) : impl_(std::make_uniq
     m.decoder->thread_count = static_cast<int>(std::clamp(sysconf(_SC_NPROCESSORS_ONLN), 1L, 64L));
     rc = avcodec_open2(m.decoder, codec, nullptr);
   }
-  if (rc < 0) throw VideoFileError("its decoder (" + std::string(codec->name) + ") refuses it (" + ffmpegError(rc) + ")");
+  if (rc < 0)
+    throw VideoFileError("its decoder (" + std::string(codec->name) + ") refuses it (" + ffmpegError(rc) + ")");
   std::size_t size = 0;
   if (const std::uint8_t* matrix = av_stream_get_side_data(st, AV_PKT_DATA_DISPLAYMATRIX, &size);
       matrix != nullptr && size >= 9 * sizeof(std::int32_t)) {
@@ -303,7 +306,8 @@ struct VideoFileWriter::Impl {
   // Sends `input` (null: the end) and writes every packet the encoder has ready.
   void encode(const AVFrame* input) {
     int rc = avcodec_send_frame(encoder, input);
-    if (rc < 0 && !(input == nullptr && rc == AVERROR_EOF)) throw VideoFileError("the encoder fails (" + ffmpegError(rc) + ")");
+    if (rc < 0 && !(input == nullptr && rc == AVERROR_EOF))
+      throw VideoFileError("the encoder fails (" + ffmpegError(rc) + ")");
     for (;;) {
       rc = avcodec_receive_packet(encoder, packet);
       if (rc == AVERROR(EAGAIN) || rc == AVERROR_EOF) return;
@@ -322,10 +326,10 @@ namespace {
 // writer gives it; an encoder with a list of rates gets the closest of them.
 AVRational frameRate(double fps, const AVCodec* codec) {
   int base = 1;
-  int num = static_cast<int>(fps + 0.5);
+  int num = static_cast<int>(std::floor(fps + 0.5));  // fps > 0: OpenCV's (int)(fps + 0.5)
   while (std::abs(static_cast<double>(num) / base - fps) > 0.001 && base < 100000) {
     base *= 10;
-    num = static_cast<int>(fps * base + 0.5);
+    num = static_cast<int>(std::floor(fps * base + 0.5));
   }
   AVRational rate{num, base};
   if (const AVRational* listed = codec->supported_framerates; listed != nullptr && listed->num != 0) {
@@ -339,8 +343,7 @@ AVRational frameRate(double fps, const AVCodec* codec) {
 
 }  // namespace
 
-VideoFileWriter::VideoFileWriter(const std::string& path, const std::string& fourcc, double fps, int width,
-                                 int height)
+VideoFileWriter::VideoFileWriter(const std::string& path, const std::string& fourcc, double fps, int width, int height)
     : impl_(std::make_unique<Impl>()) {
   quietByDefault();
   Impl& m = *impl_;
@@ -365,7 +368,8 @@ VideoFileWriter::VideoFileWriter(const std::string& path, const std::string& fou
   m.format->max_delay = static_cast<int>(0.7 * AV_TIME_BASE);
   AVCodecContext& c = *m.encoder;
   std::uint32_t tag = fourccCode(fourcc);
-  if (const AVCodecTag* const* muxer = m.format->oformat->codec_tag; muxer != nullptr && av_codec_get_id(muxer, tag) != id)
+  if (const AVCodecTag* const* muxer = m.format->oformat->codec_tag;
+      muxer != nullptr && av_codec_get_id(muxer, tag) != id)
     if (const unsigned usual = av_codec_get_tag(muxer, id); usual != 0) tag = usual;
   c.codec_tag = tag;
   c.qmin = 3;
@@ -374,12 +378,12 @@ VideoFileWriter::VideoFileWriter(const std::string& path, const std::string& fou
   const AVRational rate = frameRate(fps, codec);
   c.time_base = av_inv_q(rate);
   // Bit rate: B = fps x width x height (x 3 for Motion JPEG), 1.5 B for the codec, then B / 2 more.
-  const double nominal = std::min((id == AV_CODEC_ID_MJPEG ? 3.0 : 1.0) * fps * width * height,
-                                  std::numeric_limits<int>::max() / 2.0);
-  const auto b = static_cast<std::int64_t>(static_cast<int>(nominal + 0.5));
+  const double nominal =
+      std::min((id == AV_CODEC_ID_MJPEG ? 3.0 : 1.0) * fps * width * height, std::numeric_limits<int>::max() / 2.0);
+  const auto b = static_cast<std::int64_t>(std::floor(nominal + 0.5));
   c.bit_rate = std::min<std::int64_t>(b + b / 2, std::numeric_limits<int>::max());
   c.gop_size = 12;
-  c.pix_fmt = id == AV_CODEC_ID_MJPEG ? AV_PIX_FMT_YUVJ420P
+  c.pix_fmt = id == AV_CODEC_ID_MJPEG  ? AV_PIX_FMT_YUVJ420P
               : id == AV_CODEC_ID_FFV1 ? AV_PIX_FMT_BGRA
                                        : AV_PIX_FMT_YUV420P;
   if (id == AV_CODEC_ID_H264) {
@@ -388,11 +392,13 @@ VideoFileWriter::VideoFileWriter(const std::string& path, const std::string& fou
     c.bit_rate = 0;
     av_opt_set(c.priv_data, "crf", "23", 0);
   }
-  c.bit_rate = std::min<std::int64_t>(c.bit_rate + static_cast<std::int64_t>(nominal / 2), std::numeric_limits<int>::max());
+  c.bit_rate =
+      std::min<std::int64_t>(c.bit_rate + static_cast<std::int64_t>(nominal / 2), std::numeric_limits<int>::max());
   c.bit_rate_tolerance = static_cast<int>(c.bit_rate);
   if ((m.format->oformat->flags & AVFMT_GLOBALHEADER) != 0) c.flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
   rc = avcodec_open2(m.encoder, codec, nullptr);
-  if (rc < 0) throw VideoFileError("the encoder " + std::string(codec->name) + " refuses these frames (" + ffmpegError(rc) + ")");
+  if (rc < 0)
+    throw VideoFileError("the encoder " + std::string(codec->name) + " refuses these frames (" + ffmpegError(rc) + ")");
   rc = avcodec_parameters_from_context(m.stream->codecpar, m.encoder);
   if (rc < 0) throw VideoFileError("the encoder's parameters (" + ffmpegError(rc) + ")");
   m.stream->time_base = c.time_base;
@@ -413,8 +419,8 @@ VideoFileWriter::VideoFileWriter(const std::string& path, const std::string& fou
   if (m.pixels == nullptr ||
       av_image_fill_arrays(m.frame->data, m.frame->linesize, m.pixels, c.pix_fmt, width, height, 1) < 0)
     throw std::bad_alloc();
-  m.scale = sws_getContext(width, height, AV_PIX_FMT_BGR24, width, height, c.pix_fmt, SWS_BICUBIC, nullptr, nullptr,
-                           nullptr);
+  m.scale =
+      sws_getContext(width, height, AV_PIX_FMT_BGR24, width, height, c.pix_fmt, SWS_BICUBIC, nullptr, nullptr, nullptr);
   if (m.scale == nullptr) throw VideoFileError("swscale cannot convert BGR to the encoder's pixel format");
 }
 

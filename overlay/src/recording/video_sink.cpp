@@ -2,8 +2,8 @@
 
 #include <cctype>
 #include <cstdio>
-#include <fstream>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <vector>
 

@@ -10,7 +10,6 @@
 #include <optional>
 #include <stdexcept>
 
-
 #include "kccd/calib/camera.hpp"
 #include "kccd/overlay/bags/state_log_bag.hpp"
 #include "kccd/overlay/common/staged_output.hpp"

@@ -1,7 +1,7 @@
 // Frames of a synthetic recording (kccd/overlay/synth/synth_sensor.hpp): the robot drawn over the
 // background, the sensor model and the writer thread.
-#include "kccd/calib/image_encode.hpp"
 #include "kccd/overlay/synth/synth_sensor.hpp"
+#include "kccd/calib/image_encode.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -16,8 +16,8 @@
 
 #include "kccd/calib/camera.hpp"
 #include "kccd/model.hpp"
-#include "kccd/render/model_view.hpp"
 #include "kccd/overlay/recording/video_file.hpp"
+#include "kccd/render/model_view.hpp"
 #include "kccd/render/visuals.hpp"
 
 namespace kccd::overlay {
