@@ -8,7 +8,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -17,6 +16,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "kccd/overlay/recording/video_file.hpp"
+#include "support/files.hpp"
 
 namespace fs = std::filesystem;
 using kccd::overlay::VideoFileError;
@@ -44,10 +44,6 @@ class VideoFileTest : public ::testing::Test {
     cv::rectangle(m, cv::Rect((7 * i) % (w / 2), h / 4, w / 5, h / 3), cv::Scalar(30, 200, 250), cv::FILLED);
     cv::line(m, {0, h - 1 - i % h}, {w - 1, i % h}, cv::Scalar(255, 0, 0), 3);
     return m;
-  }
-  static std::string bytesOf(const std::string& p) {
-    std::ifstream f(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
   }
   fs::path dir_;
 };
@@ -82,8 +78,8 @@ TEST_F(VideoFileTest, WritesTheBytesOpenCVsWriterWrites) {
       }
       ours.finish();
     }
-    const std::string a = bytesOf(path(std::string("ours_") + c.file));
-    const std::string b = bytesOf(path(std::string("cv_") + c.file));
+    const std::string a = kccd::testing::readText(path(std::string("ours_") + c.file));
+    const std::string b = kccd::testing::readText(path(std::string("cv_") + c.file));
     EXPECT_GT(a.size(), 1000u);
     ASSERT_EQ(a.size(), b.size());
     // Matroska gives each file random segment and track UIDs (and the CRCs over them): those bytes
@@ -177,7 +173,7 @@ TEST_F(VideoFileTest, TurnsARotatedVideoAsFfmpegDoes) {
     const std::string decode = "ffmpeg -v error -y -i " + turned + " -frames:v 1 -f rawvideo -pix_fmt bgr24 " + raw;
     ASSERT_EQ(std::system(decode.c_str()), 0);
     const cv::Size size = angle == 180 ? cv::Size(120, 80) : cv::Size(80, 120);
-    std::string bytes = bytesOf(raw);
+    std::string bytes = kccd::testing::readText(raw);
     ASSERT_EQ(bytes.size(), static_cast<std::size_t>(size.area() * 3));
     const cv::Mat want(size, CV_8UC3, bytes.data());
     VideoFileReader r(turned);

@@ -241,7 +241,6 @@ LerobotRecording readLerobotRecording(const LerobotRecordingOptions& o, const Mo
   if (!std::filesystem::is_regular_file(span.file, ec))
     throw InputError(span.file + ": not found (episode " + std::to_string(e.index) + "'s video of " + rec.camera_key +
                      ")");
-  const QuietVideoLogs quiet;
   const VideoSource probe(span.file);
   if (!sameCodec(camera.codec, probe.codec()))
     rec.warnings.push_back(span.file + ": meta/info.json says codec " + printable(camera.codec, 20) +

@@ -304,7 +304,6 @@ OverlayReport overlayRecording(const OverlayInputs& in, const OverlayOptions& op
   if (decoration.corners().size() > 1) settings.legend_corners = decoration.corners();
   if (opt.swept) settings.braking.assign(static_cast<std::size_t>(model.stateSize()), opt.braking);
 
-  const QuietVideoLogs quiet;
   // No mask is drawn: its finer pinhole image (and its per-pixel distortion map) is not built. The
   // colour pass's map is built once here for every annotator.
   render::RenderOptions render_options;

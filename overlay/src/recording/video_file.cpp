@@ -30,17 +30,6 @@ std::string ffmpegError(int code) {
   return text.data();
 }
 
-// QuietVideoLogs' process-wide state; FFmpeg's level is the process's.
-struct LogState {
-  std::mutex mu;
-  int users = 0;
-  int level = AV_LOG_INFO;
-};
-LogState& logState() {
-  static LogState s;
-  return s;
-}
-
 // The level KCCD_FFMPEG_LOGLEVEL asks for (an FFmpeg level: -8 quiet ... 56 trace), else `otherwise`.
 int requestedLogLevel(int otherwise) {
   const char* v = std::getenv("KCCD_FFMPEG_LOGLEVEL");
@@ -58,10 +47,11 @@ void quietByDefault() {
   std::call_once(once, [] { av_log_set_level(requestedLogLevel(AV_LOG_QUIET)); });
 }
 
-// The FourCC of a codec in the tables of the containers this suite writes and reads most.
-std::uint32_t usualTag(AVCodecID id) {
-  const AVCodecTag* const tables[] = {avformat_get_riff_video_tags(), avformat_get_mov_video_tags(), nullptr};
-  return av_codec_get_tag(tables, id);
+// The FourCC tables of the containers this suite writes and reads most (AVI's, then MP4's), as
+// FFmpeg's lookups take them: null-terminated.
+const AVCodecTag* const* usualTags() {
+  static const AVCodecTag* const tables[] = {avformat_get_riff_video_tags(), avformat_get_mov_video_tags(), nullptr};
+  return tables;
 }
 
 std::string fourccText(std::uint32_t tag) {
@@ -86,8 +76,7 @@ AVCodecID codecOf(const std::string& four) {
   if (lower == "vp80") return AV_CODEC_ID_VP8;
   if (lower == "vp90") return AV_CODEC_ID_VP9;
   if (lower == "av01") return AV_CODEC_ID_AV1;
-  const AVCodecTag* const tables[] = {avformat_get_riff_video_tags(), avformat_get_mov_video_tags(), nullptr};
-  return av_codec_get_id(tables, fourccCode(four));
+  return av_codec_get_id(usualTags(), fourccCode(four));
 }
 
 }  // namespace
@@ -97,22 +86,6 @@ std::uint32_t fourccCode(const std::string& four) {
   std::uint32_t code = 0;
   for (int i = 3; i >= 0; --i) code = (code << 8) | static_cast<unsigned char>(four[static_cast<std::size_t>(i)]);
   return code;
-}
-
-QuietVideoLogs::QuietVideoLogs() {
-  quietByDefault();
-  LogState& s = logState();
-  const std::lock_guard lock(s.mu);
-  if (s.users++ > 0) return;
-  s.level = av_log_get_level();
-  av_log_set_level(requestedLogLevel(AV_LOG_QUIET));
-}
-
-QuietVideoLogs::~QuietVideoLogs() {
-  LogState& s = logState();
-  const std::lock_guard lock(s.mu);
-  if (--s.users > 0) return;
-  av_log_set_level(s.level);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -238,7 +211,7 @@ std::size_t VideoFileReader::declaredFrames() const {
 std::string VideoFileReader::fourcc() const {
   const AVCodecParameters* par = impl_->format->streams[impl_->stream]->codecpar;
   const std::string stored = fourccText(par->codec_tag);
-  return stored.size() == 4 ? stored : fourccText(usualTag(par->codec_id));
+  return stored.size() == 4 ? stored : fourccText(av_codec_get_tag(usualTags(), par->codec_id));
 }
 
 bool VideoFileReader::read(cv::Mat& bgr) {
@@ -288,7 +261,6 @@ struct VideoFileWriter::Impl {
   AVPacket* packet = nullptr;
   SwsContext* scale = nullptr;
   std::uint8_t* pixels = nullptr;  // the encoder's planes, packed (OpenCV's layout)
-  int width = 0, height = 0;
   std::int64_t next_pts = 0;
   bool file_open = false, header_written = false, finished = false;
 
@@ -350,8 +322,6 @@ VideoFileWriter::VideoFileWriter(const std::string& path, const std::string& fou
   if (!(std::isfinite(fps) && fps > 0.0 && fps <= 1000.0)) throw VideoFileError("a frame rate not in (0, 1000]");
   if (width <= 0 || height <= 0 || width > 16384 || height > 16384)
     throw VideoFileError("a frame size not in 1..16384");
-  m.width = width;
-  m.height = height;
   int rc = avformat_alloc_output_context2(&m.format, nullptr, nullptr, path.c_str());
   if (rc < 0 || m.format == nullptr) throw VideoFileError("a container FFmpeg does not write (use .mp4, .mkv or .avi)");
   const AVCodecID id = codecOf(fourcc);
@@ -428,12 +398,12 @@ VideoFileWriter::~VideoFileWriter() = default;
 
 void VideoFileWriter::write(const cv::Mat& bgr) {
   Impl& m = *impl_;
-  if (bgr.type() != CV_8UC3 || bgr.cols != m.width || bgr.rows != m.height)
+  if (bgr.type() != CV_8UC3 || bgr.cols != m.encoder->width || bgr.rows != m.encoder->height)
     throw std::logic_error("a video frame of another size or type than the writer's");
   if (m.finished) throw std::logic_error("a video frame after finish()");
   const std::uint8_t* const planes[4] = {bgr.data, nullptr, nullptr, nullptr};
   const int strides[4] = {static_cast<int>(bgr.step[0]), 0, 0, 0};
-  sws_scale(m.scale, planes, strides, 0, m.height, m.frame->data, m.frame->linesize);
+  sws_scale(m.scale, planes, strides, 0, bgr.rows, m.frame->data, m.frame->linesize);
   m.frame->pts = m.next_pts++;
   m.encode(m.frame);
 }

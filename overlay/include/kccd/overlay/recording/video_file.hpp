@@ -1,7 +1,10 @@
 // Video files through FFmpeg (libavformat, libavcodec, libswscale): frames decoded to 8-bit BGR
 // and 8-bit BGR frames encoded, nothing else. Every command that reads or writes a video file
 // goes through these two classes; OpenCV's video back end is not loaded (it brings GStreamer,
-// gphoto2 and OpenCV's image codecs into every process, ~0.13 s before main()).
+// gphoto2 and OpenCV's image codecs into every process, ~0.13 s before main()). FFmpeg's own log
+// lines stay unprinted (each failure is reported once, by the caller, in its words): the first
+// reader or writer made sets the process's FFmpeg log level to quiet, or to the level
+// KCCD_FFMPEG_LOGLEVEL gives (an FFmpeg level such as 32).
 #pragma once
 
 #include <cstddef>
@@ -74,18 +77,6 @@ class VideoFileWriter {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
-};
-
-/// While one lives, FFmpeg's own log lines are silenced (errors are reported once, by the caller;
-/// set KCCD_FFMPEG_LOGLEVEL to an FFmpeg level such as 32 to see them); the level comes back when
-/// the last one ends. Thread-safe; hold one around opening and reading recordings. (The readers
-/// and writers above also set FFmpeg's level to that once, when the first is made.)
-class QuietVideoLogs {
- public:
-  QuietVideoLogs();
-  ~QuietVideoLogs();
-  QuietVideoLogs(const QuietVideoLogs&) = delete;
-  QuietVideoLogs& operator=(const QuietVideoLogs&) = delete;
 };
 
 }  // namespace kccd::overlay
