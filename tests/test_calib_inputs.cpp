@@ -393,4 +393,26 @@ TEST(CalibTagDetect, CornersLandWhereTheyWereDrawn) {
   EXPECT_THROW(detectTags(cv::Mat(10, 10, CV_8UC3)), std::invalid_argument);
 }
 
+// Images too small to hold a tag give no detections (libapriltag 3.3 reads outside images under
+// 3 rows: a 130 x 1 JPEG found by fuzz_frame crashed it), at every size under the bound and in
+// both directions, for noise and for stripes; the first size at the bound reaches the detector.
+TEST(CalibTagDetect, ImagesTooSmallForATagHaveNone) {
+  cv::RNG rng(7);
+  for (int rows = 1; rows <= 2 * kMinTagPixels; ++rows)
+    for (const int cols : {1, 2, 3, kMinTagPixels - 1, kMinTagPixels, 64, 130}) {
+      if (rows >= kMinTagPixels && cols >= kMinTagPixels) continue;
+      for (int pattern = 0; pattern < 2; ++pattern) {
+        cv::Mat img(rows, cols, CV_8UC1);
+        if (pattern == 0) rng.fill(img, cv::RNG::UNIFORM, 0, 256);
+        for (int c = 0; pattern == 1 && c < cols; ++c) img.col(c).setTo((c / 3) % 2 ? 255 : 0);
+        EXPECT_TRUE(detectTags(img).empty()) << rows << " x " << cols;
+        EXPECT_TRUE(detectTags(img.t()).empty()) << cols << " x " << rows;
+      }
+    }
+  // A real tag scaled down to the bound still goes through the detector without harm.
+  cv::Mat small(kMinTagPixels, kMinTagPixels, CV_8UC1, cv::Scalar(255));
+  small(cv::Rect(0, 0, kMinTagPixels / 2, kMinTagPixels / 2)).setTo(0);
+  EXPECT_NO_THROW(detectTags(small));
+}
+
 }  // namespace

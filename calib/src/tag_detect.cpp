@@ -14,6 +14,9 @@ namespace kccd::calib {
 std::vector<TagDetection> detectTags(const cv::Mat& gray) {
   if (gray.empty() || gray.type() != CV_8UC1)
     throw std::invalid_argument("detectTags: needs a non-empty 8-bit single-channel image");
+  // A tag36h11 tag is 8 cells across with its black border, so an image under 8 pixels in either
+  // direction holds none; libapriltag 3.3 also reads outside images under 3 rows (a crash).
+  if (gray.rows < kMinTagPixels || gray.cols < kMinTagPixels) return {};
   const cv::Mat image = gray.isContinuous() ? gray : gray.clone();
   const std::unique_ptr<apriltag_family_t, void (*)(apriltag_family_t*)> family(tag36h11_create(), tag36h11_destroy);
   const std::unique_ptr<apriltag_detector_t, void (*)(apriltag_detector_t*)> detector(apriltag_detector_create(),

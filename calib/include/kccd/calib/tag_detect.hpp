@@ -33,8 +33,13 @@ struct TagDetection {
   double decision_margin = 0.0;  ///< AprilTag's decoding quality
 };
 
+/// The fewest pixels across an image can hold a tag in (a tag36h11 tag with its black border is
+/// 8 cells across).
+inline constexpr int kMinTagPixels = 8;
+
 /// The tag36h11 tags in an 8-bit single-channel image (full resolution, edges refined), in the
-/// detector's order. Throws std::invalid_argument for an image that is not CV_8UC1 or is empty.
+/// detector's order; none in an image under kMinTagPixels in either direction. Throws
+/// std::invalid_argument for an image that is not CV_8UC1 or is empty.
 std::vector<TagDetection> detectTags(const cv::Mat& gray);
 
 /// The correspondences of detected tags that the layout places, and the ids it does not know.

@@ -53,7 +53,6 @@ class Ros1Reader final : public LogReader {
   std::map<std::uint16_t, Schema> schemas_;
   std::map<std::string, int> chunks_;
   LogMessage message_;
-  bool pending_ = false;
 };
 
 }  // namespace kccd::logs
