@@ -37,16 +37,40 @@ inline cv::Mat cpuSilhouetteFine(const calib::Camera& c, const std::vector<Vec3>
             centres.push_back(pts[i] + s * (pts[j] - pts[i]) + t * (pts[l] - pts[i]));
           }
       }
+  // A ball's image is the image of its rim, the circle where the rays from the camera's centre
+  // touch it (every other point of the ball lies on a ray inside that cone, and the lens maps the
+  // cone's inside to the inside of the rim's image), so each ball's outline is its rim sampled
+  // densely; a ball around the camera's centre (no rim) is sampled over its whole surface.
+  cv::Mat rotation;
+  cv::Rodrigues(c.rvec, rotation);
+  const cv::Mat centre_cv = -rotation.t() * cv::Mat(c.tvec).reshape(1, 3);
+  const Vec3 eye(centre_cv.at<double>(0), centre_cv.at<double>(1), centre_cv.at<double>(2));
+  constexpr int kRim = 256;
   std::vector<cv::Point3d> sphere;
   const int m = 1500;
   for (int i = 0; i < m; ++i) {  // Fibonacci sphere
     const double z = 1.0 - (2.0 * i + 1.0) / m, rr = std::sqrt(1.0 - z * z), phi = i * 2.399963229728653;
     sphere.emplace_back(rr * std::cos(phi), rr * std::sin(phi), z);
   }
-  std::vector<cv::Point3d> world(sphere.size());
+  std::vector<cv::Point3d> world;
   std::vector<cv::Point2d> img;
   for (const Vec3& ce : centres) {
-    for (std::size_t i = 0; i < sphere.size(); ++i) world[i] = cv::Point3d(ce.x(), ce.y(), ce.z()) + radius * sphere[i];
+    const Vec3 to_eye = eye - ce;
+    const double d = to_eye.norm();
+    world.clear();
+    if (d > radius * (1.0 + 1e-9)) {
+      const Vec3 axis = to_eye / d;
+      const Vec3 u = axis.unitOrthogonal(), v = axis.cross(u);
+      const Vec3 mid = ce + axis * (radius * radius / d);
+      const double rho = radius * std::sqrt(1.0 - (radius / d) * (radius / d));
+      for (int i = 0; i < kRim; ++i) {
+        const double phi = 2.0 * M_PI * i / kRim;
+        const Vec3 p = mid + rho * (std::cos(phi) * u + std::sin(phi) * v);
+        world.emplace_back(p.x(), p.y(), p.z());
+      }
+    } else {
+      for (const cv::Point3d& q : sphere) world.push_back(cv::Point3d(ce.x(), ce.y(), ce.z()) + radius * q);
+    }
     cv::projectPoints(world, c.rvec, c.tvec, c.camera_matrix, c.distortion, img);
     std::vector<cv::Point> fixed;
     for (const cv::Point2d& p : img)
