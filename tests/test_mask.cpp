@@ -10,6 +10,8 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -381,6 +383,26 @@ TEST(RenderContext, ReportsItsRenderer) {
                                                                                   : GlBackend::Egl;
   EXPECT_EQ(ctx->backend(), expected) << toString(ctx->backend());
   EXPECT_NE(ctx->renderer().find(expected == GlBackend::Egl ? "EGL" : "OSMesa"), std::string::npos);
+}
+
+// GlPreparation loads the driver on a thread of its own; contexts made at once on other threads,
+// while it may still be loading, wait for it and work, as does one made after it ended.
+TEST(RenderContext, ContextsMadeWhileTheDriverIsPreparedWork) {
+  std::vector<std::string> renderers(3);
+  {
+    const GlPreparation preparation;
+    std::vector<std::thread> threads;
+    for (std::size_t i = 0; i < renderers.size(); ++i)
+      threads.emplace_back([&renderers, i] {
+        const auto ctx = GlContext::make();
+        renderers[i] = ctx->renderer();
+      });
+    for (std::thread& t : threads) t.join();
+  }
+  { const GlPreparation again; }
+  const std::string alone = GlContext::make()->renderer();
+  ASSERT_FALSE(alone.empty());
+  for (const std::string& r : renderers) EXPECT_EQ(r, alone);
 }
 
 TEST(RenderContext, UnknownOrMissingBackendIsAOneLineError) {

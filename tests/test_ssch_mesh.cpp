@@ -347,6 +347,32 @@ TEST(RenderMesh, TessellationErrorShrinksWithLevel) {
   EXPECT_EQ(spherePolytope(2).vertices.size(), 162u);
 }
 
+// Every level's neighbour table, checked by brute force: the triangle across edge k of t holds that
+// edge reversed, is another triangle, and the relation is mutual; out-of-range levels clamp.
+TEST(RenderMesh, SpherePolytopeNeighboursHoldTheSharedEdgeAtEveryLevel) {
+  for (int level = 0; level <= 5; ++level) {
+    const SpherePolytope& s = spherePolytope(level);
+    ASSERT_EQ(s.vertices.size(), static_cast<std::size_t>(10 * (1 << (2 * level)) + 2)) << level;
+    ASSERT_EQ(s.triangles.size(), static_cast<std::size_t>(20 * (1 << (2 * level)))) << level;
+    ASSERT_EQ(s.neighbours.size(), s.triangles.size()) << level;
+    int wrong = 0;
+    for (std::size_t t = 0; t < s.triangles.size(); ++t)
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t u = s.triangles[t][k], w = s.triangles[t][(k + 1) % 3], n = s.neighbours[t][k];
+        const auto& other = s.triangles.at(n);
+        bool reversed = false, back = false;
+        for (int j = 0; j < 3; ++j) {
+          reversed |= other[j] == w && other[(j + 1) % 3] == u;
+          back |= other[j] == w && other[(j + 1) % 3] == u && s.neighbours[n][j] == t;
+        }
+        wrong += n == t || !reversed || !back;
+      }
+    EXPECT_EQ(wrong, 0) << "level " << level;
+  }
+  EXPECT_EQ(&spherePolytope(-3), &spherePolytope(0));
+  EXPECT_EQ(&spherePolytope(9), &spherePolytope(5));
+}
+
 TEST(RenderMesh, CacheReusesUnchangedShapes) {
   MeshCache cache;
   const std::vector<Vec3> a = {Vec3(0, 0, 0), Vec3(1, 0, 0)};

@@ -14,6 +14,7 @@
 #include "commands.hpp"
 #include "kccd/overlay/jobs/overlay_job.hpp"
 #include "kccd/overlay/recording/overlay_recording.hpp"
+#include "kccd/render/gl_context.hpp"
 
 namespace kccd::cli {
 namespace {
@@ -35,6 +36,7 @@ std::string spelled(const std::string& field) { return optionSpelling(field, kSp
 
 Exit runOverlay(OverlayArgs& a) {
   const auto t_start = std::chrono::steady_clock::now();
+  const render::GlPreparation gl;  // Mesa's driver loads on a thread of its own while the inputs are read
   overlay::OverlayRequest& q = a.request;
   const Model model = loadOrExplain(a.model);
   const calib::Camera camera = calib::loadCamera(a.camera);

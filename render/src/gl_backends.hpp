@@ -12,6 +12,8 @@ std::unique_ptr<GlContext> makeOsMesaContext();
 #endif
 #ifdef KCCD_HAVE_EGL
 std::unique_ptr<GlContext> makeEglContext();
+/// Initialises EGL's surfaceless display (loading Mesa's driver) as a context would; errors ignored.
+void initialiseEglDisplay() noexcept;
 #endif
 
 }  // namespace kccd::render::detail

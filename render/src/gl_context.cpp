@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <mutex>
 #include <string>
+#include <system_error>
 
 #include "gl_backends.hpp"
 #include "kccd/render/gl_context.hpp"
@@ -54,6 +55,23 @@ std::unique_ptr<GlContext> GlContext::make(GlBackend backend) {
   if (backend == GlBackend::OsMesa) return detail::makeOsMesaContext();
 #endif
   throw GlContextError("GL: no back end");
+}
+
+GlPreparation::GlPreparation() {
+#ifdef KCCD_HAVE_EGL
+  const char* env = std::getenv("KCCD_GL");
+  const char* device = std::getenv("KCCD_EGL_DEVICE");
+  if ((env != nullptr && *env != '\0' && std::string(env) != "egl") || (device != nullptr && *device != '\0')) return;
+  try {
+    thread_ = std::thread(detail::initialiseEglDisplay);
+  } catch (const std::system_error&) {
+    // No thread: make() loads the driver itself.
+  }
+#endif
+}
+
+GlPreparation::~GlPreparation() {
+  if (thread_.joinable()) thread_.join();
 }
 
 namespace {

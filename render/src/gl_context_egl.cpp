@@ -144,4 +144,17 @@ class EglContext final : public GlContext {
 
 std::unique_ptr<GlContext> detail::makeEglContext() { return std::make_unique<EglContext>(); }
 
+void detail::initialiseEglDisplay() noexcept {
+  const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+  if (!hasExtension(client, "EGL_MESA_platform_surfaceless")) return;
+  auto get_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+  if (get_display == nullptr) return;
+  const EGLDisplay display = get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+  if (display == EGL_NO_DISPLAY) return;
+  // The same initialisation as a context's, under the same lock: one waits for the other.
+  const std::lock_guard lock(display_mutex);
+  EGLint major = 0, minor = 0;
+  (void)eglInitialize(display, &major, &minor);
+}
+
 }  // namespace kccd::render

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 
 #include <opencv2/calib3d.hpp>
 
@@ -44,55 +45,71 @@ Projection::Projection(const Camera& camera, double supersample) : camera_(camer
   }
   // Normalised coordinates of every output pixel centre (the inverse of the distortion model),
   // computed once per lens and kept in the lens cache.
-  const int n = camera.width * camera.height;
   const LensInverse inverse = lensInverse(camera);
   const cv::Mat& normal = inverse.normal;
   const std::vector<unsigned char>& valid = inverse.valid;
-  double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
-  for (int i = 0; i < n; ++i)
-    if (valid[i]) {
-      const cv::Vec2d p = normal.at<cv::Vec2d>(i);
-      xmin = std::min(xmin, p[0]), xmax = std::max(xmax, p[0]);
-      ymin = std::min(ymin, p[1]), ymax = std::max(ymax, p[1]);
-    }
-  if (xmin > xmax)
+  // One pass over the pixels, in parallel blocks of rows (minima and maxima do not depend on the
+  // order): the extent of the valid pixels' normalised coordinates, the obliquity, and the
+  // Jacobian of the camera -> pinhole map from each pixel to its right and lower neighbours (left
+  // and upper on the last column and row), whose smallest singular value is the least a camera
+  // pixel spans in pinhole pixels, the inverse of the most a pinhole pixel spans in the camera.
+  const int w = camera.width, h = camera.height;
+  struct Extremes {
+    double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300, obliquity = 1.0, least = 1e300;
+  };
+  Extremes all;
+  std::mutex merge;
+  const double pfx = pinhole_.fx, pfy = pinhole_.fy;
+  cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
+    Extremes e;
+    for (int v = rows.start; v < rows.end; ++v)
+      for (int u = 0; u < w; ++u) {
+        const int i = v * w + u;
+        if (!valid[i]) continue;
+        const cv::Vec2d p = normal.at<cv::Vec2d>(i);
+        e.xmin = std::min(e.xmin, p[0]), e.xmax = std::max(e.xmax, p[0]);
+        e.ymin = std::min(e.ymin, p[1]), e.ymax = std::max(e.ymax, p[1]);
+        e.obliquity = std::max(e.obliquity, std::sqrt(1.0 + p[0] * p[0] + p[1] * p[1]));
+        const int iu = u + 1 < w ? i + 1 : i - 1, iv = v + 1 < h ? i + w : i - w;
+        if (w < 2 || h < 2 || !valid[iu] || !valid[iv]) continue;
+        const double su = u + 1 < w ? 1.0 : -1.0, sv = v + 1 < h ? 1.0 : -1.0;
+        const cv::Vec2d du = (normal.at<cv::Vec2d>(iu) - p) * su, dv = (normal.at<cv::Vec2d>(iv) - p) * sv;
+        const double a = du[0] * pfx, b = dv[0] * pfx, c = du[1] * pfy, d = dv[1] * pfy;
+        const double t = a * a + b * b + c * c + d * d, det = a * d - b * c;
+        const double largest = std::sqrt(0.5 * (t + std::sqrt(std::max(0.0, t * t - 4.0 * det * det))));
+        e.least = std::min(e.least, largest > 0.0 ? std::abs(det) / largest : 0.0);
+      }
+    const std::lock_guard lock(merge);
+    all.xmin = std::min(all.xmin, e.xmin), all.xmax = std::max(all.xmax, e.xmax);
+    all.ymin = std::min(all.ymin, e.ymin), all.ymax = std::max(all.ymax, e.ymax);
+    all.obliquity = std::max(all.obliquity, e.obliquity);
+    all.least = std::min(all.least, e.least);
+  });
+  if (all.xmin > all.xmax)
     throw CameraError(InputLocation{"camera", 0, 0, "distortion_coefficients"},
                       "the lens model cannot be inverted anywhere in the image");
   const double pad = 2.0;
-  pinhole_.cx = -xmin * pinhole_.fx + pad;
-  pinhole_.cy = -ymin * pinhole_.fy + pad;
-  pinhole_.width = static_cast<int>(std::ceil((xmax - xmin) * pinhole_.fx + 2 * pad)) + 1;
-  pinhole_.height = static_cast<int>(std::ceil((ymax - ymin) * pinhole_.fy + 2 * pad)) + 1;
+  pinhole_.cx = -all.xmin * pinhole_.fx + pad;
+  pinhole_.cy = -all.ymin * pinhole_.fy + pad;
+  pinhole_.width = static_cast<int>(std::ceil((all.xmax - all.xmin) * pinhole_.fx + 2 * pad)) + 1;
+  pinhole_.height = static_cast<int>(std::ceil((all.ymax - all.ymin) * pinhole_.fy + 2 * pad)) + 1;
   warps_ = true;
-  // The Jacobian of the camera -> pinhole map from each pixel to its right and lower neighbours
-  // (left and upper on the last column and row): its smallest singular value is the least a camera
-  // pixel spans in pinhole pixels, the inverse of the most a pinhole pixel spans in the camera.
-  const int w = camera.width, h = camera.height;
-  double least = 1e300;
-  for (int v = 0; v < h; ++v)
-    for (int u = 0; u < w; ++u) {
-      const int i = v * w + u;
-      if (!valid[i]) continue;
-      const cv::Vec2d p = normal.at<cv::Vec2d>(i);
-      obliquity_ = std::max(obliquity_, std::sqrt(1.0 + p[0] * p[0] + p[1] * p[1]));
-      const int iu = u + 1 < w ? i + 1 : i - 1, iv = v + 1 < h ? i + w : i - w;
-      if (w < 2 || h < 2 || !valid[iu] || !valid[iv]) continue;
-      const double su = u + 1 < w ? 1.0 : -1.0, sv = v + 1 < h ? 1.0 : -1.0;
-      const cv::Vec2d du = (normal.at<cv::Vec2d>(iu) - p) * su, dv = (normal.at<cv::Vec2d>(iv) - p) * sv;
-      const double a = du[0] * pinhole_.fx, b = dv[0] * pinhole_.fx, c = du[1] * pinhole_.fy, d = dv[1] * pinhole_.fy;
-      const double t = a * a + b * b + c * c + d * d, det = a * d - b * c;
-      const double largest = std::sqrt(0.5 * (t + std::sqrt(std::max(0.0, t * t - 4.0 * det * det))));
-      least = std::min(least, largest > 0.0 ? std::abs(det) / largest : 0.0);
-    }
+  obliquity_ = all.obliquity;
+  const double least = all.least;
   stretch_ = least >= 1e300 ? 1.0 / s : least > 0.0 ? 1.0 / least : std::numeric_limits<double>::infinity();
   map_x_.create(camera.height, camera.width, CV_32F);
   map_y_.create(camera.height, camera.width, CV_32F);
-  for (int v = 0, i = 0; v < camera.height; ++v)
-    for (int u = 0; u < camera.width; ++u, ++i) {
-      const cv::Vec2d p = normal.at<cv::Vec2d>(i);
-      map_x_.at<float>(v, u) = valid[i] ? static_cast<float>(p[0] * pinhole_.fx + pinhole_.cx) : -1e6f;
-      map_y_.at<float>(v, u) = valid[i] ? static_cast<float>(p[1] * pinhole_.fy + pinhole_.cy) : -1e6f;
+  cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
+    for (int v = rows.start; v < rows.end; ++v) {
+      auto* mx = map_x_.ptr<float>(v);
+      auto* my = map_y_.ptr<float>(v);
+      for (int u = 0, i = v * w; u < w; ++u, ++i) {
+        const cv::Vec2d p = normal.at<cv::Vec2d>(i);
+        mx[u] = valid[i] ? static_cast<float>(p[0] * pinhole_.fx + pinhole_.cx) : -1e6f;
+        my[u] = valid[i] ? static_cast<float>(p[1] * pinhole_.fy + pinhole_.cy) : -1e6f;
+      }
     }
+  });
 }
 
 std::array<float, 16> Projection::glMatrix(double near, double far) const {

@@ -1,8 +1,8 @@
 #include "kccd/render/ssch_mesh.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <map>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
@@ -29,12 +29,18 @@ SpherePolytope makeSphere(int level) {
     for (int k = 0; k < 3; ++k)
       max_angle = std::max(max_angle, std::acos(std::clamp(std::abs(n.dot(v[t3[k]])), -1.0, 1.0)));
   }
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> owner;  // directed edge -> triangle
+  // Directed edge u -> w to its triangle, listed under u (each vertex starts 5 or 6 edges).
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> owner(v.size());
   for (std::uint32_t t = 0; t < s.triangles.size(); ++t)
-    for (int k = 0; k < 3; ++k) owner[{s.triangles[t][k], s.triangles[t][(k + 1) % 3]}] = t;
+    for (int k = 0; k < 3; ++k) owner[s.triangles[t][k]].emplace_back(s.triangles[t][(k + 1) % 3], t);
+  const auto triangleOf = [&owner](std::uint32_t u, std::uint32_t w) {
+    for (const auto& [to, t] : owner[u])
+      if (to == w) return t;
+    throw std::logic_error("spherePolytope: an edge without its twin");
+  };
   for (const auto& tri : s.triangles) {
     std::array<std::uint32_t, 3> nb{};
-    for (int k = 0; k < 3; ++k) nb[k] = owner.at({tri[(k + 1) % 3], tri[k]});
+    for (int k = 0; k < 3; ++k) nb[k] = triangleOf(tri[(k + 1) % 3], tri[k]);
     s.neighbours.push_back(nb);
   }
   s.vertices = v;
@@ -102,12 +108,14 @@ Mesh segmentMesh(const SpherePolytope& sphere, const Vec3& a, const Vec3& b, dou
 }  // namespace
 
 const SpherePolytope& spherePolytope(int level) {
-  static std::once_flag once;
-  static std::vector<SpherePolytope> levels;
-  std::call_once(once, [] {
-    for (int l = 0; l <= 5; ++l) levels.push_back(makeSphere(l));
-  });
-  return levels.at(static_cast<std::size_t>(std::clamp(level, 0, 5)));
+  // Each level made the first time it is asked for (level 5's 20,480 faces take most of the time,
+  // and a frame rarely needs it).
+  constexpr int kLevels = 6;
+  static std::array<std::once_flag, kLevels> once;
+  static std::array<std::optional<SpherePolytope>, kLevels> levels;
+  const auto l = static_cast<std::size_t>(std::clamp(level, 0, kLevels - 1));
+  std::call_once(once[l], [l] { levels[l].emplace(makeSphere(static_cast<int>(l))); });
+  return *levels[l];
 }
 
 namespace {

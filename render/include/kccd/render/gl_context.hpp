@@ -5,6 +5,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 namespace kccd::render {
 
@@ -59,6 +60,22 @@ class GlContext {
 
  private:
   GlBackend backend_;
+};
+
+/// Loads GlContext::make()'s first choice (EGL's surfaceless display, and with it Mesa's driver)
+/// on a thread of its own while it lives, so that contexts made after other set-up find the
+/// driver loaded; a make() that comes first waits for the load. The destructor waits for the load
+/// to end (so no exit overtakes it). Does nothing for OSMesa or an EGL device (KCCD_GL,
+/// KCCD_EGL_DEVICE) or without EGL; errors are left to make().
+class GlPreparation {
+ public:
+  GlPreparation();
+  ~GlPreparation();
+  GlPreparation(const GlPreparation&) = delete;
+  GlPreparation& operator=(const GlPreparation&) = delete;
+
+ private:
+  std::thread thread_;
 };
 
 }  // namespace kccd::render
