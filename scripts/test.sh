@@ -4,7 +4,8 @@
 # AddressSanitizer + UndefinedBehaviorSanitizer, then every libFuzzer target briefly. The
 # sanitizer build is GCC at -O1 -g1 (the reports' stacks keep files and lines; its tests run 1.3x
 # faster than clang-14's ASan at -O1, 1.8x faster than with libFuzzer's coverage too, so the fuzz
-# targets keep their own clang build, scripts/fuzz.sh), and its statistical tests draw fewer cases
+# targets keep their own clang build, scripts/fuzz.sh; the numeric core, libkccd with its hull and
+# modelling parts, at -O2: CMakeLists.txt's kccd_numeric_core), and its statistical tests draw fewer cases
 # (tests/support/sanitized.hpp). After the Release build, scripts/lint.sh checks the C++ files of
 # the last commit with clang-format and clang-tidy. GCC 12 at -O1 with the sanitizers warns falsely about
 # std::function inside <regex> (maybe-uninitialized): that warning is off there. Each stage's time
