@@ -38,6 +38,13 @@ bool hasExtension(const char* list, const char* name) {
 // and initialising an initialised display again does nothing.
 std::mutex display_mutex;
 
+// eglInitialize under the lock, for a context and for GlPreparation alike: one waits for the other.
+bool initialiseDisplay(EGLDisplay display) {
+  const std::lock_guard lock(display_mutex);
+  EGLint major = 0, minor = 0;
+  return eglInitialize(display, &major, &minor) == EGL_TRUE;
+}
+
 class EglContext final : public GlContext {
  public:
   EglContext() : GlContext(GlBackend::Egl) {
@@ -77,12 +84,7 @@ class EglContext final : public GlContext {
       where = "EGL surfaceless";
     }
     if (display_ == EGL_NO_DISPLAY) throw GlContextError("EGL: " + where + ": " + eglError("eglGetPlatformDisplayEXT"));
-    {
-      const std::lock_guard lock(display_mutex);
-      EGLint major = 0, minor = 0;
-      if (!eglInitialize(display_, &major, &minor))
-        throw GlContextError("EGL: " + where + ": " + eglError("eglInitialize"));
-    }
+    if (!initialiseDisplay(display_)) throw GlContextError("EGL: " + where + ": " + eglError("eglInitialize"));
     try {
       create(where);
     } catch (...) {
@@ -150,11 +152,7 @@ void detail::initialiseEglDisplay() noexcept {
   auto get_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
   if (get_display == nullptr) return;
   const EGLDisplay display = get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-  if (display == EGL_NO_DISPLAY) return;
-  // The same initialisation as a context's, under the same lock: one waits for the other.
-  const std::lock_guard lock(display_mutex);
-  EGLint major = 0, minor = 0;
-  (void)eglInitialize(display, &major, &minor);
+  if (display != EGL_NO_DISPLAY) (void)initialiseDisplay(display);
 }
 
 }  // namespace kccd::render
