@@ -11,70 +11,13 @@
 
 #include "gjk_core.hpp"
 #include "kccd/distance.hpp"
+#include "point_scan.hpp"
 #include "rounding.hpp"
 
 namespace kccd {
-namespace {
 
-using detail::pick;
-
-// Index of the point farthest along d. Four independent running maxima with branch-free
-// selects: the winner changes unpredictably, and one serial compare chain would bound the speed.
-inline int supportIndex(std::span<const Vec3> pts, const Vec3& d) {
-  const double dx = d.x(), dy = d.y(), dz = d.z();
-  const int n = static_cast<int>(pts.size());
-  auto dot = [&](int k) { return pts[k].x() * dx + pts[k].y() * dy + pts[k].z() * dz; };
-  double best_dot[4];
-  int best[4];
-  for (int lane = 0; lane < 4; ++lane) {
-    best[lane] = lane < n ? lane : 0;
-    best_dot[lane] = dot(best[lane]);
-  }
-  int k = 4;
-  for (; k + 4 <= n; k += 4) {
-    for (int lane = 0; lane < 4; ++lane) {
-      const double value = dot(k + lane);
-      best[lane] = pick(value > best_dot[lane], k + lane, best[lane]);
-      best_dot[lane] = std::max(value, best_dot[lane]);
-    }
-  }
-  for (; k < n; ++k) {
-    const double value = dot(k);
-    best[0] = pick(value > best_dot[0], k, best[0]);
-    best_dot[0] = std::max(value, best_dot[0]);
-  }
-  const int ab = pick(best_dot[1] > best_dot[0], 1, 0);
-  const int cd = pick(best_dot[3] > best_dot[2], 3, 2);
-  return best[pick(best_dot[cd] > best_dot[ab], cd, ab)];
-}
-
-// One pass over a point set: its largest absolute coordinate (the rounding scale), whether every
-// coordinate is finite, and its centroid (a point of the hull, to start the descent from).
-struct SetSummary {
-  double scale = 0.0;
-  bool finite = true;
-  Vec3 centroid = Vec3::Zero();
-};
-
-SetSummary summarize(std::span<const Vec3> pts) {
-  SetSummary out;
-  double m = 0.0;
-  double sx = 0.0, sy = 0.0, sz = 0.0;
-  for (const Vec3& p : pts) {
-    sx += p.x();
-    sy += p.y();
-    sz += p.z();
-    m = std::max(m, std::max(std::abs(p.x()), std::max(std::abs(p.y()), std::abs(p.z()))));
-  }
-  out.centroid = Vec3(sx, sy, sz) / static_cast<double>(pts.size());
-  // A NaN or infinite coordinate makes its sum NaN or infinite (so does an overflowing sum, which
-  // is rejected as well); an infinity also shows in the maximum.
-  out.finite = out.centroid.allFinite() && m <= std::numeric_limits<double>::max();
-  out.scale = m;
-  return out;
-}
-
-}  // namespace
+using detail::summarize;
+using detail::supportIndex;
 
 bool allFinite(std::span<const Vec3> points) noexcept {
   return std::all_of(points.begin(), points.end(), [](const Vec3& p) { return p.allFinite(); });
@@ -86,8 +29,8 @@ DistanceResult distance(const SschView& a, const SschView& b, const GjkOptions& 
       !std::isfinite(b.radius)) {
     return result;  // InvalidInput, distance 0
   }
-  const SetSummary sum_a = summarize(a.points);
-  const SetSummary sum_b = summarize(b.points);
+  const detail::PointSummary sum_a = summarize(a.points);
+  const detail::PointSummary sum_b = summarize(b.points);
   if (!sum_a.finite || !sum_b.finite) return result;
   detail::SetsInfo info;
   info.scale_a = sum_a.scale;

@@ -28,6 +28,7 @@ struct SupportHit {
 
 // The current simplex: up to four vertices w = a - b of D, the support points a and b that made
 // them and their keys. Unused slots stay finite (zero): the sub-algorithm weighs all four slots.
+// Only the first `size` slots of a, b, ka, kb and lambda are ever read, so they start unset.
 struct Simplex {
   Vec3 w[4] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
   Vec3 a[4] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
@@ -91,8 +92,10 @@ inline void keepBest(const Vec3* w, const double* cand, double* best, double& be
   }
 }
 
-// Closest point of triangle (w[i], w[j], w[k]) to the origin.
-inline void closestOnTriangle(const Vec3* w, int i, int j, int k, double* lam) {
+// Closest point of triangle (w[i], w[j], w[k]) to the origin. `newest` is the vertex GJK just
+// added (or -1): the closest point involves it, since the old vertices' closest point v is farther
+// than the segment from v towards it, so the edge opposite it is tried only if no other edge is.
+inline void closestOnTriangle(const Vec3* w, int i, int j, int k, double* lam, int newest = -1) {
   const Vec3 n = (w[j] - w[i]).cross(w[k] - w[i]);
   const int axis = argMaxAbs(n);
   const int ids[3] = {i, j, k};
@@ -121,17 +124,25 @@ inline void closestOnTriangle(const Vec3* w, int i, int j, int k, double* lam) {
   double best_vv = std::numeric_limits<double>::infinity();
   double cand[4];
   for (int e = 0; e < 3; ++e) {
-    if (mu != 0.0 && sameSign(mu, c[e])) continue;
+    if ((mu != 0.0 && sameSign(mu, c[e])) || ids[e] == newest) continue;
     closestOnSegment(w, ids[(e + 1) % 3], ids[(e + 2) % 3], cand);
     keepBest(w, cand, best, best_vv);
+  }
+  if (best_vv == std::numeric_limits<double>::infinity()) {  // rounding left no edge: try them all
+    for (int e = 0; e < 3; ++e) {
+      closestOnSegment(w, ids[(e + 1) % 3], ids[(e + 2) % 3], cand);
+      keepBest(w, cand, best, best_vv);
+    }
   }
   std::copy(best, best + 4, lam);
 }
 
 inline double det3(const Vec3& a, const Vec3& b, const Vec3& c) { return a.dot(b.cross(c)); }
 
-// Closest point of tetrahedron w[0..3] to the origin.
+// Closest point of tetrahedron w[0..3] to the origin; w[3] is the vertex GJK just added, so the
+// face opposite it is tried only if no other face is (as for a triangle).
 inline void closestOnTetrahedron(const Vec3* w, double* lam) {
+  constexpr int kNewest = 3;
   // Cofactors: c[x] is the signed volume with vertex x replaced by the origin.
   const double c[4] = {det3(w[1], w[2], w[3]), -det3(w[0], w[2], w[3]), det3(w[0], w[1], w[3]),
                        -det3(w[0], w[1], w[2])};
@@ -145,17 +156,24 @@ inline void closestOnTetrahedron(const Vec3* w, double* lam) {
   double cand[4];
   static constexpr int kFace[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
   for (int x = 0; x < 4; ++x) {
-    if (vol != 0.0 && sameSign(vol, c[x])) continue;
-    closestOnTriangle(w, kFace[x][0], kFace[x][1], kFace[x][2], cand);
+    if ((vol != 0.0 && sameSign(vol, c[x])) || x == kNewest) continue;
+    closestOnTriangle(w, kFace[x][0], kFace[x][1], kFace[x][2], cand, kNewest);
     keepBest(w, cand, best, best_vv);
+  }
+  if (best_vv == std::numeric_limits<double>::infinity()) {  // rounding left no face: try them all
+    for (int x = 0; x < 4; ++x) {
+      closestOnTriangle(w, kFace[x][0], kFace[x][1], kFace[x][2], cand);
+      keepBest(w, cand, best, best_vv);
+    }
   }
   std::copy(best, best + 4, lam);
 }
 
-// Runs the sub-algorithm on s, drops vertices with zero weight and returns the closest point.
-inline Vec3 reduce(Simplex& s) {
-  double lam[4] = {0.0, 0.0, 0.0, 0.0};
-  switch (s.size) {
+// The sub-algorithm on the first `count` vertices of s (the last of them just added): the
+// weights of the closest point to the origin, in lam. s itself is not changed.
+inline void closestWeights(const Simplex& s, int count, double* lam) {
+  clear(lam);
+  switch (count) {
     case 1:
       lam[0] = 1.0;
       break;
@@ -163,14 +181,18 @@ inline Vec3 reduce(Simplex& s) {
       closestOnSegment(s.w, 0, 1, lam);
       break;
     case 3:
-      closestOnTriangle(s.w, 0, 1, 2, lam);
+      closestOnTriangle(s.w, 0, 1, 2, lam, 2);
       break;
     default:
       closestOnTetrahedron(s.w, lam);
       break;
   }
+}
+
+// Keeps the vertices of s's first `count` with a positive weight in lam, with those weights.
+inline void keepWeighted(Simplex& s, int count, const double* lam) {
   int n = 0;
-  for (int x = 0; x < s.size; ++x) {
+  for (int x = 0; x < count; ++x) {
     if (lam[x] > 0.0) {
       s.w[n] = s.w[x];
       s.a[n] = s.a[x];
@@ -182,9 +204,6 @@ inline Vec3 reduce(Simplex& s) {
     }
   }
   s.size = n;
-  Vec3 v = Vec3::Zero();
-  for (int x = 0; x < n; ++x) v += s.lambda[x] * s.w[x];
-  return v;
 }
 
 /// What the support functions' sets look like to the descent: the largest absolute coordinate of
@@ -223,8 +242,9 @@ DistanceResult gjkDistance(const SupportA& sa, const SupportB& sb, double ra, do
   } else {
     for (; iter < options.max_iterations; ++iter) {
       const double vv = v.squaredNorm();
+      const double v_norm = std::sqrt(vv);  // one root per iteration, started before the supports
       // v is a point of the difference of the supports' hulls: |v| bounds the distance from above.
-      if (s.size > 0 && std::sqrt(vv) - radii + guard <= options.stop_below) {
+      if (s.size > 0 && v_norm - radii + guard <= options.stop_below) {
         status = GjkStatus::StoppedEarly;
         break;
       }
@@ -232,7 +252,7 @@ DistanceResult gjkDistance(const SupportA& sa, const SupportB& sb, double ra, do
       const SupportHit hb = sb(v);
       const Vec3 w = ha.point - hb.point;
       const double vw = v.dot(w);
-      lower = std::max(lower, vw / std::sqrt(vv) - ha.slack - hb.slack);
+      lower = std::max(lower, vw / v_norm - ha.slack - hb.slack);
       if (lower - radii - guard >= options.stop_above) {
         status = GjkStatus::StoppedEarly;
         break;
@@ -248,16 +268,22 @@ DistanceResult gjkDistance(const SupportA& sa, const SupportB& sb, double ra, do
         status = GjkStatus::Converged;
         break;
       }
+      // The new vertex goes into the next free slot; s keeps its size (and v's weights) until the
+      // sub-algorithm's point is known to be closer, so a stop here reports v's witnesses.
       const int previous_size = s.size;
-      s.w[s.size] = w;
-      s.a[s.size] = ha.point;
-      s.b[s.size] = hb.point;
-      s.ka[s.size] = ha.key;
-      s.kb[s.size] = hb.key;
-      ++s.size;
-      const Vec3 next = reduce(s);
+      const int count = previous_size + 1;
+      s.w[previous_size] = w;
+      s.a[previous_size] = ha.point;
+      s.b[previous_size] = hb.point;
+      s.ka[previous_size] = ha.key;
+      s.kb[previous_size] = hb.key;
+      double lam[4];
+      closestWeights(s, count, lam);
+      const Vec3 next = combine(s.w, lam);
       const double next_vv = next.squaredNorm();
-      if (s.size == 4 || next_vv <= overlap_vv) {
+      const bool inside = count == 4 && lam[0] > 0.0 && lam[1] > 0.0 && lam[2] > 0.0 && lam[3] > 0.0;
+      if (inside || next_vv <= overlap_vv) {
+        keepWeighted(s, count, lam);
         v = next;
         status = GjkStatus::Overlap;
         ++iter;
@@ -268,6 +294,7 @@ DistanceResult gjkDistance(const SupportA& sa, const SupportB& sb, double ra, do
         ++iter;
         break;
       }
+      keepWeighted(s, count, lam);
       v = next;
     }
   }

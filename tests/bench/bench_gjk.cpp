@@ -81,11 +81,16 @@ const PairSet& pairs(int regime, int n) {
 void BM_KccdGjk(benchmark::State& state) {
   const PairSet& ps = pairs(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   std::size_t i = 0;
+  long iterations = 0;
   for (auto _ : state) {
     const auto r = kccd::distance({ps.a[i], 0.0}, {ps.b[i], 0.0});
     benchmark::DoNotOptimize(r);
+    iterations += r.iterations;
     i = (i + 1) % ps.a.size();
   }
+  // GJK iterations per call (each makes one support call per set).
+  state.counters["iterations"] =
+      benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
   state.SetLabel(state.range(0) == kSeparated ? "separated" : state.range(0) == kNearTouching ? "near" : "overlap");
 }
 
