@@ -20,6 +20,7 @@
 #include "kccd/modelling/fit.hpp"
 #include "kccd/modelling/pair_proof.hpp"
 #include "kccd/modelling/urdf_import.hpp"
+#include "robots.hpp"
 
 namespace km = kccd::modelling;
 using kccd::Vec3;
@@ -292,48 +293,12 @@ BENCHMARK_CAPTURE(BM_PairLooseness, wam, "wam/wam.urdf")
 // and per pair of links (pieces of a link together) the looseness hull distance - model distance
 // in mm over the pairs whose hulls are apart but within 0.1 m (negative: tighter than the hulls,
 // which pieces can be). `ratio_*` divide by K = 8's time, measured interleaved in the same loop.
-// The KR5 and WAM come from Debian's dart-doc; the Panda and xArm from the folder
-// $KCCD_REAL_ROBOTS (panda/panda.urdf, xarm7_realsense/description/xarm7.urdf); a robot that is
-// not there is skipped. KCCD_BENCH_TOLERANCE_MM and KCCD_BENCH_CONCAVITY_MM set the default import's tolerance and
-// concavity, and
-// KCCD_BENCH_BUDGET every model's point budget, to measure other choices.
-struct Robot {
-  std::string urdf;
-  std::map<std::string, std::string> packages;
-};
-
-Robot robotNamed(const std::string& name) {
-  const std::string dart = "/usr/share/doc/dart/data/urdf/";
-  const char* real = std::getenv("KCCD_REAL_ROBOTS");
-  const std::string r = real ? real : "";
-  if (name == "kr5") return {dart + "KR5/KR5 sixx R650.urdf", {}};
-  if (name == "wam") return {dart + "wam/wam.urdf", {{"herb_description", dart + "wam"}}};
-  if (name == "panda") return {r + "/panda/panda.urdf", {{"Panda", r + "/panda"}}};
-  return {r + "/xarm7_realsense/description/xarm7.urdf", {{"xarm_description", r + "/xarm7_realsense/description"}}};
-}
-
-enum ImportMode { kDefault = 0, kEight = 1, kHulls = 2 };
-
-const kccd::Model& importedModel(const std::string& robot, int mode) {
-  static std::map<std::pair<std::string, int>, std::unique_ptr<kccd::Model>> cache;
-  auto& slot = cache[{robot, mode}];
-  if (!slot) {
-    const Robot r = robotNamed(robot);
-    km::ImportOptions o;
-    o.visuals = false;
-    o.packages = r.packages;
-    if (const char* t = std::getenv("KCCD_BENCH_TOLERANCE_MM"))
-      o.fit.tolerance = std::atof(t) * 1e-3;  // other defaults
-    if (const char* c = std::getenv("KCCD_BENCH_CONCAVITY_MM")) o.fit.concavity = std::atof(c) * 1e-3;
-    if (mode == kEight) o.fit.method = km::FitMethod::Points, o.fit.max_pieces = 1;
-    if (mode == kHulls) o.fit.method = km::FitMethod::Hull, o.fit.max_pieces = 1;
-    const std::string text = km::importUrdf(r.urdf, o);
-    slot = std::make_unique<kccd::Model>(kccd::parseModel(text, r.urdf));
-    if (const char* budget = std::getenv("KCCD_BENCH_BUDGET")) slot->point_budget = std::atoi(budget);
-    // The ignore rules of the import (rigid, adjacent) stay; every other pair is checked.
-  }
-  return *slot;
-}
+// The robots and their imports: robots.hpp.
+using kccd::bench::importedModel;
+using kccd::bench::kDefault;
+using kccd::bench::kEight;
+using kccd::bench::kHulls;
+using kccd::bench::robotNamed;
 
 // Per link pair (by name) the smallest distance over its body pairs.
 std::map<std::pair<std::string, std::string>, double> linkDistances(const kccd::Model& m, const kccd::QueryResult& r) {
