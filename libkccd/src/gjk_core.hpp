@@ -28,7 +28,6 @@ struct SupportHit {
 
 // The current simplex: up to four vertices w = a - b of D, the support points a and b that made
 // them and their keys. Unused slots stay finite (zero): the sub-algorithm weighs all four slots.
-// Only the first `size` slots of a, b, ka, kb and lambda are ever read, so they start unset.
 struct Simplex {
   Vec3 w[4] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
   Vec3 a[4] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
