@@ -41,7 +41,7 @@ __attribute__((target("avx2"))) inline __m256d dots(const double* p, __m256d dx,
 
 __attribute__((target("avx2"))) int supportIndexAvx2(std::span<const Vec3> pts, const Vec3& d) noexcept {
   const int n = static_cast<int>(pts.size());
-  if (n < 8) return supportIndexScalar(pts, d);
+  if (n < 4) return supportIndexScalar(pts, d);  // the first step reads four points
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "points are packed x, y, z");
   const double* base = pts.data()->data();
   const __m256d dx = _mm256_set1_pd(d.x()), dy = _mm256_set1_pd(d.y()), dz = _mm256_set1_pd(d.z());
@@ -69,7 +69,7 @@ __attribute__((target("avx2"))) int supportIndexAvx2(std::span<const Vec3> pts, 
 
 __attribute__((target("avx2"))) PointSummary summarizeAvx2(std::span<const Vec3> pts) noexcept {
   const std::size_t n = pts.size();
-  if (n < 4) return summarizeScalar(pts);
+  if (n < 4) return summarizeScalar(pts);  // each step reads four points
   const double* base = pts.data()->data();
   const __m256d no_sign = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffff));
   __m256d sx = _mm256_setzero_pd(), sy = sx, sz = sx, m = sx;

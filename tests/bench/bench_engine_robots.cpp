@@ -17,6 +17,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <set>
 #include <string>
@@ -46,7 +47,6 @@ constexpr double kMargin = 0.005;
 
 // A link's collision meshes as one BVH in the link's frame, and the frame the model puts it in.
 struct Link {
-  std::string name;
   int frame = kWorld;
   std::shared_ptr<Mesh> mesh;
   int triangles = 0;
@@ -69,6 +69,13 @@ std::string meshFile(const std::string& urdf, const std::string& uri, const std:
   return fs::path(uri).is_absolute() ? uri : (fs::path(urdf).parent_path() / uri).string();
 }
 
+// The two links' indices in order, when both have meshes and they differ.
+std::optional<std::pair<int, int>> linkPair(const Arm& a, const std::string& x, const std::string& y) {
+  const auto ix = a.link_index.find(x), iy = a.link_index.find(y);
+  if (ix == a.link_index.end() || iy == a.link_index.end() || ix->second == iy->second) return std::nullopt;
+  return std::minmax(ix->second, iy->second);
+}
+
 // The URDF's collision meshes per link (the four robots' collision geometry is all meshes).
 const Arm& arm(const std::string& robot) {
   static std::map<std::string, Arm> cache;
@@ -79,7 +86,6 @@ const Arm& arm(const std::string& robot) {
   const urdf::ModelInterfaceSharedPtr u = urdf::parseURDFFile(r.urdf);
   for (const auto& [name, link] : u->links_) {
     Link l;
-    l.name = name;
     const auto body =
         std::find_if(model.bodies.begin(), model.bodies.end(), [&](const Body& b) { return b.linkName() == name; });
     if (body == model.bodies.end()) continue;  // no geometry, so no body
@@ -106,12 +112,8 @@ const Arm& arm(const std::string& robot) {
     a.links.push_back(std::move(l));
   }
   std::set<std::pair<int, int>> pairs;
-  for (const BodyPair& p : model.pairs) {
-    const auto ia = a.link_index.find(model.bodies[p.a].linkName());
-    const auto ib = a.link_index.find(model.bodies[p.b].linkName());
-    if (ia == a.link_index.end() || ib == a.link_index.end() || ia->second == ib->second) continue;
-    pairs.insert(std::minmax(ia->second, ib->second));
-  }
+  for (const BodyPair& p : model.pairs)
+    if (const auto lp = linkPair(a, model.bodies[p.a].linkName(), model.bodies[p.b].linkName())) pairs.insert(*lp);
   a.pairs.assign(pairs.begin(), pairs.end());
   return a;
 }
@@ -140,6 +142,9 @@ void BM_WholeArm(benchmark::State& state, const char* robot) {
   const Arm& a = arm(robot);
   Checker checker(model);
   const auto ranges = km::jointRanges(model);
+  auto range = [&](int s) {  // a state's limits; ±3 where it has none
+    return std::pair{std::isnan(ranges[s][0]) ? -3.0 : ranges[s][0], std::isnan(ranges[s][1]) ? 3.0 : ranges[s][1]};
+  };
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const QueryOptions collision{.type = QueryType::Collision, .margin = kMargin};
@@ -163,8 +168,7 @@ void BM_WholeArm(benchmark::State& state, const char* robot) {
       std::vector<double> q(static_cast<std::size_t>(model.stateSize())), lo, hi;
       for (int tries = 0;; ++tries) {
         for (int s = 0; s < model.stateSize(); ++s) {
-          const double l = std::isnan(ranges[s][0]) ? -3.0 : ranges[s][0],
-                       h = std::isnan(ranges[s][1]) ? 3.0 : ranges[s][1];
+          const auto [l, h] = range(s);
           q[s] = l + (h - l) * u(rng);
         }
         checker.reset();
@@ -219,20 +223,14 @@ void BM_WholeArm(benchmark::State& state, const char* robot) {
       // The check: per link pair, the model's static bound at the centre <= FCL's mesh distance.
       checker.reset();
       const QueryResult& r = checker.query(q, q, statics);
-      std::map<std::pair<int, int>, double> bound;
-      for (const PairDistance& d : r.pairs) {
-        const auto ia = a.link_index.find(model.bodies[model.pairs[d.pair].a].linkName());
-        const auto ib = a.link_index.find(model.bodies[model.pairs[d.pair].b].linkName());
-        if (ia == a.link_index.end() || ib == a.link_index.end() || ia->second == ib->second) continue;
-        auto [it, fresh] = bound.try_emplace(std::minmax(ia->second, ib->second), d.distance);
-        if (!fresh) it->second = std::min(it->second, d.distance);
-      }
       const auto tf = linkPoses(model, a, q, poses);
-      for (const auto& [key, b] : bound) {
+      for (const auto& [names, b] : bench::linkDistances(model, r)) {
+        const auto lp = linkPair(a, names.first, names.second);
+        if (!lp) continue;
+        const auto [i, j] = *lp;
         fcl::DistanceRequestd request;
         fcl::DistanceResultd result;
-        const double mesh = fcl::distance(a.links[key.first].mesh.get(), tf[key.first], a.links[key.second].mesh.get(),
-                                          tf[key.second], request, result);
+        const double mesh = fcl::distance(a.links[i].mesh.get(), tf[i], a.links[j].mesh.get(), tf[j], request, result);
         ++checked_pairs;
         if (mesh <= 0.0) continue;
         above_fcl += b > mesh + 1e-9;
@@ -248,8 +246,7 @@ void BM_WholeArm(benchmark::State& state, const char* robot) {
       for (const Joint& j : model.joints) {
         if (j.type != JointType::Revolute && j.type != JointType::Prismatic) continue;
         const double step = (j.type == JointType::Revolute ? 0.25 * kDeg : 0.25e-3) * (u(rng) < 0.5 ? -1.0 : 1.0);
-        const double l = std::isnan(ranges[j.state_offset][0]) ? -3.0 : ranges[j.state_offset][0];
-        const double h = std::isnan(ranges[j.state_offset][1]) ? 3.0 : ranges[j.state_offset][1];
+        const auto [l, h] = range(j.state_offset);
         q[j.state_offset] = std::clamp(q[j.state_offset] + step, l, h);
         const double w = 10.0 * (j.type == JointType::Revolute ? kDeg : 1e-3);
         lo[j.state_offset] = q[j.state_offset] - 0.5 * w;

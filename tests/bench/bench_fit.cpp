@@ -298,19 +298,8 @@ using kccd::bench::importedModel;
 using kccd::bench::kDefault;
 using kccd::bench::kEight;
 using kccd::bench::kHulls;
+using kccd::bench::linkDistances;
 using kccd::bench::robotNamed;
-
-// Per link pair (by name) the smallest distance over its body pairs.
-std::map<std::pair<std::string, std::string>, double> linkDistances(const kccd::Model& m, const kccd::QueryResult& r) {
-  std::map<std::pair<std::string, std::string>, double> out;
-  for (const kccd::PairDistance& d : r.pairs) {
-    std::string a = m.bodies[m.pairs[d.pair].a].linkName(), b = m.bodies[m.pairs[d.pair].b].linkName();
-    if (b < a) std::swap(a, b);
-    auto [it, fresh] = out.try_emplace({a, b}, d.distance);
-    if (!fresh) it->second = std::min(it->second, d.distance);
-  }
-  return out;
-}
 
 void BM_ImportCost(benchmark::State& state, const char* robot) {
   const int mode = static_cast<int>(state.range(0));

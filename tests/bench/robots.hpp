@@ -6,6 +6,7 @@
 // concavity, and KCCD_BENCH_BUDGET every model's point budget, to measure other choices.
 #pragma once
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -15,6 +16,7 @@
 
 #include "kccd/model.hpp"
 #include "kccd/modelling/urdf_import.hpp"
+#include "kccd/query.hpp"
 
 namespace kccd::bench {
 
@@ -56,6 +58,18 @@ inline const Model& importedModel(const std::string& robot, int mode) {
     // The ignore rules of the import (rigid, adjacent) stay; every other pair is checked.
   }
   return *slot;
+}
+
+/// Per link pair (by name, in order) the smallest distance of `r` over its body pairs.
+inline std::map<std::pair<std::string, std::string>, double> linkDistances(const Model& m, const QueryResult& r) {
+  std::map<std::pair<std::string, std::string>, double> out;
+  for (const PairDistance& d : r.pairs) {
+    std::string a = m.bodies[m.pairs[d.pair].a].linkName(), b = m.bodies[m.pairs[d.pair].b].linkName();
+    if (b < a) std::swap(a, b);
+    auto [it, fresh] = out.try_emplace({a, b}, d.distance);
+    if (!fresh) it->second = std::min(it->second, d.distance);
+  }
+  return out;
 }
 
 }  // namespace kccd::bench
