@@ -85,8 +85,13 @@ recorded video, robot logs (MCAP, rosbag2, ROS 1) and LeRobot datasets.")
 # image_file.cpp): dpkg-shlibdeps cannot see it, so its package is recommended by name.
 string(REGEX REPLACE "^libopencv_imgcodecs\\.so\\.(.+)$" "libopencv-imgcodecs\\1" _kccd_imgcodecs_package
        "${KCCD_OPENCV_IMGCODECS_SONAME}")
-set(CPACK_DEBIAN_CLI_PACKAGE_RECOMMENDS "${_kccd_imgcodecs_package}")
-set(CPACK_DEBIAN_PYTHON_PACKAGE_RECOMMENDS "${_kccd_imgcodecs_package}")
+# OSMesa, the GL back end when EGL gives no context, is loaded by name too (render's gl_context_osmesa.cpp).
+set(_kccd_runtime_recommends "${_kccd_imgcodecs_package}")
+if(KCCD_OSMESA_SONAME STREQUAL "libOSMesa.so.8")
+  string(APPEND _kccd_runtime_recommends ", libosmesa6")
+endif()
+set(CPACK_DEBIAN_CLI_PACKAGE_RECOMMENDS "${_kccd_runtime_recommends}")
+set(CPACK_DEBIAN_PYTHON_PACKAGE_RECOMMENDS "${_kccd_runtime_recommends}")
 
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME libkccd-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
@@ -95,7 +100,7 @@ set(CPACK_DEBIAN_DEV_PACKAGE_ARCHITECTURE amd64)
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "cmake (>= 3.20), libeigen3-dev (>= 3.4), libccd-dev, libyaml-cpp-dev, \
 libqhull-dev, libcoin-dev, libassimp-dev, liburdfdom-dev, libtinyxml2-dev, libopencv-dev (>= 4.6), libpng-dev, \
 libjpeg-dev, libapriltag-dev, zlib1g-dev, libzstd-dev, liblz4-dev, libbz2-dev, libsqlite3-dev, libsnappy-dev, \
-libosmesa6-dev, libegl-dev, libgl-dev, libopengl-dev, nlohmann-json3-dev, libcpp-httplib-dev, libssl-dev, \
+libegl-dev, libgl-dev, nlohmann-json3-dev, libcpp-httplib-dev, libssl-dev, \
 libavformat-dev, libavcodec-dev, libavutil-dev, libswscale-dev")
 set(CPACK_DEBIAN_DEV_DESCRIPTION "strictly conservative continuous collision detection for robots (C++)
 The KCCD C++ libraries (static), their headers and their CMake package:

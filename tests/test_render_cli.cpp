@@ -118,6 +118,31 @@ TEST_F(RenderCli, AFallBackToOsMesaIsSaid) {
   EXPECT_FALSE(fs::exists(out("pinned.png")));
 }
 
+// OSMesa (and the LLVM behind it) is loaded only by a program that renders with it: the loader's
+// own record of the files it opened (LD_DEBUG=files) names libOSMesa under KCCD_GL=osmesa, never
+// under EGL, and both draw the same volumes.
+TEST_F(RenderCli, OsMesaIsLoadedOnlyWhenItRenders) {
+  const std::string args = base() + " --state 0.3,0.4,0.6 -o ";
+  auto opened = [](const std::string& err) { return err.find("file=libOSMesa.so") != std::string::npos; };
+  const Outcome egl =
+      kccd::testing::runProgram("LD_DEBUG=files KCCD_GL=egl " + std::string(KCCD_CLI) + " " + args + out("egl.png"));
+  ASSERT_EQ(egl.code, 0) << egl.err;
+  EXPECT_NE(egl.err.find("file=libEGL.so"), std::string::npos) << "no loader record in the output";
+  EXPECT_FALSE(opened(egl.err));
+  const Outcome osmesa = kccd::testing::runProgram("LD_DEBUG=files KCCD_GL=osmesa " + std::string(KCCD_CLI) + " " +
+                                                   args + out("osmesa.png"));
+  ASSERT_EQ(osmesa.code, 0) << osmesa.err;
+  EXPECT_TRUE(opened(osmesa.err));
+  EXPECT_NE(osmesa.out.find("/ OSMesa"), std::string::npos) << osmesa.out;
+  const cv::Mat a = cv::imread(out("egl.png"), cv::IMREAD_UNCHANGED),
+                b = cv::imread(out("osmesa.png"), cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(a.empty());
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_GT(cv::countNonZero(a.reshape(1) > 0), 0);
+  // The two back ends are both llvmpipe here: the same pixels but for rounding along edges.
+  EXPECT_LT(cv::countNonZero(a.reshape(1) != b.reshape(1)), a.total() / 100);
+}
+
 TEST_F(RenderCli, BadInputExitsTwoWithOneLine) {
   const std::string o = " -o " + out("bad.png");
   struct Case {

@@ -1,12 +1,11 @@
 // Choosing the GlContext back end (KCCD_GL) and the checks every back end shares.
-#include <GL/gl.h>
-
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
 #include <string>
 #include <system_error>
 
+#include "gl_api.hpp"
 #include "gl_backends.hpp"
 #include "kccd/render/gl_context.hpp"
 
@@ -33,8 +32,8 @@ bool compiledIn(GlBackend backend) {
 }
 
 void GlContext::describe(const std::string& who, const std::string& suffix) {
-  const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-  const auto* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+  const auto* renderer = reinterpret_cast<const char*>(detail::GL().GetString(GL_RENDERER));
+  const auto* version = reinterpret_cast<const char*>(detail::GL().GetString(GL_VERSION));
   if (renderer == nullptr || version == nullptr)
     throw GlContextError(who + ": the context gives no GL_RENDERER string (is libGL linked ahead of libOSMesa?)");
   int major = 0;

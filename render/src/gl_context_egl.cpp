@@ -5,15 +5,17 @@
 // rendering goes to FBOs.
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
-#include <GL/gl.h>
+#include <dlfcn.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "gl_api.hpp"
 #include "gl_backends.hpp"
 
 namespace kccd::render {
@@ -43,6 +45,25 @@ bool initialiseDisplay(EGLDisplay display) {
   const std::lock_guard lock(display_mutex);
   EGLint major = 0, minor = 0;
   return eglInitialize(display, &major, &minor) == EGL_TRUE;
+}
+
+// The GL entry points of EGL contexts: eglGetProcAddress gives them all (EGL 1.5, or glvnd's
+// dispatch to the current context); an EGL without EGL_KHR_get_all_proc_addresses has the core
+// ones in glvnd's libOpenGL.
+void* resolveGl(const char* name) {
+  if (auto* found = eglGetProcAddress(name)) return reinterpret_cast<void*>(found);
+  static void* const opengl = ::dlopen("libOpenGL.so.0", RTLD_NOW | RTLD_LOCAL);
+  return opengl == nullptr ? nullptr : ::dlsym(opengl, name);
+}
+
+const detail::GlApi& eglGlApi() {
+  static const std::pair<detail::GlApi, std::string> loaded = [] {
+    std::pair<detail::GlApi, std::string> entry;
+    entry.second = detail::loadGlApi(entry.first, resolveGl);
+    return entry;
+  }();
+  if (!loaded.second.empty()) throw GlContextError("EGL: eglGetProcAddress gives no " + loaded.second);
+  return loaded.first;
 }
 
 class EglContext final : public GlContext {
@@ -97,6 +118,7 @@ class EglContext final : public GlContext {
   void makeCurrent() override {
     if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
       throw GlContextError("EGL: " + eglError("eglMakeCurrent"));
+    detail::setCurrentGlApi(api_);
   }
 
  private:
@@ -121,6 +143,7 @@ class EglContext final : public GlContext {
                               EGL_CONTEXT_OPENGL_PROFILE_MASK,
                               EGL_CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT,
                               EGL_NONE};
+    api_ = &eglGlApi();
     context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, attribs);
     if (context_ == EGL_NO_CONTEXT)
       throw GlContextError("EGL: " + where + ": a GL 3.0 compatibility context: " + eglError("eglCreateContext"));
@@ -131,7 +154,10 @@ class EglContext final : public GlContext {
   void release() {
     if (display_ == EGL_NO_DISPLAY) return;
     if (context_ != EGL_NO_CONTEXT) {
-      if (eglGetCurrentContext() == context_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+      if (eglGetCurrentContext() == context_) {
+        eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        detail::setCurrentGlApi(nullptr);
+      }
       eglDestroyContext(display_, context_);
       context_ = EGL_NO_CONTEXT;
     }
@@ -140,6 +166,7 @@ class EglContext final : public GlContext {
 
   EGLDisplay display_ = EGL_NO_DISPLAY;
   EGLContext context_ = EGL_NO_CONTEXT;
+  const detail::GlApi* api_ = nullptr;
 };
 
 }  // namespace

@@ -1,10 +1,9 @@
 #include "gl_targets.hpp"
 
-#include <GL/glext.h>
-
 #include <algorithm>
 #include <string>
 
+#include "gl_api.hpp"
 #include "kccd/render/gl_context.hpp"
 
 namespace kccd::render::detail {
@@ -38,23 +37,23 @@ void main() {
 )";
 
 GLuint compile(GLenum type, const char* source) {
-  const GLuint shader = glCreateShader(type);
-  glShaderSource(shader, 1, &source, nullptr);
-  glCompileShader(shader);
+  const GLuint shader = GL().CreateShader(type);
+  GL().ShaderSource(shader, 1, &source, nullptr);
+  GL().CompileShader(shader);
   GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  GL().GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
   if (!ok) {
     char log[1024] = {};
-    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-    glDeleteShader(shader);
+    GL().GetShaderInfoLog(shader, sizeof log, nullptr, log);
+    GL().DeleteShader(shader);
     throw GlContextError(std::string("GL: label shader: ") + log);
   }
   return shader;
 }
 
 void check(GLuint fbo, const char* what) {
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  GL().BindFramebuffer(GL_FRAMEBUFFER, fbo);
+  const GLenum status = GL().CheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE)
     throw GlContextError(std::string("GL: ") + what + " framebuffer incomplete (status " + std::to_string(status) +
                          ")");
@@ -62,12 +61,12 @@ void check(GLuint fbo, const char* what) {
 
 GLuint renderbuffer(GLenum format, int samples, int w, int h) {
   GLuint rb = 0;
-  glGenRenderbuffers(1, &rb);
-  glBindRenderbuffer(GL_RENDERBUFFER, rb);
+  GL().GenRenderbuffers(1, &rb);
+  GL().BindRenderbuffer(GL_RENDERBUFFER, rb);
   if (samples > 1)
-    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, w, h);
+    GL().RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, w, h);
   else
-    glRenderbufferStorage(GL_RENDERBUFFER, format, w, h);
+    GL().RenderbufferStorage(GL_RENDERBUFFER, format, w, h);
   return rb;
 }
 
@@ -76,69 +75,69 @@ GLuint renderbuffer(GLenum format, int samples, int w, int h) {
 GlTargets::GlTargets(int w, int h, int want_samples, int mw, int mh)
     : width(w), height(h), mask_width(mw), mask_height(mh) {
   GLint max_samples = 0, max_size = 0;
-  glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
-  glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
+  GL().GetIntegerv(GL_MAX_SAMPLES, &max_samples);
+  GL().GetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
   if (std::max({w, h, mw, mh}) > max_size)
     throw GlContextError("GL: image " + std::to_string(std::max(w, mw)) + "x" + std::to_string(std::max(h, mh)) +
                          " exceeds the renderbuffer limit " + std::to_string(max_size));
   samples = want_samples > 1 ? std::min(want_samples, static_cast<int>(max_samples)) : 0;
   resolve_colour = renderbuffer(GL_RGBA8, 0, w, h);
-  glGenFramebuffers(1, &resolve_fbo);
-  glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, resolve_colour);
+  GL().GenFramebuffers(1, &resolve_fbo);
+  GL().BindFramebuffer(GL_FRAMEBUFFER, resolve_fbo);
+  GL().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, resolve_colour);
   resolve_depth = renderbuffer(GL_DEPTH_COMPONENT32F, 0, w, h);  // float: labels of near surfaces at any near plane
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, resolve_depth);
+  GL().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, resolve_depth);
   resolve_labels = renderbuffer(GL_R8, 0, w, h);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, resolve_labels);
+  GL().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, resolve_labels);
   check(resolve_fbo, "colour");
   if (samples > 1) {
     ms_colour = renderbuffer(GL_RGBA8, samples, w, h);
-    glGenFramebuffers(1, &ms_fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ms_colour);
+    GL().GenFramebuffers(1, &ms_fbo);
+    GL().BindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
+    GL().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ms_colour);
     ms_depth = renderbuffer(GL_DEPTH_COMPONENT24, samples, w, h);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth);
+    GL().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth);
     check(ms_fbo, "multisample colour");
   }
   if (mw != w || mh != h) {
     mask_labels = renderbuffer(GL_R8, 0, mw, mh);
-    glGenFramebuffers(1, &mask_fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, mask_fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, mask_labels);
+    GL().GenFramebuffers(1, &mask_fbo);
+    GL().BindFramebuffer(GL_FRAMEBUFFER, mask_fbo);
+    GL().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, mask_labels);
     mask_depth = renderbuffer(GL_DEPTH_COMPONENT32F, 0, mw, mh);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, mask_depth);
+    GL().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, mask_depth);
     const GLenum buffers[] = {GL_NONE, GL_COLOR_ATTACHMENT1};
-    glDrawBuffers(2, buffers);
-    glReadBuffer(GL_COLOR_ATTACHMENT1);
+    GL().DrawBuffers(2, buffers);
+    GL().ReadBuffer(GL_COLOR_ATTACHMENT1);
     check(mask_fbo, "mask");
   }
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  GL().BindFramebuffer(GL_FRAMEBUFFER, 0);
   const GLuint vs = compile(GL_VERTEX_SHADER, kLabelVertexShader);
   const GLuint fs = compile(GL_FRAGMENT_SHADER, kLabelFragmentShader);
-  program = glCreateProgram();
-  glAttachShader(program, vs);
-  glAttachShader(program, fs);
-  glLinkProgram(program);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
+  program = GL().CreateProgram();
+  GL().AttachShader(program, vs);
+  GL().AttachShader(program, fs);
+  GL().LinkProgram(program);
+  GL().DeleteShader(vs);
+  GL().DeleteShader(fs);
   GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  GL().GetProgramiv(program, GL_LINK_STATUS, &ok);
   if (!ok) {
     char log[1024] = {};
-    glGetProgramInfoLog(program, sizeof log, nullptr, log);
-    glDeleteProgram(program);
+    GL().GetProgramInfoLog(program, sizeof log, nullptr, log);
+    GL().DeleteProgram(program);
     throw GlContextError(std::string("GL: label shader: ") + log);
   }
-  label_location = glGetUniformLocation(program, "label");
-  near_location = glGetUniformLocation(program, "near");
+  label_location = GL().GetUniformLocation(program, "label");
+  near_location = GL().GetUniformLocation(program, "near");
 }
 
 GlTargets::~GlTargets() {
   const GLuint fbos[] = {ms_fbo, resolve_fbo, mask_fbo};
   const GLuint rbs[] = {ms_colour, resolve_colour, resolve_labels, mask_labels, ms_depth, resolve_depth, mask_depth};
-  glDeleteFramebuffers(3, fbos);
-  glDeleteRenderbuffers(7, rbs);
-  glDeleteProgram(program);
+  GL().DeleteFramebuffers(3, fbos);
+  GL().DeleteRenderbuffers(7, rbs);
+  GL().DeleteProgram(program);
 }
 
 }  // namespace kccd::render::detail

@@ -1,8 +1,5 @@
 #include "passes.hpp"
 
-#include <GL/gl.h>
-#include <GL/glext.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -10,64 +7,67 @@
 #include <cstdint>
 #include <limits>
 
+#include "gl_api.hpp"
+
 namespace kccd::render::detail {
 namespace {
 
 void setCamera(const Projection& projection, double near, double far) {
   const std::array<float, 16> m = projection.glMatrix(near, far);
-  glViewport(0, 0, projection.pinhole().width, projection.pinhole().height);
-  glMatrixMode(GL_PROJECTION);
-  glLoadMatrixf(m.data());
-  glMatrixMode(GL_MODELVIEW);
-  glLoadIdentity();
-  glEnable(GL_CULL_FACE);
-  glCullFace(GL_BACK);
-  glFrontFace(GL_CW);  // the projection keeps image rows top-down, which mirrors the winding
-  glEnableClientState(GL_VERTEX_ARRAY);
+  GL().Viewport(0, 0, projection.pinhole().width, projection.pinhole().height);
+  GL().MatrixMode(GL_PROJECTION);
+  GL().LoadMatrixf(m.data());
+  GL().MatrixMode(GL_MODELVIEW);
+  GL().LoadIdentity();
+  GL().Enable(GL_CULL_FACE);
+  GL().CullFace(GL_BACK);
+  GL().FrontFace(GL_CW);  // the projection keeps image rows top-down, which mirrors the winding
+  GL().EnableClientState(GL_VERTEX_ARRAY);
 }
 
 // Draws a quad over the whole viewport (the camera matrices are restored afterwards).
 void fillViewport() {
-  glMatrixMode(GL_PROJECTION);
-  glPushMatrix();
-  glLoadIdentity();
-  glMatrixMode(GL_MODELVIEW);
-  glDisable(GL_CULL_FACE);
+  GL().MatrixMode(GL_PROJECTION);
+  GL().PushMatrix();
+  GL().LoadIdentity();
+  GL().MatrixMode(GL_MODELVIEW);
+  GL().Disable(GL_CULL_FACE);
   const float quad[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
-  glVertexPointer(3, GL_FLOAT, 0, quad);
-  glDrawArrays(GL_TRIANGLE_FAN, 0, 4);
-  glEnable(GL_CULL_FACE);
-  glMatrixMode(GL_PROJECTION);
-  glPopMatrix();
-  glMatrixMode(GL_MODELVIEW);
+  GL().VertexPointer(3, GL_FLOAT, 0, quad);
+  GL().DrawArrays(GL_TRIANGLE_FAN, 0, 4);
+  GL().Enable(GL_CULL_FACE);
+  GL().MatrixMode(GL_PROJECTION);
+  GL().PopMatrix();
+  GL().MatrixMode(GL_MODELVIEW);
 }
 
 void drawTriangles(const Mesh& mesh, const std::vector<float>& vertices) {
-  glVertexPointer(3, GL_FLOAT, 0, vertices.data());
-  glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.triangles.size() * 3), GL_UNSIGNED_INT, mesh.triangles.data());
+  GL().VertexPointer(3, GL_FLOAT, 0, vertices.data());
+  GL().DrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.triangles.size() * 3), GL_UNSIGNED_INT,
+                    mesh.triangles.data());
 }
 
 // Draw buffers of the bound framebuffer: the colour attachment, the label attachment, or both.
 void drawBuffers(bool colour, bool labels) {
   const GLenum none = GL_NONE;
   const GLenum buffers[] = {colour ? GLenum{GL_COLOR_ATTACHMENT0} : none, labels ? GLenum{GL_COLOR_ATTACHMENT1} : none};
-  glDrawBuffers(labels ? 2 : 1, buffers);
+  GL().DrawBuffers(labels ? 2 : 1, buffers);
 }
 
 // Clears the label attachment (draw buffer 1) to 0 and the depth buffer to "infinitely far".
 void clearLabels() {
   const float zero[4] = {0, 0, 0, 0}, far = 0.0f;  // reversed depth: 0 is infinitely far
-  glClearBufferfv(GL_COLOR, 1, zero);
-  glClearBufferfv(GL_DEPTH, 0, &far);
+  GL().ClearBufferfv(GL_COLOR, 1, zero);
+  GL().ClearBufferfv(GL_DEPTH, 0, &far);
 }
 
 // Reads the label attachment of the bound framebuffer (CV_8UC1).
 cv::Mat readLabels(int w, int h) {
   cv::Mat labels(h, w, CV_8UC1);
-  glReadBuffer(GL_COLOR_ATTACHMENT1);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, w, h, GL_RED, GL_UNSIGNED_BYTE, labels.data);
-  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  GL().ReadBuffer(GL_COLOR_ATTACHMENT1);
+  GL().PixelStorei(GL_PACK_ALIGNMENT, 1);
+  GL().ReadPixels(0, 0, w, h, GL_RED, GL_UNSIGNED_BYTE, labels.data);
+  GL().ReadBuffer(GL_COLOR_ATTACHMENT0);
   return labels;
 }
 
@@ -75,12 +75,12 @@ cv::Mat readLabels(int w, int h) {
 // the nearest surface's label stays whatever the order (surfaces from both sides; reversed depth,
 // see the label shader in gl_targets.cpp); leaves the depth test and blending off.
 void drawLabelTriangles(const GlTargets& gl, const std::vector<PreparedVolume>& bodies, double near) {
-  glDisable(GL_BLEND);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_GREATER);
-  glDepthMask(GL_TRUE);
-  glUseProgram(gl.program);
-  glUniform1f(gl.near_location, static_cast<float>(near));
+  GL().Disable(GL_BLEND);
+  GL().Enable(GL_DEPTH_TEST);
+  GL().DepthFunc(GL_GREATER);
+  GL().DepthMask(GL_TRUE);
+  GL().UseProgram(gl.program);
+  GL().Uniform1f(gl.near_location, static_cast<float>(near));
   // Front to back: farther fragments then fail the depth test and write nothing.
   std::vector<const PreparedVolume*> order;
   for (const PreparedVolume& p : bodies)
@@ -88,24 +88,24 @@ void drawLabelTriangles(const GlTargets& gl, const std::vector<PreparedVolume>& 
   std::sort(order.begin(), order.end(),
             [](const PreparedVolume* a, const PreparedVolume* b) { return a->depth < b->depth; });
   for (const PreparedVolume* p : order) {
-    glUniform1ui(gl.label_location, static_cast<GLuint>(p->label));
-    if (p->surface) glDisable(GL_CULL_FACE);
+    GL().Uniform1ui(gl.label_location, static_cast<GLuint>(p->label));
+    if (p->surface) GL().Disable(GL_CULL_FACE);
     drawTriangles(*p->mesh, p->vertices);
-    glEnable(GL_CULL_FACE);
+    GL().Enable(GL_CULL_FACE);
   }
-  glUseProgram(0);
-  glDepthFunc(GL_LESS);
-  glDisable(GL_DEPTH_TEST);
+  GL().UseProgram(0);
+  GL().DepthFunc(GL_LESS);
+  GL().Disable(GL_DEPTH_TEST);
 }
 
 // Opaque volumes, depth-tested, each vertex lit by Lambert's law with the normal averaged over its
 // triangles (smooth shading of the tessellated surface).
 void drawShaded(const std::vector<const PreparedVolume*>& order, double ambient) {
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glDisable(GL_BLEND);
-  glShadeModel(GL_SMOOTH);
-  glEnableClientState(GL_COLOR_ARRAY);
+  GL().Enable(GL_DEPTH_TEST);
+  GL().DepthFunc(GL_LESS);
+  GL().Disable(GL_BLEND);
+  GL().ShadeModel(GL_SMOOTH);
+  GL().EnableClientState(GL_COLOR_ARRAY);
   // Light from the camera's upper left (camera frame: x right, y down, z forward), towards the scene.
   const Vec3 to_light = Vec3(-0.45, -0.6, -1.0).normalized();
   std::vector<Vec3> normals;
@@ -127,14 +127,14 @@ void drawShaded(const std::vector<const PreparedVolume*>& order, double ambient)
       for (int c = 0; c < 3; ++c) colours[4 * k + c] = static_cast<float>(std::min(1.0, p->colour[c] / 255.0 * shade));
       colours[4 * k + 3] = 1.0f;
     }
-    glColorPointer(4, GL_FLOAT, 0, colours.data());
-    glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
-    if (p->surface) glDisable(GL_CULL_FACE);
-    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.triangles.size() * 3), GL_UNSIGNED_INT, m.triangles.data());
-    glEnable(GL_CULL_FACE);
+    GL().ColorPointer(4, GL_FLOAT, 0, colours.data());
+    GL().VertexPointer(3, GL_FLOAT, 0, p->vertices.data());
+    if (p->surface) GL().Disable(GL_CULL_FACE);
+    GL().DrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.triangles.size() * 3), GL_UNSIGNED_INT, m.triangles.data());
+    GL().Enable(GL_CULL_FACE);
   }
-  glDisableClientState(GL_COLOR_ARRAY);
-  glDisable(GL_DEPTH_TEST);
+  GL().DisableClientState(GL_COLOR_ARRAY);
+  GL().Disable(GL_DEPTH_TEST);
 }
 
 // The dirty cells of `out` within `cells` (in cells), as runs along each row of cells.
@@ -167,7 +167,7 @@ cv::Rect cellsOf(const cv::Rect& r) {
 void clearCells(ColourReadBack& out) {
   constexpr int c = ColourReadBack::kCell;
   GLint viewport[4] = {0, 0, 0, 0};
-  glGetIntegerv(GL_VIEWPORT, viewport);
+  GL().GetIntegerv(GL_VIEWPORT, viewport);
   const double w = viewport[2], h = viewport[3];
   // Pixel edges to normalised device coordinates (GL's rows are the image's, see setCamera).
   const auto nx = [&](int x) { return static_cast<float>(2.0 * std::min<double>(x, w) / w - 1.0); };
@@ -179,20 +179,20 @@ void clearCells(ColourReadBack& out) {
   }
   std::fill(out.dirty.begin(), out.dirty.end(), 0);
   if (quads.empty()) return;
-  glMatrixMode(GL_PROJECTION);
-  glPushMatrix();
-  glLoadIdentity();
-  glMatrixMode(GL_MODELVIEW);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_BLEND);
-  glColor4f(0, 0, 0, 0);
-  glVertexPointer(3, GL_FLOAT, 0, quads.data());
-  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(quads.size() / 3));
-  glEnable(GL_CULL_FACE);
-  glMatrixMode(GL_PROJECTION);
-  glPopMatrix();
-  glMatrixMode(GL_MODELVIEW);
+  GL().MatrixMode(GL_PROJECTION);
+  GL().PushMatrix();
+  GL().LoadIdentity();
+  GL().MatrixMode(GL_MODELVIEW);
+  GL().Disable(GL_CULL_FACE);
+  GL().Disable(GL_DEPTH_TEST);
+  GL().Disable(GL_BLEND);
+  GL().Color4f(0, 0, 0, 0);
+  GL().VertexPointer(3, GL_FLOAT, 0, quads.data());
+  GL().DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(quads.size() / 3));
+  GL().Enable(GL_CULL_FACE);
+  GL().MatrixMode(GL_PROJECTION);
+  GL().PopMatrix();
+  GL().MatrixMode(GL_MODELVIEW);
 }
 
 // Marks dirty every cell of `out` whose part of the read-back rectangle holds a non-zero byte.
@@ -242,11 +242,11 @@ struct OutlineBatch {
   // draw of another program then came out flat-shaded.
   void draw(GLenum mode) const {
     if (indices.empty()) return;
-    glEnableClientState(GL_COLOR_ARRAY);
-    glColorPointer(4, GL_FLOAT, 0, colours.data());
-    glVertexPointer(3, GL_FLOAT, 0, vertices.data());
-    glDrawElements(mode, static_cast<GLsizei>(indices.size()), GL_UNSIGNED_INT, indices.data());
-    glDisableClientState(GL_COLOR_ARRAY);
+    GL().EnableClientState(GL_COLOR_ARRAY);
+    GL().ColorPointer(4, GL_FLOAT, 0, colours.data());
+    GL().VertexPointer(3, GL_FLOAT, 0, vertices.data());
+    GL().DrawElements(mode, static_cast<GLsizei>(indices.size()), GL_UNSIGNED_INT, indices.data());
+    GL().DisableClientState(GL_COLOR_ARRAY);
   }
   void clear() {
     vertices.clear();
@@ -302,7 +302,7 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
   const double near = frame.near, far = frame.far;
   const int w = gl.width, h = gl.height;
   const bool with_labels = labels != nullptr && gl.samples <= 1 && !style.shaded;
-  glBindFramebuffer(GL_FRAMEBUFFER, gl.samples > 1 ? gl.ms_fbo : gl.resolve_fbo);
+  GL().BindFramebuffer(GL_FRAMEBUFFER, gl.samples > 1 ? gl.ms_fbo : gl.resolve_fbo);
   if (gl.samples <= 1) drawBuffers(true, with_labels);
   setCamera(projection, near, far);
   // Only the rectangle that will be read back is cleared and drawn (the labels are read whole):
@@ -313,8 +313,8 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
   cv::Rect rect;
   for (const cv::Rect& r : out.parts) rect |= r;
   if (!with_labels) {
-    glEnable(GL_SCISSOR_TEST);
-    glScissor(rect.x, rect.y, rect.width, rect.height);
+    GL().Enable(GL_SCISSOR_TEST);
+    GL().Scissor(rect.x, rect.y, rect.width, rect.height);
   }
   if (out.cells_x !=
       (w + ColourReadBack::kCell - 1) / ColourReadBack::kCell) {  // the first frame: the target is unknown
@@ -326,13 +326,13 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
     // The tinted look tests no depth: only the colour is cleared, and only in the cells that may
     // hold a pixel (drawn as transparent quads: llvmpipe clears a scissored rectangle several
     // times slower than it fills one). The target is then zero everywhere, as a clear leaves it.
-    glDisable(GL_SCISSOR_TEST);
+    GL().Disable(GL_SCISSOR_TEST);
     clearCells(out);
-    glEnable(GL_SCISSOR_TEST);
+    GL().Enable(GL_SCISSOR_TEST);
   } else {
-    glClearColor(0, 0, 0, 0);
-    glClearDepth(1.0);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    GL().ClearColor(0, 0, 0, 0);
+    GL().ClearDepth(1.0);
+    GL().Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     if (with_labels) std::fill(out.dirty.begin(), out.dirty.end(), 0);  // cleared whole (no scissor)
   }
   if (with_labels) clearLabels();
@@ -342,10 +342,10 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
       if (p.mesh) all.push_back(&p);
     drawShaded(all, style.ambient);
   } else {
-    glDisable(GL_DEPTH_TEST);
-    glEnable(GL_BLEND);
+    GL().Disable(GL_DEPTH_TEST);
+    GL().Enable(GL_BLEND);
     // Premultiplied result on a transparent clear; converted to straight alpha after read-back.
-    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    GL().BlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     // Back to front; back faces culled, so each convex volume tints a pixel once.
     std::vector<const PreparedVolume*> order;
     for (const PreparedVolume& p : bodies)
@@ -364,20 +364,20 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
       drawBuffers(false, true);
       drawLabelTriangles(gl, bodies, near);
       drawBuffers(true, false);
-      glEnable(GL_BLEND);
+      GL().Enable(GL_BLEND);
     }
     // The tints as premultiplied colours (the blend then multiplies nothing by the source alpha:
     // ~15 % less fill time on llvmpipe than blending straight colours).
-    glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    GL().BlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     // Consecutive outlined volumes are filled in one draw call (GL blends a call's triangles in
     // their order, and a colour per volume's vertices is the colour glColor would give: the same
     // pixels for a fraction of the per-call cost on llvmpipe).
     OutlineBatch batch;
     auto flushFills = [&] {
       if (batch.indices.empty()) return;
-      glDisable(GL_CULL_FACE);  // the outline's winding is the image's, not the mesh's
+      GL().Disable(GL_CULL_FACE);  // the outline's winding is the image's, not the mesh's
       batch.draw(GL_TRIANGLES);
-      glEnable(GL_CULL_FACE);
+      GL().Enable(GL_CULL_FACE);
       batch.clear();
     };
     for (const PreparedVolume* p : order) {
@@ -391,21 +391,21 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
         continue;
       }
       flushFills();
-      glColor4f(tint[0], tint[1], tint[2], tint[3]);
+      GL().Color4f(tint[0], tint[1], tint[2], tint[3]);
       if (!p->surface && polygonFill(*p)) {
         ++frame.polygon_fills;
-        glVertexPointer(3, GL_FLOAT, 0, p->vertices.data());
-        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(p->fill.size()), GL_UNSIGNED_INT, p->fill.data());
+        GL().VertexPointer(3, GL_FLOAT, 0, p->vertices.data());
+        GL().DrawElements(GL_TRIANGLES, static_cast<GLsizei>(p->fill.size()), GL_UNSIGNED_INT, p->fill.data());
       } else {
         drawTriangles(*p->mesh, p->vertices);
       }
     }
     flushFills();
-    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE,
-                        GL_ONE_MINUS_SRC_ALPHA);  // smoothed lines: coverage in alpha
-    glLineWidth(static_cast<float>(style.outline_width * projection.supersample()));
-    glEnable(GL_LINE_SMOOTH);  // coverage in alpha, blended like the fill
-    glHint(GL_LINE_SMOOTH_HINT, GL_NICEST);
+    GL().BlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE,
+                           GL_ONE_MINUS_SRC_ALPHA);  // smoothed lines: coverage in alpha
+    GL().LineWidth(static_cast<float>(style.outline_width * projection.supersample()));
+    GL().Enable(GL_LINE_SMOOTH);  // coverage in alpha, blended like the fill
+    GL().Hint(GL_LINE_SMOOTH_HINT, GL_NICEST);
     // Every volume's outline in one draw call, in the same order, each in its own colour.
     for (const PreparedVolume* p : order) {
       const cv::Scalar c = p->colour * 0.7;
@@ -415,25 +415,25 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
           {static_cast<float>(c[0] / 255.0), static_cast<float>(c[1] / 255.0), static_cast<float>(c[2] / 255.0), 1.0f});
     }
     batch.draw(GL_LINES);
-    glDisable(GL_LINE_SMOOTH);
+    GL().Disable(GL_LINE_SMOOTH);
     // Volumes containing the camera tint the whole view, in front of everything else.
     for (const PreparedVolume& p : bodies)
       if (p.fills) {
         const cv::Scalar c = p.colour;
-        glColor4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
+        GL().Color4d(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, style.fill_alpha);
         fillViewport();
       }
-    glDisable(GL_BLEND);
+    GL().Disable(GL_BLEND);
   }
-  glDisable(GL_SCISSOR_TEST);
+  GL().Disable(GL_SCISSOR_TEST);
   if (gl.samples > 1) {
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, gl.ms_fbo);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, gl.resolve_fbo);
+    GL().BindFramebuffer(GL_READ_FRAMEBUFFER, gl.ms_fbo);
+    GL().BindFramebuffer(GL_DRAW_FRAMEBUFFER, gl.resolve_fbo);
     drawBuffers(true, false);  // a mask drawn alone before leaves the label attachment selected
-    glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    GL().BlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, gl.resolve_fbo);
-  glFinish();
+  GL().BindFramebuffer(GL_READ_FRAMEBUFFER, gl.resolve_fbo);
+  GL().Finish();
   const auto t1 = std::chrono::steady_clock::now();
   if (out.image.rows != h || out.image.cols != w || out.image.type() != CV_8UC4) {
     out.image = cv::Mat::zeros(h, w, CV_8UC4);
@@ -444,11 +444,11 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
   if (!out.rect.empty()) {
     // Colours are drawn with blue in GL's red channel, so the plain RGBA read (llvmpipe's fast
     // path, no swizzle) returns OpenCV's BGRA order. GL's rows are the image's (see setCamera).
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glPixelStorei(GL_PACK_ROW_LENGTH, w);
-    glReadPixels(out.rect.x, out.rect.y, out.rect.width, out.rect.height, GL_RGBA, GL_UNSIGNED_BYTE,
-                 out.image.ptr<uchar>(out.rect.y, out.rect.x));
-    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+    GL().PixelStorei(GL_PACK_ALIGNMENT, 1);
+    GL().PixelStorei(GL_PACK_ROW_LENGTH, w);
+    GL().ReadPixels(out.rect.x, out.rect.y, out.rect.width, out.rect.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                    out.image.ptr<uchar>(out.rect.y, out.rect.x));
+    GL().PixelStorei(GL_PACK_ROW_LENGTH, 0);
     // Without multisampling the target's pixels are the ones read: cells holding one are dirty,
     // and only they are handed on to the warp (the read-back is zero in the others).
     if (gl.samples <= 1) {
@@ -457,7 +457,7 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
     }
   }
   if (with_labels) *labels = readLabels(w, h);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  GL().BindFramebuffer(GL_FRAMEBUFFER, 0);
   const auto t2 = std::chrono::steady_clock::now();
   frame.times.draw += std::chrono::duration<double>(t1 - t0).count();
   frame.times.read_back += std::chrono::duration<double>(t2 - t1).count();
@@ -466,14 +466,14 @@ void drawColour(GlTargets& gl, const Projection& projection, const RenderOptions
 cv::Mat drawMask(GlTargets& gl, const Projection& mask_projection, const std::vector<PreparedVolume>& bodies,
                  double near, double far) {
   const int w = gl.mask_width, h = gl.mask_height;
-  glBindFramebuffer(GL_FRAMEBUFFER, gl.mask_fbo != 0 ? gl.mask_fbo : gl.resolve_fbo);
+  GL().BindFramebuffer(GL_FRAMEBUFFER, gl.mask_fbo != 0 ? gl.mask_fbo : gl.resolve_fbo);
   drawBuffers(false, true);
   setCamera(mask_projection, near, far);
   clearLabels();
   drawLabelTriangles(gl, bodies, near);
-  glFinish();
+  GL().Finish();
   cv::Mat mask = readLabels(w, h);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  GL().BindFramebuffer(GL_FRAMEBUFFER, 0);
   return mask;
 }
 

@@ -1,7 +1,5 @@
 #include "kccd/render/renderer.hpp"
 
-#include <GL/gl.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -12,6 +10,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "gl_api.hpp"
 #include "gl_targets.hpp"
 #include "kccd/render/composite.hpp"
 #include "kccd/render/prepare.hpp"
@@ -30,8 +29,8 @@ Renderer::Renderer(const Projection& projection, const RenderOptions& options)
     throw std::invalid_argument("Renderer: the projection's supersample differs from RenderOptions::supersample");
   const Camera& camera = projection_.camera();
   GLint max_renderbuffer = 0, viewport[2] = {0, 0};
-  glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
-  glGetIntegerv(GL_MAX_VIEWPORT_DIMS, viewport);
+  detail::GL().GetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
+  detail::GL().GetIntegerv(GL_MAX_VIEWPORT_DIMS, viewport);
   const int max_w = std::min<int>(max_renderbuffer, viewport[0]), max_h = std::min<int>(max_renderbuffer, viewport[1]);
   auto fits = [&](const Projection& p) { return p.pinhole().width <= max_w && p.pinhole().height <= max_h; };
   if (!fits(projection_)) {
