@@ -69,7 +69,9 @@ Runner addSynth(CLI::App& app) {
   sub->add_option("--seed", a->options.seed, "Seed of the trajectory search and the noise")
       ->capture_default_str()
       ->check(seedNumber());
-  sub->add_option("--codec", a->options.codec, "ffv1 (video.mkv, lossless), mjpg (video.avi) or mp4v (video.mp4)")
+  sub->add_option("--codec", a->options.codec,
+                  "ffvhuff (video.mkv, lossless, fast), ffv1 (video.mkv, lossless, 0.8x the size, 4x slower to write), "
+                  "mjpg (video.avi) or mp4v (video.mp4)")
       ->capture_default_str();
   sub->add_option("--log-rate", a->options.log_rate, "State log rate (Hz; must differ from --fps)")
       ->capture_default_str()

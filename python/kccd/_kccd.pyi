@@ -332,7 +332,7 @@ def synthesize_recording(
     log_rate: float = 125.0,
     time_offset: float = 0.137,
     seed: int = 1,
-    codec: str = "ffv1",
+    codec: str = "ffvhuff",
     collision: bool = True,
     replace: bool = False,
     bag: bool = False,

@@ -464,7 +464,7 @@ void bindSynth(py::module_& m) {
       },
       py::arg("model"), py::arg("output"), py::kw_only(), py::arg("camera") = "", py::arg("seconds") = 5.0,
       py::arg("fps") = 25.0, py::arg("log_rate") = 125.0, py::arg("time_offset") = 0.137, py::arg("seed") = 1,
-      py::arg("codec") = "ffv1", py::arg("collision") = true, py::arg("replace") = false, py::arg("bag") = false,
+      py::arg("codec") = "ffvhuff", py::arg("collision") = true, py::arg("replace") = false, py::arg("bag") = false,
       py::arg("width") = py::none(), py::arg("height") = py::none(), py::arg("appearance") = "auto",
       py::arg("visible_scale") = py::none(), py::arg("blur") = 0.7, py::arg("noise") = 2.5,
       py::arg("progress") = py::none(),

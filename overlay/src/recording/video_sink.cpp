@@ -17,7 +17,7 @@ std::string videoFourcc(const std::string& path, const std::string& codec) {
     // The usual codecs in their containers' own spelling, whatever the case given.
     std::string c = codec;
     for (const char* known :
-         {"MJPG", "FFV1", "mp4v", "XVID", "DIVX", "avc1", "H264", "hvc1", "HEVC", "VP80", "VP90", "FMP4"}) {
+         {"MJPG", "FFV1", "FFVH", "mp4v", "XVID", "DIVX", "avc1", "H264", "hvc1", "HEVC", "VP80", "VP90", "FMP4"}) {
       bool same = true;
       for (std::size_t k = 0; k < 4; ++k)
         same = same && std::tolower(static_cast<unsigned char>(codec[k])) == std::tolower(known[k]);

@@ -28,10 +28,11 @@ double sensorSeconds(Clock::time_point a, Clock::time_point b) { return std::chr
 }  // namespace
 
 VideoFormat videoFormat(const std::string& codec) {
+  if (codec == "ffvhuff") return {"video.mkv", "FFVH"};
   if (codec == "ffv1") return {"video.mkv", "FFV1"};
   if (codec == "mjpg") return {"video.avi", "MJPG"};
   if (codec == "mp4v") return {"video.mp4", "mp4v"};
-  throw SynthError(InputLocation{{}, 0, 0, "codec"}, "expected ffv1, mjpg or mp4v, got '" + codec + "'");
+  throw SynthError(InputLocation{{}, 0, 0, "codec"}, "expected ffvhuff, ffv1, mjpg or mp4v, got '" + codec + "'");
 }
 
 cv::Scalar bodyColour(const Model& m, std::size_t i) {

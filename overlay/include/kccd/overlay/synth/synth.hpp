@@ -53,12 +53,14 @@ struct SynthOptions {
   std::optional<int> width, height;     ///< default camera's image size (64 ... 4096 px); not with a camera file
   std::optional<double> visible_scale;  ///< Volumes: radius fraction of the SSCHs (default 0.8)
   SynthAppearance appearance = SynthAppearance::Auto;
-  double blur = 0.7;           ///< Gaussian blur of every frame (sigma, px)
-  double noise = 2.5;          ///< Gaussian sensor noise (sigma, grey levels)
-  std::uint64_t seed = 1;      ///< trajectory search and noise
-  std::string codec = "ffv1";  ///< ffv1 (video.mkv, lossless), mjpg (video.avi) or mp4v (video.mp4)
-  bool collision = true;       ///< one real collision (false: only near-collisions)
-  bool replace = false;        ///< replace an existing non-empty output folder
+  double blur = 0.7;       ///< Gaussian blur of every frame (sigma, px)
+  double noise = 2.5;      ///< Gaussian sensor noise (sigma, grey levels)
+  std::uint64_t seed = 1;  ///< trajectory search and noise
+  /// ffvhuff (video.mkv, lossless, fast), ffv1 (video.mkv, lossless, smaller), mjpg (video.avi) or
+  /// mp4v (video.mp4)
+  std::string codec = "ffvhuff";
+  bool collision = true;  ///< one real collision (false: only near-collisions)
+  bool replace = false;   ///< replace an existing non-empty output folder
   /// Also states.mcap: the state log and the frames as a ROS 2 bag (StateLogBagWriter's defaults; frame
   /// i stamped at log time i / fps + time_offset, on the log's clock).
   bool bag = false;

@@ -22,8 +22,8 @@
 
 namespace kccd::overlay {
 
-/// The video file a codec name writes and its FourCC: ffv1 -> video.mkv, mjpg -> video.avi,
-/// mp4v -> video.mp4. Throws SynthError for another name.
+/// The video file a codec name writes and its FourCC: ffvhuff and ffv1 -> video.mkv, mjpg ->
+/// video.avi, mp4v -> video.mp4. Throws SynthError for another name.
 struct VideoFormat {
   std::string file;
   std::string fourcc;
