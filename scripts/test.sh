@@ -66,7 +66,11 @@ fi
 if [ $sanitize -eq 1 ]; then
   stage "ASan + UBSan build" cmake_build build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKCCD_SANITIZE=ON \
     -DKCCD_BUILD_BENCHMARKS=OFF "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG -Wno-maybe-uninitialized"
-  stage "ASan + UBSan tests" env ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  # intercept_tls_get_addr=0: with libraries opened at run time that use dynamic TLS (EGL's driver,
+  # LLVM), GCC 12's LeakSanitizer recorded a bogus range for it here (from 0x2d8a) and its tracer
+  # crashed at exit ("Tracer caught signal 11"); without the interception that TLS is not scanned,
+  # which can only add leak reports (inside Mesa and LLVM: suppressed), never hide one.
+  stage "ASan + UBSan tests" env ASAN_OPTIONS=detect_leaks=1:intercept_tls_get_addr=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp:print_suppressions=0 \
     ctest --test-dir build-asan -j "$jobs" --output-on-failure
 fi
