@@ -17,8 +17,6 @@ std::string loadGlApi(GlApi& api, void* (*resolve)(const char* name)) {
 
 const GlApi& GL() noexcept { return *current_api; }
 
-const GlApi* currentGlApi() noexcept { return current_api; }
-
 void setCurrentGlApi(const GlApi* api) noexcept { current_api = api; }
 
 }  // namespace kccd::render::detail

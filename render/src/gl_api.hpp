@@ -40,9 +40,6 @@ std::string loadGlApi(GlApi& api, void* (*resolve)(const char* name));
 /// current on this thread, which sets them).
 const GlApi& GL() noexcept;
 
-/// The calling thread's entry points, nullptr when none were set.
-const GlApi* currentGlApi() noexcept;
-
 /// Makes api the calling thread's entry points (nullptr: none, after its context was released).
 void setCurrentGlApi(const GlApi* api) noexcept;
 

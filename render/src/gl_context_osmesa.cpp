@@ -21,6 +21,7 @@ struct OsMesaLibrary {
   decltype(&::OSMesaCreateContextExt) CreateContextExt = nullptr;
   decltype(&::OSMesaDestroyContext) DestroyContext = nullptr;
   decltype(&::OSMesaMakeCurrent) MakeCurrent = nullptr;
+  decltype(&::OSMesaGetCurrentContext) GetCurrentContext = nullptr;
   decltype(&::OSMesaGetProcAddress) GetProcAddress = nullptr;
   detail::GlApi gl;
 };
@@ -49,6 +50,7 @@ const OsMesaLibrary& osMesaLibrary() {
   symbol(found.CreateContextExt, "OSMesaCreateContextExt");
   symbol(found.DestroyContext, "OSMesaDestroyContext");
   symbol(found.MakeCurrent, "OSMesaMakeCurrent");
+  symbol(found.GetCurrentContext, "OSMesaGetCurrentContext");
   symbol(found.GetProcAddress, "OSMesaGetProcAddress");
   if (missing.empty()) {
     static decltype(&::OSMesaGetProcAddress) get = nullptr;
@@ -97,9 +99,8 @@ class OsMesaContext final : public GlContext {
 
  private:
   void destroy() {
-    // OSMesa has no "current context" query of its own: the entry points are dropped when this
-    // thread's are this library's (only OSMesa contexts use them).
-    if (detail::currentGlApi() == &lib_.gl) detail::setCurrentGlApi(nullptr);
+    // As EGL's release: the thread's entry points are dropped with its current context.
+    if (lib_.GetCurrentContext() == ctx_) detail::setCurrentGlApi(nullptr);
     lib_.DestroyContext(ctx_);
   }
 
