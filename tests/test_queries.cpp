@@ -214,6 +214,42 @@ TEST(Queries, ReusesBoundsWhenTheBoxShrinks) {
   for (std::size_t k = 0; k < r.pairs.size(); ++k) EXPECT_EQ(r.pairs[k].distance, f.pairs[k].distance);
 }
 
+// At one configuration, with no joint error and a budget that holds every body, the point volumes
+// are the bodies rigidly moved: the exact stage has nothing to add, so it is skipped, and GJK's
+// bound is the distance itself (an independent oracle at that configuration, to 1e-9).
+TEST(Queries, AtOneConfigurationTheBoundIsTheDistanceWithoutTheExactStage) {
+  std::mt19937_64 rng(97);
+  int pairs = 0, separated = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    Model m = testing::randomModel(rng, 5, 4);
+    for (Joint& j : m.joints) j.error = 0.0;
+    for (const Body& b : m.bodies) m.point_budget = std::max(m.point_budget, static_cast<int>(b.points.size()));
+    std::vector<double> lower, upper;
+    testing::randomBox(rng, m, lower, upper);
+    upper = lower;
+    Checker c(m);
+    QueryOptions o = options(QueryType::Distances);
+    o.exact_below = std::numeric_limits<double>::infinity();  // every pair would be refined
+    const QueryResult& r = c.query(lower, upper, o);
+    ASSERT_EQ(r.status, Status::Ok) << trial;
+    EXPECT_EQ(r.stats.exact_calls, 0) << trial;
+    const testing::Sample sample = testing::sampleBox(rng, m, lower, upper, 0);
+    const std::vector<Pose> poses = testing::jointPoses(m, sample);
+    for (const PairDistance& pd : r.pairs) {
+      const BodyPair& pair = m.pairs[pd.pair];
+      const double truth = static_cast<double>(
+          testing::referenceSschDistance(testing::worldPoints(m, poses, pair.a), m.bodies[pair.a].radius,
+                                         testing::worldPoints(m, poses, pair.b), m.bodies[pair.b].radius));
+      EXPECT_LE(pd.distance, truth + 1e-12) << trial << " pair " << pd.pair;
+      EXPECT_GE(pd.distance, truth - 1e-9 * (1.0 + truth)) << trial << " pair " << pd.pair;
+      ++pairs;
+      separated += truth > 0.0;
+    }
+  }
+  EXPECT_GT(pairs, 400);
+  EXPECT_GT(separated, pairs / 4);
+}
+
 // After reset() a checker answers exactly as a new one, whatever it answered before (the overlay
 // resets per frame so that its report does not depend on which thread had which frame).
 TEST(Queries, AfterResetTheAnswerIsANewCheckersBitForBit) {

@@ -116,6 +116,7 @@ void Checker::layoutVolumes() {
     v.radius = body.radius;
     v.bound = detail::boundingSphere(body.points, body.radius);
     v.swept_sphere = v.bound;
+    v.exact = true;
   }
   int expansion = 1;
   for (const Joint& j : model.joints) expansion = std::max(expansion, detail::sweepExpansion(j));
@@ -255,10 +256,28 @@ const Checker::Volume* Checker::volume(int body, int level, Box box) noexcept {
     }
   }
   std::copy(kept, kept + n, points_.begin() + v.offset);
+  // Still the body's points, rigidly moved: a joint at one value, with no error bound, and no
+  // point dropped (the budget holds them all) or replaced by the other cover.
+  bool rigid = below->exact && n == below->count && kept == scratch_.data() && joint.error == 0.0;
+  for (int k = 0; k < joint.dof && rigid; ++k) rigid = lo[k] == hi[k];
+  v.exact = rigid;
   v.count = n;
   v.radius = radius;
-  v.bound = detail::boundingSphere(view(v).points, radius);
-  if (!std::isfinite(v.bound.radius)) return nullptr;
+  if (rigid) {
+    // The sphere below moved by the same map: its centre's error is the guard its own sweep adds,
+    // each point's at most the guard the points' sweep added (counted twice: on the point and in
+    // the volume's radius).
+    Vec3 centre;
+    double centre_radius = below->bound.radius;
+    if (detail::sweepJoint(joint, lo, hi, trig, {&below->bound.center, 1}, &centre, centre_radius, 1,
+                           scratch_dist_.data(), *below_sphere) != 1)
+      return nullptr;
+    v.bound.center = centre;
+    v.bound.radius = detail::roundedUp(centre_radius + 2.0 * (radius - below_radius), 4);
+  } else {
+    v.bound = detail::boundingSphere(view(v).points, radius);
+  }
+  if (!v.bound.center.allFinite() || !std::isfinite(v.bound.radius)) return nullptr;
   v.stamp = cycle_;
   ++result_.stats.volumes_swept;
   return &v;
@@ -396,7 +415,9 @@ double Checker::refresh(int p, double stop_above, Box box) noexcept {
       e.witness_a = d.witness_a;
       e.witness_b = d.witness_b;
       e.gjk = true;
-      if (bound <= std::min(stop_above, exact_below_)) {
+      // The exact stage searches the same points when both volumes are the bodies rigidly moved
+      // (the box is a single configuration for the pair): GJK's bound is already theirs.
+      if (bound <= std::min(stop_above, exact_below_) && !(va->exact && vb->exact)) {
         if (!exactStage(p, stop_above, box, bound)) return fail();
         if (splits_ > 1 && bound > result_.margin && bound <= std::min(stop_above, exact_below_) &&
             !splitPair(p, box, bound))

@@ -75,17 +75,22 @@ int sweepRevolute(const Joint& j, const RevoluteTrig& trig, std::span<const Vec3
   // C = R_o (axis x radial), the point rotated by angle q is A + cos(q) B + sin(q) C.
   const Eigen::Matrix3d& rot = j.origin.linear();
   const Vec3& t = j.origin.translation();
-  const double in_norm = maxNorm(in);
-  if (pieces == 0) {  // a single angle: exact
+  if (pieces == 0) {  // a single angle: a rigid map, one matrix for every point
     const double c = trig.c_end[0], s = trig.s_end[0];
+    // Rodrigues: R(q) = c I + s [a]x + (1 - c) a a^T, composed with the origin's rotation. Every
+    // entry of the product errs by a few ulps (|a| = 1, |c|, |s| <= 1, rot orthonormal), so a point
+    // moves by at most about 20 ulps of |p| + |t|: the guard allows 64.
+    const Eigen::Matrix3d map =
+        rot * (c * Eigen::Matrix3d::Identity() + s * crossMatrix(a) + (1.0 - c) * (a * a.transpose()));
+    double in_sq = 0.0;
     for (int i = 0; i < n_in; ++i) {
-      const Vec3 axial = a.dot(in[i]) * a;
-      const Vec3 radial = in[i] - axial;
-      out[i] = rot * (axial + c * radial + s * a.cross(radial)) + t;
+      in_sq = std::max(in_sq, in[i].squaredNorm());
+      out[i] = map * in[i] + t;
     }
-    radius += roundingGuard(in_norm + t.norm(), 32);
+    radius += roundingGuard(std::sqrt(in_sq) + t.norm(), 64);
     return n_in;
   }
+  const double in_norm = maxNorm(in);
   const double* c_end = trig.c_end;
   const double* s_end = trig.s_end;
   const double half_cos = trig.half_cos;

@@ -56,7 +56,8 @@ double rhoBound(const Vec3& axis, const Sphere& s) noexcept;
 /// frame's origin (3-DOF joints: the box around its centre). A rotation3d box of small reach also
 /// has apexes: its centre rotation composed with the twelve rotations of an icosahedron around
 /// the reach ball, whose cover (all maps) grows by `apex_point_growth` per unit distance instead.
-struct JointMaps {
+struct JointMaps {  // NOLINT(bugprone-reserved-identifier): clang-tidy 14 names the implicit copy loop of its arrays
+                    // __i0
   static constexpr int kMax = 13;
   int count = 0;
   int chord_count = 0;

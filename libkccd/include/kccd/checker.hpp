@@ -57,6 +57,9 @@ class Checker {
     Sphere swept_sphere;  // swept cheaply from the level below (valid with sphere_stamp)
     std::uint64_t stamp = 0;
     std::uint64_t sphere_stamp = 0;
+    // The body's points moved rigidly, every one kept, the radius grown by rounding guards only
+    // (every joint below at a single value): the exact stage's chains are these points too.
+    bool exact = false;
   };
   struct Entry {  // the any-time table
     bool valid = false;
