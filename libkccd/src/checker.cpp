@@ -10,8 +10,10 @@
 
 #include "bounding_sphere.hpp"
 #include "chain_support.hpp"
+#include "gjk_core.hpp"
 #include "kccd/distance.hpp"
 #include "kccd/kinematics.hpp"
+#include "point_scan.hpp"
 #include "rounding.hpp"
 #include "sweep.hpp"
 
@@ -52,6 +54,14 @@ Checker::Checker(const Model& model) : model_(model) {
     chain_tangent_[variant].assign(volumes_.size(), 0);
   }
   for (const Body& body : model.bodies) {
+    double norm_sq = 0.0;
+    Vec3 sum = Vec3::Zero();
+    for (const Vec3& p : body.points) {
+      norm_sq = std::max(norm_sq, p.squaredNorm());
+      sum += p;
+    }
+    base_norm_.push_back(detail::roundedUp(std::sqrt(norm_sq), 2));
+    base_centroid_.push_back(sum / static_cast<double>(body.points.size()));
     base_sphere_.push_back(detail::boundingSphere(body.points, 0.0));
     Vec3 lo = body.points[0], hi = body.points[0];
     for (const Vec3& p : body.points) {
@@ -118,6 +128,11 @@ void Checker::layoutVolumes() {
     v.swept_sphere = v.bound;
     v.exact = true;
   }
+  for (std::size_t k = 0; k < volumes_.size(); ++k)
+    volumes_[k].body =
+        static_cast<int>(std::upper_bound(level_begin_.begin(), level_begin_.end(), static_cast<int>(k)) -
+                         level_begin_.begin()) -
+        1;
   int expansion = 1;
   for (const Joint& j : model.joints) expansion = std::max(expansion, detail::sweepExpansion(j));
   scratch_.resize(static_cast<std::size_t>(expansion) * max_points);
@@ -231,8 +246,19 @@ const Checker::Volume* Checker::volume(int body, int level, Box box) noexcept {
   if (below_sphere == nullptr) return nullptr;
   const double below_radius = radius;
   const detail::RevoluteTrig& trig = revoluteTrig(path_[idx - 1], box);
-  int n = detail::sweepJoint(joint, lo, hi, trig, view(*below).points, scratch_.data(), radius, v.capacity,
-                             scratch_dist_.data(), *below_sphere);
+  // A rigid level over the body itself or a posed level: posed in turn, no point moved.
+  if (below->exact && (level == 1 || below->posed) && joint.error == 0.0 && below->count <= v.capacity) {
+    bool single = true;
+    for (int k = 0; k < joint.dof; ++k) single = single && lo[k] == hi[k];
+    if (single && pose(v, *below, level == 1, joint, lo, trig)) {
+      v.stamp = cycle_;
+      ++result_.stats.volumes_swept;
+      return &v;
+    }
+  }
+  const SschView in = written(*below);
+  int n = detail::sweepJoint(joint, lo, hi, trig, in.points, scratch_.data(), radius, v.capacity, scratch_dist_.data(),
+                             *below_sphere);
   if (n < 0) return nullptr;
   n = detail::reduceToBudget(scratch_.data(), n, v.capacity, scratch_dist_.data(), scratch_order_.data(), radius);
   const Vec3* kept = scratch_.data();
@@ -243,7 +269,7 @@ const Checker::Volume* Checker::volume(int body, int level, Box box) noexcept {
   // smaller radius can be kept; it costs a farthest-point selection per sweep.
   if (tight_volumes_ && radius - below_radius > kCoarseCover * (below_sphere->radius + 1e-9)) {
     double alt_radius = below_radius;
-    int m = detail::sweepJoint(joint, lo, hi, trig, view(*below).points, scratch_alt_.data(), alt_radius,
+    int m = detail::sweepJoint(joint, lo, hi, trig, in.points, scratch_alt_.data(), alt_radius,
                                std::numeric_limits<int>::max(), scratch_dist_.data(), *below_sphere);
     if (m > 0) {
       m = detail::reduceToBudget(scratch_alt_.data(), m, v.capacity, scratch_dist_.data(), scratch_order_.data(),
@@ -261,6 +287,7 @@ const Checker::Volume* Checker::volume(int body, int level, Box box) noexcept {
   bool rigid = below->exact && n == below->count && kept == scratch_.data() && joint.error == 0.0;
   for (int k = 0; k < joint.dof && rigid; ++k) rigid = lo[k] == hi[k];
   v.exact = rigid;
+  v.posed = false;
   v.count = n;
   v.radius = radius;
   if (rigid) {
@@ -281,6 +308,117 @@ const Checker::Volume* Checker::volume(int body, int level, Box box) noexcept {
   v.stamp = cycle_;
   ++result_.stats.volumes_swept;
   return &v;
+}
+
+// Poses rigid volume v from the volume below it (`first`: below is the body itself) and the
+// joint's rigid map at `value`: lin' = A lin, off' = A off + b. Error bounds, with g = kRigidGuardUlps
+// ulps and |.| the operator norm (bounded by Frobenius'): the map applied to a vector x errs by
+// g |x| (each column of lin, so A lin by g |lin|_F) and to a point x by g (|x| + magnitude) (off);
+// the exact map's linear part is within g sqrt(3) of A. Returns false when a value is not finite.
+bool Checker::pose(Volume& v, const Volume& below, bool first, const Joint& joint, const double* value,
+                   const detail::RevoluteTrig& trig) noexcept {
+  using detail::roundedUp;
+  using detail::roundingGuard;
+  const detail::RigidMap m = detail::rigidMap(joint, value, trig);
+  if (!m.ok) return false;
+  const Eigen::Matrix3d lin0 = first ? Eigen::Matrix3d::Identity() : below.lin;
+  const Vec3 off0 = first ? Vec3::Zero() : below.off;
+  const double lin_error0 = first ? 0.0 : below.lin_error, off_error0 = first ? 0.0 : below.off_error;
+  constexpr int g = detail::kRigidGuardUlps;
+  const double exact_norm = roundedUp(m.lin.norm(), 4) + roundingGuard(1.0, 2 * g);  // bound on |exact A|
+  v.lin = m.lin * lin0;
+  v.off = m.lin * off0 + m.off;
+  v.lin_error = roundedUp(exact_norm * lin_error0 + roundingGuard(roundedUp(lin0.norm(), 4), g), 4);
+  v.off_error = roundedUp(exact_norm * off_error0 + roundingGuard(off0.norm() + m.magnitude, g), 4);
+  // A point p of the body (|p| <= P) moved in floating point lies within
+  // lin_error P + off_error + 8 ulps (|lin|_F P + |off|) of its exact place; a support chosen by
+  // the direction moved into the body's frame (lin^T d, within lin_error + 8 ulps |lin|_F of the
+  // exact one) falls short of the best by at most twice that times P, plus the dot products'
+  // rounding. Both go into the radius.
+  const Body& body = model_.bodies[v.body];
+  const double P = base_norm_[v.body];
+  const double lin_norm = roundedUp(v.lin.norm(), 4);
+  const double off_norm = roundedUp(v.off.norm(), 4);
+  const double moved = v.lin_error * P + v.off_error + roundingGuard(lin_norm * P + off_norm, 8);
+  const double chosen = 2.0 * P * (v.lin_error + roundingGuard(lin_norm, 8)) + roundingGuard(lin_norm * P, 16);
+  v.radius = body.radius + roundedUp(moved + chosen, 4);
+  v.count = static_cast<int>(body.points.size());
+  v.start = v.lin * base_centroid_[v.body] + v.off;
+  v.scale = roundedUp(lin_norm * P + off_norm, 8);
+  // The sphere below moved by the same map (its centre within the map's guard of its exact place)
+  // and grown as the radius grew.
+  v.bound.center = m.lin * below.bound.center + m.off;
+  v.bound.radius = roundedUp(below.bound.radius + roundingGuard(below.bound.center.norm() + m.magnitude, g) +
+                                 2.0 * std::max(0.0, v.radius - below.radius),
+                             4);
+  if (!v.lin.allFinite() || !v.off.allFinite() || !std::isfinite(v.radius) || !std::isfinite(v.scale) ||
+      !v.bound.center.allFinite() || !std::isfinite(v.bound.radius))
+    return false;
+  v.exact = true;
+  v.posed = true;
+  v.written = 0;
+  return true;
+}
+
+// The volume's points (a posed volume's written into the arena first).
+SschView Checker::written(const Volume& v) noexcept {
+  if (v.posed && v.written != cycle_) {
+    const std::vector<Vec3>& pts = model_.bodies[v.body].points;
+    Vec3* out = points_.data() + v.offset;
+    for (std::size_t i = 0; i < pts.size(); ++i) out[i] = v.lin * pts[i] + v.off;
+    v.written = cycle_;
+  }
+  return view(v);
+}
+
+namespace {
+
+// GJK's support on one side of a pair: a point set as it is, or a posed volume's body points
+// searched in the body's frame and moved.
+struct SideSupport {
+  const Vec3* pts = nullptr;
+  std::size_t n = 0;
+  bool posed = false;
+  Eigen::Matrix3d lin = Eigen::Matrix3d::Identity();
+  Vec3 off = Vec3::Zero();
+  detail::SupportHit operator()(const Vec3& dir) const noexcept {
+    if (!posed) {
+      const int i = detail::supportIndex({pts, n}, dir);
+      return {pts[static_cast<std::size_t>(i)], static_cast<std::uint64_t>(i), 0.0};
+    }
+    const Vec3 local = lin.transpose() * dir;
+    const int i = detail::supportIndex({pts, n}, local);
+    return {lin * pts[static_cast<std::size_t>(i)] + off, static_cast<std::uint64_t>(i), 0.0};
+  }
+};
+
+}  // namespace
+
+// The distance of two volumes of a pair: distance() on their points, or GJK on the posed
+// volumes' supports (the same result up to the rounding their radii cover).
+DistanceResult Checker::pairDistance(const Volume& a, const Volume& b, const GjkOptions& options) noexcept {
+  if (!a.posed && !b.posed) return distance(view(a), view(b), options);
+  detail::SetsInfo info;
+  SideSupport side[2];
+  const Volume* vol[2] = {&a, &b};
+  for (int k = 0; k < 2; ++k) {
+    const Volume& v = *vol[k];
+    SideSupport& s = side[k];
+    if (v.posed) {
+      const std::vector<Vec3>& pts = model_.bodies[v.body].points;
+      s = {pts.data(), pts.size(), true, v.lin, v.off};
+      (k == 0 ? info.scale_a : info.scale_b) = v.scale;
+      (k == 0 ? info.start_a : info.start_b) = v.start;
+    } else {
+      const SschView w = view(v);
+      const detail::PointSummary sum = detail::summarize(w.points);
+      if (!sum.finite) return DistanceResult{};  // InvalidInput
+      s = {w.points.data(), w.points.size(), false, Eigen::Matrix3d::Identity(), Vec3::Zero()};
+      (k == 0 ? info.scale_a : info.scale_b) = sum.scale;
+      (k == 0 ? info.start_a : info.start_b) = sum.centroid;
+    }
+  }
+  return detail::gjkDistance(side[0], side[1], a.radius, b.radius, info, options);
 }
 
 SschView Checker::view(const Volume& v) const noexcept {
@@ -307,7 +445,7 @@ SschView Checker::sweptVolume(int body, int frame) noexcept {
   for (int level = 0; level < levels_[body]; ++level) {
     if (path_[level_begin_[body] + level] != frame) continue;
     const Volume* v = volume(body, level, Box{lower_, upper_});
-    return v == nullptr ? SschView{} : view(*v);
+    return v == nullptr ? SschView{} : written(*v);
   }
   return {};
 }
@@ -407,7 +545,7 @@ double Checker::refresh(int p, double stop_above, Box box) noexcept {
       GjkOptions opt;
       opt.stop_above = stop_above;
       opt.warm_start = &e.direction;
-      const DistanceResult d = distance(view(*va), view(*vb), opt);
+      const DistanceResult d = pairDistance(*va, *vb, opt);
       ++result_.stats.gjk_calls;
       if (d.status == GjkStatus::InvalidInput) return fail();
       bound = std::max(bound, d.distance);

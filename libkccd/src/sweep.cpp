@@ -61,6 +61,17 @@ double maxNorm(std::span<const Vec3> pts) {
   return std::sqrt(m);
 }
 
+// A revolute joint at the single angle of `trig` (no pieces) as one matrix: Rodrigues,
+// R(q) = c I + s [a]x + (1 - c) a a^T, composed with the origin's rotation. Every entry of the
+// product errs by a few ulps (|a| = 1, |c|, |s| <= 1, the origin's rotation orthonormal), so a
+// point moves by at most about 20 ulps of |p| + |t| (t the origin's translation): the guard
+// (kRigidGuardUlps) allows 64.
+Eigen::Matrix3d revoluteMatrix(const Joint& j, const RevoluteTrig& trig) {
+  const Vec3& a = j.axis;
+  const double c = trig.c_end[0], s = trig.s_end[0];
+  return j.origin.linear() * (c * Eigen::Matrix3d::Identity() + s * crossMatrix(a) + (1.0 - c) * (a * a.transpose()));
+}
+
 // Revolute sweep in the joint frame (the point volumes of the first stage, whatever the joint's
 // mode): each point's arc is covered by its chords (pieces + 1 points) and the radius grows by the
 // largest sagitta rho (1 - cos(step / 2)), an error second order in the interval width. The point
@@ -76,18 +87,13 @@ int sweepRevolute(const Joint& j, const RevoluteTrig& trig, std::span<const Vec3
   const Eigen::Matrix3d& rot = j.origin.linear();
   const Vec3& t = j.origin.translation();
   if (pieces == 0) {  // a single angle: a rigid map, one matrix for every point
-    const double c = trig.c_end[0], s = trig.s_end[0];
-    // Rodrigues: R(q) = c I + s [a]x + (1 - c) a a^T, composed with the origin's rotation. Every
-    // entry of the product errs by a few ulps (|a| = 1, |c|, |s| <= 1, rot orthonormal), so a point
-    // moves by at most about 20 ulps of |p| + |t|: the guard allows 64.
-    const Eigen::Matrix3d map =
-        rot * (c * Eigen::Matrix3d::Identity() + s * crossMatrix(a) + (1.0 - c) * (a * a.transpose()));
+    const Eigen::Matrix3d map = revoluteMatrix(j, trig);
     double in_sq = 0.0;
     for (int i = 0; i < n_in; ++i) {
       in_sq = std::max(in_sq, in[i].squaredNorm());
       out[i] = map * in[i] + t;
     }
-    radius += roundingGuard(std::sqrt(in_sq) + t.norm(), 64);
+    radius += roundingGuard(std::sqrt(in_sq) + t.norm(), kRigidGuardUlps);
     return n_in;
   }
   const double in_norm = maxNorm(in);
@@ -293,6 +299,38 @@ int sweepExpansion(const Joint& joint) noexcept {
 
 double rhoBound(const Vec3& axis, const Sphere& s) noexcept {
   return (s.center - axis.dot(s.center) * axis).norm() + s.radius;
+}
+
+RigidMap rigidMap(const Joint& joint, const double* value, const RevoluteTrig& trig) noexcept {
+  RigidMap m;
+  const Eigen::Matrix3d& rot = joint.origin.linear();
+  const Vec3& t = joint.origin.translation();
+  switch (joint.type) {
+    case JointType::Fixed:
+      m.lin = rot;
+      m.off = t;
+      m.magnitude = t.norm();
+      m.ok = true;
+      break;
+    case JointType::Revolute:
+      if (trig.pieces != 0) break;
+      m.lin = revoluteMatrix(joint, trig);
+      m.off = t;
+      m.magnitude = t.norm();
+      m.ok = m.lin.allFinite();
+      break;
+    case JointType::Prismatic:
+      // rot (p + q axis) + t, with rot (q axis) + t computed once: a few ulps of |q| + |t|.
+      m.lin = rot;
+      m.off = rot * (value[0] * joint.axis) + t;
+      m.magnitude = std::abs(value[0]) + t.norm();
+      m.ok = std::isfinite(m.magnitude) && m.off.allFinite();
+      break;
+    case JointType::Translation3d:
+    case JointType::Rotation3d:
+      break;
+  }
+  return m;
 }
 
 int sweepJoint(const Joint& joint, const double* lo, const double* hi, const RevoluteTrig& trig,

@@ -45,6 +45,24 @@ int sweepJoint(const Joint& joint, const double* lo, const double* hi, const Rev
                std::span<const Vec3> in, Vec3* out, double& radius, int budget, double* rho,
                const Sphere& below) noexcept;
 
+/// Rounding guard of a rigid map (RigidMap): applying it to x errs by at most
+/// roundingGuard(|x| + magnitude, kRigidGuardUlps).
+inline constexpr int kRigidGuardUlps = 64;
+
+/// A joint at one value as the rigid map x -> lin x + off into its parent frame, as sweepJoint()
+/// moves points (fixed, revolute at a single angle, prismatic; `ok` is false for the 3-DOF joints,
+/// whose sweeps add growth). Applied in floating point to x it errs from the exact motion by at
+/// most roundingGuard(|x| + magnitude, kRigidGuardUlps); so does `lin` applied to a vector.
+struct RigidMap {
+  Eigen::Matrix3d lin = Eigen::Matrix3d::Identity();
+  Vec3 off = Vec3::Zero();
+  double magnitude = 0.0;
+  bool ok = false;
+};
+
+/// The rigid map of `joint` at `value` (joint.dof values; `trig` as for sweepJoint()).
+RigidMap rigidMap(const Joint& joint, const double* value, const RevoluteTrig& trig) noexcept;
+
 /// The largest distance from the axis (through the origin) of a point of sphere s.
 double rhoBound(const Vec3& axis, const Sphere& s) noexcept;
 
@@ -56,8 +74,8 @@ double rhoBound(const Vec3& axis, const Sphere& s) noexcept;
 /// frame's origin (3-DOF joints: the box around its centre). A rotation3d box of small reach also
 /// has apexes: its centre rotation composed with the twelve rotations of an icosahedron around
 /// the reach ball, whose cover (all maps) grows by `apex_point_growth` per unit distance instead.
-struct JointMaps {  // NOLINT(bugprone-reserved-identifier): clang-tidy 14 names the implicit copy loop of its arrays
-                    // __i0
+// NOLINTNEXTLINE(bugprone-reserved-identifier): clang-tidy 14 flags the implicit copy's loop index
+struct JointMaps {
   static constexpr int kMax = 13;
   int count = 0;
   int chord_count = 0;

@@ -21,6 +21,9 @@ struct ChainView;
 
 namespace kccd {
 
+struct DistanceResult;
+struct GjkOptions;
+
 /// Holds the per-cycle swept volumes and the any-time table of pair bounds. Bounds are reused
 /// across queries while they stay valid lower bounds for the new interval box.
 class Checker {
@@ -60,6 +63,18 @@ class Checker {
     // The body's points moved rigidly, every one kept, the radius grown by rounding guards only
     // (every joint below at a single value): the exact stage's chains are these points too.
     bool exact = false;
+    // Posed: a rigid volume kept as the map x -> lin x + off of the body's points (the levels'
+    // rigid maps composed), its points written into the arena only when asked for (written:
+    // the cycle they were written in); its radius covers the map's rounding and a support
+    // chosen in the body's frame. start and scale are GJK's start point and rounding scale.
+    bool posed = false;
+    int body = 0;
+    mutable std::uint64_t written = 0;
+    Eigen::Matrix3d lin = Eigen::Matrix3d::Identity();
+    Vec3 off = Vec3::Zero();
+    double lin_error = 0.0, off_error = 0.0;  // bounds on |lin - exact| (operator norm), |off - exact|
+    Vec3 start = Vec3::Zero();
+    double scale = 0.0;
   };
   struct Entry {  // the any-time table
     bool valid = false;
@@ -109,6 +124,10 @@ class Checker {
   bool chain(int body, int level, int variant, Box box, detail::ChainView& out) noexcept;
   void report(int pair, PairDistance& out) const noexcept;
   const Volume* volume(int body, int level, Box box) noexcept;
+  bool pose(Volume& v, const Volume& below, bool first, const Joint& joint, const double* value,
+            const detail::RevoluteTrig& trig) noexcept;
+  SschView written(const Volume& v) noexcept;
+  DistanceResult pairDistance(const Volume& a, const Volume& b, const GjkOptions& options) noexcept;
   SschView view(const Volume& v) const noexcept;
   const Sphere* sphere(int body, int level, Box box) noexcept;
 
@@ -138,6 +157,8 @@ class Checker {
   std::vector<double> chain_radius_[2];         // per body and level: radius of the chain up to it
   std::vector<std::uint8_t> chain_tangent_[2];  // per body and level: some level uses apexes
   std::vector<Sphere> base_sphere_;             // per body: sphere around its core points
+  std::vector<double> base_norm_;               // per body: the largest |core point|
+  std::vector<Vec3> base_centroid_;             // per body: its core points' centroid
   std::vector<Vec3> base_box_;                  // per body: centre and half-sizes of their box
   std::vector<detail::ChainEntry> chain_stack_;
   std::vector<int> chain_choice_, chain_best_;
