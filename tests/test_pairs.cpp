@@ -367,6 +367,9 @@ TEST(PairSurvey, CountsAndClosestAgreeWithIndependentDistances) {
   for (int trial = 0; trial < 40; ++trial) {
     Model m = kccd::testing::randomModel(rng, 5, 4);
     for (kccd::Joint& j : m.joints) j.error = 0.0;  // a recorded state is one configuration
+    // A budget that keeps every point (as an import's does): the bound at one configuration is
+    // then the distance; a smaller one covers dropped points by a larger radius.
+    for (const kccd::Body& b : m.bodies) m.point_budget = std::max(m.point_budget, static_cast<int>(b.points.size()));
     m.safety_margin = std::uniform_real_distribution<double>(0.0, 0.3)(rng);
     if (m.pairs.empty() || m.stateSize() == 0) continue;
     kccd::StateLog log;

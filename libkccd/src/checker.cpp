@@ -15,6 +15,7 @@
 #include "kccd/kinematics.hpp"
 #include "point_scan.hpp"
 #include "rounding.hpp"
+#include "support_cells.hpp"
 #include "sweep.hpp"
 
 namespace kccd {
@@ -53,6 +54,13 @@ Checker::Checker(const Model& model) : model_(model) {
     chain_radius_[variant].assign(volumes_.size(), 0.0);
     chain_tangent_[variant].assign(volumes_.size(), 0);
   }
+  // Support cells only for the bodies some pair compares (a one-pair model, as the pair proofs
+  // make, builds two).
+  std::vector<bool> paired(model.bodies.size(), false);
+  for (const BodyPair& pair : model.pairs) {
+    paired[static_cast<std::size_t>(pair.a)] = true;
+    paired[static_cast<std::size_t>(pair.b)] = true;
+  }
   for (const Body& body : model.bodies) {
     double norm_sq = 0.0;
     Vec3 sum = Vec3::Zero();
@@ -62,6 +70,9 @@ Checker::Checker(const Model& model) : model_(model) {
     }
     base_norm_.push_back(detail::roundedUp(std::sqrt(norm_sq), 2));
     base_centroid_.push_back(sum / static_cast<double>(body.points.size()));
+    base_cells_.push_back(paired[base_cells_.size()] ? detail::supportCells(body.points) : detail::SupportCells{});
+    const detail::PointSummary summary = detail::summarize(body.points);
+    base_scale_.push_back(summary.finite ? summary.scale : std::numeric_limits<double>::quiet_NaN());
     base_sphere_.push_back(detail::boundingSphere(body.points, 0.0));
     Vec3 lo = body.points[0], hi = body.points[0];
     for (const Vec3& p : body.points) {
@@ -127,6 +138,7 @@ void Checker::layoutVolumes() {
     v.bound = detail::boundingSphere(body.points, body.radius);
     v.swept_sphere = v.bound;
     v.exact = true;
+    v.own = true;
   }
   for (std::size_t k = 0; k < volumes_.size(); ++k)
     volumes_[k].body =
@@ -373,47 +385,59 @@ SschView Checker::written(const Volume& v) noexcept {
 
 namespace {
 
-// GJK's support on one side of a pair: a point set as it is, or a posed volume's body points
-// searched in the body's frame and moved.
+// GJK's support on one side of a pair: a swept point set as it is, or the body's own points
+// (a level-0 or posed volume) searched in the body's frame among its direction cell's
+// candidates (the same largest value as a scan of all, support_cells.hpp), moved when posed.
 struct SideSupport {
   const Vec3* pts = nullptr;
   std::size_t n = 0;
+  const detail::SupportCells* cells = nullptr;  // null: scan every point
   bool posed = false;
   Eigen::Matrix3d lin = Eigen::Matrix3d::Identity();
   Vec3 off = Vec3::Zero();
   detail::SupportHit operator()(const Vec3& dir) const noexcept {
-    if (!posed) {
+    if (cells == nullptr) {
       const int i = detail::supportIndex({pts, n}, dir);
       return {pts[static_cast<std::size_t>(i)], static_cast<std::uint64_t>(i), 0.0};
     }
-    const Vec3 local = lin.transpose() * dir;
-    const int i = detail::supportIndex({pts, n}, local);
-    return {lin * pts[static_cast<std::size_t>(i)] + off, static_cast<std::uint64_t>(i), 0.0};
+    const Vec3 local = posed ? Vec3(lin.transpose() * dir) : dir;
+    const detail::CellScan scan = detail::cellScan(*cells, {pts, n}, local);
+    const int j = detail::supportIndex(scan.points, local);
+    const int i = scan.index == nullptr ? j : scan.index[j];
+    const Vec3& p = pts[static_cast<std::size_t>(i)];
+    return {posed ? Vec3(lin * p + off) : p, static_cast<std::uint64_t>(i), 0.0};
   }
 };
 
 }  // namespace
 
-// The distance of two volumes of a pair: distance() on their points, or GJK on the posed
-// volumes' supports (the same result up to the rounding their radii cover).
+// The distance of two volumes of a pair: GJK on their supports (SideSupport), which is
+// distance() on their points up to the rounding a posed volume's radius covers.
 DistanceResult Checker::pairDistance(const Volume& a, const Volume& b, const GjkOptions& options) noexcept {
-  if (!a.posed && !b.posed) return distance(view(a), view(b), options);
+  for (const double r : {a.radius, b.radius})
+    if (!(r >= 0.0 && r <= std::numeric_limits<double>::max())) return DistanceResult{};  // InvalidInput
   detail::SetsInfo info;
   SideSupport side[2];
   const Volume* vol[2] = {&a, &b};
   for (int k = 0; k < 2; ++k) {
     const Volume& v = *vol[k];
     SideSupport& s = side[k];
+    const auto body = static_cast<std::size_t>(v.body);
+    const std::vector<Vec3>& pts = model_.bodies[body].points;
     if (v.posed) {
-      const std::vector<Vec3>& pts = model_.bodies[v.body].points;
-      s = {pts.data(), pts.size(), true, v.lin, v.off};
+      s = {pts.data(), pts.size(), &base_cells_[body], true, v.lin, v.off};
       (k == 0 ? info.scale_a : info.scale_b) = v.scale;
       (k == 0 ? info.start_a : info.start_b) = v.start;
+    } else if (v.own) {
+      if (!(base_scale_[body] >= 0.0)) return DistanceResult{};  // InvalidInput
+      s = {pts.data(), pts.size(), &base_cells_[body], false, Eigen::Matrix3d::Identity(), Vec3::Zero()};
+      (k == 0 ? info.scale_a : info.scale_b) = base_scale_[body];
+      (k == 0 ? info.start_a : info.start_b) = base_centroid_[body];
     } else {
       const SschView w = view(v);
       const detail::PointSummary sum = detail::summarize(w.points);
       if (!sum.finite) return DistanceResult{};  // InvalidInput
-      s = {w.points.data(), w.points.size(), false, Eigen::Matrix3d::Identity(), Vec3::Zero()};
+      s = {w.points.data(), w.points.size(), nullptr, false, Eigen::Matrix3d::Identity(), Vec3::Zero()};
       (k == 0 ? info.scale_a : info.scale_b) = sum.scale;
       (k == 0 ? info.start_a : info.start_b) = sum.centroid;
     }

@@ -81,7 +81,9 @@ Model randomModel(std::mt19937_64& rng, int max_joints, int max_bodies, MobileBa
     b.name.insert(0, 1, 'b');
     b.frame = uniformInt(rng, -1, nj - 1);
     const Vec3 centre(uniform(rng, -0.6, 0.6), uniform(rng, -0.6, 0.6), uniform(rng, -0.6, 0.6));
-    b.points = randomCloud(rng, uniformInt(rng, 1, 6), centre, uniform(rng, 0.01, 0.3));
+    // Mostly a few points; one body in four as many as an imported link's (support cells).
+    const int n_points = uniformInt(rng, 0, 3) == 0 ? uniformInt(rng, 12, 48) : uniformInt(rng, 1, 6);
+    b.points = randomCloud(rng, n_points, centre, uniform(rng, 0.01, 0.3));
     b.radius = uniform(rng, 0.0, 1.0) < 0.2 ? 0.0 : uniform(rng, 0.0, 0.05);
     m.bodies.push_back(b);
   }

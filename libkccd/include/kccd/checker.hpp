@@ -17,6 +17,7 @@ struct RevoluteTrig;
 struct ChainLevel;
 struct ChainEntry;
 struct ChainView;
+struct SupportCells;
 }  // namespace kccd::detail
 
 namespace kccd {
@@ -68,6 +69,7 @@ class Checker {
     // the cycle they were written in); its radius covers the map's rounding and a support
     // chosen in the body's frame. start and scale are GJK's start point and rounding scale.
     bool posed = false;
+    bool own = false;  // level 0: the body's own points in its frame
     int body = 0;
     mutable std::uint64_t written = 0;
     Eigen::Matrix3d lin = Eigen::Matrix3d::Identity();
@@ -154,12 +156,14 @@ class Checker {
   std::vector<std::uint64_t> joint_maps_stamp_;
   std::vector<detail::ChainLevel> chain_[2];
   std::vector<std::uint64_t> chain_stamp_[2];
-  std::vector<double> chain_radius_[2];         // per body and level: radius of the chain up to it
-  std::vector<std::uint8_t> chain_tangent_[2];  // per body and level: some level uses apexes
-  std::vector<Sphere> base_sphere_;             // per body: sphere around its core points
-  std::vector<double> base_norm_;               // per body: the largest |core point|
-  std::vector<Vec3> base_centroid_;             // per body: its core points' centroid
-  std::vector<Vec3> base_box_;                  // per body: centre and half-sizes of their box
+  std::vector<double> chain_radius_[2];           // per body and level: radius of the chain up to it
+  std::vector<std::uint8_t> chain_tangent_[2];    // per body and level: some level uses apexes
+  std::vector<Sphere> base_sphere_;               // per body: sphere around its core points
+  std::vector<double> base_norm_;                 // per body: the largest |core point|
+  std::vector<Vec3> base_centroid_;               // per body: its core points' centroid
+  std::vector<double> base_scale_;                // per body: its largest |coordinate| (NaN: not finite)
+  std::vector<detail::SupportCells> base_cells_;  // per body: its support candidates by direction
+  std::vector<Vec3> base_box_;                    // per body: centre and half-sizes of their box
   std::vector<detail::ChainEntry> chain_stack_;
   std::vector<int> chain_choice_, chain_best_;
   double exact_below_ = 0.0;

@@ -1,0 +1,58 @@
+// Support candidates by direction: a point set's directions cut into the cells of a cube map, and
+// per cell the points that can be farthest along one of its directions, so that a support scan
+// reads a few points instead of all of them. Internal.
+//
+// A cell is the cone over a rectangle of a cube face (its corners c_k, the rectangle grown by
+// kCellSlack so that a direction placed in it with rounded ratios lies inside). A point p is left
+// out of a cell when a witness w (the farthest point along the cell's centre or a corner) beats it
+// at every corner by more than a rounding margin m: (w - p).c_k > m |c_k|. Every direction d of
+// the cone is a non-negative combination of the corners, so (w - p).d >= m |d| there too (the
+// triangle inequality), and with m above the dot products' rounding the scan's computed value of
+// w exceeds p's. So the largest computed dot product over the cell's points equals the largest
+// over all points, bit for bit: the support value does not change, only the scan's length.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "kccd/ssch.hpp"
+
+namespace kccd::detail {
+
+/// Cells per edge of a cube face (6 kCellsPerEdge^2 cells).
+inline constexpr int kCellsPerEdge = 4;
+/// How much a cell's rectangle is grown on each side (in face coordinates, from -1 to 1).
+inline constexpr double kCellSlack = 1e-6;
+
+/// The range of point sets (their largest |p|) and of directions (their largest |coordinate|)
+/// the cells serve: every dot product then lies between 1e-250 and 1e301, so none overflows and
+/// none loses relative precision by underflow, which the rounding argument needs. Outside it
+/// the scan reads every point.
+inline constexpr double kCellMinNorm = 1e-100, kCellMaxNorm = 1e150;
+inline constexpr double kCellMinDirection = 1e-150, kCellMaxDirection = 1e150;
+
+/// The candidates of every cell: for cell c, points[begin[c] .. begin[c + 1]) (copies, for a
+/// contiguous scan) and their indices in the set. Empty when the set is not worth it (few points)
+/// or out of the cells' range.
+struct SupportCells {
+  std::vector<Vec3> points;
+  std::vector<int> index;
+  std::vector<int> begin;
+  bool empty() const noexcept { return begin.empty(); }
+};
+
+/// The cells of point set `pts` (empty for fewer than `min_points` points).
+SupportCells supportCells(std::span<const Vec3> pts, int min_points = 12);
+
+/// The cell of direction d, or -1 when d is out of the cells' range (zero and not finite included).
+int cellOf(const Vec3& d) noexcept;
+
+/// The points of the cell of direction d (all of `pts` when `cells` is empty or d has no cell),
+/// and the map from their positions back to indices in `pts` (null: the identity).
+struct CellScan {
+  std::span<const Vec3> points;
+  const int* index = nullptr;
+};
+CellScan cellScan(const SupportCells& cells, std::span<const Vec3> pts, const Vec3& d) noexcept;
+
+}  // namespace kccd::detail
