@@ -217,6 +217,17 @@ TEST(Queries, ReusesBoundsWhenTheBoxShrinks) {
   for (std::size_t k = 0; k < r.pairs.size(); ++k) EXPECT_EQ(r.pairs[k].distance, f.pairs[k].distance);
 }
 
+// A random model at one configuration (lower, returned in upper too) with no joint error and a
+// point budget that keeps every body's points: its point volumes are the bodies rigidly moved.
+Model rigidModelAtOneConfiguration(std::mt19937_64& rng, std::vector<double>& lower, std::vector<double>& upper) {
+  Model m = testing::randomModel(rng, 5, 4);
+  for (Joint& j : m.joints) j.error = 0.0;
+  for (const Body& b : m.bodies) m.point_budget = std::max(m.point_budget, static_cast<int>(b.points.size()));
+  testing::randomBox(rng, m, lower, upper);
+  upper = lower;
+  return m;
+}
+
 // At one configuration, with no joint error and a budget that holds every body, the point volumes
 // are the bodies rigidly moved: the exact stage has nothing to add, so it is skipped, and GJK's
 // bound is the distance itself (an independent oracle at that configuration, to 1e-9).
@@ -224,12 +235,8 @@ TEST(Queries, AtOneConfigurationTheBoundIsTheDistanceWithoutTheExactStage) {
   std::mt19937_64 rng(97);
   int pairs = 0, separated = 0;
   for (int trial = 0; trial < 200; ++trial) {
-    Model m = testing::randomModel(rng, 5, 4);
-    for (Joint& j : m.joints) j.error = 0.0;
-    for (const Body& b : m.bodies) m.point_budget = std::max(m.point_budget, static_cast<int>(b.points.size()));
     std::vector<double> lower, upper;
-    testing::randomBox(rng, m, lower, upper);
-    upper = lower;
+    const Model m = rigidModelAtOneConfiguration(rng, lower, upper);
     Checker c(m);
     QueryOptions o = options(QueryType::Distances);
     o.exact_below = std::numeric_limits<double>::infinity();  // every pair would be refined
@@ -260,13 +267,9 @@ TEST(Queries, PosedVolumesAgreeWithTheirWrittenPoints) {
   std::mt19937_64 rng(101);
   int compared = 0;
   for (int trial = 0; trial < 200; ++trial) {
-    Model m = testing::randomModel(rng, 5, 4);
     // (With pose errors the swept spheres can prove more than the point volumes: no equality.)
-    for (Joint& j : m.joints) j.error = 0.0;
-    for (const Body& b : m.bodies) m.point_budget = std::max(m.point_budget, static_cast<int>(b.points.size()));
     std::vector<double> lower, upper;
-    testing::randomBox(rng, m, lower, upper);
-    upper = lower;
+    const Model m = rigidModelAtOneConfiguration(rng, lower, upper);
     Checker c(m);
     QueryOptions o = options(QueryType::Distances);
     o.exact_below = -std::numeric_limits<double>::infinity();

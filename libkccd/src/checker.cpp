@@ -63,16 +63,10 @@ Checker::Checker(const Model& model) : model_(model) {
   }
   for (const Body& body : model.bodies) {
     double norm_sq = 0.0;
-    Vec3 sum = Vec3::Zero();
-    for (const Vec3& p : body.points) {
-      norm_sq = std::max(norm_sq, p.squaredNorm());
-      sum += p;
-    }
+    for (const Vec3& p : body.points) norm_sq = std::max(norm_sq, p.squaredNorm());
     base_norm_.push_back(detail::roundedUp(std::sqrt(norm_sq), 2));
-    base_centroid_.push_back(sum / static_cast<double>(body.points.size()));
+    base_summary_.push_back(detail::summarize(body.points));
     base_cells_.push_back(paired[base_cells_.size()] ? detail::supportCells(body.points) : detail::SupportCells{});
-    const detail::PointSummary summary = detail::summarize(body.points);
-    base_scale_.push_back(summary.finite ? summary.scale : std::numeric_limits<double>::quiet_NaN());
     base_sphere_.push_back(detail::boundingSphere(body.points, 0.0));
     Vec3 lo = body.points[0], hi = body.points[0];
     for (const Vec3& p : body.points) {
@@ -116,6 +110,7 @@ void Checker::layoutVolumes() {
     int level = 0;
     while (true) {
       Volume v;
+      v.body = b;
       v.offset = arena;
       v.capacity = level == 0 ? static_cast<int>(body.points.size()) : budget;
       arena += v.capacity;
@@ -140,11 +135,6 @@ void Checker::layoutVolumes() {
     v.exact = true;
     v.own = true;
   }
-  for (std::size_t k = 0; k < volumes_.size(); ++k)
-    volumes_[k].body =
-        static_cast<int>(std::upper_bound(level_begin_.begin(), level_begin_.end(), static_cast<int>(k)) -
-                         level_begin_.begin()) -
-        1;
   int expansion = 1;
   for (const Joint& j : model.joints) expansion = std::max(expansion, detail::sweepExpansion(j));
   scratch_.resize(static_cast<std::size_t>(expansion) * max_points);
@@ -355,7 +345,7 @@ bool Checker::pose(Volume& v, const Volume& below, bool first, const Joint& join
   const double chosen = 2.0 * P * (v.lin_error + roundingGuard(lin_norm, 8)) + roundingGuard(lin_norm * P, 16);
   v.radius = body.radius + roundedUp(moved + chosen, 4);
   v.count = static_cast<int>(body.points.size());
-  v.start = v.lin * base_centroid_[v.body] + v.off;
+  v.start = v.lin * base_summary_[v.body].centroid + v.off;
   v.scale = roundedUp(lin_norm * P + off_norm, 8);
   // The sphere below moved by the same map (its centre within the map's guard of its exact place)
   // and grown as the radius grew.
@@ -429,10 +419,11 @@ DistanceResult Checker::pairDistance(const Volume& a, const Volume& b, const Gjk
       (k == 0 ? info.scale_a : info.scale_b) = v.scale;
       (k == 0 ? info.start_a : info.start_b) = v.start;
     } else if (v.own) {
-      if (!(base_scale_[body] >= 0.0)) return DistanceResult{};  // InvalidInput
+      const detail::PointSummary& sum = base_summary_[body];
+      if (!sum.finite) return DistanceResult{};  // InvalidInput
       s = {pts.data(), pts.size(), &base_cells_[body], false, Eigen::Matrix3d::Identity(), Vec3::Zero()};
-      (k == 0 ? info.scale_a : info.scale_b) = base_scale_[body];
-      (k == 0 ? info.start_a : info.start_b) = base_centroid_[body];
+      (k == 0 ? info.scale_a : info.scale_b) = sum.scale;
+      (k == 0 ? info.start_a : info.start_b) = sum.centroid;
     } else {
       const SschView w = view(v);
       const detail::PointSummary sum = detail::summarize(w.points);

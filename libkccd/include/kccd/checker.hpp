@@ -18,6 +18,7 @@ struct ChainLevel;
 struct ChainEntry;
 struct ChainView;
 struct SupportCells;
+struct PointSummary;
 }  // namespace kccd::detail
 
 namespace kccd {
@@ -156,14 +157,13 @@ class Checker {
   std::vector<std::uint64_t> joint_maps_stamp_;
   std::vector<detail::ChainLevel> chain_[2];
   std::vector<std::uint64_t> chain_stamp_[2];
-  std::vector<double> chain_radius_[2];           // per body and level: radius of the chain up to it
-  std::vector<std::uint8_t> chain_tangent_[2];    // per body and level: some level uses apexes
-  std::vector<Sphere> base_sphere_;               // per body: sphere around its core points
-  std::vector<double> base_norm_;                 // per body: the largest |core point|
-  std::vector<Vec3> base_centroid_;               // per body: its core points' centroid
-  std::vector<double> base_scale_;                // per body: its largest |coordinate| (NaN: not finite)
-  std::vector<detail::SupportCells> base_cells_;  // per body: its support candidates by direction
-  std::vector<Vec3> base_box_;                    // per body: centre and half-sizes of their box
+  std::vector<double> chain_radius_[2];             // per body and level: radius of the chain up to it
+  std::vector<std::uint8_t> chain_tangent_[2];      // per body and level: some level uses apexes
+  std::vector<Sphere> base_sphere_;                 // per body: sphere around its core points
+  std::vector<double> base_norm_;                   // per body: the largest |core point|
+  std::vector<detail::PointSummary> base_summary_;  // per body: its core points' scale, centroid
+  std::vector<detail::SupportCells> base_cells_;    // per body: its support candidates by direction
+  std::vector<Vec3> base_box_;                      // per body: centre and half-sizes of their box
   std::vector<detail::ChainEntry> chain_stack_;
   std::vector<int> chain_choice_, chain_best_;
   double exact_below_ = 0.0;
