@@ -263,3 +263,35 @@ TEST(FourccCode, FirstCharacterInTheLowestByte) {
 }
 
 }  // namespace
+
+// The writer encodes on a thread of its own: a failure there (a full disk) reaches the caller as a
+// VideoFileError from a later write() or from finish(), never as a file passed off as whole; a
+// writer destroyed with frames still queued stops cleanly (the sanitizer builds would tell a leak).
+TEST_F(VideoFileTest, AFullDiskFailsAWriteOrTheFinishInWords) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  fs::create_symlink("/dev/full", path("full.avi"));
+  std::string error;
+  try {
+    VideoFileWriter w(path("full.avi"), "MJPG", 30, 320, 240);
+    for (int i = 0; i < 60; ++i) w.write(frame(i, 320, 240));
+    w.finish();
+  } catch (const VideoFileError& e) {
+    error = e.what();
+  }
+  EXPECT_TRUE(error.rfind("cannot write to the file (", 0) == 0 || error.rfind("cannot finish the file (", 0) == 0 ||
+              error.rfind("cannot close the file", 0) == 0 ||
+              error.rfind("cannot write the container's header (", 0) == 0)
+      << "error: '" << error << "'";
+  {
+    VideoFileWriter w(path("queued.avi"), "MJPG", 30, 320, 240);
+    for (int i = 0; i < 8; ++i) w.write(frame(i, 320, 240));
+  }  // destroyed unfinished, frames in flight
+  VideoFileWriter again(path("again.avi"), "MJPG", 30, 320, 240);
+  for (int i = 0; i < 8; ++i) again.write(frame(i, 320, 240));
+  again.finish();
+  VideoFileReader r(path("again.avi"));
+  cv::Mat m;
+  int n = 0;
+  while (r.read(m)) ++n;
+  EXPECT_EQ(n, 8);
+}

@@ -3,10 +3,15 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <condition_variable>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
+#include <exception>
 #include <limits>
 #include <mutex>
+#include <thread>
+#include <vector>
 
 #include <unistd.h>
 
@@ -259,20 +264,41 @@ struct VideoFileWriter::Impl {
   AVFormatContext* format = nullptr;
   AVCodecContext* encoder = nullptr;
   AVStream* stream = nullptr;
-  AVFrame* frame = nullptr;
   AVPacket* packet = nullptr;
   SwsContext* scale = nullptr;
-  std::uint8_t* pixels = nullptr;  // the encoder's planes, packed (OpenCV's layout)
   std::int64_t next_pts = 0;
   bool file_open = false, header_written = false, finished = false;
 
+  // The encoder's thread: write() converts a frame's pixels into a free frame of the pool and
+  // queues it; the thread encodes the queue in order and writes the packets. A null entry is the
+  // end (drain the encoder). The first failure stops it and is rethrown by the next call.
+  static constexpr std::size_t kPoolFrames = 3;
+  std::vector<AVFrame*> pool;         // every frame made, freed at the end
+  std::vector<std::uint8_t*> pixels;  // their planes, packed (OpenCV's layout), not reference-counted:
+                                      // the encoder copies what it keeps, as it did one frame at a time
+  std::vector<AVFrame*> free_ones;    // frames no one holds
+  std::deque<AVFrame*> queued;        // converted, in order, not yet encoded
+  bool end_queued = false, stop = false;
+  std::exception_ptr failure;
+  std::mutex mu;
+  std::condition_variable wake;
+  std::thread thread;
+
   ~Impl() {
+    if (thread.joinable()) {
+      {
+        std::lock_guard lock(mu);
+        stop = true;
+      }
+      wake.notify_all();
+      thread.join();
+    }
     if (header_written && !finished) av_write_trailer(format);  // an unfinished file, closed; its owner removes it
     if (file_open) avio_closep(&format->pb);
     sws_freeContext(scale);
-    av_free(pixels);
+    for (AVFrame*& f : pool) av_frame_free(&f);
+    for (std::uint8_t* p : pixels) av_free(p);
     av_packet_free(&packet);
-    av_frame_free(&frame);
     avcodec_free_context(&encoder);
     avformat_free_context(format);
   }
@@ -291,6 +317,49 @@ struct VideoFileWriter::Impl {
       rc = av_write_frame(format, packet);
       if (rc < 0) throw VideoFileError("cannot write to the file (" + ffmpegError(rc) + ")");
     }
+  }
+
+  // The encoder thread's loop: every queued frame encoded in order, then the end.
+  void run() {
+    for (;;) {
+      AVFrame* f = nullptr;
+      {
+        std::unique_lock lock(mu);
+        wake.wait(lock, [&] { return stop || !queued.empty() || end_queued; });
+        if (stop) return;
+        if (queued.empty()) break;  // the end, everything before it encoded
+        f = queued.front();
+        queued.pop_front();
+      }
+      try {
+        encode(f);
+      } catch (...) {
+        std::lock_guard lock(mu);
+        failure = std::current_exception();
+        free_ones.push_back(f);
+        wake.notify_all();
+        return;
+      }
+      std::lock_guard lock(mu);
+      free_ones.push_back(f);
+      wake.notify_all();
+    }
+    try {
+      if (next_pts > 0) encode(nullptr);
+    } catch (...) {
+      std::lock_guard lock(mu);
+      failure = std::current_exception();
+    }
+  }
+
+  // A frame to convert into: a free one of the pool, once the encoder has handed one back.
+  AVFrame* freeFrame() {
+    std::unique_lock lock(mu);
+    wake.wait(lock, [&] { return failure != nullptr || !free_ones.empty(); });
+    if (failure) std::rethrow_exception(failure);
+    AVFrame* f = free_ones.back();
+    free_ones.pop_back();
+    return f;
   }
 };
 
@@ -336,9 +405,8 @@ VideoFileWriter::VideoFileWriter(const std::string& path, const std::string& fou
     throw VideoFileError("the container does not take the codec " + fourcc);
   m.stream = avformat_new_stream(m.format, nullptr);
   m.encoder = avcodec_alloc_context3(codec);
-  m.frame = av_frame_alloc();
   m.packet = av_packet_alloc();
-  if (m.stream == nullptr || m.encoder == nullptr || m.frame == nullptr || m.packet == nullptr) throw std::bad_alloc();
+  if (m.stream == nullptr || m.encoder == nullptr || m.packet == nullptr) throw std::bad_alloc();
   // The settings of OpenCV 4.6's FFmpeg writer, so a video comes out as it did through OpenCV.
   m.format->max_delay = static_cast<int>(0.7 * AV_TIME_BASE);
   AVCodecContext& c = *m.encoder;
@@ -391,14 +459,20 @@ VideoFileWriter::VideoFileWriter(const std::string& path, const std::string& fou
   rc = avformat_write_header(m.format, nullptr);
   if (rc < 0) throw VideoFileError("cannot write the container's header (" + ffmpegError(rc) + ")");
   m.header_written = true;
-  m.frame->format = c.pix_fmt;
-  m.frame->width = width;
-  m.frame->height = height;
-  const int bytes = av_image_get_buffer_size(c.pix_fmt, width, height, 1);
-  m.pixels = bytes > 0 ? static_cast<std::uint8_t*>(av_malloc(static_cast<std::size_t>(bytes))) : nullptr;
-  if (m.pixels == nullptr ||
-      av_image_fill_arrays(m.frame->data, m.frame->linesize, m.pixels, c.pix_fmt, width, height, 1) < 0)
-    throw std::bad_alloc();
+  for (std::size_t k = 0; k < Impl::kPoolFrames; ++k) {
+    AVFrame* f = av_frame_alloc();
+    if (f == nullptr) throw std::bad_alloc();
+    m.pool.push_back(f);
+    f->format = c.pix_fmt;
+    f->width = width;
+    f->height = height;
+    const int bytes = av_image_get_buffer_size(c.pix_fmt, width, height, 1);
+    auto* planes = bytes > 0 ? static_cast<std::uint8_t*>(av_malloc(static_cast<std::size_t>(bytes))) : nullptr;
+    if (planes == nullptr) throw std::bad_alloc();
+    m.pixels.push_back(planes);
+    if (av_image_fill_arrays(f->data, f->linesize, planes, c.pix_fmt, width, height, 1) < 0) throw std::bad_alloc();
+    m.free_ones.push_back(f);
+  }
   m.scale =
       sws_getContext(width, height, AV_PIX_FMT_BGR24, width, height, c.pix_fmt, SWS_BICUBIC, nullptr, nullptr, nullptr);
   if (m.scale == nullptr) throw VideoFileError("swscale cannot convert BGR to the encoder's pixel format");
@@ -411,17 +485,31 @@ void VideoFileWriter::write(const cv::Mat& bgr) {
   if (bgr.type() != CV_8UC3 || bgr.cols != m.encoder->width || bgr.rows != m.encoder->height)
     throw std::logic_error("a video frame of another size or type than the writer's");
   if (m.finished) throw std::logic_error("a video frame after finish()");
+  if (!m.thread.joinable()) m.thread = std::thread([&m] { m.run(); });
+  AVFrame* f = m.freeFrame();
   const std::uint8_t* const planes[4] = {bgr.data, nullptr, nullptr, nullptr};
   const int strides[4] = {static_cast<int>(bgr.step[0]), 0, 0, 0};
-  sws_scale(m.scale, planes, strides, 0, bgr.rows, m.frame->data, m.frame->linesize);
-  m.frame->pts = m.next_pts++;
-  m.encode(m.frame);
+  sws_scale(m.scale, planes, strides, 0, bgr.rows, f->data, f->linesize);
+  f->pts = m.next_pts++;
+  {
+    std::lock_guard lock(m.mu);
+    m.queued.push_back(f);
+  }
+  m.wake.notify_all();
 }
 
 void VideoFileWriter::finish() {
   Impl& m = *impl_;
   if (m.finished) return;
-  if (m.next_pts > 0) m.encode(nullptr);
+  if (m.thread.joinable()) {
+    {
+      std::lock_guard lock(m.mu);
+      m.end_queued = true;
+    }
+    m.wake.notify_all();
+    m.thread.join();
+    if (m.failure) std::rethrow_exception(m.failure);
+  }
   m.finished = true;
   const int rc = av_write_trailer(m.format);
   if (rc < 0) throw VideoFileError("cannot finish the file (" + ffmpegError(rc) + ")");

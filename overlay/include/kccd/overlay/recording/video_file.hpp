@@ -58,6 +58,8 @@ class VideoFileReader {
 /// a FourCC (mp4v, XVID, DIVX, FMP4: MPEG-4 part 2; MJPG: Motion JPEG; FFV1: lossless; avc1,
 /// H264: H.264; hvc1, HEVC: H.265; VP80, VP90), the encoder's settings those of OpenCV's FFmpeg
 /// writer (bit rate fps x width x height, a key frame every 12 frames), one frame per 1/fps.
+/// write() converts the pixels to the encoder's format in the caller's thread and hands the frame
+/// to a thread of the writer's own that encodes the frames in order (up to 3 in flight).
 class VideoFileWriter {
  public:
   /// Creates `path` and opens the encoder for `width` x `height` frames at `fps`. Throws
@@ -68,10 +70,11 @@ class VideoFileWriter {
   VideoFileWriter(const VideoFileWriter&) = delete;
   VideoFileWriter& operator=(const VideoFileWriter&) = delete;
 
-  /// Encodes one 8-bit BGR frame of the writer's size. Throws VideoFileError; a frame of another
-  /// size or type is a std::logic_error.
+  /// Encodes one 8-bit BGR frame of the writer's size. Throws VideoFileError (also an earlier
+  /// frame's encoding failure); a frame of another size or type is a std::logic_error.
   void write(const cv::Mat& bgr);
-  /// Drains the encoder and writes the container's trailer. Throws VideoFileError.
+  /// Encodes what is queued, drains the encoder and writes the container's trailer. Throws
+  /// VideoFileError.
   void finish();
 
  private:
