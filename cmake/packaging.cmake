@@ -91,6 +91,10 @@ if(KCCD_OSMESA_SONAME STREQUAL "libOSMesa.so.8")
   string(APPEND _kccd_runtime_recommends ", libosmesa6")
 endif()
 set(CPACK_DEBIAN_CLI_PACKAGE_RECOMMENDS "${_kccd_runtime_recommends}")
+# FFmpeg's libraries are loaded by their sonames the first time a video is opened (overlay's
+# ffmpeg_api.cpp): dpkg-shlibdeps cannot see them either, and video is the overlay's input (the
+# Python package depends on them below).
+set(CPACK_DEBIAN_CLI_PACKAGE_DEPENDS "${KCCD_FFMPEG_PACKAGES}")
 set(CPACK_DEBIAN_PYTHON_PACKAGE_RECOMMENDS "${_kccd_runtime_recommends}")
 
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME libkccd-dev)
@@ -100,8 +104,7 @@ set(CPACK_DEBIAN_DEV_PACKAGE_ARCHITECTURE amd64)
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "cmake (>= 3.20), libeigen3-dev (>= 3.4), libccd-dev, libyaml-cpp-dev, \
 libqhull-dev, libcoin-dev, libassimp-dev, liburdfdom-dev, libtinyxml2-dev, libopencv-dev (>= 4.6), libpng-dev, \
 libjpeg-dev, libapriltag-dev, zlib1g-dev, libzstd-dev, liblz4-dev, libbz2-dev, libsqlite3-dev, libsnappy-dev, \
-libegl-dev, libgl-dev, nlohmann-json3-dev, libcpp-httplib-dev, libssl-dev, \
-libavformat-dev, libavcodec-dev, libavutil-dev, libswscale-dev")
+libegl-dev, libgl-dev, nlohmann-json3-dev, libcpp-httplib-dev, libssl-dev, ${KCCD_FFMPEG_PACKAGES}")
 set(CPACK_DEBIAN_DEV_DESCRIPTION "strictly conservative continuous collision detection for robots (C++)
 The KCCD C++ libraries (static), their headers and their CMake package:
 find_package(kccd COMPONENTS ...) gives kccd::kccd, the collision checker a
@@ -110,7 +113,7 @@ and the parts of the tool suite (modelling, calib, logs, render, overlay).")
 
 set(CPACK_DEBIAN_PYTHON_PACKAGE_NAME python3-kccd)
 set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)
-set(CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS "python3 (>= 3.11), python3 (<< 3.12), python3-numpy, python3-yaml")
+set(CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS "python3 (>= 3.11), python3 (<< 3.12), python3-numpy, python3-yaml, ${KCCD_FFMPEG_PACKAGES}")
 # Byte-compiled on install and cleaned on removal (py3compile, py3clean), as dh_python3 does.
 configure_file(${PROJECT_SOURCE_DIR}/cmake/debian/python3-kccd.postinst ${_kccd_deb_dir}/python/postinst COPYONLY)
 configure_file(${PROJECT_SOURCE_DIR}/cmake/debian/python3-kccd.prerm ${_kccd_deb_dir}/python/prerm COPYONLY)

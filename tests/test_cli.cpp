@@ -224,6 +224,22 @@ TEST(Cli, LightCommandsRunWithoutTheWholeProgramAndAgreeWithIt) {
   std::filesystem::remove_all(dir);
 }
 
+// kccd-all loads FFmpeg's libraries (with ~120 codec libraries behind them) only when a command
+// opens a video: not linked, and not loaded by a command that reads no video. (Opening one loads
+// them: every VideoFileTest does.)
+TEST(Cli, TheWholeProgramLoadsFfmpegOnlyForAVideo) {
+  const Outcome libs = kccd::testing::runProgram(std::string("ldd ") + KCCD_ALL);
+  ASSERT_EQ(libs.code, 0) << libs.err;
+  for (const char* video : {"libavcodec", "libavformat", "libswscale", "libavutil"})
+    EXPECT_EQ(libs.out.find(video), std::string::npos) << video << " is linked by kccd-all:\n" << libs.out;
+  const Outcome run =
+      kccd::testing::runProgram(std::string("env LD_DEBUG=files ") + KCCD_ALL + " render " + kDemo + " --help", true);
+  EXPECT_EQ(run.code, 0) << run.out;
+  EXPECT_NE(run.out.find("libEGL"), std::string::npos) << "LD_DEBUG=files lists no library:\n"
+                                                       << run.out.substr(0, 400);
+  EXPECT_EQ(run.out.find("libavcodec"), std::string::npos) << "render --help loaded FFmpeg";
+}
+
 }  // namespace
 
 namespace {

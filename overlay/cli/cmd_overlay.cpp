@@ -14,6 +14,7 @@
 #include "commands.hpp"
 #include "kccd/overlay/jobs/overlay_job.hpp"
 #include "kccd/overlay/recording/overlay_recording.hpp"
+#include "kccd/overlay/recording/video_file.hpp"
 #include "kccd/render/gl_context.hpp"
 
 namespace kccd::cli {
@@ -37,6 +38,7 @@ std::string spelled(const std::string& field) { return optionSpelling(field, kSp
 Exit runOverlay(OverlayArgs& a) {
   const auto t_start = std::chrono::steady_clock::now();
   const render::GlPreparation gl;  // Mesa's driver loads on a thread of its own while the inputs are read
+  const overlay::VideoLibraryPreparation video_libraries;  // and FFmpeg's libraries on another
   overlay::OverlayRequest& q = a.request;
   const Model model = loadOrExplain(a.model);
   const calib::Camera camera = calib::loadCamera(a.camera);

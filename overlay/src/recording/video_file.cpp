@@ -10,19 +10,13 @@
 #include <exception>
 #include <limits>
 #include <mutex>
+#include <system_error>
 #include <thread>
 #include <vector>
 
 #include <unistd.h>
 
-extern "C" {
-#include <libavcodec/avcodec.h>
-#include <libavformat/avformat.h>
-#include <libavutil/display.h>
-#include <libavutil/imgutils.h>
-#include <libavutil/opt.h>
-#include <libswscale/swscale.h>
-}
+#include "ffmpeg_api.hpp"
 
 #include <opencv2/core.hpp>
 
@@ -30,9 +24,12 @@ namespace kccd::overlay {
 
 namespace {
 
+// FFmpeg's functions; the first call loads the libraries (throws VideoFileError when it cannot).
+const detail::FfmpegApi& ff() { return detail::ffmpeg(); }
+
 std::string ffmpegError(int code) {
   std::array<char, AV_ERROR_MAX_STRING_SIZE> text{};
-  av_strerror(code, text.data(), text.size());
+  ff().av_strerror(code, text.data(), text.size());
   return text.data();
 }
 
@@ -50,13 +47,14 @@ int requestedLogLevel(int otherwise) {
 // unless KCCD_FFMPEG_LOGLEVEL asks for them; set once, before the first file is opened.
 void quietByDefault() {
   static std::once_flag once;
-  std::call_once(once, [] { av_log_set_level(requestedLogLevel(AV_LOG_QUIET)); });
+  std::call_once(once, [] { ff().av_log_set_level(requestedLogLevel(AV_LOG_QUIET)); });
 }
 
 // The FourCC tables of the containers this suite writes and reads most (AVI's, then MP4's), as
 // FFmpeg's lookups take them: null-terminated.
 const AVCodecTag* const* usualTags() {
-  static const AVCodecTag* const tables[] = {avformat_get_riff_video_tags(), avformat_get_mov_video_tags(), nullptr};
+  static const AVCodecTag* const tables[] = {ff().avformat_get_riff_video_tags(), ff().avformat_get_mov_video_tags(),
+                                             nullptr};
   return tables;
 }
 
@@ -83,7 +81,7 @@ AVCodecID codecOf(const std::string& four) {
   if (lower == "vp80") return AV_CODEC_ID_VP8;
   if (lower == "vp90") return AV_CODEC_ID_VP9;
   if (lower == "av01") return AV_CODEC_ID_AV1;
-  return av_codec_get_id(usualTags(), fourccCode(four));
+  return ff().av_codec_get_id(usualTags(), fourccCode(four));
 }
 
 }  // namespace
@@ -93,6 +91,24 @@ std::uint32_t fourccCode(const std::string& four) {
   std::uint32_t code = 0;
   for (int i = 3; i >= 0; --i) code = (code << 8) | static_cast<unsigned char>(four[static_cast<std::size_t>(i)]);
   return code;
+}
+
+VideoLibraryPreparation::VideoLibraryPreparation() {
+  try {
+    thread_ = std::thread([] {
+      try {
+        quietByDefault();  // loads the libraries
+      } catch (...) {
+        // Reported by the first reader or writer, which tries again.
+      }
+    });
+  } catch (const std::system_error&) {
+    // No thread: the first reader or writer loads them.
+  }
+}
+
+VideoLibraryPreparation::~VideoLibraryPreparation() {
+  if (thread_.joinable()) thread_.join();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -110,12 +126,14 @@ struct VideoFileReader::Impl {
   bool draining = false;  // the end of the file was sent to the decoder
 
   ~Impl() {
-    sws_freeContext(scale);
-    av_frame_free(&converted);
-    av_frame_free(&frame);
-    av_packet_free(&packet);
-    avcodec_free_context(&decoder);
-    avformat_close_input(&format);
+    const detail::FfmpegApi* f = detail::loadedFfmpeg();
+    if (f == nullptr) return;  // nothing of FFmpeg's was made
+    f->sws_freeContext(scale);
+    f->av_frame_free(&converted);
+    f->av_frame_free(&frame);
+    f->av_packet_free(&packet);
+    f->avcodec_free_context(&decoder);
+    f->avformat_close_input(&format);
   }
 
   // The decoded frame in BGR, turned upright. As OpenCV's FFmpeg capture converts (so the pixels
@@ -127,18 +145,18 @@ struct VideoFileReader::Impl {
     if (w <= 0 || h <= 0 || frame->format < 0) throw VideoFileError("a frame without a picture");
     const int cw = std::max(w, decoder->coded_width), ch = std::max(h, decoder->coded_height);
     if (converted == nullptr || converted->width != cw || converted->height != ch) {
-      av_frame_free(&converted);
-      converted = av_frame_alloc();
+      ff().av_frame_free(&converted);
+      converted = ff().av_frame_alloc();
       if (converted == nullptr) throw std::bad_alloc();
       converted->format = AV_PIX_FMT_BGR24;
       converted->width = cw;
       converted->height = ch;
-      if (av_frame_get_buffer(converted, 32) < 0) throw std::bad_alloc();
+      if (ff().av_frame_get_buffer(converted, 32) < 0) throw std::bad_alloc();
     }
-    scale = sws_getCachedContext(scale, cw, ch, static_cast<AVPixelFormat>(frame->format), cw, ch, AV_PIX_FMT_BGR24,
-                                 SWS_BICUBIC, nullptr, nullptr, nullptr);
+    scale = ff().sws_getCachedContext(scale, cw, ch, static_cast<AVPixelFormat>(frame->format), cw, ch,
+                                      AV_PIX_FMT_BGR24, SWS_BICUBIC, nullptr, nullptr, nullptr);
     if (scale == nullptr) throw VideoFileError("a pixel format swscale cannot convert");
-    sws_scale(scale, frame->data, frame->linesize, 0, ch, converted->data, converted->linesize);
+    ff().sws_scale(scale, frame->data, frame->linesize, 0, ch, converted->data, converted->linesize);
     const cv::Mat picture(h, w, CV_8UC3, converted->data[0], static_cast<std::size_t>(converted->linesize[0]));
     if (rotation == 90)
       cv::rotate(picture, bgr, cv::ROTATE_90_CLOCKWISE);
@@ -154,33 +172,34 @@ struct VideoFileReader::Impl {
 VideoFileReader::VideoFileReader(const std::string& path) : impl_(std::make_unique<Impl>()) {
   quietByDefault();
   Impl& m = *impl_;
-  int rc = avformat_open_input(&m.format, path.c_str(), nullptr, nullptr);
+  int rc = ff().avformat_open_input(&m.format, path.c_str(), nullptr, nullptr);
   if (rc < 0) throw VideoFileError("not a video FFmpeg reads (" + ffmpegError(rc) + ")");
-  rc = avformat_find_stream_info(m.format, nullptr);
+  rc = ff().avformat_find_stream_info(m.format, nullptr);
   if (rc < 0) throw VideoFileError("no stream can be read (" + ffmpegError(rc) + ")");
   // The first video stream (as OpenCV's capture chooses).
   for (unsigned i = 0; i < m.format->nb_streams && m.stream < 0; ++i)
     if (m.format->streams[i]->codecpar->codec_type == AVMEDIA_TYPE_VIDEO) m.stream = static_cast<int>(i);
   if (m.stream < 0) throw VideoFileError("no video stream");
   const AVStream* st = m.format->streams[m.stream];
-  const AVCodec* codec = avcodec_find_decoder(st->codecpar->codec_id);
+  const AVCodec* codec = ff().avcodec_find_decoder(st->codecpar->codec_id);
   if (codec == nullptr)
-    throw VideoFileError("no decoder for its codec (" + std::string(avcodec_get_name(st->codecpar->codec_id)) + ")");
-  m.decoder = avcodec_alloc_context3(codec);
-  m.packet = av_packet_alloc();
-  m.frame = av_frame_alloc();
+    throw VideoFileError("no decoder for its codec (" + std::string(ff().avcodec_get_name(st->codecpar->codec_id)) +
+                         ")");
+  m.decoder = ff().avcodec_alloc_context3(codec);
+  m.packet = ff().av_packet_alloc();
+  m.frame = ff().av_frame_alloc();
   if (m.decoder == nullptr || m.packet == nullptr || m.frame == nullptr) throw std::bad_alloc();
-  rc = avcodec_parameters_to_context(m.decoder, st->codecpar);
+  rc = ff().avcodec_parameters_to_context(m.decoder, st->codecpar);
   if (rc >= 0) {
     m.decoder->thread_count = static_cast<int>(std::clamp(sysconf(_SC_NPROCESSORS_ONLN), 1L, 64L));
-    rc = avcodec_open2(m.decoder, codec, nullptr);
+    rc = ff().avcodec_open2(m.decoder, codec, nullptr);
   }
   if (rc < 0)
     throw VideoFileError("its decoder (" + std::string(codec->name) + ") refuses it (" + ffmpegError(rc) + ")");
   std::size_t size = 0;
-  if (const std::uint8_t* matrix = av_stream_get_side_data(st, AV_PKT_DATA_DISPLAYMATRIX, &size);
+  if (const std::uint8_t* matrix = ff().av_stream_get_side_data(st, AV_PKT_DATA_DISPLAYMATRIX, &size);
       matrix != nullptr && size >= 9 * sizeof(std::int32_t)) {
-    const double angle = av_display_rotation_get(reinterpret_cast<const std::int32_t*>(matrix));
+    const double angle = ff().av_display_rotation_get(reinterpret_cast<const std::int32_t*>(matrix));
     if (std::isfinite(angle)) {
       // av_display_rotation_get is counter-clockwise; the picture is shown turned clockwise by its negative.
       const long turn = ((std::lround(-angle) % 360) + 360) % 360;
@@ -218,42 +237,42 @@ std::size_t VideoFileReader::declaredFrames() const {
 std::string VideoFileReader::fourcc() const {
   const AVCodecParameters* par = impl_->format->streams[impl_->stream]->codecpar;
   const std::string stored = fourccText(par->codec_tag);
-  return stored.size() == 4 ? stored : fourccText(av_codec_get_tag(usualTags(), par->codec_id));
+  return stored.size() == 4 ? stored : fourccText(ff().av_codec_get_tag(usualTags(), par->codec_id));
 }
 
 bool VideoFileReader::read(cv::Mat& bgr) {
   Impl& m = *impl_;
   int refused = 0;
   for (;;) {
-    int rc = avcodec_receive_frame(m.decoder, m.frame);
+    int rc = ff().avcodec_receive_frame(m.decoder, m.frame);
     if (rc == 0) {
       m.convert(bgr);
-      av_frame_unref(m.frame);
+      ff().av_frame_unref(m.frame);
       return true;
     }
     if (rc == AVERROR_EOF) return false;
     if (rc != AVERROR(EAGAIN)) throw VideoFileError("the decoder fails (" + ffmpegError(rc) + ")");
     if (m.draining) return false;
     // The decoder wants more: the next packet of the stream, or the end.
-    rc = av_read_frame(m.format, m.packet);
+    rc = ff().av_read_frame(m.format, m.packet);
     if (rc < 0) {
       m.draining = true;
-      rc = avcodec_send_packet(m.decoder, nullptr);
+      rc = ff().avcodec_send_packet(m.decoder, nullptr);
       if (rc < 0 && rc != AVERROR_EOF) throw VideoFileError("the decoder fails at the end (" + ffmpegError(rc) + ")");
       continue;
     }
     if (m.packet->stream_index == m.stream) {
-      rc = avcodec_send_packet(m.decoder, m.packet);
+      rc = ff().avcodec_send_packet(m.decoder, m.packet);
       if (rc < 0 && rc != AVERROR(EAGAIN)) {
         if (++refused >= 64) {
-          av_packet_unref(m.packet);
+          ff().av_packet_unref(m.packet);
           throw VideoFileError("the decoder refuses 64 packets in a row (" + ffmpegError(rc) + ")");
         }
       } else {
         refused = 0;
       }
     }
-    av_packet_unref(m.packet);
+    ff().av_packet_unref(m.packet);
   }
 }
 
@@ -293,28 +312,30 @@ struct VideoFileWriter::Impl {
       wake.notify_all();
       thread.join();
     }
-    if (header_written && !finished) av_write_trailer(format);  // an unfinished file, closed; its owner removes it
-    if (file_open) avio_closep(&format->pb);
-    sws_freeContext(scale);
-    for (AVFrame*& f : pool) av_frame_free(&f);
-    for (std::uint8_t* p : pixels) av_free(p);
-    av_packet_free(&packet);
-    avcodec_free_context(&encoder);
-    avformat_free_context(format);
+    const detail::FfmpegApi* f = detail::loadedFfmpeg();
+    if (f == nullptr) return;                                      // nothing of FFmpeg's was made
+    if (header_written && !finished) f->av_write_trailer(format);  // an unfinished file, closed; its owner removes it
+    if (file_open) f->avio_closep(&format->pb);
+    f->sws_freeContext(scale);
+    for (AVFrame*& frame : pool) f->av_frame_free(&frame);
+    for (std::uint8_t* p : pixels) f->av_free(p);
+    f->av_packet_free(&packet);
+    f->avcodec_free_context(&encoder);
+    f->avformat_free_context(format);
   }
 
   // Sends `input` (null: the end) and writes every packet the encoder has ready.
   void encode(const AVFrame* input) {
-    int rc = avcodec_send_frame(encoder, input);
+    int rc = ff().avcodec_send_frame(encoder, input);
     if (rc < 0 && !(input == nullptr && rc == AVERROR_EOF))
       throw VideoFileError("the encoder fails (" + ffmpegError(rc) + ")");
     for (;;) {
-      rc = avcodec_receive_packet(encoder, packet);
+      rc = ff().avcodec_receive_packet(encoder, packet);
       if (rc == AVERROR(EAGAIN) || rc == AVERROR_EOF) return;
       if (rc < 0) throw VideoFileError("the encoder fails (" + ffmpegError(rc) + ")");
-      av_packet_rescale_ts(packet, encoder->time_base, stream->time_base);
+      ff().av_packet_rescale_ts(packet, encoder->time_base, stream->time_base);
       packet->stream_index = stream->index;
-      rc = av_write_frame(format, packet);
+      rc = ff().av_write_frame(format, packet);
       if (rc < 0) throw VideoFileError("cannot write to the file (" + ffmpegError(rc) + ")");
     }
   }
@@ -378,7 +399,7 @@ AVRational frameRate(double fps, const AVCodec* codec) {
   if (const AVRational* listed = codec->supported_framerates; listed != nullptr && listed->num != 0) {
     AVRational best = *listed;
     for (; listed->num != 0; ++listed)
-      if (std::abs(av_q2d(av_sub_q(rate, *listed))) < std::abs(av_q2d(av_sub_q(rate, best)))) best = *listed;
+      if (std::abs(av_q2d(ff().av_sub_q(rate, *listed))) < std::abs(av_q2d(ff().av_sub_q(rate, best)))) best = *listed;
     rate = best;
   }
   return rate;
@@ -393,27 +414,27 @@ VideoFileWriter::VideoFileWriter(const std::string& path, const std::string& fou
   if (!(std::isfinite(fps) && fps > 0.0 && fps <= 1000.0)) throw VideoFileError("a frame rate not in (0, 1000]");
   if (width <= 0 || height <= 0 || width > 16384 || height > 16384)
     throw VideoFileError("a frame size not in 1..16384");
-  int rc = avformat_alloc_output_context2(&m.format, nullptr, nullptr, path.c_str());
+  int rc = ff().avformat_alloc_output_context2(&m.format, nullptr, nullptr, path.c_str());
   if (rc < 0 || m.format == nullptr) throw VideoFileError("a container FFmpeg does not write (use .mp4, .mkv or .avi)");
   const AVCodecID id = codecOf(fourcc);
-  const AVCodec* codec = id == AV_CODEC_ID_NONE ? nullptr : avcodec_find_encoder(id);
+  const AVCodec* codec = id == AV_CODEC_ID_NONE ? nullptr : ff().avcodec_find_encoder(id);
   if (codec == nullptr) throw VideoFileError("no encoder for the codec " + fourcc);
   // Matroska's list leaves out FFVHUFF, which it stores (as FFmpeg's own command does) under its
   // Video for Windows FourCC.
   const bool vfw_in_matroska = id == AV_CODEC_ID_FFVHUFF && std::strcmp(m.format->oformat->name, "matroska") == 0;
-  if (!vfw_in_matroska && avformat_query_codec(m.format->oformat, id, FF_COMPLIANCE_NORMAL) != 1)
+  if (!vfw_in_matroska && ff().avformat_query_codec(m.format->oformat, id, FF_COMPLIANCE_NORMAL) != 1)
     throw VideoFileError("the container does not take the codec " + fourcc);
-  m.stream = avformat_new_stream(m.format, nullptr);
-  m.encoder = avcodec_alloc_context3(codec);
-  m.packet = av_packet_alloc();
+  m.stream = ff().avformat_new_stream(m.format, nullptr);
+  m.encoder = ff().avcodec_alloc_context3(codec);
+  m.packet = ff().av_packet_alloc();
   if (m.stream == nullptr || m.encoder == nullptr || m.packet == nullptr) throw std::bad_alloc();
   // The settings of OpenCV 4.6's FFmpeg writer, so a video comes out as it did through OpenCV.
   m.format->max_delay = static_cast<int>(0.7 * AV_TIME_BASE);
   AVCodecContext& c = *m.encoder;
   std::uint32_t tag = fourccCode(fourcc);
   if (const AVCodecTag* const* muxer = m.format->oformat->codec_tag;
-      muxer != nullptr && av_codec_get_id(muxer, tag) != id)
-    if (const unsigned usual = av_codec_get_tag(muxer, id); usual != 0) tag = usual;
+      muxer != nullptr && ff().av_codec_get_id(muxer, tag) != id)
+    if (const unsigned usual = ff().av_codec_get_tag(muxer, id); usual != 0) tag = usual;
   if (id == AV_CODEC_ID_FFVHUFF) tag = fourccCode("FFVH");  // its one spelling, whatever the case given
   c.codec_tag = tag;
   c.qmin = 3;
@@ -433,48 +454,49 @@ VideoFileWriter::VideoFileWriter(const std::string& path, const std::string& fou
                                           : AV_PIX_FMT_YUV420P;
   // FFVHUFF (not one of OpenCV's): lossless, planar RGB with the median predictor, the smallest of
   // its fast settings (1.2x FFV1's size, 4x faster to write, 2.7x faster to read).
-  if (id == AV_CODEC_ID_FFVHUFF) av_opt_set(c.priv_data, "pred", "median", 0);
+  if (id == AV_CODEC_ID_FFVHUFF) ff().av_opt_set(c.priv_data, "pred", "median", 0);
   if (id == AV_CODEC_ID_H264) {
     c.gop_size = -1;
     c.qmin = -1;
     c.bit_rate = 0;
-    av_opt_set(c.priv_data, "crf", "23", 0);
+    ff().av_opt_set(c.priv_data, "crf", "23", 0);
   }
   c.bit_rate =
       std::min<std::int64_t>(c.bit_rate + static_cast<std::int64_t>(nominal / 2), std::numeric_limits<int>::max());
   c.bit_rate_tolerance = static_cast<int>(c.bit_rate);
   if ((m.format->oformat->flags & AVFMT_GLOBALHEADER) != 0) c.flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
-  rc = avcodec_open2(m.encoder, codec, nullptr);
+  rc = ff().avcodec_open2(m.encoder, codec, nullptr);
   if (rc < 0)
     throw VideoFileError("the encoder " + std::string(codec->name) + " refuses these frames (" + ffmpegError(rc) + ")");
-  rc = avcodec_parameters_from_context(m.stream->codecpar, m.encoder);
+  rc = ff().avcodec_parameters_from_context(m.stream->codecpar, m.encoder);
   if (rc < 0) throw VideoFileError("the encoder's parameters (" + ffmpegError(rc) + ")");
   m.stream->time_base = c.time_base;
   m.stream->avg_frame_rate = rate;
   if ((m.format->oformat->flags & AVFMT_NOFILE) == 0) {
-    rc = avio_open(&m.format->pb, path.c_str(), AVIO_FLAG_WRITE);
+    rc = ff().avio_open(&m.format->pb, path.c_str(), AVIO_FLAG_WRITE);
     if (rc < 0) throw VideoFileError("cannot create the file (" + ffmpegError(rc) + ")");
     m.file_open = true;
   }
-  rc = avformat_write_header(m.format, nullptr);
+  rc = ff().avformat_write_header(m.format, nullptr);
   if (rc < 0) throw VideoFileError("cannot write the container's header (" + ffmpegError(rc) + ")");
   m.header_written = true;
   for (std::size_t k = 0; k < Impl::kPoolFrames; ++k) {
-    AVFrame* f = av_frame_alloc();
+    AVFrame* f = ff().av_frame_alloc();
     if (f == nullptr) throw std::bad_alloc();
     m.pool.push_back(f);
     f->format = c.pix_fmt;
     f->width = width;
     f->height = height;
-    const int bytes = av_image_get_buffer_size(c.pix_fmt, width, height, 1);
-    auto* planes = bytes > 0 ? static_cast<std::uint8_t*>(av_malloc(static_cast<std::size_t>(bytes))) : nullptr;
+    const int bytes = ff().av_image_get_buffer_size(c.pix_fmt, width, height, 1);
+    auto* planes = bytes > 0 ? static_cast<std::uint8_t*>(ff().av_malloc(static_cast<std::size_t>(bytes))) : nullptr;
     if (planes == nullptr) throw std::bad_alloc();
     m.pixels.push_back(planes);
-    if (av_image_fill_arrays(f->data, f->linesize, planes, c.pix_fmt, width, height, 1) < 0) throw std::bad_alloc();
+    if (ff().av_image_fill_arrays(f->data, f->linesize, planes, c.pix_fmt, width, height, 1) < 0)
+      throw std::bad_alloc();
     m.free_ones.push_back(f);
   }
-  m.scale =
-      sws_getContext(width, height, AV_PIX_FMT_BGR24, width, height, c.pix_fmt, SWS_BICUBIC, nullptr, nullptr, nullptr);
+  m.scale = ff().sws_getContext(width, height, AV_PIX_FMT_BGR24, width, height, c.pix_fmt, SWS_BICUBIC, nullptr,
+                                nullptr, nullptr);
   if (m.scale == nullptr) throw VideoFileError("swscale cannot convert BGR to the encoder's pixel format");
 }
 
@@ -489,7 +511,7 @@ void VideoFileWriter::write(const cv::Mat& bgr) {
   AVFrame* f = m.freeFrame();
   const std::uint8_t* const planes[4] = {bgr.data, nullptr, nullptr, nullptr};
   const int strides[4] = {static_cast<int>(bgr.step[0]), 0, 0, 0};
-  sws_scale(m.scale, planes, strides, 0, bgr.rows, f->data, f->linesize);
+  ff().sws_scale(m.scale, planes, strides, 0, bgr.rows, f->data, f->linesize);
   f->pts = m.next_pts++;
   {
     std::lock_guard lock(m.mu);
@@ -511,11 +533,11 @@ void VideoFileWriter::finish() {
     if (m.failure) std::rethrow_exception(m.failure);
   }
   m.finished = true;
-  const int rc = av_write_trailer(m.format);
+  const int rc = ff().av_write_trailer(m.format);
   if (rc < 0) throw VideoFileError("cannot finish the file (" + ffmpegError(rc) + ")");
   if (m.file_open) {
     m.file_open = false;
-    if (avio_closep(&m.format->pb) < 0) throw VideoFileError("cannot close the file");
+    if (ff().avio_closep(&m.format->pb) < 0) throw VideoFileError("cannot close the file");
   }
 }
 

@@ -12,6 +12,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include <opencv2/core/mat.hpp>
 
@@ -27,6 +28,21 @@ class VideoFileError : public std::runtime_error {
 /// A FourCC as the four characters' codes, the first in the lowest byte (0 for a code that is not
 /// four characters).
 std::uint32_t fourccCode(const std::string& four);
+
+/// FFmpeg's libraries are loaded the first time a reader or writer is made (by their sonames, so a
+/// program that never opens a video does not load them). This loads them on a thread of its own
+/// while it lives, for a command that will open a video after other set-up; the destructor waits
+/// for the load to end. A load that fails is left to the first reader or writer to report.
+class VideoLibraryPreparation {
+ public:
+  VideoLibraryPreparation();
+  ~VideoLibraryPreparation();
+  VideoLibraryPreparation(const VideoLibraryPreparation&) = delete;
+  VideoLibraryPreparation& operator=(const VideoLibraryPreparation&) = delete;
+
+ private:
+  std::thread thread_;
+};
 
 /// A video file's first video stream, decoded in order. Frames are converted to 8-bit BGR at the
 /// stream's size with swscale's bicubic filter, turned by the stream's display rotation (90, 180
