@@ -262,8 +262,6 @@ TEST(FourccCode, FirstCharacterInTheLowestByte) {
   EXPECT_EQ(kccd::overlay::fourccCode("abc"), 0u);
 }
 
-}  // namespace
-
 // The writer encodes on a thread of its own: a failure there (a full disk) reaches the caller as a
 // VideoFileError from a later write() or from finish(), never as a file passed off as whole; a
 // writer destroyed with frames still queued stops cleanly (the sanitizer builds would tell a leak).
@@ -295,3 +293,5 @@ TEST_F(VideoFileTest, AFullDiskFailsAWriteOrTheFinishInWords) {
   while (r.read(m)) ++n;
   EXPECT_EQ(n, 8);
 }
+
+}  // namespace
