@@ -269,20 +269,22 @@ TEST_F(VideoFileTest, AFullDiskFailsAWriteOrTheFinishInWords) {
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
   fs::create_symlink("/dev/full", path("full.avi"));
   std::string error;
+  VideoFileWriter w(path("full.avi"), "MJPG", 30, 320, 240);
   try {
-    VideoFileWriter w(path("full.avi"), "MJPG", 30, 320, 240);
     for (int i = 0; i < 60; ++i) w.write(frame(i, 320, 240));
     w.finish();
   } catch (const VideoFileError& e) {
     error = e.what();
   }
+  // Asked again after the failure, finish() does not pass the file off as whole.
+  EXPECT_THROW(w.finish(), VideoFileError);
   EXPECT_TRUE(error.rfind("cannot write to the file (", 0) == 0 || error.rfind("cannot finish the file (", 0) == 0 ||
               error.rfind("cannot close the file", 0) == 0 ||
               error.rfind("cannot write the container's header (", 0) == 0)
       << "error: '" << error << "'";
   {
-    VideoFileWriter w(path("queued.avi"), "MJPG", 30, 320, 240);
-    for (int i = 0; i < 8; ++i) w.write(frame(i, 320, 240));
+    VideoFileWriter queued(path("queued.avi"), "MJPG", 30, 320, 240);
+    for (int i = 0; i < 8; ++i) queued.write(frame(i, 320, 240));
   }  // destroyed unfinished, frames in flight
   VideoFileWriter again(path("again.avi"), "MJPG", 30, 320, 240);
   for (int i = 0; i < 8; ++i) again.write(frame(i, 320, 240));

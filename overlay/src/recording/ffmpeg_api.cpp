@@ -3,6 +3,7 @@
 
 #include <dlfcn.h>
 
+#include <atomic>
 #include <mutex>
 #include <string>
 #include <type_traits>
@@ -13,46 +14,42 @@ namespace kccd::overlay::detail {
 
 namespace {
 
-// The soname of FFmpeg's library `name` whose headers this file was compiled with (Debian's
-// libavcodec.so.59 for FFmpeg 5.1): a library of another major version has other structures.
-std::string ffmpegSoname(const char* name, int major) {
-  return "lib" + std::string(name) + ".so." + std::to_string(major);
-}
-
-void* openFfmpegLibrary(const std::string& file) {
+// FFmpeg's library `name` of the major version whose headers this file was compiled with
+// (libavcodec.so.59 for FFmpeg 5.1; Debian's package libavcodec59): a library of another major
+// version has other structures.
+void* openFfmpegLibrary(const char* name, int major) {
+  const std::string file = "lib" + std::string(name) + ".so." + std::to_string(major);
   void* handle = ::dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (handle == nullptr) {
     const char* why = ::dlerror();
     throw VideoFileError("FFmpeg's " + file + " cannot be loaded (" + (why == nullptr ? "no reason given" : why) +
-                         "; on Debian: apt install libavformat59 libavcodec59 libswscale6)");
+                         "; on Debian: apt install lib" + name + std::to_string(major) + ")");
   }
   return handle;
 }
 
-}  // namespace
-
-namespace {
-
-std::mutex ffmpeg_mutex;
+std::mutex ffmpeg_mutex;  // held while the libraries load
 FfmpegApi ffmpeg_table;
-bool ffmpeg_loaded = false;
+// Set (release) once the table is whole; read (acquire) without the lock by every call after, so
+// the per-frame calls take no lock.
+std::atomic<bool> ffmpeg_loaded{false};
 
 }  // namespace
 
 const FfmpegApi* loadedFfmpeg() noexcept {
-  const std::lock_guard lock(ffmpeg_mutex);
-  return ffmpeg_loaded ? &ffmpeg_table : nullptr;
+  return ffmpeg_loaded.load(std::memory_order_acquire) ? &ffmpeg_table : nullptr;
 }
 
 const FfmpegApi& ffmpeg() {
+  if (ffmpeg_loaded.load(std::memory_order_acquire)) return ffmpeg_table;
   const std::lock_guard lock(ffmpeg_mutex);
-  if (ffmpeg_loaded) return ffmpeg_table;
+  if (ffmpeg_loaded.load(std::memory_order_relaxed)) return ffmpeg_table;  // loaded while this call waited
   // Each library after those it needs; a handle opened twice (a failed load tried again) is counted
   // by the loader and stays, as the libraries stay loaded for the process's life anyway.
-  void* util = openFfmpegLibrary(ffmpegSoname("avutil", LIBAVUTIL_VERSION_MAJOR));
-  void* scale = openFfmpegLibrary(ffmpegSoname("swscale", LIBSWSCALE_VERSION_MAJOR));
-  void* codec = openFfmpegLibrary(ffmpegSoname("avcodec", LIBAVCODEC_VERSION_MAJOR));
-  void* format = openFfmpegLibrary(ffmpegSoname("avformat", LIBAVFORMAT_VERSION_MAJOR));
+  void* util = openFfmpegLibrary("avutil", LIBAVUTIL_VERSION_MAJOR);
+  void* scale = openFfmpegLibrary("swscale", LIBSWSCALE_VERSION_MAJOR);
+  void* codec = openFfmpegLibrary("avcodec", LIBAVCODEC_VERSION_MAJOR);
+  void* format = openFfmpegLibrary("avformat", LIBAVFORMAT_VERSION_MAJOR);
   FfmpegApi found;
   std::string missing;
   auto symbol = [&](void* handle, auto& entry, const char* name) {
@@ -114,7 +111,7 @@ const FfmpegApi& ffmpeg() {
 #undef KCCD_FFMPEG_SYMBOL
   if (!missing.empty()) throw VideoFileError("FFmpeg's libraries have no " + missing + " (another version of FFmpeg?)");
   ffmpeg_table = found;
-  ffmpeg_loaded = true;
+  ffmpeg_loaded.store(true, std::memory_order_release);
   return ffmpeg_table;
 }
 

@@ -289,8 +289,9 @@ struct VideoFileWriter::Impl {
   bool file_open = false, header_written = false, finished = false;
 
   // The encoder's thread: write() converts a frame's pixels into a free frame of the pool and
-  // queues it; the thread encodes the queue in order and writes the packets. A null entry is the
-  // end (drain the encoder). The first failure stops it and is rethrown by the next call.
+  // queues it; the thread encodes the queue in order and writes the packets, then, once finish()
+  // sets end_queued, drains the encoder. The first failure stops it and is rethrown by the next
+  // write() or finish().
   static constexpr std::size_t kPoolFrames = 3;
   std::vector<AVFrame*> pool;         // every frame made, freed at the end
   std::vector<std::uint8_t*> pixels;  // their planes, packed (OpenCV's layout), not reference-counted:
@@ -352,18 +353,17 @@ struct VideoFileWriter::Impl {
         f = queued.front();
         queued.pop_front();
       }
+      std::exception_ptr error;
       try {
         encode(f);
       } catch (...) {
-        std::lock_guard lock(mu);
-        failure = std::current_exception();
-        free_ones.push_back(f);
-        wake.notify_all();
-        return;
+        error = std::current_exception();
       }
       std::lock_guard lock(mu);
       free_ones.push_back(f);
+      failure = error;
       wake.notify_all();
+      if (error) return;
     }
     try {
       if (next_pts > 0) encode(nullptr);
@@ -530,8 +530,8 @@ void VideoFileWriter::finish() {
     }
     m.wake.notify_all();
     m.thread.join();
-    if (m.failure) std::rethrow_exception(m.failure);
   }
+  if (m.failure) std::rethrow_exception(m.failure);  // also at a second call: the file is not whole
   m.finished = true;
   const int rc = ff().av_write_trailer(m.format);
   if (rc < 0) throw VideoFileError("cannot finish the file (" + ffmpegError(rc) + ")");
