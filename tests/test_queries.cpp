@@ -320,6 +320,58 @@ TEST(Queries, AfterResetTheAnswerIsANewCheckersBitForBit) {
   }
 }
 
+// A cube of half-size h about c.
+std::vector<Vec3> cubeAt(const Vec3& c, double h) {
+  std::vector<Vec3> out;
+  for (int k = 0; k < 8; ++k) out.push_back(c + h * Vec3(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1));
+  return out;
+}
+
+TEST(Queries, AStaleGjkDirectionIsNoWarmStart) {
+  // A cube turning about z past a cube on the base, 5 cm from it at q = 0.
+  Model m;
+  Joint j;
+  j.name = "j";
+  j.type = JointType::Revolute;
+  j.axis = Vec3::UnitZ();
+  m.joints.push_back(j);
+  m.bodies.push_back({"obstacle", kWorld, cubeAt(Vec3(1.45, 0.3, 0.1), 0.15), 0.0});
+  m.bodies.push_back({"moving", 0, cubeAt(Vec3(1.0, 0.0, 0.0), 0.25), 0.0});
+  m.finalize(true, {}, {});
+  QueryOptions exact = options(QueryType::Distances);
+  exact.exact_below = std::numeric_limits<double>::infinity();
+  auto at = [](double q) { return std::vector<double>{q}; };
+  // After a jump the pair's points moved far more than twice its stored bound: GJK starts as a
+  // new checker's does, so the answer is that checker's bit for bit, and so is GJK's work.
+  for (const double jump : {0.8, 1.5, 2.5, -2.0}) {
+    Checker used(m);
+    used.query(at(0.0), at(0.0), exact);
+    const QueryResult r = used.query(at(jump), at(jump), exact);
+    Checker fresh(m);
+    const QueryResult& f = fresh.query(at(jump), at(jump), exact);
+    ASSERT_EQ(r.pairs.size(), 1u);
+    EXPECT_EQ(r.pairs[0].distance, f.pairs[0].distance) << jump;
+    EXPECT_EQ(r.pairs[0].witness_a, f.pairs[0].witness_a) << jump;
+    EXPECT_EQ(r.stats.gjk_iterations, f.stats.gjk_iterations) << jump;
+    EXPECT_GT(r.stats.gjk_iterations, 0);
+  }
+  // Along a motion of small steps the last direction is kept: GJK's work over the motion is
+  // below that of a new checker at every step, for the same bounds up to GJK's tolerance.
+  Checker moving(m);
+  int warm = 0, cold = 0;
+  for (int step = 0; step <= 100; ++step) {
+    const double q = -0.3 + 0.006 * step;
+    const QueryResult& r = moving.query(at(q), at(q), exact);
+    warm += r.stats.gjk_iterations;
+    const double bound = r.pairs[0].distance;
+    Checker fresh(m);
+    const QueryResult& f = fresh.query(at(q), at(q), exact);
+    cold += f.stats.gjk_iterations;
+    EXPECT_NEAR(bound, f.pairs[0].distance, 1e-9) << q;
+  }
+  EXPECT_LT(warm, cold);
+}
+
 TEST(Queries, BadStateInputIsAnUnsafeStatus) {
   const Model m = testing::randomModel(*std::make_unique<std::mt19937_64>(5), 3, 3);
   const int n = m.stateSize();

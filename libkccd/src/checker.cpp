@@ -25,6 +25,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // With QueryOptions::tight_volumes, a sweep whose radius growth exceeds this fraction of the swept
 // sphere's radius also tries the other cover (chords for every point, reduced to the budget).
 constexpr double kCoarseCover = 0.02;
+// A pair's last GJK direction is its warm start while its points have moved at most this many times
+// its stored bound since (Checker::refresh).
+constexpr double kWarmStartReach = 2.0;
 using Clock = std::chrono::steady_clock;
 using detail::shrunkBound;
 
@@ -559,9 +562,14 @@ double Checker::refresh(int p, double stop_above, Box box) noexcept {
     if (bound <= stop_above) {
       GjkOptions opt;
       opt.stop_above = stop_above;
-      opt.warm_start = &e.direction;
+      // The last direction starts GJK while the pair's points have moved at most twice the stored
+      // bound since it was found (a moving robot); after a jump it points anywhere, and the
+      // volumes' start points (their centroids) do better: random poses of the Panda and the
+      // xArm 7 at the default import take 20-30 % fewer iterations, a trajectory as many.
+      opt.warm_start = e.valid && e.moved <= kWarmStartReach * e.bound ? &e.direction : nullptr;
       const DistanceResult d = pairDistance(*va, *vb, opt);
       ++result_.stats.gjk_calls;
+      result_.stats.gjk_iterations += d.iterations;
       if (d.status == GjkStatus::InvalidInput) return fail();
       bound = std::max(bound, d.distance);
       e.direction = d.direction;
@@ -581,6 +589,7 @@ double Checker::refresh(int p, double stop_above, Box box) noexcept {
   e.valid = true;
   e.bound = bound;
   e.current = bound;
+  e.moved = 0.0;
   for (int k = reach_begin_[p]; k < reach_begin_[p + 1]; ++k) {
     box_[2 * k] = box.lower[reach_state_[k]];
     box_[2 * k + 1] = box.upper[reach_state_[k]];
@@ -678,6 +687,7 @@ void Checker::carryBounds(Box box) noexcept {
       const double grow = std::max({0.0, box_[2 * k] - box.lower[st], box.upper[st] - box_[2 * k + 1]});
       if (grow > 0.0) moved += reach_[k] * grow;
     }
+    e.moved = moved;
     e.current = moved == 0.0 ? e.bound : std::max(0.0, shrunkBound(e.bound - moved));
     if (!std::isfinite(e.current)) e.current = 0.0;
   }

@@ -118,12 +118,21 @@ inline void closestOnTriangle(const Vec3* w, int i, int j, int k, double* lam, i
       return;
     }
   }
-  // Outside (or degenerate): the closest point lies on an edge facing the origin's projection.
+  // Outside (or degenerate): the closest point lies on an edge facing the origin's projection
+  // (with one such edge, that edge's closest point is the answer: no comparison).
+  int facing[3];
+  int nf = 0;
+  for (int e = 0; e < 3; ++e)
+    if (!((mu != 0.0 && sameSign(mu, c[e])) || ids[e] == newest)) facing[nf++] = e;
+  if (nf == 1) {
+    closestOnSegment(w, ids[(facing[0] + 1) % 3], ids[(facing[0] + 2) % 3], lam);
+    return;
+  }
   double best[4] = {0.0, 0.0, 0.0, 0.0};
   double best_vv = std::numeric_limits<double>::infinity();
   double cand[4];
-  for (int e = 0; e < 3; ++e) {
-    if ((mu != 0.0 && sameSign(mu, c[e])) || ids[e] == newest) continue;
+  for (int f = 0; f < nf; ++f) {
+    const int e = facing[f];
     closestOnSegment(w, ids[(e + 1) % 3], ids[(e + 2) % 3], cand);
     keepBest(w, cand, best, best_vv);
   }
@@ -150,12 +159,21 @@ inline void closestOnTetrahedron(const Vec3* w, double* lam) {
     for (int x = 0; x < 4; ++x) lam[x] = c[x] / vol;
     return;
   }
+  // Outside: the closest point lies on a face facing the origin (one such face: its point).
+  static constexpr int kFace[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+  int facing[4];
+  int nf = 0;
+  for (int x = 0; x < 4; ++x)
+    if (!((vol != 0.0 && sameSign(vol, c[x])) || x == kNewest)) facing[nf++] = x;
+  if (nf == 1) {
+    closestOnTriangle(w, kFace[facing[0]][0], kFace[facing[0]][1], kFace[facing[0]][2], lam, kNewest);
+    return;
+  }
   double best[4] = {0.0, 0.0, 0.0, 0.0};
   double best_vv = std::numeric_limits<double>::infinity();
   double cand[4];
-  static constexpr int kFace[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
-  for (int x = 0; x < 4; ++x) {
-    if ((vol != 0.0 && sameSign(vol, c[x])) || x == kNewest) continue;
+  for (int f = 0; f < nf; ++f) {
+    const int x = facing[f];
     closestOnTriangle(w, kFace[x][0], kFace[x][1], kFace[x][2], cand, kNewest);
     keepBest(w, cand, best, best_vv);
   }

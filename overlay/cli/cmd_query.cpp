@@ -133,6 +133,7 @@ Exit runQuery(const QueryArgs& args) {
     j["stats"] = {{"time_us", r.stats.time_us},
                   {"pairs_checked", r.stats.pairs_checked},
                   {"gjk_calls", r.stats.gjk_calls},
+                  {"gjk_iterations", r.stats.gjk_iterations},
                   {"exact_calls", r.stats.exact_calls},
                   {"split_pairs", r.stats.split_pairs},
                   {"volumes_swept", r.stats.volumes_swept},
@@ -151,9 +152,9 @@ Exit runQuery(const QueryArgs& args) {
                 << (pd.fresh ? "" : " (carried over)") << "\n";
     }
     std::cout << "time " << r.stats.time_us << " us, " << r.stats.pairs_checked << " pairs checked, "
-              << r.stats.gjk_calls << " GJK calls, " << r.stats.exact_calls << " exact-stage calls, "
-              << r.stats.split_pairs << " pairs split" << (r.stats.budget_exhausted ? ", budget exhausted" : "")
-              << "\n";
+              << r.stats.gjk_calls << " GJK calls (" << r.stats.gjk_iterations << " iterations), "
+              << r.stats.exact_calls << " exact-stage calls, " << r.stats.split_pairs << " pairs split"
+              << (r.stats.budget_exhausted ? ", budget exhausted" : "") << "\n";
     if (explain) printExplain(m, explained, r.margin);
   }
   if (r.status != Status::Ok) {

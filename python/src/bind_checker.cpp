@@ -121,6 +121,7 @@ py::dict statsDict(const QueryStats& s) {
   d["time_us"] = s.time_us;
   d["pairs_checked"] = s.pairs_checked;
   d["gjk_calls"] = s.gjk_calls;
+  d["gjk_iterations"] = s.gjk_iterations;
   d["exact_calls"] = s.exact_calls;
   d["split_pairs"] = s.split_pairs;
   d["volumes_swept"] = s.volumes_swept;
@@ -287,7 +288,8 @@ void bindChecker(py::module_& m) {
           "bool (N,): witness points are valid")
       .def_property_readonly(
           "stats", [](const PyResult& r) { return statsDict(r.stats); },
-          "time_us, pairs_checked, gjk_calls, exact_calls, split_pairs, volumes_swept, budget_exhausted")
+          "time_us, pairs_checked, gjk_calls, gjk_iterations, exact_calls, split_pairs, volumes_swept, "
+          "budget_exhausted")
       .def("__len__", [](const PyResult& r) { return r.pairs.size(); })
       .def("__repr__", [](const PyResult& r) {
         return "<kccd.QueryResult " + py::str(statusObject(r.status).attr("name")).cast<std::string>() + " " +

@@ -81,10 +81,11 @@ class Checker {
   };
   struct Entry {  // the any-time table
     bool valid = false;
-    double bound = 0.0;    // lower bound for the box stored in box_
-    double current = 0.0;  // bound valid for this query's box
-    bool gjk = false;      // the stored bound came from GJK (witness points valid)
-    Vec3 direction = Vec3::UnitX();
+    double bound = 0.0;              // lower bound for the box stored in box_
+    double current = 0.0;            // bound valid for this query's box
+    bool gjk = false;                // the stored bound came from GJK (witness points valid)
+    Vec3 direction = Vec3::UnitX();  // GJK's last direction for the pair (its warm start)
+    double moved = 0.0;              // how far the pair's points may have moved since the stored bound (carryBounds)
     Vec3 witness_a = Vec3::Zero(), witness_b = Vec3::Zero();
   };
 

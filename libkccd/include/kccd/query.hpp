@@ -103,8 +103,9 @@ struct QueryStats {
   double time_us = 0.0;
   int pairs_checked = 0;  ///< pairs whose bound was recomputed
   int gjk_calls = 0;
-  int exact_calls = 0;  ///< distance computations of the exact stage
-  int split_pairs = 0;  ///< pairs whose box was split (QueryOptions::exact_splits)
+  int gjk_iterations = 0;  ///< the iterations of those gjk_calls (GJK's work, where warm starts show)
+  int exact_calls = 0;     ///< distance computations of the exact stage
+  int split_pairs = 0;     ///< pairs whose box was split (QueryOptions::exact_splits)
   int volumes_swept = 0;
   bool budget_exhausted = false;  ///< a time or work budget stopped refinement (answer still conservative)
 };
