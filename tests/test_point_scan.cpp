@@ -89,6 +89,28 @@ TEST(SupportScan, Avx2AndScalarPathsPickTheSamePoint) {
   EXPECT_GT(maxima, 15000);  // most draws have finite dot products, so the maximum was checked
 }
 
+TEST(SupportScan, TheInOrderScanFindsTheLanesLargestValueAndItsFirstPoint) {
+  std::mt19937_64 rng(20261201);
+  std::uniform_int_distribution<int> count(1, 12);
+  int numbers = 0, ties = 0;
+  for (int trial = 0; trial < 50000; ++trial) {
+    const std::vector<Vec3> pts = randomPoints(rng, count(rng));
+    const Vec3 d = randomDirection(rng);
+    bool finite = true;
+    for (const Vec3& p : pts) finite &= std::isfinite(dot(p, d));
+    if (!finite) continue;  // a cell's dot products are finite (support_cells.hpp)
+    ++numbers;
+    const int in_order = supportIndexInOrder(pts, d);
+    const int lanes = supportIndexScalar(pts, d);
+    const double value = dot(pts[static_cast<std::size_t>(in_order)], d);
+    ASSERT_EQ(value, dot(pts[static_cast<std::size_t>(lanes)], d)) << "trial " << trial;
+    for (int k = 0; k < in_order; ++k) ASSERT_LT(dot(pts[static_cast<std::size_t>(k)], d), value) << trial;
+    ties += in_order != lanes;
+  }
+  EXPECT_GT(numbers, 30000);
+  EXPECT_GT(ties, 0);  // the grids' ties: the two scans may name different points of one value
+}
+
 bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 TEST(PointSummary, Avx2AndScalarPathsAgreeBitForBit) {

@@ -320,6 +320,21 @@ TEST(Queries, AfterResetTheAnswerIsANewCheckersBitForBit) {
   }
 }
 
+// One revolute joint about z at the origin turning `moving` (radius 0) past a fixed obstacle;
+// safety margin 0.
+Model turningPast(std::vector<Vec3> obstacle, std::vector<Vec3> moving) {
+  Model m;
+  Joint j;
+  j.name = "j";
+  j.type = JointType::Revolute;
+  j.axis = Vec3::UnitZ();
+  m.joints.push_back(j);
+  m.bodies.push_back({"obstacle", kWorld, std::move(obstacle), 0.0});
+  m.bodies.push_back({"moving", 0, std::move(moving), 0.0});
+  m.finalize(true, {}, {});
+  return m;
+}
+
 // A cube of half-size h about c.
 std::vector<Vec3> cubeAt(const Vec3& c, double h) {
   std::vector<Vec3> out;
@@ -329,15 +344,7 @@ std::vector<Vec3> cubeAt(const Vec3& c, double h) {
 
 TEST(Queries, AStaleGjkDirectionIsNoWarmStart) {
   // A cube turning about z past a cube on the base, 5 cm from it at q = 0.
-  Model m;
-  Joint j;
-  j.name = "j";
-  j.type = JointType::Revolute;
-  j.axis = Vec3::UnitZ();
-  m.joints.push_back(j);
-  m.bodies.push_back({"obstacle", kWorld, cubeAt(Vec3(1.45, 0.3, 0.1), 0.15), 0.0});
-  m.bodies.push_back({"moving", 0, cubeAt(Vec3(1.0, 0.0, 0.0), 0.25), 0.0});
-  m.finalize(true, {}, {});
+  const Model m = turningPast(cubeAt(Vec3(1.45, 0.3, 0.1), 0.15), cubeAt(Vec3(1.0, 0.0, 0.0), 0.25));
   QueryOptions exact = options(QueryType::Distances);
   exact.exact_below = std::numeric_limits<double>::infinity();
   auto at = [](double q) { return std::vector<double>{q}; };
@@ -411,24 +418,9 @@ TEST(Queries, ExactSweepRejectsWideIntervals) {
   EXPECT_NEAR(r.pairs[0].distance, 0.8, 1e-12);
 }
 
-// One revolute joint about z at the origin turning `moving` (radius 0) past a fixed point obstacle;
-// safety margin 0.
-Model turningPastAPoint(const Vec3& obstacle, std::vector<Vec3> moving) {
-  Model m;
-  Joint j;
-  j.name = "j";
-  j.type = JointType::Revolute;
-  j.axis = Vec3::UnitZ();
-  m.joints.push_back(j);
-  m.bodies.push_back({"obstacle", kWorld, {obstacle}, 0.0});
-  m.bodies.push_back({"moving", 0, std::move(moving), 0.0});
-  m.finalize(true, {}, {});
-  return m;
-}
-
 TEST(Queries, RevoluteSweepBoundIsTightForASpinningPoint) {
   // A point at radius 1 sweeping 90 degrees towards an obstacle on the arc's far end.
-  Model m = turningPastAPoint(Vec3(0, 1.5, 0), {Vec3(1, 0, 0)});
+  Model m = turningPast({Vec3(0, 1.5, 0)}, {Vec3(1, 0, 0)});
   Checker c(m);
   const std::vector<double> lo{0.0}, hi{1.5707963267948966};
   // The point volumes (pairs above the margin are not refined by default) cover the arc by its
@@ -467,7 +459,7 @@ TEST(Queries, SplittingTightensAWideBodyOnAWideArc) {
   // hull of the sweep holds the chord between the plate's ends at -10 and +10 degrees, at x =
   // 0.5 cos 10 - 0.4 sin 10 = 0.4229: a bound of about 0.073 m at best. Eight sub-boxes of 2.5
   // degrees lose at most 0.5 - (0.5 cos 1.25 - 0.4 sin 1.25) = 8.9 mm.
-  Model m = turningPastAPoint(Vec3(0.35, 0, 0), {Vec3(0.5, -0.4, 0), Vec3(0.5, 0.4, 0)});
+  Model m = turningPast({Vec3(0.35, 0, 0)}, {Vec3(0.5, -0.4, 0), Vec3(0.5, 0.4, 0)});
   const double truth = 0.15, deg = 3.141592653589793 / 180.0;
   const std::vector<double> lo{-10 * deg}, hi{10 * deg};
   const double hull = 0.5 * std::cos(10 * deg) - 0.4 * std::sin(10 * deg) - 0.35;

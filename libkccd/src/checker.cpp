@@ -394,9 +394,7 @@ struct SideSupport {
       return {pts[static_cast<std::size_t>(i)], static_cast<std::uint64_t>(i), 0.0};
     }
     const Vec3 local = posed ? Vec3(lin.transpose() * dir) : dir;
-    const detail::CellScan scan = detail::cellScan(*cells, {pts, n}, local);
-    const int j = detail::supportIndex(scan.points, local);
-    const int i = scan.index == nullptr ? j : scan.index[j];
+    const int i = detail::cellSupport(*cells, {pts, n}, local);
     const Vec3& p = pts[static_cast<std::size_t>(i)];
     return {posed ? Vec3(lin * p + off) : p, static_cast<std::uint64_t>(i), 0.0};
   }

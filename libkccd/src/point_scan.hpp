@@ -140,6 +140,23 @@ inline PointSummary summarizeScalar(std::span<const Vec3> pts) noexcept {
   return scan::finish(sum, m, pts.size());
 }
 
+/// The support scan of a short run of points (`pts` not empty), in order: the first point of the
+/// largest dot product, each computed as the other paths do. Over finite dot products the largest
+/// value is theirs bit for bit (a maximum does not depend on the order); on a tie the point named
+/// may be another of that value.
+inline int supportIndexInOrder(std::span<const Vec3> pts, const Vec3& d) noexcept {
+  const double dx = d.x(), dy = d.y(), dz = d.z();
+  const int n = static_cast<int>(pts.size());
+  int best = 0;
+  double best_dot = pts[0].x() * dx + pts[0].y() * dy + pts[0].z() * dz;
+  for (int k = 1; k < n; ++k) {
+    const double value = pts[k].x() * dx + pts[k].y() * dy + pts[k].z() * dz;
+    best = scan::pick(value > best_dot, k, best);
+    best_dot = std::max(value, best_dot);
+  }
+  return best;
+}
+
 /// Sets smaller than this take the scalar paths, inlined where they are called: for them the AVX2
 /// paths' set-up costs more than they save.
 inline constexpr std::size_t kAvx2MinPoints = 8;

@@ -11,7 +11,6 @@ namespace kccd::detail {
 
 namespace {
 
-constexpr int kCellsPerFace = kCellsPerEdge * kCellsPerEdge;
 constexpr int kCells = 6 * kCellsPerFace;
 
 // The direction with face coordinates (u, v) on face `face` (axis face / 2, sign by face % 2).
@@ -27,29 +26,6 @@ Vec3 faceDirection(int face, double u, double v) {
 double faceCoordinate(int i) { return -1.0 + 2.0 * static_cast<double>(i) / kCellsPerEdge; }
 
 }  // namespace
-
-int cellOf(const Vec3& d) noexcept {
-  // The face: the axis of the largest |coordinate| (the first on a tie), chosen without branches
-  // (which way it goes is unpredictable).
-  const double ax = std::abs(d.x()), ay = std::abs(d.y()), az = std::abs(d.z());
-  const bool y_wins = ay > ax && ay >= az, z_wins = az > ax && az > ay;
-  const int axis = static_cast<int>(y_wins) + 2 * static_cast<int>(z_wins);
-  const double m = std::max(ax, std::max(ay, az));
-  if (!(m >= kCellMinDirection && m <= kCellMaxDirection)) return -1;  // tiny, huge or NaN
-  static constexpr int kNext[3][2] = {{1, 2}, {2, 0}, {0, 1}};
-  const double u = d[kNext[axis][0]], v = d[kNext[axis][1]];
-  if (std::isnan(u) || std::isnan(v)) return -1;
-  // The face coordinate u / m against the borders -1 + 2k / N, as u against m times them: no
-  // division, and a border's product errs by an ulp at most, far inside kCellSlack.
-  int iu = 0, iv = 0;
-  for (int k = 1; k < kCellsPerEdge; ++k) {
-    const double border = m * (-1.0 + 2.0 * k / kCellsPerEdge);
-    iu += static_cast<int>(u >= border);
-    iv += static_cast<int>(v >= border);
-  }
-  const int face = 2 * axis + static_cast<int>(std::signbit(d[axis]));
-  return face * kCellsPerFace + iu * kCellsPerEdge + iv;
-}
 
 SupportCells supportCells(std::span<const Vec3> pts, int min_points) {
   SupportCells out;
@@ -89,15 +65,6 @@ SupportCells supportCells(std::span<const Vec3> pts, int min_points) {
   }
   out.begin.push_back(static_cast<int>(out.index.size()));
   return out;
-}
-
-CellScan cellScan(const SupportCells& cells, std::span<const Vec3> pts, const Vec3& d) noexcept {
-  if (cells.empty()) return {pts, nullptr};
-  const int cell = cellOf(d);
-  if (cell < 0) return {pts, nullptr};
-  const auto b = static_cast<std::size_t>(cells.begin[static_cast<std::size_t>(cell)]);
-  const auto e = static_cast<std::size_t>(cells.begin[static_cast<std::size_t>(cell) + 1]);
-  return {std::span<const Vec3>(cells.points).subspan(b, e - b), cells.index.data() + b};
 }
 
 }  // namespace kccd::detail

@@ -12,15 +12,19 @@
 // over all points, bit for bit: the support value does not change, only the scan's length.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <span>
 #include <vector>
 
 #include "kccd/ssch.hpp"
+#include "point_scan.hpp"
 
 namespace kccd::detail {
 
 /// Cells per edge of a cube face (6 kCellsPerEdge^2 cells).
 inline constexpr int kCellsPerEdge = 4;
+inline constexpr int kCellsPerFace = kCellsPerEdge * kCellsPerEdge;
 /// How much a cell's rectangle is grown on each side (in face coordinates, from -1 to 1).
 inline constexpr double kCellSlack = 1e-6;
 
@@ -45,7 +49,28 @@ struct SupportCells {
 SupportCells supportCells(std::span<const Vec3> pts, int min_points = 12);
 
 /// The cell of direction d, or -1 when d is out of the cells' range (zero and not finite included).
-int cellOf(const Vec3& d) noexcept;
+inline int cellOf(const Vec3& d) noexcept {
+  // The face: the axis of the largest |coordinate| (the first on a tie), chosen without branches
+  // (which way it goes is unpredictable).
+  const double ax = std::abs(d.x()), ay = std::abs(d.y()), az = std::abs(d.z());
+  const bool y_wins = ay > ax && ay >= az, z_wins = az > ax && az > ay;
+  const int axis = static_cast<int>(y_wins) + 2 * static_cast<int>(z_wins);
+  const double m = std::max(ax, std::max(ay, az));
+  if (!(m >= kCellMinDirection && m <= kCellMaxDirection)) return -1;  // tiny, huge or NaN
+  static constexpr int kNext[3][2] = {{1, 2}, {2, 0}, {0, 1}};
+  const double u = d[kNext[axis][0]], v = d[kNext[axis][1]];
+  if (std::isnan(u) || std::isnan(v)) return -1;
+  // The face coordinate u / m against the borders -1 + 2k / N, as u against m times them: no
+  // division, and a border's product errs by an ulp at most, far inside kCellSlack.
+  int iu = 0, iv = 0;
+  for (int k = 1; k < kCellsPerEdge; ++k) {
+    const double border = m * (-1.0 + 2.0 * k / kCellsPerEdge);
+    iu += static_cast<int>(u >= border);
+    iv += static_cast<int>(v >= border);
+  }
+  const int face = 2 * axis + static_cast<int>(std::signbit(d[axis]));
+  return face * kCellsPerFace + iu * kCellsPerEdge + iv;
+}
 
 /// The points of the cell of direction d (all of `pts` when `cells` is empty or d has no cell),
 /// and the map from their positions back to indices in `pts` (null: the identity).
@@ -53,6 +78,24 @@ struct CellScan {
   std::span<const Vec3> points;
   const int* index = nullptr;
 };
-CellScan cellScan(const SupportCells& cells, std::span<const Vec3> pts, const Vec3& d) noexcept;
+inline CellScan cellScan(const SupportCells& cells, std::span<const Vec3> pts, const Vec3& d) noexcept {
+  if (cells.empty()) return {pts, nullptr};
+  const int cell = cellOf(d);
+  if (cell < 0) return {pts, nullptr};
+  const auto b = static_cast<std::size_t>(cells.begin[static_cast<std::size_t>(cell)]);
+  const auto e = static_cast<std::size_t>(cells.begin[static_cast<std::size_t>(cell) + 1]);
+  return {std::span<const Vec3>(cells.points).subspan(b, e - b), cells.index.data() + b};
+}
+
+/// The index in `pts` of a point farthest along d, read from d's cell (all of `pts` when there is
+/// none): the largest dot product of supportIndex(pts, d), bit for bit (the argument at the
+/// top), the cell's few candidates scanned in order (on a tie another point of that value).
+inline int cellSupport(const SupportCells& cells, std::span<const Vec3> pts, const Vec3& d) noexcept {
+  const CellScan scan = cellScan(cells, pts, d);
+  if (scan.index == nullptr) return supportIndex(scan.points, d);
+  const int j =
+      scan.points.size() < kAvx2MinPoints ? supportIndexInOrder(scan.points, d) : supportIndex(scan.points, d);
+  return scan.index[j];
+}
 
 }  // namespace kccd::detail
