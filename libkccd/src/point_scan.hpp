@@ -145,16 +145,11 @@ inline PointSummary summarizeScalar(std::span<const Vec3> pts) noexcept {
 /// value is theirs bit for bit (a maximum does not depend on the order); on a tie the point named
 /// may be another of that value.
 inline int supportIndexInOrder(std::span<const Vec3> pts, const Vec3& d) noexcept {
-  const double dx = d.x(), dy = d.y(), dz = d.z();
-  const int n = static_cast<int>(pts.size());
-  int best = 0;
-  double best_dot = pts[0].x() * dx + pts[0].y() * dy + pts[0].z() * dz;
-  for (int k = 1; k < n; ++k) {
-    const double value = pts[k].x() * dx + pts[k].y() * dy + pts[k].z() * dz;
-    best = scan::pick(value > best_dot, k, best);
-    best_dot = std::max(value, best_dot);
-  }
-  return best;
+  // Lane 0 alone: the first point, then the others as the lanes' tail takes them.
+  double best_dot[1] = {pts[0].x() * d.x() + pts[0].y() * d.y() + pts[0].z() * d.z()};
+  int best[1] = {0};
+  scan::tail(pts, d, 1, best_dot, best);
+  return best[0];
 }
 
 /// Sets smaller than this take the scalar paths, inlined where they are called: for them the AVX2
