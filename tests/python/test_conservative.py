@@ -39,15 +39,23 @@ def frames(doc: dict, q: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]
 
 def hull_distance(a: np.ndarray, b: np.ndarray, iters: int = 400) -> np.ndarray:
     """Distance between the hulls of point sets a (S, na, 3) and b (S, nb, 3): Frank-Wolfe with
-    exact line search on the Minkowski difference, from its best vertex; >= the true distance."""
+    exact line search on the Minkowski difference, from its best vertex; >= the true distance. A
+    sample stops once its duality gap x.(x - v) is at most 5e-19: |x|^2 - d^2 <= 2 gap, so |x| is
+    then within 1e-9 of the distance d (the others go on, up to `iters` steps)."""
     d = (a[:, :, None, :] - b[:, None, :, :]).reshape(a.shape[0], -1, 3)
     x = d[np.arange(d.shape[0]), np.argmin((d * d).sum(-1), axis=1)]
+    live = np.arange(d.shape[0])
     for _ in range(iters):
-        v = d[np.arange(d.shape[0]), np.argmin(np.einsum("skj,sj->sk", d, x), axis=1)]
-        step = x - v
+        dl, xl = d[live], x[live]
+        v = dl[np.arange(len(live)), np.argmin(np.einsum("skj,sj->sk", dl, xl), axis=1)]
+        step = xl - v
+        gap = (xl * step).sum(-1)
         den = (step * step).sum(-1)
-        t = np.clip(np.where(den > 0, (x * step).sum(-1) / np.maximum(den, 1e-300), 0.0), 0.0, 1.0)
-        x = x - t[:, None] * step
+        t = np.clip(np.where(den > 0, gap / np.maximum(den, 1e-300), 0.0), 0.0, 1.0)
+        x[live] = xl - t[:, None] * step
+        live = live[gap > 5e-19]
+        if len(live) == 0:
+            break
     return np.linalg.norm(x, axis=1)
 
 
