@@ -106,6 +106,40 @@ TEST(SupportCells, ACellsLargestDotProductIsTheWholeSetsBitForBit) {
   EXPECT_GT(shortened, compared / 2);
 }
 
+// Points that differ by 1e-16 to 1e-3 of the set's size around a few centres, the cells'
+// threshold (kCellThreshold) among them: whether one beats another at a cell's vertices is decided
+// by the threshold and the rounding, the case the argument at the top of support_cells.hpp is for.
+TEST(SupportCells, PointsAsCloseAsTheThresholdKeepTheLargestDotProduct) {
+  std::mt19937_64 rng(19);
+  std::normal_distribution<double> g;
+  long compared = 0;
+  for (int trial = 0; trial < 1500; ++trial) {
+    const double scale = std::pow(10.0, std::uniform_int_distribution<int>(-90, 140)(rng));
+    const double spread = std::pow(10.0, std::uniform_real_distribution<double>(-16.0, -3.0)(rng));
+    std::vector<Vec3> centres;
+    for (int c = 0; c < 3; ++c) centres.push_back(Vec3(g(rng), g(rng), g(rng)).normalized());
+    std::vector<Vec3> pts;
+    const int n = std::uniform_int_distribution<int>(12, 60)(rng);
+    for (int i = 0; i < n; ++i) {
+      const Vec3& c = centres[static_cast<std::size_t>(i % 3)];
+      pts.push_back((c + spread * Vec3(g(rng), g(rng), g(rng))) * scale);
+    }
+    const SupportCells cells = supportCells(pts);
+    ASSERT_FALSE(cells.empty());
+    for (int q = 0; q < 100; ++q) {
+      // Directions along the centres (where their points compete) and on the cells' borders.
+      const Vec3 d = q % 2 == 0 ? Vec3(centres[static_cast<std::size_t>(q % 3)] + 1e-3 * Vec3(g(rng), g(rng), g(rng)))
+                                : borderDirection(rng);
+      const double want = cellDot(pts[static_cast<std::size_t>(supportIndex(pts, d))], d);
+      const double got = cellDot(pts[static_cast<std::size_t>(cellSupport(cells, pts, d))], d);
+      ASSERT_TRUE(got == want || (std::isnan(got) && std::isnan(want)))  // huge directions overflow
+          << "trial " << trial << " direction " << d.transpose() << ": " << got << " against " << want;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 150000);
+}
+
 TEST(SupportCells, DirectionsWithoutACellAndSmallSetsScanEveryPoint) {
   const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(cellOf(Vec3::Zero()), -1);

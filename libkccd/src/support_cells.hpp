@@ -2,14 +2,22 @@
 // per cell the points that can be farthest along one of its directions, so that a support scan
 // reads a few points instead of all of them. Internal.
 //
-// A cell is the cone over a rectangle of a cube face (its corners c_k, the rectangle grown by
-// kCellSlack so that a direction placed in it with rounded ratios lies inside). A point p is left
-// out of a cell when a witness w (the farthest point along the cell's centre or a corner) beats it
-// at every corner by more than a rounding margin m: (w - p).c_k > m |c_k|. Every direction d of
-// the cone is a non-negative combination of the corners, so (w - p).d >= m |d| there too (the
-// triangle inequality), and with m above the dot products' rounding the scan's computed value of
-// w exceeds p's. So the largest computed dot product over the cell's points equals the largest
-// over all points, bit for bit: the support value does not change, only the scan's length.
+// A cell is the cone over a rectangle of a cube face: its corners c_k are the face's grid vertices
+// g_k (coordinates -1 + 2j / kCellsPerEdge, |g_k| <= sqrt 3) moved out by kCellSlack on each side,
+// so that a direction placed in it with rounded ratios lies inside; |c_k - g_k| <= sqrt 2 kCellSlack.
+// With N the set's largest |p|, a point p is left out of a cell when a witness w (another point of
+// the set) beats it at every grid vertex of the cell by more than t = kCellThreshold N (or at the
+// four corners of the cell's face, which then holds at every grid vertex of the face: each is a
+// combination of the four with non-negative weights summing to one), computed as
+// fl(fl(w.g_k) - fl(p.g_k)) > t. That difference errs by at most 7 eps N (each dot product by
+// 1.5 eps N |g_k|, the subtraction by half an ulp of 2 N |g_k|; a product that underflows, by
+// less than 1e-323, far below eps N in the cells' range), and |w - p| <= 2N, so with m = 64 eps N:
+//   (w - p).c_k >= (w - p).g_k - 2N sqrt 2 kCellSlack > t - 7 eps N - 2.9e-6 N > 2m > m |c_k|.
+// Every direction d of the cone is a non-negative combination of the corners, so (w - p).d >= m |d|
+// there too (the triangle inequality), and with m above the scan's rounding (1.5 eps N |d| per dot
+// product) the scan's computed value of w exceeds p's. So the largest computed dot product over
+// the cell's points equals the largest over all points, bit for bit: the support value does not
+// change, only the scan's length.
 #pragma once
 
 #include <algorithm>
@@ -27,6 +35,9 @@ inline constexpr int kCellsPerEdge = 4;
 inline constexpr int kCellsPerFace = kCellsPerEdge * kCellsPerEdge;
 /// How much a cell's rectangle is grown on each side (in face coordinates, from -1 to 1).
 inline constexpr double kCellSlack = 1e-6;
+/// The threshold by which a witness must beat a point at a cell's grid vertices, relative to the
+/// set's largest |p|: above 2 sqrt 2 kCellSlack plus the rounding (the argument at the top).
+inline constexpr double kCellThreshold = 4e-6;
 
 /// The range of point sets (their largest |p|) and of directions (their largest |coordinate|)
 /// the cells serve: every dot product then lies between 1e-250 and 1e301, so none overflows and
