@@ -148,7 +148,9 @@ TEST(SupportCells, DirectionsWithoutACellAndSmallSetsScanEveryPoint) {
   EXPECT_EQ(cellOf(Vec3(nan, nan, nan)), -1);
   std::vector<Vec3> pts(40, Vec3(1.0, 2.0, 3.0));
   pts.push_back(Vec3(inf, 0.0, 0.0));
-  EXPECT_TRUE(supportCells(pts).empty());                                  // not finite
+  EXPECT_TRUE(supportCells(pts).empty());  // not finite
+  pts.back() = Vec3(0.0, nan, 0.0);
+  EXPECT_TRUE(supportCells(pts).empty());                                  // NaN
   EXPECT_TRUE(supportCells(std::vector<Vec3>(40, Vec3::Zero())).empty());  // no extent
   EXPECT_TRUE(supportCells(std::vector<Vec3>(8, Vec3(1.0, 0.0, 0.0))).empty());
   EXPECT_TRUE(supportCells(std::vector<Vec3>(40, Vec3(1e200, 0.0, 0.0))).empty());

@@ -55,8 +55,12 @@ SupportCells supportCells(std::span<const Vec3> pts, int min_points) {
   SupportCells out;
   if (static_cast<int>(pts.size()) < min_points) return out;
   double norm = 0.0;
-  for (const Vec3& p : pts) norm = std::max(norm, p.norm());
-  if (!(norm >= kCellMinNorm && norm <= kCellMaxNorm)) return out;  // beyond the argued range: scan all
+  for (const Vec3& p : pts) {
+    const double r = p.norm();
+    if (!(r <= kCellMaxNorm)) return out;  // huge, infinite or NaN: beyond the argued range, scan all
+    norm = std::max(norm, r);
+  }
+  if (!(norm >= kCellMinNorm)) return out;
   const double threshold = kCellThreshold * norm;
   const std::size_t n = pts.size();
   // Per face, first the points that no witness beats at the face's four corners (the others are

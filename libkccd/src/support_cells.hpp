@@ -6,12 +6,13 @@
 // g_k (coordinates -1 + 2j / kCellsPerEdge, |g_k| <= sqrt 3) moved out by kCellSlack on each side,
 // so that a direction placed in it with rounded ratios lies inside; |c_k - g_k| <= sqrt 2 kCellSlack.
 // With N the set's largest |p|, a point p is left out of a cell when a witness w (another point of
-// the set) beats it at every grid vertex of the cell by more than t = kCellThreshold N (or at the
-// four corners of the cell's face, which then holds at every grid vertex of the face: each is a
-// combination of the four with non-negative weights summing to one), computed as
-// fl(fl(w.g_k) - fl(p.g_k)) > t. That difference errs by at most 7 eps N (each dot product by
-// 1.5 eps N |g_k|, the subtraction by half an ulp of 2 N |g_k|; a product that underflows, by
-// less than 1e-323, far below eps N in the cells' range), and |w - p| <= 2N, so with m = 64 eps N:
+// the set) beats it at every grid vertex of the cell by more than t = kCellThreshold N, computed as
+// fl(fl(w.g_k) - fl(p.g_k)) > t (or at the four corners of the cell's face: each grid vertex of
+// the face is a combination of the four with non-negative weights summing to one, so the exact
+// inequality below, (w - p).g > t - 7 eps N, then holds at all of them). That difference errs by
+// at most 7 eps N (each dot product by 1.5 eps N |g_k|, the subtraction by half an ulp of
+// 2 N |g_k|; a product that underflows, by less than 1e-323, far below eps N in the cells'
+// range), and |w - p| <= 2N, so with m = 64 eps N:
 //   (w - p).c_k >= (w - p).g_k - 2N sqrt 2 kCellSlack > t - 7 eps N - 2.9e-6 N > 2m > m |c_k|.
 // Every direction d of the cone is a non-negative combination of the corners, so (w - p).d >= m |d|
 // there too (the triangle inequality), and with m above the scan's rounding (1.5 eps N |d| per dot
@@ -40,9 +41,9 @@ inline constexpr double kCellSlack = 1e-6;
 inline constexpr double kCellThreshold = 4e-6;
 
 /// The range of point sets (their largest |p|) and of directions (their largest |coordinate|)
-/// the cells serve: every dot product then lies between 1e-250 and 1e301, so none overflows and
-/// none loses relative precision by underflow, which the rounding argument needs. Outside it
-/// the scan reads every point.
+/// the cells serve: the scale N |d| of every dot product then lies between 1e-250 and 1e301, so
+/// none overflows and a product that underflows errs by far less than the rounding margins, as
+/// the argument needs. Outside it (and for a set with a NaN) the scan reads every point.
 inline constexpr double kCellMinNorm = 1e-100, kCellMaxNorm = 1e150;
 inline constexpr double kCellMinDirection = 1e-150, kCellMaxDirection = 1e150;
 
@@ -56,7 +57,7 @@ struct SupportCells {
   bool empty() const noexcept { return begin.empty(); }
 };
 
-/// The cells of point set `pts` (empty for fewer than `min_points` points).
+/// The cells of point set `pts` (empty for fewer than `min_points` points, and out of the range).
 SupportCells supportCells(std::span<const Vec3> pts, int min_points = 12);
 
 /// The cell of direction d, or -1 when d is out of the cells' range (zero and not finite included).
