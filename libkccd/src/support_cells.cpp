@@ -13,17 +13,16 @@ constexpr int kGrid = kCellsPerEdge + 1;  // grid vertices per edge of a face
 
 double faceCoordinate(int i) { return -1.0 + 2.0 * static_cast<double>(i) / kCellsPerEdge; }
 
-// The position of the first largest of values[0 .. n) (n > 0).
+// The position of the first largest of values[0 .. n) (n > 0; the values are finite).
 std::size_t argMax(const double* values, std::size_t n) {
-  std::size_t best = 0;
-  double best_value = values[0];
-  for (std::size_t i = 1; i < n; ++i) {
-    if (values[i] > best_value) {
-      best_value = values[i];
-      best = i;
-    }
-  }
-  return best;
+  return static_cast<std::size_t>(std::max_element(values, values + n) - values);
+}
+
+// row[j] = the dot product of point j with the face's direction (1, s, t), from the points' face
+// coordinates a, u, v: a + (s u + t v). Returns the position of the first largest.
+std::size_t faceRow(const double* a, const double* u, const double* v, std::size_t n, double s, double t, double* row) {
+  for (std::size_t j = 0; j < n; ++j) row[j] = a[j] + (s * u[j] + t * v[j]);
+  return argMax(row, n);
 }
 
 constexpr int kWitnesses = 5;
@@ -65,10 +64,9 @@ SupportCells supportCells(std::span<const Vec3> pts, int min_points) {
   const std::size_t n = pts.size();
   // Per face, first the points that no witness beats at the face's four corners (the others are
   // beaten at every grid vertex of the face, their combinations with weights summing to one),
-  // then per cell those of them that no witness beats at the cell's four grid vertices. A point's
-  // dot product with the face's direction (1, s, t) is a + s u + t v in the face's coordinates
-  // (a along its axis, u and v along the next two), each product exact or within the rounding
-  // the argument allows.
+  // then per cell those of them that no witness beats at the cell's four grid vertices. Dot
+  // products come from the face's coordinates (faceRow: a along its axis, u and v along the next
+  // two), each product exact or within the rounding the argument allows.
   std::vector<double> a(n), u(n), v(n);  // the face's coordinates of every point
   std::vector<double> face_dots(4 * n);  // per corner k of the face: face_dots[k * n + i]
   std::vector<std::size_t> kept;         // the face's remaining points, in order
@@ -90,9 +88,8 @@ SupportCells supportCells(std::span<const Vec3> pts, int min_points) {
     for (int k = 0; k < 4; ++k) {
       const double s = (k & 1) != 0 ? 1.0 : -1.0, t = (k & 2) != 0 ? 1.0 : -1.0;
       double* row = face_dots.data() + static_cast<std::size_t>(k) * n;
-      for (std::size_t i = 0; i < n; ++i) row[i] = a[i] + (s * u[i] + t * v[i]);
+      witness[k] = faceRow(a.data(), u.data(), v.data(), n, s, t, row);
       corner_row[k] = row;
-      witness[k] = argMax(row, n);
     }
     witness[4] = argMax(a.data(), n);  // the farthest point along the face's axis
     unbeaten(corner_row, n, witness, threshold, keep.data());
@@ -113,10 +110,9 @@ SupportCells supportCells(std::span<const Vec3> pts, int min_points) {
     std::size_t grid_witness[kGrid * kGrid];  // positions in `kept`
     for (int ia = 0; ia < kGrid; ++ia) {
       for (int ib = 0; ib < kGrid; ++ib) {
-        const double s = faceCoordinate(ia), t = faceCoordinate(ib);
         double* row = dots.data() + static_cast<std::size_t>(ia * kGrid + ib) * m;
-        for (std::size_t j = 0; j < m; ++j) row[j] = ka[j] + (s * ku[j] + t * kv[j]);
-        grid_witness[ia * kGrid + ib] = argMax(row, m);
+        grid_witness[ia * kGrid + ib] =
+            faceRow(ka.data(), ku.data(), kv.data(), m, faceCoordinate(ia), faceCoordinate(ib), row);
       }
     }
     for (int iu = 0; iu < kCellsPerEdge; ++iu) {
