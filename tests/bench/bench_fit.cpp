@@ -293,6 +293,7 @@ BENCHMARK_CAPTURE(BM_PairLooseness, wam, "wam/wam.urdf")
 // and per pair of links (pieces of a link together) the looseness hull distance - model distance
 // in mm over the pairs whose hulls are apart but within 0.1 m (negative: tighter than the hulls,
 // which pieces can be). `ratio_*` divide by K = 8's time, measured interleaved in the same loop.
+// `gjk_iterations_per_pair*`: GJK iterations per pair of the distances query, the model and K = 8.
 // The robots and their imports: robots.hpp.
 using kccd::bench::importedModel;
 using kccd::bench::kDefault;
@@ -322,6 +323,7 @@ void BM_ImportCost(benchmark::State& state, const char* robot) {
   double t_col = 0, t_col8 = 0, t_dist = 0, t_dist8 = 0;
   std::vector<double> loose;
   int tighter = 0;
+  double calls = 0, iterations = 0, calls8 = 0, iterations8 = 0;  // GJK's, in the distances query
   auto seconds = [](auto&& f) {
     const auto t0 = std::chrono::steady_clock::now();
     f();
@@ -348,7 +350,13 @@ void BM_ImportCost(benchmark::State& state, const char* robot) {
           theirs(), mine();
       }
     for (const auto& q : states) {
-      const auto dm = linkDistances(m, cm.query(q, q, distances));
+      const kccd::QueryResult& r8 = c8.query(q, q, distances);
+      calls8 += r8.stats.gjk_calls;
+      iterations8 += r8.stats.gjk_iterations;
+      const kccd::QueryResult& rm = cm.query(q, q, distances);
+      calls += rm.stats.gjk_calls;
+      iterations += rm.stats.gjk_iterations;
+      const auto dm = linkDistances(m, rm);
       const auto dh = linkDistances(hulls, ch.query(q, q, distances));
       for (const auto& [pair, h] : dh) {
         const auto it = dm.find(pair);
@@ -364,6 +372,10 @@ void BM_ImportCost(benchmark::State& state, const char* robot) {
   state.counters["bodies"] = static_cast<double>(m.bodies.size());
   state.counters["points"] = points;
   state.counters["pairs"] = static_cast<double>(m.pairs.size());
+  state.counters["pairs_k8"] = static_cast<double>(eight.pairs.size());
+  // Where the distances ratio comes from: pairs x GJK iterations per pair x time per iteration.
+  state.counters["gjk_iterations_per_pair"] = iterations / calls;
+  state.counters["gjk_iterations_per_pair_k8"] = iterations8 / calls8;
   state.counters["collision_us"] = 1e6 * t_col / n;
   state.counters["distances_us"] = 1e6 * t_dist / n;
   state.counters["ratio_collision"] = t_col / t_col8;
