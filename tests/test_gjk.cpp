@@ -113,6 +113,45 @@ TEST(Gjk, StopAboveEndsEarlyWithAValidBound) {
   EXPECT_GT(early, 50);
 }
 
+// stop_below: GJK ends once two points of the volumes are proven within it (the true distance is
+// then at most stop_below), from the start when the centroids already are; the bound stays a
+// lower bound; without the stop the answer is the converged distance.
+TEST(Gjk, StopBelowEndsOnceTheVolumesAreProvenWithinIt) {
+  std::mt19937_64 rng(8);
+  int early = 0, at_start = 0, converged = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const Pair p = randomPair(rng);
+    const double ref = static_cast<double>(testing::referenceSschDistance(p.a, p.ra, p.b, p.rb));
+    GjkOptions opt;
+    opt.stop_below = 0.1 * p.scale;
+    const DistanceResult r = distance({p.a, p.ra}, {p.b, p.rb}, opt);
+    ASSERT_LE(r.distance, ref + 1e-13 * p.scale) << "pair " << i;
+    if (r.status == GjkStatus::StoppedEarly) {
+      ++early;
+      at_start += r.iterations == 0;
+      ASSERT_LE(ref, opt.stop_below + tolerance(ref, p.scale)) << "pair " << i;
+      ASSERT_LE(r.distance, opt.stop_below);
+    } else if (r.status != GjkStatus::Overlap) {
+      ++converged;
+      ASSERT_NEAR(r.distance, ref, tolerance(ref, p.scale)) << "pair " << i;
+      ASSERT_GT(ref, opt.stop_below - tolerance(ref, p.scale)) << "pair " << i;
+    }
+  }
+  EXPECT_GT(early, 100);
+  EXPECT_GT(at_start, 0);
+  EXPECT_GT(converged, 100);
+  // A warm start replaces the start points: v is then a direction, not a point of the difference.
+  const Points a{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const Points b{{0, 0, 0.5}, {1, 0, 0.5}, {0, 1, 0.5}};
+  const Vec3 dir(0, 0, -1e-3);
+  GjkOptions warm;
+  warm.stop_below = 0.6;
+  warm.warm_start = &dir;
+  EXPECT_GT(distance({a, 0.0}, {b, 0.0}, warm).iterations, 0);
+  warm.warm_start = nullptr;
+  EXPECT_EQ(distance({a, 0.0}, {b, 0.0}, warm).iterations, 0);
+}
+
 TEST(Gjk, WarmStartFromLastDirectionSavesIterations) {
   std::mt19937_64 rng(11);
   long cold_total = 0, warm_total = 0;

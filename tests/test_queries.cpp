@@ -260,6 +260,50 @@ TEST(Queries, AtOneConfigurationTheBoundIsTheDistanceWithoutTheExactStage) {
   EXPECT_GT(separated, pairs / 4);
 }
 
+// At one configuration a collision query stops a pair's GJK once two points of the bodies are
+// proven within the margin: the verdict is the distances query's, the reported bound stays below
+// the independent distance, and the witness points are within the margin of each other (radii
+// counted), while the pair's GJK does no more iterations than converging takes.
+TEST(Queries, AtOneConfigurationACollisionStopsOnceWithinTheMargin) {
+  std::mt19937_64 rng(131);
+  int hits = 0, lower_than_converged = 0;
+  long iterations_col = 0, iterations_all = 0;
+  for (int trial = 0; trial < 1000; ++trial) {
+    std::vector<double> lower, upper;
+    const Model m = rigidModelAtOneConfiguration(rng, lower, upper);
+    const double margin = std::uniform_real_distribution<double>(0.0, 0.3)(rng);
+    Checker col_c(m), all_c(m);
+    const QueryResult& all = all_c.query(lower, upper, options(QueryType::Distances, 1, margin));
+    const QueryResult& col = col_c.query(lower, upper, options(QueryType::Collision, 1, margin));
+    ASSERT_EQ(col.status, Status::Ok) << trial;
+    EXPECT_EQ(col.collision, all.collision) << trial;
+    if (!col.collision || col.pairs.empty()) continue;
+    ++hits;
+    const PairDistance& hit = col.pairs[0];
+    const PairDistance& converged = all.pairs[static_cast<std::size_t>(hit.pair)];
+    EXPECT_LE(hit.distance, margin) << trial;
+    EXPECT_LE(hit.distance, converged.distance + 1e-12) << trial;
+    lower_than_converged += hit.distance < converged.distance - 1e-9;
+    const BodyPair& pair = m.pairs[static_cast<std::size_t>(hit.pair)];
+    const testing::Sample sample = testing::sampleBox(rng, m, lower, upper, 0);
+    const std::vector<Pose> poses = testing::jointPoses(m, sample);
+    const double truth = static_cast<double>(
+        testing::referenceSschDistance(testing::worldPoints(m, poses, pair.a), m.bodies[pair.a].radius,
+                                       testing::worldPoints(m, poses, pair.b), m.bodies[pair.b].radius));
+    EXPECT_LE(hit.distance, truth + 1e-12) << trial;
+    EXPECT_LE(truth, margin + 1e-9) << trial;  // the stop proves the pair within the margin
+    if (hit.has_witness) {
+      const double radii = m.bodies[pair.a].radius + m.bodies[pair.b].radius;
+      EXPECT_LE((hit.witness_a - hit.witness_b).norm(), margin + radii + 1e-9) << trial;
+    }
+    iterations_col += col.stats.gjk_iterations;
+    iterations_all += all.stats.gjk_iterations;
+  }
+  EXPECT_GT(hits, 50);
+  EXPECT_GT(lower_than_converged, 5);  // the stop came before convergence in some cases
+  EXPECT_LT(iterations_col, iterations_all);
+}
+
 // At one configuration the checker keeps rigid volumes as maps of the body's points and runs GJK
 // on the body's points searched in its frame; the points it writes out on request (the rendered
 // volumes) give distance() the same bound, to rounding.

@@ -37,6 +37,7 @@ DistanceResult distance(const SschView& a, const SschView& b, const GjkOptions& 
   info.scale_b = sum_b.scale;
   info.start_a = sum_a.centroid;
   info.start_b = sum_b.centroid;
+  info.starts_in_hulls = true;
   const std::span<const Vec3> pa = a.points, pb = b.points;
   auto support_a = [pa](const Vec3& dir) {
     const int i = supportIndex(pa, dir);

@@ -228,6 +228,9 @@ inline void keepWeighted(Simplex& s, int count, const double* lam) {
 struct SetsInfo {
   double scale_a = 0.0, scale_b = 0.0;
   Vec3 start_a = Vec3::Zero(), start_b = Vec3::Zero();
+  /// The start points lie in their hulls (up to rounding: e.g. centroids of the points), so their
+  /// difference bounds the distance from above before any support is taken (GjkOptions::stop_below).
+  bool starts_in_hulls = false;
 };
 
 /// Distance between conv(A) + B(ra) and conv(B) + B(rb) where A and B are given by support
@@ -245,11 +248,14 @@ DistanceResult gjkDistance(const SupportA& sa, const SupportB& sb, double ra, do
 
   // Start from the given points' difference (e.g. the centroids: near the middle of the difference).
   Vec3 v = info.start_a - info.start_b;
-  if (options.warm_start != nullptr && options.warm_start->allFinite() && options.warm_start->squaredNorm() > 0.0) {
-    v = *options.warm_start;
-  }
+  const bool warm =
+      options.warm_start != nullptr && options.warm_start->allFinite() && options.warm_start->squaredNorm() > 0.0;
+  if (warm) v = *options.warm_start;
 
   Simplex s;
+  // v is a point of the hulls' difference once the simplex has one, or from the start when the
+  // start points are the hulls' own and no warm start replaced them.
+  const bool start_in_difference = info.starts_in_hulls && !warm;
   double lower = -std::numeric_limits<double>::infinity();
   GjkStatus status = GjkStatus::IterationLimit;
   int iter = 0;
@@ -261,7 +267,7 @@ DistanceResult gjkDistance(const SupportA& sa, const SupportB& sb, double ra, do
       const double vv = v.squaredNorm();
       const double v_norm = std::sqrt(vv);  // one root per iteration, started before the supports
       // v is a point of the difference of the supports' hulls: |v| bounds the distance from above.
-      if (s.size > 0 && v_norm - radii + guard <= options.stop_below) {
+      if ((s.size > 0 || start_in_difference) && v_norm - radii + guard <= options.stop_below) {
         status = GjkStatus::StoppedEarly;
         break;
       }
