@@ -93,15 +93,28 @@ TEST(Gjk, TruncatedIterationsStillGiveLowerBounds) {
   }
 }
 
+// A random pair, its reference distance, and GJK's answer with a stop at `stop` times its scale
+// (stop_above or stop_below, as `set` assigns it).
+struct StopRun {
+  Pair p;
+  double ref = 0.0;
+  GjkOptions opt;
+  DistanceResult r;
+};
+StopRun runWithStop(std::mt19937_64& rng, double stop, double GjkOptions::*set) {
+  StopRun run;
+  run.p = randomPair(rng);
+  run.ref = static_cast<double>(testing::referenceSschDistance(run.p.a, run.p.ra, run.p.b, run.p.rb));
+  run.opt.*set = stop * run.p.scale;
+  run.r = distance({run.p.a, run.p.ra}, {run.p.b, run.p.rb}, run.opt);
+  return run;
+}
+
 TEST(Gjk, StopAboveEndsEarlyWithAValidBound) {
   std::mt19937_64 rng(5);
   int early = 0;
   for (int i = 0; i < 500; ++i) {
-    const Pair p = randomPair(rng);
-    const double ref = static_cast<double>(testing::referenceSschDistance(p.a, p.ra, p.b, p.rb));
-    GjkOptions opt;
-    opt.stop_above = 0.1 * p.scale;
-    const DistanceResult r = distance({p.a, p.ra}, {p.b, p.rb}, opt);
+    const auto [p, ref, opt, r] = runWithStop(rng, 0.1, &GjkOptions::stop_above);
     ASSERT_LE(r.distance, ref + 1e-13 * p.scale);
     if (r.status == GjkStatus::StoppedEarly) {
       ++early;
@@ -120,11 +133,7 @@ TEST(Gjk, StopBelowEndsOnceTheVolumesAreProvenWithinIt) {
   std::mt19937_64 rng(8);
   int early = 0, at_start = 0, converged = 0;
   for (int i = 0; i < 1000; ++i) {
-    const Pair p = randomPair(rng);
-    const double ref = static_cast<double>(testing::referenceSschDistance(p.a, p.ra, p.b, p.rb));
-    GjkOptions opt;
-    opt.stop_below = 0.1 * p.scale;
-    const DistanceResult r = distance({p.a, p.ra}, {p.b, p.rb}, opt);
+    const auto [p, ref, opt, r] = runWithStop(rng, 0.1, &GjkOptions::stop_below);
     ASSERT_LE(r.distance, ref + 1e-13 * p.scale) << "pair " << i;
     if (r.status == GjkStatus::StoppedEarly) {
       ++early;
