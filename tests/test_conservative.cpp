@@ -192,9 +192,7 @@ TEST(Conservative, CarriedOverBoundsStayValidAcrossCycles) {
           if (pd.distance <= 0.0) continue;
           ++carried_checks;
           const BodyPair& pair = m.pairs[pd.pair];
-          const double truth = static_cast<double>(
-              testing::referenceSschDistance(testing::worldPoints(m, poses, pair.a), m.bodies[pair.a].radius,
-                                             testing::worldPoints(m, poses, pair.b), m.bodies[pair.b].radius));
+          const double truth = testing::referencePairDistance(m, poses, pair);
           if (pd.distance > truth + 1e-12) {
             ++violations;
             ADD_FAILURE() << "carried-over bound invalid, seed " << seed << " cycle " << cycle << ": bound "

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "random_shapes.hpp"
+#include "reference_distance.hpp"
 
 namespace kccd::testing {
 namespace {
@@ -171,6 +172,11 @@ std::vector<Eigen::Vector3d> worldPoints(const Model& m, const std::vector<Pose>
   std::vector<Eigen::Vector3d> out;
   for (const Vec3& p : b.points) out.push_back(frame * p);
   return out;
+}
+
+double referencePairDistance(const Model& m, const std::vector<Pose>& poses, const BodyPair& pair) {
+  return static_cast<double>(referenceSschDistance(worldPoints(m, poses, pair.a), m.bodies[pair.a].radius,
+                                                   worldPoints(m, poses, pair.b), m.bodies[pair.b].radius));
 }
 
 }  // namespace kccd::testing

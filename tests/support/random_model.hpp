@@ -40,4 +40,7 @@ std::vector<Pose> jointPoses(const Model& m, const Sample& s);
 /// The body's core points in the world for those poses.
 std::vector<Eigen::Vector3d> worldPoints(const Model& m, const std::vector<Pose>& poses, int body);
 
+/// The pair's SSCH distance for those poses, by the independent oracle (referenceSschDistance).
+double referencePairDistance(const Model& m, const std::vector<Pose>& poses, const BodyPair& pair);
+
 }  // namespace kccd::testing
